@@ -1,0 +1,36 @@
+# Two entry points for a fresh machine with Python 3.11 (see README):
+#   make study   - build .venv from environment.lock, then run the full study
+#   make test    - build .venv from environment.lock, then run the test suite
+PYTHON ?= python3.11
+VENV   ?= .venv
+BIN    := $(VENV)/bin
+CORES  ?= 2
+
+.PHONY: study test bench lock report clean-venv
+
+$(BIN)/.installed: environment.lock pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --require-hashes --no-deps -r environment.lock
+	$(BIN)/python -m pip install --quiet --no-deps --no-build-isolation -e .
+	touch $@
+
+study: $(BIN)/.installed
+	$(BIN)/snakemake -j$(CORES) figures
+
+report: $(BIN)/.installed
+	$(BIN)/snakemake --report results/report.html
+
+test: $(BIN)/.installed
+	$(BIN)/python -m pytest; rc=$$?; if [ $$rc -eq 5 ]; then echo "no tests collected"; exit 0; fi; exit $$rc
+
+bench: $(BIN)/.installed
+	$(BIN)/python benchmarks/bench_gfo.py
+	$(BIN)/python benchmarks/bench_closure.py
+
+# Regenerate the pinned, hashed lock from pyproject.toml (Python 3.11, Linux x86_64).
+lock:
+	$(PYTHON) -m pip install --quiet pip-tools
+	$(PYTHON) -m piptools compile --quiet --generate-hashes --allow-unsafe --extra test --strip-extras --output-file environment.lock pyproject.toml
+
+clean-venv:
+	rm -rf $(VENV)
