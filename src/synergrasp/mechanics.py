@@ -1,0 +1,313 @@
+"""Grasp mechanics in the palm frame: grasp matrix, contact stiffness, K-weighted
+pseudo-inverse, particular force solution and the synergy-driven internal forces.
+
+Conventions (docs/design.md): lengths in mm, forces in N, torques in N·mm, joint
+stiffness in N·mm/rad, contact stiffness in N/mm. Contact forces are the forces the hand
+applies to the object, stacked per contact as (f_1x, f_1y, f_1z, f_2x, ...) with c = 3m
+components. The wrench reference point is the object centre o.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+from numpy.typing import NDArray
+
+__all__ = [
+    "Grasp",
+    "GraspMechanics",
+    "contact_stiffness",
+    "friction_cone_rows",
+    "grasp_matrix",
+    "grasp_mechanics",
+    "internal_force_basis",
+    "object_wrench",
+    "tangent_pairs",
+]
+
+#: Relative tolerance of the rank decision on the dimensionless grasp matrix.
+GRASP_RANK_RTOL = 1e-9
+#: Relative tolerance of the rank decision for the internal-force basis E_s.
+BASIS_RTOL = 1e-9
+#: How far a normal may be from unit length before it is rejected.
+_UNIT_TOL = 1e-6
+
+
+@dataclass(frozen=True)
+class Grasp:
+    """One simulated grasp, every quantity in the palm frame.
+
+    points:   (m, 3) contact points on the object surface, mm
+    normals:  (m, 3) object's inward unit surface normals
+    links:    (m,) int, hand link index of each contact (0 = palm)
+    jacobian: (3m, n) translational Jacobian of the contact points, mm/rad
+              (rows of palm contacts are zero)
+    center:   (3,) object centre o, mm (reference point of the wrench)
+    """
+
+    points: NDArray
+    normals: NDArray
+    links: NDArray
+    jacobian: NDArray
+    center: NDArray
+
+    def __post_init__(self) -> None:
+        points = np.asarray(self.points, dtype=float)
+        m = points.shape[0] if points.ndim == 2 else -1
+        if points.ndim != 2 or points.shape[1] != 3:
+            raise ValueError(f"Grasp.points must have shape (m, 3), got {points.shape}")
+        normals = _unit_normals(self.normals, m, "Grasp.normals")
+        links = np.asarray(self.links)
+        if links.shape != (m,) or not np.issubdtype(links.dtype, np.integer):
+            raise ValueError(f"Grasp.links must be an int array of shape ({m},), got {links.dtype} {links.shape}")
+        jac = np.asarray(self.jacobian, dtype=float)
+        if jac.ndim != 2 or jac.shape[0] != 3 * m:
+            raise ValueError(f"Grasp.jacobian must have shape (3m, n) = ({3 * m}, n), got {jac.shape}")
+        center = np.asarray(self.center, dtype=float)
+        if center.shape != (3,):
+            raise ValueError(f"Grasp.center must have shape (3,), got {center.shape}")
+        for name, value in (("points", points), ("normals", normals), ("jacobian", jac), ("center", center)):
+            if not np.all(np.isfinite(value)):
+                raise ValueError(f"Grasp.{name} must be finite")
+        object.__setattr__(self, "points", points)
+        object.__setattr__(self, "normals", normals)
+        object.__setattr__(self, "links", links.astype(np.int64))
+        object.__setattr__(self, "jacobian", jac)
+        object.__setattr__(self, "center", center)
+
+    @property
+    def n_contacts(self) -> int:
+        return int(self.points.shape[0])
+
+
+def _unit_normals(normals: NDArray, m: int | None, field: str) -> NDArray:
+    """Validate an (m, 3) array of unit vectors (returned as float)."""
+    n = np.asarray(normals, dtype=float)
+    if n.ndim != 2 or n.shape[1] != 3 or (m is not None and n.shape[0] != m):
+        want = f"({m}, 3)" if m is not None else "(m, 3)"
+        raise ValueError(f"{field} must have shape {want}, got {n.shape}")
+    norms = np.linalg.norm(n, axis=1)
+    if n.shape[0] and not np.all(np.abs(norms - 1.0) <= _UNIT_TOL):
+        raise ValueError(f"{field} must be unit vectors (|n| = 1 within {_UNIT_TOL}); got norms {norms.min():.6g}..{norms.max():.6g}")
+    return n
+
+
+def _cross_matrices(v: NDArray) -> NDArray:
+    """(m, 3) vectors -> (m, 3, 3) matrices [v]x with [v]x w = v x w."""
+    out = np.zeros(v.shape[:-1] + (3, 3))
+    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
+    return out
+
+
+def grasp_matrix(points: NDArray, center: NDArray) -> NDArray:
+    """Grasp matrix G (6, 3m): column block i is [I3; [p_i - o]x].
+
+    G f gives the net force (N, rows 0-2) and the torque about the centre o (N·mm, rows
+    3-5) of the contact forces f (N) applied at the points p_i (mm).
+    """
+    p = np.asarray(points, dtype=float)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise ValueError(f"points must have shape (m, 3), got {p.shape}")
+    o = np.asarray(center, dtype=float)
+    if o.shape != (3,):
+        raise ValueError(f"center must have shape (3,), got {o.shape}")
+    m = p.shape[0]
+    blocks = np.empty((2, 3, m, 3))
+    blocks[0] = np.broadcast_to(np.eye(3)[:, None, :], (3, m, 3))
+    blocks[1] = _cross_matrices(p - o).transpose(1, 0, 2)
+    return blocks.reshape(6, 3 * m)
+
+
+def object_wrench(mass_kg: float, gravity_direction: NDArray, g: float = 9.81) -> NDArray:
+    """Wrench w_e (6,) the contacts must apply to hold the object against its weight.
+
+    Gravity pulls with m g ĝ at the centre (no torque about o), so the contacts must apply
+    w_e = [-m g ĝ; 0] (N, N·mm). `gravity_direction` is normalised; mass in kg, g in m/s².
+    """
+    if not np.isfinite(mass_kg) or mass_kg < 0:
+        raise ValueError(f"mass_kg must be a finite number >= 0, got {mass_kg}")
+    if not np.isfinite(g) or g < 0:
+        raise ValueError(f"g must be a finite number >= 0 (m/s^2), got {g}")
+    d = np.asarray(gravity_direction, dtype=float)
+    norm = np.linalg.norm(d) if d.shape == (3,) else 0.0
+    if d.shape != (3,) or not np.isfinite(norm) or norm == 0.0:
+        raise ValueError(f"gravity_direction must be a non-zero finite 3-vector, got {gravity_direction!r}")
+    w = np.zeros(6)
+    w[:3] = -mass_kg * g * d / norm
+    return w
+
+
+def contact_stiffness(jacobian: NDArray, k_stru: float, k_ss: float) -> NDArray:
+    """Contact stiffness K = (C_s + J C_q J^T)^-1 (c, c), N/mm.
+
+    C_s = I/k_stru (mm/N) is the structural compliance of the contacts, C_q = I/k_ss
+    (rad/(N·mm)) the joint compliance. C is symmetric positive definite, so K is obtained by
+    a Cholesky solve and symmetrised against round-off.
+    """
+    if not (np.isfinite(k_stru) and k_stru > 0):
+        raise ValueError(f"k_stru must be a finite number > 0 (N/mm), got {k_stru}")
+    if not (np.isfinite(k_ss) and k_ss > 0):
+        raise ValueError(f"k_ss must be a finite number > 0 (N·mm/rad), got {k_ss}")
+    J = np.asarray(jacobian, dtype=float)
+    if J.ndim != 2:
+        raise ValueError(f"jacobian must be a 2-D array (c, n), got shape {J.shape}")
+    c = J.shape[0]
+    compliance = np.eye(c) / k_stru + (J @ J.T) / k_ss
+    K = sla.cho_solve(sla.cho_factor(compliance, lower=True), np.eye(c))
+    return 0.5 * (K + K.T)
+
+
+def _grasp_rank(G: NDArray, points: NDArray, center: NDArray, rtol: float) -> int:
+    """Numerical rank of G, decided on its dimensionless form.
+
+    The torque rows are in mm, the force rows dimensionless; dividing the torque rows by the
+    largest lever arm makes the singular values comparable, so that `rtol` is a pure number.
+    """
+    if G.shape[1] == 0:
+        return 0
+    arm = float(np.max(np.linalg.norm(points - center, axis=1)))
+    scaled = G.copy()
+    if arm > 0:
+        scaled[3:] /= arm
+    sv = np.linalg.svd(scaled, compute_uv=False)
+    return int(np.sum(sv > rtol * sv[0]))
+
+
+@dataclass(frozen=True)
+class GraspMechanics:
+    """Everything about a grasp that does not depend on the synergy set (one per pose).
+
+    G:          (6, c) grasp matrix
+    K:          (c, c) contact stiffness, N/mm
+    GKR:        (c, 6) K-weighted right pseudo-inverse K G^T (G K G^T)^-1, or None if rank(G) < 6
+    f_p:        (c,) particular contact forces G_K^R w_e, N, or None if rank(G) < 6
+    projector:  (c, n) (I - G_K^R G) K J, N/rad, or None if rank(G) < 6;
+                F_s = projector @ S for a synergy subset S (n, s)
+    rank_G:     numerical rank of G
+    normals:    (m, 3) inward unit normals
+    links:      (m,) link index per contact
+    wrench:     (6,) w_e, N and N·mm
+    KJ:         (c, n) K J, N/rad (the contact-force response to joint motion)
+    """
+
+    G: NDArray
+    K: NDArray
+    GKR: NDArray | None
+    f_p: NDArray | None
+    projector: NDArray | None
+    rank_G: int
+    normals: NDArray
+    links: NDArray
+    wrench: NDArray
+    KJ: NDArray
+
+    @property
+    def n_contacts(self) -> int:
+        return int(self.normals.shape[0])
+
+    @property
+    def force_closure_possible(self) -> bool:
+        """rank(G) = 6: the contacts can resist any wrench (first half of Bicchi's test)."""
+        return self.rank_G == 6
+
+
+def grasp_mechanics(
+    grasp: Grasp,
+    wrench: NDArray,
+    k_stru: float,
+    k_ss: float,
+    rank_rtol: float = GRASP_RANK_RTOL,
+) -> GraspMechanics:
+    """Compute G, K, G_K^R, f_p and the internal-force projector of a grasp.
+
+    wrench: (6,) w_e the contacts must apply (see `object_wrench`), N and N·mm.
+    A grasp with rank(G) < 6 is recorded (rank_G, and None for GKR, f_p and projector);
+    it is never an error.
+    """
+    w = np.asarray(wrench, dtype=float)
+    if w.shape != (6,) or not np.all(np.isfinite(w)):
+        raise ValueError(f"wrench must be a finite array of shape (6,), got {w.shape}")
+    G = grasp_matrix(grasp.points, grasp.center)
+    K = contact_stiffness(grasp.jacobian, k_stru, k_ss)
+    KJ = K @ grasp.jacobian
+    rank = _grasp_rank(G, grasp.points, grasp.center, rank_rtol)
+    GKR = f_p = projector = None
+    if rank == 6:
+        GK = G @ K
+        # G K G^T is SPD when rank(G) = 6; G_K^R = K G^T A^-1 = (A^-1 G K)^T since K, A symmetric.
+        A = GK @ G.T
+        GKR = sla.cho_solve(sla.cho_factor(0.5 * (A + A.T), lower=True), GK).T
+        f_p = GKR @ w
+        projector = KJ - GKR @ (G @ KJ)
+    return GraspMechanics(
+        G=G, K=K, GKR=GKR, f_p=f_p, projector=projector, rank_G=rank,
+        normals=grasp.normals, links=grasp.links, wrench=w, KJ=KJ,
+    )
+
+
+def internal_force_basis(
+    projector: NDArray,
+    synergy_matrix: NDArray,
+    rtol: float = BASIS_RTOL,
+) -> NDArray:
+    """Orthonormal basis E_s (c, e_s) of range(F_s), F_s = projector @ synergy_matrix.
+
+    synergy_matrix: (n, s) the enrolled synergy columns S (rad per unit activation).
+    Rank decision: a singular value of F_s counts if it exceeds
+    rtol * ||projector||_2 * ||S||_2. This scale bounds ||F_s||_2 from above and does not
+    depend on how much the particular subset cancels, so a subset whose internal forces
+    are pure round-off gets e_s = 0 instead of a basis of noise (docs/force_optimisation.md).
+    """
+    P = np.asarray(projector, dtype=float)
+    S = np.asarray(synergy_matrix, dtype=float)
+    if S.ndim == 1:
+        S = S[:, None]
+    if P.ndim != 2 or S.ndim != 2 or P.shape[1] != S.shape[0]:
+        raise ValueError(f"projector (c, n) and synergy_matrix (n, s) must agree in n; got {P.shape} and {S.shape}")
+    if not (np.isfinite(rtol) and 0 < rtol < 1):
+        raise ValueError(f"rtol must be in (0, 1), got {rtol}")
+    c = P.shape[0]
+    if S.shape[1] == 0 or c == 0:
+        return np.zeros((c, 0))
+    scale = _spectral_norm(P) * _spectral_norm(S)
+    if scale == 0.0:
+        return np.zeros((c, 0))
+    U, sv, _ = np.linalg.svd(P @ S, full_matrices=False)
+    rank = int(np.sum(sv > rtol * scale))
+    return U[:, :rank].copy()
+
+
+def _spectral_norm(A: NDArray) -> float:
+    return float(np.linalg.norm(A, 2)) if A.size else 0.0
+
+
+def tangent_pairs(normals: NDArray) -> tuple[NDArray, NDArray]:
+    """A deterministic orthonormal tangent pair (t1, t2), each (m, 3), per unit normal.
+
+    t1 is the normalised cross product of n with the coordinate axis least aligned with n
+    (never nearly parallel to n), t2 = n x t1, so (n, t1, t2) is right-handed.
+    """
+    n = _unit_normals(normals, None, "normals")
+    axis = np.zeros_like(n)
+    axis[np.arange(n.shape[0]), np.argmin(np.abs(n), axis=1)] = 1.0
+    t1 = np.cross(n, axis)
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    t2 = np.cross(n, t1)
+    return t1, t2
+
+
+def friction_cone_rows(normals: NDArray, mu: float) -> NDArray:
+    """Rows (m, 3, 3) [mu n; t1; t2] per contact.
+
+    The Coulomb cone of contact i is R_i f_i in the second-order cone
+    {(u, v): u >= ||v||}, i.e. ||tangential part of f_i|| <= mu n_i.f_i.
+    """
+    if not (np.isfinite(mu) and mu > 0):
+        raise ValueError(f"mu must be a finite number > 0, got {mu}")
+    n = _unit_normals(normals, None, "normals")
+    t1, t2 = tangent_pairs(n)
+    return np.stack([mu * n, t1, t2], axis=1)
