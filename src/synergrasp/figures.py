@@ -1,0 +1,210 @@
+"""Figures of the study drawn from its tables: Fig. 3 (rule graph), Fig. 4 (force maps and
+exploded views), Fig. 5 (hierarchy matrices); and Markdown rendering of tables.
+
+Every figure function takes tables (pandas) and output paths, and writes PNG and PDF.
+Forces are in N; angles in deg.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")  # headless: figures are files, never windows
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+import seaborn as sns  # noqa: E402
+
+from synergrasp.config import incremental_set_id  # noqa: E402
+
+__all__ = [
+    "write_table",
+    "force_grid",
+    "figure_force_maps",
+    "figure_exploded_views",
+    "figure_hierarchy",
+    "parse_rulegraph",
+    "figure_rulegraph",
+]
+
+
+def _save(fig: plt.Figure, png: str | Path, pdf: str | Path) -> None:
+    fig.savefig(png, dpi=150, bbox_inches="tight")
+    fig.savefig(pdf, bbox_inches="tight")
+    plt.close(fig)
+
+
+def write_table(table: pd.DataFrame, csv_path: str | Path, md_path: str | Path,
+                title: str | None = None, floatfmt: str = ".4g") -> None:
+    """Write a table as CSV (full precision) and as Markdown (for reading)."""
+    table.to_csv(csv_path, index=False)
+    text = table.to_markdown(index=False, floatfmt=floatfmt) if len(table) else "(no rows)"
+    with open(md_path, "w", encoding="utf-8") as handle:
+        if title:
+            handle.write(f"# {title}\n\n")
+        handle.write(text + "\n")
+
+
+def force_grid(gfo: pd.DataFrame, set_id: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Optimal force of one synergy set on the (β, α) grid.
+
+    Returns ``(alpha_deg, beta_deg, force)`` with ``force[i_beta, i_alpha]`` in N, NaN
+    where the pose is not force closure.
+    """
+    rows = gfo[gfo["set_id"] == set_id]
+    alphas = np.sort(gfo["alpha_deg"].unique())
+    betas = np.sort(gfo["beta_deg"].unique())
+    force = np.full((betas.size, alphas.size), np.nan)
+    fc = rows[rows["force_closure"]]
+    ia = np.searchsorted(alphas, fc["alpha_deg"].to_numpy())
+    ib = np.searchsorted(betas, fc["beta_deg"].to_numpy())
+    force[ib, ia] = fc["force_norm"].to_numpy()
+    return alphas, betas, force
+
+
+def _set_label(k: int) -> str:
+    return "{S1}" if k == 1 else f"{{S1..S{k}}}"
+
+
+def figure_force_maps(gfo: pd.DataFrame, minima: pd.DataFrame, panel_k: Sequence[int],
+                      object_name: str, png: str | Path, pdf: str | Path) -> None:
+    """Fig. 4 (maps): log10 of the optimal force (N) over (α, β), one panel per {S1..Sk};
+    empty cells where there is no force closure, dots on the local minima."""
+    grids = [force_grid(gfo, incremental_set_id(k)) for k in panel_k]
+    finite = np.concatenate([np.log10(g[2][np.isfinite(g[2])]) for g in grids] + [np.zeros(0)])
+    vmin, vmax = (np.percentile(finite, [1, 99]) if finite.size else (0.0, 1.0))
+    fig, axes = plt.subplots(len(panel_k), 1, figsize=(9, 2.4 * len(panel_k) + 0.6),
+                             sharex=True, squeeze=False)
+    cmap = matplotlib.colormaps["viridis"].copy()
+    cmap.set_bad("white")
+    for ax, k, (alphas, betas, force) in zip(axes[:, 0], panel_k, grids):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            logf = np.log10(force)
+        step_a = alphas[1] - alphas[0] if alphas.size > 1 else 5.0
+        step_b = betas[1] - betas[0] if betas.size > 1 else 5.0
+        image = ax.imshow(np.ma.masked_invalid(logf), origin="lower", aspect="auto", cmap=cmap,
+                          vmin=vmin, vmax=vmax,
+                          extent=(alphas[0] - step_a / 2, alphas[-1] + step_a / 2,
+                                  betas[0] - step_b / 2, betas[-1] + step_b / 2))
+        mins = minima[minima["set_id"] == incremental_set_id(k)]
+        ax.plot(mins["alpha_deg"], mins["beta_deg"], "o", ms=3.5, mfc="none", mec="red", mew=0.8,
+                label="local minimum")
+        n_fc = int(np.isfinite(force).sum())
+        ax.set_title(f"{object_name}, {_set_label(k)}: {n_fc} force-closure poses, "
+                     f"{len(mins)} local minima", fontsize=9)
+        ax.set_ylabel("β (deg)")
+        fig.colorbar(image, ax=ax, label="log10 ‖f‖ (N)", pad=0.01)
+    axes[-1, 0].set_xlabel("α (deg)")
+    _save(fig, png, pdf)
+
+
+def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: float,
+                          beta_deg: float, object_name: str, png: str | Path,
+                          pdf: str | Path) -> None:
+    """Fig. 4 (exploded views): optimal force vs β at α = ``alpha_deg`` and vs α at
+    β = ``beta_deg`` (nearest grid values), one line per {S1..Sk}; gaps where there is no
+    force closure."""
+    fig, (ax_b, ax_a) = plt.subplots(1, 2, figsize=(11, 3.8))
+    palette = sns.color_palette("viridis", len(panel_k))
+    for colour, k in zip(palette, panel_k):
+        alphas, betas, force = force_grid(gfo, incremental_set_id(k))
+        ia = int(np.argmin(np.abs(((alphas - alpha_deg) + 180.0) % 360.0 - 180.0)))
+        ib = int(np.argmin(np.abs(betas - beta_deg)))
+        ax_b.plot(betas, force[:, ia], "-o", ms=2.5, color=colour, label=_set_label(k))
+        ax_a.plot(alphas, force[ib, :], "-o", ms=2.5, color=colour, label=_set_label(k))
+        ax_b.set_title(f"{object_name}: α = {alphas[ia]:g} deg", fontsize=9)
+        ax_a.set_title(f"{object_name}: β = {betas[ib]:g} deg", fontsize=9)
+    for ax, xlabel in ((ax_b, "β (deg)"), (ax_a, "α (deg)")):
+        ax.set_yscale("log")
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel("optimal ‖f‖ (N)")
+        ax.grid(alpha=0.3, which="both")
+    ax_a.legend(fontsize=8, frameon=False)
+    fig.tight_layout()
+    _save(fig, png, pdf)
+
+
+def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str,
+                     fmt: str, png: str | Path, pdf: str | Path) -> None:
+    """Fig. 5: ``first`` matrices ``first`` × ``first``, one per first synergy S_k; cell
+    (i, j) of matrix k is the set {S_k, S_i, S_j}. Grey scale, the value in each cell.
+
+    ``matrices`` has one row per (k, i, j) with 1-based columns ``k``, ``i``, ``j`` and the
+    column ``value``.
+    """
+    ncols = min(first, 4)
+    nrows = int(np.ceil(first / ncols))
+    fig, axes = plt.subplots(nrows, ncols, figsize=(3.3 * ncols, 3.1 * nrows), squeeze=False)
+    values = matrices[value].to_numpy(dtype=float)
+    vmin, vmax = (np.nanmin(values), np.nanmax(values)) if np.isfinite(values).any() else (0, 1)
+    labels = [f"S{i}" for i in range(1, first + 1)]
+    for index, ax in enumerate(axes.flat):
+        if index >= first:
+            ax.axis("off")
+            continue
+        k = index + 1
+        sub = matrices[matrices["k"] == k]
+        grid = np.full((first, first), np.nan)
+        grid[sub["i"].to_numpy() - 1, sub["j"].to_numpy() - 1] = sub[value].to_numpy(dtype=float)
+        sns.heatmap(grid, ax=ax, cmap="Greys", vmin=vmin, vmax=vmax, annot=True, fmt=fmt,
+                    annot_kws={"fontsize": 6}, cbar=False, square=True,
+                    xticklabels=labels, yticklabels=labels, linewidths=0.3, linecolor="0.8")
+        ax.set_title(f"first synergy S{k}", fontsize=9)
+        ax.tick_params(labelsize=7)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    _save(fig, png, pdf)
+
+
+_NODE = re.compile(r'^\s*(\d+)\s*\[.*?label\s*=\s*"([^"]+)"')
+_EDGE = re.compile(r"^\s*(\d+)\s*->\s*(\d+)")
+
+
+def parse_rulegraph(dot: str) -> tuple[dict[int, str], list[tuple[int, int]]]:
+    """Nodes (id → rule name) and edges (from, to) of Snakemake's ``--rulegraph`` DOT text."""
+    nodes: dict[int, str] = {}
+    edges: list[tuple[int, int]] = []
+    for line in dot.splitlines():
+        if (match := _EDGE.match(line)) is not None:
+            edges.append((int(match.group(1)), int(match.group(2))))
+        elif (match := _NODE.match(line)) is not None:
+            nodes[int(match.group(1))] = match.group(2)
+    return nodes, edges
+
+
+def figure_rulegraph(dot: str, png: str | Path, pdf: str | Path) -> None:
+    """Fig. 3: the workflow's rule graph (the block scheme of the procedure), drawn in
+    layers: a rule sits one layer below the deepest rule it consumes."""
+    nodes, edges = parse_rulegraph(dot)
+    parents: dict[int, list[int]] = {n: [] for n in nodes}
+    for src, dst in edges:
+        parents[dst].append(src)
+    layer: dict[int, int] = {}
+
+    def depth(n: int) -> int:
+        if n not in layer:
+            layer[n] = 1 + max((depth(p) for p in parents[n]), default=-1)
+        return layer[n]
+
+    for n in nodes:
+        depth(n)
+    n_layers = max(layer.values(), default=0) + 1
+    by_layer = [sorted((n for n in nodes if layer[n] == d), key=lambda n: nodes[n]) for d in range(n_layers)]
+    width = max((len(ns) for ns in by_layer), default=1)
+    pos = {n: ((i + 0.5) / len(ns) * width, -d) for d, ns in enumerate(by_layer) for i, n in enumerate(ns)}
+    fig, ax = plt.subplots(figsize=(max(6.0, 2.3 * width), 1.1 * n_layers + 0.5))
+    for src, dst in edges:
+        (x0, y0), (x1, y1) = pos[src], pos[dst]
+        ax.annotate("", xy=(x1, y1 + 0.18), xytext=(x0, y0 - 0.18),
+                    arrowprops={"arrowstyle": "->", "color": "0.4", "lw": 0.8})
+    for n, (x, y) in pos.items():
+        ax.text(x, y, nodes[n], ha="center", va="center", fontsize=8,
+                bbox={"boxstyle": "round,pad=0.3", "fc": "#e8eef7", "ec": "#4a6fa5"})
+    ax.set_xlim(-0.2, width + 0.2)
+    ax.set_ylim(-n_layers + 0.4, 0.6)
+    ax.axis("off")
+    _save(fig, png, pdf)

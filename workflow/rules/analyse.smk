@@ -1,0 +1,39 @@
+# Stage 3: local minima per object and set, success rates, and the study's tables.
+
+
+rule local_minima:
+    input:
+        gfo="results/objects/{object}/gfo.parquet",
+        code=code("minima"),
+    output:
+        "results/objects/{object}/minima.parquet",
+    params:
+        radius_deg=config["analyses"]["minima_radius_deg"],
+    log:
+        "results/logs/local_minima/{object}.log",
+    script:
+        "../scripts/local_minima.py"
+
+
+rule study_tables:
+    input:
+        gfo=expand("results/objects/{object}/gfo.parquet", object=OBJECTS),
+        minima=expand("results/objects/{object}/minima.parquet", object=OBJECTS),
+        code=code("summaries", "config"),
+    output:
+        **{
+            f"{t}_{ext}": report(
+                f"results/tables/{t}.{ext}", caption=f"../report/{t}.rst", category="Tables"
+            )
+            if ext == "csv"
+            else f"results/tables/{t}.{ext}"
+            for t in TABLES
+            for ext in ("csv", "md")
+        },
+    params:
+        sets=config["synergy_sets"],
+        table2_k_max=config["analyses"]["table2_k_max"],
+    log:
+        "results/logs/study_tables.log",
+    script:
+        "../scripts/study_tables.py"

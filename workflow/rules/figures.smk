@@ -1,0 +1,77 @@
+# Stage 4: the study's figures from the tables (Fig. 4 per object, Fig. 5) and the
+# workflow's own rule graph (Fig. 3).
+
+
+rule fig4_force_maps:
+    input:
+        gfo="results/objects/{object}/gfo.parquet",
+        minima="results/objects/{object}/minima.parquet",
+        code=code("figures"),
+    output:
+        maps_png=report(
+            "results/objects/{object}/fig4_force_maps.png",
+            caption="../report/fig4_force_maps.rst",
+            category="Fig. 4",
+            subcategory="{object}",
+        ),
+        maps_pdf="results/objects/{object}/fig4_force_maps.pdf",
+        exploded_png=report(
+            "results/objects/{object}/fig4_exploded.png",
+            caption="../report/fig4_exploded.rst",
+            category="Fig. 4",
+            subcategory="{object}",
+        ),
+        exploded_pdf="results/objects/{object}/fig4_exploded.pdf",
+    params:
+        fig4=config["analyses"]["fig4"],
+    log:
+        "results/logs/fig4/{object}.log",
+    script:
+        "../scripts/fig4_force_maps.py"
+
+
+rule fig5_hierarchy:
+    input:
+        hierarchy="results/tables/hierarchy.csv",
+        code=code("figures"),
+    output:
+        success_png=report(
+            "results/figures/fig5a_hierarchy_success.png",
+            caption="../report/fig5a.rst",
+            category="Figures",
+        ),
+        success_pdf="results/figures/fig5a_hierarchy_success.pdf",
+        force_png=report(
+            "results/figures/fig5b_hierarchy_force.png",
+            caption="../report/fig5b.rst",
+            category="Figures",
+        ),
+        force_pdf="results/figures/fig5b_hierarchy_force.pdf",
+    params:
+        first=config["synergy_sets"]["hierarchy_first"],
+    log:
+        "results/logs/fig5_hierarchy.log",
+    script:
+        "../scripts/fig5_hierarchy.py"
+
+
+rule fig3_rulegraph:
+    input:
+        rules=[str(p) for p in sorted((ROOT / "workflow" / "rules").glob("*.smk"))],
+        snakefile=str(ROOT / "Snakefile"),
+        code=code("figures"),
+    output:
+        png=report(
+            "results/figures/fig3_rulegraph.png",
+            caption="../report/fig3.rst",
+            category="Figures",
+        ),
+        pdf="results/figures/fig3_rulegraph.pdf",
+        dot="results/figures/fig3_rulegraph.dot",
+    params:
+        snakefile=str(ROOT / "Snakefile"),
+        configfiles=workflow.configfiles,
+    log:
+        "results/logs/fig3_rulegraph.log",
+    script:
+        "../scripts/fig3_rulegraph.py"

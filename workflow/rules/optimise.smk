@@ -1,0 +1,32 @@
+# Stage 2: grasp-force optimisation of every (pose, synergy set), sharded over poses so
+# that each pose's mechanics (J, G, K, G_K^R, f_p) is built once for all its sets.
+
+
+rule optimise_shard:
+    input:
+        contacts="results/objects/{object}/contacts.parquet",
+        code=code("mechanics", "force_optimisation", "batched", "synergies", "closure"),
+        data=SHIPPED_DATA,
+        user=user_files(),
+    output:
+        temp("results/objects/{object}/gfo_shards/{shard}.parquet"),
+    params:
+        opt=optimisation_params,
+        n_shards=len(SHARDS),
+    log:
+        "results/logs/optimise/{object}_{shard}.log",
+    benchmark:
+        "results/benchmarks/optimise/{object}_{shard}.tsv"
+    script:
+        "../scripts/optimise_shard.py"
+
+
+rule aggregate_gfo:
+    input:
+        shards=expand("results/objects/{{object}}/gfo_shards/{shard}.parquet", shard=SHARDS),
+    output:
+        "results/objects/{object}/gfo.parquet",
+    log:
+        "results/logs/aggregate_gfo/{object}.log",
+    script:
+        "../scripts/aggregate_gfo.py"

@@ -1,0 +1,61 @@
+# Stage 1: close the hand on each object at every pose (pybullet), and the pictures of
+# the hand (Fig. 1) and of example grasps (Fig. 2).
+
+
+rule simulate_contacts:
+    input:
+        code=code("closure", "hand", "bullet", "synergies", "objects"),
+        data=SHIPPED_DATA,
+        user=user_files(),
+    output:
+        "results/objects/{object}/contacts.parquet",
+    params:
+        sim=simulation_params,
+    log:
+        "results/logs/simulate_contacts/{object}.log",
+    benchmark:
+        "results/benchmarks/simulate_contacts/{object}.tsv"
+    script:
+        "../scripts/simulate_contacts.py"
+
+
+rule fig1_synergy_postures:
+    input:
+        code=code("render", "hand", "bullet", "synergies"),
+        data=SHIPPED_DATA,
+        user=user_files(),
+    output:
+        png=report(
+            "results/figures/fig1_synergy_postures.png",
+            caption="../report/fig1.rst",
+            category="Figures",
+        ),
+        pdf="results/figures/fig1_synergy_postures.pdf",
+    params:
+        hand=config["hand"],
+        synergies=config["synergies"],
+    log:
+        "results/logs/fig1_synergy_postures.log",
+    script:
+        "../scripts/fig1_synergy_postures.py"
+
+
+rule fig2_example_grasps:
+    input:
+        contacts=expand("results/objects/{object}/contacts.parquet", object=OBJECTS),
+        code=code("render", "hand", "bullet"),
+    output:
+        png=report(
+            "results/figures/fig2_example_grasps.png",
+            caption="../report/fig2.rst",
+            category="Figures",
+        ),
+        pdf="results/figures/fig2_example_grasps.pdf",
+    params:
+        objects=[object_config(name) for name in OBJECTS],
+        hand=config["hand"],
+        poses=config["analyses"]["fig2_poses"],
+    log:
+        "results/logs/fig2_example_grasps.log",
+    script:
+        "../scripts/fig2_example_grasps.py"
