@@ -1,0 +1,269 @@
+"""All pybullet-specific code for the hand and the boxes.
+
+pybullet works in metres; every function here takes and returns mm (and the palm frame).
+The hand's base (its palm) is fixed at the world origin with identity orientation, so
+pybullet's world frame *is* the palm frame, scaled by 1/1000.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pybullet as pb
+from numpy.typing import NDArray
+
+from synergrasp.hand import Hand, write_urdf
+
+MM = 1e-3  # metres per mm
+
+
+@dataclass(frozen=True)
+class HandBody:
+    """A hand loaded into pybullet.
+
+    ``joint_indices[j]`` is the pybullet joint of elementary axis j, turning by
+    ``joint_scale[j] * q[joint_q[j]]``; ``link_index[i]`` is the pybullet link of hand link i
+    (-1 = the base, i.e. the palm); ``hand_link`` maps a pybullet link index back to a hand
+    link index (base -1 -> 0 = palm; links of half-axis frames map to the link they carry
+    no shape for, -1).
+    """
+
+    body: int
+    hand: Hand
+    joint_indices: NDArray[np.int64]
+    joint_q: NDArray[np.int64]
+    joint_scale: NDArray[np.float64]
+    link_index: NDArray[np.int64]
+    hand_link: dict[int, int]
+
+
+@dataclass(frozen=True)
+class ClosestPoints:
+    """Closest-point pairs between two bodies, mm, palm frame (m rows).
+
+    ``link_a`` / ``link_b`` are hand link indices when the body is a HandBody, pybullet link
+    indices otherwise (-1 = base). ``normal_on_b`` points from B toward A; ``distance`` is
+    negative when the shapes overlap (penetration depth).
+    """
+
+    link_a: NDArray[np.int64]
+    link_b: NDArray[np.int64]
+    point_a: NDArray[np.float64]
+    point_b: NDArray[np.float64]
+    normal_on_b: NDArray[np.float64]
+    distance: NDArray[np.float64]
+
+    def __len__(self) -> int:
+        return len(self.distance)
+
+
+def connect() -> int:
+    """A headless DIRECT pybullet client with deterministic settings (no gravity; never stepped)."""
+    client = pb.connect(pb.DIRECT)
+    pb.resetSimulation(physicsClientId=client)
+    pb.setGravity(0, 0, 0, physicsClientId=client)
+    pb.setPhysicsEngineParameter(deterministicOverlappingPairs=1, physicsClientId=client)
+    return client
+
+
+def disconnect(client: int) -> None:
+    """Close a client made by ``connect``."""
+    pb.disconnect(physicsClientId=client)
+
+
+def load_hand_body(client: int, hand: Hand) -> HandBody:
+    """Load ``hand`` (generated URDF) as a fixed-base body at the origin, posture q = 0."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "hand.urdf"
+        write_urdf(hand, path)
+        body = pb.loadURDF(str(path), basePosition=[0, 0, 0], baseOrientation=[0, 0, 0, 1],
+                           useFixedBase=True, flags=pb.URDF_USE_INERTIA_FROM_FILE,
+                           physicsClientId=client)
+    by_joint_name: dict[str, int] = {}
+    by_link_name: dict[str, int] = {}
+    for j in range(pb.getNumJoints(body, physicsClientId=client)):
+        info = pb.getJointInfo(body, j, physicsClientId=client)
+        by_joint_name[info[1].decode()] = j
+        by_link_name[info[12].decode()] = j
+    n_frames = len(hand.frame_names)
+    joint_indices = np.array([by_joint_name[hand.frame_joint_names[f]] for f in range(1, n_frames)])
+    link_index = np.array([-1] + [by_link_name[name] for name in hand.link_names[1:]])
+    hand_link = {int(b): i for i, b in enumerate(link_index)}
+    return HandBody(
+        body=body,
+        hand=hand,
+        joint_indices=joint_indices,
+        joint_q=hand.frame_joint[1:].copy(),
+        joint_scale=hand.frame_scale[1:].copy(),
+        link_index=link_index,
+        hand_link=hand_link,
+    )
+
+
+def set_posture(client: int, body: HandBody, q: NDArray) -> None:
+    """Put the hand at joint angles q (19, rad) instantly (no dynamics)."""
+    q = np.asarray(q, dtype=float)
+    if q.shape != (body.hand.n_joints,):
+        raise ValueError(f"q must have shape ({body.hand.n_joints},), got {q.shape}")
+    values = body.joint_scale * q[body.joint_q]
+    pb.resetJointStatesMultiDof(body.body, body.joint_indices.tolist(),
+                                [[float(v)] for v in values], physicsClientId=client)
+
+
+def joint_positions(client: int, body: HandBody) -> NDArray[np.float64]:
+    """Current pybullet joint positions of every elementary axis (rad), HandBody order."""
+    states = pb.getJointStates(body.body, body.joint_indices.tolist(), physicsClientId=client)
+    return np.array([s[0] for s in states])
+
+
+def link_frames(client: int, body: HandBody) -> NDArray[np.float64]:
+    """(n_links, 4, 4) hand link frames as pybullet has them, palm frame, mm (single precision)."""
+    out = np.empty((body.hand.n_links, 4, 4))
+    out[0] = np.eye(4)
+    states = pb.getLinkStates(body.body, body.link_index[1:].tolist(), computeForwardKinematics=1,
+                              physicsClientId=client)
+    for i, s in enumerate(states, start=1):
+        out[i] = np.eye(4)
+        out[i, :3, :3] = np.array(pb.getMatrixFromQuaternion(s[5])).reshape(3, 3)
+        out[i, :3, 3] = np.array(s[4]) / MM
+    return out
+
+
+def bullet_jacobian(client: int, body: HandBody, q: NDArray, link: int, point_mm: NDArray) -> NDArray[np.float64]:
+    """(3, 19) translational Jacobian of a point of hand link ``link`` from pybullet, mm/rad.
+
+    ``point_mm`` in the palm frame. Independent check of ``hand.point_jacobian``: pybullet's
+    per-axis columns are summed per joint with the half-angle weights.
+    """
+    hand = body.hand
+    if link == 0:
+        return np.zeros((3, hand.n_joints))
+    set_posture(client, body, q)
+    frame = link_frames(client, body)[link]
+    local = frame[:3, :3].T @ (np.asarray(point_mm, dtype=float) - frame[:3, 3])
+    n = pb.getNumJoints(body.body, physicsClientId=client)
+    positions = [0.0] * n
+    values = body.joint_scale * np.asarray(q, dtype=float)[body.joint_q]
+    for j, v in zip(body.joint_indices, values):
+        positions[int(j)] = float(v)
+    lin, _ = pb.calculateJacobian(body.body, int(body.link_index[link]), (local * MM).tolist(),
+                                  positions, [0.0] * n, [0.0] * n, physicsClientId=client)
+    lin = np.array(lin)  # (3, n) m/rad, columns in pybullet joint order
+    jac = np.zeros((3, hand.n_joints))
+    for j, qi, s in zip(body.joint_indices, body.joint_q, body.joint_scale):
+        jac[:, qi] += s * lin[:, j] / MM
+    return jac
+
+
+def load_box(client: int, size_mm: NDArray, center_mm: NDArray, rotation: NDArray | None = None) -> int:
+    """A static box body of full edge lengths ``size_mm`` centred at ``center_mm`` (palm frame),
+    oriented by the 3 × 3 rotation matrix ``rotation`` (identity if None). Returns its body id."""
+    size = np.asarray(size_mm, dtype=float)
+    if size.shape != (3,) or np.any(size <= 0):
+        raise ValueError(f"size_mm must be 3 positive lengths (mm), got {size_mm!r}")
+    shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(0.5 * size * MM).tolist(), physicsClientId=client)
+    visual = pb.createVisualShape(pb.GEOM_BOX, halfExtents=(0.5 * size * MM).tolist(),
+                                  rgbaColor=[0.8, 0.8, 0.75, 1.0], physicsClientId=client)
+    body = pb.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=shape, baseVisualShapeIndex=visual,
+                              physicsClientId=client)
+    move_body(client, body, center_mm, rotation)
+    return body
+
+
+def move_body(client: int, body: int, center_mm: NDArray, rotation: NDArray | None = None) -> None:
+    """Place a (box) body's base at ``center_mm`` with orientation ``rotation`` (3 × 3), palm frame."""
+    center = np.asarray(center_mm, dtype=float)
+    if center.shape != (3,):
+        raise ValueError(f"center_mm must be 3 numbers (mm), got {center_mm!r}")
+    quat = _quaternion(np.eye(3) if rotation is None else np.asarray(rotation, dtype=float))
+    pb.resetBasePositionAndOrientation(body, (center * MM).tolist(), quat, physicsClientId=client)
+
+
+def remove_body(client: int, body: int) -> None:
+    """Remove a body (e.g. a box) from the client."""
+    pb.removeBody(body, physicsClientId=client)
+
+
+def _quaternion(rotation: NDArray) -> list[float]:
+    if rotation.shape != (3, 3) or not np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-6):
+        raise ValueError("rotation must be a 3 × 3 rotation matrix")
+    from scipy.spatial.transform import Rotation  # scipy order (x, y, z, w) is pybullet's
+
+    return Rotation.from_matrix(rotation).as_quat().tolist()
+
+
+def _body_and_link(body: int | HandBody, link: int | None) -> tuple[int, int | None]:
+    if isinstance(body, HandBody):
+        if link is None:
+            return body.body, None
+        if not 0 <= link < body.hand.n_links:
+            raise ValueError(f"link must be a hand link index 0 ... {body.hand.n_links - 1}, got {link!r}")
+        return body.body, int(body.link_index[link])
+    return body, link
+
+
+def _to_hand_links(body: int | HandBody, links: list[int]) -> NDArray[np.int64]:
+    if isinstance(body, HandBody):
+        return np.array([body.hand_link.get(b, -1) for b in links], dtype=np.int64)
+    return np.array(links, dtype=np.int64)
+
+
+def closest_points(client: int, body_a: int | HandBody, body_b: int | HandBody, distance_mm: float,
+                   link_a: int | None = None, link_b: int | None = None) -> ClosestPoints:
+    """Closest points between A and B closer than ``distance_mm`` (all links unless given).
+
+    A HandBody argument takes and returns hand link indices. With the object as A and the
+    hand as B, ``normal_on_b`` is the object's inward normal (from the hand into the object)
+    and ``point_a`` lies on the object's surface. Uses the current postures; no stepping.
+    """
+    a, la = _body_and_link(body_a, link_a)
+    b, lb = _body_and_link(body_b, link_b)
+    kwargs = {}
+    if la is not None:
+        kwargs["linkIndexA"] = la
+    if lb is not None:
+        kwargs["linkIndexB"] = lb
+    pts = pb.getClosestPoints(a, b, float(distance_mm) * MM, physicsClientId=client, **kwargs)
+    return _closest(body_a, body_b, pts)
+
+
+def _closest(body_a: int | HandBody, body_b: int | HandBody, pts: list) -> ClosestPoints:
+    if not pts:
+        e = np.zeros((0, 3))
+        return ClosestPoints(np.zeros(0, np.int64), np.zeros(0, np.int64), e, e.copy(), e.copy(), np.zeros(0))
+    return ClosestPoints(
+        link_a=_to_hand_links(body_a, [p[3] for p in pts]),
+        link_b=_to_hand_links(body_b, [p[4] for p in pts]),
+        point_a=np.array([p[5] for p in pts]) / MM,
+        point_b=np.array([p[6] for p in pts]) / MM,
+        normal_on_b=np.array([p[7] for p in pts]),
+        distance=np.array([p[8] for p in pts]) / MM,
+    )
+
+
+def self_collision_pairs(hand: Hand, links: tuple[int, ...] | None = None) -> tuple[tuple[int, int], ...]:
+    """Pairs (i < j) of hand links to test against each other: every pair except
+    ``hand.ignored_link_pairs`` (parent/child links that touch by design). With ``links``,
+    only pairs with at least one link from that set."""
+    ignored = set(hand.ignored_link_pairs)
+    keep = None if links is None else set(links)
+    return tuple((i, j) for i in range(hand.n_links) for j in range(i + 1, hand.n_links)
+                 if (i, j) not in ignored and (keep is None or i in keep or j in keep))
+
+
+def self_closest_points(client: int, body: HandBody, distance_mm: float,
+                        pairs: tuple[tuple[int, int], ...] | None = None) -> ClosestPoints:
+    """Closest points between pairs of hand links (default ``self_collision_pairs``), mm.
+
+    ``link_a`` / ``link_b`` are hand link indices; distances < 0 are overlaps.
+    """
+    pairs = self_collision_pairs(body.hand) if pairs is None else pairs
+    pts: list = []
+    for i, j in pairs:
+        pts.extend(pb.getClosestPoints(body.body, body.body, float(distance_mm) * MM,
+                                       linkIndexA=int(body.link_index[i]), linkIndexB=int(body.link_index[j]),
+                                       physicsClientId=client))
+    return _closest(body, body, pts)
