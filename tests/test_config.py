@@ -83,3 +83,14 @@ def test_study_synergy_sets_are_the_75_distinct_sets():
     assert sets["1-2-3"] == (1, 2, 3)
     assert "2-5-7" in sets and "1-2-3-4-5-6-7-8-9-10-11-12-13-14-15" in sets
     assert all(set_id(v) == k for k, v in sets.items())
+
+
+def test_gfo_params_carry_the_mechanics_block():
+    from synergrasp.config import gfo_params
+
+    mech = dict(STUDY["mechanics"], gravity_direction=[0.0, 0.0, -2.0])
+    params = gfo_params(mech, mass_kg=0.5)
+    assert params.gravity_direction == (0.0, 0.0, -1.0)
+    assert (params.mu, params.f_min, params.k_stru, params.k_ss) == (1.5, 0.1, 1.0, 200.0)
+    # the wrench the contacts apply balances the weight: +z force of 0.5 kg x 9.81 m/s^2
+    assert params.wrench()[2] == pytest.approx(0.5 * 9.81)

@@ -21,6 +21,7 @@ __all__ = [
     "incremental_set_id",
     "set_id",
     "merge_config",
+    "gfo_params",
 ]
 
 
@@ -153,3 +154,22 @@ def merge_config(base: Mapping[str, Any], override: Mapping[str, Any]) -> dict[s
         else:
             out[key] = value
     return out
+
+
+def gfo_params(mechanics: Mapping[str, Any], mass_kg: float):
+    """:class:`synergrasp.force_optimisation.GFOParams` from the config's ``mechanics``
+    block (units in its key names) and the object's mass (kg); gravity is normalised."""
+    import numpy as np
+
+    from synergrasp.force_optimisation import GFOParams
+
+    gravity = np.asarray(mechanics["gravity_direction"], dtype=float)
+    return GFOParams(
+        gravity_direction=tuple(gravity / np.linalg.norm(gravity)),
+        mu=float(mechanics["mu"]),
+        f_min=float(mechanics["f_min_N"]),
+        k_stru=float(mechanics["k_stru_N_per_mm"]),
+        k_ss=float(mechanics["k_ss_Nmm_per_rad"]),
+        mass_kg=float(mass_kg),
+        g=float(mechanics["g_m_per_s2"]),
+    )

@@ -1,0 +1,17 @@
+"""Close the hand on one object at every pose of the grid; write its contacts table."""
+from contextlib import redirect_stderr
+
+from synergrasp.closure import ClosureParams, Placement, simulate_object, write_contacts
+from synergrasp.hand import load_hand
+from synergrasp.objects import boxes_from_config
+from synergrasp.synergies import load_synergies
+
+with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+    sim = snakemake.params.sim
+    obj = dict(sim["object"])
+    placement = Placement.from_config(obj.pop("placement"), sim["grid"])
+    (box,) = boxes_from_config([obj])
+    hand = load_hand(sim["hand"])
+    synergies = load_synergies(sim["synergies"], joint_names=hand.joint_names)
+    table = simulate_object(hand, synergies, box, placement, ClosureParams.from_config(sim["closure"]))
+    write_contacts(table, snakemake.output[0])
