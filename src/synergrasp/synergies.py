@@ -1,0 +1,296 @@
+"""Postural synergies of the 19-joint hand: mapping from human data, loading, validation.
+
+A synergy file is a CSV with one row per hand joint and the columns ``joint``,
+``mean_rad`` (the mean posture q_m, rad) and ``syn1`` … ``synK`` (synergy vectors, rad per
+unit of the synergy coordinate σ). The shipped file ``data/synergies_19dof.csv`` is
+generated from the human synergies (``data/santello_synergies_20dof.csv``) and the mapping
+``data/synergy_mapping.yaml`` by :func:`map_human_synergies`; regenerate it with
+``python -m synergrasp.synergies``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import yaml
+from numpy.typing import ArrayLike, NDArray
+
+from synergrasp.hand import JOINT_NAMES
+
+__all__ = [
+    "Synergies",
+    "SynergyFileError",
+    "HUMAN_JOINT_NAMES",
+    "load_synergies",
+    "load_human_synergies",
+    "load_synergy_mapping",
+    "map_human_synergies",
+    "reference_posture",
+    "write_synergies",
+    "shipped_path",
+]
+
+HUMAN_JOINT_NAMES: tuple[str, ...] = (
+    "thumb_j1", "thumb_j2", "thumb_j3", "thumb_j4",
+    "index_abd", "index_mcp", "index_pip", "index_dip",
+    "middle_abd", "middle_mcp", "middle_pip", "middle_dip",
+    "ring_abd", "ring_mcp", "ring_pip", "ring_dip",
+    "little_abd", "little_mcp", "little_pip", "little_dip",
+)
+"""Joints of the 20-joint human hand of the human synergy data, in file order."""
+
+SHIPPED_SYNERGIES = "synergies_19dof.csv"
+HUMAN_SYNERGIES = "santello_synergies_20dof.csv"
+SYNERGY_MAPPING = "synergy_mapping.yaml"
+
+
+class SynergyFileError(ValueError):
+    """A synergy file (or mapping) is malformed; the message names file, field and what is allowed."""
+
+
+@dataclass(frozen=True)
+class Synergies:
+    """Synergy matrix and mean posture of a hand.
+
+    Attributes
+    ----------
+    joint_names : joint names, row order of ``mean`` and ``matrix``.
+    mean : (n,) mean posture q_m, rad; the origin of the synergy coordinates.
+    matrix : (n, k) synergy vectors as columns, rad per unit σ.
+    names : ("S1", …, "Sk").
+    """
+
+    joint_names: tuple[str, ...]
+    mean: NDArray[np.float64]
+    matrix: NDArray[np.float64]
+    names: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        mean = np.array(self.mean, dtype=float)
+        matrix = np.array(self.matrix, dtype=float)
+        n = len(self.joint_names)
+        if mean.shape != (n,) or matrix.ndim != 2 or matrix.shape[0] != n:
+            raise ValueError(f"Synergies: mean must be ({n},) and matrix ({n}, k) for {n} joints; "
+                             f"got {mean.shape} and {matrix.shape}")
+        if len(self.names) != matrix.shape[1]:
+            raise ValueError(f"Synergies: {len(self.names)} names for {matrix.shape[1]} columns")
+        mean.setflags(write=False)
+        matrix.setflags(write=False)
+        object.__setattr__(self, "mean", mean)
+        object.__setattr__(self, "matrix", matrix)
+        object.__setattr__(self, "joint_names", tuple(self.joint_names))
+        object.__setattr__(self, "names", tuple(self.names))
+
+    @property
+    def n_synergies(self) -> int:
+        return self.matrix.shape[1]
+
+    def columns(self, indices: Sequence[int]) -> NDArray[np.float64]:
+        """The (n, s) matrix of the synergies with the given 1-based indices, in that order."""
+        idx = list(indices)
+        bad = [i for i in idx if not (isinstance(i, (int, np.integer)) and 1 <= i <= self.n_synergies)]
+        if bad:
+            raise ValueError(f"synergy indices {bad} are not allowed; allowed: 1..{self.n_synergies}")
+        return self.matrix[:, [i - 1 for i in idx]]
+
+
+def _data_file(name: str) -> Path:
+    return Path(str(resources.files("synergrasp") / "data" / name))
+
+
+def shipped_path() -> Path:
+    """Path of the shipped 19-joint synergy file."""
+    return _data_file(SHIPPED_SYNERGIES)
+
+
+def _syn_names(k: int) -> list[str]:
+    return [f"syn{i}" for i in range(1, k + 1)]
+
+
+def _read_table(path: str | Path, joint_names: Sequence[str]) -> tuple[list[str], NDArray, NDArray]:
+    """Read and validate a synergy CSV; return (syn columns, mean, matrix) in joint_names order."""
+    where = f"synergy file '{path}'"
+    try:
+        table = pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True)
+    except FileNotFoundError:
+        raise
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as err:
+        raise SynergyFileError(f"{where}: not a readable CSV table ({err})") from None
+    columns = [str(c).strip() for c in table.columns]
+    table.columns = columns
+    for required in ("joint", "mean_rad"):
+        if required not in columns:
+            raise SynergyFileError(f"{where}: missing column '{required}'; the columns must be "
+                                   "joint, mean_rad, syn1..synK")
+    if columns[:2] != ["joint", "mean_rad"]:
+        raise SynergyFileError(f"{where}: columns start {columns[:2]}; they must be joint, mean_rad, syn1..synK")
+    syn_cols = columns[2:]
+    if not syn_cols:
+        raise SynergyFileError(f"{where}: no synergy columns; expected syn1..synK after mean_rad")
+    if syn_cols != _syn_names(len(syn_cols)):
+        raise SynergyFileError(f"{where}: synergy columns {syn_cols} are not allowed; they must be "
+                               f"named syn1..syn{len(syn_cols)} in this order")
+
+    names = [s.strip() for s in table["joint"].tolist()]
+    expected = list(joint_names)
+    duplicated = sorted({n for n in names if names.count(n) > 1})
+    unknown = [n for n in names if n not in expected]
+    missing = [n for n in expected if n not in names]
+    if duplicated or unknown or missing:
+        parts = []
+        if duplicated:
+            parts.append(f"duplicated {duplicated}")
+        if unknown:
+            parts.append(f"unknown {unknown}")
+        if missing:
+            parts.append(f"missing {missing}")
+        raise SynergyFileError(f"{where}: field 'joint': {'; '.join(parts)}; expected exactly one row "
+                               f"for each of {expected}")
+    if len(syn_cols) > len(expected):
+        raise SynergyFileError(f"{where}: {len(syn_cols)} synergy columns for {len(expected)} joints; "
+                               f"at most {len(expected)} are allowed")
+
+    values = np.empty((len(names), 1 + len(syn_cols)))
+    for j, col in enumerate(["mean_rad", *syn_cols]):
+        for i, text in enumerate(table[col].tolist()):
+            try:
+                value = float(text)
+            except ValueError:
+                value = math.nan
+            if not math.isfinite(value):
+                raise SynergyFileError(f"{where}: field '{col}' of joint '{names[i]}' is {text!r}; "
+                                       "a finite number (rad) is required")
+            values[i, j] = value
+    order = [names.index(n) for n in expected]
+    values = values[order]
+    return syn_cols, values[:, 0], values[:, 1:]
+
+
+def load_synergies(path: str | Path | None = None,
+                   joint_names: Sequence[str] = JOINT_NAMES) -> Synergies:
+    """Load a synergy file (joint, mean_rad, syn1..synK; rad and rad per unit σ).
+
+    ``path=None`` loads the shipped 19-joint synergies. Rows may come in any order; the
+    result follows ``joint_names``.
+
+    Raises
+    ------
+    SynergyFileError
+        Naming the file, the field and what is allowed.
+    FileNotFoundError
+        If ``path`` does not exist.
+    """
+    path = shipped_path() if path is None else Path(path)
+    syn_cols, mean, matrix = _read_table(path, joint_names)
+    return Synergies(tuple(joint_names), mean, matrix, tuple(f"S{i}" for i in range(1, len(syn_cols) + 1)))
+
+
+def load_human_synergies(path: str | Path | None = None) -> Synergies:
+    """The 20-joint human synergies (Santello et al. 1998 via SynGrasp); None = the shipped copy."""
+    return load_synergies(_data_file(HUMAN_SYNERGIES) if path is None else path, HUMAN_JOINT_NAMES)
+
+
+def load_synergy_mapping(path: str | Path | None = None) -> dict[str, Any]:
+    """The human-to-hand joint mapping (YAML, see data/synergy_mapping.yaml); None = shipped."""
+    with open(_data_file(SYNERGY_MAPPING) if path is None else path, encoding="utf-8") as handle:
+        return yaml.safe_load(handle)
+
+
+def map_human_synergies(human_table: Synergies, mapping: Mapping[str, Any],
+                        joint_names: Sequence[str] = JOINT_NAMES) -> Synergies:
+    """Map human synergies onto the hand's joints.
+
+    For each hand joint j (``mapping["joints"][j]``: ``terms`` [{human, weight}],
+    ``offset_rad``, ``limits_deg`` [lower, upper]):
+    q_m[j] = clip(offset + Σ weight · q_m,human, limits) and
+    S[j, c] = column_sign[c] · Σ weight · S_human[·, c].
+    Clipping the mean keeps the origin of the synergy coordinates reachable.
+
+    Parameters
+    ----------
+    human_table : human synergies (rad), e.g. :func:`load_human_synergies`.
+    mapping : parsed mapping, e.g. :func:`load_synergy_mapping`.
+    joint_names : the hand's joints; the mapping must cover each exactly once.
+    """
+    joints = mapping.get("joints")
+    if not isinstance(joints, Mapping):
+        raise SynergyFileError("synergy mapping: field 'joints' must map each hand joint to its terms")
+    unknown = [j for j in joints if j not in joint_names]
+    missing = [j for j in joint_names if j not in joints]
+    if unknown or missing:
+        raise SynergyFileError(f"synergy mapping: field 'joints': unknown {unknown}, missing {missing}; "
+                               f"expected {list(joint_names)}")
+    k = human_table.n_synergies
+    signs = np.ones(k)
+    for col, sign in (mapping.get("column_sign") or {}).items():
+        if col not in _syn_names(k) or sign not in (1, -1):
+            raise SynergyFileError(f"synergy mapping: field 'column_sign': {col}: {sign} is not allowed; "
+                                   f"keys syn1..syn{k}, values +1 or -1")
+        signs[int(col[3:]) - 1] = sign
+
+    n = len(joint_names)
+    weights = np.zeros((n, len(human_table.joint_names)))
+    offsets = np.zeros(n)
+    lower = np.zeros(n)
+    upper = np.zeros(n)
+    for j, name in enumerate(joint_names):
+        spec = joints[name]
+        for term in spec["terms"]:
+            if term["human"] not in human_table.joint_names:
+                raise SynergyFileError(f"synergy mapping: joint '{name}': human joint {term['human']!r} "
+                                       f"is not allowed; allowed: {list(human_table.joint_names)}")
+            weights[j, human_table.joint_names.index(term["human"])] += float(term["weight"])
+        offsets[j] = float(spec.get("offset_rad", 0.0))
+        lower[j], upper[j] = np.radians(spec["limits_deg"])
+        if not lower[j] < upper[j]:
+            raise SynergyFileError(f"synergy mapping: joint '{name}': limits_deg {spec['limits_deg']} "
+                                   "must be [lower, upper] with lower < upper")
+    mean = np.clip(offsets + weights @ human_table.mean, lower, upper)
+    matrix = (weights @ human_table.matrix) * signs + 0.0  # + 0.0 turns -0.0 into 0.0
+    return Synergies(tuple(joint_names), mean, matrix, human_table.names)
+
+
+def reference_posture(synergies: Synergies, sigma: ArrayLike, lower: ArrayLike,
+                      upper: ArrayLike) -> NDArray[np.float64]:
+    """Joint reference of the closure along the first synergy: clip(q_m + σ·S1, lower, upper).
+
+    Parameters
+    ----------
+    sigma : scalar, or (m,) values of the first synergy coordinate.
+    lower, upper : (n,) joint limits, rad (from the hand model).
+
+    Returns
+    -------
+    (n,) for a scalar σ, (m, n) for an array of σ; rad.
+    """
+    sigma_arr = np.asarray(sigma, dtype=float)
+    lower_arr = np.asarray(lower, dtype=float)
+    upper_arr = np.asarray(upper, dtype=float)
+    n = len(synergies.joint_names)
+    if lower_arr.shape != (n,) or upper_arr.shape != (n,):
+        raise ValueError(f"lower and upper must have shape ({n},); got {lower_arr.shape} and {upper_arr.shape}")
+    if sigma_arr.ndim > 1:
+        raise ValueError(f"sigma must be a scalar or 1-D; got shape {sigma_arr.shape}")
+    q = synergies.mean + sigma_arr[..., None] * synergies.matrix[:, 0]
+    return np.clip(q, lower_arr, upper_arr)
+
+
+def write_synergies(synergies: Synergies, path: str | Path) -> None:
+    """Write a synergy file (joint, mean_rad, syn1..synK) that round-trips exactly."""
+    table = pd.DataFrame(synergies.matrix, columns=_syn_names(synergies.n_synergies))
+    table.insert(0, "mean_rad", synergies.mean)
+    table.insert(0, "joint", list(synergies.joint_names))
+    table.to_csv(path, index=False, float_format="%.17g", lineterminator="\n")
+
+
+if __name__ == "__main__":
+    mapped = map_human_synergies(load_human_synergies(), load_synergy_mapping())
+    write_synergies(mapped, shipped_path())
+    print(f"wrote {shipped_path()}")
