@@ -268,8 +268,8 @@ def hand_from_dict(doc: Any) -> Hand:
     if not np.isclose(np.linalg.norm(palm_normal), 1.0, atol=1e-6):
         raise _err("palm_normal", f"must be a unit vector, got {palm_normal.tolist()}")
     fingers = _mapping(doc["fingers"], "fingers")
-    if tuple(fingers) != FINGERS:
-        raise _err("fingers", f"must list exactly {FINGERS} in this order, got {tuple(fingers)}")
+    if sorted(fingers) != sorted(FINGERS):
+        raise _err("fingers", f"must have exactly the keys {FINGERS}, got {tuple(fingers)}")
 
     frame_names = ["palm"]
     frame_parent = [-1]
