@@ -407,13 +407,20 @@ def _check_q(hand: Hand, q: NDArray) -> NDArray[np.float64]:
 def frame_transforms(hand: Hand, q: NDArray) -> NDArray[np.float64]:
     """(n_frames, 4, 4) transforms of every elementary axis frame in the palm frame, mm."""
     q = _check_q(hand, q)
-    n = len(hand.frame_names)
-    t = np.empty((n, 4, 4))
+    # all axis rotations at once (Rodrigues), then the chain in tree order (parents first)
+    angle = hand.frame_scale[1:] * q[hand.frame_joint[1:]]
+    axis = hand.frame_axis[1:]
+    c, s = np.cos(angle)[:, None, None], np.sin(angle)[:, None, None]
+    cross = np.zeros((len(angle), 3, 3))
+    cross[:, 0, 1], cross[:, 0, 2], cross[:, 1, 2] = -axis[:, 2], axis[:, 1], -axis[:, 0]
+    cross -= cross.transpose(0, 2, 1)
+    local = hand.frame_offset[1:].copy()
+    local[:, :3, :3] = local[:, :3, :3] @ (c * np.eye(3) + s * cross + (1 - c) * axis[:, :, None] * axis[:, None, :])
+    t = np.empty((len(hand.frame_names), 4, 4))
     t[0] = np.eye(4)
-    rot = np.eye(4)
-    for f in range(1, n):
-        rot[:3, :3] = axis_rotation(hand.frame_axis[f], hand.frame_scale[f] * q[hand.frame_joint[f]])
-        t[f] = t[hand.frame_parent[f]] @ hand.frame_offset[f] @ rot
+    parent = hand.frame_parent
+    for f in range(1, len(t)):
+        t[f] = t[parent[f]] @ local[f - 1]
     return t
 
 
@@ -428,13 +435,25 @@ def fingertip_positions(hand: Hand, q: NDArray) -> NDArray[np.float64]:
     return np.einsum("kij,kj->ki", links[:, :3, :3], hand.fingertip_point) + links[:, :3, 3]
 
 
-def _jacobian_rows(hand: Hand, frames: NDArray, link: int, point: NDArray) -> NDArray[np.float64]:
-    jac = np.zeros((3, hand.n_joints))
+def _chain(hand: Hand, link: int) -> NDArray[np.int64]:
+    """Frames from the link's own frame down to (excluding) the palm."""
+    chain = []
     f = int(hand.link_frame[link])
     while f > 0:
-        axis_world = frames[f, :3, :3] @ hand.frame_axis[f]
-        jac[:, hand.frame_joint[f]] += hand.frame_scale[f] * np.cross(axis_world, point - frames[f, :3, 3])
+        chain.append(f)
         f = int(hand.frame_parent[f])
+    return np.array(chain, dtype=np.int64)
+
+
+def _jacobian_rows(hand: Hand, frames: NDArray, link: int, point: NDArray) -> NDArray[np.float64]:
+    jac = np.zeros((3, hand.n_joints))
+    chain = _chain(hand, link)
+    if len(chain) == 0:
+        return jac
+    axes = np.einsum("fij,fj->fi", frames[chain, :3, :3], hand.frame_axis[chain])
+    cols = hand.frame_scale[chain, None] * np.cross(axes, point - frames[chain, :3, 3])
+    # the two halves of a rolling joint add into one column
+    np.add.at(jac.T, hand.frame_joint[chain], cols)
     return jac
 
 
