@@ -1,0 +1,549 @@
+"""Batched grasp-force optimisation: one primal-dual interior-point method run on thousands
+of GFO problems at once (docs/batched_solver.md).
+
+Per problem (method.md §4), forces in N:
+
+    minimise ||f_p + E y||_2   subject to, per contact i,
+        n_i.f_i >= f_min,   ||f_i - (n_i.f_i) n_i|| <= mu n_i.f_i
+
+With E orthonormal, ||f_p + E y||^2 = ||f_p - E a||^2 + ||y + a||^2 (a = E^T f_p), so the
+solver minimises t subject to (t, y + a) in a second-order cone: a linear-objective SOCP
+in x = (t, y), solved through the homogeneous self-dual embedding (infeasibility ends in a
+certificate, not a time-out) with Nesterov-Todd scaling and Mehrotra's predictor-corrector.
+Every array carries the batch on its last axis; every operation is element-wise over the
+batch and reduces over small leading axes in a fixed order, so a problem gives the same
+numbers alone or inside any batch, padded or not.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from synergrasp.force_optimisation import GFOParams, mechanics_for, solve_gfo, strict_internal_forces
+from synergrasp.mechanics import Grasp, tangent_pairs
+
+__all__ = [
+    "BatchResult",
+    "GFOBatch",
+    "SolverSettings",
+    "gfo_batch",
+    "optimise_grasps",
+    "solve_batch",
+    "solve_gfo_batch",
+]
+
+#: Problems per padded batch in `optimise_grasps` (bounds the memory whatever the study size).
+DEFAULT_BATCH_SIZE = 4096
+
+# Status codes of the interior-point iteration (BatchResult.code).
+_RUNNING, _OPTIMAL, _INFEASIBLE, _UNSOLVED = 0, 1, 2, 3
+
+
+@dataclass(frozen=True, kw_only=True)
+class SolverSettings:
+    """Tolerances of the batched interior-point method.
+
+    tol: relative primal/dual residual and duality-gap tolerance of an optimal point, and the
+        residual tolerance of an infeasibility certificate (dimensionless; the data are
+        scaled so that max(||f_p||, f_min) = 1)
+    reduced_tol: the same tests, applied when the iteration stalls (step below
+        `stall_step`) or reaches `max_iter`; failing them the problem is 'not decided'
+    max_iter: iteration cap; a problem not decided by then falls back to `solve_gfo`
+    step_fraction: fraction of the step to the cone boundary taken each iteration
+    """
+
+    tol: float = 1e-8
+    reduced_tol: float = 1e-6
+    max_iter: int = 50
+    step_fraction: float = 0.99
+    stall_step: float = 1e-3
+    refine: int = 1
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.tol) and 0 < self.tol < 1):
+            raise ValueError(f"tol must be in (0, 1), got {self.tol}")
+        if not (isinstance(self.max_iter, int) and self.max_iter > 0):
+            raise ValueError(f"max_iter must be a positive int, got {self.max_iter!r}")
+        if not (0 < self.step_fraction < 1):
+            raise ValueError(f"step_fraction must be in (0, 1), got {self.step_fraction}")
+
+
+@dataclass(frozen=True)
+class GFOBatch:
+    """B GFO problems padded to a common contact count m and basis size e, batch last.
+
+    rows:    (m, 3, e, B) contact-frame rows [n.E_i; t1.E_i / mu; t2.E_i / mu], per N of y
+    h:       (m, 3, B)    the same rows applied to f_p, N
+    a:       (e, B)       E^T f_p, N
+    r0:      (B,)         ||f_p - E a||, the part of f_p no internal force can cancel, N
+    f_min:   (B,)         least normal force, N
+    contact: (m, B)       True where the contact exists (padding contacts are masked out)
+    """
+
+    rows: NDArray
+    h: NDArray
+    a: NDArray
+    r0: NDArray
+    f_min: NDArray
+    contact: NDArray
+
+    @property
+    def size(self) -> int:
+        return int(self.a.shape[-1])
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """Outcome of `solve_batch`, one entry per problem.
+
+    code: 1 optimal, 2 infeasible (certificate), 3 not decided within the iteration cap
+    y: (e, B) optimal internal-force coordinates, N (NaN unless optimal)
+    t: (B,) optimal ||y + a||, N (NaN unless optimal)
+    iterations: (B,) interior-point iterations
+    """
+
+    code: NDArray
+    y: NDArray
+    t: NDArray
+    iterations: NDArray
+
+
+# --------------------------------------------------------------------------- building
+
+
+def gfo_batch(
+    f_p: Sequence[NDArray],
+    E: Sequence[NDArray],
+    normals: Sequence[NDArray],
+    mu: float | Sequence[float],
+    f_min: float | Sequence[float],
+    m_pad: int | None = None,
+    e_pad: int | None = None,
+) -> GFOBatch:
+    """Pad and stack GFO problems (f_p (3m,), E (3m, e) orthonormal, normals (m, 3)).
+
+    Absent contacts and basis columns of a problem are zero-padded at the end, so the
+    padded problem has exactly the same iterates as the problem alone.
+    """
+    B = len(f_p)
+    if not (len(E) == len(normals) == B):
+        raise ValueError(f"f_p, E and normals must have the same length, got {B}, {len(E)}, {len(normals)}")
+    mus = np.broadcast_to(np.asarray(mu, dtype=float), (B,))
+    fmins = np.broadcast_to(np.asarray(f_min, dtype=float), (B,))
+    if not np.all(np.isfinite(mus) & (mus > 0)):
+        raise ValueError("mu must be finite and > 0")
+    if not np.all(np.isfinite(fmins) & (fmins >= 0)):
+        raise ValueError("f_min must be finite and >= 0 (N)")
+    ms = [np.asarray(n).shape[0] for n in normals]
+    es = [np.asarray(x).reshape(3 * ms[k], -1).shape[1] for k, x in enumerate(E)]
+    m = max(ms + [1]) if m_pad is None else m_pad
+    e = max(es + [1]) if e_pad is None else e_pad
+    if max(ms + [0]) > m or max(es + [0]) > e:
+        raise ValueError(f"m_pad={m_pad} / e_pad={e_pad} smaller than the largest problem (m={max(ms)}, e={max(es)})")
+    rows = np.zeros((B, m, 3, e))
+    h = np.zeros((B, m, 3))
+    a = np.zeros((B, e))
+    r0 = np.zeros(B)
+    contact = np.zeros((B, m), dtype=bool)
+    for k in range(B):
+        mk, ek = ms[k], es[k]
+        n = np.asarray(normals[k], dtype=float)
+        frames = _contact_frames(n, mus[k])
+        Ek = np.asarray(E[k], dtype=float).reshape(3 * mk, ek)
+        fp = np.asarray(f_p[k], dtype=float).reshape(3 * mk)
+        rows[k, :mk, :, :ek] = np.einsum("iab,ibk->iak", frames, Ek.reshape(mk, 3, ek))
+        h[k, :mk] = np.einsum("iab,ib->ia", frames, fp.reshape(mk, 3))
+        a[k, :ek] = Ek.T @ fp
+        r0[k] = np.linalg.norm(fp - Ek @ a[k, :ek])
+        contact[k, :mk] = True
+    return GFOBatch(
+        rows=np.ascontiguousarray(rows.transpose(1, 2, 3, 0)),
+        h=np.ascontiguousarray(h.transpose(1, 2, 0)),
+        a=np.ascontiguousarray(a.T),
+        r0=r0,
+        f_min=np.array(fmins, dtype=float),
+        contact=np.ascontiguousarray(contact.T),
+    )
+
+
+def _contact_frames(normals: NDArray, mu: float | NDArray) -> NDArray:
+    """(m, 3, 3) rows [n; t1/mu; t2/mu]: the Coulomb cone is rows @ f_i in SOC(3)."""
+    t1, t2 = tangent_pairs(normals)
+    mu = np.asarray(mu, dtype=float)[..., None]
+    return np.stack([normals, t1 / mu, t2 / mu], axis=1)
+
+
+# --------------------------------------------------------------------------- cone algebra
+# A second-order cone vector is stored with its components on axis 0: v[0] >= ||v[1:]||.
+
+
+def _soc_det(v: NDArray) -> NDArray:
+    """v^T J v = v0^2 - ||v1||^2, computed as a product to keep relative accuracy near the boundary."""
+    r = np.sqrt(np.sum(v[1:] * v[1:], axis=0))
+    return (v[0] - r) * (v[0] + r)
+
+
+def _soc_nt(s: NDArray, z: NDArray):
+    """Nesterov-Todd scaling point of SOC pairs (s, z) in the interior.
+
+    Returns (w, beta) with W = beta [[w0, w1^T], [w1, I + w1 w1^T / (1 + w0)]], w^T J w = 1,
+    so that W z = W^-1 s = lambda and (W^T W)^-1 = beta^-2 (2 (Jw)(Jw)^T - J).
+    """
+    sd = np.sqrt(_soc_det(s))
+    zd = np.sqrt(_soc_det(z))
+    sb = s / sd
+    zb = z / zd
+    gamma = np.sqrt(0.5 * (1.0 + np.sum(sb * zb, axis=0)))
+    w = sb.copy()
+    w[0] += zb[0]
+    w[1:] -= zb[1:]
+    w /= 2.0 * gamma
+    beta = np.sqrt(sd / zd)
+    return w, beta
+
+
+def _soc_apply(w: NDArray, beta: NDArray, v: NDArray, inverse: bool = False) -> NDArray:
+    """W v (or W^-1 v) for the NT scaling (w, beta) of `_soc_nt`."""
+    sign = -1.0 if inverse else 1.0
+    w1v1 = np.sum(w[1:] * v[1:], axis=0)
+    out = np.empty_like(v)
+    out[0] = w[0] * v[0] + sign * w1v1
+    out[1:] = v[1:] + w[1:] * (sign * v[0] + w1v1 / (1.0 + w[0]))
+    return out * (1.0 / beta if inverse else beta)
+
+
+def _soc_prod(u: NDArray, v: NDArray) -> NDArray:
+    """Jordan product u o v = (u^T v, u0 v1 + v0 u1)."""
+    out = np.empty_like(u)
+    out[0] = np.sum(u * v, axis=0)
+    out[1:] = u[0] * v[1:] + v[0] * u[1:]
+    return out
+
+
+def _soc_div(lam: NDArray, w: NDArray) -> NDArray:
+    """x with lam o x = w (lam in the interior)."""
+    rho = _soc_det(lam)
+    nu = np.sum(lam[1:] * w[1:], axis=0)
+    out = np.empty_like(w)
+    out[0] = (lam[0] * w[0] - nu) / rho
+    out[1:] = ((nu / lam[0] - w[0]) / rho) * lam[1:] + w[1:] / lam[0]
+    return out
+
+
+def _soc_max_step(v: NDArray, d: NDArray) -> NDArray:
+    """Largest alpha >= 0 with v + alpha d in the cone (inf if unbounded); v interior."""
+    a = d[0] * d[0] - np.sum(d[1:] * d[1:], axis=0)
+    b = v[0] * d[0] - np.sum(v[1:] * d[1:], axis=0)
+    c = _soc_det(v)
+    disc = b * b - a * c
+    with np.errstate(invalid="ignore", divide="ignore"):
+        denom = -b + np.sqrt(np.maximum(disc, 0.0))
+        step = np.where((disc >= 0) & (denom > 0), c / denom, np.inf)
+    return step
+
+
+def _lin_max_step(v: NDArray, d: NDArray) -> NDArray:
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(d < 0, -v / d, np.inf)
+
+
+def _soc_hessian(w: NDArray, beta: NDArray) -> NDArray:
+    """(W^T W)^-1 = beta^-2 (2 u u^T - J), u = J w, as a (d, d, ...) array."""
+    u = w.copy()
+    u[1:] = -u[1:]
+    H = 2.0 * u[:, None] * u[None, :]
+    d = w.shape[0]
+    H[0, 0] -= 1.0
+    idx = np.arange(1, d)
+    H[idx, idx] += 1.0
+    return H / (beta * beta)
+
+
+# --------------------------------------------------------------------------- linear algebra
+
+
+def _cholesky(M: NDArray) -> NDArray:
+    """Lower Cholesky factor of the SPD matrices M (n, n, B), column by column, batch last."""
+    n = M.shape[0]
+    L = np.zeros_like(M)
+    for j in range(n):
+        col = M[j:, j] - np.sum(L[j:, :j] * L[j, :j][None], axis=1) if j else M[j:, j].copy()
+        d = np.sqrt(np.maximum(col[0], 1e-300))
+        L[j, j] = d
+        L[j + 1:, j] = col[1:] / d
+    return L
+
+
+def _cho_solve(L: NDArray, b: NDArray) -> NDArray:
+    """Solve L L^T x = b for L (n, n, B), b (n, B)."""
+    n = L.shape[0]
+    u = np.empty_like(b)
+    for i in range(n):
+        acc = b[i] - np.sum(L[i, :i] * u[:i], axis=0) if i else b[i]
+        u[i] = acc / L[i, i]
+    x = np.empty_like(b)
+    for i in range(n - 1, -1, -1):
+        acc = u[i] - np.sum(L[i + 1:, i] * x[i + 1:], axis=0) if i < n - 1 else u[i]
+        x[i] = acc / L[i, i]
+    return x
+
+
+# --------------------------------------------------------------------------- the solver
+
+
+class _Cones:
+    """Cone variables of a batch: per contact a linear slack (n.f - f_min) and a SOC(3)
+    (the Coulomb cone), plus one SOC(e+1) for the objective epigraph (t, y + a)."""
+
+    __slots__ = ("lin", "soc", "obj")
+
+    def __init__(self, lin, soc, obj):
+        self.lin, self.soc, self.obj = lin, soc, obj
+
+    def copy(self):
+        return _Cones(self.lin.copy(), self.soc.copy(), self.obj.copy())
+
+
+def solve_batch(batch: GFOBatch, settings: SolverSettings = SolverSettings()) -> BatchResult:
+    """Solve the padded batch with the homogeneous self-dual interior-point method.
+
+    The data are scaled per problem by rho = max(||f_p||, f_min) (reported y, t in N).
+    Verdicts: optimal when the scaled primal and dual residuals and the duality gap are below
+    `tol`; infeasible when the dual iterate is a Farkas certificate (h^T z < 0 and
+    ||G^T z|| <= tol |h^T z|); otherwise 'not decided' after `max_iter` iterations.
+    """
+    D, mask = batch.rows, batch.contact
+    m, _, e, B = D.shape
+    cm = mask.astype(float)
+    # Scale so that the forces are O(1): the iteration then starts well centred.
+    fp_norm = np.sqrt(batch.r0 * batch.r0 + np.sum(batch.a * batch.a, axis=0))
+    rho = np.maximum(fp_norm, np.maximum(batch.f_min, 1e-12))
+    h_soc = batch.h / rho
+    h_soc = np.where(mask[:, None, :], h_soc, 0.0)
+    h_lin = np.where(mask, (batch.h[:, 0] - batch.f_min) / rho, 0.0)
+    a = batch.a / rho
+    h_obj = np.concatenate([np.zeros((1, B)), (batch.r0 / rho)[None], a], axis=0)
+    h_norm = np.maximum(1.0, np.sqrt(np.sum(h_lin * h_lin, axis=0) + np.sum(np.sum(h_soc * h_soc, axis=1), axis=0)
+                                     + np.sum(a * a, axis=0)))
+    n_deg = 2.0 * np.sum(cm, axis=0) + 1.0  # barrier degree: m linear + m SOC(3) + 1 objective cone
+
+    # G x for x = (t, y): linear rows -D0 y, SOC rows -D y, objective rows -(t, 0, y):
+    # the objective cone is (t, r0, y + a), so t is ||f|| / rho itself.
+    def G_mul(x):
+        Dy = np.einsum("mrjb,jb->mrb", D, x[1:])
+        obj = np.zeros((x.shape[0] + 1, x.shape[1]))
+        obj[0] = -x[0]
+        obj[2:] = -x[1:]
+        return _Cones(-Dy[:, 0], -Dy, obj)
+
+    def GT_mul(zc: _Cones):
+        zz = zc.soc.copy()
+        zz[:, 0] += zc.lin
+        zz *= cm[:, None]
+        out = -np.delete(zc.obj, 1, axis=0)
+        out[1:] -= np.einsum("mrjb,mrb->jb", D, zz)
+        return out
+
+    # Initial point of the embedding: x = 0, s = z = identity of the cone, tau = kappa = 1.
+    x = np.zeros((e + 1, B))
+    ident = _Cones(np.ones((m, B)), np.zeros((m, 3, B)), np.zeros((e + 2, B)))
+    ident.soc[:, 0] = 1.0
+    ident.obj[0] = 1.0
+    s, z = ident.copy(), ident.copy()
+    tau = np.ones(B)
+    kappa = np.ones(B)
+    code = np.zeros(B, dtype=np.int8)
+    iters = np.zeros(B, dtype=np.int32)
+    y_out = np.full((e, B), np.nan)
+    t_out = np.full(B, np.nan)
+    active = np.arange(B)
+    tol = settings.tol
+    stalled = np.zeros(B, dtype=bool)
+
+    def take(c: _Cones, idx):
+        return _Cones(c.lin[:, idx], c.soc[:, :, idx], c.obj[:, idx])
+
+    for it in range(settings.max_iter + 1):
+        Gx = G_mul(x)
+        GTz = GT_mul(z)
+        r_x = GTz.copy()
+        r_x[0] += tau
+        r_z = _Cones(Gx.lin + s.lin - h_lin * tau, Gx.soc + s.soc - h_soc * tau[None, None], Gx.obj + s.obj - h_obj * tau)
+        r_z.lin *= cm
+        r_z.soc *= cm[:, None]
+        hz = np.sum(h_lin * z.lin * cm, axis=0) + np.sum(np.sum(h_soc * z.soc, axis=1) * cm, axis=0) \
+            + np.sum(h_obj * z.obj, axis=0)
+        r_tau = kappa + x[0] + hz
+        sz = np.sum((s.lin * z.lin + np.sum(s.soc * z.soc, axis=1)) * cm, axis=0) + np.sum(s.obj * z.obj, axis=0)
+        mu = (sz + tau * kappa) / (n_deg + 1.0)
+
+        # Stopping tests on the de-homogenised point.
+        pres = np.sqrt(np.sum(r_z.lin ** 2, axis=0) + np.sum(np.sum(r_z.soc ** 2, axis=1), axis=0)
+                       + np.sum(r_z.obj ** 2, axis=0)) / tau / h_norm
+        dres = np.sqrt(np.sum(r_x ** 2, axis=0)) / tau
+        pcost = x[0] / tau
+        gap = sz / (tau * tau)
+        gtz_norm = np.sqrt(np.sum(GTz ** 2, axis=0))
+
+        def verdicts(eps):
+            opt = (pres <= eps) & (dres <= eps) & ((gap <= eps) | (gap <= eps * np.abs(pcost)))
+            return opt, ~opt & (hz < 0) & (gtz_norm <= eps * -hz)
+
+        optimal, infeasible = verdicts(tol)
+        near_opt, near_inf = verdicts(settings.reduced_tol)
+        last = (it == settings.max_iter) | stalled
+        optimal |= last & near_opt
+        infeasible |= last & ~optimal & near_inf
+        bad = ~(np.isfinite(mu) & np.isfinite(tau) & (tau > 0))
+        done = optimal | infeasible | bad | last
+        if np.any(done):
+            ids = active[done]
+            code[ids] = np.where(optimal[done], _OPTIMAL, np.where(infeasible[done], _INFEASIBLE, _UNSOLVED))
+            iters[ids] = it
+            opt = done & optimal
+            y_out[:, active[opt]] = x[1:, opt] / tau[opt] * rho[opt]
+            t_out[active[opt]] = x[0, opt] / tau[opt] * rho[opt]
+            keep = ~done
+            if not np.any(keep):
+                break
+            active = active[keep]
+            D, cm, mask = D[..., keep], cm[:, keep], mask[:, keep]
+            h_lin, h_soc, h_obj, h_norm = h_lin[:, keep], h_soc[..., keep], h_obj[:, keep], h_norm[keep]
+            n_deg, rho, stalled = n_deg[keep], rho[keep], stalled[keep]
+            x, tau, kappa, mu = x[:, keep], tau[keep], kappa[keep], mu[keep]
+            s, z = take(s, keep), take(z, keep)
+            r_x, r_tau = r_x[:, keep], r_tau[keep]
+            r_z = take(r_z, keep)
+
+        # Nesterov-Todd scaling and the normal matrix M = G^T (W^T W)^-1 G, (e+1, e+1).
+        w_lin = np.where(cm > 0, z.lin / s.lin, 0.0)  # (W^T W)^-1 of the linear cone
+        s_over_z = np.where(cm > 0, s.lin / z.lin, 0.0)
+        lam_lin = np.sqrt(s.lin * z.lin)
+        w_soc, b_soc = _soc_nt(s.soc.transpose(1, 0, 2), z.soc.transpose(1, 0, 2))
+        w_obj, b_obj = _soc_nt(s.obj, z.obj)
+        lam_soc = _soc_apply(w_soc, b_soc, z.soc.transpose(1, 0, 2))
+        lam_obj = _soc_apply(w_obj, b_obj, z.obj)
+        H_soc = _soc_hessian(w_soc, b_soc) * cm  # (3, 3, m, B)
+        H_con = H_soc.copy()  # a contact's linear row is the first row of its cone rows
+        H_con[0, 0] += w_lin
+        H_obj = _soc_hessian(w_obj, b_obj)
+        T = np.einsum("rkmb,mkjb->mrjb", H_con, D)
+        M = np.delete(np.delete(H_obj, 1, axis=0), 1, axis=1)
+        M[1:, 1:] += np.einsum("mrib,mrjb->ijb", D, T)
+        L = _cholesky(M)
+
+        def H_mul(v: _Cones) -> _Cones:
+            return _Cones(w_lin * v.lin, np.einsum("rkmb,mkb->mrb", H_soc, v.soc), np.einsum("rkb,kb->rb", H_obj, v.obj))
+
+        def V_mul(v: _Cones) -> _Cones:
+            """W^T W v through the factors (more accurate than inverting H)."""
+            vs = v.soc.transpose(1, 0, 2)
+            return _Cones(s_over_z * v.lin,
+                          _soc_apply(w_soc, b_soc, _soc_apply(w_soc, b_soc, vs)).transpose(1, 0, 2) * cm[:, None],
+                          _soc_apply(w_obj, b_obj, _soc_apply(w_obj, b_obj, v.obj)))
+
+        def reduced(bx, bz: _Cones):
+            dx = _cho_solve(L, bx + GT_mul(H_mul(bz)))
+            Gd = G_mul(dx)
+            return dx, H_mul(_Cones(Gd.lin - bz.lin, Gd.soc - bz.soc, Gd.obj - bz.obj))
+
+        def solve_kkt(bx, bz: _Cones):
+            """[0 G^T; G -W^T W] [dx; dz] = [bx; bz], with iterative refinement on the full system."""
+            dx, dz = reduced(bx, bz)
+            for _ in range(settings.refine):
+                Gd, Vz = G_mul(dx), V_mul(dz)
+                rx = bx - GT_mul(dz)
+                rz = _Cones(bz.lin - Gd.lin + Vz.lin, bz.soc - Gd.soc + Vz.soc, bz.obj - Gd.obj + Vz.obj)
+                rz.lin *= cm
+                rz.soc *= cm[:, None]
+                ex, ez = reduced(rx, rz)
+                dx = dx + ex
+                dz = _Cones(dz.lin + ez.lin, dz.soc + ez.soc, dz.obj + ez.obj)
+            return dx, dz
+
+        c_vec = np.zeros_like(x)
+        c_vec[0] = 1.0
+        x1, z1 = solve_kkt(-c_vec, _Cones(h_lin, h_soc, h_obj))
+        cx1_hz1 = x1[0] + np.sum(h_lin * z1.lin * cm, axis=0) + np.sum(np.sum(h_soc * z1.soc, axis=1) * cm, axis=0) \
+            + np.sum(h_obj * z1.obj, axis=0)
+
+        def direction(sigma, ds_lin, ds_soc, ds_obj, d_kappa):
+            """Newton direction for the complementarity right-hand sides (lambda \\ d_s form)."""
+            # W^T (lambda \ d_s) per cone
+            q_lin = np.sqrt(s.lin / np.where(cm > 0, z.lin, 1.0)) * (ds_lin / lam_lin)
+            q_soc = _soc_apply(w_soc, b_soc, _soc_div(lam_soc, ds_soc))
+            q_obj = _soc_apply(w_obj, b_obj, _soc_div(lam_obj, ds_obj))
+            f = 1.0 - sigma
+            bx = -f * r_x
+            bz = _Cones(-f * r_z.lin + q_lin, -f * r_z.soc + q_soc.transpose(1, 0, 2), -f * r_z.obj + q_obj)
+            x2, z2 = solve_kkt(bx, bz)
+            cx2_hz2 = x2[0] + np.sum(h_lin * z2.lin * cm, axis=0) + np.sum(np.sum(h_soc * z2.soc, axis=1) * cm, axis=0) \
+                + np.sum(h_obj * z2.obj, axis=0)
+            dtau = (d_kappa / tau - f * r_tau - cx2_hz2) / (cx1_hz1 - kappa / tau)
+            dx = x2 + dtau * x1
+            dz = _Cones(z2.lin + dtau * z1.lin, z2.soc + dtau[None, None] * z1.soc, z2.obj + dtau * z1.obj)
+            dkappa = -(d_kappa + kappa * dtau) / tau
+            # ds from the primal row G dx + ds - h dtau = -(1 - sigma) r_z: it keeps the primal
+            # residual exact where W^T W is badly conditioned near the optimum.
+            Gdx = G_mul(dx)
+            ds_l = -f * r_z.lin - Gdx.lin + h_lin * dtau
+            ds_s = (-f * r_z.soc - Gdx.soc + h_soc * dtau[None, None]).transpose(1, 0, 2)
+            ds_o = -f * r_z.obj - Gdx.obj + h_obj * dtau
+            dz.lin *= cm
+            dz.soc *= cm[:, None]
+            ds_l *= cm
+            ds_s *= cm
+            ds = _Cones(ds_l, ds_s.transpose(1, 0, 2), ds_o)
+            return dx, dz, ds, dtau, dkappa
+
+        def max_step(dz, ds, dtau, dkappa):
+            inf = np.inf
+            st = np.minimum(_lin_max_step(s.lin, ds.lin), _lin_max_step(z.lin, dz.lin))
+            st = np.minimum(st, np.minimum(_soc_max_step(s.soc.transpose(1, 0, 2), ds.soc.transpose(1, 0, 2)),
+                                           _soc_max_step(z.soc.transpose(1, 0, 2), dz.soc.transpose(1, 0, 2))))
+            st = np.where(cm > 0, st, inf).min(axis=0)
+            st = np.minimum(st, np.minimum(_soc_max_step(s.obj, ds.obj), _soc_max_step(z.obj, dz.obj)))
+            st = np.minimum(st, np.minimum(_lin_max_step(tau, dtau), _lin_max_step(kappa, dkappa)))
+            return st
+
+        # Predictor (affine scaling): d_s = lambda o lambda, d_kappa = tau kappa.
+        lam_soc_sq = _soc_prod(lam_soc, lam_soc)
+        lam_obj_sq = _soc_prod(lam_obj, lam_obj)
+        dx_a, dz_a, ds_a, dtau_a, dkappa_a = direction(0.0, lam_lin * lam_lin, lam_soc_sq, lam_obj_sq, tau * kappa)
+        alpha_a = np.minimum(1.0, max_step(dz_a, ds_a, dtau_a, dkappa_a))
+        sigma = np.clip((1.0 - alpha_a) ** 3, 0.0, 1.0)
+        sm = sigma * mu
+
+        # Corrector: Mehrotra's second-order term (W^-T ds_a) o (W dz_a) and centring sigma mu.
+        Wi_ds_l = np.sqrt(np.where(cm > 0, z.lin / np.where(cm > 0, s.lin, 1.0), 0.0)) * ds_a.lin
+        W_dz_l = np.sqrt(np.where(cm > 0, s.lin / np.where(cm > 0, z.lin, 1.0), 0.0)) * dz_a.lin
+        d_lin = lam_lin * lam_lin + Wi_ds_l * W_dz_l - sm
+        corr_soc = _soc_prod(_soc_apply(w_soc, b_soc, ds_a.soc.transpose(1, 0, 2), inverse=True),
+                             _soc_apply(w_soc, b_soc, dz_a.soc.transpose(1, 0, 2)))
+        d_soc = lam_soc_sq + corr_soc
+        d_soc[0] -= sm
+        corr_obj = _soc_prod(_soc_apply(w_obj, b_obj, ds_a.obj, inverse=True), _soc_apply(w_obj, b_obj, dz_a.obj))
+        d_obj = lam_obj_sq + corr_obj
+        d_obj[0] -= sm
+        d_kap = tau * kappa + dtau_a * dkappa_a - sm
+        dx, dz, ds, dtau, dkappa = direction(sigma, d_lin, d_soc, d_obj, d_kap)
+        alpha = np.minimum(1.0, settings.step_fraction * max_step(dz, ds, dtau, dkappa))
+
+        # A vanishing step near the optimum means the normal equations have run out of
+        # accuracy: keep the current point and judge it with the reduced tolerance.
+        stalled = alpha < settings.stall_step
+        alpha = np.where(stalled, 0.0, alpha)
+        x = x + alpha * dx
+        s = _Cones(s.lin + alpha * ds.lin, s.soc + alpha * ds.soc, s.obj + alpha * ds.obj)
+        z = _Cones(z.lin + alpha * dz.lin, z.soc + alpha * dz.soc, z.obj + alpha * dz.obj)
+        tau = tau + alpha * dtau
+        kappa = kappa + alpha * dkappa
+
+    return BatchResult(code=code, y=y_out, t=t_out, iterations=iters)
+
+
