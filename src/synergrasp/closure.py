@@ -235,7 +235,7 @@ class ClosureParams:
     tolerance_mm: float = 0.2
     contact_distance_mm: float = 0.5
     penetration_tolerance_mm: float = 0.5
-    step_mm: float = 4.0
+    step_mm: float = 8.0
 
     def __post_init__(self) -> None:
         for name in ("sigma_open", "sigma_closed", "tolerance_mm", "contact_distance_mm",
@@ -467,6 +467,9 @@ class _Closer:
             if fi == fj:
                 continue
             if fi in _LONG_FINGERS and fj in _LONG_FINGERS:
+                continue
+            # the knuckles barely move: only the outer links can run into the palm or the thumb
+            if any(hand.link_names[k].endswith("_knuckle") for k in (i, j)):
                 continue
             pairs.append((i, j))
         self.bullet.set_posture(self.client, self.body, self.q_open)
