@@ -27,8 +27,8 @@ class HandBody:
     ``joint_indices[j]`` is the pybullet joint of elementary axis j, turning by
     ``joint_scale[j] * q[joint_q[j]]``; ``link_index[i]`` is the pybullet link of hand link i
     (-1 = the base, i.e. the palm); ``hand_link`` maps a pybullet link index back to a hand
-    link index (base -1 -> 0 = palm; links of half-axis frames map to the link they carry
-    no shape for, -1).
+    link index (base -1 -> 0 = palm). The shape-less links between the two half axes of a
+    rolling joint have no hand link and never appear in collision results.
     """
 
     body: int
