@@ -9,6 +9,7 @@ from synergrasp.summaries import (
     mean_over_objects,
     minimum_preservation,
     success_rates,
+    study_tables,
     verdict_disagreements,
 )
 
@@ -136,3 +137,16 @@ def test_verdict_disagreements():
     assert (row["set_id"], row["n_poses"], row["n_disagree"], row["n_fc_not_strict"], row["n_strict_not_fc"]) == \
         ("1", 4, 2, 1, 1)
     assert row["disagree_percent"] == pytest.approx(50.0)
+
+
+def test_study_tables_names_and_csv_round_trip(gfo, tmp_path):
+    minima = pd.DataFrame([dict(object="a", set_id="1", alpha_deg=0.0, beta_deg=0.0)])
+    tables = study_tables(gfo, minima, {"incremental_max": 3, "hierarchy_first": 2, "hierarchy_max_size": 2}, 3)
+    assert set(tables) == {"success_rates", "table2_success_rates", "hierarchy", "minimum_preservation",
+                           "full_not_first7", "verdict_disagreements"}
+    assert tables["full_not_first7"][1]["pose"].tolist() == [2, 3]
+    # the figure step reads the rates back from CSV
+    path = tmp_path / "rates.csv"
+    tables["success_rates"][1].to_csv(path, index=False)
+    h = hierarchy_matrices(mean_over_objects(pd.read_csv(path)), 2).set_index(["k", "i", "j"])
+    assert h.loc[(1, 1, 2), "success_rate"] == pytest.approx(50.0)

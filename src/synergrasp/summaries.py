@@ -22,6 +22,7 @@ __all__ = [
     "full_but_not_first7",
     "verdict_disagreements",
     "set_sort_key",
+    "study_tables",
 ]
 
 ALL_OBJECTS = "all"
@@ -74,6 +75,7 @@ def mean_over_objects(rates: pd.DataFrame) -> pd.DataFrame:
     """Per set: success_rate, absolute_share, mean_force averaged over the objects where each
     is defined (NaN entries skipped), and n_objects (objects in the average of success_rate)."""
     _require(rates, "rates table", ("set_id", "n_synergies", "success_rate", "absolute_share", "mean_force"))
+    rates = rates.assign(set_id=rates["set_id"].astype(str))  # a CSV round trip may read "1" as 1
     grouped = rates.groupby("set_id", sort=False)
     out = grouped.agg(n_synergies=("n_synergies", "first"), success_rate=("success_rate", "mean"),
                       absolute_share=("absolute_share", "mean"), mean_force=("mean_force", "mean"),
@@ -210,3 +212,33 @@ def verdict_disagreements(gfo: pd.DataFrame) -> pd.DataFrame:
     cols = ["object", "set_id", "n_synergies", "n_poses", "n_disagree", "n_fc_not_strict", "n_strict_not_fc",
             "disagree_percent"]
     return out[cols].astype({c: "int64" for c in cols[3:7]})
+
+
+def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: dict, table2_k_max: int,
+                 radius_deg: float = 10.0) -> dict[str, tuple[str, pd.DataFrame]]:
+    """Every study table by name: (title, table).
+
+    ``sets_config`` is the configuration's ``synergy_sets`` (incremental_max,
+    hierarchy_first, ...): the full set is {S1..S_incremental_max}, the hierarchy uses the
+    first ``hierarchy_first`` synergies.
+    """
+    k_max = int(sets_config["incremental_max"])
+    first = int(sets_config["hierarchy_first"])
+    full = incremental_set_id(k_max)
+    first_n = incremental_set_id(first)
+    rates = success_rates(gfo, full)
+    if first_n in set(gfo["set_id"]):
+        lost = full_but_not_first7(gfo, full, first_n)
+    else:
+        lost = pd.DataFrame(columns=["object", "pose", "alpha_deg", "beta_deg", "full_force_norm", "first7_status"])
+    return {
+        "success_rates": ("Success rate and optimal force per object and synergy set", rates),
+        "table2_success_rates": (f"Table II: success rate (%) with {{S1..Sk}}, k = 1..{table2_k_max}",
+                                 incrementality_table(rates, table2_k_max)),
+        "hierarchy": (f"Hierarchy: sets {{S_k, S_i, S_j}} of the first {first} synergies, mean over objects",
+                      hierarchy_matrices(mean_over_objects(rates), first)),
+        "minimum_preservation": ("Local minima of {S1..Sk} preserved in {S1..Sk+1}",
+                                 minimum_preservation(gfo, minima, k_max, radius_deg)),
+        "full_not_first7": (f"Poses where {{S1..S{k_max}}} is force closure and {{S1..S{first}}} is not", lost),
+        "verdict_disagreements": ("Optimisation verdict vs strict internal-force test", verdict_disagreements(gfo)),
+    }
