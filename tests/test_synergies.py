@@ -165,3 +165,14 @@ def test_missing_file_is_file_not_found(tmp_path):
 
 def test_shipped_path_exists():
     assert shipped_path().is_file()
+
+
+def test_mapping_limits_agree_with_hand_model():
+    from synergrasp.hand import load_hand
+
+    hand = load_hand(None)
+    joints = load_synergy_mapping()["joints"]
+    np.testing.assert_allclose(np.radians([joints[j]["limits_deg"][0] for j in hand.joint_names]), hand.lower)
+    np.testing.assert_allclose(np.radians([joints[j]["limits_deg"][1] for j in hand.joint_names]), hand.upper)
+    s = load_synergies(joint_names=hand.joint_names)
+    assert np.all((s.mean >= hand.lower) & (s.mean <= hand.upper))
