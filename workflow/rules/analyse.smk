@@ -19,7 +19,7 @@ rule study_tables:
     input:
         gfo=expand("results/objects/{object}/gfo.parquet", object=OBJECTS),
         minima=expand("results/objects/{object}/minima.parquet", object=OBJECTS),
-        code=code("summaries", "config"),
+        code=code("summaries", "minima", "config", "figures"),
     output:
         **{
             f"{t}_{ext}": report(
@@ -33,6 +33,7 @@ rule study_tables:
     params:
         sets=config["synergy_sets"],
         table2_k_max=config["analyses"]["table2_k_max"],
+        radius_deg=config["analyses"]["minima_radius_deg"],
     log:
         "results/logs/study_tables.log",
     script:

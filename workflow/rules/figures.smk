@@ -32,8 +32,8 @@ rule fig4_force_maps:
 
 rule fig5_hierarchy:
     input:
-        hierarchy="results/tables/hierarchy.csv",
-        code=code("figures"),
+        rates="results/tables/success_rates.csv",
+        code=code("figures", "summaries"),
     output:
         success_png=report(
             "results/figures/fig5a_hierarchy_success.png",

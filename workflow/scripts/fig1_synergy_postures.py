@@ -1,0 +1,12 @@
+"""Fig. 1: the hand along each of the first seven synergies, sigma = -1, 0, +1."""
+from contextlib import redirect_stderr
+
+from synergrasp.hand import load_hand
+from synergrasp.render import figure_synergy_postures
+from synergrasp.synergies import load_synergies
+
+with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+    hand = load_hand(snakemake.params.hand)
+    synergies = load_synergies(snakemake.params.synergies, joint_names=hand.joint_names)
+    figure_synergy_postures(hand, synergies, snakemake.output.png, snakemake.output.pdf,
+                            n_synergies=min(7, synergies.matrix.shape[1]))

@@ -1,0 +1,14 @@
+"""Fig. 2: example simulated grasps of every object (hand and box drawn together)."""
+from contextlib import redirect_stderr
+
+import pandas as pd
+
+from synergrasp.hand import load_hand
+from synergrasp.objects import boxes_from_config
+from synergrasp.render import figure_example_grasps
+
+with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+    boxes = boxes_from_config([{k: v for k, v in o.items() if k != "placement"} for o in snakemake.params.objects])
+    tables = [pd.read_parquet(path) for path in snakemake.input.contacts]
+    figure_example_grasps(load_hand(snakemake.params.hand), boxes, tables, snakemake.params.poses,
+                          snakemake.output.png, snakemake.output.pdf)

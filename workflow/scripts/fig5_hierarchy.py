@@ -1,0 +1,15 @@
+"""Fig. 5A/5B: success rate and mean force of every set {S_k, S_i, S_j}, averaged over objects."""
+from contextlib import redirect_stderr
+
+import pandas as pd
+
+from synergrasp.figures import figure_hierarchy
+from synergrasp.summaries import hierarchy_matrices, mean_over_objects
+
+with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+    first, out = snakemake.params.first, snakemake.output
+    matrices = hierarchy_matrices(mean_over_objects(pd.read_csv(snakemake.input.rates)), first)
+    figure_hierarchy(matrices, "success_rate", first, "Fig. 5A: success rate (%), mean over objects",
+                     ".0f", out.success_png, out.success_pdf)
+    figure_hierarchy(matrices, "mean_force", first, "Fig. 5B: mean optimal force (N), mean over objects",
+                     ".1f", out.force_png, out.force_pdf)
