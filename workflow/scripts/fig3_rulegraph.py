@@ -6,13 +6,16 @@ from contextlib import redirect_stderr
 from synergrasp.figures import figure_rulegraph
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
-    command = [sys.executable, "-m", "snakemake", "-s", snakemake.params.snakefile, "--nolock",
-               "--rulegraph", "figures", "--quiet", "all"]
+    command = [sys.executable, "-m", "snakemake", "figures", "-s", snakemake.params.snakefile,
+               "--nolock", "--quiet", "all", "--rulegraph", "dot"]
     for path in snakemake.params.configfiles:
-        command += ["--configfile", path]
+        command += ["--configfile", str(path)]
     if snakemake.params.configfiles:
         command.append("--replace-workflow-config")
-    dot = subprocess.run(command, check=True, capture_output=True, text=True).stdout
+    run = subprocess.run(command, capture_output=True, text=True)
+    log.write(run.stderr)
+    run.check_returncode()
+    dot = run.stdout
     with open(snakemake.output.dot, "w") as handle:
         handle.write(dot)
     figure_rulegraph(dot, snakemake.output.png, snakemake.output.pdf)
