@@ -547,3 +547,364 @@ def solve_batch(batch: GFOBatch, settings: SolverSettings = SolverSettings()) ->
     return BatchResult(code=code, y=y_out, t=t_out, iterations=iters)
 
 
+# --------------------------------------------------------------------------- many problems
+
+
+@dataclass(frozen=True)
+class _Block:
+    """Problems sharing a contact count m and padded basis size e (one pose, one set size)."""
+
+    rows: NDArray     # (n, m, 3, e)
+    h: NDArray        # (n, m, 3)
+    a: NDArray        # (n, e)
+    r0: NDArray       # (n,)
+    f_min: NDArray    # (n,)
+    index: NDArray    # (n,) position of each problem in the caller's order
+
+    @property
+    def m(self) -> int:
+        return int(self.rows.shape[1])
+
+    @property
+    def e(self) -> int:
+        return int(self.rows.shape[3])
+
+
+@dataclass(frozen=True)
+class BatchSolution:
+    """Verdicts of many GFO problems, in the caller's order (columnar).
+
+    status: 'force_closure' | 'infeasible' | 'numerical_failure'
+    force_norm: optimal ||f||_2, N (NaN unless force closure)
+    iterations: interior-point iterations (of the fallback solver where it was used)
+    solver: 'batched' | 'clarabel_fallback'
+    max_violation: worst constraint violation of the optimal forces, N (NaN unless force closure)
+    """
+
+    status: NDArray
+    force_norm: NDArray
+    iterations: NDArray
+    solver: NDArray
+    max_violation: NDArray
+
+
+def _pieces(blocks: list[_Block], batch_size: int) -> list[list[_Block]]:
+    """Consecutive runs of blocks (sorted by e, then m) of about `batch_size` problems each.
+
+    Splitting never changes a problem's numbers (padding is exact), only the speed: runs
+    stay within one e so that padding costs little.
+    """
+    order = sorted(range(len(blocks)), key=lambda k: (blocks[k].e, blocks[k].m))
+    runs: list[list[_Block]] = []
+    current: list[_Block] = []
+    size = 0
+    for k in order:
+        b = blocks[k]
+        if current and (size + b.a.shape[0] > batch_size or b.e != current[-1].e):
+            runs.append(current)
+            current, size = [], 0
+        current.append(b)
+        size += b.a.shape[0]
+    if current:
+        runs.append(current)
+    return runs
+
+
+def _stack(run: list[_Block]) -> tuple[GFOBatch, NDArray]:
+    B = sum(b.a.shape[0] for b in run)
+    m = max(b.m for b in run)
+    e = max(b.e for b in run)
+    rows = np.zeros((m, 3, e, B))
+    h = np.zeros((m, 3, B))
+    a = np.zeros((e, B))
+    contact = np.zeros((m, B), dtype=bool)
+    r0 = np.concatenate([b.r0 for b in run])
+    f_min = np.concatenate([b.f_min for b in run])
+    index = np.concatenate([b.index for b in run])
+    k = 0
+    for b in run:
+        n = b.a.shape[0]
+        rows[:b.m, :, :b.e, k:k + n] = b.rows.transpose(1, 2, 3, 0)
+        h[:b.m, :, k:k + n] = b.h.transpose(1, 2, 0)
+        a[:b.e, k:k + n] = b.a.T
+        contact[:b.m, k:k + n] = True
+        k += n
+    return GFOBatch(rows=rows, h=h, a=a, r0=r0, f_min=f_min, contact=contact), index
+
+
+def _forces_check(batch: GFOBatch, y: NDArray, mu: NDArray) -> tuple[NDArray, NDArray]:
+    """||f|| (N) and the worst constraint violation (N) of f = f_p + E y, from the batch rows."""
+    frame = batch.h + np.einsum("mrjb,jb->mrb", batch.rows, np.nan_to_num(y))  # [n.f, t1.f/mu, t2.f/mu]
+    fn = frame[:, 0]
+    ft = mu * np.sqrt(frame[:, 1] ** 2 + frame[:, 2] ** 2)
+    norm = np.sqrt(np.sum(np.where(batch.contact, fn * fn + ft * ft, 0.0), axis=0))
+    viol = np.where(batch.contact, np.maximum(batch.f_min - fn, ft - mu * fn), -np.inf).max(axis=0)
+    return norm, viol
+
+
+def _solve_blocks(
+    blocks: list[_Block],
+    mu: NDArray,
+    total: int,
+    fallback: list[tuple[NDArray, NDArray, NDArray, float, float]] | None,
+    fallback_problem,
+    settings: SolverSettings,
+    batch_size: int,
+    params_tol: float,
+    params_max_iter: int,
+) -> BatchSolution:
+    """Solve every problem of `blocks` in padded batches; undecided ones go to `solve_gfo`."""
+    from synergrasp.force_optimisation import ALMOST_SOLVED_TOL
+
+    status = np.full(total, "numerical_failure", dtype=object)
+    norm = np.full(total, np.nan)
+    iters = np.zeros(total, dtype=np.int32)
+    solver = np.full(total, "batched", dtype=object)
+    viol = np.full(total, np.nan)
+    for run in _pieces(blocks, batch_size):
+        batch, index = _stack(run)
+        res = solve_batch(batch, settings)
+        fn, fv = _forces_check(batch, res.y, mu[index])
+        ok = (res.code == _OPTIMAL) & (fv <= ALMOST_SOLVED_TOL * np.maximum(1.0, fn))
+        status[index[ok]] = "force_closure"
+        norm[index[ok]] = fn[ok]
+        viol[index[ok]] = fv[ok]
+        inf = res.code == _INFEASIBLE
+        status[index[inf]] = "infeasible"
+        iters[index] = res.iterations
+        for k in index[~(ok | inf)]:
+            r = fallback_problem(int(k))
+            status[k], iters[k], solver[k] = r.status, r.iterations, "clarabel_fallback"
+            norm[k] = r.force_norm
+            viol[k] = r.max_violation if r.status == "force_closure" else np.nan
+    return BatchSolution(status=status, force_norm=norm, iterations=iters, solver=solver, max_violation=viol)
+
+
+def _problem_block(f_p, E, normals, mu, f_min, index) -> _Block:
+    n = np.asarray(normals, dtype=float)
+    m = n.shape[0]
+    Em = np.asarray(E, dtype=float).reshape(3 * m, -1)
+    fp = np.asarray(f_p, dtype=float).reshape(3 * m)
+    frames = _contact_frames(n, mu)
+    e = Em.shape[1]
+    a = Em.T @ fp
+    return _Block(
+        rows=np.einsum("iab,ibk->iak", frames, Em.reshape(m, 3, e))[None],
+        h=np.einsum("iab,ib->ia", frames, fp.reshape(m, 3))[None],
+        a=a[None], r0=np.array([np.linalg.norm(fp - Em @ a)]), f_min=np.array([float(f_min)]),
+        index=np.array([index]),
+    )
+
+
+def solve_gfo_batch(
+    f_p: Sequence[NDArray],
+    E: Sequence[NDArray],
+    normals: Sequence[NDArray],
+    mu: float | Sequence[float],
+    f_min: float | Sequence[float],
+    *,
+    settings: SolverSettings = SolverSettings(),
+    batch_size: int = DEFAULT_BATCH_SIZE,
+    tol: float = 1e-8,
+    max_iter: int = 200,
+) -> BatchSolution:
+    """Solve many GFO problems (f_p (3m,) N, E (3m, e) orthonormal, normals (m, 3)) at once.
+
+    Problems the batched method does not decide (iteration cap, stall, or an optimal point
+    violating a constraint by more than 1e-6 max(1 N, ||f||)) are solved by `solve_gfo`
+    (tolerance `tol`, cap `max_iter`) and marked 'clarabel_fallback'. Problems with e = 0
+    are judged directly by `solve_gfo` (f = f_p), as the per-problem path does.
+    """
+    B = len(f_p)
+    if not (len(E) == len(normals) == B):
+        raise ValueError(f"f_p, E and normals must have the same length, got {B}, {len(E)}, {len(normals)}")
+    if not (isinstance(batch_size, int) and batch_size > 0):
+        raise ValueError(f"batch_size must be a positive int, got {batch_size!r}")
+    mus = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (B,)))
+    fmins = np.array(np.broadcast_to(np.asarray(f_min, dtype=float), (B,)))
+    blocks = []
+    direct = []
+    for k in range(B):
+        Ek = np.asarray(E[k], dtype=float)
+        if Ek.ndim == 1:
+            Ek = Ek[:, None]
+        if Ek.shape[1] == 0:
+            direct.append(k)
+            continue
+        blocks.append(_problem_block(f_p[k], Ek, normals[k], mus[k], fmins[k], k))
+
+    def fallback(k: int):
+        return solve_gfo(f_p[k], E[k], normals[k], mus[k], fmins[k], tol=tol, max_iter=max_iter)
+
+    out = _solve_blocks(blocks, mus, B, None, fallback, settings, batch_size, tol, max_iter)
+    for k in direct:
+        r = fallback(k)
+        out.status[k], out.force_norm[k], out.iterations[k] = r.status, r.force_norm, 0
+        out.max_violation[k] = r.max_violation if r.status == "force_closure" else np.nan
+    return out
+
+
+def set_id(subset: Sequence[int]) -> str:
+    """'1-2-3' for the 1-based synergy indices of a set (sorted)."""
+    return "-".join(str(int(k)) for k in sorted(subset))
+
+
+def _check_sets(sets: Sequence[tuple[int, ...]], k: int) -> list[NDArray]:
+    out = []
+    for s in sets:
+        idx = np.asarray(sorted(int(v) for v in s), dtype=int)
+        if idx.size == 0 or idx[0] < 1 or idx[-1] > k or np.unique(idx).size != idx.size:
+            raise ValueError(f"sets: each set must hold distinct 1-based synergy indices in 1..{k}, got {tuple(s)!r}")
+        out.append(idx - 1)
+    return out
+
+
+def optimise_grasps(
+    grasps: Sequence[Grasp | None],
+    synergies: NDArray,
+    sets: Sequence[tuple[int, ...]],
+    params: GFOParams,
+    batch_size: int = DEFAULT_BATCH_SIZE,
+    *,
+    strict: bool = True,
+    settings: SolverSettings = SolverSettings(),
+) -> dict[str, NDArray]:
+    """GFO verdict, optimal force and strict internal-force test for every (grasp, set).
+
+    grasps: poses (None or no contacts: 'no_grasp'); synergies: (n, k) synergy matrix,
+    rad per unit activation; sets: 1-based synergy indices. Mechanics once per pose; E_s by
+    the rule of `internal_force_basis` (singular values above
+    basis_rtol ||projector||_2 ||S_set||_2); both SOCPs (GFO and strict test) solved by the
+    batched method, poses taken in chunks of about `batch_size` problems (bounded memory).
+    strict=False skips the strict test (column all False).
+    Returns columns (one row per (pose, set), pose-major): pose, set_id, n_synergies,
+    status, force_closure, strict_internal, force_norm (N), e_s, rank_G, n_contacts,
+    iterations, solver.
+    """
+    S = np.asarray(synergies, dtype=float)
+    if S.ndim != 2:
+        raise ValueError(f"synergies must be an (n, k) matrix, got shape {S.shape}")
+    if not (isinstance(batch_size, int) and batch_size > 0):
+        raise ValueError(f"batch_size must be a positive int, got {batch_size!r}")
+    cols = _check_sets(sets, S.shape[1])
+    n_sets, n_poses = len(cols), len(grasps)
+    total = n_sets * n_poses
+    out = {
+        "pose": np.repeat(np.arange(n_poses, dtype=np.int32), n_sets),
+        "set_id": np.array([set_id(c + 1) for c in cols] * n_poses, dtype=object),
+        "n_synergies": np.tile(np.array([c.size for c in cols], dtype=np.int32), n_poses),
+        "status": np.full(total, "no_grasp", dtype=object),
+        "force_closure": np.zeros(total, dtype=bool),
+        "strict_internal": np.zeros(total, dtype=bool),
+        "force_norm": np.full(total, np.nan),
+        "e_s": np.zeros(total, dtype=np.int32),
+        "rank_G": np.zeros(total, dtype=np.int32),
+        "n_contacts": np.zeros(total, dtype=np.int32),
+        "iterations": np.zeros(total, dtype=np.int32),
+        "solver": np.full(total, "batched", dtype=object),
+    }
+    if total == 0:
+        return out
+    set_norms = np.array([np.linalg.norm(S[:, c], 2) for c in cols])
+    by_size: dict[int, list[int]] = {}
+    for j, c in enumerate(cols):
+        by_size.setdefault(c.size, []).append(j)
+    mu_strict = params.mu * (1.0 - params.strict_shrink)
+    per_chunk = max(1, batch_size // (n_sets * (2 if strict else 1)))
+
+    for start in range(0, n_poses, per_chunk):
+        stop = min(n_poses, start + per_chunk)
+        chunk = _Chunk(row0=start * n_sets, n_rows=(stop - start) * n_sets)
+        for p in range(start, stop):
+            grasp = grasps[p]
+            if grasp is None or grasp.n_contacts == 0:
+                continue
+            rows0 = p * n_sets
+            mech = mechanics_for(grasp, params)
+            out["rank_G"][rows0:rows0 + n_sets] = mech.rank_G
+            out["n_contacts"][rows0:rows0 + n_sets] = mech.n_contacts
+            if mech.rank_G < 6 or mech.projector is None:
+                out["status"][rows0:rows0 + n_sets] = "rank_deficient"
+                continue
+            _pose_blocks(chunk, mech, S, cols, by_size, set_norms, params, mu_strict, rows0, strict, out["e_s"])
+        if chunk.bases:
+            _solve_chunk(chunk, params, mu_strict, settings, batch_size, strict, out)
+    out["force_closure"] = out["status"] == "force_closure"
+    return out
+
+
+@dataclass
+class _Chunk:
+    """Problems of consecutive poses; GFO problem of output row r has local index
+    r - row0, its strict test r - row0 + n_rows."""
+
+    row0: int
+    n_rows: int
+    blocks: list = None
+    bases: dict = None     # output row -> (E (c, e_s), mechanics)
+
+    def __post_init__(self) -> None:
+        self.blocks, self.bases = [], {}
+
+
+def _pose_blocks(chunk, mech, S, cols, by_size, set_norms, params, mu_strict, rows0, strict, out_e_s) -> None:
+    """Blocks of one pose: per set size s, the bases of all its sets from one stacked SVD."""
+    m = mech.n_contacts
+    P = mech.projector
+    scale_P = float(np.linalg.norm(P, 2)) if P.size else 0.0
+    F_all = P @ S                                     # (c, k): one column per synergy
+    frames = _contact_frames(mech.normals, params.mu)
+    frames_strict = _contact_frames(mech.normals, mu_strict)
+    fp = mech.f_p
+    h = np.einsum("iab,ib->ia", frames, fp.reshape(m, 3))
+    for size, js in by_size.items():
+        F = np.stack([F_all[:, cols[j]] for j in js])  # (n, c, s)
+        U, sv, _ = np.linalg.svd(F, full_matrices=False)
+        rank = np.sum(sv > (params.basis_rtol * scale_P * set_norms[js])[:, None], axis=1)
+        U = U * (np.arange(U.shape[2])[None, None, :] < rank[:, None, None])  # zero columns beyond e_s
+        rows = np.asarray(js) + rows0
+        out_e_s[rows] = rank
+        for k, row in enumerate(rows):
+            chunk.bases[int(row)] = (U[k, :, :rank[k]], mech)
+        pos = rank > 0
+        n = int(pos.sum())
+        if n == 0:
+            continue
+        Up = U[pos]
+        a = np.einsum("nck,c->nk", Up, fp)
+        r0 = np.linalg.norm(fp[None] - np.einsum("nck,nk->nc", Up, a), axis=1)
+        U4 = Up.reshape(n, m, 3, Up.shape[2])
+        local = rows[pos] - chunk.row0
+        chunk.blocks.append(_Block(rows=np.einsum("iab,nibk->niak", frames, U4), h=np.broadcast_to(h, (n, m, 3)),
+                                   a=a, r0=r0, f_min=np.full(n, params.f_min), index=local))
+        if strict:
+            chunk.blocks.append(_Block(rows=np.einsum("iab,nibk->niak", frames_strict, U4), h=np.zeros((n, m, 3)),
+                                       a=np.zeros_like(a), r0=np.zeros(n), f_min=np.ones(n), index=local + chunk.n_rows))
+
+
+def _solve_chunk(chunk: _Chunk, params, mu_strict, settings, batch_size, strict, out) -> None:
+    n = chunk.n_rows
+
+    def fallback(k: int):
+        E, mech = chunk.bases[chunk.row0 + k % n]
+        if k < n:
+            return solve_gfo(mech.f_p, E, mech.normals, params.mu, params.f_min, tol=params.tol,
+                             max_iter=params.max_iter)
+        return strict_internal_forces(E, mech.normals, params.mu, params.strict_shrink, tol=params.tol,
+                                      max_iter=params.max_iter).result
+
+    mu = np.empty(2 * n)
+    mu[:n], mu[n:] = params.mu, mu_strict
+    sol = _solve_blocks(chunk.blocks, mu, 2 * n, None, fallback, settings, batch_size, params.tol, params.max_iter)
+    for row, (E, mech) in chunk.bases.items():
+        k = row - chunk.row0
+        if E.shape[1] == 0:  # f = f_p only: judged directly, as the per-problem path does
+            r = solve_gfo(mech.f_p, E, mech.normals, params.mu, params.f_min, tol=params.tol)
+            out["status"][row], out["force_norm"][row] = r.status, r.force_norm
+            continue
+        out["status"][row] = sol.status[k]
+        out["force_norm"][row] = sol.force_norm[k]
+        out["iterations"][row] = sol.iterations[k]
+        out["solver"][row] = sol.solver[k]
+        if strict:
+            out["strict_internal"][row] = sol.status[k + n] == "force_closure"
