@@ -206,6 +206,8 @@ def object_pose(placement: Placement, size_mm: Sequence[float], alpha_deg: float
     R0 = np.zeros((3, 3))
     for k, edge in enumerate(placement.box_axes):
         R0[k, edge] = 1.0  # box edge `edge` lies along palm axis k
+    if np.linalg.det(R0) < 0:  # an odd permutation: flip the box's z edge (a box is mirror-symmetric)
+        R0[:, placement.box_axes[2]] *= -1.0
     Ra = _axis_rotation(np.asarray(palm_normal, dtype=float), math.radians(alpha_deg))
     Rb = _axis_rotation(FINGER_AXIS, math.radians(beta_deg))
     R = Rb @ Ra @ R0 if placement.rotation_order == "alpha_then_beta" else Ra @ Rb @ R0

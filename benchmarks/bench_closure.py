@@ -1,0 +1,70 @@
+"""Closure cost and contact statistics per study box (one core).
+
+Prints per object the median and 90th-percentile time per grasp over a spread of poses,
+the status counts, the contact-count distribution and how many poses have at least two
+fingers in contact. Last line: ``closure_median_ms: N`` over all objects.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+from synergrasp.closure import ClosureParams, Placement, _Closer, object_pose, pose_grid, simulate_pose  # noqa: E402
+from synergrasp.hand import load_hand  # noqa: E402
+from synergrasp.objects import STUDY_BOXES  # noqa: E402
+from synergrasp.synergies import load_synergies  # noqa: E402
+
+
+#: Per-object placements (docs/closure.md): the default centre for the 30 mm boxes; the
+#: 60 mm cube 15 mm further out along the palm normal, obj4 52 mm further out with its 60 mm edge along it.
+PLACEMENTS = {
+    "obj1": Placement(),
+    "obj2": Placement(),
+    "obj3": Placement(center_mm=(53.0, 5.0, 112.0)),
+    "obj4": Placement(center_mm=(90.0, 5.0, 112.0), box_axes=(1, 0, 2)),
+}
+
+
+def main(n_poses: int = 300) -> None:
+    hand = load_hand()
+    synergies = load_synergies(None, joint_names=hand.joint_names)
+    placement, params = Placement(), ClosureParams()
+    grid = pose_grid(placement)
+    poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
+    closer = _Closer(hand, synergies, params)
+    all_times = []
+    try:
+        for box in STUDY_BOXES:
+            size = np.asarray(box.size_mm, dtype=float)
+            placement = PLACEMENTS.get(box.name, Placement())
+            times, statuses, counts, two_fingers = [], [], [], 0
+            for pose in poses:
+                placed = object_pose(placement, size, *grid.angles_deg(int(pose)), hand.palm_normal)
+                t0 = time.perf_counter()
+                result = simulate_pose(closer, size, placed)
+                times.append(time.perf_counter() - t0)
+                statuses.append(result.status)
+                counts.append(len(result.links))
+                two_fingers += sum(s == "contact" for s in result.finger_state) >= 2
+            t = np.array(times) * 1e3
+            all_times.extend(t)
+            status, n_status = np.unique(statuses, return_counts=True)
+            m, n_m = np.unique(counts, return_counts=True)
+            print(f"{box.name} {tuple(size.tolist())} centre {placement.center_mm} axes {placement.box_axes}: {len(poses)} poses, median {np.median(t):.2f} ms, "
+                  f"p90 {np.percentile(t, 90):.2f} ms per grasp")
+            print(f"  status: {dict(zip(status.tolist(), n_status.tolist()))}")
+            print(f"  contacts m: {dict(zip(m.tolist(), n_m.tolist()))}")
+            print(f"  poses with >= 2 fingers in contact: {two_fingers} / {len(poses)}")
+    finally:
+        closer.close()
+    print(f"closure_median_ms: {np.median(all_times):.2f}")
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 300)
