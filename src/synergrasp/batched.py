@@ -317,6 +317,11 @@ def solve_batch(batch: GFOBatch, settings: SolverSettings = SolverSettings()) ->
     `tol`; infeasible when the dual iterate is a Farkas certificate (h^T z < 0 and
     ||G^T z|| <= tol |h^T z|); otherwise 'not decided' after `max_iter` iterations.
     """
+    with np.errstate(all="ignore"):  # a breakdown shows as a non-finite iterate: 'not decided'
+        return _solve_batch(batch, settings)
+
+
+def _solve_batch(batch: GFOBatch, settings: SolverSettings) -> BatchResult:
     D, mask = batch.rows, batch.contact
     m, _, e, B = D.shape
     cm = mask.astype(float)
