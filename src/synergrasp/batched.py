@@ -597,7 +597,7 @@ def _pieces(blocks: list[_Block], batch_size: int) -> list[list[_Block]]:
     """Consecutive runs of blocks (sorted by e, then m) of about `batch_size` problems each.
 
     Splitting never changes a problem's numbers (padding is exact), only the speed: runs
-    stay within one e so that padding costs little.
+    stay within one e (unless still below batch_size / 4) so that padding costs little.
     """
     order = sorted(range(len(blocks)), key=lambda k: (blocks[k].e, blocks[k].m))
     runs: list[list[_Block]] = []
@@ -605,7 +605,8 @@ def _pieces(blocks: list[_Block], batch_size: int) -> list[list[_Block]]:
     size = 0
     for k in order:
         b = blocks[k]
-        if current and (size + b.a.shape[0] > batch_size or b.e != current[-1].e):
+        # A new e starts a new run unless the run is still small (padding e beats tiny batches).
+        if current and (size + b.a.shape[0] > batch_size or (b.e != current[-1].e and size >= batch_size // 4)):
             runs.append(current)
             current, size = [], 0
         current.append(b)
@@ -815,7 +816,7 @@ def optimise_grasps(
     for j, c in enumerate(cols):
         by_size.setdefault(c.size, []).append(j)
     mu_strict = params.mu * (1.0 - params.strict_shrink)
-    per_chunk = max(1, batch_size // (n_sets * (2 if strict else 1)))
+    per_chunk = max(1, 4 * batch_size // (n_sets * (2 if strict else 1)))  # several batches per chunk
 
     for start in range(0, n_poses, per_chunk):
         stop = min(n_poses, start + per_chunk)

@@ -1,0 +1,89 @@
+"""Throughput of grasp-force optimisation: batched vs per-problem Clarabel vs cvxpy.
+
+Realistic study mix: random grasps with 4-12 contacts (some on the palm) x the 75 synergy
+sets of the study (15 incremental + subsets of 1-3 of S1..S7). The batched figure includes
+mechanics, bases and matrix building (`optimise_grasps`, GFO only). Run on one core with
+OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1. The last two lines are machine-read.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import time
+
+import numpy as np
+
+from synergrasp.batched import optimise_grasps
+from synergrasp.force_optimisation import GFOParams, mechanics_for, solve_gfo, solve_gfo_cvxpy
+from synergrasp.mechanics import internal_force_basis
+from synergrasp.problems import random_grasp, random_synergies
+
+
+def study_sets() -> list[tuple[int, ...]]:
+    sets = [tuple(range(1, k + 1)) for k in range(1, 16)]
+    for r in (1, 2, 3):
+        sets += [c for c in itertools.combinations(range(1, 8), r) if c not in sets]
+    return sets
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--problems", type=int, default=15000, help="number of (pose, set) GFO problems")
+    ap.add_argument("--exact", type=int, default=1500, help="problems for the per-problem exact solver")
+    ap.add_argument("--cvxpy", type=int, default=60, help="problems for the cvxpy loop")
+    ap.add_argument("--batch-size", type=int, default=4096)
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args()
+
+    rng = np.random.default_rng(args.seed)
+    sets = study_sets()
+    n_poses = max(1, args.problems // len(sets))
+    grasps = [random_grasp(rng, int(rng.integers(4, 13)), palm_contacts=int(rng.integers(0, 2))) for _ in range(n_poses)]
+    S = random_synergies(rng)
+    params = GFOParams(gravity_direction=(0.0, 0.0, -1.0))
+    n = n_poses * len(sets)
+
+    t0 = time.perf_counter()
+    out = optimise_grasps(grasps, S, sets, params, batch_size=args.batch_size, strict=False)
+    t_batched = time.perf_counter() - t0
+    batched_rate = n / t_batched
+    fallback = float(np.mean(out["solver"] == "clarabel_fallback"))
+
+    # The same problems, per problem (subset): mechanics once per pose, then E and the solve.
+    problems = []
+    for p, grasp in enumerate(grasps):
+        mech = mechanics_for(grasp, params)
+        for st in sets:
+            problems.append((mech, np.array(st) - 1))
+    pick = rng.permutation(len(problems))
+    sub = [problems[k] for k in pick[: args.exact]]
+    t0 = time.perf_counter()
+    for mech, cols in sub:
+        if mech.rank_G == 6:
+            E = internal_force_basis(mech.projector, S[:, cols], params.basis_rtol)
+            solve_gfo(mech.f_p, E, mech.normals, params.mu, params.f_min)
+    exact_rate = len(sub) / (time.perf_counter() - t0)
+
+    sub = [problems[k] for k in pick[: args.cvxpy]]
+    t0 = time.perf_counter()
+    for mech, cols in sub:
+        if mech.rank_G == 6:
+            E = internal_force_basis(mech.projector, S[:, cols], params.basis_rtol)
+            solve_gfo_cvxpy(mech.f_p, E, mech.normals, params.mu, params.f_min)
+    cvxpy_rate = len(sub) / (time.perf_counter() - t0)
+
+    statuses = {s: int(np.sum(out["status"] == s)) for s in sorted(set(out["status"]))}
+    print(f"problems: {n} ({n_poses} grasps x {len(sets)} sets), statuses {statuses}")
+    print(f"mean batched iterations: {out['iterations'][out['solver'] == 'batched'].mean():.2f}")
+    print(f"batched (incl. mechanics and building): {batched_rate:.0f} solves/s ({t_batched:.2f} s)")
+    print(f"per-problem exact (Clarabel, {min(args.exact, n)} problems): {exact_rate:.0f} solves/s")
+    print(f"per-problem cvxpy ({min(args.cvxpy, n)} problems): {cvxpy_rate:.1f} solves/s")
+    print(f"batched / exact: {batched_rate / exact_rate:.2f}x; batched / cvxpy: {batched_rate / cvxpy_rate:.0f}x")
+    print(f"fallback share: {fallback:.4f}")
+    print(f"gfo_solves_per_s: {batched_rate:.0f}")
+    print(f"gfo_speedup_vs_cvxpy: {batched_rate / cvxpy_rate:.0f}")
+
+
+if __name__ == "__main__":
+    main()
