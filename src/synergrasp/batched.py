@@ -29,10 +29,12 @@ from synergrasp.mechanics import Grasp, tangent_pairs
 
 __all__ = [
     "BatchResult",
+    "BatchSolution",
     "GFOBatch",
     "SolverSettings",
     "gfo_batch",
     "optimise_grasps",
+    "set_id",
     "solve_batch",
     "solve_gfo_batch",
 ]
