@@ -54,7 +54,7 @@ _DELETE = object()
         (("mechanics", "mu"), -1.0, "'mechanics.mu'"),
         (("objects", "obj1", "size_mm"), [30, -1, 30], "'objects.obj1.size_mm[1]'"),
         (("objects", "obj1", "mass_kg"), 0, "'objects.obj1.mass_kg'"),
-        (("solver", "method"), "newton", "allowed values: ['batched', 'clarabel']"),
+        (("solver", "method"), "newton", "'solver': unknown key(s) ['method']"),
         (("placement", "rotation_order"), "any", "allowed values: ['alpha_then_beta', 'beta_then_alpha']"),
         (("closure", "sigma_open"), _DELETE, "'closure': 'sigma_open' is a required property"),
         (("analyses", "fig4", "object"), "obj9", "unknown object 'obj9'; allowed values: ['obj1', 'obj4']"),
