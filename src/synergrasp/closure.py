@@ -427,6 +427,7 @@ class _Closer:
                 self.link_finger_index[link] = f
                 self.link_chain_pos[link] = i
         self.reach = self._finger_reach()
+        self._profiles: dict[tuple[int, tuple[int, ...]], tuple[NDArray, NDArray]] = {}
         self.q_open = self.reference(params.sigma_open)
         self.self_pairs = self._monitored_pairs()
 
@@ -509,32 +510,44 @@ class _Closer:
         return d
 
     # -- the closure ------------------------------------------------------------------------
+    def _travel_profile(self, f: int, moving: tuple[int, ...]) -> tuple[NDArray, NDArray]:
+        """Knots σ_k on [σ_open, σ_closed] and the travel bound T(σ_k) (mm) accumulated from
+        σ_open by any point of finger f when only the joints ``moving`` follow the reference.
+
+        T is piecewise linear: joint j adds |S1_j| · reach(f) mm per unit σ while its
+        reference is inside its limits (a clipped joint does not move). Cached per
+        (finger, moving joints): there are only a few such sets per finger.
+        """
+        key = (f, moving)
+        profile = self._profiles.get(key)
+        if profile is None:
+            p = self.params
+            idx = list(moving)
+            lo, hi = self.active_lo[idx], self.active_hi[idx]
+            rate = np.abs(self.s1[idx]) * self.reach[f]  # mm per unit σ while active
+            knots = np.unique(np.clip(np.concatenate([lo, hi, [p.sigma_open, p.sigma_closed]]),
+                                      p.sigma_open, p.sigma_closed))
+            mids = 0.5 * (knots[:-1] + knots[1:])
+            speed = np.array([float(np.sum(rate[(lo <= m) & (hi >= m)])) for m in mids])
+            profile = (knots, np.concatenate([[0.0], np.cumsum(speed * np.diff(knots))]))
+            self._profiles[key] = profile
+        return profile
+
     def advance(self, sigma: float, budget_mm: NDArray, held: NDArray) -> float:
         """Largest σ' ≤ σ_closed such that no point of finger f travels more than
         budget_mm[f] on [σ, σ'] (clipped joints do not move; held joints do not move)."""
         best = self.params.sigma_closed
         for f, (joints, _) in enumerate(self.fingers):
-            moving = [j for j in joints if not held[j]]
+            moving = tuple(j for j in joints if not held[j])
             if not moving:
                 continue
-            lo = np.maximum(self.active_lo[moving], sigma)
-            hi = self.active_hi[moving]
-            rate = np.abs(self.s1[moving]) * self.reach[f]  # mm per unit σ while active
-            # travel(σ') = Σ rate · |[lo, hi] ∩ [σ, σ']|: piecewise linear, increasing
-            knots = np.unique(np.concatenate([lo, hi, [sigma]]))
-            knots = knots[(knots >= sigma) & (knots <= best)]
-            knots = np.append(knots, best)
-            travel, prev = 0.0, sigma
-            target = best
-            for k in knots[1:]:
-                mid = 0.5 * (prev + k)
-                speed = float(np.sum(rate[(lo <= mid) & (hi >= mid)]))
-                if speed > 0 and travel + speed * (k - prev) >= budget_mm[f]:
-                    target = prev + (budget_mm[f] - travel) / speed
-                    break
-                travel += speed * (k - prev)
-                prev = k
-            best = min(best, target)
+            knots, travel = self._travel_profile(f, moving)
+            level = float(np.interp(sigma, knots, travel)) + budget_mm[f]
+            if level > travel[-1]:
+                continue  # the budget outlasts the closure
+            k = int(np.searchsorted(travel, level, side="left"))  # travel[k-1] < level <= travel[k]
+            t0, t1 = travel[k - 1], travel[k]
+            best = min(best, knots[k - 1] + (level - t0) / (t1 - t0) * (knots[k] - knots[k - 1]))
         return best
 
     def posture(self, sigma: float, held: NDArray, q_held: NDArray) -> NDArray:
@@ -591,13 +604,16 @@ class _Closer:
         touched_obj[self.link_finger_index[np.flatnonzero(touching)]] = True
 
         sigma = p.sigma_open
+        mv = moving_links()
+        pairs = tuple(pr for pr in self.self_pairs if mv[pr[0]] or mv[pr[1]])
+        # gaps (margin _QUERY_MARGIN_MM) at the posture of σ, when already known from the
+        # previous step's check or event: every query is made once
+        known: tuple[NDArray, NDArray] | None = None
         while sigma < p.sigma_closed:
-            mv = moving_links()
             if not mv.any():
                 break
-            pairs = tuple(pr for pr in self.self_pairs if mv[pr[0]] or mv[pr[1]])
             q = self.posture(sigma, held, q_held)
-            d_obj, d_self = self.gaps(q, mv, pairs, _QUERY_MARGIN_MM)
+            d_obj, d_self = known if known is not None else self.gaps(q, mv, pairs, _QUERY_MARGIN_MM)
             budget = np.full(len(self.fingers), p.step_mm)
             for f, (_, links) in enumerate(self.fingers):
                 free = min(float(np.min(d_obj[list(links)])), 0.5 * float(np.min(d_self[list(links)])))
@@ -606,9 +622,9 @@ class _Closer:
             if sigma_next <= sigma:
                 break
             q_next = self.posture(sigma_next, held, q_held)
-            o_next, s_next = self.gaps(q_next, mv, pairs, p.contact_distance_mm)
+            o_next, s_next = self.gaps(q_next, mv, pairs, _QUERY_MARGIN_MM)
             if min(o_next.min(), s_next.min()) >= 0.0:
-                sigma = sigma_next
+                sigma, known = sigma_next, (o_next, s_next)
                 continue
             # a moving link crosses something in (σ, σ_next]: find where, to within tolerance_mm
             lo, hi = sigma, sigma_next
@@ -625,7 +641,7 @@ class _Closer:
                 else:
                     mid = 0.5 * (lo + hi)
                 q_mid = self.posture(mid, held, q_held)
-                o_mid, s_mid = self.gaps(q_mid, mv, pairs, max(p.contact_distance_mm, _QUERY_MARGIN_MM))
+                o_mid, s_mid = self.gaps(q_mid, mv, pairs, _QUERY_MARGIN_MM)
                 d_mid = min(o_mid.min(), s_mid.min())
                 if d_mid < 0.0:
                     hi, d_hi = mid, d_mid
@@ -655,6 +671,14 @@ class _Closer:
             for link in np.flatnonzero(self_touch):
                 touched_self[self.link_finger_index[link]] = True
             sigma = lo
+            # the posture at σ is q_at again (the new holds keep q_at's values); a link that
+            # still moves keeps all its pairs, so its gaps are those of the event
+            mv = moving_links()
+            pairs = tuple(pr for pr in self.self_pairs if mv[pr[0]] or mv[pr[1]])
+            o_at, s_at = o_at.copy(), s_at.copy()
+            o_at[~mv] = np.inf
+            s_at[~mv] = np.inf
+            known = (o_at, s_at)
         q_final = self.posture(min(sigma, p.sigma_closed), held, q_held)
         state = ["contact" if touched_obj[f] else "self" if touched_self[f] else "limit"
                  for f in range(len(self.fingers))]
