@@ -57,6 +57,9 @@ class SolverSettings:
         `stall_step`) or reaches `max_iter`; failing them the problem is 'not decided'
     max_iter: iteration cap; a problem not decided by then falls back to `solve_gfo`
     step_fraction: fraction of the step to the cone boundary taken each iteration
+    stall_step: a step below this ends the iteration (judged with `reduced_tol`)
+    refine: iterative-refinement steps on the full KKT system per solve (0: none; 1 lowers
+        the fallback share slightly at about 20 % more time per iteration)
     """
 
     tol: float = 1e-8
@@ -64,7 +67,7 @@ class SolverSettings:
     max_iter: int = 50
     step_fraction: float = 0.99
     stall_step: float = 1e-3
-    refine: int = 1
+    refine: int = 0
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.tol) and 0 < self.tol < 1):
@@ -330,36 +333,36 @@ def _solve_batch(batch: GFOBatch, settings: SolverSettings) -> BatchResult:
     # Scale so that the forces are O(1): the iteration then starts well centred.
     fp_norm = np.sqrt(batch.r0 * batch.r0 + np.sum(batch.a * batch.a, axis=0))
     rho = np.maximum(fp_norm, np.maximum(batch.f_min, 1e-12))
-    h_soc = batch.h / rho
-    h_soc = np.where(mask[:, None, :], h_soc, 0.0)
+    h_soc = np.ascontiguousarray(np.where(mask, batch.h.transpose(1, 0, 2) / rho, 0.0))  # (3, m, B), components first
     h_lin = np.where(mask, (batch.h[:, 0] - batch.f_min) / rho, 0.0)
     a = batch.a / rho
     h_obj = np.concatenate([np.zeros((1, B)), (batch.r0 / rho)[None], a], axis=0)
-    h_norm = np.maximum(1.0, np.sqrt(np.sum(h_lin * h_lin, axis=0) + np.sum(np.sum(h_soc * h_soc, axis=1), axis=0)
+    h_norm = np.maximum(1.0, np.sqrt(np.sum(h_lin * h_lin, axis=0) + np.sum(np.sum(h_soc * h_soc, axis=0), axis=0)
                                      + np.sum(a * a, axis=0)))
     n_deg = 2.0 * np.sum(cm, axis=0) + 1.0  # barrier degree: m linear + m SOC(3) + 1 objective cone
 
     # G x for x = (t, y): linear rows -D0 y, SOC rows -D y, objective rows -(t, 0, y):
     # the objective cone is (t, r0, y + a), so t is ||f|| / rho itself.
     def G_mul(x):
-        Dy = np.einsum("mrjb,jb->mrb", D, x[1:])
+        Dy = np.einsum("mrjb,jb->rmb", D, x[1:])
         obj = np.zeros((x.shape[0] + 1, x.shape[1]))
         obj[0] = -x[0]
         obj[2:] = -x[1:]
-        return _Cones(-Dy[:, 0], -Dy, obj)
+        np.negative(Dy, out=Dy)
+        return _Cones(Dy[0], Dy, obj)
 
     def GT_mul(zc: _Cones):
         zz = zc.soc.copy()
-        zz[:, 0] += zc.lin
-        zz *= cm[:, None]
+        zz[0] += zc.lin
+        zz *= cm
         out = -np.delete(zc.obj, 1, axis=0)
-        out[1:] -= np.einsum("mrjb,mrb->jb", D, zz)
+        out[1:] -= np.einsum("mrjb,rmb->jb", D, zz)
         return out
 
     # Initial point of the embedding: x = 0, s = z = identity of the cone, tau = kappa = 1.
     x = np.zeros((e + 1, B))
-    ident = _Cones(np.ones((m, B)), np.zeros((m, 3, B)), np.zeros((e + 2, B)))
-    ident.soc[:, 0] = 1.0
+    ident = _Cones(np.ones((m, B)), np.zeros((3, m, B)), np.zeros((e + 2, B)))
+    ident.soc[0] = 1.0
     ident.obj[0] = 1.0
     s, z = ident.copy(), ident.copy()
     tau = np.ones(B)
@@ -380,17 +383,17 @@ def _solve_batch(batch: GFOBatch, settings: SolverSettings) -> BatchResult:
         GTz = GT_mul(z)
         r_x = GTz.copy()
         r_x[0] += tau
-        r_z = _Cones(Gx.lin + s.lin - h_lin * tau, Gx.soc + s.soc - h_soc * tau[None, None], Gx.obj + s.obj - h_obj * tau)
+        r_z = _Cones(Gx.lin + s.lin - h_lin * tau, Gx.soc + s.soc - h_soc * tau, Gx.obj + s.obj - h_obj * tau)
         r_z.lin *= cm
-        r_z.soc *= cm[:, None]
-        hz = np.sum(h_lin * z.lin * cm, axis=0) + np.sum(np.sum(h_soc * z.soc, axis=1) * cm, axis=0) \
+        r_z.soc *= cm
+        hz = np.sum(h_lin * z.lin * cm, axis=0) + np.sum(np.sum(h_soc * z.soc, axis=0) * cm, axis=0) \
             + np.sum(h_obj * z.obj, axis=0)
         r_tau = kappa + x[0] + hz
-        sz = np.sum((s.lin * z.lin + np.sum(s.soc * z.soc, axis=1)) * cm, axis=0) + np.sum(s.obj * z.obj, axis=0)
+        sz = np.sum((s.lin * z.lin + np.sum(s.soc * z.soc, axis=0)) * cm, axis=0) + np.sum(s.obj * z.obj, axis=0)
         mu = (sz + tau * kappa) / (n_deg + 1.0)
 
         # Stopping tests on the de-homogenised point.
-        pres = np.sqrt(np.sum(r_z.lin ** 2, axis=0) + np.sum(np.sum(r_z.soc ** 2, axis=1), axis=0)
+        pres = np.sqrt(np.sum(r_z.lin ** 2, axis=0) + np.sum(np.sum(r_z.soc ** 2, axis=0), axis=0)
                        + np.sum(r_z.obj ** 2, axis=0)) / tau / h_norm
         dres = np.sqrt(np.sum(r_x ** 2, axis=0)) / tau
         pcost = x[0] / tau
@@ -431,9 +434,9 @@ def _solve_batch(batch: GFOBatch, settings: SolverSettings) -> BatchResult:
         w_lin = np.where(cm > 0, z.lin / s.lin, 0.0)  # (W^T W)^-1 of the linear cone
         s_over_z = np.where(cm > 0, s.lin / z.lin, 0.0)
         lam_lin = np.sqrt(s.lin * z.lin)
-        w_soc, b_soc = _soc_nt(s.soc.transpose(1, 0, 2), z.soc.transpose(1, 0, 2))
+        w_soc, b_soc = _soc_nt(s.soc, z.soc)
         w_obj, b_obj = _soc_nt(s.obj, z.obj)
-        lam_soc = _soc_apply(w_soc, b_soc, z.soc.transpose(1, 0, 2))
+        lam_soc = _soc_apply(w_soc, b_soc, z.soc)
         lam_obj = _soc_apply(w_obj, b_obj, z.obj)
         H_soc = _soc_hessian(w_soc, b_soc) * cm  # (3, 3, m, B)
         H_con = H_soc.copy()  # a contact's linear row is the first row of its cone rows
@@ -445,13 +448,14 @@ def _solve_batch(batch: GFOBatch, settings: SolverSettings) -> BatchResult:
         L = _cholesky(M)
 
         def H_mul(v: _Cones) -> _Cones:
-            return _Cones(w_lin * v.lin, np.einsum("rkmb,mkb->mrb", H_soc, v.soc), np.einsum("rkb,kb->rb", H_obj, v.obj))
+            # The same H matrices as in M: a closed form (2 u u^T - J) v rounds differently and,
+            # without refinement, the mismatch with M costs accuracy near the optimum.
+            return _Cones(w_lin * v.lin, np.einsum("rkmb,kmb->rmb", H_soc, v.soc), np.einsum("rkb,kb->rb", H_obj, v.obj))
 
         def V_mul(v: _Cones) -> _Cones:
             """W^T W v through the factors (more accurate than inverting H)."""
-            vs = v.soc.transpose(1, 0, 2)
             return _Cones(s_over_z * v.lin,
-                          _soc_apply(w_soc, b_soc, _soc_apply(w_soc, b_soc, vs)).transpose(1, 0, 2) * cm[:, None],
+                          _soc_apply(w_soc, b_soc, _soc_apply(w_soc, b_soc, v.soc)) * cm,
                           _soc_apply(w_obj, b_obj, _soc_apply(w_obj, b_obj, v.obj)))
 
         def reduced(bx, bz: _Cones):
@@ -467,7 +471,7 @@ def _solve_batch(batch: GFOBatch, settings: SolverSettings) -> BatchResult:
                 rx = bx - GT_mul(dz)
                 rz = _Cones(bz.lin - Gd.lin + Vz.lin, bz.soc - Gd.soc + Vz.soc, bz.obj - Gd.obj + Vz.obj)
                 rz.lin *= cm
-                rz.soc *= cm[:, None]
+                rz.soc *= cm
                 ex, ez = reduced(rx, rz)
                 dx = dx + ex
                 dz = _Cones(dz.lin + ez.lin, dz.soc + ez.soc, dz.obj + ez.obj)
@@ -476,7 +480,7 @@ def _solve_batch(batch: GFOBatch, settings: SolverSettings) -> BatchResult:
         c_vec = np.zeros_like(x)
         c_vec[0] = 1.0
         x1, z1 = solve_kkt(-c_vec, _Cones(h_lin, h_soc, h_obj))
-        cx1_hz1 = x1[0] + np.sum(h_lin * z1.lin * cm, axis=0) + np.sum(np.sum(h_soc * z1.soc, axis=1) * cm, axis=0) \
+        cx1_hz1 = x1[0] + np.sum(h_lin * z1.lin * cm, axis=0) + np.sum(np.sum(h_soc * z1.soc, axis=0) * cm, axis=0) \
             + np.sum(h_obj * z1.obj, axis=0)
 
         def direction(sigma, ds_lin, ds_soc, ds_obj, d_kappa):
@@ -487,32 +491,31 @@ def _solve_batch(batch: GFOBatch, settings: SolverSettings) -> BatchResult:
             q_obj = _soc_apply(w_obj, b_obj, _soc_div(lam_obj, ds_obj))
             f = 1.0 - sigma
             bx = -f * r_x
-            bz = _Cones(-f * r_z.lin + q_lin, -f * r_z.soc + q_soc.transpose(1, 0, 2), -f * r_z.obj + q_obj)
+            bz = _Cones(-f * r_z.lin + q_lin, -f * r_z.soc + q_soc, -f * r_z.obj + q_obj)
             x2, z2 = solve_kkt(bx, bz)
-            cx2_hz2 = x2[0] + np.sum(h_lin * z2.lin * cm, axis=0) + np.sum(np.sum(h_soc * z2.soc, axis=1) * cm, axis=0) \
+            cx2_hz2 = x2[0] + np.sum(h_lin * z2.lin * cm, axis=0) + np.sum(np.sum(h_soc * z2.soc, axis=0) * cm, axis=0) \
                 + np.sum(h_obj * z2.obj, axis=0)
             dtau = (d_kappa / tau - f * r_tau - cx2_hz2) / (cx1_hz1 - kappa / tau)
             dx = x2 + dtau * x1
-            dz = _Cones(z2.lin + dtau * z1.lin, z2.soc + dtau[None, None] * z1.soc, z2.obj + dtau * z1.obj)
+            dz = _Cones(z2.lin + dtau * z1.lin, z2.soc + dtau * z1.soc, z2.obj + dtau * z1.obj)
             dkappa = -(d_kappa + kappa * dtau) / tau
             # ds from the primal row G dx + ds - h dtau = -(1 - sigma) r_z: it keeps the primal
             # residual exact where W^T W is badly conditioned near the optimum.
             Gdx = G_mul(dx)
             ds_l = -f * r_z.lin - Gdx.lin + h_lin * dtau
-            ds_s = (-f * r_z.soc - Gdx.soc + h_soc * dtau[None, None]).transpose(1, 0, 2)
+            ds_s = -f * r_z.soc - Gdx.soc + h_soc * dtau
             ds_o = -f * r_z.obj - Gdx.obj + h_obj * dtau
             dz.lin *= cm
-            dz.soc *= cm[:, None]
+            dz.soc *= cm
             ds_l *= cm
             ds_s *= cm
-            ds = _Cones(ds_l, ds_s.transpose(1, 0, 2), ds_o)
+            ds = _Cones(ds_l, ds_s, ds_o)
             return dx, dz, ds, dtau, dkappa
 
         def max_step(dz, ds, dtau, dkappa):
             inf = np.inf
             st = np.minimum(_lin_max_step(s.lin, ds.lin), _lin_max_step(z.lin, dz.lin))
-            st = np.minimum(st, np.minimum(_soc_max_step(s.soc.transpose(1, 0, 2), ds.soc.transpose(1, 0, 2)),
-                                           _soc_max_step(z.soc.transpose(1, 0, 2), dz.soc.transpose(1, 0, 2))))
+            st = np.minimum(st, np.minimum(_soc_max_step(s.soc, ds.soc), _soc_max_step(z.soc, dz.soc)))
             st = np.where(cm > 0, st, inf).min(axis=0)
             st = np.minimum(st, np.minimum(_soc_max_step(s.obj, ds.obj), _soc_max_step(z.obj, dz.obj)))
             st = np.minimum(st, np.minimum(_lin_max_step(tau, dtau), _lin_max_step(kappa, dkappa)))
@@ -530,8 +533,7 @@ def _solve_batch(batch: GFOBatch, settings: SolverSettings) -> BatchResult:
         Wi_ds_l = np.sqrt(np.where(cm > 0, z.lin / np.where(cm > 0, s.lin, 1.0), 0.0)) * ds_a.lin
         W_dz_l = np.sqrt(np.where(cm > 0, s.lin / np.where(cm > 0, z.lin, 1.0), 0.0)) * dz_a.lin
         d_lin = lam_lin * lam_lin + Wi_ds_l * W_dz_l - sm
-        corr_soc = _soc_prod(_soc_apply(w_soc, b_soc, ds_a.soc.transpose(1, 0, 2), inverse=True),
-                             _soc_apply(w_soc, b_soc, dz_a.soc.transpose(1, 0, 2)))
+        corr_soc = _soc_prod(_soc_apply(w_soc, b_soc, ds_a.soc, inverse=True), _soc_apply(w_soc, b_soc, dz_a.soc))
         d_soc = lam_soc_sq + corr_soc
         d_soc[0] -= sm
         corr_obj = _soc_prod(_soc_apply(w_obj, b_obj, ds_a.obj, inverse=True), _soc_apply(w_obj, b_obj, dz_a.obj))
