@@ -23,9 +23,10 @@ report: $(BIN)/.installed
 test: $(BIN)/.installed
 	$(BIN)/python -m pytest; rc=$$?; if [ $$rc -eq 5 ]; then echo "no tests collected"; exit 0; fi; exit $$rc
 
+# One core, as the targets are stated per core.
 bench: $(BIN)/.installed
-	$(BIN)/python benchmarks/bench_gfo.py
-	$(BIN)/python benchmarks/bench_closure.py
+	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_gfo.py
+	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_closure.py
 
 # Regenerate the pinned, hashed lock from pyproject.toml (Python 3.11, Linux x86_64).
 lock:
