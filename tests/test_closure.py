@@ -17,24 +17,13 @@ from synergrasp.closure import (
     simulate_object,
     write_contacts,
 )
-from synergrasp.hand import forward_kinematics, load_hand
+from synergrasp.hand import forward_kinematics
 from synergrasp.objects import Box
-from synergrasp.synergies import load_synergies
 
 PARAMS = ClosureParams()
 PLACEMENT = Placement()
 CUBE = Box("obj1", (30.0, 30.0, 30.0), 1.0)
 PLATE = Box("obj2", (30.0, 60.0, 60.0), 1.0)
-
-
-@pytest.fixture(scope="module")
-def hand():
-    return load_hand()
-
-
-@pytest.fixture(scope="module")
-def synergies(hand):
-    return load_synergies(None, joint_names=hand.joint_names)
 
 
 @pytest.fixture(scope="module")

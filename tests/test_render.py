@@ -6,20 +6,8 @@ import numpy as np
 import pytest
 
 from synergrasp.closure import ClosureParams, Placement, pose_grid, simulate_object
-from synergrasp.hand import load_hand
 from synergrasp.objects import Box
 from synergrasp.render import figure_example_grasps, figure_synergy_postures, render_posture
-from synergrasp.synergies import load_synergies
-
-
-@pytest.fixture(scope="module")
-def hand():
-    return load_hand()
-
-
-@pytest.fixture(scope="module")
-def synergies(hand):
-    return load_synergies(None, joint_names=hand.joint_names)
 
 
 def _hand_pixels(image):
