@@ -144,36 +144,13 @@ def gfo_batch(
         raise ValueError("mu must be finite and > 0")
     if not np.all(np.isfinite(fmins) & (fmins >= 0)):
         raise ValueError("f_min must be finite and >= 0 (N)")
-    ms = [np.asarray(n).shape[0] for n in normals]
-    es = [np.asarray(x).reshape(3 * ms[k], -1).shape[1] for k, x in enumerate(E)]
-    m = max(ms + [1]) if m_pad is None else m_pad
-    e = max(es + [1]) if e_pad is None else e_pad
-    if max(ms + [0]) > m or max(es + [0]) > e:
-        raise ValueError(f"m_pad={m_pad} / e_pad={e_pad} smaller than the largest problem (m={max(ms)}, e={max(es)})")
-    rows = np.zeros((B, m, 3, e))
-    h = np.zeros((B, m, 3))
-    a = np.zeros((B, e))
-    r0 = np.zeros(B)
-    contact = np.zeros((B, m), dtype=bool)
-    for k in range(B):
-        mk, ek = ms[k], es[k]
-        n = np.asarray(normals[k], dtype=float)
-        frames = _contact_frames(n, mus[k])
-        Ek = np.asarray(E[k], dtype=float).reshape(3 * mk, ek)
-        fp = np.asarray(f_p[k], dtype=float).reshape(3 * mk)
-        rows[k, :mk, :, :ek] = np.einsum("iab,ibk->iak", frames, Ek.reshape(mk, 3, ek))
-        h[k, :mk] = np.einsum("iab,ib->ia", frames, fp.reshape(mk, 3))
-        a[k, :ek] = Ek.T @ fp
-        r0[k] = np.linalg.norm(fp - Ek @ a[k, :ek])
-        contact[k, :mk] = True
-    return GFOBatch(
-        rows=np.ascontiguousarray(rows.transpose(1, 2, 3, 0)),
-        h=np.ascontiguousarray(h.transpose(1, 2, 0)),
-        a=np.ascontiguousarray(a.T),
-        r0=r0,
-        f_min=np.array(fmins, dtype=float),
-        contact=np.ascontiguousarray(contact.T),
-    )
+    blocks = [_problem_block(f_p[k], E[k], normals[k], mus[k], fmins[k], k) for k in range(B)]
+    m = max([b.m for b in blocks] + [1]) if m_pad is None else m_pad
+    e = max([b.e for b in blocks] + [1]) if e_pad is None else e_pad
+    if max([b.m for b in blocks] + [0]) > m or max([b.e for b in blocks] + [0]) > e:
+        raise ValueError(f"m_pad={m_pad} / e_pad={e_pad} smaller than the largest problem")
+    batch, _ = _stack(blocks, m, e)
+    return batch
 
 
 def _contact_frames(normals: NDArray, mu: float | NDArray) -> NDArray:
@@ -620,10 +597,12 @@ def _pieces(blocks: list[_Block], batch_size: int) -> list[list[_Block]]:
     return runs
 
 
-def _stack(run: list[_Block]) -> tuple[GFOBatch, NDArray]:
+def _stack(run: list[_Block], m: int | None = None, e: int | None = None) -> tuple[GFOBatch, NDArray]:
+    """Zero-pad the blocks of a run to m contacts and e basis columns (default: the run's
+    largest) and stack them batch-last; also return each problem's caller index."""
     B = sum(b.a.shape[0] for b in run)
-    m = max(b.m for b in run)
-    e = max(b.e for b in run)
+    m = max(b.m for b in run) if m is None else m
+    e = max(b.e for b in run) if e is None else e
     rows = np.zeros((m, 3, e, B))
     h = np.zeros((m, 3, B))
     a = np.zeros((e, B))
@@ -656,12 +635,9 @@ def _solve_blocks(
     blocks: list[_Block],
     mu: NDArray,
     total: int,
-    fallback: list[tuple[NDArray, NDArray, NDArray, float, float]] | None,
     fallback_problem,
     settings: SolverSettings,
     batch_size: int,
-    params_tol: float,
-    params_max_iter: int,
 ) -> BatchSolution:
     """Solve every problem of `blocks` in padded batches; undecided ones go to `solve_gfo`."""
     from synergrasp.force_optimisation import ALMOST_SOLVED_TOL
@@ -746,7 +722,7 @@ def solve_gfo_batch(
     def fallback(k: int):
         return solve_gfo(f_p[k], E[k], normals[k], mus[k], fmins[k], tol=tol, max_iter=max_iter)
 
-    out = _solve_blocks(blocks, mus, B, None, fallback, settings, batch_size, tol, max_iter)
+    out = _solve_blocks(blocks, mus, B, fallback, settings, batch_size)
     for k in direct:
         r = fallback(k)
         out.status[k], out.force_norm[k], out.iterations[k] = r.status, r.force_norm, 0
@@ -905,7 +881,7 @@ def _solve_chunk(chunk: _Chunk, params, mu_strict, settings, batch_size, strict,
 
     mu = np.empty(2 * n)
     mu[:n], mu[n:] = params.mu, mu_strict
-    sol = _solve_blocks(chunk.blocks, mu, 2 * n, None, fallback, settings, batch_size, params.tol, params.max_iter)
+    sol = _solve_blocks(chunk.blocks, mu, 2 * n, fallback, settings, batch_size)
     for row, (E, mech) in chunk.bases.items():
         k = row - chunk.row0
         if E.shape[1] == 0:  # f = f_p only: judged directly, as the per-problem path does
