@@ -79,8 +79,7 @@ def figure_force_maps(gfo: pd.DataFrame, minima: pd.DataFrame, panel_k: Sequence
     vmin, vmax = (np.percentile(finite, [1, 99]) if finite.size else (0.0, 1.0))
     fig, axes = plt.subplots(len(panel_k), 1, figsize=(9, 2.4 * len(panel_k) + 0.6),
                              sharex=True, squeeze=False)
-    cmap = matplotlib.colormaps["viridis"].copy()
-    cmap.set_bad("white")
+    cmap = matplotlib.colormaps["viridis"].with_extremes(bad="white")
     for ax, k, (alphas, betas, force) in zip(axes[:, 0], panel_k, grids):
         with np.errstate(divide="ignore", invalid="ignore"):
             logf = np.log10(force)
@@ -118,9 +117,16 @@ def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: 
         ax_a.plot(alphas, force[ib, :], "-o", ms=2.5, color=colour, label=_set_label(k))
         ax_b.set_title(f"{object_name}: α = {alphas[ia]:g} deg", fontsize=9)
         ax_a.set_title(f"{object_name}: β = {betas[ib]:g} deg", fontsize=9)
-    for ax, xlabel in ((ax_b, "β (deg)"), (ax_a, "α (deg)")):
-        ax.set_yscale("log")
+    alphas, betas = np.sort(gfo["alpha_deg"].unique()), np.sort(gfo["beta_deg"].unique())
+    for ax, xlabel, grid in ((ax_b, "β (deg)", betas), (ax_a, "α (deg)", alphas)):
+        ax.set_xlim(grid[0], grid[-1])
         ax.set_xlabel(xlabel)
+        if not any(np.isfinite(line.get_ydata()).any() for line in ax.get_lines()):
+            ax.text(0.5, 0.5, "no force-closure pose on this slice", transform=ax.transAxes,
+                    ha="center", va="center", fontsize=9, color="0.4")
+            ax.set_yticks([])
+            continue
+        ax.set_yscale("log")
         ax.set_ylabel("optimal ‖f‖ (N)")
         ax.grid(alpha=0.3, which="both")
     ax_a.legend(fontsize=8, frameon=False)
@@ -129,18 +135,21 @@ def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: 
 
 
 def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str,
-                     fmt: str, png: str | Path, pdf: str | Path) -> None:
+                     fmt: str, png: str | Path, pdf: str | Path, log_scale: bool = False) -> None:
     """Fig. 5: ``first`` matrices ``first`` × ``first``, one per first synergy S_k; cell
     (i, j) of matrix k is the set {S_k, S_i, S_j}. Grey scale, the value in each cell.
 
     ``matrices`` has one row per (k, i, j) with 1-based columns ``k``, ``i``, ``j`` and the
-    column ``value``.
+    column ``value``. ``log_scale`` spreads the grey levels logarithmically (mean forces
+    span decades, and one near-infeasible set would otherwise whiten every other cell).
     """
     ncols = min(first, 4)
     nrows = int(np.ceil(first / ncols))
     fig, axes = plt.subplots(nrows, ncols, figsize=(3.3 * ncols, 3.1 * nrows), squeeze=False)
     values = matrices[value].to_numpy(dtype=float)
     vmin, vmax = (np.nanmin(values), np.nanmax(values)) if np.isfinite(values).any() else (0, 1)
+    norm = (matplotlib.colors.LogNorm(vmin=max(vmin, 1e-9), vmax=max(vmax, 2e-9))
+            if log_scale else matplotlib.colors.Normalize(vmin=vmin, vmax=vmax))
     labels = [f"S{i}" for i in range(1, first + 1)]
     for index, ax in enumerate(axes.flat):
         if index >= first:
@@ -150,7 +159,7 @@ def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str,
         sub = matrices[matrices["k"] == k]
         grid = np.full((first, first), np.nan)
         grid[sub["i"].to_numpy() - 1, sub["j"].to_numpy() - 1] = sub[value].to_numpy(dtype=float)
-        sns.heatmap(grid, ax=ax, cmap="Greys", vmin=vmin, vmax=vmax, annot=True, fmt=fmt,
+        sns.heatmap(grid, ax=ax, cmap="Greys", norm=norm, annot=True, fmt=fmt,
                     annot_kws={"fontsize": 6}, cbar=False, square=True,
                     xticklabels=labels, yticklabels=labels, linewidths=0.3, linecolor="0.8")
         ax.set_title(f"first synergy S{k}", fontsize=9)

@@ -11,5 +11,5 @@ with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     matrices = hierarchy_matrices(mean_over_objects(pd.read_csv(snakemake.input.rates)), first)
     figure_hierarchy(matrices, "success_rate", first, "Fig. 5A: success rate (%), mean over objects",
                      ".0f", out.success_png, out.success_pdf)
-    figure_hierarchy(matrices, "mean_force", first, "Fig. 5B: mean optimal force (N), mean over objects",
-                     ".1f", out.force_png, out.force_pdf)
+    figure_hierarchy(matrices, "mean_force", first, "Fig. 5B: mean optimal force (N), mean over objects (log grey scale)",
+                     ".1f", out.force_png, out.force_pdf, log_scale=True)

@@ -1,0 +1,49 @@
+"""Figure helpers: the force grid, the rule-graph parser, and files written for the study's plots."""
+import numpy as np
+import pandas as pd
+
+from synergrasp.figures import (figure_exploded_views, figure_force_maps, figure_hierarchy,
+                                force_grid, parse_rulegraph, write_table)
+
+
+def _gfo() -> pd.DataFrame:
+    """Two α × three β poses, set "1": force closure except at (α=0, β=10)."""
+    rows = []
+    for alpha in (0.0, 180.0):
+        for beta in (-10.0, 0.0, 10.0):
+            fc = not (alpha == 0.0 and beta == 10.0)
+            rows.append({"set_id": "1", "alpha_deg": alpha, "beta_deg": beta, "force_closure": fc,
+                         "force_norm": (1.0 + alpha / 90.0 + beta / 10.0 + 2.0) if fc else np.nan})
+    return pd.DataFrame(rows)
+
+
+def test_force_grid_places_each_pose_and_leaves_no_closure_empty():
+    alphas, betas, force = force_grid(_gfo(), "1")
+    np.testing.assert_array_equal(alphas, [0.0, 180.0])
+    np.testing.assert_array_equal(betas, [-10.0, 0.0, 10.0])
+    assert force.shape == (3, 2)
+    assert force[0, 0] == 2.0 and force[1, 1] == 5.0 and force[2, 1] == 6.0
+    assert np.isnan(force[2, 0])
+
+
+def test_parse_rulegraph_reads_nodes_and_edges():
+    dot = 'digraph {\n\t0[label = "all", color = "x"];\n\t1[label = "simulate", color = "y"];\n\t1 -> 0\n}'
+    nodes, edges = parse_rulegraph(dot)
+    assert nodes == {0: "all", 1: "simulate"}
+    assert edges == [(1, 0)]
+
+
+def test_figures_and_tables_are_written(tmp_path):
+    gfo = _gfo()
+    minima = gfo.iloc[[0]]
+    figure_force_maps(gfo, minima, [1], "box", tmp_path / "m.png", tmp_path / "m.pdf")
+    # the β slice at 10 deg has force closure only at α = 180; the α slice at β = 99 -> 10 deg
+    figure_exploded_views(gfo, [1], 0.0, 99.0, "box", tmp_path / "e.png", tmp_path / "e.pdf")
+    matrices = pd.DataFrame({"k": [1, 1], "i": [1, 1], "j": [1, 2], "success_rate": [50.0, 80.0],
+                             "mean_force": [3.0, 3000.0]})
+    figure_hierarchy(matrices, "mean_force", 2, "t", ".1f", tmp_path / "h.png", tmp_path / "h.pdf", log_scale=True)
+    write_table(pd.DataFrame({"a": [1.23456]}), tmp_path / "t.csv", tmp_path / "t.md", title="T")
+    for name in ("m.png", "m.pdf", "e.png", "e.pdf", "h.png", "h.pdf"):
+        assert (tmp_path / name).stat().st_size > 1000, name
+    assert (tmp_path / "t.md").read_text().startswith("# T\n")
+    assert pd.read_csv(tmp_path / "t.csv")["a"].iloc[0] == 1.23456
