@@ -32,7 +32,6 @@ def main() -> None:
     ap.add_argument("--problems", type=int, default=15000, help="number of (pose, set) GFO problems")
     ap.add_argument("--exact", type=int, default=1500, help="problems for the per-problem exact solver")
     ap.add_argument("--cvxpy", type=int, default=60, help="problems for the cvxpy loop")
-    ap.add_argument("--batch-size", type=int, default=4096)
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
 
@@ -45,7 +44,7 @@ def main() -> None:
     n = n_poses * len(sets)
 
     t0 = time.perf_counter()
-    out = optimise_grasps(grasps, S, sets, params, batch_size=args.batch_size, strict=False)
+    out = optimise_grasps(grasps, S, sets, params, strict=False)
     t_batched = time.perf_counter() - t0
     batched_rate = n / t_batched
     fallback = float(np.mean(out["solver"] == "clarabel_fallback"))

@@ -21,11 +21,12 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
 from synergrasp.force_optimisation import GFOParams, mechanics_for, solve_gfo, strict_internal_forces
-from synergrasp.mechanics import Grasp, tangent_pairs
+from synergrasp.mechanics import Grasp, internal_force_basis, tangent_pairs
 
 __all__ = [
     "BatchResult",
@@ -39,11 +40,8 @@ __all__ = [
     "solve_gfo_batch",
 ]
 
-#: Problems per padded batch in `optimise_grasps` (bounds the memory whatever the study size).
-DEFAULT_BATCH_SIZE = 4096
-
-# Status codes of the interior-point iteration (BatchResult.code).
-_RUNNING, _OPTIMAL, _INFEASIBLE, _UNSOLVED = 0, 1, 2, 3
+# Codes of the interior-point method (BatchResult.code); 0: e = 0, nothing to solve.
+_OPTIMAL, _INFEASIBLE, _UNDECIDED = 1, 2, 3
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -58,8 +56,10 @@ class SolverSettings:
     max_iter: iteration cap; a problem not decided by then falls back to `solve_gfo`
     step_fraction: fraction of the step to the cone boundary taken each iteration
     stall_step: a step below this ends the iteration (judged with `reduced_tol`)
-    refine: iterative-refinement steps on the full KKT system per solve (0: none; 1 lowers
-        the fallback share slightly at about 20 % more time per iteration)
+    refine: iterative-refinement steps on the full KKT system per linear solve (0: none)
+    retry_refine: refinement steps of a second attempt on a problem the first attempt leaves
+        undecided (no second attempt unless it exceeds `refine`); problems still undecided
+        fall back to the per-problem exact solver
     """
 
     tol: float = 1e-8
@@ -68,6 +68,7 @@ class SolverSettings:
     step_fraction: float = 0.99
     stall_step: float = 1e-3
     refine: int = 0
+    retry_refine: int = 1
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.tol) and 0 < self.tol < 1):
@@ -76,45 +77,52 @@ class SolverSettings:
             raise ValueError(f"max_iter must be a positive int, got {self.max_iter!r}")
         if not (0 < self.step_fraction < 1):
             raise ValueError(f"step_fraction must be in (0, 1), got {self.step_fraction}")
+        for name in ("refine", "retry_refine"):
+            value = getattr(self, name)
+            if not (isinstance(value, int) and 0 <= value <= 10):
+                raise ValueError(f"{name} must be an int in 0..10, got {value!r}")
 
 
 @dataclass(frozen=True)
 class GFOBatch:
-    """B GFO problems padded to a common contact count m and basis size e, batch last.
+    """B GFO problems padded to a common contact count m and basis size e, batch first.
 
-    rows:    (m, 3, e, B) contact-frame rows [n.E_i; t1.E_i / mu; t2.E_i / mu], per N of y
-    h:       (m, 3, B)    the same rows applied to f_p, N
-    a:       (e, B)       E^T f_p, N
-    r0:      (B,)         ||f_p - E a||, the part of f_p no internal force can cancel, N
-    f_min:   (B,)         least normal force, N
-    contact: (m, B)       True where the contact exists (padding contacts are masked out)
+    frames:     (B, m, 3, 3)  rows [n; t1/mu; t2/mu] per contact (Coulomb cone: frames @ f_i in SOC(3))
+    E:          (B, 3m, e)    orthonormal internal-force bases
+    f_p:        (B, 3m)       particular forces, N
+    mu, f_min:  (B,)          friction coefficient; least normal force, N
+    n_contacts: (B,)          contacts of each problem (the first ones; the rest is zero padding)
+    n_basis:    (B,)          basis columns of each problem (the first ones)
     """
 
-    rows: NDArray
-    h: NDArray
-    a: NDArray
-    r0: NDArray
+    frames: NDArray
+    E: NDArray
+    f_p: NDArray
+    mu: NDArray
     f_min: NDArray
-    contact: NDArray
+    n_contacts: NDArray
+    n_basis: NDArray
 
     @property
     def size(self) -> int:
-        return int(self.a.shape[-1])
+        return int(self.f_p.shape[0])
 
 
 @dataclass(frozen=True)
 class BatchResult:
     """Outcome of `solve_batch`, one entry per problem.
 
-    code: 1 optimal, 2 infeasible (certificate), 3 not decided within the iteration cap
-    y: (e, B) optimal internal-force coordinates, N (NaN unless optimal)
-    t: (B,) optimal ||y + a||, N (NaN unless optimal)
+    code: 1 optimal, 2 infeasible (certificate), 3 not decided; 0 for e = 0 (nothing to solve)
+    y: (B, e) optimal internal-force coordinates, N (NaN unless optimal, and in padding)
+    force_norm: optimal ||f_p + E y||, N (NaN unless optimal)
+    max_violation: worst constraint violation of those forces, N (NaN unless optimal)
     iterations: (B,) interior-point iterations
     """
 
     code: NDArray
     y: NDArray
-    t: NDArray
+    force_norm: NDArray
+    max_violation: NDArray
     iterations: NDArray
 
 
@@ -130,27 +138,38 @@ def gfo_batch(
     m_pad: int | None = None,
     e_pad: int | None = None,
 ) -> GFOBatch:
-    """Pad and stack GFO problems (f_p (3m,), E (3m, e) orthonormal, normals (m, 3)).
+    """Pad and stack GFO problems (f_p (3m,) N, E (3m, e) orthonormal, normals (m, 3)).
 
-    Absent contacts and basis columns of a problem are zero-padded at the end, so the
-    padded problem has exactly the same iterates as the problem alone.
+    Each problem is solved from its own sizes only, so it has the same iterates alone or in
+    any batch, padded or not.
     """
     B = len(f_p)
     if not (len(E) == len(normals) == B):
         raise ValueError(f"f_p, E and normals must have the same length, got {B}, {len(E)}, {len(normals)}")
-    mus = np.broadcast_to(np.asarray(mu, dtype=float), (B,))
-    fmins = np.broadcast_to(np.asarray(f_min, dtype=float), (B,))
+    mus = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (B,)))
+    fmins = np.array(np.broadcast_to(np.asarray(f_min, dtype=float), (B,)))
     if not np.all(np.isfinite(mus) & (mus > 0)):
         raise ValueError("mu must be finite and > 0")
     if not np.all(np.isfinite(fmins) & (fmins >= 0)):
         raise ValueError("f_min must be finite and >= 0 (N)")
-    blocks = [_problem_block(f_p[k], E[k], normals[k], mus[k], fmins[k], k) for k in range(B)]
-    m = max([b.m for b in blocks] + [1]) if m_pad is None else m_pad
-    e = max([b.e for b in blocks] + [1]) if e_pad is None else e_pad
-    if max([b.m for b in blocks] + [0]) > m or max([b.e for b in blocks] + [0]) > e:
+    bases = [np.asarray(Ek, dtype=float).reshape(np.asarray(Ek).shape[0], -1) for Ek in E]
+    ms = np.array([np.asarray(n).reshape(-1, 3).shape[0] for n in normals], dtype=np.int64)
+    es = np.array([Ek.shape[1] for Ek in bases], dtype=np.int64)
+    m = max(int(ms.max(initial=0)), 1) if m_pad is None else m_pad
+    e = max(int(es.max(initial=0)), 1) if e_pad is None else e_pad
+    if ms.max(initial=0) > m or es.max(initial=0) > e:
         raise ValueError(f"m_pad={m_pad} / e_pad={e_pad} smaller than the largest problem")
-    batch, _ = _stack(blocks, m, e)
-    return batch
+    frames = np.zeros((B, m, 3, 3))
+    Eb = np.zeros((B, 3 * m, e))
+    fp = np.zeros((B, 3 * m))
+    for k in range(B):
+        mk, ek = ms[k], es[k]
+        if bases[k].shape[0] != 3 * mk or np.size(f_p[k]) != 3 * mk:
+            raise ValueError(f"problem {k}: f_p and E must have 3m = {3 * mk} rows")
+        frames[k, :mk] = _contact_frames(np.asarray(normals[k], dtype=float).reshape(mk, 3), mus[k])
+        Eb[k, :3 * mk, :ek] = bases[k]
+        fp[k, :3 * mk] = np.asarray(f_p[k], dtype=float).ravel()
+    return GFOBatch(frames=frames, E=Eb, f_p=fp, mu=mus, f_min=fmins, n_contacts=ms, n_basis=es)
 
 
 def _contact_frames(normals: NDArray, mu: float | NDArray) -> NDArray:
@@ -161,399 +180,649 @@ def _contact_frames(normals: NDArray, mu: float | NDArray) -> NDArray:
 
 
 # --------------------------------------------------------------------------- cone algebra
-# A second-order cone vector is stored with its components on axis 0: v[0] >= ||v[1:]||.
+# Compiled with numba: one problem at a time, so a problem's numbers never depend on the
+# batch it arrives in, and the ~10 iterations of a tiny problem cost microseconds instead of
+# the hundreds of numpy calls a vectorised iteration needs. A cone vector v has v[0] >= ||v[1:]||.
+# Flat layout of a problem's cone vectors (length 4m + e + 2): m linear slacks n.f - f_min,
+# then m Coulomb cones SOC(3) [n.f, t1.f/mu, t2.f/mu], then the objective cone (t, r0, y + a).
+
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
+_jit_small = numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 
 
-def _soc_det(v: NDArray) -> NDArray:
-    """v^T J v = v0^2 - ||v1||^2, computed as a product to keep relative accuracy near the boundary."""
-    r = np.sqrt(np.sum(v[1:] * v[1:], axis=0))
+@_jit_small
+def _soc_det(v):
+    """v^T J v = v0^2 - ||v1||^2, as a product to keep relative accuracy near the boundary."""
+    r = 0.0
+    for i in range(1, v.size):
+        r += v[i] * v[i]
+    r = math.sqrt(r)
     return (v[0] - r) * (v[0] + r)
 
 
-def _soc_nt(s: NDArray, z: NDArray):
-    """Nesterov-Todd scaling point of SOC pairs (s, z) in the interior.
-
-    Returns (w, beta) with W = beta [[w0, w1^T], [w1, I + w1 w1^T / (1 + w0)]], w^T J w = 1,
-    so that W z = W^-1 s = lambda and (W^T W)^-1 = beta^-2 (2 (Jw)(Jw)^T - J).
-    """
-    sd = np.sqrt(_soc_det(s))
-    zd = np.sqrt(_soc_det(z))
-    sb = s / sd
-    zb = z / zd
-    gamma = np.sqrt(0.5 * (1.0 + np.sum(sb * zb, axis=0)))
-    w = sb.copy()
-    w[0] += zb[0]
-    w[1:] -= zb[1:]
-    w /= 2.0 * gamma
-    beta = np.sqrt(sd / zd)
-    return w, beta
+@_jit_small
+def _soc_nt(s, z, w):
+    """Nesterov-Todd scaling point of the interior pair (s, z): fills w (w^T J w = 1) and
+    returns beta, with W z = W^-1 s = lambda and (W^T W)^-1 = beta^-2 (2 (Jw)(Jw)^T - J)."""
+    sd = math.sqrt(_soc_det(s))
+    zd = math.sqrt(_soc_det(z))
+    dot = 0.0
+    for i in range(s.size):
+        dot += (s[i] / sd) * (z[i] / zd)
+    gamma2 = 2.0 * math.sqrt(0.5 * (1.0 + dot))
+    w[0] = (s[0] / sd + z[0] / zd) / gamma2
+    for i in range(1, s.size):
+        w[i] = (s[i] / sd - z[i] / zd) / gamma2
+    return math.sqrt(sd / zd)
 
 
-def _soc_apply(w: NDArray, beta: NDArray, v: NDArray, inverse: bool = False) -> NDArray:
-    """W v (or W^-1 v) for the NT scaling (w, beta) of `_soc_nt`."""
+@_jit_small
+def _soc_apply(w, beta, v, out, inverse):
+    """out = W v (or W^-1 v) for the NT scaling (w, beta)."""
     sign = -1.0 if inverse else 1.0
-    w1v1 = np.sum(w[1:] * v[1:], axis=0)
-    out = np.empty_like(v)
-    out[0] = w[0] * v[0] + sign * w1v1
-    out[1:] = v[1:] + w[1:] * (sign * v[0] + w1v1 / (1.0 + w[0]))
-    return out * (1.0 / beta if inverse else beta)
+    scale = 1.0 / beta if inverse else beta
+    w1v1 = 0.0
+    for i in range(1, v.size):
+        w1v1 += w[i] * v[i]
+    c = sign * v[0] + w1v1 / (1.0 + w[0])
+    out[0] = (w[0] * v[0] + sign * w1v1) * scale
+    for i in range(1, v.size):
+        out[i] = (v[i] + w[i] * c) * scale
 
 
-def _soc_prod(u: NDArray, v: NDArray) -> NDArray:
+@_jit_small
+def _soc_hessian(w, beta, H):
+    """H = (W^T W)^-1 = beta^-2 (2 u u^T - J), u = J w."""
+    d = w.size
+    ib2 = 1.0 / (beta * beta)
+    for i in range(d):
+        ui = w[i] if i == 0 else -w[i]
+        for j in range(d):
+            uj = w[j] if j == 0 else -w[j]
+            H[i, j] = 2.0 * ui * uj
+        H[i, i] += -1.0 if i == 0 else 1.0
+        for j in range(d):
+            H[i, j] *= ib2
+
+
+@_jit_small
+def _soc_prod(u, v, out):
     """Jordan product u o v = (u^T v, u0 v1 + v0 u1)."""
-    out = np.empty_like(u)
-    out[0] = np.sum(u * v, axis=0)
-    out[1:] = u[0] * v[1:] + v[0] * u[1:]
-    return out
+    acc = 0.0
+    for i in range(u.size):
+        acc += u[i] * v[i]
+    for i in range(1, u.size):
+        out[i] = u[0] * v[i] + v[0] * u[i]
+    out[0] = acc
 
 
-def _soc_div(lam: NDArray, w: NDArray) -> NDArray:
-    """x with lam o x = w (lam in the interior)."""
+@_jit_small
+def _soc_div(lam, w, out):
+    """out = x with lam o x = w (lam in the interior)."""
     rho = _soc_det(lam)
-    nu = np.sum(lam[1:] * w[1:], axis=0)
-    out = np.empty_like(w)
+    nu = 0.0
+    for i in range(1, lam.size):
+        nu += lam[i] * w[i]
+    c = (nu / lam[0] - w[0]) / rho
     out[0] = (lam[0] * w[0] - nu) / rho
-    out[1:] = ((nu / lam[0] - w[0]) / rho) * lam[1:] + w[1:] / lam[0]
-    return out
+    for i in range(1, lam.size):
+        out[i] = c * lam[i] + w[i] / lam[0]
 
 
-def _soc_max_step(v: NDArray, d: NDArray) -> NDArray:
+@_jit_small
+def _soc_max_step(v, d):
     """Largest alpha >= 0 with v + alpha d in the cone (inf if unbounded); v interior."""
-    a = d[0] * d[0] - np.sum(d[1:] * d[1:], axis=0)
-    b = v[0] * d[0] - np.sum(v[1:] * d[1:], axis=0)
+    a = d[0] * d[0]
+    b = v[0] * d[0]
+    for i in range(1, v.size):
+        a -= d[i] * d[i]
+        b -= v[i] * d[i]
     c = _soc_det(v)
     disc = b * b - a * c
-    with np.errstate(invalid="ignore", divide="ignore"):
-        denom = -b + np.sqrt(np.maximum(disc, 0.0))
-        step = np.where((disc >= 0) & (denom > 0), c / denom, np.inf)
-    return step
+    denom = -b + math.sqrt(max(disc, 0.0))
+    if disc >= 0.0 and denom > 0.0:
+        return c / denom
+    return math.inf
 
 
-def _lin_max_step(v: NDArray, d: NDArray) -> NDArray:
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(d < 0, -v / d, np.inf)
+@_jit_small
+def _lin_max_step(v, d):
+    return -v / d if d < 0.0 else math.inf
 
 
-def _soc_hessian(w: NDArray, beta: NDArray) -> NDArray:
-    """(W^T W)^-1 = beta^-2 (2 u u^T - J), u = J w, as a (d, d, ...) array."""
-    u = w.copy()
-    u[1:] = -u[1:]
-    H = 2.0 * u[:, None] * u[None, :]
-    d = w.shape[0]
-    H[0, 0] -= 1.0
-    idx = np.arange(1, d)
-    H[idx, idx] += 1.0
-    return H / (beta * beta)
+# --------------------------------------------------------------------------- one problem
 
 
-# --------------------------------------------------------------------------- linear algebra
+@_jit
+def _G_mul(D, m, e, x, out):
+    """out = G x for x = (t, y): linear rows -D0 y, Coulomb rows -D y, objective -(t, 0, y)."""
+    for i in range(m):
+        for r in range(3):
+            acc = 0.0
+            for j in range(e):
+                acc += D[i, r, j] * x[1 + j]
+            out[m + 3 * i + r] = -acc
+        out[i] = out[m + 3 * i]
+    o = 4 * m
+    out[o] = -x[0]
+    out[o + 1] = 0.0
+    for j in range(e):
+        out[o + 2 + j] = -x[1 + j]
 
 
-def _cholesky(M: NDArray) -> NDArray:
-    """Lower Cholesky factor of the SPD matrices M (n, n, B), column by column, batch last."""
+@_jit
+def _GT_mul(D, m, e, z, out):
+    """out = G^T z."""
+    o = 4 * m
+    out[0] = -z[o]
+    for j in range(e):
+        acc = 0.0
+        for i in range(m):
+            c = m + 3 * i
+            acc += D[i, 0, j] * (z[c] + z[i]) + D[i, 1, j] * z[c + 1] + D[i, 2, j] * z[c + 2]
+        out[1 + j] = -z[o + 2 + j] - acc
+
+
+@_jit
+def _H_mul(m, e, w_lin, H_soc, H_obj, v, out):
+    """out = (W^T W)^-1 v, with the same matrices as the normal matrix (a closed form
+    rounds differently, and that mismatch costs accuracy near the optimum)."""
+    for i in range(m):
+        out[i] = w_lin[i] * v[i]
+        c = m + 3 * i
+        for r in range(3):
+            out[c + r] = H_soc[i, r, 0] * v[c] + H_soc[i, r, 1] * v[c + 1] + H_soc[i, r, 2] * v[c + 2]
+    o = 4 * m
+    for r in range(e + 2):
+        acc = 0.0
+        for k in range(e + 2):
+            acc += H_obj[r, k] * v[o + k]
+        out[o + r] = acc
+
+
+@_jit
+def _V_mul(m, e, s_over_z, w_soc, b_soc, w_obj, b_obj, v, tmp, out):
+    """out = W^T W v through the scaling factors (iterative refinement)."""
+    for i in range(m):
+        out[i] = s_over_z[i] * v[i]
+        c = m + 3 * i
+        _soc_apply(w_soc[i], b_soc[i], v[c:c + 3], tmp[c:c + 3], False)
+        _soc_apply(w_soc[i], b_soc[i], tmp[c:c + 3], out[c:c + 3], False)
+    o = 4 * m
+    _soc_apply(w_obj, b_obj, v[o:], tmp[o:], False)
+    _soc_apply(w_obj, b_obj, tmp[o:], out[o:], False)
+
+
+@_jit
+def _cholesky(M, L):
+    """Lower Cholesky factor L of the SPD matrix M (lower triangle read)."""
     n = M.shape[0]
-    L = np.zeros_like(M)
     for j in range(n):
-        col = M[j:, j] - np.sum(L[j:, :j] * L[j, :j][None], axis=1) if j else M[j:, j].copy()
-        d = np.sqrt(np.maximum(col[0], 1e-300))
-        L[j, j] = d
-        L[j + 1:, j] = col[1:] / d
-    return L
+        for i in range(j, n):
+            acc = M[i, j]
+            for k in range(j):
+                acc -= L[i, k] * L[j, k]
+            if i == j:
+                L[j, j] = math.sqrt(max(acc, 1e-300))
+            else:
+                L[i, j] = acc / L[j, j]
 
 
-def _cho_solve(L: NDArray, b: NDArray) -> NDArray:
-    """Solve L L^T x = b for L (n, n, B), b (n, B)."""
+@_jit
+def _cho_solve(L, b, x):
+    """x with L L^T x = b."""
     n = L.shape[0]
-    u = np.empty_like(b)
     for i in range(n):
-        acc = b[i] - np.sum(L[i, :i] * u[:i], axis=0) if i else b[i]
-        u[i] = acc / L[i, i]
-    x = np.empty_like(b)
-    for i in range(n - 1, -1, -1):
-        acc = u[i] - np.sum(L[i + 1:, i] * x[i + 1:], axis=0) if i < n - 1 else u[i]
+        acc = b[i]
+        for k in range(i):
+            acc -= L[i, k] * x[k]
         x[i] = acc / L[i, i]
-    return x
+    for i in range(n - 1, -1, -1):
+        acc = x[i]
+        for k in range(i + 1, n):
+            acc -= L[k, i] * x[k]
+        x[i] = acc / L[i, i]
 
 
-# --------------------------------------------------------------------------- the solver
+@_jit
+def _reduced(D, m, e, L, w_lin, H_soc, H_obj, bx, bz, dx, dz, wN, wn):
+    """[0 G^T; G -W^T W] [dx; dz] = [bx; bz] by the normal equations."""
+    _H_mul(m, e, w_lin, H_soc, H_obj, bz, wN)
+    _GT_mul(D, m, e, wN, wn)
+    for j in range(e + 1):
+        wn[j] += bx[j]
+    _cho_solve(L, wn, dx)
+    _G_mul(D, m, e, dx, wN)
+    for k in range(wN.size):
+        wN[k] -= bz[k]
+    _H_mul(m, e, w_lin, H_soc, H_obj, wN, dz)
 
 
-class _Cones:
-    """Cone variables of a batch: per contact a linear slack (n.f - f_min) and a SOC(3)
-    (the Coulomb cone), plus one SOC(e+1) for the objective epigraph (t, y + a)."""
-
-    __slots__ = ("lin", "soc", "obj")
-
-    def __init__(self, lin, soc, obj):
-        self.lin, self.soc, self.obj = lin, soc, obj
-
-    def copy(self):
-        return _Cones(self.lin.copy(), self.soc.copy(), self.obj.copy())
-
-
-def solve_batch(batch: GFOBatch, settings: SolverSettings = SolverSettings()) -> BatchResult:
-    """Solve the padded batch with the homogeneous self-dual interior-point method.
-
-    The data are scaled per problem by rho = max(||f_p||, f_min) (reported y, t in N).
-    Verdicts: optimal when the scaled primal and dual residuals and the duality gap are below
-    `tol`; infeasible when the dual iterate is a Farkas certificate (h^T z < 0 and
-    ||G^T z|| <= tol |h^T z|); otherwise 'not decided' after `max_iter` iterations.
-    """
-    with np.errstate(all="ignore"):  # a breakdown shows as a non-finite iterate: 'not decided'
-        return _solve_batch(batch, settings)
+@_jit
+def _solve_kkt(D, m, e, L, w_lin, H_soc, H_obj, s_over_z, w_soc, b_soc, w_obj, b_obj, refine,
+               bx, bz, dx, dz, wN, wN2, wN3, wn, wn2):
+    _reduced(D, m, e, L, w_lin, H_soc, H_obj, bx, bz, dx, dz, wN, wn)
+    for _ in range(refine):
+        # residual of the full system, then a correction from the same factorisation
+        _G_mul(D, m, e, dx, wN2)
+        _V_mul(m, e, s_over_z, w_soc, b_soc, w_obj, b_obj, dz, wN, wN3)
+        for k in range(wN.size):
+            wN2[k] = bz[k] - wN2[k] + wN3[k]
+        _GT_mul(D, m, e, dz, wn2)
+        for j in range(e + 1):
+            wn2[j] = bx[j] - wn2[j]
+        ex = np.empty(e + 1)
+        ez = np.empty(wN.size)
+        _reduced(D, m, e, L, w_lin, H_soc, H_obj, wn2, wN2, ex, ez, wN, wn)
+        for j in range(e + 1):
+            dx[j] += ex[j]
+        for k in range(wN.size):
+            dz[k] += ez[k]
 
 
-def _solve_batch(batch: GFOBatch, settings: SolverSettings) -> BatchResult:
-    D, mask = batch.rows, batch.contact
-    m, _, e, B = D.shape
-    cm = mask.astype(float)
+@_jit
+def _max_step(m, s, z, ds, dz, tau, dtau, kappa, dkappa):
+    st = min(_lin_max_step(tau, dtau), _lin_max_step(kappa, dkappa))
+    for i in range(m):
+        st = min(st, _lin_max_step(s[i], ds[i]), _lin_max_step(z[i], dz[i]))
+        c = m + 3 * i
+        st = min(st, _soc_max_step(s[c:c + 3], ds[c:c + 3]), _soc_max_step(z[c:c + 3], dz[c:c + 3]))
+    o = 4 * m
+    return min(st, _soc_max_step(s[o:], ds[o:]), _soc_max_step(z[o:], dz[o:]))
+
+
+@_jit
+def _is_optimal(pres, dres, gap, pcost, eps):
+    return pres <= eps and dres <= eps and (gap <= eps or gap <= eps * abs(pcost))
+
+
+@_jit
+def _is_certificate(hz, gtz_norm, eps):
+    """The dual iterate proves infeasibility (Farkas): h^T z < 0 and ||G^T z|| <= eps |h^T z|."""
+    return hz < 0.0 and gtz_norm <= eps * -hz
+
+
+@_jit
+def _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine, y):
+    """Solve one GFO problem (contact rows D (m, 3, e), h (m, 3), a (e,), N) by the homogeneous
+    self-dual embedding. Returns (code, t in N, iterations); fills y (N) when optimal."""
+    N = 4 * m + e + 2
+    n = e + 1
+    o = 4 * m
     # Scale so that the forces are O(1): the iteration then starts well centred.
-    fp_norm = np.sqrt(batch.r0 * batch.r0 + np.sum(batch.a * batch.a, axis=0))
-    rho = np.maximum(fp_norm, np.maximum(batch.f_min, 1e-12))
-    h_soc = np.ascontiguousarray(np.where(mask, batch.h.transpose(1, 0, 2) / rho, 0.0))  # (3, m, B), components first
-    h_lin = np.where(mask, (batch.h[:, 0] - batch.f_min) / rho, 0.0)
-    a = batch.a / rho
-    h_obj = np.concatenate([np.zeros((1, B)), (batch.r0 / rho)[None], a], axis=0)
-    h_norm = np.maximum(1.0, np.sqrt(np.sum(h_lin * h_lin, axis=0) + np.sum(np.sum(h_soc * h_soc, axis=0), axis=0)
-                                     + np.sum(a * a, axis=0)))
-    n_deg = 2.0 * np.sum(cm, axis=0) + 1.0  # barrier degree: m linear + m SOC(3) + 1 objective cone
+    fp_norm = r0 * r0
+    for j in range(e):
+        fp_norm += a[j] * a[j]
+    rho = max(math.sqrt(fp_norm), max(f_min, 1e-12))
+    h = np.zeros(N)
+    for i in range(m):
+        h[i] = (hv[i, 0] - f_min) / rho
+        for r in range(3):
+            h[m + 3 * i + r] = hv[i, r] / rho
+    h[o + 1] = r0 / rho
+    for j in range(e):
+        h[o + 2 + j] = a[j] / rho
+    hh = 0.0
+    for k in range(N):
+        if k != o + 1:
+            hh += h[k] * h[k]
+    h_norm = max(1.0, math.sqrt(hh))
+    n_deg = 2.0 * m + 1.0
 
-    # G x for x = (t, y): linear rows -D0 y, SOC rows -D y, objective rows -(t, 0, y):
-    # the objective cone is (t, r0, y + a), so t is ||f|| / rho itself.
-    def G_mul(x):
-        Dy = np.einsum("mrjb,jb->rmb", D, x[1:])
-        obj = np.zeros((x.shape[0] + 1, x.shape[1]))
-        obj[0] = -x[0]
-        obj[2:] = -x[1:]
-        np.negative(Dy, out=Dy)
-        return _Cones(Dy[0], Dy, obj)
+    x = np.zeros(n)
+    s = np.zeros(N)
+    for i in range(m):
+        s[i] = 1.0
+        s[m + 3 * i] = 1.0
+    s[o] = 1.0
+    z = s.copy()
+    tau = 1.0
+    kappa = 1.0
 
-    def GT_mul(zc: _Cones):
-        zz = zc.soc.copy()
-        zz[0] += zc.lin
-        zz *= cm
-        out = -np.delete(zc.obj, 1, axis=0)
-        out[1:] -= np.einsum("mrjb,rmb->jb", D, zz)
-        return out
+    r_x, x1, x2, dx, dx_a = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    bx, wn, wn2 = np.empty(n), np.empty(n), np.empty(n)
+    r_z, z1, z2, dz, dz_a = np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N)
+    ds, ds_a, dsv, q = np.empty(N), np.empty(N), np.empty(N), np.empty(N)
+    wN, wN2, wN3 = np.empty(N), np.empty(N), np.empty(N)
+    lam = np.empty(N)
+    w_lin = np.empty(m)
+    s_over_z = np.empty(m)
+    w_soc = np.empty((m, 3))
+    b_soc = np.empty(m)
+    w_obj = np.empty(e + 2)
+    H_soc = np.empty((m, 3, 3))
+    H_obj = np.empty((e + 2, e + 2))
+    T = np.empty((m, 3, e))
+    M = np.empty((n, n))
+    L = np.zeros((n, n))
+    tmp3 = np.empty(3)
+    tmp_o = np.empty(e + 2)
+    stalled = False
 
-    # Initial point of the embedding: x = 0, s = z = identity of the cone, tau = kappa = 1.
-    x = np.zeros((e + 1, B))
-    ident = _Cones(np.ones((m, B)), np.zeros((3, m, B)), np.zeros((e + 2, B)))
-    ident.soc[0] = 1.0
-    ident.obj[0] = 1.0
-    s, z = ident.copy(), ident.copy()
-    tau = np.ones(B)
-    kappa = np.ones(B)
-    code = np.zeros(B, dtype=np.int8)
-    iters = np.zeros(B, dtype=np.int32)
-    y_out = np.full((e, B), np.nan)
-    t_out = np.full(B, np.nan)
-    active = np.arange(B)
-    tol = settings.tol
-    stalled = np.zeros(B, dtype=bool)
-
-    def take(c: _Cones, idx):
-        return _Cones(c.lin[:, idx], c.soc[:, :, idx], c.obj[:, idx])
-
-    for it in range(settings.max_iter + 1):
-        Gx = G_mul(x)
-        GTz = GT_mul(z)
-        r_x = GTz.copy()
+    for it in range(max_iter + 1):
+        _GT_mul(D, m, e, z, r_x)
+        gtz = 0.0
+        for j in range(n):
+            gtz += r_x[j] * r_x[j]
+        gtz_norm = math.sqrt(gtz)
         r_x[0] += tau
-        r_z = _Cones(Gx.lin + s.lin - h_lin * tau, Gx.soc + s.soc - h_soc * tau, Gx.obj + s.obj - h_obj * tau)
-        r_z.lin *= cm
-        r_z.soc *= cm
-        hz = np.sum(h_lin * z.lin * cm, axis=0) + np.sum(np.sum(h_soc * z.soc, axis=0) * cm, axis=0) \
-            + np.sum(h_obj * z.obj, axis=0)
+        _G_mul(D, m, e, x, r_z)
+        hz = 0.0
+        sz = 0.0
+        pr = 0.0
+        for k in range(N):
+            r_z[k] += s[k] - h[k] * tau
+            hz += h[k] * z[k]
+            sz += s[k] * z[k]
+            pr += r_z[k] * r_z[k]
         r_tau = kappa + x[0] + hz
-        sz = np.sum((s.lin * z.lin + np.sum(s.soc * z.soc, axis=0)) * cm, axis=0) + np.sum(s.obj * z.obj, axis=0)
         mu = (sz + tau * kappa) / (n_deg + 1.0)
-
+        dr = 0.0
+        for j in range(n):
+            dr += r_x[j] * r_x[j]
         # Stopping tests on the de-homogenised point.
-        pres = np.sqrt(np.sum(r_z.lin ** 2, axis=0) + np.sum(np.sum(r_z.soc ** 2, axis=0), axis=0)
-                       + np.sum(r_z.obj ** 2, axis=0)) / tau / h_norm
-        dres = np.sqrt(np.sum(r_x ** 2, axis=0)) / tau
+        pres = math.sqrt(pr) / tau / h_norm
+        dres = math.sqrt(dr) / tau
         pcost = x[0] / tau
         gap = sz / (tau * tau)
-        gtz_norm = np.sqrt(np.sum(GTz ** 2, axis=0))
-
-        def verdicts(eps):
-            opt = (pres <= eps) & (dres <= eps) & ((gap <= eps) | (gap <= eps * np.abs(pcost)))
-            return opt, ~opt & (hz < 0) & (gtz_norm <= eps * -hz)
-
-        optimal, infeasible = verdicts(tol)
-        near_opt, near_inf = verdicts(settings.reduced_tol)
-        last = (it == settings.max_iter) | stalled
-        optimal |= last & near_opt
-        infeasible |= last & ~optimal & near_inf
-        bad = ~(np.isfinite(mu) & np.isfinite(tau) & (tau > 0))
-        done = optimal | infeasible | bad | last
-        if np.any(done):
-            ids = active[done]
-            code[ids] = np.where(optimal[done], _OPTIMAL, np.where(infeasible[done], _INFEASIBLE, _UNSOLVED))
-            iters[ids] = it
-            opt = done & optimal
-            y_out[:, active[opt]] = x[1:, opt] / tau[opt] * rho[opt]
-            t_out[active[opt]] = x[0, opt] / tau[opt] * rho[opt]
-            keep = ~done
-            if not np.any(keep):
-                break
-            active = active[keep]
-            D, cm, mask = D[..., keep], cm[:, keep], mask[:, keep]
-            h_lin, h_soc, h_obj, h_norm = h_lin[:, keep], h_soc[..., keep], h_obj[:, keep], h_norm[keep]
-            n_deg, rho, stalled = n_deg[keep], rho[keep], stalled[keep]
-            x, tau, kappa, mu = x[:, keep], tau[keep], kappa[keep], mu[keep]
-            s, z = take(s, keep), take(z, keep)
-            r_x, r_tau = r_x[:, keep], r_tau[keep]
-            r_z = take(r_z, keep)
+        last = it == max_iter or stalled
+        optimal = _is_optimal(pres, dres, gap, pcost, tol)
+        infeasible = not optimal and _is_certificate(hz, gtz_norm, tol)
+        if last:
+            optimal = optimal or _is_optimal(pres, dres, gap, pcost, reduced_tol)
+            infeasible = infeasible or (not optimal and _is_certificate(hz, gtz_norm, reduced_tol))
+        if optimal:
+            for j in range(e):
+                y[j] = x[1 + j] / tau * rho
+            return _OPTIMAL, x[0] / tau * rho, it
+        if infeasible:
+            return _INFEASIBLE, math.nan, it
+        if last or not (math.isfinite(mu) and math.isfinite(tau) and tau > 0.0):
+            return _UNDECIDED, math.nan, it
 
         # Nesterov-Todd scaling and the normal matrix M = G^T (W^T W)^-1 G, (e+1, e+1).
-        w_lin = np.where(cm > 0, z.lin / s.lin, 0.0)  # (W^T W)^-1 of the linear cone
-        s_over_z = np.where(cm > 0, s.lin / z.lin, 0.0)
-        lam_lin = np.sqrt(s.lin * z.lin)
-        w_soc, b_soc = _soc_nt(s.soc, z.soc)
-        w_obj, b_obj = _soc_nt(s.obj, z.obj)
-        lam_soc = _soc_apply(w_soc, b_soc, z.soc)
-        lam_obj = _soc_apply(w_obj, b_obj, z.obj)
-        H_soc = _soc_hessian(w_soc, b_soc) * cm  # (3, 3, m, B)
-        H_con = H_soc.copy()  # a contact's linear row is the first row of its cone rows
-        H_con[0, 0] += w_lin
-        H_obj = _soc_hessian(w_obj, b_obj)
-        T = np.einsum("rkmb,mkjb->mrjb", H_con, D)
-        M = np.delete(np.delete(H_obj, 1, axis=0), 1, axis=1)
-        M[1:, 1:] += np.einsum("mrib,mrjb->ijb", D, T)
-        L = _cholesky(M)
+        for i in range(m):
+            w_lin[i] = z[i] / s[i]
+            s_over_z[i] = s[i] / z[i]
+            lam[i] = math.sqrt(s[i] * z[i])
+            c = m + 3 * i
+            b_soc[i] = _soc_nt(s[c:c + 3], z[c:c + 3], w_soc[i])
+            _soc_apply(w_soc[i], b_soc[i], z[c:c + 3], lam[c:c + 3], False)
+            _soc_hessian(w_soc[i], b_soc[i], H_soc[i])
+        b_obj = _soc_nt(s[o:], z[o:], w_obj)
+        _soc_apply(w_obj, b_obj, z[o:], lam[o:], False)
+        _soc_hessian(w_obj, b_obj, H_obj)
+        M[0, 0] = H_obj[0, 0]
+        for j in range(e):
+            M[1 + j, 0] = H_obj[2 + j, 0]
+            for k in range(j + 1):
+                M[1 + j, 1 + k] = H_obj[2 + j, 2 + k]
+        for i in range(m):
+            # a contact's linear row is the first row of its Coulomb rows
+            h00 = H_soc[i, 0, 0] + w_lin[i]
+            for j in range(e):
+                d0, d1, d2 = D[i, 0, j], D[i, 1, j], D[i, 2, j]
+                T[i, 0, j] = h00 * d0 + H_soc[i, 0, 1] * d1 + H_soc[i, 0, 2] * d2
+                T[i, 1, j] = H_soc[i, 1, 0] * d0 + H_soc[i, 1, 1] * d1 + H_soc[i, 1, 2] * d2
+                T[i, 2, j] = H_soc[i, 2, 0] * d0 + H_soc[i, 2, 1] * d1 + H_soc[i, 2, 2] * d2
+        for j in range(e):
+            for k in range(j + 1):
+                acc = 0.0
+                for i in range(m):
+                    acc += D[i, 0, j] * T[i, 0, k] + D[i, 1, j] * T[i, 1, k] + D[i, 2, j] * T[i, 2, k]
+                M[1 + j, 1 + k] += acc
+        _cholesky(M, L)
 
-        def H_mul(v: _Cones) -> _Cones:
-            # The same H matrices as in M: a closed form (2 u u^T - J) v rounds differently and,
-            # without refinement, the mismatch with M costs accuracy near the optimum.
-            return _Cones(w_lin * v.lin, np.einsum("rkmb,kmb->rmb", H_soc, v.soc), np.einsum("rkb,kb->rb", H_obj, v.obj))
-
-        def V_mul(v: _Cones) -> _Cones:
-            """W^T W v through the factors (more accurate than inverting H)."""
-            return _Cones(s_over_z * v.lin,
-                          _soc_apply(w_soc, b_soc, _soc_apply(w_soc, b_soc, v.soc)) * cm,
-                          _soc_apply(w_obj, b_obj, _soc_apply(w_obj, b_obj, v.obj)))
-
-        def reduced(bx, bz: _Cones):
-            dx = _cho_solve(L, bx + GT_mul(H_mul(bz)))
-            Gd = G_mul(dx)
-            return dx, H_mul(_Cones(Gd.lin - bz.lin, Gd.soc - bz.soc, Gd.obj - bz.obj))
-
-        def solve_kkt(bx, bz: _Cones):
-            """[0 G^T; G -W^T W] [dx; dz] = [bx; bz], with iterative refinement on the full system."""
-            dx, dz = reduced(bx, bz)
-            for _ in range(settings.refine):
-                Gd, Vz = G_mul(dx), V_mul(dz)
-                rx = bx - GT_mul(dz)
-                rz = _Cones(bz.lin - Gd.lin + Vz.lin, bz.soc - Gd.soc + Vz.soc, bz.obj - Gd.obj + Vz.obj)
-                rz.lin *= cm
-                rz.soc *= cm
-                ex, ez = reduced(rx, rz)
-                dx = dx + ex
-                dz = _Cones(dz.lin + ez.lin, dz.soc + ez.soc, dz.obj + ez.obj)
-            return dx, dz
-
-        c_vec = np.zeros_like(x)
-        c_vec[0] = 1.0
-        x1, z1 = solve_kkt(-c_vec, _Cones(h_lin, h_soc, h_obj))
-        cx1_hz1 = x1[0] + np.sum(h_lin * z1.lin * cm, axis=0) + np.sum(np.sum(h_soc * z1.soc, axis=0) * cm, axis=0) \
-            + np.sum(h_obj * z1.obj, axis=0)
-
-        def direction(sigma, ds_lin, ds_soc, ds_obj, d_kappa):
-            """Newton direction for the complementarity right-hand sides (lambda \\ d_s form)."""
-            # W^T (lambda \ d_s) per cone
-            q_lin = np.sqrt(s.lin / np.where(cm > 0, z.lin, 1.0)) * (ds_lin / lam_lin)
-            q_soc = _soc_apply(w_soc, b_soc, _soc_div(lam_soc, ds_soc))
-            q_obj = _soc_apply(w_obj, b_obj, _soc_div(lam_obj, ds_obj))
-            f = 1.0 - sigma
-            bx = -f * r_x
-            bz = _Cones(-f * r_z.lin + q_lin, -f * r_z.soc + q_soc, -f * r_z.obj + q_obj)
-            x2, z2 = solve_kkt(bx, bz)
-            cx2_hz2 = x2[0] + np.sum(h_lin * z2.lin * cm, axis=0) + np.sum(np.sum(h_soc * z2.soc, axis=0) * cm, axis=0) \
-                + np.sum(h_obj * z2.obj, axis=0)
-            dtau = (d_kappa / tau - f * r_tau - cx2_hz2) / (cx1_hz1 - kappa / tau)
-            dx = x2 + dtau * x1
-            dz = _Cones(z2.lin + dtau * z1.lin, z2.soc + dtau * z1.soc, z2.obj + dtau * z1.obj)
-            dkappa = -(d_kappa + kappa * dtau) / tau
-            # ds from the primal row G dx + ds - h dtau = -(1 - sigma) r_z: it keeps the primal
-            # residual exact where W^T W is badly conditioned near the optimum.
-            Gdx = G_mul(dx)
-            ds_l = -f * r_z.lin - Gdx.lin + h_lin * dtau
-            ds_s = -f * r_z.soc - Gdx.soc + h_soc * dtau
-            ds_o = -f * r_z.obj - Gdx.obj + h_obj * dtau
-            dz.lin *= cm
-            dz.soc *= cm
-            ds_l *= cm
-            ds_s *= cm
-            ds = _Cones(ds_l, ds_s, ds_o)
-            return dx, dz, ds, dtau, dkappa
-
-        def max_step(dz, ds, dtau, dkappa):
-            inf = np.inf
-            st = np.minimum(_lin_max_step(s.lin, ds.lin), _lin_max_step(z.lin, dz.lin))
-            st = np.minimum(st, np.minimum(_soc_max_step(s.soc, ds.soc), _soc_max_step(z.soc, dz.soc)))
-            st = np.where(cm > 0, st, inf).min(axis=0)
-            st = np.minimum(st, np.minimum(_soc_max_step(s.obj, ds.obj), _soc_max_step(z.obj, dz.obj)))
-            st = np.minimum(st, np.minimum(_lin_max_step(tau, dtau), _lin_max_step(kappa, dkappa)))
-            return st
+        # x1, z1: the solution for the tau column, -c and h.
+        for j in range(n):
+            bx[j] = -1.0 if j == 0 else 0.0
+        _solve_kkt(D, m, e, L, w_lin, H_soc, H_obj, s_over_z, w_soc, b_soc, w_obj, b_obj, refine,
+                   bx, h, x1, z1, wN, wN2, wN3, wn, wn2)
+        cx1_hz1 = x1[0]
+        for k in range(N):
+            cx1_hz1 += h[k] * z1[k]
 
         # Predictor (affine scaling): d_s = lambda o lambda, d_kappa = tau kappa.
-        lam_soc_sq = _soc_prod(lam_soc, lam_soc)
-        lam_obj_sq = _soc_prod(lam_obj, lam_obj)
-        dx_a, dz_a, ds_a, dtau_a, dkappa_a = direction(0.0, lam_lin * lam_lin, lam_soc_sq, lam_obj_sq, tau * kappa)
-        alpha_a = np.minimum(1.0, max_step(dz_a, ds_a, dtau_a, dkappa_a))
-        sigma = np.clip((1.0 - alpha_a) ** 3, 0.0, 1.0)
+        for i in range(m):
+            dsv[i] = lam[i] * lam[i]
+            c = m + 3 * i
+            _soc_prod(lam[c:c + 3], lam[c:c + 3], dsv[c:c + 3])
+        _soc_prod(lam[o:], lam[o:], dsv[o:])
+        dtau_a, dkappa_a = _direction(D, m, e, 0.0, dsv, tau * kappa, s, z, lam, h, r_x, r_z, r_tau, tau, kappa,
+                                      cx1_hz1, x1, z1, L, w_lin, H_soc, H_obj, s_over_z, w_soc, b_soc, w_obj, b_obj,
+                                      refine, dx_a, dz_a, ds_a, q, x2, z2, wN, wN2, wN3, bx, wn, wn2)
+        alpha_a = min(1.0, _max_step(m, s, z, ds_a, dz_a, tau, dtau_a, kappa, dkappa_a))
+        sigma = min(max((1.0 - alpha_a) ** 3, 0.0), 1.0)
         sm = sigma * mu
 
         # Corrector: Mehrotra's second-order term (W^-T ds_a) o (W dz_a) and centring sigma mu.
-        Wi_ds_l = np.sqrt(np.where(cm > 0, z.lin / np.where(cm > 0, s.lin, 1.0), 0.0)) * ds_a.lin
-        W_dz_l = np.sqrt(np.where(cm > 0, s.lin / np.where(cm > 0, z.lin, 1.0), 0.0)) * dz_a.lin
-        d_lin = lam_lin * lam_lin + Wi_ds_l * W_dz_l - sm
-        corr_soc = _soc_prod(_soc_apply(w_soc, b_soc, ds_a.soc, inverse=True), _soc_apply(w_soc, b_soc, dz_a.soc))
-        d_soc = lam_soc_sq + corr_soc
-        d_soc[0] -= sm
-        corr_obj = _soc_prod(_soc_apply(w_obj, b_obj, ds_a.obj, inverse=True), _soc_apply(w_obj, b_obj, dz_a.obj))
-        d_obj = lam_obj_sq + corr_obj
-        d_obj[0] -= sm
+        for i in range(m):
+            dsv[i] = lam[i] * lam[i] + (math.sqrt(z[i] / s[i]) * ds_a[i]) * (math.sqrt(s[i] / z[i]) * dz_a[i]) - sm
+            c = m + 3 * i
+            _soc_apply(w_soc[i], b_soc[i], ds_a[c:c + 3], wN[c:c + 3], True)
+            _soc_apply(w_soc[i], b_soc[i], dz_a[c:c + 3], wN2[c:c + 3], False)
+            _soc_prod(wN[c:c + 3], wN2[c:c + 3], tmp3)
+            _soc_prod(lam[c:c + 3], lam[c:c + 3], dsv[c:c + 3])
+            for r in range(3):
+                dsv[c + r] += tmp3[r]
+            dsv[c] -= sm
+        _soc_apply(w_obj, b_obj, ds_a[o:], wN[o:], True)
+        _soc_apply(w_obj, b_obj, dz_a[o:], wN2[o:], False)
+        _soc_prod(wN[o:], wN2[o:], tmp_o)
+        _soc_prod(lam[o:], lam[o:], dsv[o:])
+        for r in range(e + 2):
+            dsv[o + r] += tmp_o[r]
+        dsv[o] -= sm
         d_kap = tau * kappa + dtau_a * dkappa_a - sm
-        dx, dz, ds, dtau, dkappa = direction(sigma, d_lin, d_soc, d_obj, d_kap)
-        alpha = np.minimum(1.0, settings.step_fraction * max_step(dz, ds, dtau, dkappa))
+        dtau, dkappa = _direction(D, m, e, sigma, dsv, d_kap, s, z, lam, h, r_x, r_z, r_tau, tau, kappa,
+                                  cx1_hz1, x1, z1, L, w_lin, H_soc, H_obj, s_over_z, w_soc, b_soc, w_obj, b_obj,
+                                  refine, dx, dz, ds, q, x2, z2, wN, wN2, wN3, bx, wn, wn2)
+        alpha = min(1.0, step_fraction * _max_step(m, s, z, ds, dz, tau, dtau, kappa, dkappa))
 
         # A vanishing step near the optimum means the normal equations have run out of
         # accuracy: keep the current point and judge it with the reduced tolerance.
-        stalled = alpha < settings.stall_step
-        alpha = np.where(stalled, 0.0, alpha)
-        x = x + alpha * dx
-        s = _Cones(s.lin + alpha * ds.lin, s.soc + alpha * ds.soc, s.obj + alpha * ds.obj)
-        z = _Cones(z.lin + alpha * dz.lin, z.soc + alpha * dz.soc, z.obj + alpha * dz.obj)
-        tau = tau + alpha * dtau
-        kappa = kappa + alpha * dkappa
+        stalled = alpha < stall_step
+        if stalled:
+            alpha = 0.0
+        for j in range(n):
+            x[j] += alpha * dx[j]
+        for k in range(N):
+            s[k] += alpha * ds[k]
+            z[k] += alpha * dz[k]
+        tau += alpha * dtau
+        kappa += alpha * dkappa
+    return _UNDECIDED, math.nan, max_iter
 
-    return BatchResult(code=code, y=y_out, t=t_out, iterations=iters)
+
+@_jit
+def _direction(D, m, e, sigma, dsv, d_kappa, s, z, lam, h, r_x, r_z, r_tau, tau, kappa, cx1_hz1, x1, z1,
+               L, w_lin, H_soc, H_obj, s_over_z, w_soc, b_soc, w_obj, b_obj, refine,
+               dx, dz, ds, q, x2, z2, wN, wN2, wN3, bx, wn, wn2):
+    """Newton direction for the complementarity right-hand side dsv (lambda \\ d_s form);
+    fills dx, dz, ds and returns (dtau, dkappa)."""
+    N = 4 * m + e + 2
+    o = 4 * m
+    f = 1.0 - sigma
+    # q = W^T (lambda \ d_s) per cone
+    for i in range(m):
+        q[i] = math.sqrt(s[i] / z[i]) * (dsv[i] / lam[i])
+        c = m + 3 * i
+        _soc_div(lam[c:c + 3], dsv[c:c + 3], wN[c:c + 3])
+        _soc_apply(w_soc[i], b_soc[i], wN[c:c + 3], q[c:c + 3], False)
+    _soc_div(lam[o:], dsv[o:], wN[o:])
+    _soc_apply(w_obj, b_obj, wN[o:], q[o:], False)
+    for k in range(N):
+        q[k] -= f * r_z[k]
+    for j in range(e + 1):
+        bx[j] = -f * r_x[j]
+    _solve_kkt(D, m, e, L, w_lin, H_soc, H_obj, s_over_z, w_soc, b_soc, w_obj, b_obj, refine,
+               bx, q, x2, z2, wN, wN2, wN3, wn, wn2)
+    cx2_hz2 = x2[0]
+    for k in range(N):
+        cx2_hz2 += h[k] * z2[k]
+    dtau = (d_kappa / tau - f * r_tau - cx2_hz2) / (cx1_hz1 - kappa / tau)
+    for j in range(e + 1):
+        dx[j] = x2[j] + dtau * x1[j]
+    for k in range(N):
+        dz[k] = z2[k] + dtau * z1[k]
+    dkappa = -(d_kappa + kappa * dtau) / tau
+    # ds from the primal row G dx + ds - h dtau = -(1 - sigma) r_z: it keeps the primal
+    # residual exact where W^T W is badly conditioned near the optimum.
+    _G_mul(D, m, e, dx, ds)
+    for k in range(N):
+        ds[k] = -f * r_z[k] - ds[k] + h[k] * dtau
+    return dtau, dkappa
+
+
+# --------------------------------------------------------------------------- one problem, built
+
+
+@_jit
+def _solve_one(frames, E, fp, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine,
+               retry_refine, violation_tol, y):
+    """Build the contact rows of one GFO problem from its frames (m, 3, 3), basis E (3m, e) and
+    f_p (3m,) (N) and solve it. Returns (code, ||f|| N, worst violation N, iterations); fills y.
+
+    An optimal point whose forces violate a constraint by more than violation_tol max(1 N, ||f||)
+    is 'not decided' (the rule of `solve_gfo` for reduced accuracy).
+    """
+    D = np.empty((m, 3, e))
+    hv = np.empty((m, 3))
+    a = np.zeros(e)
+    for i in range(m):
+        for r in range(3):
+            acc = 0.0
+            for q in range(3):
+                acc += frames[i, r, q] * fp[3 * i + q]
+            hv[i, r] = acc
+            for k in range(e):
+                acc = 0.0
+                for q in range(3):
+                    acc += frames[i, r, q] * E[3 * i + q, k]
+                D[i, r, k] = acc
+    for c in range(3 * m):
+        for k in range(e):
+            a[k] += E[c, k] * fp[c]
+    r0 = 0.0
+    for c in range(3 * m):
+        acc = fp[c]
+        for k in range(e):
+            acc -= E[c, k] * a[k]
+        r0 += acc * acc
+    r0 = math.sqrt(r0)
+    code, norm, viol, it = _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction,
+                                    stall_step, refine, violation_tol, y)
+    if code == _UNDECIDED and retry_refine > refine:
+        # Undecided problems are mostly stalls at a degenerate optimum, where the normal
+        # equations lose accuracy: a second attempt with iterative refinement decides most.
+        code, norm, viol, it2 = _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction,
+                                         stall_step, retry_refine, violation_tol, y)
+        it += it2
+    return code, norm, viol, it
+
+
+@_jit
+def _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine,
+             violation_tol, y):
+    """`_hsde`, then the force check of an optimal point: (code, ||f|| N, violation N, iterations)."""
+    code, _, it = _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine, y)
+    if code != _OPTIMAL:
+        return code, math.nan, math.nan, it
+    # f = f_p + E y in the contact frames: [n.f, t1.f/mu, t2.f/mu]
+    norm = 0.0
+    viol = -math.inf
+    fr = np.empty(3)
+    for i in range(m):
+        for r in range(3):
+            acc = hv[i, r]
+            for k in range(e):
+                acc += D[i, r, k] * y[k]
+            fr[r] = acc
+        ft = mu * math.sqrt(fr[1] * fr[1] + fr[2] * fr[2])
+        norm += fr[0] * fr[0] + ft * ft
+        viol = max(viol, f_min - fr[0], ft - mu * fr[0])
+    norm = math.sqrt(norm)
+    if viol > violation_tol * max(1.0, norm):
+        return _UNDECIDED, math.nan, math.nan, it
+    return code, norm, viol, it
+
+
+@_jit
+def _solve_given(frames, E, fp, mu, f_min, n_contacts, n_basis, tol, reduced_tol, max_iter, step_fraction,
+                 stall_step, refine, retry_refine, violation_tol, code, y, norm, viol, iters):
+    """`_solve_one` for each problem of a padded batch (each reads only its own sizes)."""
+    for b in range(fp.shape[0]):
+        if n_basis[b] == 0:
+            code[b] = 0
+            continue
+        code[b], norm[b], viol[b], iters[b] = _solve_one(
+            frames[b], E[b], fp[b], mu[b], f_min[b], n_contacts[b], n_basis[b], tol, reduced_tol, max_iter,
+            step_fraction, stall_step, refine, retry_refine, violation_tol, y[b])
+
+
+@_jit
+def _solve_pose(F_all, fp, frames, frames_strict, cols, n_cols, thresholds, mu, mu_strict, f_min, strict,
+                tol, reduced_tol, max_iter, step_fraction, stall_step, refine, retry_refine, violation_tol,
+                code, norm, viol, iters, e_s, strict_code):
+    """Every synergy set of one pose: E_s from the SVD of F_s = F_all[:, set] (columns with a
+    singular value above the set's threshold), then the GFO and, if `strict`, the strict
+    internal-force test (f_p = 0, f_min = 1 N, mu_strict). Sets with e_s = 0 get code 0."""
+    c = F_all.shape[0]
+    m = c // 3
+    zero = np.zeros(c)
+    y = np.empty(cols.shape[1])
+    for j in range(cols.shape[0]):
+        s = n_cols[j]
+        F = np.empty((c, s))
+        for q in range(s):
+            F[:, q] = F_all[:, cols[j, q]]
+        U, sv, _ = np.linalg.svd(F, full_matrices=False)
+        rank = 0
+        for q in range(sv.size):
+            if sv[q] > thresholds[j]:
+                rank += 1
+        e_s[j] = rank
+        if rank == 0:
+            code[j] = 0
+            continue
+        E = np.ascontiguousarray(U[:, :rank])
+        code[j], norm[j], viol[j], iters[j] = _solve_one(
+            frames, E, fp, mu, f_min, m, rank, tol, reduced_tol, max_iter, step_fraction, stall_step, refine,
+            retry_refine, violation_tol, y)
+        if strict:
+            strict_code[j] = _solve_one(frames_strict, E, zero, mu_strict, 1.0, m, rank, tol, reduced_tol, max_iter,
+                                        step_fraction, stall_step, refine, retry_refine, violation_tol, y)[0]
+
+
+def _kernel_settings(settings: SolverSettings) -> tuple:
+    from synergrasp.force_optimisation import ALMOST_SOLVED_TOL
+
+    return (float(settings.tol), float(settings.reduced_tol), int(settings.max_iter), float(settings.step_fraction),
+            float(settings.stall_step), int(settings.refine), int(settings.retry_refine), float(ALMOST_SOLVED_TOL))
 
 
 # --------------------------------------------------------------------------- many problems
 
 
-@dataclass(frozen=True)
-class _Block:
-    """Problems sharing a contact count m and padded basis size e (one pose, one set size)."""
+def solve_batch(batch: GFOBatch, settings: SolverSettings = SolverSettings()) -> BatchResult:
+    """Solve every problem of the batch with the homogeneous self-dual interior-point method.
 
-    rows: NDArray     # (n, m, 3, e)
-    h: NDArray        # (n, m, 3)
-    a: NDArray        # (n, e)
-    r0: NDArray       # (n,)
-    f_min: NDArray    # (n,)
-    index: NDArray    # (n,) position of each problem in the caller's order
-
-    @property
-    def m(self) -> int:
-        return int(self.rows.shape[1])
-
-    @property
-    def e(self) -> int:
-        return int(self.rows.shape[3])
+    The data are scaled per problem by rho = max(||f_p||, f_min) (reported y in N).
+    Verdicts: optimal when the scaled primal and dual residuals and the duality gap are below
+    `tol` and the forces pass the violation check; infeasible when the dual iterate is a
+    Farkas certificate (h^T z < 0 and ||G^T z|| <= tol |h^T z|); otherwise 'not decided'
+    (iteration cap, stall, breakdown, or an optimal point that fails the violation check).
+    """
+    B = batch.size
+    code = np.zeros(B, dtype=np.int8)
+    y = np.full(batch.E.shape[::2], np.nan)
+    norm = np.full(B, np.nan)
+    viol = np.full(B, np.nan)
+    iters = np.zeros(B, dtype=np.int32)
+    _solve_given(batch.frames, batch.E, batch.f_p, batch.mu, batch.f_min, batch.n_contacts, batch.n_basis,
+                 *_kernel_settings(settings), code, y, norm, viol, iters)
+    y[code != _OPTIMAL] = np.nan
+    return BatchResult(code=code, y=y, force_norm=norm, max_violation=viol, iterations=iters)
 
 
 @dataclass(frozen=True)
@@ -574,114 +843,6 @@ class BatchSolution:
     max_violation: NDArray
 
 
-def _pieces(blocks: list[_Block], batch_size: int) -> list[list[_Block]]:
-    """Consecutive runs of blocks (sorted by e, then m) of about `batch_size` problems each.
-
-    Splitting never changes a problem's numbers (padding is exact), only the speed: runs
-    stay within one e (unless still below batch_size / 4) so that padding costs little.
-    """
-    order = sorted(range(len(blocks)), key=lambda k: (blocks[k].e, blocks[k].m))
-    runs: list[list[_Block]] = []
-    current: list[_Block] = []
-    size = 0
-    for k in order:
-        b = blocks[k]
-        # A new e starts a new run unless the run is still small (padding e beats tiny batches).
-        if current and (size + b.a.shape[0] > batch_size or (b.e != current[-1].e and size >= batch_size // 4)):
-            runs.append(current)
-            current, size = [], 0
-        current.append(b)
-        size += b.a.shape[0]
-    if current:
-        runs.append(current)
-    return runs
-
-
-def _stack(run: list[_Block], m: int | None = None, e: int | None = None) -> tuple[GFOBatch, NDArray]:
-    """Zero-pad the blocks of a run to m contacts and e basis columns (default: the run's
-    largest) and stack them batch-last; also return each problem's caller index."""
-    B = sum(b.a.shape[0] for b in run)
-    m = max(b.m for b in run) if m is None else m
-    e = max(b.e for b in run) if e is None else e
-    rows = np.zeros((m, 3, e, B))
-    h = np.zeros((m, 3, B))
-    a = np.zeros((e, B))
-    contact = np.zeros((m, B), dtype=bool)
-    r0 = np.concatenate([b.r0 for b in run])
-    f_min = np.concatenate([b.f_min for b in run])
-    index = np.concatenate([b.index for b in run])
-    k = 0
-    for b in run:
-        n = b.a.shape[0]
-        rows[:b.m, :, :b.e, k:k + n] = b.rows.transpose(1, 2, 3, 0)
-        h[:b.m, :, k:k + n] = b.h.transpose(1, 2, 0)
-        a[:b.e, k:k + n] = b.a.T
-        contact[:b.m, k:k + n] = True
-        k += n
-    return GFOBatch(rows=rows, h=h, a=a, r0=r0, f_min=f_min, contact=contact), index
-
-
-def _forces_check(batch: GFOBatch, y: NDArray, mu: NDArray) -> tuple[NDArray, NDArray]:
-    """||f|| (N) and the worst constraint violation (N) of f = f_p + E y, from the batch rows."""
-    frame = batch.h + np.einsum("mrjb,jb->mrb", batch.rows, np.nan_to_num(y))  # [n.f, t1.f/mu, t2.f/mu]
-    fn = frame[:, 0]
-    ft = mu * np.sqrt(frame[:, 1] ** 2 + frame[:, 2] ** 2)
-    norm = np.sqrt(np.sum(np.where(batch.contact, fn * fn + ft * ft, 0.0), axis=0))
-    viol = np.where(batch.contact, np.maximum(batch.f_min - fn, ft - mu * fn), -np.inf).max(axis=0)
-    return norm, viol
-
-
-def _solve_blocks(
-    blocks: list[_Block],
-    mu: NDArray,
-    total: int,
-    fallback_problem,
-    settings: SolverSettings,
-    batch_size: int,
-) -> BatchSolution:
-    """Solve every problem of `blocks` in padded batches; undecided ones go to `solve_gfo`."""
-    from synergrasp.force_optimisation import ALMOST_SOLVED_TOL
-
-    status = np.full(total, "numerical_failure", dtype=object)
-    norm = np.full(total, np.nan)
-    iters = np.zeros(total, dtype=np.int32)
-    solver = np.full(total, "batched", dtype=object)
-    viol = np.full(total, np.nan)
-    for run in _pieces(blocks, batch_size):
-        batch, index = _stack(run)
-        res = solve_batch(batch, settings)
-        fn, fv = _forces_check(batch, res.y, mu[index])
-        ok = (res.code == _OPTIMAL) & (fv <= ALMOST_SOLVED_TOL * np.maximum(1.0, fn))
-        status[index[ok]] = "force_closure"
-        norm[index[ok]] = fn[ok]
-        viol[index[ok]] = fv[ok]
-        inf = res.code == _INFEASIBLE
-        status[index[inf]] = "infeasible"
-        iters[index] = res.iterations
-        for k in index[~(ok | inf)]:
-            r = fallback_problem(int(k))
-            status[k], iters[k], solver[k] = r.status, r.iterations, "clarabel_fallback"
-            norm[k] = r.force_norm
-            viol[k] = r.max_violation if r.status == "force_closure" else np.nan
-    return BatchSolution(status=status, force_norm=norm, iterations=iters, solver=solver, max_violation=viol)
-
-
-def _problem_block(f_p, E, normals, mu, f_min, index) -> _Block:
-    n = np.asarray(normals, dtype=float)
-    m = n.shape[0]
-    Em = np.asarray(E, dtype=float).reshape(3 * m, -1)
-    fp = np.asarray(f_p, dtype=float).reshape(3 * m)
-    frames = _contact_frames(n, mu)
-    e = Em.shape[1]
-    a = Em.T @ fp
-    return _Block(
-        rows=np.einsum("iab,ibk->iak", frames, Em.reshape(m, 3, e))[None],
-        h=np.einsum("iab,ib->ia", frames, fp.reshape(m, 3))[None],
-        a=a[None], r0=np.array([np.linalg.norm(fp - Em @ a)]), f_min=np.array([float(f_min)]),
-        index=np.array([index]),
-    )
-
-
 def solve_gfo_batch(
     f_p: Sequence[NDArray],
     E: Sequence[NDArray],
@@ -690,7 +851,6 @@ def solve_gfo_batch(
     f_min: float | Sequence[float],
     *,
     settings: SolverSettings = SolverSettings(),
-    batch_size: int = DEFAULT_BATCH_SIZE,
     tol: float = 1e-8,
     max_iter: int = 200,
 ) -> BatchSolution:
@@ -702,32 +862,26 @@ def solve_gfo_batch(
     are judged directly by `solve_gfo` (f = f_p), as the per-problem path does.
     """
     B = len(f_p)
-    if not (len(E) == len(normals) == B):
-        raise ValueError(f"f_p, E and normals must have the same length, got {B}, {len(E)}, {len(normals)}")
-    if not (isinstance(batch_size, int) and batch_size > 0):
-        raise ValueError(f"batch_size must be a positive int, got {batch_size!r}")
-    mus = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (B,)))
-    fmins = np.array(np.broadcast_to(np.asarray(f_min, dtype=float), (B,)))
-    blocks = []
-    direct = []
-    for k in range(B):
-        Ek = np.asarray(E[k], dtype=float)
-        if Ek.ndim == 1:
-            Ek = Ek[:, None]
-        if Ek.shape[1] == 0:
-            direct.append(k)
-            continue
-        blocks.append(_problem_block(f_p[k], Ek, normals[k], mus[k], fmins[k], k))
-
-    def fallback(k: int):
-        return solve_gfo(f_p[k], E[k], normals[k], mus[k], fmins[k], tol=tol, max_iter=max_iter)
-
-    out = _solve_blocks(blocks, mus, B, fallback, settings, batch_size)
-    for k in direct:
-        r = fallback(k)
-        out.status[k], out.force_norm[k], out.iterations[k] = r.status, r.force_norm, 0
-        out.max_violation[k] = r.max_violation if r.status == "force_closure" else np.nan
+    batch = gfo_batch(f_p, E, normals, mu, f_min)
+    res = solve_batch(batch, settings)
+    status = np.full(B, "numerical_failure", dtype=object)
+    status[res.code == _OPTIMAL] = "force_closure"
+    status[res.code == _INFEASIBLE] = "infeasible"
+    out = BatchSolution(status=status, force_norm=res.force_norm, iterations=res.iterations,
+                        solver=np.full(B, "batched", dtype=object), max_violation=res.max_violation)
+    for k in np.flatnonzero((res.code != _OPTIMAL) & (res.code != _INFEASIBLE)):
+        r = solve_gfo(f_p[k], E[k], normals[k], batch.mu[k], batch.f_min[k], tol=tol, max_iter=max_iter)
+        _record(out, k, r, fallback=batch.n_basis[k] > 0)
     return out
+
+
+def _record(out: BatchSolution, k: int, r, fallback: bool) -> None:
+    """Store the per-problem result r (GFOResult) in row k."""
+    out.status[k], out.force_norm[k] = r.status, r.force_norm
+    out.max_violation[k] = r.max_violation if r.status == "force_closure" else np.nan
+    out.iterations[k] = r.iterations if fallback else 0
+    if fallback:
+        out.solver[k] = "clarabel_fallback"
 
 
 def set_id(subset: Sequence[int]) -> str:
@@ -750,7 +904,6 @@ def optimise_grasps(
     synergies: NDArray,
     sets: Sequence[tuple[int, ...]],
     params: GFOParams,
-    batch_size: int = DEFAULT_BATCH_SIZE,
     *,
     strict: bool = True,
     settings: SolverSettings = SolverSettings(),
@@ -761,8 +914,9 @@ def optimise_grasps(
     rad per unit activation; sets: 1-based synergy indices. Mechanics once per pose; E_s by
     the rule of `internal_force_basis` (singular values above
     basis_rtol ||projector||_2 ||S_set||_2); both SOCPs (GFO and strict test) solved by the
-    batched method, poses taken in chunks of about `batch_size` problems (bounded memory).
-    strict=False skips the strict test (column all False).
+    compiled interior-point method, one pose at a time (memory does not grow with the study).
+    Problems it does not decide are solved by `solve_gfo` / `strict_internal_forces` and
+    marked solver 'clarabel_fallback'. strict=False skips the strict test (column all False).
     Returns columns (one row per (pose, set), pose-major): pose, set_id, n_synergies,
     status, force_closure, strict_internal, force_norm (N), e_s, rank_G, n_contacts,
     iterations, solver.
@@ -770,8 +924,6 @@ def optimise_grasps(
     S = np.asarray(synergies, dtype=float)
     if S.ndim != 2:
         raise ValueError(f"synergies must be an (n, k) matrix, got shape {S.shape}")
-    if not (isinstance(batch_size, int) and batch_size > 0):
-        raise ValueError(f"batch_size must be a positive int, got {batch_size!r}")
     cols = _check_sets(sets, S.shape[1])
     n_sets, n_poses = len(cols), len(grasps)
     total = n_sets * n_poses
@@ -792,105 +944,57 @@ def optimise_grasps(
     if total == 0:
         return out
     set_norms = np.array([np.linalg.norm(S[:, c], 2) for c in cols])
-    by_size: dict[int, list[int]] = {}
+    col_table = np.zeros((n_sets, max(c.size for c in cols)), dtype=np.int64)
     for j, c in enumerate(cols):
-        by_size.setdefault(c.size, []).append(j)
+        col_table[j, :c.size] = c
+    n_cols = np.array([c.size for c in cols], dtype=np.int64)
     mu_strict = params.mu * (1.0 - params.strict_shrink)
-    per_chunk = max(1, 4 * batch_size // (n_sets * (2 if strict else 1)))  # several batches per chunk
+    kernel = _kernel_settings(settings)
+    code = np.zeros(n_sets, dtype=np.int8)
+    strict_code = np.zeros(n_sets, dtype=np.int8)
+    norm, viol = np.empty(n_sets), np.empty(n_sets)
+    iters, e_s = np.zeros(n_sets, dtype=np.int32), np.zeros(n_sets, dtype=np.int64)
 
-    for start in range(0, n_poses, per_chunk):
-        stop = min(n_poses, start + per_chunk)
-        chunk = _Chunk(row0=start * n_sets, n_rows=(stop - start) * n_sets)
-        for p in range(start, stop):
-            grasp = grasps[p]
-            if grasp is None or grasp.n_contacts == 0:
-                continue
-            rows0 = p * n_sets
-            mech = mechanics_for(grasp, params)
-            out["rank_G"][rows0:rows0 + n_sets] = mech.rank_G
-            out["n_contacts"][rows0:rows0 + n_sets] = mech.n_contacts
-            if mech.rank_G < 6 or mech.projector is None:
-                out["status"][rows0:rows0 + n_sets] = "rank_deficient"
-                continue
-            _pose_blocks(chunk, mech, S, cols, by_size, set_norms, params, mu_strict, rows0, strict, out["e_s"])
-        if chunk.bases:
-            _solve_chunk(chunk, params, mu_strict, settings, batch_size, strict, out)
+    for p, grasp in enumerate(grasps):
+        if grasp is None or grasp.n_contacts == 0:
+            continue
+        rows = slice(p * n_sets, (p + 1) * n_sets)
+        mech = mechanics_for(grasp, params)
+        out["rank_G"][rows] = mech.rank_G
+        out["n_contacts"][rows] = mech.n_contacts
+        if mech.rank_G < 6 or mech.projector is None:
+            out["status"][rows] = "rank_deficient"
+            continue
+        P = mech.projector
+        thresholds = params.basis_rtol * (float(np.linalg.norm(P, 2)) if P.size else 0.0) * set_norms
+        code[:], strict_code[:], iters[:] = 0, _INFEASIBLE, 0
+        _solve_pose(np.ascontiguousarray(P @ S), np.ascontiguousarray(mech.f_p, dtype=float),
+                    _contact_frames(mech.normals, params.mu), _contact_frames(mech.normals, mu_strict), col_table,
+                    n_cols, thresholds, float(params.mu), float(mu_strict), float(params.f_min), bool(strict),
+                    *kernel, code, norm, viol, iters, e_s, strict_code)
+        status = np.where(code == _OPTIMAL, "force_closure", np.where(code == _INFEASIBLE, "infeasible", ""))
+        out["status"][rows] = status
+        out["force_norm"][rows] = np.where(code == _OPTIMAL, norm, np.nan)
+        out["iterations"][rows] = iters
+        out["e_s"][rows] = e_s
+        out["strict_internal"][rows] = strict_code == _OPTIMAL
+        for j in np.flatnonzero(status == ""):
+            _pose_fallback(out, p * n_sets + j, mech, S[:, cols[j]], params)
+        if strict:
+            for j in np.flatnonzero((strict_code != _OPTIMAL) & (strict_code != _INFEASIBLE) & (e_s > 0)):
+                E = internal_force_basis(P, S[:, cols[j]], params.basis_rtol)
+                out["strict_internal"][p * n_sets + j] = strict_internal_forces(
+                    E, mech.normals, params.mu, params.strict_shrink, tol=params.tol, max_iter=params.max_iter).strict
     out["force_closure"] = out["status"] == "force_closure"
     return out
 
 
-@dataclass
-class _Chunk:
-    """Problems of consecutive poses; GFO problem of output row r has local index
-    r - row0, its strict test r - row0 + n_rows."""
-
-    row0: int
-    n_rows: int
-    blocks: list = None
-    bases: dict = None     # output row -> (E (c, e_s), mechanics)
-
-    def __post_init__(self) -> None:
-        self.blocks, self.bases = [], {}
-
-
-def _pose_blocks(chunk, mech, S, cols, by_size, set_norms, params, mu_strict, rows0, strict, out_e_s) -> None:
-    """Blocks of one pose: per set size s, the bases of all its sets from one stacked SVD."""
-    m = mech.n_contacts
-    P = mech.projector
-    scale_P = float(np.linalg.norm(P, 2)) if P.size else 0.0
-    F_all = P @ S                                     # (c, k): one column per synergy
-    frames = _contact_frames(mech.normals, params.mu)
-    frames_strict = _contact_frames(mech.normals, mu_strict)
-    fp = mech.f_p
-    h = np.einsum("iab,ib->ia", frames, fp.reshape(m, 3))
-    for size, js in by_size.items():
-        F = np.stack([F_all[:, cols[j]] for j in js])  # (n, c, s)
-        U, sv, _ = np.linalg.svd(F, full_matrices=False)
-        rank = np.sum(sv > (params.basis_rtol * scale_P * set_norms[js])[:, None], axis=1)
-        U = U * (np.arange(U.shape[2])[None, None, :] < rank[:, None, None])  # zero columns beyond e_s
-        rows = np.asarray(js) + rows0
-        out_e_s[rows] = rank
-        for k, row in enumerate(rows):
-            chunk.bases[int(row)] = (U[k, :, :rank[k]], mech)
-        pos = rank > 0
-        n = int(pos.sum())
-        if n == 0:
-            continue
-        Up = U[pos]
-        a = np.einsum("nck,c->nk", Up, fp)
-        r0 = np.linalg.norm(fp[None] - np.einsum("nck,nk->nc", Up, a), axis=1)
-        U4 = Up.reshape(n, m, 3, Up.shape[2])
-        local = rows[pos] - chunk.row0
-        chunk.blocks.append(_Block(rows=np.einsum("iab,nibk->niak", frames, U4), h=np.broadcast_to(h, (n, m, 3)),
-                                   a=a, r0=r0, f_min=np.full(n, params.f_min), index=local))
-        if strict:
-            chunk.blocks.append(_Block(rows=np.einsum("iab,nibk->niak", frames_strict, U4), h=np.zeros((n, m, 3)),
-                                       a=np.zeros_like(a), r0=np.zeros(n), f_min=np.ones(n), index=local + chunk.n_rows))
-
-
-def _solve_chunk(chunk: _Chunk, params, mu_strict, settings, batch_size, strict, out) -> None:
-    n = chunk.n_rows
-
-    def fallback(k: int):
-        E, mech = chunk.bases[chunk.row0 + k % n]
-        if k < n:
-            return solve_gfo(mech.f_p, E, mech.normals, params.mu, params.f_min, tol=params.tol,
-                             max_iter=params.max_iter)
-        return strict_internal_forces(E, mech.normals, params.mu, params.strict_shrink, tol=params.tol,
-                                      max_iter=params.max_iter).result
-
-    mu = np.empty(2 * n)
-    mu[:n], mu[n:] = params.mu, mu_strict
-    sol = _solve_blocks(chunk.blocks, mu, 2 * n, fallback, settings, batch_size)
-    for row, (E, mech) in chunk.bases.items():
-        k = row - chunk.row0
-        if E.shape[1] == 0:  # f = f_p only: judged directly, as the per-problem path does
-            r = solve_gfo(mech.f_p, E, mech.normals, params.mu, params.f_min, tol=params.tol)
-            out["status"][row], out["force_norm"][row] = r.status, r.force_norm
-            continue
-        out["status"][row] = sol.status[k]
-        out["force_norm"][row] = sol.force_norm[k]
-        out["iterations"][row] = sol.iterations[k]
-        out["solver"][row] = sol.solver[k]
-        if strict:
-            out["strict_internal"][row] = sol.status[k + n] == "force_closure"
+def _pose_fallback(out: dict[str, NDArray], row: int, mech, S_set: NDArray, params: GFOParams) -> None:
+    """Row not decided by the compiled method (or e_s = 0: f = f_p judged directly): `solve_gfo`."""
+    E = internal_force_basis(mech.projector, S_set, params.basis_rtol)
+    r = solve_gfo(mech.f_p, E, mech.normals, params.mu, params.f_min, tol=params.tol, max_iter=params.max_iter)
+    out["status"][row], out["force_norm"][row] = r.status, r.force_norm
+    if E.shape[1] > 0:
+        out["iterations"][row], out["solver"][row] = r.iterations, "clarabel_fallback"
+    else:
+        out["iterations"][row] = 0

@@ -15,8 +15,7 @@ with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     shard = contacts.iloc[np.array_split(np.arange(len(contacts)), snakemake.params.n_shards)[opt["shard"]]]
     synergies = load_synergies(opt["synergies"])
     result = optimise_grasps(read_grasps(shard), synergies.matrix, list(opt["sets"].values()),
-                             gfo_params(opt["mechanics"], opt["mass_kg"]),
-                             batch_size=opt["solver"]["batch_size"])
+                             gfo_params(opt["mechanics"], opt["mass_kg"]))
     table = pd.DataFrame(result)
     poses = shard.iloc[table["pose"].to_numpy()]
     table.insert(0, "object", snakemake.wildcards.object)
