@@ -14,13 +14,18 @@ $(BIN)/.installed: environment.lock pyproject.toml
 	$(BIN)/python -m pip install --quiet --no-deps --no-build-isolation -e .
 	touch $@
 
+# Compiled solver code is cached next to the source; build it once here, not in every job.
+WARM_UP = $(BIN)/python -c "from synergrasp.batched import warm_up; warm_up()"
+
 study: $(BIN)/.installed
+	$(WARM_UP)
 	$(BIN)/snakemake -j$(CORES) figures
 
 report: $(BIN)/.installed
 	$(BIN)/snakemake --report results/report.html
 
 test: $(BIN)/.installed
+	$(WARM_UP)
 	$(BIN)/python -m pytest; rc=$$?; if [ $$rc -eq 5 ]; then echo "no tests collected"; exit 0; fi; exit $$rc
 
 # One core, as the targets are stated per core.

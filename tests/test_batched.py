@@ -92,6 +92,19 @@ def test_generated_kinds_match_exact_solver_outside_the_band_and_cvxpy_on_a_subs
             assert sol.force_norm[k] == pytest.approx(ref.force_norm, rel=RTOL_NORM)
 
 
+def test_second_attempt_with_refinement_decides_problems_the_first_leaves_open():
+    problems = _study_sized_problems(1500, seed=13)
+    once = _solve(problems, settings=SolverSettings(retry_refine=0))
+    twice = _solve(problems)
+    n_once = int(np.sum(once.solver == "clarabel_fallback"))
+    n_twice = int(np.sum(twice.solver == "clarabel_fallback"))
+    assert n_once > 0  # the premise: the first attempt leaves some problems open
+    assert n_twice < n_once
+    np.testing.assert_array_equal(once.status, twice.status)
+    both = twice.status == "force_closure"
+    np.testing.assert_allclose(twice.force_norm[both], once.force_norm[both], rtol=RTOL_NORM)
+
+
 def test_hand_derivable_problem():
     # One contact pair squeezing along x, f_p = 0, E = the squeeze direction: the optimum is
     # the least squeeze with n.f = f_min at both contacts, ||f|| = sqrt(2) f_min.
@@ -166,3 +179,5 @@ def test_bad_input_names_the_field():
         optimise_grasps([None], np.ones(19), [(1,)], params)
     with pytest.raises(ValueError, match="max_iter"):
         SolverSettings(max_iter=0)
+    with pytest.raises(ValueError, match="retry_refine"):
+        SolverSettings(retry_refine=-1)

@@ -38,10 +38,14 @@ __all__ = [
     "set_id",
     "solve_batch",
     "solve_gfo_batch",
+    "warm_up",
 ]
 
 # Codes of the interior-point method (BatchResult.code); 0: e = 0, nothing to solve.
 _OPTIMAL, _INFEASIBLE, _UNDECIDED = 1, 2, 3
+
+#: Problems padded together by `solve_gfo_batch` (bounds its memory whatever the input size).
+_PIECE = 4096
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -862,16 +866,25 @@ def solve_gfo_batch(
     are judged directly by `solve_gfo` (f = f_p), as the per-problem path does.
     """
     B = len(f_p)
-    batch = gfo_batch(f_p, E, normals, mu, f_min)
-    res = solve_batch(batch, settings)
-    status = np.full(B, "numerical_failure", dtype=object)
-    status[res.code == _OPTIMAL] = "force_closure"
-    status[res.code == _INFEASIBLE] = "infeasible"
-    out = BatchSolution(status=status, force_norm=res.force_norm, iterations=res.iterations,
-                        solver=np.full(B, "batched", dtype=object), max_violation=res.max_violation)
-    for k in np.flatnonzero((res.code != _OPTIMAL) & (res.code != _INFEASIBLE)):
-        r = solve_gfo(f_p[k], E[k], normals[k], batch.mu[k], batch.f_min[k], tol=tol, max_iter=max_iter)
-        _record(out, k, r, fallback=batch.n_basis[k] > 0)
+    if not (len(E) == len(normals) == B):
+        raise ValueError(f"f_p, E and normals must have the same length, got {B}, {len(E)}, {len(normals)}")
+    mus = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (B,)))
+    fmins = np.array(np.broadcast_to(np.asarray(f_min, dtype=float), (B,)))
+    out = BatchSolution(status=np.full(B, "numerical_failure", dtype=object), force_norm=np.full(B, np.nan),
+                        iterations=np.zeros(B, dtype=np.int32), solver=np.full(B, "batched", dtype=object),
+                        max_violation=np.full(B, np.nan))
+    for start in range(0, B, _PIECE):  # fixed-size pieces: the padded copy stays small
+        part = slice(start, min(B, start + _PIECE))
+        batch = gfo_batch(f_p[part], E[part], normals[part], mus[part], fmins[part])
+        res = solve_batch(batch, settings)
+        out.status[part] = np.where(res.code == _OPTIMAL, "force_closure",
+                                    np.where(res.code == _INFEASIBLE, "infeasible", "numerical_failure"))
+        out.force_norm[part], out.max_violation[part], out.iterations[part] = \
+            res.force_norm, res.max_violation, res.iterations
+        for k in np.flatnonzero((res.code != _OPTIMAL) & (res.code != _INFEASIBLE)):
+            g = start + int(k)
+            r = solve_gfo(f_p[g], E[g], normals[g], mus[g], fmins[g], tol=tol, max_iter=max_iter)
+            _record(out, g, r, fallback=batch.n_basis[k] > 0)
     return out
 
 
@@ -998,3 +1011,19 @@ def _pose_fallback(out: dict[str, NDArray], row: int, mech, S_set: NDArray, para
         out["iterations"][row], out["solver"][row] = r.iterations, "clarabel_fallback"
     else:
         out["iterations"][row] = 0
+
+
+def warm_up() -> None:
+    """Compile the solver's machine code, or load it from the cache next to this file.
+
+    Called once after installation (Makefile) so that no workflow job pays the compilation
+    (about a minute on one core) and parallel jobs do not compile it side by side.
+    """
+    normals = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])
+    E = np.array([[1.0], [0.0], [0.0], [-1.0], [0.0], [0.0]]) / np.sqrt(2.0)  # a squeeze
+    solve_gfo_batch([np.zeros(6)], [E], [normals], 1.0, 0.5)
+    frames = _contact_frames(normals, 1.0)
+    n = np.zeros(1, dtype=np.int8)
+    _solve_pose(E.copy(), np.zeros(6), frames, frames, np.zeros((1, 1), dtype=np.int64), np.ones(1, dtype=np.int64),
+                np.full(1, 1e-9), 1.0, 0.99, 0.5, True, *_kernel_settings(SolverSettings()), n, np.empty(1),
+                np.empty(1), np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.int64), n.copy())
