@@ -61,21 +61,18 @@ def main() -> None:
         for st in sets:
             problems.append((mech, np.array(st) - 1))
     pick = rng.permutation(len(problems))
-    sub = [problems[k] for k in pick[: args.exact]]
-    t0 = time.perf_counter()
-    for mech, cols in sub:
-        if mech.rank_G == 6:
-            E = internal_force_basis(mech.projector, S[:, cols], params.basis_rtol)
-            solve_gfo(mech.f_p, E, mech.normals, params.mu, params.f_min)
-    exact_rate = len(sub) / (time.perf_counter() - t0)
 
-    sub = [problems[k] for k in pick[: args.cvxpy]]
-    t0 = time.perf_counter()
-    for mech, cols in sub:
-        if mech.rank_G == 6:
-            E = internal_force_basis(mech.projector, S[:, cols], params.basis_rtol)
-            solve_gfo_cvxpy(mech.f_p, E, mech.normals, params.mu, params.f_min)
-    cvxpy_rate = len(sub) / (time.perf_counter() - t0)
+    def per_problem_rate(solve, count: int) -> float:
+        sub = [problems[k] for k in pick[:count]]
+        t0 = time.perf_counter()
+        for mech, cols in sub:
+            if mech.rank_G == 6:
+                E = internal_force_basis(mech.projector, S[:, cols], params.basis_rtol)
+                solve(mech.f_p, E, mech.normals, params.mu, params.f_min)
+        return len(sub) / (time.perf_counter() - t0)
+
+    exact_rate = per_problem_rate(solve_gfo, args.exact)
+    cvxpy_rate = per_problem_rate(solve_gfo_cvxpy, args.cvxpy)
 
     statuses = {s: int(np.sum(out["status"] == s)) for s in sorted(set(out["status"]))}
     print(f"problems: {n} ({n_poses} grasps x {len(sets)} sets), statuses {statuses}")

@@ -1,5 +1,5 @@
-"""Batched grasp-force optimisation: one primal-dual interior-point method run on thousands
-of GFO problems at once (docs/batched_solver.md).
+"""Batched grasp-force optimisation: one primal-dual interior-point method, compiled with
+numba, run over thousands of GFO problems (docs/batched_solver.md).
 
 Per problem (method.md §4), forces in N:
 
@@ -10,9 +10,8 @@ With E orthonormal, ||f_p + E y||^2 = ||f_p - E a||^2 + ||y + a||^2 (a = E^T f_p
 solver minimises t subject to (t, y + a) in a second-order cone: a linear-objective SOCP
 in x = (t, y), solved through the homogeneous self-dual embedding (infeasibility ends in a
 certificate, not a time-out) with Nesterov-Todd scaling and Mehrotra's predictor-corrector.
-Every array carries the batch on its last axis; every operation is element-wise over the
-batch and reduces over small leading axes in a fixed order, so a problem gives the same
-numbers alone or inside any batch, padded or not.
+Each problem is solved on its own from its own sizes, so it gives the same numbers alone or
+inside any batch, padded or not.
 """
 
 from __future__ import annotations
@@ -148,14 +147,7 @@ def gfo_batch(
     any batch, padded or not.
     """
     B = len(f_p)
-    if not (len(E) == len(normals) == B):
-        raise ValueError(f"f_p, E and normals must have the same length, got {B}, {len(E)}, {len(normals)}")
-    mus = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (B,)))
-    fmins = np.array(np.broadcast_to(np.asarray(f_min, dtype=float), (B,)))
-    if not np.all(np.isfinite(mus) & (mus > 0)):
-        raise ValueError("mu must be finite and > 0")
-    if not np.all(np.isfinite(fmins) & (fmins >= 0)):
-        raise ValueError("f_min must be finite and >= 0 (N)")
+    mus, fmins = _problem_parameters(f_p, E, normals, mu, f_min)
     bases = [np.asarray(Ek, dtype=float).reshape(np.asarray(Ek).shape[0], -1) for Ek in E]
     ms = np.array([np.asarray(n).reshape(-1, 3).shape[0] for n in normals], dtype=np.int64)
     es = np.array([Ek.shape[1] for Ek in bases], dtype=np.int64)
@@ -174,6 +166,20 @@ def gfo_batch(
         Eb[k, :3 * mk, :ek] = bases[k]
         fp[k, :3 * mk] = np.asarray(f_p[k], dtype=float).ravel()
     return GFOBatch(frames=frames, E=Eb, f_p=fp, mu=mus, f_min=fmins, n_contacts=ms, n_basis=es)
+
+
+def _problem_parameters(f_p, E, normals, mu, f_min) -> tuple[NDArray, NDArray]:
+    """Check that the problem lists agree in length; mu and f_min (N) as checked (B,) arrays."""
+    B = len(f_p)
+    if not (len(E) == len(normals) == B):
+        raise ValueError(f"f_p, E and normals must have the same length, got {B}, {len(E)}, {len(normals)}")
+    mus = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (B,)))
+    fmins = np.array(np.broadcast_to(np.asarray(f_min, dtype=float), (B,)))
+    if not np.all(np.isfinite(mus) & (mus > 0)):
+        raise ValueError("mu must be finite and > 0")
+    if not np.all(np.isfinite(fmins) & (fmins >= 0)):
+        raise ValueError("f_min must be finite and >= 0 (N)")
+    return mus, fmins
 
 
 def _contact_frames(normals: NDArray, mu: float | NDArray) -> NDArray:
@@ -449,7 +455,7 @@ def _is_certificate(hz, gtz_norm, eps):
 @_jit
 def _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine, y):
     """Solve one GFO problem (contact rows D (m, 3, e), h (m, 3), a (e,), N) by the homogeneous
-    self-dual embedding. Returns (code, t in N, iterations); fills y (N) when optimal."""
+    self-dual embedding. Returns (code, iterations); fills y (N) when optimal."""
     N = 4 * m + e + 2
     n = e + 1
     o = 4 * m
@@ -538,11 +544,11 @@ def _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, 
         if optimal:
             for j in range(e):
                 y[j] = x[1 + j] / tau * rho
-            return _OPTIMAL, x[0] / tau * rho, it
+            return _OPTIMAL, it
         if infeasible:
-            return _INFEASIBLE, math.nan, it
+            return _INFEASIBLE, it
         if last or not (math.isfinite(mu) and math.isfinite(tau) and tau > 0.0):
-            return _UNDECIDED, math.nan, it
+            return _UNDECIDED, it
 
         # Nesterov-Todd scaling and the normal matrix M = G^T (W^T W)^-1 G, (e+1, e+1).
         for i in range(m):
@@ -635,7 +641,7 @@ def _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, 
             z[k] += alpha * dz[k]
         tau += alpha * dtau
         kappa += alpha * dkappa
-    return _UNDECIDED, math.nan, max_iter
+    return _UNDECIDED, max_iter
 
 
 @_jit
@@ -729,7 +735,7 @@ def _solve_one(frames, E, fp, mu, f_min, m, e, tol, reduced_tol, max_iter, step_
 def _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine,
              violation_tol, y):
     """`_hsde`, then the force check of an optimal point: (code, ||f|| N, violation N, iterations)."""
-    code, _, it = _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine, y)
+    code, it = _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine, y)
     if code != _OPTIMAL:
         return code, math.nan, math.nan, it
     # f = f_p + E y in the contact frames: [n.f, t1.f/mu, t2.f/mu]
@@ -866,10 +872,7 @@ def solve_gfo_batch(
     are judged directly by `solve_gfo` (f = f_p), as the per-problem path does.
     """
     B = len(f_p)
-    if not (len(E) == len(normals) == B):
-        raise ValueError(f"f_p, E and normals must have the same length, got {B}, {len(E)}, {len(normals)}")
-    mus = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (B,)))
-    fmins = np.array(np.broadcast_to(np.asarray(f_min, dtype=float), (B,)))
+    mus, fmins = _problem_parameters(f_p, E, normals, mu, f_min)
     out = BatchSolution(status=np.full(B, "numerical_failure", dtype=object), force_norm=np.full(B, np.nan),
                         iterations=np.zeros(B, dtype=np.int32), solver=np.full(B, "batched", dtype=object),
                         max_violation=np.full(B, np.nan))
