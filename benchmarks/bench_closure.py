@@ -15,10 +15,10 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from synergrasp.closure import ClosureParams, Placement, _Closer, object_pose, pose_grid, simulate_pose  # noqa: E402
-from synergrasp.hand import load_hand  # noqa: E402
-from synergrasp.objects import STUDY_BOXES  # noqa: E402
-from synergrasp.synergies import load_synergies  # noqa: E402
+from synergrasp.simulation.closure import ClosureParams, Placement, _Closer, object_pose, pose_grid, simulate_pose  # noqa: E402
+from synergrasp.hand.kinematics import load_hand  # noqa: E402
+from synergrasp.simulation.objects import STUDY_BOXES  # noqa: E402
+from synergrasp.hand.synergies import load_synergies  # noqa: E402
 
 
 #: Per-object placements (docs/closure.md): the default centre for the 30 mm boxes; the

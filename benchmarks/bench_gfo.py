@@ -16,10 +16,10 @@ import time
 
 import numpy as np
 
-from synergrasp.batched import optimise_grasps
-from synergrasp.force_optimisation import GFOParams, mechanics_for, solve_gfo, solve_gfo_cvxpy
-from synergrasp.mechanics import internal_force_basis
-from synergrasp.problems import random_grasp, random_synergies
+from synergrasp.optimisation.batched import optimise_grasps
+from synergrasp.optimisation.force_optimisation import GFOParams, mechanics_for, solve_gfo, solve_gfo_cvxpy
+from synergrasp.optimisation.mechanics import internal_force_basis
+from synergrasp.optimisation.problems import random_grasp, random_synergies
 
 
 def study_sets() -> list[tuple[int, ...]]:

@@ -1,8 +1,8 @@
 """Fixtures shared by the test modules: the shipped hand and its synergies."""
 import pytest
 
-from synergrasp.hand import load_hand
-from synergrasp.synergies import load_synergies
+from synergrasp.hand.kinematics import load_hand
+from synergrasp.hand.synergies import load_synergies
 
 
 @pytest.fixture(scope="session")

@@ -7,16 +7,16 @@ import itertools
 import numpy as np
 import pytest
 
-from synergrasp.batched import (
+from synergrasp.optimisation.batched import (
     SolverSettings,
     gfo_batch,
     optimise_grasps,
     solve_batch,
     solve_gfo_batch,
 )
-from synergrasp.force_optimisation import GFOParams, mechanics_for, optimise_grasp, solve_gfo, solve_gfo_cvxpy
-from synergrasp.mechanics import grasp_mechanics, internal_force_basis, object_wrench
-from synergrasp.problems import random_gfo_problems, random_grasp, random_synergies, random_unit_vector
+from synergrasp.optimisation.force_optimisation import GFOParams, mechanics_for, optimise_grasp, solve_gfo, solve_gfo_cvxpy
+from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_basis, object_wrench
+from synergrasp.optimisation.problems import random_gfo_problems, random_grasp, random_synergies, random_unit_vector
 
 #: Near-boundary band (docs/batched_solver.md): problems whose friction coefficient is within
 #: this relative distance of the critical one may get either verdict.

@@ -8,8 +8,8 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from synergrasp import bullet
-from synergrasp.hand import JOINT_NAMES, fingertip_positions, forward_kinematics, load_hand, point_jacobian
+from synergrasp.simulation import bullet
+from synergrasp.hand.kinematics import JOINT_NAMES, fingertip_positions, forward_kinematics, load_hand, point_jacobian
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.closure import (
+from synergrasp.simulation.closure import (
     ClosureParams,
     Placement,
     object_pose,
@@ -17,8 +17,8 @@ from synergrasp.closure import (
     simulate_object,
     write_contacts,
 )
-from synergrasp.hand import forward_kinematics
-from synergrasp.objects import Box
+from synergrasp.hand.kinematics import forward_kinematics
+from synergrasp.simulation.objects import Box
 
 PARAMS = ClosureParams()
 PLACEMENT = Placement()

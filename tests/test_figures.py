@@ -2,7 +2,7 @@
 import numpy as np
 import pandas as pd
 
-from synergrasp.figures import (figure_exploded_views, figure_force_maps, figure_hierarchy,
+from synergrasp.figures.study_figures import (figure_exploded_views, figure_force_maps, figure_hierarchy,
                                 force_grid, parse_rulegraph, write_table)
 
 

@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 import pytest
 
-from synergrasp.force_optimisation import (
+from synergrasp.optimisation.force_optimisation import (
     GFOParams,
     mechanics_for,
     optimise_grasp,
@@ -15,8 +15,8 @@ from synergrasp.force_optimisation import (
     solve_gfo_cvxpy,
     strict_internal_forces,
 )
-from synergrasp.mechanics import Grasp
-from synergrasp.problems import critical_friction, random_gfo_problems
+from synergrasp.optimisation.mechanics import Grasp
+from synergrasp.optimisation.problems import critical_friction, random_gfo_problems
 
 W = 9.81  # N, weight of 1 kg
 MU = 1.5

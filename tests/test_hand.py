@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import yaml
 
-from synergrasp.hand import (
+from synergrasp.hand.kinematics import (
     FINGERS,
     FINGERTIP_LINKS,
     JOINT_NAMES,

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from synergrasp.mechanics import (
+from synergrasp.optimisation.mechanics import (
     Grasp,
     contact_stiffness,
     friction_cone_rows,
@@ -12,7 +12,7 @@ from synergrasp.mechanics import (
     internal_force_basis,
     object_wrench,
 )
-from synergrasp.problems import LINK_CHAINS, random_grasp, random_synergies
+from synergrasp.optimisation.problems import LINK_CHAINS, random_grasp, random_synergies
 
 W = 9.81  # N, weight of the 1 kg object
 

@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.minima import local_minima, minima_table, preserved
+from synergrasp.analysis.minima import local_minima, minima_table, preserved
 
 
 def ring(forces: dict[float, float], default: float = 5.0):

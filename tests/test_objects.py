@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from synergrasp.objects import STUDY_BOXES, Box, ObjectError, boxes_from_config
+from synergrasp.simulation.objects import STUDY_BOXES, Box, ObjectError, boxes_from_config
 
 
 def test_study_boxes():

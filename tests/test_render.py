@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from synergrasp.closure import ClosureParams, Placement, pose_grid, simulate_object
-from synergrasp.objects import Box
-from synergrasp.render import figure_example_grasps, figure_synergy_postures, render_posture
+from synergrasp.simulation.closure import ClosureParams, Placement, pose_grid, simulate_object
+from synergrasp.simulation.objects import Box
+from synergrasp.figures.hand_drawing import figure_example_grasps, figure_synergy_postures, render_posture
 
 
 def _hand_pixels(image):
@@ -37,8 +37,8 @@ def test_figures_are_written(hand, synergies, tmp_path):
 
 def test_capsules_end_at_the_fingertips(hand):
     """The distal capsule's far end (sphere centre + radius along the axis) is the fingertip."""
-    from synergrasp.hand import fingertip_positions
-    from synergrasp.render import hand_capsules
+    from synergrasp.hand.kinematics import fingertip_positions
+    from synergrasp.figures.hand_drawing import hand_capsules
 
     rng = np.random.default_rng(3)
     for _ in range(3):
@@ -63,8 +63,8 @@ def test_drawing_spans_the_projected_capsules_and_closing_moves_toward_the_palm_
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from synergrasp.hand import fingertip_positions
-    from synergrasp.render import FIGURE_VIEW, draw_hand, hand_capsules
+    from synergrasp.hand.kinematics import fingertip_positions
+    from synergrasp.figures.hand_drawing import FIGURE_VIEW, draw_hand, hand_capsules
 
     eye = FIGURE_VIEW.target_mm - FIGURE_VIEW.eye_mm
     forward = eye / np.linalg.norm(eye)

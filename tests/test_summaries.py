@@ -2,7 +2,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.summaries import (
+from synergrasp.analysis.summaries import (
     full_but_not_first7,
     hierarchy_matrices,
     incrementality_table,

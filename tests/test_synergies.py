@@ -4,8 +4,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from synergrasp.hand import JOINT_NAMES
-from synergrasp.synergies import (
+from synergrasp.hand.kinematics import JOINT_NAMES
+from synergrasp.hand.synergies import (
     HUMAN_JOINT_NAMES,
     Synergies,
     SynergyFileError,
@@ -168,7 +168,7 @@ def test_shipped_path_exists():
 
 
 def test_mapping_limits_agree_with_hand_model():
-    from synergrasp.hand import load_hand
+    from synergrasp.hand.kinematics import load_hand
 
     hand = load_hand(None)
     joints = load_synergy_mapping()["joints"]

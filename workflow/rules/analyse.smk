@@ -4,7 +4,7 @@
 rule local_minima:
     input:
         gfo="results/objects/{object}/gfo.parquet",
-        code=code("minima"),
+        code=code("local_minima"),
     output:
         "results/objects/{object}/minima.parquet",
     params:
@@ -19,7 +19,7 @@ rule study_tables:
     input:
         gfo=expand("results/objects/{object}/gfo.parquet", object=OBJECTS),
         minima=expand("results/objects/{object}/minima.parquet", object=OBJECTS),
-        code=code("summaries", "minima", "config", "figures"),
+        code=code("study_tables"),
     output:
         **{
             f"{t}_{ext}": report(

@@ -14,9 +14,9 @@ SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
 def _check_inputs(cfg):
     """Validate config, hand, synergies and objects; return the synergy count."""
-    from synergrasp.hand import load_hand
-    from synergrasp.objects import boxes_from_config
-    from synergrasp.synergies import load_synergies
+    from synergrasp.hand.kinematics import load_hand
+    from synergrasp.simulation.objects import boxes_from_config
+    from synergrasp.hand.synergies import load_synergies
 
     validate_config(cfg, SCHEMA)
     hand = load_hand(cfg["hand"])
@@ -42,9 +42,45 @@ wildcard_constraints:
     shard=r"\d+",
 
 
-def code(*modules):
-    """Source files whose change must rerun a rule (Snakemake does not track src/)."""
-    return [str(SRC / f"{m}.py") for m in modules] + [str(ROOT / "environment.lock")]
+def _imported_modules(path):
+    """Names of the synergrasp modules a Python file imports, at any depth of the file."""
+    import ast
+
+    found = set()
+    for node in ast.walk(ast.parse(Path(path).read_text())):
+        if isinstance(node, ast.Import):
+            found |= {a.name for a in node.names if a.name.startswith("synergrasp")}
+        elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("synergrasp"):
+            found.add(node.module)
+            found |= {f"{node.module}.{a.name}" for a in node.names}  # `from pkg import module`
+    return found
+
+
+def _module_file(name):
+    """Source file of a synergrasp module or package, or None for a name that is not one."""
+    rel = Path(*name.split("."))
+    for candidate in (SRC.parent / rel.with_suffix(".py"), SRC.parent / rel / "__init__.py"):
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def code(script):
+    """Source files whose change must rerun the rule running ``workflow/scripts/<script>.py``:
+    the synergrasp modules it imports, transitively (lazy imports inside functions
+    included), their packages' ``__init__.py``, and the lock. Derived from the code, so a
+    new import cannot be missed; Snakemake itself does not track src/."""
+    todo = [ROOT / "workflow" / "scripts" / f"{script}.py"]
+    files = set()
+    while todo:
+        for name in _imported_modules(todo.pop()):
+            parts = name.split(".")
+            for depth in range(1, len(parts) + 1):  # a module's packages run their __init__
+                path = _module_file(".".join(parts[:depth]))
+                if path is not None and path not in files:
+                    files.add(path)
+                    todo.append(path)
+    return sorted(str(f) for f in files) + [str(ROOT / "environment.lock")]
 
 
 def user_files():

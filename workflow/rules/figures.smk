@@ -6,7 +6,7 @@ rule fig4_force_maps:
     input:
         gfo="results/objects/{object}/gfo.parquet",
         minima="results/objects/{object}/minima.parquet",
-        code=code("figures"),
+        code=code("fig4_force_maps"),
     output:
         maps_png=report(
             "results/objects/{object}/fig4_force_maps.png",
@@ -33,7 +33,7 @@ rule fig4_force_maps:
 rule fig5_hierarchy:
     input:
         rates="results/tables/success_rates.csv",
-        code=code("figures", "summaries"),
+        code=code("fig5_hierarchy"),
     output:
         success_png=report(
             "results/figures/fig5a_hierarchy_success.png",
@@ -59,7 +59,7 @@ rule fig3_rulegraph:
     input:
         rules=[str(p) for p in sorted((ROOT / "workflow" / "rules").glob("*.smk"))],
         snakefile=str(ROOT / "Snakefile"),
-        code=code("figures"),
+        code=code("fig3_rulegraph"),
     output:
         png=report(
             "results/figures/fig3_rulegraph.png",

@@ -5,7 +5,7 @@
 rule optimise_shard:
     input:
         contacts="results/objects/{object}/contacts.parquet",
-        code=code("mechanics", "force_optimisation", "batched", "synergies", "closure"),
+        code=code("optimise_shard"),
         data=SHIPPED_DATA,
         user=user_files(),
     output:

@@ -4,7 +4,7 @@
 
 rule simulate_contacts:
     input:
-        code=code("closure", "hand", "bullet", "synergies", "objects"),
+        code=code("simulate_contacts"),
         data=SHIPPED_DATA,
         user=user_files(),
     output:
@@ -21,7 +21,7 @@ rule simulate_contacts:
 
 rule fig1_synergy_postures:
     input:
-        code=code("render", "hand", "bullet", "synergies"),
+        code=code("fig1_synergy_postures"),
         data=SHIPPED_DATA,
         user=user_files(),
     output:
@@ -43,7 +43,7 @@ rule fig1_synergy_postures:
 rule fig2_example_grasps:
     input:
         contacts=expand("results/objects/{object}/contacts.parquet", object=OBJECTS),
-        code=code("render", "hand", "bullet"),
+        code=code("fig2_example_grasps"),
     output:
         png=report(
             "results/figures/fig2_example_grasps.png",

@@ -3,9 +3,9 @@ from contextlib import redirect_stderr
 
 import pandas as pd
 
-from synergrasp.hand import load_hand
-from synergrasp.objects import boxes_from_config
-from synergrasp.render import figure_example_grasps
+from synergrasp.hand.kinematics import load_hand
+from synergrasp.simulation.objects import boxes_from_config
+from synergrasp.figures.hand_drawing import figure_example_grasps
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     boxes = boxes_from_config([{k: v for k, v in o.items() if k != "placement"} for o in snakemake.params.objects])

@@ -3,7 +3,7 @@ import subprocess
 import sys
 from contextlib import redirect_stderr
 
-from synergrasp.figures import figure_rulegraph
+from synergrasp.figures.study_figures import figure_rulegraph
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     command = [sys.executable, "-m", "snakemake", "figures", "-s", snakemake.params.snakefile,

@@ -3,7 +3,7 @@ from contextlib import redirect_stderr
 
 import pandas as pd
 
-from synergrasp.figures import figure_exploded_views, figure_force_maps
+from synergrasp.figures.study_figures import figure_exploded_views, figure_force_maps
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     gfo = pd.read_parquet(snakemake.input.gfo)

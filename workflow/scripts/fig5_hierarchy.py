@@ -3,8 +3,8 @@ from contextlib import redirect_stderr
 
 import pandas as pd
 
-from synergrasp.figures import figure_hierarchy
-from synergrasp.summaries import hierarchy_matrices, mean_over_objects
+from synergrasp.figures.study_figures import figure_hierarchy
+from synergrasp.analysis.summaries import hierarchy_matrices, mean_over_objects
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     first, out = snakemake.params.first, snakemake.output

@@ -1,7 +1,7 @@
 """Local minima of the optimal force over one object's (alpha, beta) grid, every set."""
 import pandas as pd
 
-from synergrasp.minima import minima_table
+from synergrasp.analysis.minima import minima_table
 
 gfo = pd.read_parquet(snakemake.input.gfo)
 minima_table(gfo, radius_deg=snakemake.params.radius_deg).to_parquet(snakemake.output[0], index=False)

@@ -4,10 +4,10 @@ from contextlib import redirect_stderr
 import numpy as np
 import pandas as pd
 
-from synergrasp.batched import optimise_grasps
-from synergrasp.closure import read_grasps
+from synergrasp.optimisation.batched import optimise_grasps
+from synergrasp.simulation.closure import read_grasps
 from synergrasp.config import gfo_params
-from synergrasp.synergies import load_synergies
+from synergrasp.hand.synergies import load_synergies
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     opt = snakemake.params.opt

@@ -3,8 +3,8 @@ from contextlib import redirect_stderr
 
 import pandas as pd
 
-from synergrasp.figures import write_table
-from synergrasp.summaries import study_tables
+from synergrasp.figures.study_figures import write_table
+from synergrasp.analysis.summaries import study_tables
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     gfo = pd.concat([pd.read_parquet(p) for p in snakemake.input.gfo], ignore_index=True)

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from synergrasp.force_optimisation import solve_gfo
-from synergrasp.mechanics import Grasp, grasp_mechanics, internal_force_basis, object_wrench
+from synergrasp.optimisation.force_optimisation import solve_gfo
+from synergrasp.optimisation.mechanics import Grasp, grasp_mechanics, internal_force_basis, object_wrench
 
 __all__ = [
     "GFOProblem",

@@ -20,7 +20,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from synergrasp.mechanics import (
+from synergrasp.optimisation.mechanics import (
     BASIS_RTOL,
     GRASP_RANK_RTOL,
     Grasp,

@@ -24,7 +24,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 if TYPE_CHECKING:  # pragma: no cover
-    from synergrasp.mechanics import Grasp
+    from synergrasp.optimisation.mechanics import Grasp
 
 __all__ = [
     "ROTATION_ORDERS",
@@ -197,7 +197,7 @@ def object_pose(placement: Placement, size_mm: Sequence[float], alpha_deg: float
                 palm_normal: Sequence[float] = (1.0, 0.0, 0.0)) -> ObjectPose:
     """Centre and orientation of a box of ``size_mm`` at (α, β) deg.
 
-    α turns about ``palm_normal`` (``synergrasp.hand.PALM_NORMAL``), β about the palm z
+    α turns about ``palm_normal`` (``synergrasp.hand.kinematics.PALM_NORMAL``), β about the palm z
     axis, both about the box centre; see :class:`Placement` for the order.
     """
     size = np.asarray(size_mm, dtype=float)
@@ -355,12 +355,12 @@ def _table(rows: list[dict[str, Any]]) -> pd.DataFrame:
 
 
 def read_grasps(table: pd.DataFrame) -> list[Grasp | None]:
-    """One :class:`synergrasp.mechanics.Grasp` per row of a contacts table, in row order.
+    """One :class:`synergrasp.optimisation.mechanics.Grasp` per row of a contacts table, in row order.
 
     Rows whose status is not ``grasp`` or that have no contact give ``None``. Reads only
     numbers: pybullet is not imported.
     """
-    from synergrasp.mechanics import Grasp
+    from synergrasp.optimisation.mechanics import Grasp
 
     missing = [c for c in ("status", "n_contacts", "contact_link", "contact_point", "contact_normal",
                            "jacobian", "object_center") if c not in table.columns]
@@ -397,7 +397,7 @@ class _Closer:
     """One pybullet scene (hand + box) and the closure along S1 on it."""
 
     def __init__(self, hand: Any, synergies: Any, params: ClosureParams) -> None:
-        from synergrasp import bullet
+        from synergrasp.simulation import bullet
 
         self.bullet = bullet
         self.hand = hand
@@ -442,7 +442,7 @@ class _Closer:
     def _finger_reach(self) -> NDArray:
         """Per finger, an upper bound (mm) on the distance of any point of its links from any
         of its joint axes: the extended chain (q = 0) from the finger's first axis, plus radius."""
-        from synergrasp.hand import forward_kinematics
+        from synergrasp.hand.kinematics import forward_kinematics
 
         frames = forward_kinematics(self.hand, np.zeros(self.hand.n_joints))
         reach = np.zeros(len(self.fingers))
@@ -734,7 +734,7 @@ def _box_surface_point(placed: ObjectPose, on_link: NDArray, on_box: NDArray,
 
 def simulate_pose(closer: _Closer, size_mm: NDArray, placed: ObjectPose) -> ClosureResult:
     """Close the hand of ``closer`` on a box of ``size_mm`` placed at ``placed``."""
-    from synergrasp.hand import contact_jacobian
+    from synergrasp.hand.kinematics import contact_jacobian
 
     closer.place_box(size_mm, placed)
     q, state, intersects = closer.run()

@@ -5,7 +5,7 @@ A synergy file is a CSV with one row per hand joint and the columns ``joint``,
 unit of the synergy coordinate σ). The shipped file ``data/synergies_19dof.csv`` is
 generated from the human synergies (``data/santello_synergies_20dof.csv``) and the mapping
 ``data/synergy_mapping.yaml`` by :func:`map_human_synergies`; regenerate it with
-``python -m synergrasp.synergies``.
+``python -m synergrasp.hand.synergies``.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import pandas as pd
 import yaml
 from numpy.typing import ArrayLike, NDArray
 
-from synergrasp.hand import JOINT_NAMES
+from synergrasp.hand.kinematics import JOINT_NAMES
 
 __all__ = [
     "Synergies",

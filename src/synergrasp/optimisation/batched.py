@@ -24,8 +24,8 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from synergrasp.force_optimisation import GFOParams, mechanics_for, solve_gfo, strict_internal_forces
-from synergrasp.mechanics import Grasp, internal_force_basis, tangent_pairs
+from synergrasp.optimisation.force_optimisation import GFOParams, mechanics_for, solve_gfo, strict_internal_forces
+from synergrasp.optimisation.mechanics import Grasp, internal_force_basis, tangent_pairs
 
 __all__ = [
     "BatchResult",
@@ -805,7 +805,7 @@ def _solve_pose(F_all, fp, frames, frames_strict, cols, n_cols, thresholds, mu, 
 
 
 def _kernel_settings(settings: SolverSettings) -> tuple:
-    from synergrasp.force_optimisation import ALMOST_SOLVED_TOL
+    from synergrasp.optimisation.force_optimisation import ALMOST_SOLVED_TOL
 
     return (float(settings.tol), float(settings.reduced_tol), int(settings.max_iter), float(settings.step_fraction),
             float(settings.stall_step), int(settings.refine), int(settings.retry_refine), float(ALMOST_SOLVED_TOL))

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from synergrasp.config import incremental_set_id, set_id
-from synergrasp.minima import preserved
+from synergrasp.analysis.minima import preserved
 
 __all__ = [
     "success_rates",

@@ -15,7 +15,7 @@ import numpy as np
 import pybullet as pb
 from numpy.typing import NDArray
 
-from synergrasp.hand import Hand, write_urdf
+from synergrasp.hand.kinematics import Hand, write_urdf
 
 MM = 1e-3  # metres per mm
 

@@ -44,11 +44,11 @@ def render_posture(hand: Any, q: NDArray, view: View = PALM_VIEW, box: tuple[NDA
                    body: Any | None = None) -> NDArray:
     """RGB image (h, w, 3) uint8 of the hand at q (rad), optionally with a box.
 
-    ``box`` = (size_mm, ObjectPose) as made by ``synergrasp.closure.object_pose``.
+    ``box`` = (size_mm, ObjectPose) as made by ``synergrasp.simulation.closure.object_pose``.
     """
     import pybullet as pb
 
-    from synergrasp import bullet
+    from synergrasp.simulation import bullet
 
     own = client is None
     if own:
@@ -114,7 +114,7 @@ class HandCapsules:
 def hand_capsules(hand: Any, q: NDArray) -> HandCapsules:
     """Capsules (and palm box corners) of ``hand`` at joint angles q (rad), from
     ``hand.forward_kinematics``; lengths in mm, palm frame."""
-    from synergrasp.hand import forward_kinematics
+    from synergrasp.hand.kinematics import forward_kinematics
 
     frames = forward_kinematics(hand, np.asarray(q, dtype=float))
     ends, radius, link, corners = [], [], [], np.zeros((0, 3))
@@ -318,7 +318,7 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[Any]
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from synergrasp.closure import ObjectPose
+    from synergrasp.simulation.closure import ObjectPose
 
     if len(boxes) != len(tables):
         raise ValueError(f"boxes and tables must have the same length, got {len(boxes)} and {len(tables)}")

@@ -1,0 +1,135 @@
+"""Table contracts: the columns, types and units of every table passed between steps.
+
+One :class:`Table` per table; writers, readers, workflow scripts and ``docs/design.md``
+take their columns from here. :func:`write` checks a frame against its contract and
+writes Parquet with the exact types; :func:`read` checks what it reads.
+Units are in the column names where a column has one (``_mm``, ``_deg``, ``_N``) and in
+``Column.unit`` always.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "write", "read", "empty"]
+
+
+@dataclass(frozen=True)
+class Column:
+    """One column: name, Arrow type name, unit ('' if none) and meaning."""
+
+    name: str
+    dtype: str  # "string", "int32", "float64", "bool", "list<float64>", "list<int32>", "list<string>"
+    unit: str
+    meaning: str
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table's name, one-line description, row key and columns in order."""
+
+    name: str
+    rows: str
+    columns: tuple[Column, ...]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(c.name for c in self.columns)
+
+    def arrow_schema(self):
+        import pyarrow as pa
+
+        scalar = {"string": pa.string(), "int32": pa.int32(), "float64": pa.float64(), "bool": pa.bool_()}
+
+        def arrow(t: str):
+            return pa.list_(scalar[t[5:-1]]) if t.startswith("list<") else scalar[t]
+
+        return pa.schema([(c.name, arrow(c.dtype)) for c in self.columns])
+
+    def markdown(self) -> str:
+        """The contract as a Markdown table (for the docs)."""
+        lines = ["| column | type | unit | meaning |", "|---|---|---|---|"]
+        lines += [f"| `{c.name}` | {c.dtype} | {c.unit or '–'} | {c.meaning} |" for c in self.columns]
+        return "\n".join(lines)
+
+
+def _pose_columns() -> tuple[Column, ...]:
+    return (
+        Column("object", "string", "", "object name"),
+        Column("pose", "int32", "", "pose index, alpha_index * n_beta + beta_index"),
+        Column("alpha_deg", "float64", "deg", "rotation about the palm normal"),
+        Column("beta_deg", "float64", "deg", "rotation about the long-finger axis"),
+    )
+
+
+CONTACTS = Table("contacts", "one row per pose", _pose_columns() + (
+    Column("status", "string", "", "closure outcome (see synergrasp.simulation)"),
+    Column("q", "list<float64>", "rad", "final joint angles (19)"),
+    Column("finger_state", "list<string>", "", "per finger thumb..little: contact, limit, self"),
+    Column("n_contacts", "int32", "", "number of contacts m"),
+    Column("contact_link", "list<int32>", "", "link index per contact (Hand.link_names)"),
+    Column("contact_point", "list<float64>", "mm", "contact points on the box surface, palm frame, 3m row-major"),
+    Column("contact_normal", "list<float64>", "", "object's inward unit normals, palm frame, 3m"),
+    Column("jacobian", "list<float64>", "mm/rad", "translational Jacobian rows, 3m x 19 row-major"),
+    Column("object_center", "list<float64>", "mm", "box centre, palm frame (3)"),
+    Column("object_rotation", "list<float64>", "", "box orientation, row-major rotation matrix (9)"),
+    Column("max_penetration_mm", "float64", "mm", "deepest contact penetration"),
+))
+
+GFO = Table("gfo", "one row per (pose, synergy set)", _pose_columns() + (
+    Column("set_id", "string", "", "enrolled synergies, 1-based, sorted, joined by '-'"),
+    Column("n_synergies", "int32", "", "number of enrolled synergies s"),
+    Column("status", "string", "", "force_closure, infeasible, rank_deficient, no_grasp, numerical_failure"),
+    Column("force_closure", "bool", "", "status == force_closure"),
+    Column("strict_internal", "bool", "", "Bicchi's strict internal-force test"),
+    Column("force_norm", "float64", "N", "optimal contact-force norm (NaN unless force closure)"),
+    Column("e_s", "int32", "", "rank of the internal-force basis"),
+    Column("rank_G", "int32", "", "rank of the grasp matrix"),
+    Column("n_contacts", "int32", "", "number of contacts"),
+    Column("iterations", "int32", "", "interior-point iterations"),
+    Column("solver", "string", "", "back end that decided the problem"),
+))
+
+MINIMA = Table("minima", "one row per local minimum of (object, synergy set)", (
+    Column("object", "string", "", "object name"),
+    Column("set_id", "string", "", "enrolled synergies"),
+    Column("n_synergies", "int32", "", "number of enrolled synergies"),
+    Column("pose", "int32", "", "pose index"),
+    Column("alpha_deg", "float64", "deg", "rotation about the palm normal"),
+    Column("beta_deg", "float64", "deg", "rotation about the long-finger axis"),
+    Column("force_norm", "float64", "N", "optimal contact-force norm at the minimum"),
+))
+
+TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA)}
+
+
+def _check(table: Table, frame: pd.DataFrame, where: str) -> None:
+    missing = [c for c in table.names if c not in frame.columns]
+    if missing:
+        raise ValueError(f"{table.name} table ({where}): missing column(s) {missing}; "
+                         f"required: {list(table.names)}")
+
+
+def empty(table: Table) -> pd.DataFrame:
+    """A frame with the table's columns and no rows, with the contract's types."""
+    return table.arrow_schema().empty_table().to_pandas()
+
+
+def write(table: Table, frame: pd.DataFrame, path: str | Path) -> None:
+    """Write ``frame`` as Parquet with exactly the contract's columns, order and types."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    _check(table, frame, str(path))
+    arrow = pa.Table.from_pandas(frame[list(table.names)], schema=table.arrow_schema(), preserve_index=False)
+    pq.write_table(arrow, str(path))
+
+
+def read(table: Table, path: str | Path) -> pd.DataFrame:
+    """Read a Parquet table and check it holds the contract's columns."""
+    frame = pd.read_parquet(path)
+    _check(table, frame, str(path))
+    return frame
