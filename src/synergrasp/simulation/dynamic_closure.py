@@ -3,22 +3,20 @@
 The second closure model (``closure.model: dynamic``, docs/closure.md). Same inputs as the
 kinematic closure (hand, synergies, box, the placed object pose, the σ path) and the same
 result type. The 19 joints are springs of stiffness k_ss (N·mm/rad) about the synergy
-reference q_r(σ) = clip(q_m + σ·S1, lower, upper), realised with the engine's joint motors:
-every elementary axis i (scale s_i: 1, or 1/2 for each half of a rolling joint) is driven
-toward s_i·q_r by a position motor whose torque is capped at (k_ss/s_i)·|s_i·q_r − θ_i|.
-A motor that cannot reach its target (a link blocked by the box or the hand) therefore
-pushes with exactly the spring torque; a free joint follows the reference at the motor's
-rate (implicit, so stable at any time step). The two half axes of a rolling joint are two
-such springs in series (2·k_ss each about q_r/2): the joint's stiffness is k_ss and, at
-rest, k_ss·(q_r − q) = J_qᵀ f with q = θ_a + θ_b; under load the halves differ by
-(J_b − J_a)ᵀ f / (2·k_ss) (reported, docs/closure.md). σ ramps over the path; the box is
-a free rigid body with friction μ against the hand. The run ends when hand and box have settled (every joint
-speed and the box's speed below their thresholds for ``settle_steps`` consecutive steps) or
-at the time limit. The settled state is the soft-synergy equilibrium
-k_ss·(q_r − q) = Jᵀ f, f the forces the hand applies at its contacts.
+reference q_r(σ) = clip(q_m + σ·S1, lower, upper), realised as explicit joint torques on the
+elementary axes: axis i (scale s_i: 1, or 1/2 for each half of a rolling joint) gets
+(k_ss/s_i)·(s_i·q_r − θ_i) − c·θ̇_i. The two half axes of a rolling joint are thus two
+springs in series (2·k_ss each about q_r/2): the joint's stiffness is k_ss and at rest
+k_ss·(q_r − q) = J_qᵀ f with q = θ_a + θ_b and J_q = (J_a + J_b)/2, exactly the soft-synergy
+balance. (A gear constraint that would keep the halves equal is not usable on this
+multibody in pybullet 3.2.7: with several of them the joints leave their limits; under load
+the halves therefore differ by (J_b − J_a)ᵀ f / (2·k_ss), reported in docs/closure.md.)
+σ ramps over the path; the box is a free rigid body with friction μ against the hand. The
+run ends when hand and box have settled (every joint speed and the box's speed below their
+thresholds for ``settle_steps`` consecutive steps) or at the time limit.
 
-The dynamics are only the way to that equilibrium: link inertias, motor gain, time step,
-ramp time and the box's mass during the closure are chosen for speed (DynamicParams), and
+The dynamics are only the way to that equilibrium: link inertias, joint damping, time
+step, ramp time and the box's mass during the closure are chosen for speed (DynamicParams), and
 gravity is off by default. Units: mm, rad, N, N·mm, s; the palm frame. pybullet calls go
 through :mod:`synergrasp.simulation.bullet`.
 """
@@ -28,12 +26,21 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["UNLOADED_CONTACTS", "DynamicParams", "DynamicResult", "CompliantHand"]
+from synergrasp.hand.synergies import SynergyPath
+from synergrasp.simulation.contacts import ClosureResult
+from synergrasp.simulation.placement import ObjectPose
+
+if TYPE_CHECKING:  # pragma: no cover
+    from synergrasp.hand.kinematics import Hand
+    from synergrasp.hand.synergies import Synergies
+    from synergrasp.simulation.closure import ClosureParams
+
+__all__ = ["UNLOADED_CONTACTS", "DynamicParams", "DynamicClosure", "compliant_self_pairs"]
 
 #: What happens to a contact whose normal force at the settled state is below
 #: ``DynamicParams.load_threshold_N``: ``drop`` (not listed) or ``keep`` (listed).
@@ -71,15 +78,15 @@ class DynamicParams:
 
     time_step_s: float = 1.0 / 240.0
     solver_iterations: int = 10
-    link_mass_kg: float = 0.001
-    link_inertia_kg_mm2: float = 10.0
+    link_mass_kg: float = 0.01
+    link_inertia_kg_mm2: float = 100.0
     joint_damping_Nmm_s_per_rad: float = 4.0
     object_mass_kg: float = 0.05
     object_damping_per_s: float = 20.0
-    ramp_time_s: float = 0.25
+    ramp_time_s: float = 0.3
     time_limit_s: float = 1.0
-    settle_joint_speed_rad_per_s: float = 0.02
-    settle_object_speed_mm_per_s: float = 1.0
+    settle_joint_speed_rad_per_s: float = 0.05
+    settle_object_speed_mm_per_s: float = 2.0
     settle_steps: int = 5
     hand_hand_mu: float = 0.1
     gravity: bool = False
@@ -132,37 +139,6 @@ class DynamicParams:
         return max(self.ramp_steps, int(round(self.time_limit_s / self.time_step_s)))
 
 
-@dataclass(frozen=True)
-class DynamicResult:
-    """The settled state of one dynamic closure, palm frame.
-
-    status:        ``grasp``, ``no_contact``, ``lost`` or ``intersects_open_hand``
-    q:             (19,) settled joint angles, rad
-    finger_state:  per finger: ``contact`` (a link touches the box), ``self`` (touches the
-                   hand), ``limit`` (neither)
-    links, points, normals, jacobian: the contacts, as the kinematic closure gives them
-    forces_N:      (m,) normal force of each contact at the settled state, N
-    max_penetration_mm: deepest penetration among the listed contacts
-    center_mm, rotation: the box's settled pose
-    settled:       False if the time limit ended the closure
-    steps:         physics steps taken
-    """
-
-    status: str
-    q: NDArray
-    finger_state: tuple[str, ...]
-    links: NDArray
-    points: NDArray
-    normals: NDArray
-    jacobian: NDArray
-    forces_N: NDArray
-    max_penetration_mm: float
-    center_mm: NDArray
-    rotation: NDArray
-    settled: bool
-    steps: int
-
-
 def compliant_self_pairs(hand: Any) -> tuple[tuple[int, int], ...]:
     """Hand link pairs that collide during the dynamic closure: the pairs that can meet, i.e. a
     finger link against the palm, the thumb against a long finger, and neighbouring long
@@ -181,52 +157,52 @@ def compliant_self_pairs(hand: Any) -> tuple[tuple[int, int], ...]:
     return tuple(pairs)
 
 
-class CompliantHand:
-    """One pybullet scene for the dynamic closure: the compliant hand and a free box.
+class DynamicClosure:
+    """The compliant dynamic closure on one pybullet scene: the hand and a free box.
 
-    ``k_ss_Nmm_per_rad`` is the joint stiffness, ``mu`` the hand–box friction coefficient,
-    ``gravity_mm_s2`` the gravity vector (palm frame, mm/s²) that acts on the box when
-    ``params.gravity`` is true.
+    ``params`` is the closure's :class:`synergrasp.simulation.closure.ClosureParams` (σ path,
+    contact distance, ``params.dynamic``); ``mechanics`` the config's mechanics block (k_ss,
+    μ, gravity direction and g); ``mass_kg`` the box's mass (its weight, if gravity is on).
     """
 
-    def __init__(self, hand: Any, synergies: Any, k_ss_Nmm_per_rad: float, mu: float, params: DynamicParams,
-                 gravity_mm_s2: NDArray | None = None) -> None:
+    def __init__(self, hand: Hand, synergies: Synergies, params: ClosureParams, mechanics: Mapping[str, Any],
+                 mass_kg: float = 1.0) -> None:
         from synergrasp.simulation import bullet
 
         names = tuple(synergies.joint_names)
         if names != tuple(hand.joint_names):
             raise ValueError(f"synergies.joint_names must equal hand.joint_names {hand.joint_names}, got {names}")
-        if not k_ss_Nmm_per_rad > 0 or not mu > 0:
-            raise ValueError(f"mechanics.k_ss_Nmm_per_rad and mechanics.mu must be > 0, got {k_ss_Nmm_per_rad}, {mu}")
+        missing = [k for k in ("mu", "k_ss_Nmm_per_rad", "gravity_direction", "g_m_per_s2") if k not in mechanics]
+        if missing:
+            raise ValueError(f"mechanics: the dynamic closure needs key(s) {missing}")
         self.bullet = bullet
         self.hand = hand
-        self.params = params
-        self.k_ss = float(k_ss_Nmm_per_rad)
-        self.mu = float(mu)
-        self.gravity = np.zeros(3) if gravity_mm_s2 is None else np.asarray(gravity_mm_s2, dtype=float)
-        self.mean = np.asarray(synergies.mean, dtype=float)
-        self.s1 = np.asarray(synergies.matrix, dtype=float)[:, 0]
+        self.closure = params
+        self.params = p = params.dynamic
+        self.k_ss = float(mechanics["k_ss_Nmm_per_rad"])
+        self.mu = float(mechanics["mu"])
+        down = np.asarray(mechanics["gravity_direction"], dtype=float)
+        # weight of the box, N (palm frame), applied only when params.dynamic.gravity is true
+        self.weight = float(mass_kg) * float(mechanics["g_m_per_s2"]) * down / np.linalg.norm(down)
+        self.path = SynergyPath.along(synergies, hand.lower, hand.upper)
         self.client = bullet.connect()
-        bullet.set_dynamics(self.client, params.time_step_s, params.solver_iterations)
+        bullet.set_dynamics(self.client, p.time_step_s, p.solver_iterations)
         # hand–hand friction = product of the two links' coefficients (Bullet's rule): √μ_hh on
         # every hand link; the box's coefficient μ/√μ_hh makes hand–box friction exactly μ
-        self.link_friction = math.sqrt(params.hand_hand_mu)
-        self.self_pairs = compliant_self_pairs(hand)
-        self.body = bullet.load_compliant_hand(self.client, hand, params.link_mass_kg,
-                                               params.link_inertia_kg_mm2, self.link_friction)
+        self.link_friction = math.sqrt(p.hand_hand_mu)
+        self.body = bullet.load_compliant_hand(self.client, hand, p.link_mass_kg, p.link_inertia_kg_mm2,
+                                               self.link_friction)
         self.axis_joint = self.body.joint_q
         self.axis_scale = self.body.joint_scale
         self.axis_sum = np.zeros((hand.n_joints, len(self.axis_joint)))  # q = axis_sum @ θ
         self.axis_sum[self.axis_joint, np.arange(len(self.axis_joint))] = 1.0
+        self.q_open = self.path.reference(params.sigma_open)
+        self.self_pairs = self._colliding_pairs()
         self.box: int | None = None
         self.box_size: NDArray | None = None
 
     def close(self) -> None:
         self.bullet.disconnect(self.client)
-
-    def reference(self, sigma: float) -> NDArray:
-        """q_r(σ) = clip(q_m + σ·S1, lower, upper), rad."""
-        return np.clip(self.mean + sigma * self.s1, self.hand.lower, self.hand.upper)
 
     def joint_values(self, axis_values: NDArray) -> NDArray:
         """Joint angles (rad) from the elementary axes' angles: q_j = Σ θ_i over the axes of joint j."""
@@ -242,31 +218,30 @@ class CompliantHand:
             self.box_size = size
         self.bullet.reset_body(self.client, self.box, placed.center_mm, placed.rotation)
 
-    def _exclude_open_overlaps(self, q_open: NDArray) -> None:
-        """Collide the pairs of ``compliant_self_pairs`` except those overlapping at ``q_open``
-        (a property of the model, not an event)."""
+    def _colliding_pairs(self) -> tuple[tuple[int, int], ...]:
+        """``compliant_self_pairs`` except those overlapping at the open posture (a property of
+        the model, not an event); set them in the engine."""
         b = self.bullet
-        if getattr(self, "_q_open", None) is not None and np.array_equal(self._q_open, q_open):
-            return
-        b.reset_hand(self.client, self.body, q_open)
-        pts = b.self_closest_points(self.client, self.body, 0.0, self.self_pairs)
+        pairs = compliant_self_pairs(self.hand)
+        b.reset_hand(self.client, self.body, self.q_open)
+        pts = b.self_closest_points(self.client, self.body, 0.0, pairs)
         bad = {(min(i, j), max(i, j)) for i, j, d in zip(pts.link_a, pts.link_b, pts.distance) if d < 0}
-        b.set_self_collision(self.client, self.body, tuple(p for p in self.self_pairs if p not in bad))
-        self._q_open = q_open.copy()
+        kept = tuple(pair for pair in pairs if pair not in bad)
+        b.set_self_collision(self.client, self.body, kept)
+        return kept
 
-    def run(self, size_mm: NDArray, mass_kg: float, placed: Any, sigma_open: float, sigma_closed: float,
-            contact_distance_mm: float, penetration_tolerance_mm: float) -> DynamicResult:
-        """Close the hand from q_r(σ_open) to q_r(σ_closed) on a free box of ``size_mm`` (mm) and
-        ``mass_kg`` placed at ``placed`` (an ObjectPose); return its settled state."""
-        p, b = self.params, self.bullet
-        q_open = self.reference(sigma_open)
-        self._exclude_open_overlaps(q_open)
+    def grasp(self, size_mm: NDArray, placed: ObjectPose) -> ClosureResult:
+        """Close the hand from q_r(σ_open) to q_r(σ_closed) on a free box of ``size_mm`` (mm)
+        placed at ``placed``; the contacts of its settled state."""
+        p, b, c = self.params, self.bullet, self.closure
+        q_open = self.q_open
+        sigma_open, sigma_closed = c.sigma_open, c.sigma_closed
         self._place(size_mm, placed)
         b.reset_hand(self.client, self.body, q_open)
-        gaps = b.closest_points(self.client, self.box, self.body, contact_distance_mm)
-        if len(gaps) and float(gaps.distance.min()) < -penetration_tolerance_mm:
-            return self._empty("intersects_open_hand", q_open, (), placed.center_mm, placed.rotation, True, 0)
-        weight = 1e-3 * float(mass_kg) * self.gravity if p.gravity else None  # N
+        gaps = b.closest_points(self.client, self.box, self.body, c.contact_distance_mm)
+        if len(gaps) and float(gaps.distance.min()) < -c.penetration_tolerance_mm:
+            return self._result("intersects_open_hand", q_open, (), None, True)
+        weight = self.weight if p.gravity else None
         radius = float(np.linalg.norm(placed.half_extents_mm))
         calm, settled, steps = 0, False, p.max_steps
         scale, axis_joint = self.axis_scale, self.axis_joint
@@ -284,39 +259,45 @@ class CompliantHand:
                     break
             else:
                 sigma = sigma_open + (sigma_closed - sigma_open) * (step + 1) / p.ramp_steps
-                target = scale * self.reference(sigma)[axis_joint]
+                target = scale * self.path.reference(sigma)[axis_joint]
             if weight is not None:
                 b.apply_force(self.client, self.box, weight)
             b.step_with_torques(self.client, self.body, axis_k * (target - theta) - p.joint_damping_Nmm_s_per_rad * omega)
-        return self._settled(placed, contact_distance_mm, settled, steps)
+        self.steps = steps
+        return self._settled(placed, settled)
 
-    def _empty(self, status: str, q: NDArray, state: tuple[str, ...], center: NDArray, rotation: NDArray,
-               settled: bool, steps: int) -> DynamicResult:
-        n = self.hand.n_joints
-        e3 = np.zeros((0, 3))
-        return DynamicResult(status, q, state, np.zeros(0, np.int64), e3, e3.copy(), np.zeros((0, n)),
-                             np.zeros(0), 0.0, np.asarray(center, dtype=float), np.asarray(rotation, dtype=float),
-                             settled, steps)
-
-    def _settled(self, placed: Any, contact_distance_mm: float, settled: bool, steps: int) -> DynamicResult:
-        """Read the settled state: q, the box pose, one contact per touching hand link."""
+    def _result(self, status: str, q: NDArray, state: tuple[str, ...], settled_pose: ObjectPose | None,
+                settled: bool, links: list[int] = (), points: list = (), normals: list = (), loads: list = (),
+                depth: float = 0.0) -> ClosureResult:
         from synergrasp.hand.kinematics import contact_jacobian
-        from synergrasp.simulation.closure import ObjectPose
 
-        b, p, hand = self.bullet, self.params, self.hand
+        links_a = np.asarray(links, dtype=np.int64)
+        points_a = np.asarray(points, dtype=float).reshape(-1, 3)
+        jac = contact_jacobian(self.hand, q, links_a, points_a) if len(links_a) else np.zeros((0, self.hand.n_joints))
+        return ClosureResult(status, q, state, links_a, points_a, np.asarray(normals, dtype=float).reshape(-1, 3),
+                             jac, float(depth), model="dynamic", normal_force_N=np.asarray(loads, dtype=float),
+                             settled_pose=settled_pose, settled=settled)
+
+    def _finger_states(self, touching: list[int]) -> tuple[str, ...]:
+        """Per finger: ``contact`` (a link touches the box), ``self`` (a link touches the hand), ``limit``."""
+        on_hand = self.bullet.contact_forces(self.client, self.body, self.body)
+        self_links = set(on_hand.link_a.tolist()) | set(on_hand.link_b.tolist())
+        return tuple("contact" if any(li in touching for li in links)
+                     else "self" if any(li in self_links for li in links) else "limit"
+                     for links in self.hand.finger_links)
+
+    def _settled(self, placed: ObjectPose, settled: bool) -> ClosureResult:
+        """The settled state: q, the box pose, one contact per hand link touching the box (the
+        force-weighted mean of its engine contact points, projected onto the exact box)."""
+        b, p = self.bullet, self.params
         theta, _ = b.axis_states(self.client, self.body)
         q = self.joint_values(theta)
         center, rotation, _, _ = b.body_state(self.client, self.box)
         now = ObjectPose(center, rotation, placed.half_extents_mm)
         forces = b.contact_forces(self.client, self.box, self.body)
-        near = b.closest_points(self.client, self.box, self.body, contact_distance_mm)
+        near = b.closest_points(self.client, self.box, self.body, self.closure.contact_distance_mm)
         touching = sorted({int(v) for v in near.link_b if v >= 0})
-        on_hand = b.contact_forces(self.client, self.body, self.body)
-        self_links = set(on_hand.link_a.tolist()) | set(on_hand.link_b.tolist())
-        finger_of = {link: f for f, links in enumerate(hand.finger_links) for link in links}
-        state = tuple("contact" if any(finger_of.get(li) == f for li in touching)
-                      else "self" if any(li in self_links for li in links) else "limit"
-                      for f, links in enumerate(hand.finger_links))
+        state = self._finger_states(touching)
         links, points, normals, loads, depth = [], [], [], [], 0.0
         for link in touching:
             rows = np.flatnonzero(forces.link_b == link)
@@ -324,32 +305,18 @@ class CompliantHand:
             if load < p.load_threshold_N and p.unloaded_contacts == "drop":
                 continue
             if load > 0.0:
-                w = forces.normal_force[rows] / load
-                on_link = w @ forces.point_b[rows]
-                on_box = w @ forces.point_a[rows]
+                on_link = (forces.normal_force[rows] / load) @ forces.point_b[rows]
             else:
                 k = np.flatnonzero(near.link_b == link)
-                k = k[np.argmin(near.distance[k])]
-                on_link, on_box = near.point_b[k], near.point_a[k]
-            point, normal = _surface_point(now, on_link, on_box)
+                on_link = near.point_b[k[np.argmin(near.distance[k])]]
+            point, normal = now.surface_point(on_link)
             links.append(link)
             points.append(point)
             normals.append(normal)
             loads.append(load)
             depth = max(depth, -float(near.distance[near.link_b == link].min()))
-        if not links:
-            moved = float(np.linalg.norm(center - placed.center_mm))
-            status = "lost" if not touching and moved > p.lost_distance_mm else "no_contact"
-            return self._empty(status, q, state, center, rotation, settled, steps)
-        links_a = np.asarray(links, dtype=np.int64)
-        points_a = np.asarray(points)
-        return DynamicResult("grasp", q, state, links_a, points_a, np.asarray(normals),
-                             contact_jacobian(hand, q, links_a, points_a), np.asarray(loads), max(depth, 0.0),
-                             center, rotation, settled, steps)
-
-
-def _surface_point(placed: Any, on_link: NDArray, on_box: NDArray) -> tuple[NDArray, NDArray]:
-    """The contact point on the exact box surface and the box's inward unit normal there."""
-    from synergrasp.simulation.closure import _box_surface_point
-
-    return _box_surface_point(placed, on_link, on_box, np.zeros(3))
+        if links:
+            return self._result("grasp", q, state, now, settled, links, points, normals, loads, max(depth, 0.0))
+        moved = float(np.linalg.norm(center - placed.center_mm))
+        status = "lost" if not touching and moved > p.lost_distance_mm else "no_contact"
+        return self._result(status, q, state, now, settled)
