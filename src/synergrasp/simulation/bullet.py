@@ -433,5 +433,8 @@ def contact_force_vectors(client: int, body_a: int | HandBody, body_b: HandBody)
     links_a = _to_hand_links(body_a, [p[3] for p in pts]) if isinstance(body_a, HandBody) else np.full(len(pts), -1)
     links = np.stack([links_a, _to_hand_links(body_b, [p[4] for p in pts])], axis=1) if pts else np.zeros((0, 2), np.int64)
     points = np.array([p[6] for p in pts]).reshape(-1, 3) / MM
-    force = np.array([p[9] * np.array(p[7]) + p[10] * np.array(p[11]) + p[12] * np.array(p[13]) for p in pts]).reshape(-1, 3)
+    # pybullet's friction components act on B along its lateral directions: on A, opposite
+    # (checked by the soft-synergy balance at rest, tests/test_dynamic_closure.py)
+    force = np.array([p[9] * np.array(p[7]) - p[10] * np.array(p[11]) - p[12] * np.array(p[13])
+                      for p in pts]).reshape(-1, 3)
     return links, points, force
