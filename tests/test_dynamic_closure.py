@@ -15,6 +15,9 @@ from synergrasp.simulation.placement import Placement, object_pose
 MECHANICS = {"mu": 1.5, "k_ss_Nmm_per_rad": 200.0, "gravity_direction": [1.0, 0.0, 0.0], "g_m_per_s2": 9.81}
 PARAMS = ClosureParams(model="dynamic", dynamic=DynamicParams(time_limit_s=3.0))
 CUBE60 = np.array([60.0, 60.0, 60.0])
+#: A 60 mm cube against the palm: the palm's surface is at x = 9.5 mm (hand.yaml), the
+#: cube's palm-side face 0.3 mm in front of it, centred on the palm's width.
+AGAINST_PALM = Placement(center_mm=(9.5 + 30.0 + 0.3, -9.0, 75.0))
 
 
 @pytest.fixture(scope="module")
@@ -40,7 +43,7 @@ def test_no_object_every_finger_closes_to_its_limits_or_to_the_hand(model, hand)
     result = model.grasp(CUBE60, far)
     assert result.status == "no_contact" and result.settled
     assert np.allclose(result.settled_pose.center_mm, far.center_mm)
-    reference = model.path.reference(PARAMS.sigma_closed)
+    reference = model.path.reference(model.sigma_closed)
     for f, joints in enumerate(hand.finger_joints):
         state = result.finger_state[f]
         assert state in ("limit", "self")
@@ -49,9 +52,9 @@ def test_no_object_every_finger_closes_to_its_limits_or_to_the_hand(model, hand)
 
 
 def test_box_against_the_palm_ends_with_a_palm_contact(model, hand):
-    placed = object_pose(Placement(center_mm=(50.0, -5.0, 75.0)), CUBE60, 0.0, 0.0, hand.palm_normal)
+    placed = object_pose(AGAINST_PALM, CUBE60, 0.0, 0.0, hand.palm_normal)
     result = model.grasp(CUBE60, placed)
-    assert result.status == "grasp"
+    assert result.status == "grasp" and result.settled
     assert 0 in result.links.tolist()
     assert np.all(result.normal_force_N >= PARAMS.dynamic.load_threshold_N)
     # contact points on the exact box surface at its settled pose, inward normals
@@ -104,7 +107,7 @@ def test_at_rest_the_springs_balance_the_contact_forces(hand, synergies):
                           settle_object_speed_mm_per_s=2.0)
     params = ClosureParams(model="dynamic", dynamic=tight)
     model = closure_model(hand, synergies, params, MECHANICS, 1.0)
-    placed = object_pose(Placement(center_mm=(50.0, -5.0, 75.0)), CUBE60, 0.0, 0.0, hand.palm_normal)
+    placed = object_pose(AGAINST_PALM, CUBE60, 0.0, 0.0, hand.palm_normal)
     try:
         _check_balance(model, hand, params, model.grasp(CUBE60, placed))
     finally:
@@ -115,7 +118,7 @@ def _check_balance(model, hand, params, result):
     assert result.settled and result.status == "grasp"
     theta, _ = model.bullet.axis_states(model.client, model.body)
     scale, axis = model.axis_scale, model.axis_joint
-    reference = scale * model.path.reference(params.sigma_closed)[axis]
+    reference = scale * model.path.reference(model.sigma_closed)[axis]
     spring = model.k_ss / scale * (reference - theta)
     contact = _generalised_contact_forces(model)
     # fingers pressed against the hand itself are left out: on them the residual reached
@@ -138,3 +141,18 @@ def test_deterministic_on_rerun_and_whatever_ran_before(hand, synergies):
     for column in ("status", "q", "contact_link", "contact_point", "contact_normal_force_N", "object_center"):
         assert np.array_equal(np.asarray(alone.iloc[0][column]), np.asarray(after.iloc[2][column])), column
     assert after.iloc[2]["closure_model"] == "dynamic"
+
+
+def test_settled_box_carries_a_near_zero_net_contact_wrench(model, hand):
+    """Gravity off: the box at rest between palm, thumb and fingers feels no net wrench from
+    its contacts (force within 5 % of the summed contact-force magnitudes; moment about its
+    centre within 5 % of that sum times the half edge)."""
+    placed = object_pose(AGAINST_PALM, CUBE60, 0.0, 0.0, hand.palm_normal)
+    result = model.grasp(CUBE60, placed)
+    assert result.settled and {0, 3, 7}.issubset(result.links.tolist())  # palm, thumb and index tips
+    _, points, forces = model.bullet.contact_force_vectors(model.client, model.box, model.body)
+    scale = np.linalg.norm(forces, axis=1).sum()
+    assert scale > 1.0
+    assert np.linalg.norm(forces.sum(axis=0)) <= 0.05 * scale
+    moment = np.cross(points - result.settled_pose.center_mm, forces).sum(axis=0)
+    assert np.linalg.norm(moment) <= 0.05 * scale * 30.0

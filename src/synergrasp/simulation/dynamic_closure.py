@@ -160,8 +160,9 @@ def compliant_self_pairs(hand: Any) -> tuple[tuple[int, int], ...]:
 class DynamicClosure:
     """The compliant dynamic closure on one pybullet scene: the hand and a free box.
 
-    ``params`` is the closure's :class:`synergrasp.simulation.closure.ClosureParams` (σ path,
-    contact distance, ``params.dynamic``); ``mechanics`` the config's mechanics block (k_ss,
+    ``params`` is the closure's :class:`synergrasp.simulation.closure.ClosureParams` (contact
+    distance, penetration tolerance, ``params.dynamic``); the σ path is the kinematic
+    model's (``SynergyPath.closure_range``); ``mechanics`` the config's mechanics block (k_ss,
     μ, gravity direction and g); ``mass_kg`` the box's mass (its weight, if gravity is on).
     """
 
@@ -185,6 +186,8 @@ class DynamicClosure:
         # weight of the box, N (palm frame), applied only when params.dynamic.gravity is true
         self.weight = float(mass_kg) * float(mechanics["g_m_per_s2"]) * down / np.linalg.norm(down)
         self.path = SynergyPath.along(synergies, hand.lower, hand.upper)
+        # the same path as the kinematic model: fully open hand to every S1 joint at a limit
+        self.sigma_open, self.sigma_closed = self.path.closure_range(hand.flexion_joints)
         self.client = bullet.connect()
         bullet.set_dynamics(self.client, p.time_step_s, p.solver_iterations)
         # hand–hand friction = product of the two links' coefficients (Bullet's rule): √μ_hh on
@@ -196,7 +199,7 @@ class DynamicClosure:
         self.axis_scale = self.body.joint_scale
         self.axis_sum = np.zeros((hand.n_joints, len(self.axis_joint)))  # q = axis_sum @ θ
         self.axis_sum[self.axis_joint, np.arange(len(self.axis_joint))] = 1.0
-        self.q_open = self.path.reference(params.sigma_open)
+        self.q_open = self.path.reference(self.sigma_open)
         self.self_pairs = self._colliding_pairs()
         self.box: int | None = None
         self.box_size: NDArray | None = None
@@ -231,11 +234,11 @@ class DynamicClosure:
         return kept
 
     def grasp(self, size_mm: NDArray, placed: ObjectPose) -> ClosureResult:
-        """Close the hand from q_r(σ_open) to q_r(σ_closed) on a free box of ``size_mm`` (mm)
+        """Close the hand from q_r(σ_open) to q_r(σ_closed) (the fully open hand to the end of S1) on a free box of ``size_mm`` (mm)
         placed at ``placed``; the contacts of its settled state."""
         p, b, c = self.params, self.bullet, self.closure
         q_open = self.q_open
-        sigma_open, sigma_closed = c.sigma_open, c.sigma_closed
+        sigma_open, sigma_closed = self.sigma_open, self.sigma_closed
         self._place(size_mm, placed)
         b.reset_hand(self.client, self.body, q_open)
         gaps = b.closest_points(self.client, self.box, self.body, c.contact_distance_mm)
