@@ -108,3 +108,23 @@ def test_figure_is_written_and_the_same_on_rerun(hand, tmp_path):
         first = (tmp_path / f"r1.{ext}").read_bytes()
         assert len(first) > 5000
         assert first == (tmp_path / f"r2.{ext}").read_bytes()
+
+
+def test_representative_grasps_follow_the_stated_rule(hand):
+    from synergrasp.analysis.realism import representative_grasps
+
+    # Patterns: {3, 7} x 3 grasps, {3, 7, 11} x 2, {7, 11, 15} x 1, {3, 7, 11, 15} x 1, one dropped pose.
+    # Contacts 2, 2, 3 (two on link 7), 3, 3, 3, 4: median 3, the typical count.
+    poses = [("grasp", [3, 7], []), ("grasp", [7, 3], []), ("grasp", [3, 7, 7], []),
+             ("grasp", [3, 7, 11], []), ("grasp", [3, 7, 11], []), ("grasp", [7, 11, 15], []),
+             ("grasp", [3, 7, 11, 15], []), ("intersects_open_hand", [], [])]
+    contacts = _contacts(poses=poses)
+    contacts["alpha_deg"] = [40.0, -10.0, 5.0, 0.0, 180.0, 0.0, 0.0, 0.0]
+    contacts["beta_deg"] = [0.0, 0.0, 0.0, 20.0, 0.0, 0.0, 0.0, 0.0]
+    chosen = representative_grasps(contacts, n=3)
+    assert [tuple(p) for p in chosen["pattern"]] == [(3, 7), (3, 7, 11), (7, 11, 15)]
+    assert list(chosen["reason"]) == ["most common contacts", "typical count (m = 3)", "next most common"]
+    # (3, 7): poses 0, 1, 2 at |(α, β)| = 40, 10, 5 -> pose 2; (3, 7, 11): 20 vs 180 -> pose 3.
+    assert list(chosen["pose"]) == [2, 3, 5]
+    np.testing.assert_allclose(chosen["share_pct"], [100 * 3 / 7, 100 * 2 / 7, 100 / 7])
+    assert representative_grasps(contacts[contacts["status"] != "grasp"]).empty
