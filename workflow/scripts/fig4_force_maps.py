@@ -1,11 +1,11 @@
 """Fig. 4 for one object: force maps over (alpha, beta) and exploded views."""
-from contextlib import redirect_stderr
 
 import pandas as pd
 
 from synergrasp.figures.study_figures import figure_exploded_views, figure_force_maps
+from synergrasp.job_log import job_log
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+with job_log(snakemake.log[0]):
     gfo = pd.read_parquet(snakemake.input.gfo)
     minima = pd.read_parquet(snakemake.input.minima)
     fig4, name, out = snakemake.params.fig4, snakemake.wildcards.object, snakemake.output

@@ -1,12 +1,12 @@
 """Fig. 5A/5B: success rate and mean force of every set {S_k, S_i, S_j}, averaged over objects."""
-from contextlib import redirect_stderr
 
 import pandas as pd
 
 from synergrasp.figures.study_figures import figure_hierarchy
 from synergrasp.analysis.summaries import hierarchy_matrices, mean_over_objects
+from synergrasp.job_log import job_log
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+with job_log(snakemake.log[0]):
     first, out = snakemake.params.first, snakemake.output
     matrices = hierarchy_matrices(mean_over_objects(pd.read_csv(snakemake.input.rates)), first)
     figure_hierarchy(matrices, "success_rate", first, "Fig. 5A: success rate (%), mean over objects",

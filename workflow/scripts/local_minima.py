@@ -2,6 +2,8 @@
 import pandas as pd
 
 from synergrasp.analysis.minima import minima_table
+from synergrasp.job_log import job_log
 
-gfo = pd.read_parquet(snakemake.input.gfo)
-minima_table(gfo, radius_deg=snakemake.params.radius_deg).to_parquet(snakemake.output[0], index=False)
+with job_log(snakemake.log[0]):
+    gfo = pd.read_parquet(snakemake.input.gfo)
+    minima_table(gfo, radius_deg=snakemake.params.radius_deg).to_parquet(snakemake.output[0], index=False)

@@ -1,5 +1,4 @@
 """Grasp-force optimisation of one shard of an object's poses, for every synergy set."""
-from contextlib import redirect_stderr
 
 import numpy as np
 import pandas as pd
@@ -8,8 +7,9 @@ from synergrasp.optimisation.batched import optimise_grasps
 from synergrasp.simulation.closure import read_grasps
 from synergrasp.config import gfo_params
 from synergrasp.hand.synergies import load_synergies
+from synergrasp.job_log import job_log
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+with job_log(snakemake.log[0]):
     opt = snakemake.params.opt
     contacts = pd.read_parquet(snakemake.input.contacts)
     shard = contacts.iloc[np.array_split(np.arange(len(contacts)), snakemake.params.n_shards)[opt["shard"]]]

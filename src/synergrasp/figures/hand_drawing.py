@@ -263,11 +263,6 @@ def _draw_triad(ax: Any, view: View, origin: tuple[float, float] = (0.1, 0.1)) -
                 fontsize=7, color="0.3", ha="center", va="center")
 
 
-def _save(fig: Any, png_path: str, pdf_path: str) -> None:
-    fig.savefig(png_path, dpi=150)
-    fig.savefig(pdf_path)
-
-
 def figure_synergy_postures(hand: Any, synergies: Any, png_path: str, pdf_path: str, n_synergies: int = 7,
                             sigmas: Sequence[float] = (-1.0, 0.0, 1.0), view: View = FIGURE_VIEW) -> None:
     """Fig. 1: the hand at q_m + σ·S_k (joint limits clip) for k = 1..n_synergies (rows) and
@@ -277,6 +272,8 @@ def figure_synergy_postures(hand: Any, synergies: Any, png_path: str, pdf_path: 
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from synergrasp.figures.files import save_figure
 
     matrix = np.asarray(synergies.matrix, dtype=float)
     if not 1 <= n_synergies <= matrix.shape[1]:
@@ -301,8 +298,7 @@ def figure_synergy_postures(hand: Any, synergies: Any, png_path: str, pdf_path: 
     _draw_triad(axes[0, 0], view)
     fig.suptitle("Hand postures along each synergy (grey: mean posture)", fontsize=11)
     fig.tight_layout(rect=(0, 0, 1, 0.995))
-    _save(fig, png_path, pdf_path)
-    plt.close(fig)
+    save_figure(fig, png_path, pdf_path)
 
 
 def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[Any], poses: Sequence[Sequence[float]],
@@ -317,6 +313,8 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[Any]
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from synergrasp.figures.files import save_figure
 
     from synergrasp.simulation.closure import ObjectPose
 
@@ -352,5 +350,4 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[Any]
             _set_limits(axes[r], np.vstack(points))
     _draw_triad(axes[0, 0], view)
     fig.tight_layout()
-    _save(fig, png_path, pdf_path)
-    plt.close(fig)
+    save_figure(fig, png_path, pdf_path)
