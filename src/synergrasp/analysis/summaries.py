@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
 from synergrasp.analysis.chance import preservation_vs_chance
 from synergrasp.analysis.claims import claims_table
@@ -18,7 +19,7 @@ from synergrasp.analysis.forces import force_summary
 from synergrasp.analysis.invariants import invariant_checks
 from synergrasp.analysis.minima import preserved
 from synergrasp.analysis.periods import distinct_pose_mask
-from synergrasp.analysis.verdicts import DEFAULT_VERDICT, with_verdicts
+from synergrasp.analysis.verdicts import DEFAULT_VERDICT, success_verdict, with_verdicts
 from synergrasp.config import incremental_set_id, set_id
 
 __all__ = [
@@ -78,12 +79,16 @@ class AnalysisSettings:
         the defaults above."""
         from synergrasp.analysis.periods import object_periods
 
+        default = cls()
         null = analyses.get("null_model", {})
-        return cls(success=analyses.get("success", DEFAULT_VERDICT),
-                   marginal_weight_multiple=float(analyses.get("marginal_weight_multiple", 10.0)),
+        return cls(success=success_verdict(analyses),
+                   marginal_weight_multiple=float(analyses.get("marginal_weight_multiple",
+                                                               default.marginal_weight_multiple)),
                    radius_deg=float(analyses["minima_radius_deg"]),
-                   null_draws=int(null.get("draws", 1000)), null_seed=int(null.get("seed", 2018)),
-                   success_rate_tolerance_percent=float(analyses.get("success_rate_tolerance_percent", 1.0)),
+                   null_draws=int(null.get("draws", default.null_draws)),
+                   null_seed=int(null.get("seed", default.null_seed)),
+                   success_rate_tolerance_percent=float(analyses.get("success_rate_tolerance_percent",
+                                                                     default.success_rate_tolerance_percent)),
                    weights_N={name: float(spec["mass_kg"]) * float(g_m_per_s2) for name, spec in objects.items()},
                    periods_deg=object_periods(objects, grid, hand))
 
@@ -97,30 +102,42 @@ def _rate_columns(table: pd.DataFrame, column: str, full_set_id: str) -> pd.Data
     return counts
 
 
+#: Columns of the success-rates table, in order (docs/analyses.md).
+RATE_COLUMNS = ("object", "set_id", "n_synergies", "n_poses", "n_success", "success_rate", "full_set_empty",
+                "absolute_share", "success_rate_force_closure", "success_rate_load_feasible", "n_success_distinct",
+                "success_rate_distinct", "n_marginal", "marginal_percent", "force_ratio_median",
+                "force_ratio_median_non_marginal", "n_ratio_undefined", "plain_mean_force_N", "plain_median_force_N",
+                "plain_mean_force_non_marginal_N", "plain_median_force_non_marginal_N")
+
+
+def _distinct_poses(table: pd.DataFrame, periods_deg: Mapping[str, float]) -> NDArray[np.bool_]:
+    """Per row: its pose lies in the first α-period of its object's grid."""
+    distinct = np.zeros(len(table), dtype=bool)
+    for obj, rows in table.groupby("object", sort=False).indices.items():
+        alpha = table["alpha_deg"].to_numpy(float)[rows]
+        distinct[rows] = distinct_pose_mask(alpha, periods_deg.get(obj, 360.0))
+    return distinct
+
+
 def success_rates(table: pd.DataFrame, full_set_id: str, periods_deg: Mapping[str, float] | None = None) -> pd.DataFrame:
     """Success rates under both verdicts, per distinct pose, and force statistics, per object and set.
 
-    ``table``: a gfo table with the columns of :func:`synergrasp.analysis.verdicts.with_verdicts`.
-    Returns one row per (object, set_id); columns in docs/analyses.md: n_poses, n_success,
-    success_rate (percent of the full set's successes; NaN where the full set has none),
-    full_set_empty, absolute_share, success_rate_force_closure, success_rate_load_feasible,
-    n_success_distinct and success_rate_distinct (poses of one α-period), then the columns
-    of :func:`synergrasp.analysis.forces.force_summary`.
+    ``table``: a gfo table with the columns of :func:`synergrasp.analysis.verdicts.with_verdicts`;
+    ``periods_deg``: α-period per object (360 if absent). Returns one row per (object,
+    set_id) with the columns ``RATE_COLUMNS`` (docs/analyses.md): the normalised rate
+    (percent of the full set's successes; NaN where the full set has none) under the
+    verdict in use, under each verdict and per distinct pose, and the columns of
+    :func:`synergrasp.analysis.forces.force_summary`.
     """
     _require(table, "gfo table", ("object", "set_id", "n_synergies", "pose", "alpha_deg", "success",
                                   "verdict_force_closure", "verdict_load_feasible", "success_force"))
     present = sorted(table["set_id"].unique(), key=lambda s: (len(s.split("-")), s))
     if full_set_id not in present:
         raise ValueError(f"full_set_id {full_set_id!r} is not in the gfo table; allowed values: {present}")
-    periods = dict(periods_deg or {})
-    distinct = np.zeros(len(table), dtype=bool)
-    for obj, rows in table.groupby("object", sort=False).groups.items():
-        alpha = table.loc[rows, "alpha_deg"].to_numpy(float)
-        distinct[table.index.get_indexer(rows)] = distinct_pose_mask(alpha, periods.get(obj, 360.0))
-    work = table.assign(success_distinct=table["success"].astype(bool) & distinct)
-    out = work.groupby(["object", "set_id"], sort=False).agg(
-        n_synergies=("n_synergies", "first"), n_poses=("success", "size")).reset_index()
+    work = table.assign(success_distinct=table["success"].astype(bool) & _distinct_poses(table, periods_deg or {}))
     keys = ["object", "set_id"]
+    out = work.groupby(keys, sort=False).agg(n_synergies=("n_synergies", "first"),
+                                             n_poses=("success", "size")).reset_index()
     for name, column in (("", "success"), ("_force_closure", "verdict_force_closure"),
                          ("_load_feasible", "verdict_load_feasible"), ("_distinct", "success_distinct")):
         rates = _rate_columns(work, column, full_set_id)
@@ -129,13 +146,7 @@ def success_rates(table: pd.DataFrame, full_set_id: str, periods_deg: Mapping[st
     out["absolute_share"] = 100.0 * out["n_success"] / out["n_poses"]
     out = out.merge(force_summary(table, full_set_id).drop(columns="n_success"), on=keys)
     out = out.sort_values(keys, key=lambda c: set_sort_key(c) if c.name == "set_id" else c, ignore_index=True)
-    ints = ["n_poses", "n_success", "n_success_distinct"]
-    columns = ["object", "set_id", "n_synergies", *ints[:2], "success_rate", "full_set_empty", "absolute_share",
-               "success_rate_force_closure", "success_rate_load_feasible", "n_success_distinct",
-               "success_rate_distinct", "n_marginal", "marginal_percent", "force_ratio_median",
-               "force_ratio_median_non_marginal", "n_ratio_undefined", "plain_mean_force_N", "plain_median_force_N",
-               "plain_mean_force_non_marginal_N", "plain_median_force_non_marginal_N"]
-    return out[columns].astype({c: "int64" for c in ints})
+    return out[list(RATE_COLUMNS)].astype({c: "int64" for c in ("n_poses", "n_success", "n_success_distinct")})
 
 
 #: Columns of the success-rates table averaged over objects (mean_over_objects, Fig. 5).

@@ -202,7 +202,11 @@ def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str,
     fig.suptitle(title, fontsize=10)
     fig.tight_layout(rect=(0, 0, 0.93, 1))
     if image is not None:
-        fig.colorbar(image, ax=list(axes.flat), label=colorbar_label, fraction=0.02, pad=0.02)
+        bar = fig.colorbar(image, ax=list(axes.flat), label=colorbar_label, fraction=0.02, pad=0.02)
+        if log_scale:  # plain numbers, not powers of ten
+            ticks = [t for t in (1, 1.5, 2, 3, 5, 7, 10, 20, 50, 100) if low <= t <= high]
+            bar.set_ticks(ticks, labels=[f"{t:g}" for t in ticks])
+            bar.ax.minorticks_off()
     _save(fig, png, pdf)
 
 
