@@ -15,10 +15,11 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from synergrasp.simulation.closure import ClosureParams, Placement, _Closer, object_pose, pose_grid, simulate_pose  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
-from synergrasp.simulation.objects import STUDY_BOXES  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
+from synergrasp.simulation.closure import ClosureParams, closure_model  # noqa: E402
+from synergrasp.simulation.objects import STUDY_BOXES  # noqa: E402
+from synergrasp.simulation.placement import Placement, object_pose, pose_grid  # noqa: E402
 
 
 #: Per-object placements (docs/closure.md): the default centre for the 30 mm boxes; the
@@ -37,7 +38,7 @@ def main(n_poses: int = 300) -> None:
     placement, params = Placement(), ClosureParams()
     grid = pose_grid(placement)
     poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
-    closer = _Closer(hand, synergies, params)
+    closer = closure_model(hand, synergies, params)
     all_times = []
     try:
         for box in STUDY_BOXES:
@@ -47,7 +48,7 @@ def main(n_poses: int = 300) -> None:
             for pose in poses:
                 placed = object_pose(placement, size, *grid.angles_deg(int(pose)), hand.palm_normal)
                 t0 = time.perf_counter()
-                result = simulate_pose(closer, size, placed)
+                result = closer.grasp(size, placed)
                 times.append(time.perf_counter() - t0)
                 statuses.append(result.status)
                 counts.append(len(result.links))

@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from synergrasp.analysis.periods import alpha_period_deg, distinct_pose_mask, object_periods, period_violations
-from synergrasp.simulation.closure import Placement
+from synergrasp.simulation.placement import Placement
 
 GRID = dict(alpha_deg=(-180.0, 175.0, 5.0), beta_deg=(-60.0, 60.0, 5.0))
 

@@ -35,7 +35,7 @@ rule study_tables:
     params:
         sets=config["synergy_sets"],
         table2_k_max=config["analyses"]["table2_k_max"],
-        analyses={k: v for k, v in config["analyses"].items() if k not in ("fig4", "fig2_poses")},
+        analyses={k: v for k, v in config["analyses"].items() if k != "fig4"},
         objects={name: object_config(name) for name in OBJECTS},
         grid=config["grid"],
         hand=config["hand"],
@@ -44,3 +44,36 @@ rule study_tables:
         "results/logs/study_tables.log",
     script:
         "../scripts/study_tables.py"
+
+
+rule grasp_realism:
+    input:
+        contacts=expand("results/objects/{object}/contacts.parquet", object=OBJECTS),
+        gfo=expand("results/objects/{object}/gfo.parquet", object=OBJECTS),
+        code=code("grasp_realism"),
+        data=SHIPPED_DATA,
+        user=user_files(),
+    output:
+        csv=report(
+            "results/tables/grasp_realism.csv",
+            caption="../report/grasp_realism_table.rst",
+            category="Tables",
+        ),
+        md="results/tables/grasp_realism.md",
+        png=report(
+            "results/figures/grasp_realism.png",
+            caption="../report/grasp_realism.rst",
+            category="Figures",
+        ),
+        pdf="results/figures/grasp_realism.pdf",
+    params:
+        hand=config["hand"],
+        full_set_id=incremental_set_id(config["synergy_sets"]["incremental_max"]),
+        weights_N={
+            name: spec["mass_kg"] * config["mechanics"]["g_m_per_s2"]
+            for name, spec in config["objects"].items()
+        },
+    log:
+        "results/logs/grasp_realism.log",
+    script:
+        "../scripts/grasp_realism.py"

@@ -1,10 +1,12 @@
 """Close the hand on one object at every pose of the grid; write its contacts table."""
 from contextlib import redirect_stderr
 
-from synergrasp.simulation.closure import ClosureParams, Placement, simulate_object, write_contacts
 from synergrasp.hand.kinematics import load_hand
-from synergrasp.simulation.objects import boxes_from_config
 from synergrasp.hand.synergies import load_synergies
+from synergrasp.simulation.closure import ClosureParams, simulate_object
+from synergrasp.simulation.contacts import write_contacts
+from synergrasp.simulation.objects import boxes_from_config
+from synergrasp.simulation.placement import Placement
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     sim = snakemake.params.sim

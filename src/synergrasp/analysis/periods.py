@@ -47,11 +47,11 @@ def alpha_period_deg(placement, size_mm: Sequence[float], palm_normal: Sequence[
     """Smallest P in {90, 120, 180} deg such that the box at (α + P, β) fills the same
     region as at (α, β) for every β of the placement's grid; 360 if none.
 
-    ``placement`` is a :class:`synergrasp.simulation.closure.Placement` (centre, box axes,
+    ``placement`` is a :class:`synergrasp.simulation.placement.Placement` (centre, box axes,
     rotation order, grid); ``size_mm`` the box's edges (mm); ``palm_normal`` the hand's palm
     normal (the α axis).
     """
-    from synergrasp.simulation.closure import object_pose, pose_grid
+    from synergrasp.simulation.placement import object_pose, pose_grid
 
     size = np.asarray(size_mm, dtype=float)
     tol = 1e-9 * float(size.max()) + 1e-12
@@ -77,7 +77,7 @@ def object_periods(objects: Mapping[str, Mapping[str, Any]], grid: Mapping[str, 
     ``grid`` is the config's grid block, ``hand`` the hand file (None: the shipped hand,
     whose palm normal is the α axis)."""
     from synergrasp.hand.kinematics import load_hand
-    from synergrasp.simulation.closure import Placement
+    from synergrasp.simulation.placement import Placement
 
     normal = load_hand(hand).palm_normal
     return {name: alpha_period_deg(Placement.from_config(spec["placement"], grid), spec["size_mm"], normal)
