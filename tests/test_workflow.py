@@ -83,9 +83,11 @@ def run_j2(tmp_path_factory) -> Path:
 def expected_targets() -> list[str]:
     config = yaml.safe_load(SMALL.read_text())
     figures = [f"results/figures/{n}.{e}" for n in ("fig1_synergy_postures", "fig2_example_grasps",
-               "fig3_rulegraph", "fig5a_hierarchy_success", "fig5b_hierarchy_force") for e in ("png", "pdf")]
+               "fig3_rulegraph", "fig5a_hierarchy_success", "fig5b_hierarchy_force", "grasp_realism")
+               for e in ("png", "pdf")]
     tables = [f"results/tables/{t}.{e}" for t in ("success_rates", "table2_success_rates", "hierarchy",
-              "minimum_preservation", "full_not_first7", "verdict_disagreements") for e in ("csv", "md")]
+              "minimum_preservation", "full_not_first7", "verdict_disagreements", "preservation_vs_chance",
+              "invariant_checks", "claims", "grasp_realism") for e in ("csv", "md")]
     per_object = [f"results/objects/{o}/{f}" for o in config["objects"] for f in (
         "contacts.parquet", "gfo.parquet", "minima.parquet", "fig4_force_maps.png", "fig4_force_maps.pdf",
         "fig4_exploded.png", "fig4_exploded.pdf")]
@@ -102,8 +104,8 @@ def test_every_target_exists_and_is_not_empty(run_j2):
 def test_tables_have_documented_columns_and_sane_values(run_j2):
     tables = run_j2 / "results" / "tables"
     rates = pd.read_csv(tables / "success_rates.csv")
-    for column in ("object", "set_id", "n_force_closure", "success_rate", "absolute_share",
-                   "mean_force", "median_force"):
+    for column in ("object", "set_id", "n_success", "success_rate", "absolute_share", "success_rate_force_closure",
+                   "success_rate_load_feasible", "force_ratio_median", "plain_mean_force_N", "plain_median_force_N"):
         assert column in rates.columns, column
     defined = rates["success_rate"].dropna()
     assert ((defined >= 0) & (defined <= 100)).all()
@@ -111,13 +113,18 @@ def test_tables_have_documented_columns_and_sane_values(run_j2):
     full = rates[rates["set_id"] == "-".join(str(i) for i in range(1, 16))]
     # the full set is the normalisation: 100 where it ever succeeds, undefined where it never does
     for _, row in full.iterrows():
-        if row["n_force_closure"] > 0:
+        if row["n_success"] > 0:
             assert row["success_rate"] == pytest.approx(100.0)
         else:
             assert pd.isna(row["success_rate"])
     preservation = pd.read_csv(tables / "minimum_preservation.csv")
     share = preservation["preserved_percent"].dropna()
     assert ((share >= 0) & (share <= 100)).all()
+    claims = pd.read_csv(tables / "claims.csv")
+    assert claims["claim"].tolist() == list(range(1, 8))
+    assert set(claims["verdict"]) <= {"holds", "does not hold", "undefined"}
+    checks = pd.read_csv(tables / "invariant_checks.csv")
+    assert (checks.loc[checks["check"] == "alpha_period", "count"] == 0).all()  # results repeat every 90 deg
     gfo = pd.read_parquet(run_j2 / "results" / "objects" / "obj4" / "gfo.parquet")
     assert set(gfo["status"]) <= {"force_closure", "infeasible", "rank_deficient", "no_grasp", "numerical_failure"}
     fc = gfo[gfo["force_closure"]]
@@ -171,7 +178,8 @@ def test_report_holds_every_figure_and_table(run_j2):
     for name in ("fig1_synergy_postures.png", "fig2_example_grasps.png", "fig3_rulegraph.png",
                  "fig4_force_maps.png", "fig4_exploded.png", "fig5a_hierarchy_success.png",
                  "fig5b_hierarchy_force.png", "table2_success_rates.csv", "minimum_preservation.csv",
-                 "full_not_first7.csv", "verdict_disagreements.csv"):
+                 "full_not_first7.csv", "verdict_disagreements.csv", "claims.csv", "preservation_vs_chance.csv",
+                 "invariant_checks.csv", "grasp_realism.png", "grasp_realism.csv"):
         assert name in html, name
     assert "Pisa/IIT SoftHand" in html  # the workflow's description page (report: in the Snakefile)
     out = snakemake(run_j2, "--report", "results/report.zip")
@@ -224,7 +232,7 @@ def test_code_inputs_hold_every_module_a_job_loads(run_j2):
         loaded.setdefault(script, set()).update(files)
     assert set(loaded) == {"simulate_contacts", "optimise_shard", "aggregate_gfo", "local_minima",
                            "study_tables", "fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph",
-                           "fig4_force_maps", "fig5_hierarchy"}
+                           "fig4_force_maps", "fig5_hierarchy", "grasp_realism"}
     for script, files in loaded.items():
         assert files, script
         assert files <= declared[script], (script, sorted(files - declared[script]))
@@ -284,7 +292,7 @@ def _planned_after_edit(project_copy, module: str) -> dict[str, int]:
 
 
 FIGURE_RULES = {"fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph", "fig4_force_maps",
-                "fig5_hierarchy", "figures"}
+                "fig5_hierarchy", "grasp_realism", "figures"}
 
 
 def test_changing_the_config_module_reruns_the_optimisation(project_copy):
@@ -295,7 +303,7 @@ def test_changing_the_config_module_reruns_the_optimisation(project_copy):
     assert planned_jobs(workdir, root=root, env=env) == {}
 
 
-@pytest.mark.parametrize("module", ["figures/study_figures.py", "figures/hand_drawing.py"])
+@pytest.mark.parametrize("module", ["figures/study_figures.py", "figures/hand_figures.py"])
 def test_changing_a_figure_module_reruns_only_figures(project_copy, module):
     planned = _planned_after_edit(project_copy, module)
     assert planned and set(planned) <= FIGURE_RULES, planned

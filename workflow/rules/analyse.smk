@@ -1,4 +1,5 @@
 # Stage 3: local minima per object and set, success rates, and the study's tables.
+from synergrasp.analysis.verdicts import success_verdict
 
 
 rule local_minima:
@@ -17,6 +18,7 @@ rule local_minima:
         runtime=runtime_min("local_minima"),
     params:
         radius_deg=config["analyses"]["minima_radius_deg"],
+        success=success_verdict(config["analyses"]),
     script:
         "../scripts/local_minima.py"
 
@@ -51,6 +53,49 @@ rule study_tables:
     params:
         sets=config["synergy_sets"],
         table2_k_max=config["analyses"]["table2_k_max"],
-        radius_deg=config["analyses"]["minima_radius_deg"],
+        analyses={k: v for k, v in config["analyses"].items() if k != "fig4"},
+        objects={name: object_config(name) for name in OBJECTS},
+        grid=config["grid"],
+        hand=config["hand"],
+        g_m_per_s2=config["mechanics"]["g_m_per_s2"],
     script:
         "../scripts/study_tables.py"
+
+
+rule grasp_realism:
+    input:
+        contacts=expand("results/objects/{object}/contacts.parquet", object=OBJECTS),
+        gfo=expand("results/objects/{object}/gfo.parquet", object=OBJECTS),
+        code=code("grasp_realism"),
+        data=SHIPPED_DATA,
+        user=user_files(),
+    output:
+        csv=report(
+            "results/tables/grasp_realism.csv",
+            caption="../report/grasp_realism_table.rst",
+            category="Tables",
+        ),
+        md="results/tables/grasp_realism.md",
+        png=report(
+            "results/figures/grasp_realism.png",
+            caption="../report/grasp_realism.rst",
+            category="Figures",
+        ),
+        pdf="results/figures/grasp_realism.pdf",
+    log:
+        "results/logs/grasp_realism.log",
+    benchmark:
+        "results/benchmarks/grasp_realism.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("grasp_realism"),
+        runtime=runtime_min("grasp_realism"),
+    params:
+        hand=config["hand"],
+        full_set_id=incremental_set_id(config["synergy_sets"]["incremental_max"]),
+        weights_N={
+            name: spec["mass_kg"] * config["mechanics"]["g_m_per_s2"]
+            for name, spec in config["objects"].items()
+        },
+    script:
+        "../scripts/grasp_realism.py"

@@ -5,7 +5,13 @@ from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from synergrasp.config import ConfigError, merge_config, synergy_sets, validate_config
+from synergrasp.config import (
+    ConfigError,
+    incremental_set_id,
+    merge_config,
+    synergy_sets,
+    validate_config,
+)
 
 ROOT = Path(workflow.basedir)
 SRC = ROOT / "src" / "synergrasp"
@@ -91,8 +97,11 @@ def code(script):
 
 
 def user_files():
-    """User-supplied hand/synergy files: a change of their content reruns what uses them."""
-    return [p for p in (config["hand"], config["synergies"]) if p]
+    """User-supplied hand/synergy files: a change of their content reruns what uses them
+    (a shipped synergy table given by name is under SHIPPED_DATA)."""
+    from synergrasp.hand.synergies import SHIPPED_TABLES
+
+    return [p for p in (config["hand"], config["synergies"]) if p and p not in SHIPPED_TABLES]
 
 
 SHIPPED_DATA = sorted(str(p) for p in (SRC / "data").glob("*") if p.is_file())
@@ -112,6 +121,8 @@ def simulation_params(wildcards):
         "closure": config["closure"],
         "hand": config["hand"],
         "synergies": config["synergies"],
+        # the dynamic closure needs k_ss, mu and gravity; the kinematic one does not rerun on them
+        "mechanics": config["mechanics"] if config["closure"].get("model") == "dynamic" else None,
     }
 
 
@@ -155,6 +166,9 @@ TABLES = [
     "minimum_preservation",
     "full_not_first7",
     "verdict_disagreements",
+    "preservation_vs_chance",
+    "invariant_checks",
+    "claims",
 ]
 
 
@@ -167,9 +181,12 @@ def study_targets():
             "fig3_rulegraph",
             "fig5a_hierarchy_success",
             "fig5b_hierarchy_force",
+            "grasp_realism",
         )
         for ext in ("png", "pdf")
     ]
-    tables = [f"results/tables/{t}.{ext}" for t in TABLES for ext in ("csv", "md")]
+    tables = [
+        f"results/tables/{t}.{ext}" for t in [*TABLES, "grasp_realism"] for ext in ("csv", "md")
+    ]
     per_object = [f for name in OBJECTS for f in object_targets(name)]
     return figures + tables + per_object

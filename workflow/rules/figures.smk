@@ -32,13 +32,14 @@ rule fig4_force_maps:
         runtime=runtime_min("fig4_force_maps"),
     params:
         fig4=config["analyses"]["fig4"],
+        success=success_verdict(config["analyses"]),
     script:
         "../scripts/fig4_force_maps.py"
 
 
 rule fig5_hierarchy:
     input:
-        rates="results/tables/success_rates.csv",
+        hierarchy="results/tables/hierarchy.csv",
         code=code("fig5_hierarchy"),
     output:
         success_png=report(
@@ -63,6 +64,7 @@ rule fig5_hierarchy:
         runtime=runtime_min("fig5_hierarchy"),
     params:
         first=config["synergy_sets"]["hierarchy_first"],
+        success=success_verdict(config["analyses"]),
     script:
         "../scripts/fig5_hierarchy.py"
 

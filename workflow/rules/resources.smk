@@ -3,7 +3,7 @@
 # sets, shards, closure model) instead of going stale. docs/cluster.md gives the method.
 import math
 
-from synergrasp.simulation.closure import Placement, pose_grid
+from synergrasp.simulation.placement import Placement, pose_grid
 
 # Measured cost of one job: fixed wall time (s) and memory (MB) of the job itself (imports,
 # reading inputs), plus wall time and memory per unit of work. From results/benchmarks/*.tsv
@@ -46,6 +46,12 @@ JOB_COST = {
         "unit_s": 3.2e-6,
         "fixed_mb": 231,
         "unit_mb": 2.2e-4,
+    },
+    "grasp_realism": {
+        "fixed_s": 4.0,
+        "unit_s": 4.0e-6,
+        "fixed_mb": 300,
+        "unit_mb": 3.0e-4,
     },
     "fig1_synergy_postures": {
         "fixed_s": 3.8,
@@ -90,6 +96,7 @@ def job_size(step):
         "local_minima": N_POSES * N_SETS,
         "fig4_force_maps": N_POSES * N_SETS,
         "study_tables": len(OBJECTS) * N_POSES * N_SETS,
+        "grasp_realism": len(OBJECTS) * N_POSES * N_SETS,
     }.get(step, 0)
 
 
@@ -117,6 +124,7 @@ localrules:
     aggregate_gfo,
     local_minima,
     study_tables,
+    grasp_realism,
     fig1_synergy_postures,
     fig2_example_grasps,
     fig3_rulegraph,

@@ -54,6 +54,8 @@ rule fig2_example_grasps:
     input:
         contacts=expand("results/objects/{object}/contacts.parquet", object=OBJECTS),
         code=code("fig2_example_grasps"),
+        data=SHIPPED_DATA,
+        user=user_files(),
     output:
         png=report(
             "results/figures/fig2_example_grasps.png",
@@ -72,6 +74,5 @@ rule fig2_example_grasps:
     params:
         objects=[object_config(name) for name in OBJECTS],
         hand=config["hand"],
-        poses=config["analyses"]["fig2_poses"],
     script:
         "../scripts/fig2_example_grasps.py"

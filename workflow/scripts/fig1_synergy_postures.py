@@ -1,7 +1,7 @@
 """Fig. 1: the hand along each of the first seven synergies, sigma = -1, 0, +1."""
 
+from synergrasp.figures.hand_figures import figure_synergy_postures
 from synergrasp.hand.kinematics import load_hand
-from synergrasp.figures.hand_drawing import figure_synergy_postures
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
 

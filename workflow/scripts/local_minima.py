@@ -2,8 +2,9 @@
 import pandas as pd
 
 from synergrasp.analysis.minima import minima_table
+from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
-    gfo = pd.read_parquet(snakemake.input.gfo)
+    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), snakemake.params.success)
     minima_table(gfo, radius_deg=snakemake.params.radius_deg).to_parquet(snakemake.output[0], index=False)

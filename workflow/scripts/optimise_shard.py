@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 
 from synergrasp.optimisation.batched import optimise_grasps
-from synergrasp.simulation.closure import read_grasps
+from synergrasp.simulation.contacts import read_grasps
 from synergrasp.config import gfo_params
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
