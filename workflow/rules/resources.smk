@@ -7,13 +7,14 @@ from synergrasp.simulation.placement import Placement, pose_grid
 
 # Measured cost of one job: fixed wall time (s) and memory (MB) of the job itself (imports,
 # reading inputs), plus wall time and memory per unit of work. From results/benchmarks/*.tsv
-# (columns s and max_rss) of the default study and of tests/config/small.yaml on a 2-core
-# x86_64 machine running two jobs at a time; the slope is between the two sizes.
+# (columns s, cpu_time and max_rss) of the default study and of tests/config/small.yaml on a
+# 2-core x86_64 machine running two jobs at a time; the slope is between the two sizes. The
+# closure's cost per pose is CPU time per pose of the closure to the end of S1 (docs/cluster.md).
 #   unit = pose (closure), pose x synergy set (optimisation, minima, Fig. 4, tables), none (figures)
 JOB_COST = {
     "simulate_contacts": {
         "fixed_s": 1.5,
-        "unit_s": 1.85e-2,
+        "unit_s": 4.5e-2,
         "fixed_mb": 178,
         "unit_mb": 7.6e-3,
     },
@@ -54,15 +55,15 @@ JOB_COST = {
         "unit_mb": 3.0e-4,
     },
     "fig1_synergy_postures": {
-        "fixed_s": 3.8,
+        "fixed_s": 3.0,
         "unit_s": 0.0,
-        "fixed_mb": 188,
+        "fixed_mb": 565,
         "unit_mb": 0.0,
     },
     "fig2_example_grasps": {
         "fixed_s": 2.3,
         "unit_s": 0.0,
-        "fixed_mb": 247,
+        "fixed_mb": 311,
         "unit_mb": 0.0,
     },
     "fig3_rulegraph": {"fixed_s": 5.3, "unit_s": 0.0, "fixed_mb": 380, "unit_mb": 0.0},
@@ -70,7 +71,7 @@ JOB_COST = {
 }
 # Closure cost per pose relative to the kinematic closure measured above, per closure model;
 # a model not listed is charged CLOSURE_UNMEASURED_FACTOR until its cost is measured.
-CLOSURE_COST_FACTOR = {"kinematic": 1.0}
+CLOSURE_COST_FACTOR = {"kinematic": 1.0, "dynamic": 1.8}
 CLOSURE_UNMEASURED_FACTOR = 20.0
 # A cold compiled-solver cache (a node whose CPU model has no cached build) compiles the
 # solver once in the job: about 50 s and 150 MB on the measuring machine.
