@@ -13,8 +13,9 @@ from synergrasp.hand.synergies import (
     load_synergies,
     load_synergy_mapping,
     map_human_synergies,
-    reference_posture,
+    SynergyPath,
     shipped_path,
+    SHIPPED_TABLES,
     write_synergies,
 )
 
@@ -23,9 +24,10 @@ UPPER = np.radians([90, 90, 90] + [30, 90, 90, 90] * 4)
 LONG_FLEXIONS = [f"{f}_{j}" for f in ("index", "middle", "ring", "little") for j in ("mcp", "pip", "dip")]
 
 
-def test_shipped_file_equals_fresh_mapping():
-    shipped = load_synergies()
-    fresh = map_human_synergies(load_human_synergies(), load_synergy_mapping())
+@pytest.mark.parametrize("table", SHIPPED_TABLES)
+def test_shipped_file_equals_fresh_mapping(table):
+    shipped = load_synergies(table)
+    fresh = map_human_synergies(load_human_synergies(), load_synergy_mapping(table))
     assert shipped.joint_names == JOINT_NAMES == fresh.joint_names
     assert shipped.names == tuple(f"S{i}" for i in range(1, 16))
     np.testing.assert_array_equal(shipped.mean, fresh.mean)
@@ -55,8 +57,31 @@ def test_long_fingers_map_one_to_one_and_s1_closes():
     assert s1["index_abd"] < 0 < s1["ring_abd"] < s1["little_abd"]
 
 
+def test_default_is_softhand_opposed_and_names_resolve(tmp_path):
+    default = load_synergies()
+    np.testing.assert_array_equal(default.matrix, load_synergies("softhand_opposed").matrix)
+    assert not np.array_equal(default.matrix, load_synergies("legacy_thumb").matrix)
+    with pytest.raises(FileNotFoundError, match="softhand_opposed"):
+        load_synergies("softhand")
+
+
+def test_softhand_thumb_follows_the_average_finger_flexion():
+    """Thumb rows = (1.3, 1.3, 1.0) x the mean of the 12 long-finger flexion rows, in the mean
+    posture and in every column (hand_model.md: the SoftHand's own synergy)."""
+    s = load_synergies("softhand_opposed")
+    flex = [JOINT_NAMES.index(n) for n in LONG_FLEXIONS]
+    human = load_human_synergies()
+    human_mean = np.mean([human.mean[HUMAN_JOINT_NAMES.index(n)] for n in LONG_FLEXIONS])
+    for name, ratio in (("thumb_abd", 1.3), ("thumb_flex1", 1.3), ("thumb_flex2", 1.0)):
+        j = JOINT_NAMES.index(name)
+        np.testing.assert_allclose(s.matrix[j], ratio * s.matrix[flex].mean(axis=0), atol=1e-12)
+        assert s.mean[j] == pytest.approx(ratio * human_mean)
+    assert s.matrix[JOINT_NAMES.index("thumb_abd"), 0] > 0  # S1 opposes the thumb
+
+
 def test_mean_posture_is_reachable_and_clipped_where_needed():
-    s = load_synergies()
+    assert np.all(load_synergies().mean >= LOWER) and np.all(load_synergies().mean <= UPPER)
+    s = load_synergies("legacy_thumb")
     assert np.all(s.mean >= LOWER) and np.all(s.mean <= UPPER)
     mean = dict(zip(JOINT_NAMES, s.mean))
     assert mean["little_abd"] == pytest.approx(-math.pi / 6)  # human -30.3 deg, clipped
@@ -88,9 +113,10 @@ def test_mapping_rejects_missing_joint():
 
 def test_reference_posture_clips_and_broadcasts():
     s = load_synergies()
-    q0 = reference_posture(s, 0.0, LOWER, UPPER)
+    path = SynergyPath.along(s, LOWER, UPPER)
+    q0 = path.reference(0.0)
     np.testing.assert_array_equal(q0, s.mean)
-    q = reference_posture(s, [-10.0, 1.0, 10.0], LOWER, UPPER)
+    q = path.reference([-10.0, 1.0, 10.0])
     assert q.shape == (3, 19)
     np.testing.assert_allclose(q[1], np.clip(s.mean + s.matrix[:, 0], LOWER, UPPER))
     # far along +S1 every long-finger flexion is at its upper limit
@@ -98,7 +124,7 @@ def test_reference_posture_clips_and_broadcasts():
     np.testing.assert_allclose(q[2, idx], math.pi / 2)
     np.testing.assert_allclose(q[0, idx], 0.0)
     with pytest.raises(ValueError, match="lower and upper"):
-        reference_posture(s, 0.0, LOWER[:3], UPPER)
+        SynergyPath.along(s, LOWER[:3], UPPER)
 
 
 def test_columns_selects_one_based():
@@ -164,7 +190,8 @@ def test_missing_file_is_file_not_found(tmp_path):
 
 
 def test_shipped_path_exists():
-    assert shipped_path().is_file()
+    for table in SHIPPED_TABLES:
+        assert shipped_path(table).is_file()
 
 
 def test_mapping_limits_agree_with_hand_model():

@@ -92,9 +92,6 @@ def validate_config(config: Mapping[str, Any], schema_path: str | Path,
         problems.append("config error at 'grid.alpha_deg': alpha is periodic; the range must span less than 360 deg")
     if all(abs(v) < 1e-12 for v in config["mechanics"]["gravity_direction"]):
         problems.append("config error at 'mechanics.gravity_direction': must be a non-zero vector")
-    closure = config["closure"]
-    if closure["sigma_closed"] <= closure["sigma_open"]:
-        problems.append("config error at 'closure.sigma_closed': must exceed closure.sigma_open")
     objects = sorted(config["objects"])
     fig4 = config["analyses"]["fig4"]
     if fig4["object"] not in config["objects"]:

@@ -1,4 +1,5 @@
 # Stage 3: local minima per object and set, success rates, and the study's tables.
+from synergrasp.analysis.verdicts import success_verdict
 
 
 rule local_minima:
@@ -9,6 +10,7 @@ rule local_minima:
         "results/objects/{object}/minima.parquet",
     params:
         radius_deg=config["analyses"]["minima_radius_deg"],
+        success=success_verdict(config["analyses"]),
     log:
         "results/logs/local_minima/{object}.log",
     script:
@@ -33,8 +35,45 @@ rule study_tables:
     params:
         sets=config["synergy_sets"],
         table2_k_max=config["analyses"]["table2_k_max"],
-        radius_deg=config["analyses"]["minima_radius_deg"],
+        analyses={k: v for k, v in config["analyses"].items() if k != "fig4"},
+        objects={name: object_config(name) for name in OBJECTS},
+        grid=config["grid"],
+        hand=config["hand"],
+        g_m_per_s2=config["mechanics"]["g_m_per_s2"],
     log:
         "results/logs/study_tables.log",
     script:
         "../scripts/study_tables.py"
+
+
+rule grasp_realism:
+    input:
+        contacts=expand("results/objects/{object}/contacts.parquet", object=OBJECTS),
+        gfo=expand("results/objects/{object}/gfo.parquet", object=OBJECTS),
+        code=code("grasp_realism"),
+        data=SHIPPED_DATA,
+        user=user_files(),
+    output:
+        csv=report(
+            "results/tables/grasp_realism.csv",
+            caption="../report/grasp_realism_table.rst",
+            category="Tables",
+        ),
+        md="results/tables/grasp_realism.md",
+        png=report(
+            "results/figures/grasp_realism.png",
+            caption="../report/grasp_realism.rst",
+            category="Figures",
+        ),
+        pdf="results/figures/grasp_realism.pdf",
+    params:
+        hand=config["hand"],
+        full_set_id=incremental_set_id(config["synergy_sets"]["incremental_max"]),
+        weights_N={
+            name: spec["mass_kg"] * config["mechanics"]["g_m_per_s2"]
+            for name, spec in config["objects"].items()
+        },
+    log:
+        "results/logs/grasp_realism.log",
+    script:
+        "../scripts/grasp_realism.py"

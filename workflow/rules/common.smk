@@ -5,7 +5,7 @@ from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from synergrasp.config import ConfigError, merge_config, synergy_sets, validate_config
+from synergrasp.config import ConfigError, incremental_set_id, merge_config, synergy_sets, validate_config
 
 ROOT = Path(workflow.basedir)
 SRC = ROOT / "src" / "synergrasp"
@@ -84,8 +84,11 @@ def code(script):
 
 
 def user_files():
-    """User-supplied hand/synergy files: a change of their content reruns what uses them."""
-    return [p for p in (config["hand"], config["synergies"]) if p]
+    """User-supplied hand/synergy files: a change of their content reruns what uses them
+    (a shipped synergy table given by name is under SHIPPED_DATA)."""
+    from synergrasp.hand.synergies import SHIPPED_TABLES
+
+    return [p for p in (config["hand"], config["synergies"]) if p and p not in SHIPPED_TABLES]
 
 
 SHIPPED_DATA = sorted(str(p) for p in (SRC / "data").glob("*") if p.is_file())
@@ -105,6 +108,8 @@ def simulation_params(wildcards):
         "closure": config["closure"],
         "hand": config["hand"],
         "synergies": config["synergies"],
+        # the dynamic closure needs k_ss, mu and gravity; the kinematic one does not rerun on them
+        "mechanics": config["mechanics"] if config["closure"].get("model") == "dynamic" else None,
     }
 
 
@@ -138,6 +143,9 @@ TABLES = [
     "minimum_preservation",
     "full_not_first7",
     "verdict_disagreements",
+    "preservation_vs_chance",
+    "invariant_checks",
+    "claims",
 ]
 
 
@@ -145,9 +153,9 @@ def study_targets():
     figures = [
         f"results/figures/{name}.{ext}"
         for name in ("fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph",
-                     "fig5a_hierarchy_success", "fig5b_hierarchy_force")
+                     "fig5a_hierarchy_success", "fig5b_hierarchy_force", "grasp_realism")
         for ext in ("png", "pdf")
     ]
-    tables = [f"results/tables/{t}.{ext}" for t in TABLES for ext in ("csv", "md")]
+    tables = [f"results/tables/{t}.{ext}" for t in [*TABLES, "grasp_realism"] for ext in ("csv", "md")]
     per_object = [f for name in OBJECTS for f in object_targets(name)]
     return figures + tables + per_object

@@ -1,10 +1,12 @@
 """Close the hand on one object at every pose of the grid; write its contacts table."""
 from contextlib import redirect_stderr
 
-from synergrasp.simulation.closure import ClosureParams, Placement, simulate_object, write_contacts
 from synergrasp.hand.kinematics import load_hand
-from synergrasp.simulation.objects import boxes_from_config
 from synergrasp.hand.synergies import load_synergies
+from synergrasp.simulation.closure import ClosureParams, simulate_object
+from synergrasp.simulation.contacts import write_contacts
+from synergrasp.simulation.objects import boxes_from_config
+from synergrasp.simulation.placement import Placement
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     sim = snakemake.params.sim
@@ -13,5 +15,6 @@ with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     (box,) = boxes_from_config([obj])
     hand = load_hand(sim["hand"])
     synergies = load_synergies(sim["synergies"], joint_names=hand.joint_names)
-    table = simulate_object(hand, synergies, box, placement, ClosureParams.from_config(sim["closure"]))
+    table = simulate_object(hand, synergies, box, placement, ClosureParams.from_config(sim["closure"]),
+                            mechanics=sim.get("mechanics"))
     write_contacts(table, snakemake.output[0])

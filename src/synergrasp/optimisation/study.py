@@ -29,7 +29,7 @@ from synergrasp.optimisation.mechanics import (
     object_wrench,
 )
 from synergrasp.optimisation.problem import DEFAULT_TOL, STRICT_SHRINK, GraspSets, SynergySets
-from synergrasp.simulation.closure import read_grasps
+from synergrasp.simulation.contacts import read_grasps
 
 __all__ = ["GFOParams", "gfo_table", "mechanics_for", "merge_shards", "optimise_grasps", "optimise_shard",
            "shard_rows"]

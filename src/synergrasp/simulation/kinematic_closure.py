@@ -1,0 +1,341 @@
+"""The quasi-static kinematic closure along S1 (docs/closure.md).
+
+The joint reference follows q_r(σ) = clip(q_m + σ·S1, lower, upper) (``SynergyPath``) from
+σ_open to σ_closed; a link that touches the object (or the hand itself) holds the joints
+proximal to it, the distal joints and the other fingers keep following the reference (soft
+synergies). The scene is never stepped: joints are set and the collision pipeline is
+queried (``HandScene``). mm, rad, palm frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from synergrasp.hand.kinematics import FINGERS
+from synergrasp.hand.synergies import SynergyPath
+from synergrasp.simulation import bullet
+from synergrasp.simulation.contacts import ClosureResult, closure_result
+from synergrasp.simulation.placement import ObjectPose
+from synergrasp.simulation.scene import HandScene
+
+if TYPE_CHECKING:  # pragma: no cover
+    from synergrasp.hand.kinematics import Hand
+    from synergrasp.hand.synergies import Synergies
+    from synergrasp.simulation.closure import ClosureParams
+
+__all__ = ["KinematicClosure"]
+
+_LONG_FINGERS = ("index", "middle", "ring", "little")
+#: Distance (mm) within which the hand is queried for the next step size.
+_QUERY_MARGIN_MM = 40.0
+_MAX_REFINE = 40
+
+
+class KinematicClosure:
+    """The quasi-static kinematic closure along S1 on one pybullet scene (hand + box)."""
+
+    def __init__(self, hand: Hand, synergies: Synergies, params: ClosureParams) -> None:
+        self.hand = hand
+        self.params = params
+        names = tuple(synergies.joint_names)
+        if names != tuple(hand.joint_names):
+            raise ValueError(f"synergies.joint_names must equal hand.joint_names {hand.joint_names}, got {names}")
+        self.path = SynergyPath.along(synergies, hand.lower, hand.upper)
+        self.s1 = self.path.direction
+        # σ interval on which each joint's reference is inside its limits (clipped outside)
+        self.active_lo, self.active_hi = self.path.active_interval()
+        # the path: from the fully open hand to where every joint moved by S1 is at a limit
+        self.sigma_open, self.sigma_closed = self.path.closure_range(hand.flexion_joints)
+        self.scene = HandScene(hand)
+        self.fingers = [(tuple(j), tuple(li)) for j, li in zip(hand.finger_joints, hand.finger_links)]
+        self.link_finger_index = np.full(hand.n_links, -1)
+        self.link_chain_pos = np.full(hand.n_links, -1)
+        for f, (_, links) in enumerate(self.fingers):
+            for i, link in enumerate(links):
+                self.link_finger_index[link] = f
+                self.link_chain_pos[link] = i
+        self.reach = self._finger_reach()
+        self._profiles: dict[tuple[int, tuple[int, ...]], tuple[NDArray, NDArray]] = {}
+        self.q_open = self.reference(self.sigma_open)
+        self.self_pairs = self._monitored_pairs()
+        self.long_fingers = {f for f, name in enumerate(FINGERS) if name in _LONG_FINGERS}
+
+    def close(self) -> None:
+        """Release the pybullet scene."""
+        self.scene.close()
+
+    def grasp(self, size_mm: NDArray, placed: ObjectPose) -> ClosureResult:
+        """Close the hand on a box of edge lengths ``size_mm`` (mm) placed at ``placed``."""
+        self.scene.place_box(size_mm, placed)
+        q, state, intersects = self.run()
+        if intersects:
+            return closure_result(self.hand, q, state, np.zeros(0, dtype=np.int64), np.zeros((0, 3)),
+                                  np.zeros((0, 3)), 0.0, intersects_open_hand=True)
+        links, points, normals, depth = self.scene.object_contacts(q, self.params.contact_distance_mm)
+        return closure_result(self.hand, q, state, links, points, normals, depth)
+
+    # -- kinematic helpers -------------------------------------------------------------
+    def reference(self, sigma: float) -> NDArray:
+        """q_r(σ), rad (``SynergyPath.reference``)."""
+        return self.path.reference(sigma)
+
+    def _finger_reach(self) -> NDArray:
+        """Per finger, an upper bound (mm) on the distance of any point of its links from any
+        of its joint axes: the extended chain (q = 0) from the finger's first axis, plus radius."""
+        from synergrasp.hand.kinematics import forward_kinematics
+
+        frames = forward_kinematics(self.hand, np.zeros(self.hand.n_joints))
+        reach = np.zeros(len(self.fingers))
+        for f, (_, links) in enumerate(self.fingers):
+            base = frames[links[0], :3, 3]
+            r = 0.0
+            for link in links:
+                for shape in self.hand.link_shapes[link]:
+                    centre = frames[link] @ shape.pose
+                    half = 0.5 * shape.length if shape.kind == "capsule" else 0.5 * float(np.linalg.norm(shape.size))
+                    ext = half + shape.radius
+                    r = max(r, float(np.linalg.norm(centre[:3, 3] - base)) + ext)
+            reach[f] = r + 10.0  # the first axis sits up to one rolling gap before the base frame
+        return reach
+
+    def _monitored_pairs(self) -> tuple[tuple[int, int], ...]:
+        """Hand–hand pairs checked during the closure: a finger link against the palm or
+        against a link of another finger, except the knuckles (they barely move) and pairs
+        already overlapping at the open posture (a property of the model, not an event)."""
+        hand = self.hand
+        pairs = []
+        for i, j in bullet.self_collision_pairs(hand):
+            if hand.link_finger[i] == hand.link_finger[j]:
+                continue
+            if any(hand.link_names[k].endswith("_knuckle") for k in (i, j)):
+                continue
+            pairs.append((i, j))
+        self.scene.set_posture(self.q_open)
+        overlap = bullet.self_closest_points(self.scene.client, self.scene.body, 0.0, tuple(pairs))
+        bad = {(int(a), int(b)) for a, b, d in zip(overlap.link_a, overlap.link_b, overlap.distance) if d < 0}
+        return tuple(p for p in pairs if p not in bad and (p[1], p[0]) not in bad)
+
+    # -- the closure ------------------------------------------------------------------------
+    def _travel_profile(self, f: int, moving: tuple[int, ...]) -> tuple[NDArray, NDArray]:
+        """Knots σ_k on [σ_open, σ_closed] and the travel bound T(σ_k) (mm) accumulated from
+        σ_open by any point of finger f when only the joints ``moving`` follow the reference.
+
+        T is piecewise linear: joint j adds |S1_j| · reach(f) mm per unit σ while its
+        reference is inside its limits (a clipped joint does not move). Cached per
+        (finger, moving joints): there are only a few such sets per finger.
+        """
+        key = (f, moving)
+        profile = self._profiles.get(key)
+        if profile is None:
+            p = self.params
+            idx = list(moving)
+            lo, hi = self.active_lo[idx], self.active_hi[idx]
+            rate = np.abs(self.s1[idx]) * self.reach[f]  # mm per unit σ while active
+            knots = np.unique(np.clip(np.concatenate([lo, hi, [self.sigma_open, self.sigma_closed]]),
+                                      self.sigma_open, self.sigma_closed))
+            mids = 0.5 * (knots[:-1] + knots[1:])
+            speed = np.array([float(np.sum(rate[(lo <= m) & (hi >= m)])) for m in mids])
+            profile = (knots, np.concatenate([[0.0], np.cumsum(speed * np.diff(knots))]))
+            self._profiles[key] = profile
+        return profile
+
+    def advance(self, sigma: float, budget_mm: NDArray, held: NDArray) -> float:
+        """Largest σ' ≤ σ_closed such that no point of finger f travels more than
+        budget_mm[f] on [σ, σ'] (clipped joints do not move; held joints do not move)."""
+        best = self.sigma_closed
+        for f, (joints, _) in enumerate(self.fingers):
+            moving = tuple(j for j in joints if not held[j])
+            if not moving:
+                continue
+            knots, travel = self._travel_profile(f, moving)
+            level = float(np.interp(sigma, knots, travel)) + budget_mm[f]
+            if level > travel[-1]:
+                continue  # the budget outlasts the closure
+            k = int(np.searchsorted(travel, level, side="left"))  # travel[k-1] < level <= travel[k]
+            t0, t1 = travel[k - 1], travel[k]
+            best = min(best, knots[k - 1] + (level - t0) / (t1 - t0) * (knots[k] - knots[k - 1]))
+        return best
+
+    def posture(self, sigma: float, held: NDArray, q_held: NDArray) -> NDArray:
+        return np.where(held, q_held, self.reference(sigma))
+
+    def gaps(self, q: NDArray, moving_links: NDArray, pairs: tuple[tuple[int, int], ...],
+             margin_mm: float) -> _Gaps:
+        """Per moving link: distance to the box and to the monitored hand links (and which),
+        at posture q (mm; +inf for links that do not move)."""
+        self.scene.set_posture(q)
+        d_obj = self.scene.object_distance(margin_mm)
+        d_self, partner = self.scene.self_distance(pairs, margin_mm)
+        d_obj[~moving_links] = np.inf
+        d_self[~moving_links] = np.inf
+        return _Gaps(q, d_obj, d_self, partner)
+
+    def run(self) -> tuple[NDArray, list[str], bool]:
+        """Close the hand on the placed box from σ_open to σ_closed. Returns (q, finger_state,
+        intersects_open_hand)."""
+        p = self.params
+        state = _HoldState(self)
+        q = self.q_open.copy()
+        self.scene.set_posture(q)
+        d_all = self.scene.object_distance(p.contact_distance_mm)
+        if np.min(d_all) < -p.penetration_tolerance_mm:
+            return q, [], True
+        # links touching (or slightly penetrating) the box in the open posture hold at once
+        touching = d_all <= p.contact_distance_mm
+        touching[0] = False
+        state.touch_object(touching, q)
+        sigma = self.sigma_open
+        mv, pairs = self._moving(state)
+        known: _Gaps | None = None  # the gaps at σ when known from the previous step or event
+        while sigma < self.sigma_closed and mv.any():
+            now = known if known is not None else self.gaps(self.posture(sigma, state.held, state.q_held),
+                                                           mv, pairs, _QUERY_MARGIN_MM)
+            sigma_next = self.advance(sigma, self._budget(now), state.held)
+            if sigma_next <= sigma:
+                break
+            after = self.gaps(self.posture(sigma_next, state.held, state.q_held), mv, pairs, _QUERY_MARGIN_MM)
+            if after.smallest >= 0.0:
+                sigma, known = sigma_next, after
+                continue
+            sigma, event = self._refine(sigma, now, sigma_next, after, state, mv, pairs)
+            state.touch_object(event.d_obj <= p.contact_distance_mm, event.q)
+            state.touch_hand(event, p.contact_distance_mm)
+            # the posture at σ is the event's again (new holds keep its values); a link that
+            # still moves keeps all its pairs, so its gaps are those of the event
+            mv, pairs = self._moving(state)
+            known = event.masked(mv)
+        q_final = self.posture(min(sigma, self.sigma_closed), state.held, state.q_held)
+        return q_final, state.finger_states(), False
+
+    def _moving(self, state: _HoldState) -> tuple[NDArray, tuple[tuple[int, int], ...]]:
+        """Links that still move (their own joint is not held) and the monitored pairs with one."""
+        mv = np.zeros(self.hand.n_links, dtype=bool)
+        for joints, links in self.fingers:
+            for i, link in enumerate(links):
+                mv[link] = not state.held[joints[i]]
+        return mv, tuple(pr for pr in self.self_pairs if mv[pr[0]] or mv[pr[1]])
+
+    def _budget(self, gaps: _Gaps) -> NDArray:
+        """Travel budget (mm) per finger for the next step: max(step_mm, its free distance),
+        at most the query margin; hand gaps count half (both links may move)."""
+        budget = np.full(len(self.fingers), self.params.step_mm)
+        for f, (_, links) in enumerate(self.fingers):
+            free = min(float(np.min(gaps.d_obj[list(links)])), 0.5 * float(np.min(gaps.d_self[list(links)])))
+            budget[f] = max(self.params.step_mm, min(free, _QUERY_MARGIN_MM))
+        return budget
+
+    def _refine(self, sigma: float, now: _Gaps, sigma_next: float, after: _Gaps, state: _HoldState,
+                mv: NDArray, pairs: tuple[tuple[int, int], ...]) -> tuple[float, _Gaps]:
+        """A moving link crosses something in (σ, σ_next]: the last σ before it, where the
+        smallest gap is in [0, tolerance_mm] (Illinois false position, bisection when it
+        stalls), and the gaps there. If nothing is within the contact distance there (the
+        refinement ran out), the closest link is made to touch so the closure progresses."""
+        lo, hi, d_lo, d_hi = sigma, sigma_next, now.smallest, after.smallest
+        side, event = 0, now
+        for _ in range(_MAX_REFINE):
+            mid = 0.5 * (lo + hi)
+            if np.isfinite(d_lo) and (hi - lo) > 1e-12:
+                guess = hi - d_hi * (hi - lo) / (d_hi - d_lo)
+                mid = guess if lo < guess < hi else mid
+            at = self.gaps(self.posture(mid, state.held, state.q_held), mv, pairs, _QUERY_MARGIN_MM)
+            if at.smallest < 0.0:
+                hi, d_hi = mid, at.smallest
+                d_lo = 0.5 * d_lo if side == -1 else d_lo
+                side = -1
+                continue
+            lo, d_lo, event = mid, at.smallest, at
+            if at.smallest <= self.params.tolerance_mm:
+                break
+            d_hi = 0.5 * d_hi if side == +1 else d_hi
+            side = +1
+        touch = self.params.contact_distance_mm
+        if not (np.any(event.d_obj <= touch) or np.any(event.d_self <= touch)):
+            event = event.forced_touch(touch)
+        return (lo if event is not now else sigma), event
+
+
+@dataclass
+class _Gaps:
+    """Gaps of the moving links at posture q (mm): to the box, to the nearest monitored
+    hand link and which link that is (-1 if none)."""
+
+    q: NDArray
+    d_obj: NDArray
+    d_self: NDArray
+    partner: NDArray
+
+    @property
+    def smallest(self) -> float:
+        return float(min(self.d_obj.min(), self.d_self.min()))
+
+    def masked(self, moving: NDArray) -> _Gaps:
+        d_obj, d_self = self.d_obj.copy(), self.d_self.copy()
+        d_obj[~moving] = np.inf
+        d_self[~moving] = np.inf
+        return _Gaps(self.q, d_obj, d_self, self.partner)
+
+    def forced_touch(self, touch_mm: float) -> _Gaps:
+        """The same gaps with the closest link set to touch (``touch_mm``)."""
+        d_obj, d_self = self.d_obj.copy(), self.d_self.copy()
+        k = int(np.argmin(np.minimum(d_obj, d_self)))
+        if d_obj[k] <= d_self[k]:
+            d_obj[k] = min(d_obj[k], touch_mm)
+        else:
+            d_self[k] = min(d_self[k], touch_mm)
+        return _Gaps(self.q, d_obj, d_self, self.partner)
+
+
+class _HoldState:
+    """Which joints are held (and at what angle), and what each finger has touched.
+
+    A link touching the box, the palm or the thumb holds the joints of its chain up to
+    its own. Two long fingers touching each other hold only their abduction joints, and
+    flexion goes on (docs/closure.md); if they touch again with both abductions held, it
+    is a block like any other.
+    """
+
+    def __init__(self, closure: KinematicClosure) -> None:
+        self.c = closure
+        n = closure.hand.n_joints
+        self.held = np.zeros(n, dtype=bool)
+        self.q_held = np.zeros(n)
+        self.object = np.zeros(len(closure.fingers), dtype=bool)
+        self.hand = np.zeros(len(closure.fingers), dtype=bool)
+
+    def _hold(self, joints: tuple[int, ...], q: NDArray) -> None:
+        for j in joints:
+            if not self.held[j]:
+                self.held[j], self.q_held[j] = True, q[j]
+
+    def _hold_chain(self, link: int, q: NDArray) -> int:
+        f = int(self.c.link_finger_index[link])
+        if f >= 0:
+            self._hold(self.c.fingers[f][0][: self.c.link_chain_pos[link] + 1], q)
+        return f
+
+    def touch_object(self, touching: NDArray, q: NDArray) -> None:
+        for link in np.flatnonzero(touching):
+            f = self._hold_chain(int(link), q)
+            if f >= 0:
+                self.object[f] = True
+
+    def touch_hand(self, gaps: _Gaps, touch_mm: float) -> None:
+        c = self.c
+        for link in np.flatnonzero(gaps.d_self <= touch_mm):
+            other = int(gaps.partner[link])
+            fa, fb = int(c.link_finger_index[link]), int(c.link_finger_index[other]) if other >= 0 else -1
+            if fa in c.long_fingers and fb in c.long_fingers:
+                abd = (c.fingers[fa][0][0], c.fingers[fb][0][0])
+                if not (self.held[abd[0]] and self.held[abd[1]]):
+                    self._hold(abd, gaps.q)
+                    continue
+            if self._hold_chain(int(link), gaps.q) >= 0:
+                self.hand[fa] = True
+
+    def finger_states(self) -> list[str]:
+        return ["contact" if self.object[f] else "self" if self.hand[f] else "limit"
+                for f in range(len(self.c.fingers))]
