@@ -19,9 +19,12 @@ import pandas as pd
 
 from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 
-__all__ = ["CONTACT_BINS", "DEFAULT_CLOSURE_MODEL", "NORMAL_FORCE_COLUMN", "link_categories", "grasp_realism",
+__all__ = ["SIMULATED_STATUSES", "CONTACT_BINS", "DEFAULT_CLOSURE_MODEL", "NORMAL_FORCE_COLUMN", "link_categories", "grasp_realism",
            "representative_grasps"]
 
+#: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.STATUSES): a
+#: ``no_contact`` closure is a simulated grasp with 0 contacts; any other status is a dropped pose.
+SIMULATED_STATUSES: tuple[str, ...] = ("grasp", "no_contact")
 #: Contact-count bins of the table: 0, 1, …, 5 and "6 or more".
 CONTACT_BINS: tuple[int, ...] = (0, 1, 2, 3, 4, 5, 6)
 #: Closure model written in the table when the contacts table has no ``closure_model`` column.
@@ -75,7 +78,7 @@ def _weight_multiples(gfo: pd.DataFrame, full_set_id: str, weights_N: Mapping[st
 
 
 def _one_group(rows: pd.DataFrame, categories: dict[str, frozenset[int]]) -> dict[str, float]:
-    simulated = rows["status"] == "grasp"
+    simulated = rows["status"].isin(SIMULATED_STATUSES)
     grasps = rows[simulated]
     n = len(grasps)
     m = grasps["n_contacts"].astype(int).clip(upper=CONTACT_BINS[-1])
@@ -112,7 +115,7 @@ def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequenc
     ``gfo``: their optimisation results; rank(G), force closure and ‖f‖₂ are taken from the
     full set ``full_set_id`` (e.g. ``"1-2-…-15"``). ``weights_N``: m·g per object, N.
     ``link_names`` / ``link_finger``: the hand's links (``Hand.link_names``, ``Hand.link_finger``).
-    Shares are percent of the simulated grasps (status ``grasp``); a contact carries load if
+    Shares are percent of the simulated poses (``SIMULATED_STATUSES``); a contact carries load if
     its normal force exceeds ``load_threshold_N``. One row per (object, closure model).
     """
     for table, frame in ((CONTACTS, contacts), (GFO, gfo)):
