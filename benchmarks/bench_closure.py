@@ -2,7 +2,11 @@
 
 Prints per object the median and 90th-percentile time per grasp over a spread of poses,
 the status counts, the contact-count distribution and how many poses have at least two
-fingers in contact. Last line: ``closure_median_ms: N`` over all objects.
+fingers in contact; for the dynamic closure model (``closure.model: dynamic``, on fewer
+poses: it costs more) the same, then ``closure_dynamic_median_ms: N``. Last line:
+``closure_median_ms: N`` (kinematic model) over all objects.
+
+Usage: bench_closure.py [poses per object, kinematic (300)] [poses per object, dynamic (60)]
 """
 
 from __future__ import annotations
@@ -10,6 +14,7 @@ from __future__ import annotations
 import os
 import sys
 import time
+from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
@@ -32,13 +37,23 @@ PLACEMENTS = {
 }
 
 
-def main(n_poses: int = 300) -> None:
+def study_mechanics() -> dict:
+    """The study's mechanics block (config/config.yaml): k_ss, μ and gravity of the dynamic model."""
+    import yaml
+
+    with open(Path(__file__).resolve().parents[1] / "config" / "config.yaml", encoding="utf-8") as handle:
+        return yaml.safe_load(handle)["mechanics"]
+
+
+def main(n_poses: int = 300, params: ClosureParams = ClosureParams(), key: str = "closure_median_ms") -> None:
     hand = load_hand()
     synergies = load_synergies(None, joint_names=hand.joint_names)
-    placement, params = Placement(), ClosureParams()
+    placement = Placement()
     grid = pose_grid(placement)
     poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
-    closer = closure_model(hand, synergies, params)
+    mechanics = study_mechanics() if params.model == "dynamic" else None
+    print(f"closure model: {params.model}")
+    closer = closure_model(hand, synergies, params, mechanics)
     all_times = []
     try:
         for box in STUDY_BOXES:
@@ -64,8 +79,9 @@ def main(n_poses: int = 300) -> None:
             print(f"  poses with >= 2 fingers in contact: {two_fingers} / {len(poses)}")
     finally:
         closer.close()
-    print(f"closure_median_ms: {np.median(all_times):.2f}")
+    print(f"{key}: {np.median(all_times):.2f}")
 
 
 if __name__ == "__main__":
+    main(int(sys.argv[2]) if len(sys.argv) > 2 else 60, ClosureParams(model="dynamic"), "closure_dynamic_median_ms")
     main(int(sys.argv[1]) if len(sys.argv) > 1 else 300)

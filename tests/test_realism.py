@@ -28,7 +28,8 @@ def _contacts(obj: str = "a", poses=_POSES) -> pd.DataFrame:
                      "q": [0.0] * 19, "finger_state": [], "n_contacts": m, "contact_link": links,
                      "contact_point": [0.0] * 3 * m, "contact_normal": [1.0, 0.0, 0.0] * m,
                      "jacobian": [0.0] * 57 * m, "object_center": [0.0] * 3, "object_rotation": list(np.eye(3).ravel()),
-                     "max_penetration_mm": 0.0, NORMAL_FORCE_COLUMN: forces})
+                     "max_penetration_mm": 0.0, NORMAL_FORCE_COLUMN: forces, "closure_model": "kinematic",
+                     "object_translation_mm": [0.0] * 3, "object_rotation_deg": 0.0, "settled": True})
     return pd.DataFrame(rows)
 
 
@@ -40,7 +41,7 @@ def _gfo(obj: str = "a") -> pd.DataFrame:
             rows.append({"object": obj, "pose": pose, "alpha_deg": 5.0 * pose, "beta_deg": 0.0, "set_id": set_id,
                          "n_synergies": len(set_id.split("-")), "status": "force_closure" if values[1] else "infeasible",
                          "force_closure": values[1], "strict_internal": values[1], "force_norm": values[2], "e_s": 1,
-                         "rank_G": values[0], "n_contacts": 0, "iterations": 1, "solver": "batched"})
+                         "rank_G": values[0], "n_contacts": 0, "iterations": 1, "solver": "ipm"})
     return pd.DataFrame(rows)
 
 
@@ -72,7 +73,8 @@ def test_counts_and_shares_by_hand(hand):
 
 
 def test_without_normal_forces_the_loaded_count_is_nan_and_models_group(hand):
-    contacts = _contacts().drop(columns=[NORMAL_FORCE_COLUMN])
+    contacts = _contacts()  # the kinematic closure records no forces: NaN per contact
+    contacts[NORMAL_FORCE_COLUMN] = [[np.nan] * len(links) for links in contacts["contact_link"]]
     assert np.isnan(_table(hand, contacts)["loaded_contacts_median"].iloc[0])
     two = pd.concat([contacts.assign(closure_model="kinematic"), contacts.assign(closure_model="dynamic")])
     gfo = pd.concat([_gfo().assign(closure_model="kinematic"), _gfo().assign(closure_model="dynamic")])

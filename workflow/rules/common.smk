@@ -108,6 +108,8 @@ def simulation_params(wildcards):
         "closure": config["closure"],
         "hand": config["hand"],
         "synergies": config["synergies"],
+        # the dynamic closure needs k_ss, mu and gravity; the kinematic one does not rerun on them
+        "mechanics": config["mechanics"] if config["closure"].get("model") == "dynamic" else None,
     }
 
 
@@ -116,7 +118,6 @@ def optimisation_params(wildcards):
         "mechanics": config["mechanics"],
         "mass_kg": config["objects"][wildcards.object]["mass_kg"],
         "sets": SETS,
-        "solver": config["solver"],
         "synergies": config["synergies"],
         "shard": int(wildcards.shard),
     }
@@ -142,6 +143,9 @@ TABLES = [
     "minimum_preservation",
     "full_not_first7",
     "verdict_disagreements",
+    "preservation_vs_chance",
+    "invariant_checks",
+    "claims",
 ]
 
 

@@ -50,14 +50,18 @@ def _touches(links: pd.Series, category: frozenset[int]) -> pd.Series:
 
 
 def _loaded(contacts: pd.DataFrame, threshold_N: float) -> pd.Series:
-    """Contacts per row whose normal force exceeds ``threshold_N``; NaN where unknown."""
+    """Contacts per row whose normal force exceeds ``threshold_N``; NaN where unknown (no
+    column, or NaN forces: the kinematic closure records none)."""
     if NORMAL_FORCE_COLUMN not in contacts.columns:
         return pd.Series(np.nan, index=contacts.index)
 
     def count(forces) -> float:
         if forces is None or (np.isscalar(forces) and pd.isna(forces)):
             return np.nan
-        return float(np.count_nonzero(np.asarray(forces, dtype=float) > threshold_N))
+        values = np.asarray(forces, dtype=float)
+        if np.isnan(values).any():
+            return np.nan
+        return float(np.count_nonzero(values > threshold_N))
 
     return contacts[NORMAL_FORCE_COLUMN].map(count)
 
