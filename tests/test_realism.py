@@ -138,3 +138,4 @@ def test_a_closure_without_contact_is_simulated_not_dropped(hand):
     assert row["pct_m0"] == pytest.approx(25.0)
     assert row["pct_thumb"] == pytest.approx(75.0)
     assert row["median_force_per_weight"] == pytest.approx(2.0)
+
