@@ -125,6 +125,20 @@ def figure_synergy_postures(hand: Any, synergies: Any, png_path: str | Path, pdf
     save_figure(fig, png_path, pdf_path)
 
 
+def _touching_words(hand: Any, links: Sequence[int]) -> str:
+    """The touching links in words, finger by finger: "palm, thumb tip, index middle + tip"."""
+    import textwrap
+
+    parts = []
+    for finger in ("palm", "thumb", "index", "middle", "ring", "little"):
+        segments = [hand.link_names[i].split("_", 1)[-1] for i in sorted(links) if hand.link_finger[i] == finger]
+        if finger == "palm" and segments:
+            parts.append("palm")
+        elif segments:
+            parts.append(f"{finger} " + " + ".join("tip" if s == "distal" else s for s in segments))
+    return "\n".join(textwrap.wrap("touching: " + ", ".join(parts), 48))
+
+
 def _box_of(row: pd.Series, size_mm: ArrayLike) -> BoxInPicture:
     return BoxInPicture(np.asarray(size_mm, dtype=float), np.asarray(row["object_center"], dtype=float),
                         np.asarray(row["object_rotation"], dtype=float).reshape(3, 3))
@@ -189,6 +203,7 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.D
             ax.set_title(f"{pick['reason']}: {pick['share_pct']:.0f} % of grasps\n"
                          f"α = {pick['alpha_deg']:g}°, β = {pick['beta_deg']:g}°, {int(row['n_contacts'])} contacts",
                          fontsize=8)
+            ax.set_xlabel(_touching_words(hand, pick["pattern"]), fontsize=7, labelpad=2)
         if pictures:
             _frame(axes[r, :len(pictures)], pictures)
             for ax, (picture, q) in zip(axes[r], thumbs):
