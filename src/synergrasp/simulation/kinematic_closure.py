@@ -103,14 +103,20 @@ class KinematicClosure:
         return reach
 
     def _monitored_pairs(self) -> tuple[tuple[int, int], ...]:
-        """Hand–hand pairs checked during the closure: a finger link against the palm or
-        against a link of another finger, except the knuckles (they barely move) and pairs
-        already overlapping at the open posture (a property of the model, not an event)."""
+        """Hand–hand pairs checked during the closure: a finger link against the palm, the
+        thumb or a neighbouring long finger (the long fingers lie side by side: one cannot
+        reach a finger beyond its neighbour without touching the neighbour), except the
+        knuckles (they barely move) and pairs already overlapping at the open posture (a
+        property of the model, not an event)."""
         hand = self.hand
         pairs = []
+        order = {name: k for k, name in enumerate(_LONG_FINGERS)}
         for i, j in bullet.self_collision_pairs(hand):
-            if hand.link_finger[i] == hand.link_finger[j]:
+            fi, fj = hand.link_finger[i], hand.link_finger[j]
+            if fi == fj:
                 continue
+            if fi in order and fj in order and abs(order[fi] - order[fj]) > 1:
+                continue  # long fingers side by side: only neighbours can touch
             if any(hand.link_names[k].endswith("_knuckle") for k in (i, j)):
                 continue
             pairs.append((i, j))

@@ -20,6 +20,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["HandScene"]
 
+_MAX_APPROACH_STEPS = 500
+
 
 class HandScene:
     """A headless pybullet client holding ``hand`` (fixed palm at the origin) and at most one box."""
@@ -57,6 +59,37 @@ class HandScene:
         else:
             bullet.move_body(self.client, self.box, placed.center_mm, placed.rotation)
         self.placed = placed
+
+    def bring_box(self, size_mm: NDArray, rotation: NDArray, point_mm: NDArray, direction: NDArray,
+                  q: NDArray, clearance_mm: float = 0.0, tolerance_mm: float = 0.01) -> ObjectPose:
+        """Bring a box (edge lengths ``size_mm``, orientation ``rotation``) from far along the
+        line point + t·direction (mm; ``direction`` a unit vector pointing away from the hand)
+        toward the hand at posture q, until its gap to the hand is ``clearance_mm`` (to
+        within ``tolerance_mm``). The box is left there; returns its pose.
+
+        Conservative advancement: a translation by δ changes every distance by at most δ, so
+        stepping by the current excess gap never passes the first touch.
+        """
+        size = np.asarray(size_mm, dtype=float)
+        point, direction = np.asarray(point_mm, dtype=float), np.asarray(direction, dtype=float)
+        self.set_posture(q)
+
+        def excess(t: float) -> tuple[ObjectPose, float]:
+            placed = ObjectPose(point + t * direction, rotation, size / 2.0)
+            self.place_box(size, placed)
+            return placed, float(np.min(self.object_distance(1e5))) - clearance_mm
+
+        t = float(np.linalg.norm(size)) + 100.0
+        placed, gap = excess(t)
+        while gap <= tolerance_mm:  # start clear of the hand
+            t *= 2.0
+            placed, gap = excess(t)
+        for _ in range(_MAX_APPROACH_STEPS):
+            if gap <= tolerance_mm:
+                break
+            t -= gap
+            placed, gap = excess(t)
+        return placed
 
     def object_distance(self, margin_mm: float) -> NDArray:
         """(n_links,) distance of each hand link to the box at the current posture
