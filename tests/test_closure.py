@@ -342,7 +342,7 @@ def test_approach_brings_the_box_to_the_open_hand(hand, synergies, clearance):
     model = closure_model(hand, synergies, PARAMS)
     try:
         for alpha, beta in [(0.0, 0.0), (-30.0, 0.0), (45.0, 20.0), (90.0, -60.0)]:
-            placed = place_box(model, placement, np.asarray(PLATE.size_mm), alpha, beta)
+            placed = place_box(model.scene, model.q_open, placement, np.asarray(PLATE.size_mm), alpha, beta)
             offset = placed.center_mm - point
             np.testing.assert_allclose(offset - (offset @ normal) * normal, 0.0, atol=1e-9)
             model.scene.set_posture(model.q_open)

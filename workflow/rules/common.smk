@@ -108,6 +108,8 @@ def simulation_params(wildcards):
         "closure": config["closure"],
         "hand": config["hand"],
         "synergies": config["synergies"],
+        # the dynamic closure needs k_ss, mu and gravity; the kinematic one does not rerun on them
+        "mechanics": config["mechanics"] if config["closure"].get("model") == "dynamic" else None,
     }
 
 

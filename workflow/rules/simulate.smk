@@ -44,6 +44,8 @@ rule fig2_example_grasps:
     input:
         contacts=expand("results/objects/{object}/contacts.parquet", object=OBJECTS),
         code=code("fig2_example_grasps"),
+        data=SHIPPED_DATA,
+        user=user_files(),
     output:
         png=report(
             "results/figures/fig2_example_grasps.png",
@@ -54,7 +56,6 @@ rule fig2_example_grasps:
     params:
         objects=[object_config(name) for name in OBJECTS],
         hand=config["hand"],
-        poses=config["analyses"]["fig2_poses"],
     log:
         "results/logs/fig2_example_grasps.log",
     script:

@@ -1,8 +1,8 @@
 """Fig. 1: the hand along each of the first seven synergies, sigma = -1, 0, +1."""
 from contextlib import redirect_stderr
 
+from synergrasp.figures.hand_figures import figure_synergy_postures
 from synergrasp.hand.kinematics import load_hand
-from synergrasp.figures.hand_drawing import figure_synergy_postures
 from synergrasp.hand.synergies import load_synergies
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):

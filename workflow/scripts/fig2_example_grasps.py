@@ -1,14 +1,13 @@
-"""Fig. 2: example simulated grasps of every object (hand and box drawn together)."""
+"""Fig. 2: representative simulated grasps of every object, chosen by rule from its contacts."""
 from contextlib import redirect_stderr
 
-import pandas as pd
-
+from synergrasp import tables
+from synergrasp.figures.hand_figures import figure_example_grasps
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.simulation.objects import boxes_from_config
-from synergrasp.figures.hand_drawing import figure_example_grasps
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     boxes = boxes_from_config([{k: v for k, v in o.items() if k != "placement"} for o in snakemake.params.objects])
-    tables = [pd.read_parquet(path) for path in snakemake.input.contacts]
-    figure_example_grasps(load_hand(snakemake.params.hand), boxes, tables, snakemake.params.poses,
-                          snakemake.output.png, snakemake.output.pdf)
+    contacts = [tables.read(tables.CONTACTS, path) for path in snakemake.input.contacts]
+    figure_example_grasps(load_hand(snakemake.params.hand), boxes, contacts, snakemake.output.png,
+                          snakemake.output.pdf)

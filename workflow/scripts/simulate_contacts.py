@@ -15,5 +15,6 @@ with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     (box,) = boxes_from_config([obj])
     hand = load_hand(sim["hand"])
     synergies = load_synergies(sim["synergies"], joint_names=hand.joint_names)
-    table = simulate_object(hand, synergies, box, placement, ClosureParams.from_config(sim["closure"]))
+    table = simulate_object(hand, synergies, box, placement, ClosureParams.from_config(sim["closure"]),
+                            mechanics=sim.get("mechanics"))
     write_contacts(table, snakemake.output[0])

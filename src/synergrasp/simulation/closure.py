@@ -1,11 +1,11 @@
 """Closing the hand on an object at every pose: the closure settings and the study loop.
 
-``simulate_object`` places the box at each pose of the grid (:func:`place_box`), runs a
-closure model on it and collects one contacts-table row per pose (``contacts``). A
-closure model (today the kinematic one, ``kinematic_closure``) is built from the hand, the
-synergies and :class:`ClosureParams`; it has a ``scene`` (``HandScene``), the open posture
-``q_open`` (rad) the closure starts from, ``grasp(size_mm, placed) -> ClosureResult`` and
-``close()``. mm, rad, palm frame (docs/closure.md).
+``simulate_object`` places the box at each pose of the grid (:func:`place_box`: fixed, or
+brought to the open hand), runs a closure model on it and collects one contacts-table row
+per pose (``contacts``). A closure model (``kinematic_closure``, ``dynamic_closure``) takes
+the hand, the synergies and :class:`ClosureParams`; it has the open posture ``q_open``
+(rad) its closure starts from, ``grasp(size_mm, placed) -> ClosureResult`` and ``close()``.
+mm, rad, palm frame (docs/closure.md).
 """
 
 from __future__ import annotations
@@ -20,13 +20,19 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp.simulation.contacts import contacts_row, contacts_table
+from synergrasp.simulation.dynamic_closure import DynamicParams
 from synergrasp.simulation.placement import ObjectPose, Placement, approach_line, object_pose, pose_grid
+from synergrasp.simulation.scene import HandScene
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
 
-__all__ = ["ClosureParams", "simulate_object", "closure_model", "place_box"]
+__all__ = ["CLOSURE_MODELS", "ClosureParams", "simulate_object", "closure_model", "place_box"]
+
+#: ``kinematic``: the quasi-static closure (links stop at first touch, the box fixed);
+#: ``dynamic``: the compliant hand closing on a free box (``dynamic_closure``).
+CLOSURE_MODELS: tuple[str, ...] = ("kinematic", "dynamic")
 
 
 @dataclass(frozen=True)
@@ -42,14 +48,22 @@ class ClosureParams:
                               the open hand deeper than this; also the largest accepted
                               penetration of a recorded contact.
     step_mm:                  largest travel of any link point per coarse σ step, mm.
+    model:                    one of CLOSURE_MODELS.
+    dynamic:                  settings of the dynamic model (``DynamicParams``).
     """
 
     tolerance_mm: float = 0.2
     contact_distance_mm: float = 0.5
     penetration_tolerance_mm: float = 0.5
     step_mm: float = 8.0
+    model: str = "kinematic"
+    dynamic: DynamicParams = DynamicParams()
 
     def __post_init__(self) -> None:
+        if self.model not in CLOSURE_MODELS:
+            raise ValueError(f"closure.model must be one of {list(CLOSURE_MODELS)}, got {self.model!r}")
+        if isinstance(self.dynamic, Mapping):
+            object.__setattr__(self, "dynamic", DynamicParams.from_config(self.dynamic))
         for name in ("tolerance_mm", "contact_distance_mm",
                      "penetration_tolerance_mm", "step_mm"):
             v = getattr(self, name)
@@ -71,7 +85,7 @@ class ClosureParams:
     def from_config(cls, closure: Mapping[str, Any]) -> ClosureParams:
         """From the config's ``closure`` block."""
         allowed = {"tolerance_mm", "contact_distance_mm",
-                   "penetration_tolerance_mm", "step_mm"}
+                   "penetration_tolerance_mm", "step_mm", "model", "dynamic"}
         unknown = set(closure) - allowed
         if unknown:
             raise ValueError(f"closure: unknown key(s) {sorted(unknown)}; allowed keys: {sorted(allowed)}")
@@ -79,26 +93,37 @@ class ClosureParams:
 
 
 
-def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams):
-    """The closure model of ``params`` on a new pybullet scene of ``hand``."""
+def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams,
+                  mechanics: Mapping[str, Any] | None = None, mass_kg: float = 1.0):
+    """The closure model of ``params`` on a new pybullet scene of ``hand``; the dynamic model
+    also needs the config's ``mechanics`` block (k_ss, μ, gravity) and the box's mass (kg)."""
+    if params.model == "dynamic":
+        from synergrasp.simulation.dynamic_closure import DynamicClosure
+
+        if mechanics is None:
+            raise ValueError("closure.model: dynamic needs the mechanics block (k_ss_Nmm_per_rad, mu, gravity)")
+        return DynamicClosure(hand, synergies, params, mechanics, mass_kg)
     from synergrasp.simulation.kinematic_closure import KinematicClosure
 
     return KinematicClosure(hand, synergies, params)
 
 
-def place_box(model: Any, placement: Placement, size_mm: NDArray, alpha_deg: float, beta_deg: float) -> ObjectPose:
+def place_box(scene: HandScene, q_open: NDArray, placement: Placement, size_mm: NDArray, alpha_deg: float,
+              beta_deg: float) -> ObjectPose:
     """The box of ``size_mm`` at pose (α, β) deg: at the fixed centre (``fixed``), or turned
-    by (α, β) and brought along the palm normal to the open hand of ``model`` (``approach``)."""
-    hand = model.scene.hand
+    by (α, β) and brought along the palm normal to the open hand (posture ``q_open``, rad)
+    of ``scene`` (``approach``)."""
+    hand = scene.hand
     turned = object_pose(placement, size_mm, alpha_deg, beta_deg, hand.palm_normal)
     if placement.mode == "fixed":
         return turned
     point, direction = approach_line(placement, hand)
-    return model.scene.bring_box(size_mm, turned.rotation, point, direction, model.q_open, placement.clearance_mm)
+    return scene.bring_box(size_mm, turned.rotation, point, direction, q_open, placement.clearance_mm)
 
 
 def simulate_object(hand: Hand, synergies: Synergies, box: Any, placement: Placement,
-                    closure_params: ClosureParams, poses: Iterable[int] | None = None) -> pd.DataFrame:
+                    closure_params: ClosureParams, poses: Iterable[int] | None = None,
+                    mechanics: Mapping[str, Any] | None = None) -> pd.DataFrame:
     """Close the hand on ``box`` at every pose of the placement's grid (or at ``poses``).
 
     Returns the contacts table (``synergrasp.tables.CONTACTS``, one row per pose, in the
@@ -110,13 +135,15 @@ def simulate_object(hand: Hand, synergies: Synergies, box: Any, placement: Place
         if not 0 <= v < grid.n_poses:
             raise ValueError(f"poses must be in 0 … {grid.n_poses - 1}, got {v}")
     size = np.asarray(box.size_mm, dtype=float)
-    model = closure_model(hand, synergies, closure_params)
+    model = closure_model(hand, synergies, closure_params, mechanics, float(getattr(box, "mass_kg", 1.0)))
+    placer = HandScene(hand)  # the open hand the box is brought to (placement)
     try:
         rows = []
         for pose in pose_list:
             a, b = grid.angles_deg(pose)
-            placed = place_box(model, placement, size, a, b)
+            placed = place_box(placer, model.q_open, placement, size, a, b)
             rows.append(contacts_row(str(box.name), pose, a, b, model.grasp(size, placed), placed))
     finally:
         model.close()
+        placer.close()
     return contacts_table(rows)
