@@ -298,7 +298,8 @@ def test_every_finger_ends_in_contact_blocked_by_the_hand_or_at_its_limits(hand,
         for row in _final_rows(sample, empty_hand):
             q = np.asarray(row.q)
             model.scene.set_posture(q)
-            near = model.scene.pair_distances(model.self_pairs, PARAMS.contact_distance_mm)
+            gaps = model.scene.pair_distances(model.self_pairs)
+            near = [pair for pair, gap in zip(model.self_pairs, gaps) if gap <= PARAMS.contact_distance_mm]
             for f, (state, joints, links) in enumerate(zip(row.finger_state, hand.finger_joints, hand.finger_links)):
                 if state == "contact":
                     assert set(links) & set(int(v) for v in row.contact_link)
@@ -312,16 +313,22 @@ def test_every_finger_ends_in_contact_blocked_by_the_hand_or_at_its_limits(hand,
 
 
 def test_no_two_hand_links_overlap_at_the_end(hand, synergies, sample, empty_hand):
+    """Independent check with pybullet's collision pipeline: no monitored pair of hand links
+    overlaps by more than the tolerance at the end of a closure."""
+    from synergrasp.simulation import bullet
     from synergrasp.simulation.closure import closure_model
 
     model = closure_model(hand, synergies, PARAMS)
+    client = bullet.connect()
+    body = bullet.load_hand_body(client, hand)
     try:
         for row in _final_rows(sample, empty_hand):
-            model.scene.set_posture(np.asarray(row.q))
-            gaps = model.scene.pair_distances(model.self_pairs, 0.0)
-            assert min(gaps.values(), default=0.0) >= -PARAMS.tolerance_mm, (row.object, row.pose, gaps)
+            bullet.set_posture(client, body, np.asarray(row.q))
+            pts = bullet.self_closest_points(client, body, 0.0, model.self_pairs)
+            assert np.all(pts.distance >= -PARAMS.tolerance_mm - 0.05), (row.object, row.pose, pts.distance.min())
     finally:
         model.close()
+        bullet.disconnect(client)
 
 
 # ------------------------------------------------------------------ approach placement
