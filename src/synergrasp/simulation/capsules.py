@@ -30,11 +30,19 @@ _EPS = 1e-12
 
 
 @numba.njit(cache=True)
+def _dot(a0: float, a1: float, a2: float, b0: float, b1: float, b2: float) -> float:
+    return a0 * b0 + a1 * b1 + a2 * b2
+
+
+@numba.njit(cache=True)
 def _seg_seg(p0: NDArray, p1: NDArray, q0: NDArray, q1: NDArray) -> float:
     """Distance (mm) between segments p0–p1 and q0–q1: the clamped closed form."""
-    d1, d2, r = p1 - p0, q1 - q0, p0 - q0
-    a, e, f = d1 @ d1, d2 @ d2, d2 @ r
-    c, b = d1 @ r, d1 @ d2
+    d10, d11, d12 = p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]
+    d20, d21, d22 = q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]
+    r0, r1, r2 = p0[0] - q0[0], p0[1] - q0[1], p0[2] - q0[2]
+    a, e = _dot(d10, d11, d12, d10, d11, d12), _dot(d20, d21, d22, d20, d21, d22)
+    f, c = _dot(d20, d21, d22, r0, r1, r2), _dot(d10, d11, d12, r0, r1, r2)
+    b = _dot(d10, d11, d12, d20, d21, d22)
     denom = a * e - b * b
     s = 0.0
     if denom > _EPS * max(a * e, 1.0):
@@ -46,8 +54,8 @@ def _seg_seg(p0: NDArray, p1: NDArray, q0: NDArray, q1: NDArray) -> float:
     elif t > 1.0:
         t = 1.0
         s = min(max((b - c) / a, 0.0), 1.0) if a > _EPS else 0.0
-    g = (p0 + s * d1) - (q0 + t * d2)
-    return np.sqrt(g @ g)
+    g0, g1, g2 = r0 + s * d10 - t * d20, r1 + s * d11 - t * d21, r2 + s * d12 - t * d22
+    return np.sqrt(_dot(g0, g1, g2, g0, g1, g2))
 
 
 @numba.njit(cache=True)
@@ -70,22 +78,32 @@ def _depth(p0: NDArray, d: NDArray, half: NDArray, t: float) -> float:
 
 @numba.njit(cache=True)
 def _seg_box(p0: NDArray, p1: NDArray, half: NDArray) -> tuple[float, float]:
+    """See ``_seg_box_into`` (allocates its own work arrays)."""
+    return _seg_box_into(p0, p1 - p0, half, np.empty(8))
+
+
+@numba.njit(cache=True)
+def _seg_box_into(p0: NDArray, d: NDArray, half: NDArray, knots: NDArray) -> tuple[float, float]:
     """Signed distance (mm) from segment p0–p1 (box frame) to the box [-half, half] and the
     segment parameter t in [0, 1] attaining it. The squared distance along the segment is
     convex and piecewise quadratic with breaks where a coordinate crosses ±half: its
-    minimum is at a break, an end, or the vertex of one piece."""
-    d = p1 - p0
-    knots = np.empty(8)
+    minimum is at a break, an end, or the vertex of one piece. ``d`` = p1 − p0; ``knots`` is
+    work space of 8 values."""
     knots[0], knots[1] = 0.0, 1.0
     n = 2
     for i in range(3):
         if abs(d[i]) > _EPS:
-            for sgn in (1.0, -1.0):
-                tb = (sgn * half[i] - p0[i]) / d[i]
+            for k in range(2):
+                tb = ((half[i] if k == 0 else -half[i]) - p0[i]) / d[i]
                 if 0.0 < tb < 1.0:
                     knots[n] = tb
                     n += 1
-    knots = np.sort(knots[:n])
+    for k in range(1, n):  # insertion sort of at most 8 values
+        v, j = knots[k], k - 1
+        while j >= 0 and knots[j] > v:
+            knots[j + 1] = knots[j]
+            j -= 1
+        knots[j + 1] = v
     best_sq, best_t = np.inf, 0.0
     for k in range(n):
         sq = _sq_excess(p0, d, half, knots[k])
@@ -108,11 +126,11 @@ def _seg_box(p0: NDArray, p1: NDArray, half: NDArray) -> tuple[float, float]:
     if best_sq > 0.0:
         return np.sqrt(best_sq), best_t
     deepest, at = 0.0, best_t  # crossing the box: minus the deepest penetration found
-    for k in range(n):
-        for tc in (knots[k], 0.5 * (knots[k] + knots[min(k + 1, n - 1)])):
-            dep = _depth(p0, d, half, tc)
-            if dep > deepest:
-                deepest, at = dep, tc
+    for k in range(2 * n):
+        tc = knots[k // 2] if k % 2 == 0 else 0.5 * (knots[k // 2] + knots[min(k // 2 + 1, n - 1)])
+        dep = _depth(p0, d, half, tc)
+        if dep > deepest:
+            deepest, at = dep, tc
     for j in range(9):
         dep = _depth(p0, d, half, j / 8.0)
         if dep > deepest:
@@ -147,15 +165,16 @@ def _frames(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: 
     n = parent.shape[0]
     out = np.empty((n, 4, 4))
     out[0] = np.eye(4)
+    rot, local = np.empty((3, 3)), np.empty((4, 4))
     for f in range(1, n):
         angle = scale[f] * q[joint[f]]
         c, s = np.cos(angle), np.sin(angle)
         x, y, z = axis[f, 0], axis[f, 1], axis[f, 2]
         v = 1.0 - c
-        rot = np.array([[c + x * x * v, x * y * v - z * s, x * z * v + y * s],
-                        [y * x * v + z * s, c + y * y * v, y * z * v - x * s],
-                        [z * x * v - y * s, z * y * v + x * s, c + z * z * v]])
-        local = offset[f].copy()
+        rot[0, 0], rot[0, 1], rot[0, 2] = c + x * x * v, x * y * v - z * s, x * z * v + y * s
+        rot[1, 0], rot[1, 1], rot[1, 2] = y * x * v + z * s, c + y * y * v, y * z * v - x * s
+        rot[2, 0], rot[2, 1], rot[2, 2] = z * x * v - y * s, z * y * v + x * s, c + z * z * v
+        local[:, :] = offset[f]
         for i in range(3):
             for j in range(3):
                 local[i, j] = offset[f, i, 0] * rot[0, j] + offset[f, i, 1] * rot[1, j] + offset[f, i, 2] * rot[2, j]
@@ -180,13 +199,23 @@ def _segments(frames: NDArray, cap_frame: NDArray, ends: NDArray) -> tuple[NDArr
 
 
 @numba.njit(cache=True)
-def _to_box(p: NDArray, rotation: NDArray, centre: NDArray) -> NDArray:
-    """p (palm frame) in the frame of a box at (rotation, centre): rotationᵀ (p − centre)."""
-    out = np.empty(3)
+def _to_box(p: NDArray, rotation: NDArray, centre: NDArray, out: NDArray) -> None:
+    """p (palm frame) in the frame of a box at (rotation, centre): out = rotationᵀ (p − centre)."""
     for j in range(3):
         out[j] = ((p[0] - centre[0]) * rotation[0, j] + (p[1] - centre[1]) * rotation[1, j]
                   + (p[2] - centre[2]) * rotation[2, j])
-    return out
+
+
+@numba.njit(cache=True)
+def _capsule_to_box(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray, half: NDArray,
+                    work: NDArray) -> tuple[float, float]:
+    """Signed distance of the axis p0–p1 (palm frame) to a box at (rotation, centre) and its
+    parameter; ``work`` (4, 8) is scratch space."""
+    _to_box(p0, rotation, centre, work[0])
+    _to_box(p1, rotation, centre, work[1])
+    for i in range(3):
+        work[1, i] -= work[0, i]
+    return _seg_box_into(work[0, :3], work[1, :3], half, work[2])
 
 
 @numba.njit(cache=True)
@@ -196,8 +225,9 @@ def capsule_box(p0: NDArray, p1: NDArray, radius: NDArray, rotation: NDArray, ce
     the closest point of its axis."""
     c = p0.shape[0]
     dist, t = np.empty(c), np.empty(c)
+    work = np.empty((3, 8))
     for i in range(c):
-        d, ti = _seg_box(_to_box(p0[i], rotation, centre), _to_box(p1[i], rotation, centre), half)
+        d, ti = _capsule_to_box(p0[i], p1[i], rotation, centre, half, work)
         dist[i], t[i] = d - radius[i], ti
     return dist, t
 
@@ -208,6 +238,7 @@ def pair_gaps(p0: NDArray, p1: NDArray, radius: NDArray, first: NDArray, second:
     """Signed distance (p,) of pairs of capsules (rows ``first``, ``second``); ``second`` = -1:
     the capsule against the palm boxes (b, ...) instead."""
     out = np.empty(first.shape[0])
+    work = np.empty((3, 8))
     for k in range(first.shape[0]):
         i, j = first[k], second[k]
         if j >= 0:
@@ -215,8 +246,7 @@ def pair_gaps(p0: NDArray, p1: NDArray, radius: NDArray, first: NDArray, second:
         else:
             best = np.inf
             for b in range(palm_half.shape[0]):
-                d, _ = _seg_box(_to_box(p0[i], palm_rotation[b], palm_centre[b]),
-                                _to_box(p1[i], palm_rotation[b], palm_centre[b]), palm_half[b])
+                d, _ = _capsule_to_box(p0[i], p1[i], palm_rotation[b], palm_centre[b], palm_half[b], work)
                 best = min(best, d - radius[i])
             out[k] = best
     return out

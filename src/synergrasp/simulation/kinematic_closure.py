@@ -9,6 +9,7 @@ queried (``HandScene``). mm, rad, palm frame.
 
 from __future__ import annotations
 
+from bisect import bisect_left, bisect_right
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -59,7 +60,7 @@ class KinematicClosure:
                 self.link_finger_index[link] = f
                 self.link_chain_pos[link] = i
         self.reach = self._joint_reach()
-        self._profiles: dict[tuple[int, tuple[int, ...]], tuple[NDArray, NDArray]] = {}
+        self._profiles: dict[tuple[int, tuple[int, ...]], tuple[list[float], list[float]]] = {}
         self.q_open = self.reference(self.sigma_open)
         self.self_pairs = self._monitored_pairs()
         self.finger_link_mask = np.zeros((len(self.fingers), hand.n_links), dtype=bool)
@@ -131,7 +132,7 @@ class KinematicClosure:
         return tuple(p for p, gap in zip(pairs, gaps) if gap >= 0.0)
 
     # -- the closure ------------------------------------------------------------------------
-    def _travel_profile(self, f: int, moving: tuple[int, ...]) -> tuple[NDArray, NDArray]:
+    def _travel_profile(self, f: int, moving: tuple[int, ...]) -> tuple[list[float], list[float]]:
         """Knots σ_k on [σ_open, σ_closed] and the travel bound T(σ_k) (mm) accumulated from
         σ_open by any point of finger f when only the joints ``moving`` follow the reference.
 
@@ -150,7 +151,7 @@ class KinematicClosure:
                                       self.sigma_open, self.sigma_closed))
             mids = 0.5 * (knots[:-1] + knots[1:])
             speed = np.array([float(np.sum(rate[(lo <= m) & (hi >= m)])) for m in mids])
-            profile = (knots, np.concatenate([[0.0], np.cumsum(speed * np.diff(knots))]))
+            profile = (knots.tolist(), np.concatenate([[0.0], np.cumsum(speed * np.diff(knots))]).tolist())
             self._profiles[key] = profile
         return profile
 
@@ -158,15 +159,18 @@ class KinematicClosure:
         """Largest σ' ≤ σ_closed such that no point of finger f travels more than
         budget_mm[f] on [σ, σ'] (clipped joints do not move; held joints do not move)."""
         best = self.sigma_closed
+        held_list = held.tolist()
         for f, (joints, _) in enumerate(self.fingers):
-            moving = tuple(j for j in joints if not held[j])
+            moving = tuple(j for j in joints if not held_list[j])
             if not moving:
                 continue
-            knots, travel = self._travel_profile(f, moving)
-            level = float(np.interp(sigma, knots, travel)) + budget_mm[f]
+            knots, travel = self._travel_profile(f, moving)  # Python lists: scalar work is cheaper
+            i = min(max(bisect_right(knots, sigma), 1), len(knots) - 1)
+            level = travel[i - 1] + (sigma - knots[i - 1]) / (knots[i] - knots[i - 1]) * (travel[i] - travel[i - 1])
+            level += float(budget_mm[f])
             if level > travel[-1]:
                 continue  # the budget outlasts the closure
-            k = int(np.searchsorted(travel, level, side="left"))  # travel[k-1] < level <= travel[k]
+            k = bisect_left(travel, level)  # travel[k-1] < level <= travel[k]
             t0, t1 = travel[k - 1], travel[k]
             best = min(best, knots[k - 1] + (level - t0) / (t1 - t0) * (knots[k] - knots[k - 1]))
         return best
