@@ -1,4 +1,5 @@
 # Stage 3: local minima per object and set, success rates, and the study's tables.
+from synergrasp.analysis.verdicts import success_verdict
 
 
 rule local_minima:
@@ -9,6 +10,7 @@ rule local_minima:
         "results/objects/{object}/minima.parquet",
     params:
         radius_deg=config["analyses"]["minima_radius_deg"],
+        success=success_verdict(config["analyses"]),
     log:
         "results/logs/local_minima/{object}.log",
     script:
@@ -33,7 +35,11 @@ rule study_tables:
     params:
         sets=config["synergy_sets"],
         table2_k_max=config["analyses"]["table2_k_max"],
-        radius_deg=config["analyses"]["minima_radius_deg"],
+        analyses={k: v for k, v in config["analyses"].items() if k != "fig4"},
+        objects={name: object_config(name) for name in OBJECTS},
+        grid=config["grid"],
+        hand=config["hand"],
+        g_m_per_s2=config["mechanics"]["g_m_per_s2"],
     log:
         "results/logs/study_tables.log",
     script:

@@ -24,6 +24,7 @@ rule fig4_force_maps:
         exploded_pdf="results/objects/{object}/fig4_exploded.pdf",
     params:
         fig4=config["analyses"]["fig4"],
+        success=success_verdict(config["analyses"]),
     log:
         "results/logs/fig4/{object}.log",
     script:
@@ -32,7 +33,7 @@ rule fig4_force_maps:
 
 rule fig5_hierarchy:
     input:
-        rates="results/tables/success_rates.csv",
+        hierarchy="results/tables/hierarchy.csv",
         code=code("fig5_hierarchy"),
     output:
         success_png=report(
@@ -49,6 +50,7 @@ rule fig5_hierarchy:
         force_pdf="results/figures/fig5b_hierarchy_force.pdf",
     params:
         first=config["synergy_sets"]["hierarchy_first"],
+        success=success_verdict(config["analyses"]),
     log:
         "results/logs/fig5_hierarchy.log",
     script:
