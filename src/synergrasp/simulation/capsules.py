@@ -27,6 +27,7 @@ __all__ = ["HandCapsules", "segment_segment_distance", "segment_box_distance", "
            "nearest_per_link", "posture_gaps"]
 
 _EPS = 1e-12
+_FLAT_MM2 = 1e-9  # squared distances (mm²) this close count as equal (flat stretch of a segment)
 
 
 @numba.njit(cache=True)
@@ -124,7 +125,13 @@ def _seg_box_into(p0: NDArray, d: NDArray, half: NDArray, knots: NDArray) -> tup
         if sq < best_sq:
             best_sq, best_t = sq, tv
     if best_sq > 0.0:
-        return np.sqrt(best_sq), best_t
+        # a segment parallel to a face or edge is nearest along an interval (bounded by
+        # knots): take its middle, which does not depend on the box's own axes
+        t_lo, t_hi = best_t, best_t
+        for k in range(n):
+            if _sq_excess(p0, d, half, knots[k]) <= best_sq + _FLAT_MM2:
+                t_lo, t_hi = min(t_lo, knots[k]), max(t_hi, knots[k])
+        return np.sqrt(best_sq), 0.5 * (t_lo + t_hi)
     deepest, at = 0.0, best_t  # crossing the box: minus the deepest penetration found
     for k in range(2 * n):
         tc = knots[k // 2] if k % 2 == 0 else 0.5 * (knots[k // 2] + knots[min(k // 2 + 1, n - 1)])
