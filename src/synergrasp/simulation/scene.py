@@ -110,6 +110,18 @@ class HandScene:
         near = np.concatenate(near)
         return near.mean(axis=0) if len(near) else self._palm_gap[1]
 
+    def _palm_face_normal(self, point: NDArray, reach_mm: float, otherwise: NDArray) -> NDArray:
+        """The outward normal of the one palm face within ``reach_mm`` of ``point`` (the
+        object's inward normal at a contact on that face); ``otherwise`` if the point is near
+        no face or near several (a palm edge: then the box's face decides)."""
+        faces = []
+        for pose, half in self._palm_boxes():
+            local = pose[:3, :3].T @ (np.asarray(point) - pose[:3, 3])
+            for k in range(3):
+                if abs(abs(local[k]) - half[k]) <= reach_mm:
+                    faces.append(np.sign(local[k]) * pose[:3, k])
+        return faces[0] if len(faces) == 1 else otherwise
+
     def _capsule_box(self) -> tuple[NDArray, NDArray]:
         """Signed distance (c,) of every capsule to the box (mm) and the closest axis points (c, 3)."""
         placed = self.placed
@@ -211,6 +223,8 @@ class HandScene:
             if dist > contact_distance_mm:
                 continue
             point, normal = self.placed.surface_point(near)
+            if link == 0:  # on a palm face, the contact normal is that face's (an edge of the box may lie on it)
+                normal = self._palm_face_normal(near, max(self._palm_gap[0], 0.0) + contact_distance_mm, normal)
             links.append(link)
             points.append(point)
             normals.append(normal)
