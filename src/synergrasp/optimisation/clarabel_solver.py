@@ -1,9 +1,10 @@
-"""Back end: one GFO problem with a circular cone solved exactly by Clarabel (conic QP).
+"""Back end: one GFO problem solved exactly by Clarabel (conic QP), circular or pyramid cone.
 
 Minimising ½||f_p + E y||² has the argmin of ||f_p + E y||, so the problem is passed to
 Clarabel as a QP over cones: P = E^T E (= I for an orthonormal E), q = E^T f_p, and per
 contact the rows of the nonnegative cone (n.f - f_min >= 0) and of SOC(3) (the rows
-[mu n; t1; t2] of `CircularCone.soc_rows` applied to f). Also the fallback of the compiled
+[mu n; t1; t2] of `CircularCone.soc_rows` applied to f), or, for a pyramid, the linear rows
+of `problem.linear_constraints` in one nonnegative cone. Also the fallback of the compiled
 interior-point back end for the problems it leaves undecided (`gfo.solve_gfo`).
 """
 
@@ -14,20 +15,16 @@ import numpy as np
 import scipy.sparse as sp
 
 from synergrasp.optimisation.mechanics import contact_frames
-from synergrasp.optimisation.problem import ALMOST_SOLVED_TOL, DEFAULT_TOL, GFOProblem, Outcome
+from synergrasp.optimisation.problem import (
+    ALMOST_SOLVED_TOL,
+    DEFAULT_TOL,
+    GFOProblem,
+    Outcome,
+    judge_direct,
+    linear_constraints,
+)
 
-__all__ = ["judge_direct", "solve"]
-
-
-def judge_direct(problem: GFOProblem, tol: float = DEFAULT_TOL) -> Outcome:
-    """e_s = 0: the only candidate is f = f_p; admissible when its worst violation is at
-    most tol max(1 N, ||f_p||)."""
-    fp = problem.f_p
-    viol = problem.cone.violation(fp, problem.normals, problem.f_min)
-    norm = float(np.linalg.norm(fp))
-    if viol <= tol * max(1.0, norm):
-        return Outcome("force_closure", norm, fp.copy(), 0, "direct", "direct", viol)
-    return Outcome("infeasible", float("nan"), None, 0, "direct", "direct", viol)
+__all__ = ["solve"]
 
 
 def solve(problem: GFOProblem, *, tol: float = DEFAULT_TOL, max_iter: int = 200) -> Outcome:
@@ -42,21 +39,10 @@ def solve(problem: GFOProblem, *, tol: float = DEFAULT_TOL, max_iter: int = 200)
     """
     if problem.e_s == 0:
         return judge_direct(problem, tol)
-    fp, Em, n, f_min = problem.f_p, problem.E, problem.normals, problem.f_min
-    m, e = problem.n_contacts, problem.e_s
-    # Constraints as A y + s = b, s in K (Clarabel's form), f = f_p + E y:
-    #   n_i.f - f_min >= 0     -> rows -(N E), b = N f_p - f_min   (nonnegative cone, m)
-    #   R_i f_i in SOC(3)       -> rows -(R E), b = R f_p           (m cones of size 3)
-    E3 = Em.reshape(m, 3, e)
-    R = problem.cone.soc_rows(contact_frames(n))
-    NE = np.einsum("ij,ijk->ik", n, E3)
-    RE = np.einsum("iab,ibk->iak", R, E3).reshape(3 * m, e)
-    A = sp.csc_matrix(-np.vstack([NE, RE]))
-    F3 = fp.reshape(m, 3)
-    b = np.concatenate([np.einsum("ij,ij->i", n, F3) - f_min, np.einsum("iab,ib->ia", R, F3).ravel()])
+    Em, fp = problem.E, problem.f_p
+    A, b, cones = _conic_constraints(problem) if problem.cone.kind == "circular" else _linear_constraints(problem)
     P = sp.csc_matrix(np.triu(Em.T @ Em))
     q = Em.T @ fp
-    cones = [clarabel.NonnegativeConeT(m)] + [clarabel.SecondOrderConeT(3)] * m
 
     settings = clarabel.DefaultSettings()
     settings.verbose = False
@@ -68,6 +54,28 @@ def solve(problem: GFOProblem, *, tol: float = DEFAULT_TOL, max_iter: int = 200)
     except Exception as exc:  # a solver crash on one problem is a verdict, not an abort
         return Outcome("numerical_failure", float("nan"), None, 0, "clarabel", f"error: {exc}")
     return _verdict(str(sol.status), np.asarray(sol.x, dtype=float), int(sol.iterations), problem)
+
+
+def _conic_constraints(problem: GFOProblem):
+    """Constraints as A y + s = b, s in K (Clarabel's form), f = f_p + E y:
+    n_i.f - f_min >= 0 -> rows -(N E), b = N f_p - f_min (nonnegative cone, m);
+    R_i f_i in SOC(3) -> rows -(R E), b = R f_p (m cones of size 3)."""
+    fp, Em, n, f_min = problem.f_p, problem.E, problem.normals, problem.f_min
+    m, e = problem.n_contacts, problem.e_s
+    E3 = Em.reshape(m, 3, e)
+    R = problem.cone.soc_rows(contact_frames(n))
+    NE = np.einsum("ij,ijk->ik", n, E3)
+    RE = np.einsum("iab,ibk->iak", R, E3).reshape(3 * m, e)
+    A = sp.csc_matrix(-np.vstack([NE, RE]))
+    F3 = fp.reshape(m, 3)
+    b = np.concatenate([np.einsum("ij,ij->i", n, F3) - f_min, np.einsum("iab,ib->ia", R, F3).ravel()])
+    return A, b, [clarabel.NonnegativeConeT(m)] + [clarabel.SecondOrderConeT(3)] * m
+
+
+def _linear_constraints(problem: GFOProblem):
+    """A pyramid's constraints G y <= h as A = G, b = h in one nonnegative cone."""
+    G, h = linear_constraints(problem)
+    return sp.csc_matrix(G), h, [clarabel.NonnegativeConeT(h.size)]
 
 
 def _verdict(name: str, x: np.ndarray, iterations: int, problem: GFOProblem) -> Outcome:

@@ -8,6 +8,7 @@ method picks the back end; every back end returns one `problem.GFOSolution`.
   are solved again by Clarabel and marked 'clarabel_fallback' (nothing is dropped).
 - "clarabel": Clarabel per problem (`clarabel_solver`), the exact reference of the study.
 - "cvxpy": the cvxpy reference (`cvxpy_reference`), for tests and benchmarks.
+- "piqp": PIQP per problem (`piqp_solver`), for pyramid cones (a QP).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from synergrasp.optimisation import clarabel_solver, cvxpy_reference, ipm_kernel
+from synergrasp.optimisation import clarabel_solver, cvxpy_reference, ipm_kernel, piqp_solver
 from synergrasp.optimisation.cones import CircularCone
 from synergrasp.optimisation.ipm_kernel import IPMSettings
 from synergrasp.optimisation.mechanics import contact_frames
@@ -31,10 +32,18 @@ from synergrasp.optimisation.problem import (
     as_problems,
 )
 
-__all__ = ["METHODS", "solve_gfo", "warm_up"]
+__all__ = ["FASTEST_METHOD", "METHODS", "solve_gfo", "warm_up"]
 
 #: Methods of `solve_gfo` and the friction-cone kinds each accepts.
-METHODS: dict[str, tuple[str, ...]] = {"ipm": ("circular",), "clarabel": ("circular",), "cvxpy": ("circular",)}
+METHODS: dict[str, tuple[str, ...]] = {
+    "ipm": ("circular",),
+    "clarabel": ("circular", "pyramid"),
+    "cvxpy": ("circular",),
+    "piqp": ("pyramid",),
+}
+
+#: The fastest method for each cone kind (the study's choice).
+FASTEST_METHOD: dict[str, str] = {"circular": "ipm", "pyramid": "piqp"}
 
 #: Verdict of each kernel code; '' marks the problems that go to the Clarabel fallback.
 _STATUS_OF_CODE = np.array(["", "force_closure", "infeasible", ""], dtype=object)
@@ -54,8 +63,8 @@ def solve_gfo(
     strict_shrink: if given, also Bicchi's strict internal-force test of every problem
         (`GFOProblem.strict_test`, the cone narrowed by this relative amount), else
         `strict_internal` is None.
-    tol, max_iter: tolerance and iteration cap of Clarabel (method "clarabel" and the
-        fallback of "ipm"); ipm: settings of the interior-point kernel.
+    tol, max_iter: tolerance and iteration cap of Clarabel and PIQP (methods "clarabel",
+        "piqp" and the fallback of "ipm"); ipm: settings of the interior-point kernel.
     Bad input (unknown method, a cone the method does not accept) raises ValueError before
     any solve; a failure on one problem is its status.
     """
@@ -86,6 +95,8 @@ def solve_gfo(
 def _per_problem(method: str, tol: float, max_iter: int):
     if method == "clarabel":
         return lambda p: clarabel_solver.solve(p, tol=tol, max_iter=max_iter)
+    if method == "piqp":
+        return lambda p: piqp_solver.solve(p, tol=tol, max_iter=max_iter)
     return cvxpy_reference.solve
 
 

@@ -27,7 +27,6 @@ __all__ = ["INFEASIBLE", "IPMSettings", "NOT_SOLVED", "OPTIMAL", "SetsResult", "
 
 #: Codes of the kernel's verdicts.
 NOT_SOLVED, OPTIMAL, INFEASIBLE, UNDECIDED = 0, 1, 2, 3
-_OPTIMAL, _INFEASIBLE, _UNDECIDED = OPTIMAL, INFEASIBLE, UNDECIDED
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -67,7 +66,6 @@ class IPMSettings:
             value = getattr(self, name)
             if not (isinstance(value, int) and 0 <= value <= 10):
                 raise ValueError(f"{name} must be an int in 0..10, got {value!r}")
-
 
 
 # --------------------------------------------------------------------------- cone algebra
@@ -425,11 +423,11 @@ def _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, 
         if optimal:
             for j in range(e):
                 y[j] = x[1 + j] / tau * rho
-            return _OPTIMAL, it
+            return OPTIMAL, it
         if infeasible:
-            return _INFEASIBLE, it
+            return INFEASIBLE, it
         if last or not (math.isfinite(mu) and math.isfinite(tau) and tau > 0.0):
-            return _UNDECIDED, it
+            return UNDECIDED, it
 
         # Nesterov-Todd scaling and the normal matrix M = G^T (W^T W)^-1 G, (e+1, e+1).
         for i in range(m):
@@ -522,7 +520,7 @@ def _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, 
             z[k] += alpha * dz[k]
         tau += alpha * dtau
         kappa += alpha * dkappa
-    return _UNDECIDED, max_iter
+    return UNDECIDED, max_iter
 
 
 @_jit
@@ -603,7 +601,7 @@ def _solve_one(rows, E, fp, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fr
     r0 = math.sqrt(r0)
     code, norm, viol, it = _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction,
                                     stall_step, refine, violation_tol, y)
-    if code == _UNDECIDED and retry_refine > refine:
+    if code == UNDECIDED and retry_refine > refine:
         # Undecided problems are mostly stalls at a degenerate optimum, where the normal
         # equations lose accuracy: a second attempt with iterative refinement decides most.
         code, norm, viol, it2 = _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction,
@@ -617,7 +615,7 @@ def _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fra
              violation_tol, y):
     """`_hsde`, then the force check of an optimal point: (code, ||f|| N, violation N, iterations)."""
     code, it = _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine, y)
-    if code != _OPTIMAL:
+    if code != OPTIMAL:
         return code, math.nan, math.nan, it
     # f = f_p + E y in the contact frames: [n.f, t1.f/mu, t2.f/mu]
     norm = 0.0
@@ -634,9 +632,8 @@ def _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fra
         viol = max(viol, f_min - fr[0], ft - mu * fr[0])
     norm = math.sqrt(norm)
     if viol > violation_tol * max(1.0, norm):
-        return _UNDECIDED, math.nan, math.nan, it
+        return UNDECIDED, math.nan, math.nan, it
     return code, norm, viol, it
-
 
 
 @_jit

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from synergrasp.optimisation.cones import FrictionCone
-from synergrasp.optimisation.mechanics import BASIS_RTOL, _unit_normals, internal_force_basis
+from synergrasp.optimisation.mechanics import BASIS_RTOL, _unit_normals, contact_frames, internal_force_basis
 
 __all__ = [
     "ALMOST_SOLVED_TOL",
@@ -34,6 +34,8 @@ __all__ = [
     "STATUSES",
     "STRICT_SHRINK",
     "SynergySets",
+    "judge_direct",
+    "linear_constraints",
 ]
 
 #: Verdicts of one GFO problem (the `status` column of gfo.parquet, minus `rank_deficient`
@@ -110,13 +112,15 @@ class SynergySets:
     """Synergy sets enrolled in the optimisation: the synergy matrix and each set's columns.
 
     matrix: (n, k) synergies, rad per unit activation; sets: 1-based synergy indices per set.
-    Derived once: `columns` (0-based, sorted, per set), `norms` (||S_set||_2 per set) and
-    `table` (n_sets, largest set) of the columns, padded with 0 after each set's size.
+    Derived once: `columns` (0-based, sorted, per set), `sizes` (synergies per set), `norms`
+    (||S_set||_2 per set) and `table` (n_sets, largest set) of the columns, padded with 0
+    after each set's size.
     """
 
     matrix: NDArray
     sets: tuple[tuple[int, ...], ...]
     columns: tuple[NDArray, ...] = field(init=False, repr=False)
+    sizes: NDArray = field(init=False, repr=False)
     norms: NDArray = field(init=False, repr=False)
     table: NDArray = field(init=False, repr=False)
 
@@ -139,11 +143,7 @@ class SynergySets:
         for j, c in enumerate(columns):
             table[j, :c.size] = c
         object.__setattr__(self, "table", table)
-
-    @property
-    def sizes(self) -> NDArray:
-        """Number of synergies of every set."""
-        return np.array([c.size for c in self.columns], dtype=np.int64)
+        object.__setattr__(self, "sizes", np.array([c.size for c in columns], dtype=np.int64))
 
     def __len__(self) -> int:
         return len(self.columns)
@@ -240,6 +240,31 @@ class GFOSolution:
     @property
     def force_closure(self) -> NDArray:
         return self.status == "force_closure"
+
+
+def judge_direct(problem: GFOProblem, tol: float = DEFAULT_TOL) -> Outcome:
+    """e_s = 0: the only candidate is f = f_p; admissible when its worst violation is at
+    most tol max(1 N, ||f_p||) (solver 'direct')."""
+    fp = problem.f_p
+    viol = problem.cone.violation(fp, problem.normals, problem.f_min)
+    norm = float(np.linalg.norm(fp))
+    if viol <= tol * max(1.0, norm):
+        return Outcome("force_closure", norm, fp.copy(), 0, "direct", "direct", viol)
+    return Outcome("infeasible", float("nan"), None, 0, "direct", "direct", viol)
+
+
+def linear_constraints(problem: GFOProblem) -> tuple[NDArray, NDArray]:
+    """(G, h) with the constraints of a problem with a pyramid cone as G y <= h: per contact
+    the normal bound -(n.E) y <= n.f_p - f_min, then per face (a_k.E) y <= -a_k.f_p."""
+    m, e = problem.n_contacts, problem.e_s
+    frames = contact_frames(problem.normals)
+    E3 = problem.E.reshape(m, 3, e)
+    F3 = problem.f_p.reshape(m, 3)
+    faces = problem.cone.face_rows(frames)  # (m, sides, 3)
+    G = np.vstack([-np.einsum("ij,ijk->ik", frames[:, 0], E3), np.einsum("isj,ijk->isk", faces, E3).reshape(-1, e)])
+    h = np.concatenate([np.einsum("ij,ij->i", frames[:, 0], F3) - problem.f_min,
+                        -np.einsum("isj,ij->is", faces, F3).ravel()])
+    return G, h
 
 
 def as_problems(problems: Sequence[GFOProblem] | GraspSets) -> Sequence[GFOProblem]:
