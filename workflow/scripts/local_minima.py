@@ -1,4 +1,5 @@
 """Local minima of the optimal force over one object's (alpha, beta) grid, every set."""
+
 import pandas as pd
 
 from synergrasp.analysis.minima import minima_table
