@@ -91,16 +91,25 @@ def _one_grasp_table(hand, synergies) -> pd.DataFrame:
                           "max_penetration_mm": 0.0}])
 
 
+def test_touching_links_in_words(hand):
+    from synergrasp.figures.hand_figures import _touching_words
+
+    links = [hand.link_index(n) for n in ("palm", "thumb_distal", "index_middle", "index_distal")]
+    assert _touching_words(hand, links) == "touching: palm, thumb tip, index middle + tip"
+
+
 def test_figures_are_written_and_the_same_on_rerun(hand, synergies, tmp_path):
     from synergrasp.figures.hand_figures import figure_example_grasps, figure_synergy_postures
     from synergrasp.simulation.objects import Box
 
     box = Box("cube", (30.0, 30.0, 30.0), 1.0)
     table = _one_grasp_table(hand, synergies)
+    dropped = table.assign(object="big", status="intersects_open_hand", n_contacts=0, contact_link=[[]])
     for run in ("a", "b"):
         figure_synergy_postures(hand, synergies, tmp_path / f"f1{run}.png", tmp_path / f"f1{run}.pdf",
                                 n_synergies=1, sigmas=(-1.0, 0.0))
-        figure_example_grasps(hand, [box], [table], tmp_path / f"f2{run}.png", tmp_path / f"f2{run}.pdf", n_grasps=2)
+        figure_example_grasps(hand, [box, Box("big", (90.0, 60.0, 90.0), 1.0)], [table, dropped],
+                              tmp_path / f"f2{run}.png", tmp_path / f"f2{run}.pdf", n_grasps=2)
     for name in ("f1", "f2"):
         for ext in ("png", "pdf"):
             first = (tmp_path / f"{name}a.{ext}").read_bytes()

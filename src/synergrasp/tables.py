@@ -97,7 +97,7 @@ GFO = Table("gfo", "one row per (pose, synergy set)", _pose_columns() + (
     Column("rank_G", "int32", "", "rank of the grasp matrix"),
     Column("n_contacts", "int32", "", "number of contacts"),
     Column("iterations", "int32", "", "interior-point iterations"),
-    Column("solver", "string", "", "back end that decided the problem"),
+    Column("solver", "string", "", "back end that decided the problem: ipm, clarabel_fallback, direct, none"),
 ))
 
 MINIMA = Table("minima", "one row per local minimum of (object, synergy set)", (
@@ -114,10 +114,10 @@ def _realism_columns() -> tuple[Column, ...]:
     bins = tuple(Column(f"pct_m{m}", "float64", "%", f"grasps with exactly {m} contacts") for m in range(6))
     return (
         Column("object", "string", "", "object name"),
-        Column("closure_model", "string", "", "closure model that made the grasps (kinematic unless the contacts say)"),
+        Column("closure_model", "string", "", "closure model that made the grasps (contacts table)"),
         Column("poses", "int32", "", "poses of the grid"),
-        Column("simulated", "int32", "", "poses whose closure ran (status grasp)"),
-        Column("dropped", "int32", "", "poses not simulated (any other status)"),
+        Column("simulated", "int32", "", "poses whose closure ran (status grasp or no_contact)"),
+        Column("dropped", "int32", "", "poses whose closure did not run (any other status)"),
         Column("dropped_by", "string", "", "dropped poses per status"),
         Column("contacts_median", "float64", "", "median contacts per simulated grasp"),
     ) + bins + (

@@ -118,7 +118,6 @@ def optimisation_params(wildcards):
         "mechanics": config["mechanics"],
         "mass_kg": config["objects"][wildcards.object]["mass_kg"],
         "sets": SETS,
-        "solver": config["solver"],
         "synergies": config["synergies"],
         "shard": int(wildcards.shard),
     }

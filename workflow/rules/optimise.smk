@@ -24,6 +24,7 @@ rule optimise_shard:
 rule aggregate_gfo:
     input:
         shards=expand("results/objects/{{object}}/gfo_shards/{shard}.parquet", shard=SHARDS),
+        code=code("aggregate_gfo"),
     output:
         "results/objects/{object}/gfo.parquet",
     log:

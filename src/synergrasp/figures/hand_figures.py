@@ -11,10 +11,11 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import ArrayLike, NDArray
 
 from synergrasp.analysis.realism import representative_grasps
 from synergrasp.figures.hand_pictures import (BOX, GRASP_CAMERA, PALM_CAMERA, SKIN, TOUCHING, BoxInPicture, Camera,
-                                              render)
+                                              hand_capsules, render)
 from synergrasp.figures.output import save_figure
 
 __all__ = ["figure_synergy_postures", "figure_example_grasps", "PANEL_PX"]
@@ -22,7 +23,6 @@ __all__ = ["figure_synergy_postures", "figure_example_grasps", "PANEL_PX"]
 #: Rendered panel size, pixels (width, height).
 PANEL_PX = (330, 330)
 _CONTACT = "#c2000b"
-NDArrayLike = Any  # anything np.asarray takes
 
 
 def _bare(ax: Any) -> None:
@@ -47,24 +47,39 @@ def _frame(axes: Sequence[Any], pictures: Sequence[Any], margin_px: float = 8.0)
         ax.set_ylim(mid_r + half, mid_r - half)
 
 
-def _label(ax: Any, name: str, at: NDArray, offset: tuple[float, float]) -> None:
-    """Name a part at image point ``at``; the text sits ``offset`` away, in fractions of the window."""
-    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()  # y runs downward in an image
-    text = (at[0] + offset[0] * (x1 - x0), at[1] + offset[1] * (y0 - y1))
+#: A point on the palm's front face (mm, palm frame): the centre labels point away from.
+_PALM_POINT = np.array([12.0, -9.0, 45.0])
+
+
+def _label(ax: Any, name: str, at: NDArray, away_from: NDArray, distance: float = 0.2) -> None:
+    """Name a part at image point ``at``; the text sits ``distance`` (fraction of the window)
+    further along the direction from ``away_from`` to ``at``, inside the window."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()  # y runs downward in an image: y0 > y1
+    direction = np.asarray(at, float) - np.asarray(away_from, float)
+    direction = direction / max(float(np.linalg.norm(direction)), 1e-9)
+    text = np.asarray(at, float) + distance * (x1 - x0) * direction
+    text = (np.clip(text[0], x0 + 0.1 * (x1 - x0), x1 - 0.1 * (x1 - x0)),
+            np.clip(text[1], y1 + 0.05 * (y0 - y1), y0 - 0.05 * (y0 - y1)))
     ax.annotate(name, xy=at, xytext=text, fontsize=8, color="0.1", ha="center", va="center",
                 bbox=dict(boxstyle="round,pad=0.15", facecolor="white", edgecolor="none", alpha=0.8),
                 arrowprops=dict(arrowstyle="-", color="0.3", lw=0.7, shrinkA=0, shrinkB=1))
 
 
-def _label_parts(ax: Any, hand: Any, q: NDArrayLike, picture: Any) -> None:
+def _thumb_point(hand: Any, q: ArrayLike) -> NDArray:
+    """Centre of the thumb's proximal phalanx (mm): the thumb's middle, seen even when it is flexed."""
+    caps = hand_capsules(hand, np.asarray(q, dtype=float))
+    return caps.ends[caps.link == hand.link_index("thumb_proximal")][0].mean(axis=0)
+
+
+def _label_parts(ax: Any, hand: Any, q: ArrayLike, picture: Any) -> None:
     """Name the thumb, index, little finger and palm on a picture of the hand at q (after framing)."""
     from synergrasp.hand.kinematics import fingertip_positions
 
     tips = picture.pixels(fingertip_positions(hand, np.asarray(q, dtype=float)))
-    _label(ax, "thumb", tips[0], (-0.02, 0.16))
-    _label(ax, "index", tips[1], (0.10, -0.08))
-    _label(ax, "little", tips[4], (-0.04, -0.16))
-    palm = picture.pixels(np.array([[12.0, -9.0, 45.0]]))[0]  # on the palm's front face, mm
+    palm = picture.pixels(_PALM_POINT[None])[0]
+    _label(ax, "thumb", picture.pixels(_thumb_point(hand, q)[None])[0], palm)
+    _label(ax, "index", tips[1], palm, 0.12)
+    _label(ax, "little", tips[4], palm, 0.12)
     ax.text(*palm, "palm", fontsize=8, color="0.1", ha="center", va="center")
 
 
@@ -110,7 +125,21 @@ def figure_synergy_postures(hand: Any, synergies: Any, png_path: str | Path, pdf
     save_figure(fig, png_path, pdf_path)
 
 
-def _box_of(row: pd.Series, size_mm: NDArrayLike) -> BoxInPicture:
+def _touching_words(hand: Any, links: Sequence[int]) -> str:
+    """The touching links in words, finger by finger: "palm, thumb tip, index middle + tip"."""
+    import textwrap
+
+    parts = []
+    for finger in ("palm", "thumb", "index", "middle", "ring", "little"):
+        segments = [hand.link_names[i].split("_", 1)[-1] for i in sorted(links) if hand.link_finger[i] == finger]
+        if finger == "palm" and segments:
+            parts.append("palm")
+        elif segments:
+            parts.append(f"{finger} " + " + ".join("tip" if s == "distal" else s for s in segments))
+    return "\n".join(textwrap.wrap("touching: " + ", ".join(parts), 48))
+
+
+def _box_of(row: pd.Series, size_mm: ArrayLike) -> BoxInPicture:
     return BoxInPicture(np.asarray(size_mm, dtype=float), np.asarray(row["object_center"], dtype=float),
                         np.asarray(row["object_rotation"], dtype=float).reshape(3, 3))
 
@@ -141,8 +170,6 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.D
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from synergrasp.hand.kinematics import fingertip_positions
 
     if len(boxes) != len(tables):
         raise ValueError(f"boxes and tables must have the same length, got {len(boxes)} and {len(tables)}")
@@ -176,10 +203,12 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.D
             ax.set_title(f"{pick['reason']}: {pick['share_pct']:.0f} % of grasps\n"
                          f"α = {pick['alpha_deg']:g}°, β = {pick['beta_deg']:g}°, {int(row['n_contacts'])} contacts",
                          fontsize=8)
+            ax.set_xlabel(_touching_words(hand, pick["pattern"]), fontsize=7, labelpad=2)
         if pictures:
             _frame(axes[r, :len(pictures)], pictures)
             for ax, (picture, q) in zip(axes[r], thumbs):
-                _label(ax, "thumb", picture.pixels(fingertip_positions(hand, q))[0], (0.13, 0.09))
+                _label(ax, "thumb", picture.pixels(_thumb_point(hand, q)[None])[0],
+                       picture.pixels(_PALM_POINT[None])[0])
     _legend(fig)
     fig.tight_layout(rect=(0, 0.035, 1, 1), h_pad=0.6, w_pad=0.3)
     save_figure(fig, png_path, pdf_path)
