@@ -45,6 +45,18 @@ def test_rotated_box_covers_its_projected_area():
     assert rays.depth[100, 100] == pytest.approx(rays.depth_of(np.array([[5.0, 0.0, 0.0]]))[0], abs=1e-6)
 
 
+def test_a_fitted_camera_frames_the_spheres_with_its_margin():
+    points = np.array([[0.0, -30.0, 10.0], [5.0, 40.0, 90.0], [-20.0, 0.0, 50.0]])
+    radii = np.array([5.0, 8.0, 0.0])
+    camera = _CAMERA.fitted(points, radii, margin_mm=4.0)
+    # Seen along -x: image right is +y, up is +z. Extents y -35 … 48, z 5 … 98 -> 93 + 2 x 4 mm wide.
+    assert camera.width_mm == pytest.approx(101.0)
+    rays = hp._Rays(camera, 202, 202)  # 0.5 mm per pixel
+    px = rays.to_image(points)
+    assert px[:, 1].min() - 8.0 / 0.5 == pytest.approx(4.0 / 0.5)  # top sphere: 8 mm radius, 4 mm margin
+    assert px[:, 0].min() - 5.0 / 0.5 == pytest.approx((101.0 - 83.0) / 2.0 / 0.5)  # centred across
+
+
 def test_the_hand_is_where_its_kinematics_puts_it(hand):
     """At the flat posture, the pixel of every distal capsule's centre and of the palm's front
     face shows that link."""

@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Camera", "BoxInPicture", "HandCapsules", "Picture", "hand_capsules", "render", "SKIN", "TOUCHING",
-           "BOX", "PALM_CAMERA", "GRASP_CAMERA"]
+__all__ = ["Camera", "BoxInPicture", "HandCapsules", "Picture", "hand_capsules", "box_corners", "render", "SKIN", "TOUCHING",
+           "BOX", "PALM_CAMERA"]
 
 #: Colours (r, g, b in [0, 1]): the hand, a link touching the box, the box.
 SKIN = (0.96, 0.80, 0.67)
@@ -46,6 +46,18 @@ class Camera:
     center_mm: tuple[float, float, float] = (20.0, -5.0, 85.0)
     width_mm: float = 200.0
 
+    def fitted(self, points_mm: NDArray, radii_mm: NDArray | None = None, margin_mm: float = 4.0) -> Camera:
+        """The same view, centred on and just wide enough for spheres at ``points_mm`` (n, 3)
+        of ``radii_mm`` (n,; 0 if None) plus ``margin_mm`` on every side."""
+        basis = self.basis()
+        pts = np.asarray(points_mm, dtype=float).reshape(-1, 3)
+        r = np.zeros(len(pts)) if radii_mm is None else np.asarray(radii_mm, dtype=float)
+        uv = pts @ basis[:2].T
+        lo, hi = (uv - r[:, None]).min(axis=0), (uv + r[:, None]).max(axis=0)
+        mid = 0.5 * (lo + hi)
+        center = mid[0] * basis[0] + mid[1] * basis[1] + float(np.mean(pts @ basis[2])) * basis[2]
+        return Camera(self.direction, self.up, tuple(center), float(max(hi - lo)) + 2.0 * margin_mm)
+
     def basis(self) -> NDArray:
         """Rows: image right, image up, viewing direction (unit vectors, palm frame)."""
         forward = np.asarray(self.direction, dtype=float)
@@ -57,11 +69,9 @@ class Camera:
 
 #: The palm seen from in front, a little from the little-finger side and from below, fingers
 #: up: a right hand with its thumb to the image right, as one sees one's own right hand held
-#: up with the palm toward the face. Flexing fingers come toward the viewer.
+#: up with the palm toward the face. Flexing fingers come toward the viewer. The figures fit
+#: its centre and width to what they show (``Camera.fitted``).
 PALM_CAMERA = Camera(direction=(-1.0, 0.32, 0.22), center_mm=(10.0, -2.0, 92.0), width_mm=205.0)
-#: Grasps: the same view as PALM_CAMERA, wider and centred further in front of the palm,
-#: where the boxes are.
-GRASP_CAMERA = Camera(direction=PALM_CAMERA.direction, center_mm=(35.0, -2.0, 95.0), width_mm=240.0)
 
 @dataclass(frozen=True)
 class BoxInPicture:
@@ -83,6 +93,14 @@ class HandCapsules:
     link: NDArray
     boxes: tuple[BoxInPicture, ...]
     box_link: tuple[int, ...]
+
+
+    def extent(self) -> tuple[NDArray, NDArray]:
+        """Points (k, 3) and radii (k,) whose spheres cover every shape (for ``Camera.fitted``)."""
+        corners = [box_corners(b) for b in self.boxes]
+        points = np.vstack([self.ends.reshape(-1, 3), *corners]) if corners else self.ends.reshape(-1, 3)
+        radii = np.concatenate([np.repeat(self.radius, 2), np.zeros(8 * len(corners))])
+        return points, radii
 
 
 def hand_capsules(hand: Any, q: NDArray) -> HandCapsules:
@@ -185,7 +203,8 @@ def _cast_capsule(rays: _Rays, a: NDArray, b: NDArray, r: float, label: int) -> 
     rays.keep(rows, cols, t, normal, label)
 
 
-def _box_corners(box: BoxInPicture) -> NDArray:
+def box_corners(box: BoxInPicture) -> NDArray:
+    """(8, 3) corners of a box, mm, palm frame."""
     signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
     return (signs * np.asarray(box.size_mm, float) / 2.0) @ np.asarray(box.rotation, float).T + box.center_mm
 
@@ -193,7 +212,7 @@ def _box_corners(box: BoxInPicture) -> NDArray:
 def _cast_box(rays: _Rays, box: BoxInPicture, label: int) -> NDArray | None:
     """Nearest hit of every ray with the box (slabs); returns the face index (axis·2 + side)
     hit at each pixel of the window (-1: missed), or None when the box is out of the image."""
-    corners = rays.to_image(_box_corners(box))
+    corners = rays.to_image(box_corners(box))
     win = rays.window(corners.min(axis=0) - 1.0, corners.max(axis=0) + 1.0)
     if win is None:
         return None
