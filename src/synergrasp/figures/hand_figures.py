@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from synergrasp.analysis.realism import SIMULATED_STATUSES, representative_grasps
 from synergrasp.figures.hand_pictures import (BOX, PALM_CAMERA, SKIN, TOUCHING, BoxInPicture, Camera, box_corners,
-                                              hand_capsules, render)
+                                              hand_shapes, render)
 from synergrasp.figures.output import save_figure
 
 __all__ = ["figure_synergy_postures", "figure_example_grasps", "PANEL_PX"]
@@ -50,20 +50,20 @@ def _frame(axes: Sequence[Any], pictures: Sequence[Any], margin_px: float = 8.0)
 def _palm_point(hand: Any) -> NDArray:
     """Centre of the palm box's face toward the palm normal (mm, palm frame; the origin if the
     palm has no box): where "palm" is written and what the other labels point away from."""
-    caps = hand_capsules(hand, np.zeros(hand.n_joints))  # the palm does not move
-    for box, link in zip(caps.boxes, caps.box_link):
-        if link == 0:
-            normal = np.asarray(hand.palm_normal, dtype=float)
-            half = np.abs(np.asarray(box.rotation).T @ normal) @ (np.asarray(box.size_mm) / 2.0)
-            return np.asarray(box.center_mm) + half * normal
-    return np.zeros(3)
+    boxes = hand_shapes(hand, np.zeros(hand.n_joints)).boxes  # the palm does not move
+    if not boxes:
+        return np.zeros(3)
+    normal = np.asarray(hand.palm_normal, dtype=float)
+    front = [np.asarray(b.center_mm) + (np.abs(np.asarray(b.rotation).T @ normal) @ (np.asarray(b.size_mm) / 2.0)) * normal
+             for b in boxes]
+    return max(front, key=lambda p: float(p @ normal))
 
 
 def _fit(camera: Camera, hand: Any, postures: Sequence[NDArray], boxes: Sequence[BoxInPicture] = ()) -> Camera:
     """``camera`` centred on and sized to the hand at every posture and the boxes."""
     points, radii = [], []
     for q in postures:
-        p, r = hand_capsules(hand, q).extent()
+        p, r = hand_shapes(hand, q).extent()
         points.append(p)
         radii.append(r)
     for box in boxes:
@@ -88,7 +88,7 @@ def _label(ax: Any, name: str, at: NDArray, away_from: NDArray, distance: float 
 
 def _thumb_point(hand: Any, q: ArrayLike) -> NDArray:
     """Centre of the thumb's proximal phalanx (mm): the thumb's middle, seen even when it is flexed."""
-    caps = hand_capsules(hand, np.asarray(q, dtype=float))
+    caps = hand_shapes(hand, np.asarray(q, dtype=float))
     return caps.ends[caps.link == hand.link_index("thumb_proximal")][0].mean(axis=0)
 
 

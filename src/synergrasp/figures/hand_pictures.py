@@ -1,7 +1,7 @@
 """Shaded pictures of the hand and of a box, ray-cast from the bodies the simulation uses.
 
-The hand is what pybullet collides: a capsule per phalanx (two end-sphere centres and a
-radius, from the hand's forward kinematics) and the palm box; the object is its box. Every
+The hand is what the closure collides (``synergrasp.simulation.capsules``): a capsule per
+phalanx (axis end points and radius at the posture) and the palm box; the object is its box. Every
 pixel of an orthographic camera casts a ray and the nearest exact intersection with a
 capsule or box gives its depth, surface normal and link (a z-buffer). The picture is then
 shaded (ambient + diffuse + a little specular light from the upper left of the viewer),
@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Camera", "BoxInPicture", "HandCapsules", "Picture", "hand_capsules", "box_corners", "render", "SKIN", "TOUCHING",
+__all__ = ["Camera", "BoxInPicture", "HandShapes", "Picture", "hand_shapes", "box_corners", "render", "SKIN", "TOUCHING",
            "BOX", "PALM_CAMERA"]
 
 #: Colours (r, g, b in [0, 1]): the hand, a link touching the box, the box.
@@ -83,17 +83,15 @@ class BoxInPicture:
 
 
 @dataclass(frozen=True)
-class HandCapsules:
-    """The hand's shapes at a posture, palm frame, mm: ``ends`` (n, 2, 3) end-sphere centres,
-    ``radius`` (n,), ``link`` (n,) hand link of each capsule, ``boxes`` the links' boxes
-    (the palm) with their ``box_link``."""
+class HandShapes:
+    """The hand's shapes at a posture, palm frame, mm: ``ends`` (n, 2, 3) capsule axis end
+    points, ``radius`` (n,), ``link`` (n,) hand link of each capsule, ``boxes`` the palm's
+    boxes (hand link 0)."""
 
     ends: NDArray
     radius: NDArray
     link: NDArray
     boxes: tuple[BoxInPicture, ...]
-    box_link: tuple[int, ...]
-
 
     def extent(self) -> tuple[NDArray, NDArray]:
         """Points (k, 3) and radii (k,) whose spheres cover every shape (for ``Camera.fitted``)."""
@@ -103,25 +101,17 @@ class HandCapsules:
         return points, radii
 
 
-def hand_capsules(hand: Any, q: NDArray) -> HandCapsules:
-    """Capsules and boxes of ``hand`` at joint angles q (rad), from its forward kinematics."""
-    from synergrasp.hand.kinematics import forward_kinematics
+def hand_shapes(hand: Any, q: NDArray) -> HandShapes:
+    """The shapes the closure collides (``synergrasp.simulation.capsules.HandCapsules``) at
+    joint angles q (rad)."""
+    from synergrasp.simulation.capsules import HandCapsules
 
-    frames = forward_kinematics(hand, np.asarray(q, dtype=float))
-    ends, radius, link, boxes, box_link = [], [], [], [], []
-    for i, shapes in enumerate(hand.link_shapes):
-        for shape in shapes:
-            pose = frames[i] @ shape.pose
-            if shape.kind == "capsule":
-                half = 0.5 * shape.length * pose[:3, 2]  # capsules lie along their local z
-                ends.append((pose[:3, 3] - half, pose[:3, 3] + half))
-                radius.append(shape.radius)
-                link.append(i)
-            else:
-                boxes.append(BoxInPicture(np.asarray(shape.size, dtype=float), pose[:3, 3].copy(), pose[:3, :3].copy()))
-                box_link.append(i)
-    return HandCapsules(np.asarray(ends, dtype=float).reshape(-1, 2, 3), np.asarray(radius, dtype=float),
-                        np.asarray(link, dtype=np.int64), tuple(boxes), tuple(box_link))
+    capsules = HandCapsules.of(hand)
+    start, end = capsules.segments(np.asarray(q, dtype=float))
+    boxes = tuple(BoxInPicture(2.0 * half, centre, rotation) for rotation, centre, half
+                  in zip(capsules.palm_rotation, capsules.palm_centre, capsules.palm_half))
+    return HandShapes(np.stack([start, end], axis=1), np.asarray(capsules.radius, dtype=float),
+                      np.asarray(capsules.links, dtype=np.int64), boxes)
 
 
 # ------------------------------------------------------------------------------ ray casting
@@ -237,9 +227,9 @@ def _cast_box(rays: _Rays, box: BoxInPicture, label: int) -> NDArray | None:
     return full
 
 
-def _cast_hand(rays: _Rays, caps: HandCapsules) -> None:
-    for box, link in zip(caps.boxes, caps.box_link):
-        _cast_box(rays, box, link)
+def _cast_hand(rays: _Rays, caps: HandShapes) -> None:
+    for box in caps.boxes:
+        _cast_box(rays, box, 0)
     for (a, b), r, link in zip(caps.ends, caps.radius, caps.link):
         _cast_capsule(rays, a, b, float(r), int(link))
 
@@ -309,7 +299,7 @@ def render(hand: Any, q: NDArray, camera: Camera, size_px: tuple[int, int] = (36
     """
     w, h, k = int(size_px[0]) * supersample, int(size_px[1]) * supersample, int(supersample)
     rays = _Rays(camera, w, h)
-    _cast_hand(rays, hand_capsules(hand, q))
+    _cast_hand(rays, hand_shapes(hand, q))
     basis = rays.basis
     palette = np.tile(np.asarray(SKIN), (hand.n_links, 1))
     for link in touching:
@@ -319,7 +309,7 @@ def render(hand: Any, q: NDArray, camera: Camera, size_px: tuple[int, int] = (36
     rgb[on_hand] = _shade(palette[rays.label[on_hand]], rays.normal[on_hand], basis)
     if ghost_q is not None:
         ghost = _Rays(camera, w, h)
-        _cast_hand(ghost, hand_capsules(hand, ghost_q))
+        _cast_hand(ghost, hand_shapes(hand, ghost_q))
         pale = (ghost.label >= 0) & ~on_hand
         rgb[pale] = _GHOST
         rgb[_edges(ghost.label >= 0) & ~on_hand] = 0.72
