@@ -68,7 +68,7 @@ def _pose_columns() -> tuple[Column, ...]:
 CONTACTS = Table("contacts", "one row per pose", _pose_columns() + (
     Column("status", "string", "", "closure outcome (see synergrasp.simulation)"),
     Column("q", "list<float64>", "rad", "final joint angles (19)"),
-    Column("finger_state", "list<string>", "", "per finger thumb..little: contact, limit, self"),
+    Column("finger_state", "list<string>", "", "per finger thumb..little: contact (box), self (blocked by the hand), limit (end of the closure path)"),
     Column("n_contacts", "int32", "", "number of contacts m"),
     Column("contact_link", "list<int32>", "", "link index per contact (Hand.link_names)"),
     Column("contact_point", "list<float64>", "mm", "contact points on the box surface, palm frame, 3m row-major"),
