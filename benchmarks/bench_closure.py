@@ -22,19 +22,15 @@ import numpy as np  # noqa: E402
 
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
-from synergrasp.simulation.closure import ClosureParams, closure_model  # noqa: E402
+from synergrasp.simulation.closure import ClosureParams, closure_model, place_box  # noqa: E402
+from synergrasp.simulation.scene import HandScene  # noqa: E402
 from synergrasp.simulation.objects import STUDY_BOXES  # noqa: E402
-from synergrasp.simulation.placement import Placement, object_pose, pose_grid  # noqa: E402
+from synergrasp.simulation.placement import Placement, pose_grid  # noqa: E402
 
 
-#: Per-object placements (docs/closure.md): the default centre for the 30 mm boxes; the
-#: 60 mm cube 15 mm further out along the palm normal, obj4 52 mm further out with its 60 mm edge along it.
-PLACEMENTS = {
-    "obj1": Placement(),
-    "obj2": Placement(),
-    "obj3": Placement(center_mm=(53.0, 5.0, 112.0)),
-    "obj4": Placement(center_mm=(90.0, 5.0, 112.0), box_axes=(1, 0, 2)),
-}
+#: Per-object placements: the study's default (approach to the palm centre); obj4 with its
+#: 100 x 100 face toward the palm (config/config.yaml).
+PLACEMENTS = {"obj4": Placement(box_axes=(1, 0, 2))}
 
 
 def study_mechanics() -> dict:
@@ -54,17 +50,20 @@ def main(n_poses: int = 300, params: ClosureParams = ClosureParams(), key: str =
     mechanics = study_mechanics() if params.model == "dynamic" else None
     print(f"closure model: {params.model}")
     closer = closure_model(hand, synergies, params, mechanics)
+    placer = HandScene(hand)
     all_times = []
     try:
         for box in STUDY_BOXES:
             size = np.asarray(box.size_mm, dtype=float)
             placement = PLACEMENTS.get(box.name, Placement())
-            times, statuses, counts, two_fingers = [], [], [], 0
+            times, placing, statuses, counts, two_fingers = [], [], [], [], 0
             for pose in poses:
-                placed = object_pose(placement, size, *grid.angles_deg(int(pose)), hand.palm_normal)
                 t0 = time.perf_counter()
+                placed = place_box(placer, closer.q_open, placement, size, *grid.angles_deg(int(pose)))
+                t1 = time.perf_counter()
                 result = closer.grasp(size, placed)
                 times.append(time.perf_counter() - t0)
+                placing.append(t1 - t0)
                 statuses.append(result.status)
                 counts.append(len(result.links))
                 two_fingers += sum(s == "contact" for s in result.finger_state) >= 2
@@ -72,13 +71,15 @@ def main(n_poses: int = 300, params: ClosureParams = ClosureParams(), key: str =
             all_times.extend(t)
             status, n_status = np.unique(statuses, return_counts=True)
             m, n_m = np.unique(counts, return_counts=True)
-            print(f"{box.name} {tuple(size.tolist())} centre {placement.center_mm} axes {placement.box_axes}: {len(poses)} poses, median {np.median(t):.2f} ms, "
-                  f"p90 {np.percentile(t, 90):.2f} ms per grasp")
+            print(f"{box.name} {tuple(size.tolist())} {placement.mode} axes {placement.box_axes}: {len(poses)} poses, median {np.median(t):.2f} ms, "
+                  f"p90 {np.percentile(t, 90):.2f} ms per grasp "
+                  f"(placement median {1e3 * np.median(placing):.2f} ms)")
             print(f"  status: {dict(zip(status.tolist(), n_status.tolist()))}")
             print(f"  contacts m: {dict(zip(m.tolist(), n_m.tolist()))}")
             print(f"  poses with >= 2 fingers in contact: {two_fingers} / {len(poses)}")
     finally:
         closer.close()
+        placer.close()
     print(f"{key}: {np.median(all_times):.2f}")
 
 

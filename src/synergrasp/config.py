@@ -154,11 +154,11 @@ def merge_config(base: Mapping[str, Any], override: Mapping[str, Any]) -> dict[s
 
 
 def gfo_params(mechanics: Mapping[str, Any], mass_kg: float):
-    """:class:`synergrasp.optimisation.force_optimisation.GFOParams` from the config's ``mechanics``
+    """:class:`synergrasp.optimisation.study.GFOParams` from the config's ``mechanics``
     block (units in its key names) and the object's mass (kg); gravity is normalised."""
     import numpy as np
 
-    from synergrasp.optimisation.force_optimisation import GFOParams
+    from synergrasp.optimisation.study import GFOParams
 
     gravity = np.asarray(mechanics["gravity_direction"], dtype=float)
     return GFOParams(

@@ -14,7 +14,8 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "write", "read", "empty"]
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "write", "read", "empty",
+           "write_study_table"]
 
 
 @dataclass(frozen=True)
@@ -68,7 +69,7 @@ def _pose_columns() -> tuple[Column, ...]:
 CONTACTS = Table("contacts", "one row per pose", _pose_columns() + (
     Column("status", "string", "", "closure outcome (see synergrasp.simulation)"),
     Column("q", "list<float64>", "rad", "final joint angles (19)"),
-    Column("finger_state", "list<string>", "", "per finger thumb..little: contact, limit, self"),
+    Column("finger_state", "list<string>", "", "per finger thumb..little: contact (box), self (blocked by the hand), limit (end of the closure path)"),
     Column("n_contacts", "int32", "", "number of contacts m"),
     Column("contact_link", "list<int32>", "", "link index per contact (Hand.link_names)"),
     Column("contact_point", "list<float64>", "mm", "contact points on the box surface, palm frame, 3m row-major"),
@@ -97,7 +98,7 @@ GFO = Table("gfo", "one row per (pose, synergy set)", _pose_columns() + (
     Column("rank_G", "int32", "", "rank of the grasp matrix"),
     Column("n_contacts", "int32", "", "number of contacts"),
     Column("iterations", "int32", "", "interior-point iterations"),
-    Column("solver", "string", "", "back end that decided the problem"),
+    Column("solver", "string", "", "back end that decided the problem: ipm, clarabel_fallback, direct, none"),
 ))
 
 MINIMA = Table("minima", "one row per local minimum of (object, synergy set)", (
@@ -114,10 +115,10 @@ def _realism_columns() -> tuple[Column, ...]:
     bins = tuple(Column(f"pct_m{m}", "float64", "%", f"grasps with exactly {m} contacts") for m in range(6))
     return (
         Column("object", "string", "", "object name"),
-        Column("closure_model", "string", "", "closure model that made the grasps (kinematic unless the contacts say)"),
+        Column("closure_model", "string", "", "closure model that made the grasps (contacts table)"),
         Column("poses", "int32", "", "poses of the grid"),
-        Column("simulated", "int32", "", "poses whose closure ran (status grasp)"),
-        Column("dropped", "int32", "", "poses not simulated (any other status)"),
+        Column("simulated", "int32", "", "poses whose closure ran (status grasp or no_contact)"),
+        Column("dropped", "int32", "", "poses whose closure did not run (any other status)"),
         Column("dropped_by", "string", "", "dropped poses per status"),
         Column("contacts_median", "float64", "", "median contacts per simulated grasp"),
     ) + bins + (
@@ -167,3 +168,15 @@ def read(table: Table, path: str | Path) -> pd.DataFrame:
     frame = pd.read_parquet(path)
     _check(table, frame, str(path))
     return frame
+
+
+def write_study_table(table: pd.DataFrame, csv_path: str | Path, md_path: str | Path,
+                      title: str | None = None, floatfmt: str = ".4g") -> None:
+    """Write one of the study's result tables as CSV (full precision) and as Markdown (for
+    reading, numbers to ``floatfmt``, under the heading ``title``)."""
+    table.to_csv(csv_path, index=False)
+    text = table.to_markdown(index=False, floatfmt=floatfmt) if len(table) else "(no rows)"
+    with open(md_path, "w", encoding="utf-8") as handle:
+        if title:
+            handle.write(f"# {title}\n\n")
+        handle.write(text + "\n")

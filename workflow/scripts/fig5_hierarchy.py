@@ -1,15 +1,16 @@
-"""Fig. 5A/5B: success rate and mean force of every set {S_k, S_i, S_j}, averaged over objects."""
-from contextlib import redirect_stderr
+"""Fig. 5A/5B: success rate and paired force ratio of every set {S_k, S_i, S_j}, mean over objects."""
 
 import pandas as pd
 
-from synergrasp.figures.study_figures import figure_hierarchy
-from synergrasp.analysis.summaries import hierarchy_matrices, mean_over_objects
+from synergrasp.figures.study_figures import FIG5B_RATIO_RANGE, figure_hierarchy
+from synergrasp.job_log import job_log
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
-    first, out = snakemake.params.first, snakemake.output
-    matrices = hierarchy_matrices(mean_over_objects(pd.read_csv(snakemake.input.rates)), first)
-    figure_hierarchy(matrices, "success_rate", first, "Fig. 5A: success rate (%), mean over objects",
-                     ".0f", out.success_png, out.success_pdf)
-    figure_hierarchy(matrices, "mean_force", first, "Fig. 5B: mean optimal force (N), mean over objects (log grey scale)",
-                     ".1f", out.force_png, out.force_pdf, log_scale=True)
+with job_log(snakemake.log[0]):
+    first, out, success = snakemake.params.first, snakemake.output, snakemake.params.success
+    matrices = pd.read_csv(snakemake.input.hierarchy)
+    figure_hierarchy(matrices, "success_rate", first, f"Fig. 5A: success rate (%, {success}), mean over objects",
+                     ".0f", (0.0, 100.0), "success rate (%)", out.success_png, out.success_pdf)
+    figure_hierarchy(matrices, "force_ratio_median", first,
+                     "Fig. 5B: optimal force / full set's optimal force on the same pose "
+                     "(median per object, mean over objects)", ".2f", FIG5B_RATIO_RANGE,
+                     "paired force ratio (log scale)", out.force_png, out.force_pdf, log_scale=True)

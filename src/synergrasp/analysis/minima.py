@@ -3,11 +3,12 @@
 Method (docs/analyses.md, method.md §5): for one object and one synergy set,
 
 1. candidates are force-closure poses whose optimal force is below the median optimal
-   force of that set's force-closure poses;
+   force of that set's force-closure poses (by more than FORCE_TIE_RTOL, relative);
 2. the neighbourhood of a pose is every *other* grid pose within ±radius in α (α is an
    angle: distances wrap around the period) and ±radius in β (no wrap);
 3. a candidate is a local minimum if no neighbour is force closure, or if its force is
-   strictly lower than the force of every force-closure neighbour (a tie discards it).
+   lower than the force of every force-closure neighbour by more than FORCE_TIE_RTOL
+   (relative; a closer force is a tie, and a tie discards it).
 
 A minimum of {S1..Sk} is *preserved* if {S1..Sk+1} has a minimum within ±radius in α
 (wrapping) and in β.
@@ -19,11 +20,15 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["local_minima", "preserved", "minima_table", "MINIMA_COLUMNS"]
+__all__ = ["local_minima", "preserved", "minima_table", "MINIMA_COLUMNS", "FORCE_TIE_RTOL"]
 
 # Grid angles are multiples of a step; the tolerance makes "within ±radius" inclusive
 # despite rounding in the stored degrees.
 _TOL_DEG = 1e-6
+#: Forces closer than this (relative) are a tie: the optimiser decides forces to about
+#: 1e-6 relative (the same grasp at α and α + period differs by up to ~2e-6), so a smaller
+#: difference must not decide which of two poses is the minimum.
+FORCE_TIE_RTOL = 1e-5
 
 MINIMA_COLUMNS = ("object", "set_id", "n_synergies", "pose", "alpha_deg", "beta_deg", "force_norm")
 
@@ -79,7 +84,7 @@ def local_minima(alpha_deg: ArrayLike, beta_deg: ArrayLike, force: ArrayLike, fo
     result = np.zeros(p, dtype=bool)
     if not fc.any():
         return result
-    candidates = np.flatnonzero(fc & (f < np.median(f[fc])))
+    candidates = np.flatnonzero(fc & (f < np.median(f[fc]) * (1.0 - FORCE_TIE_RTOL)))
     closure = np.flatnonzero(fc)
     if candidates.size == 0:
         return result
@@ -88,7 +93,7 @@ def local_minima(alpha_deg: ArrayLike, beta_deg: ArrayLike, force: ArrayLike, fo
     near &= candidates[:, None] != closure[None, :]  # a pose is not its own neighbour
     # lowest force among each candidate's force-closure neighbours (inf if none)
     lowest = np.where(near, f[closure][None, :], np.inf).min(axis=1)
-    result[candidates] = f[candidates] < lowest
+    result[candidates] = f[candidates] < lowest * (1.0 - FORCE_TIE_RTOL)
     return result
 
 
@@ -115,23 +120,29 @@ def preserved(minima_alpha: ArrayLike, minima_beta: ArrayLike, next_alpha: Array
     return _within(a, b, na, nb, radius_deg, alpha_period_deg).any(axis=1)
 
 
-def minima_table(gfo: pd.DataFrame, radius_deg: float = 10.0, alpha_period_deg: float = 360.0) -> pd.DataFrame:
-    """Every local minimum of every (object, synergy set) of a gfo table, one row each.
+def minima_table(table: pd.DataFrame, radius_deg: float = 10.0, alpha_period_deg: float = 360.0) -> pd.DataFrame:
+    """Every local minimum of every (object, synergy set), one row each.
 
+    ``table``: a gfo table with the columns ``success`` and ``success_force`` of
+    :func:`synergrasp.analysis.verdicts.with_verdicts` (the chosen verdict and the optimal
+    force there, N); a success without an optimal force is left out of the map.
     Columns: object, set_id, n_synergies, pose, alpha_deg, beta_deg, force_norm (N);
     rows sorted by object, n_synergies, set_id, pose.
     """
     missing = [c for c in ("object", "set_id", "n_synergies", "pose", "alpha_deg", "beta_deg",
-                           "force_closure", "force_norm") if c not in gfo.columns]
+                           "success", "success_force") if c not in table.columns]
     if missing:
         raise ValueError(f"gfo table: missing columns {missing}")
     parts = []
-    for _, group in gfo.groupby(["object", "set_id"], sort=False):
-        mask = local_minima(group["alpha_deg"].to_numpy(), group["beta_deg"].to_numpy(),
-                            group["force_norm"].to_numpy(), group["force_closure"].to_numpy(dtype=bool),
+    for _, group in table.groupby(["object", "set_id"], sort=False):
+        force = group["success_force"].to_numpy(float)
+        success = group["success"].to_numpy(dtype=bool) & np.isfinite(force)
+        mask = local_minima(group["alpha_deg"].to_numpy(), group["beta_deg"].to_numpy(), force, success,
                             radius_deg, alpha_period_deg)
-        parts.append(group.loc[mask, list(MINIMA_COLUMNS)])
+        parts.append(group.loc[mask, list(MINIMA_COLUMNS[:-1]) + ["success_force"]]
+                     .rename(columns={"success_force": "force_norm"}))
     if not parts:
-        return pd.DataFrame({c: pd.Series(dtype=gfo[c].dtype) for c in MINIMA_COLUMNS})
+        return pd.DataFrame({c: pd.Series(dtype=table[c].dtype) for c in MINIMA_COLUMNS[:-1]}
+                            | {"force_norm": pd.Series(dtype=float)})
     out = pd.concat(parts, ignore_index=True)
     return out.sort_values(["object", "n_synergies", "set_id", "pose"], ignore_index=True)
