@@ -97,5 +97,7 @@ rule grasp_realism:
             name: spec["mass_kg"] * config["mechanics"]["g_m_per_s2"]
             for name, spec in config["objects"].items()
         },
+        # a contact carries load above closure.dynamic.load_threshold_N (docs/dynamic_closure.md)
+        dynamic=config["closure"].get("dynamic", {}),
     script:
         "../scripts/grasp_realism.py"
