@@ -7,7 +7,9 @@ from snakemake.utils import min_version
 min_version("9.0")
 
 
-configfile: "config/config.yaml"
+# The study's configuration. `--configfile my.yaml` is an overlay on it (config/README.md:
+# mappings merge key by key, other values replace, null removes a key).
+configfile: f"{workflow.basedir}/config/config.yaml"
 
 
 include: "workflow/rules/common.smk"

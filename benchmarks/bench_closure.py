@@ -15,34 +15,29 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from synergrasp.simulation.closure import ClosureParams, Placement, _Closer, object_pose, pose_grid, simulate_pose  # noqa: E402
+from synergrasp.config import defaults, step_params  # noqa: E402
+from synergrasp.simulation.closure import _Closer, object_pose, pose_grid, simulate_pose  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
-from synergrasp.simulation.objects import STUDY_BOXES  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
 
 
-#: Per-object placements (docs/closure.md): the default centre for the 30 mm boxes; the
-#: 60 mm cube 15 mm further out along the palm normal, obj4 52 mm further out with its 60 mm edge along it.
-PLACEMENTS = {
-    "obj1": Placement(),
-    "obj2": Placement(),
-    "obj3": Placement(center_mm=(53.0, 5.0, 112.0)),
-    "obj4": Placement(center_mm=(90.0, 5.0, 112.0), box_axes=(1, 0, 2)),
-}
+#: The study's boxes, placements and closure settings: the configuration's defaults.
+STUDY = defaults()
 
 
 def main(n_poses: int = 300) -> None:
     hand = load_hand()
     synergies = load_synergies(None, joint_names=hand.joint_names)
-    placement, params = Placement(), ClosureParams()
-    grid = pose_grid(placement)
+    first = step_params(STUDY, "simulate", next(iter(STUDY["objects"])))
+    grid = pose_grid(first.placement)
     poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
-    closer = _Closer(hand, synergies, params)
+    closer = _Closer(hand, synergies, first.closure)
     all_times = []
     try:
-        for box in STUDY_BOXES:
+        for name in STUDY["objects"]:
+            sim = step_params(STUDY, "simulate", name)
+            box, placement = sim.box, sim.placement
             size = np.asarray(box.size_mm, dtype=float)
-            placement = PLACEMENTS.get(box.name, Placement())
             times, statuses, counts, two_fingers = [], [], [], 0
             for pose in poses:
                 placed = object_pose(placement, size, *grid.angles_deg(int(pose)), hand.palm_normal)

@@ -8,7 +8,7 @@ rule local_minima:
     output:
         "results/objects/{object}/minima.parquet",
     params:
-        radius_deg=config["analyses"]["minima_radius_deg"],
+        cfg=step_cfg("minima"),
     log:
         "results/logs/local_minima/{object}.log",
     script:
@@ -31,9 +31,7 @@ rule study_tables:
             for ext in ("csv", "md")
         },
     params:
-        sets=config["synergy_sets"],
-        table2_k_max=config["analyses"]["table2_k_max"],
-        radius_deg=config["analyses"]["minima_radius_deg"],
+        cfg=step_cfg("tables"),
     log:
         "results/logs/study_tables.log",
     script:

@@ -5,36 +5,46 @@ from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from synergrasp.config import ConfigError, merge_config, synergy_sets, validate_config
+from synergrasp.config import ConfigError, check_relations, scenario_configs, step_config
 
 ROOT = Path(workflow.basedir)
 SRC = ROOT / "src" / "synergrasp"
-SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
 
-def _check_inputs(cfg):
-    """Validate config, hand, synergies and objects; return the synergy count."""
+def _check_inputs(raw):
+    """Every scenario's complete configuration (``default`` first), checked with its hand
+    and synergy files before any job runs (config/README.md)."""
     from synergrasp.hand.kinematics import load_hand
-    from synergrasp.simulation.objects import boxes_from_config
     from synergrasp.hand.synergies import load_synergies
 
-    validate_config(cfg, SCHEMA)
-    hand = load_hand(cfg["hand"])
-    synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
-    boxes_from_config([{"name": name, **spec} for name, spec in cfg["objects"].items()])
-    validate_config(cfg, SCHEMA, n_synergies=synergies.matrix.shape[1])
+    scenarios = scenario_configs(raw)
+    problems = []
+    for name, cfg in scenarios.items():
+        hand = load_hand(cfg["hand"])
+        synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
+        where = "" if name == "default" else f"scenario '{name}': "
+        problems += [where + p for p in check_relations(cfg, synergies.matrix.shape[1])]
+    if problems:
+        raise ConfigError("\n".join(problems))
+    return scenarios
 
 
 try:
-    _check_inputs(config)
-except (ValueError, FileNotFoundError) as err:  # ConfigError, SynergyFileError, ... are ValueErrors
+    SCENARIOS = _check_inputs(config)
+except ValueError as err:  # ConfigError, SynergyFileError, hand-file errors are ValueErrors
     raise WorkflowError(f"Invalid input, nothing was run:\n{err}") from None
 
+#: The main configuration, complete (defaults filled in) and checked.
+STUDY = SCENARIOS["default"]
+OBJECTS = list(STUDY["objects"])
+SHARDS = list(range(STUDY["solver"]["pose_shards"]))
 
-OBJECTS = list(config["objects"])
-SETS = synergy_sets(config["synergy_sets"])
-SHARDS = list(range(config["solver"]["pose_shards"]))
-FIG4_OBJECT = config["analyses"]["fig4"]["object"]
+
+def step_cfg(step):
+    """A rule's ``params``: the part of the configuration its step reads (for the job's
+    object; synergrasp.config.STEP_KEYS), so that a job reruns only when a key it reads
+    changes. Its script turns it into typed parameters with synergrasp.config.step_params."""
+    return lambda wildcards: step_config(STUDY, step, wildcards.get("object"))
 
 
 wildcard_constraints:
@@ -85,38 +95,10 @@ def code(script):
 
 def user_files():
     """User-supplied hand/synergy files: a change of their content reruns what uses them."""
-    return [p for p in (config["hand"], config["synergies"]) if p]
+    return [p for p in (STUDY["hand"], STUDY["synergies"]) if p]
 
 
 SHIPPED_DATA = sorted(str(p) for p in (SRC / "data").glob("*") if p.is_file())
-
-
-def object_config(name):
-    """The object's box and its effective placement (global placement + its override)."""
-    spec = dict(config["objects"][name])
-    placement = merge_config(config["placement"], spec.pop("placement", {}))
-    return {"name": name, **spec, "placement": placement}
-
-
-def simulation_params(wildcards):
-    return {
-        "object": object_config(wildcards.object),
-        "grid": config["grid"],
-        "closure": config["closure"],
-        "hand": config["hand"],
-        "synergies": config["synergies"],
-    }
-
-
-def optimisation_params(wildcards):
-    return {
-        "mechanics": config["mechanics"],
-        "mass_kg": config["objects"][wildcards.object]["mass_kg"],
-        "sets": SETS,
-        "solver": config["solver"],
-        "synergies": config["synergies"],
-        "shard": int(wildcards.shard),
-    }
 
 
 def object_dir(name):

@@ -11,8 +11,7 @@ rule optimise_shard:
     output:
         temp("results/objects/{object}/gfo_shards/{shard}.parquet"),
     params:
-        opt=optimisation_params,
-        n_shards=len(SHARDS),
+        cfg=step_cfg("optimise"),
     log:
         "results/logs/optimise/{object}_{shard}.log",
     benchmark:

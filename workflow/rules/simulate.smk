@@ -10,7 +10,7 @@ rule simulate_contacts:
     output:
         "results/objects/{object}/contacts.parquet",
     params:
-        sim=simulation_params,
+        cfg=step_cfg("simulate"),
     log:
         "results/logs/simulate_contacts/{object}.log",
     benchmark:
@@ -32,8 +32,7 @@ rule fig1_synergy_postures:
         ),
         pdf="results/figures/fig1_synergy_postures.pdf",
     params:
-        hand=config["hand"],
-        synergies=config["synergies"],
+        cfg=step_cfg("fig1"),
     log:
         "results/logs/fig1_synergy_postures.log",
     script:
@@ -52,9 +51,7 @@ rule fig2_example_grasps:
         ),
         pdf="results/figures/fig2_example_grasps.pdf",
     params:
-        objects=[object_config(name) for name in OBJECTS],
-        hand=config["hand"],
-        poses=config["analyses"]["fig2_poses"],
+        cfg=step_cfg("fig2"),
     log:
         "results/logs/fig2_example_grasps.log",
     script:

@@ -3,12 +3,12 @@ from contextlib import redirect_stderr
 
 import pandas as pd
 
-from synergrasp.hand.kinematics import load_hand
-from synergrasp.simulation.objects import boxes_from_config
+from synergrasp.config import step_params
 from synergrasp.figures.hand_drawing import figure_example_grasps
+from synergrasp.hand.kinematics import load_hand
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
-    boxes = boxes_from_config([{k: v for k, v in o.items() if k != "placement"} for o in snakemake.params.objects])
+    params = step_params(snakemake.params.cfg, "fig2")
     tables = [pd.read_parquet(path) for path in snakemake.input.contacts]
-    figure_example_grasps(load_hand(snakemake.params.hand), boxes, tables, snakemake.params.poses,
+    figure_example_grasps(load_hand(params.hand), params.boxes, tables, params.fig2_poses_deg,
                           snakemake.output.png, snakemake.output.pdf)

@@ -8,10 +8,7 @@ from synergrasp.figures.study_figures import figure_rulegraph
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     command = [sys.executable, "-m", "snakemake", "figures", "-s", snakemake.params.snakefile,
                "--nolock", "--quiet", "all", "--rulegraph", "dot"]
-    for path in snakemake.params.configfiles:
-        command += ["--configfile", str(path)]
-    if snakemake.params.configfiles:
-        command.append("--replace-workflow-config")
+    command += ["--configfile", snakemake.params.configfile, "--replace-workflow-config"]
     run = subprocess.run(command, capture_output=True, text=True)
     log.write(run.stderr)
     run.check_returncode()

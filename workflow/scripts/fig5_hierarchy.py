@@ -3,11 +3,12 @@ from contextlib import redirect_stderr
 
 import pandas as pd
 
-from synergrasp.figures.study_figures import figure_hierarchy
 from synergrasp.analysis.summaries import hierarchy_matrices, mean_over_objects
+from synergrasp.config import step_params
+from synergrasp.figures.study_figures import figure_hierarchy
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
-    first, out = snakemake.params.first, snakemake.output
+    first, out = step_params(snakemake.params.cfg, "fig5").hierarchy_first, snakemake.output
     matrices = hierarchy_matrices(mean_over_objects(pd.read_csv(snakemake.input.rates)), first)
     figure_hierarchy(matrices, "success_rate", first, "Fig. 5A: success rate (%), mean over objects",
                      ".0f", out.success_png, out.success_pdf)

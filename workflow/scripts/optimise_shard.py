@@ -4,18 +4,17 @@ from contextlib import redirect_stderr
 import numpy as np
 import pandas as pd
 
+from synergrasp.config import step_params
+from synergrasp.hand.synergies import load_synergies
 from synergrasp.optimisation.batched import optimise_grasps
 from synergrasp.simulation.closure import read_grasps
-from synergrasp.config import gfo_params
-from synergrasp.hand.synergies import load_synergies
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
-    opt = snakemake.params.opt
+    opt = step_params(snakemake.params.cfg, "optimise", snakemake.wildcards.object)
     contacts = pd.read_parquet(snakemake.input.contacts)
-    shard = contacts.iloc[np.array_split(np.arange(len(contacts)), snakemake.params.n_shards)[opt["shard"]]]
-    synergies = load_synergies(opt["synergies"])
-    result = optimise_grasps(read_grasps(shard), synergies.matrix, list(opt["sets"].values()),
-                             gfo_params(opt["mechanics"], opt["mass_kg"]))
+    shard = contacts.iloc[np.array_split(np.arange(len(contacts)), opt.pose_shards)[int(snakemake.wildcards.shard)]]
+    synergies = load_synergies(opt.synergies)
+    result = optimise_grasps(read_grasps(shard), synergies.matrix, list(opt.sets.values()), opt.gfo)
     table = pd.DataFrame(result)
     poses = shard.iloc[table["pose"].to_numpy()]
     table.insert(0, "object", snakemake.wildcards.object)

@@ -1,17 +1,14 @@
 """Close the hand on one object at every pose of the grid; write its contacts table."""
 from contextlib import redirect_stderr
 
-from synergrasp.simulation.closure import ClosureParams, Placement, simulate_object, write_contacts
+from synergrasp.config import step_params
 from synergrasp.hand.kinematics import load_hand
-from synergrasp.simulation.objects import boxes_from_config
 from synergrasp.hand.synergies import load_synergies
+from synergrasp.simulation.closure import simulate_object, write_contacts
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
-    sim = snakemake.params.sim
-    obj = dict(sim["object"])
-    placement = Placement.from_config(obj.pop("placement"), sim["grid"])
-    (box,) = boxes_from_config([obj])
-    hand = load_hand(sim["hand"])
-    synergies = load_synergies(sim["synergies"], joint_names=hand.joint_names)
-    table = simulate_object(hand, synergies, box, placement, ClosureParams.from_config(sim["closure"]))
+    sim = step_params(snakemake.params.cfg, "simulate", snakemake.wildcards.object)
+    hand = load_hand(sim.hand)
+    synergies = load_synergies(sim.synergies, joint_names=hand.joint_names)
+    table = simulate_object(hand, synergies, sim.box, sim.placement, sim.closure)
     write_contacts(table, snakemake.output[0])

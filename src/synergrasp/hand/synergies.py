@@ -119,8 +119,8 @@ def _read_table(path: str | Path, joint_names: Sequence[str]) -> tuple[list[str]
     where = f"synergy file '{path}'"
     try:
         table = pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True)
-    except FileNotFoundError:
-        raise
+    except OSError as err:
+        raise SynergyFileError(f"{where}: cannot be read ({err.strerror or err})") from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as err:
         raise SynergyFileError(f"{where}: not a readable CSV table ({err})") from None
     columns = [str(c).strip() for c in table.columns]
@@ -184,8 +184,6 @@ def load_synergies(path: str | Path | None = None,
     ------
     SynergyFileError
         Naming the file, the field and what is allowed.
-    FileNotFoundError
-        If ``path`` does not exist.
     """
     path = shipped_path() if path is None else Path(path)
     syn_cols, mean, matrix = _read_table(path, joint_names)
