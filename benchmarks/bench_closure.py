@@ -16,9 +16,10 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 from synergrasp.config import defaults, step_params  # noqa: E402
-from synergrasp.simulation.closure import _Closer, object_pose, pose_grid, simulate_pose  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
+from synergrasp.simulation.closure import closure_model  # noqa: E402
+from synergrasp.simulation.placement import object_pose, pose_grid  # noqa: E402
 
 
 #: The study's boxes, placements and closure settings: the configuration's defaults.
@@ -31,7 +32,7 @@ def main(n_poses: int = 300) -> None:
     first = step_params(STUDY, "simulate", next(iter(STUDY["objects"])))
     grid = pose_grid(first.placement)
     poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
-    closer = _Closer(hand, synergies, first.closure)
+    closer = closure_model(hand, synergies, first.closure)
     all_times = []
     try:
         for name in STUDY["objects"]:
@@ -42,7 +43,7 @@ def main(n_poses: int = 300) -> None:
             for pose in poses:
                 placed = object_pose(placement, size, *grid.angles_deg(int(pose)), hand.palm_normal)
                 t0 = time.perf_counter()
-                result = simulate_pose(closer, size, placed)
+                result = closer.grasp(size, placed)
                 times.append(time.perf_counter() - t0)
                 statuses.append(result.status)
                 counts.append(len(result.links))

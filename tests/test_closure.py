@@ -8,15 +8,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.simulation.closure import (
-    ClosureParams,
-    Placement,
-    object_pose,
-    pose_grid,
-    read_grasps,
-    simulate_object,
-    write_contacts,
-)
+from synergrasp.simulation.closure import ClosureParams, simulate_object
+from synergrasp.simulation.contacts import read_grasps, write_contacts
+from synergrasp.simulation.placement import Placement, object_pose, pose_grid
 from synergrasp.hand.kinematics import forward_kinematics
 from synergrasp.simulation.objects import Box
 

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from synergrasp.simulation.closure import ClosureParams, Placement, pose_grid, simulate_object
+from synergrasp.simulation.closure import ClosureParams, simulate_object
+from synergrasp.simulation.placement import Placement, pose_grid
 from synergrasp.simulation.objects import Box
 from synergrasp.figures.hand_drawing import figure_example_grasps, figure_synergy_postures, render_posture
 

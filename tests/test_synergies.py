@@ -13,7 +13,7 @@ from synergrasp.hand.synergies import (
     load_synergies,
     load_synergy_mapping,
     map_human_synergies,
-    reference_posture,
+    SynergyPath,
     shipped_path,
     write_synergies,
 )
@@ -88,9 +88,10 @@ def test_mapping_rejects_missing_joint():
 
 def test_reference_posture_clips_and_broadcasts():
     s = load_synergies()
-    q0 = reference_posture(s, 0.0, LOWER, UPPER)
+    path = SynergyPath.along(s, LOWER, UPPER)
+    q0 = path.reference(0.0)
     np.testing.assert_array_equal(q0, s.mean)
-    q = reference_posture(s, [-10.0, 1.0, 10.0], LOWER, UPPER)
+    q = path.reference([-10.0, 1.0, 10.0])
     assert q.shape == (3, 19)
     np.testing.assert_allclose(q[1], np.clip(s.mean + s.matrix[:, 0], LOWER, UPPER))
     # far along +S1 every long-finger flexion is at its upper limit
@@ -98,7 +99,7 @@ def test_reference_posture_clips_and_broadcasts():
     np.testing.assert_allclose(q[2, idx], math.pi / 2)
     np.testing.assert_allclose(q[0, idx], 0.0)
     with pytest.raises(ValueError, match="lower and upper"):
-        reference_posture(s, 0.0, LOWER[:3], UPPER)
+        SynergyPath.along(s, LOWER[:3], UPPER)
 
 
 def test_columns_selects_one_based():

@@ -41,9 +41,11 @@ def run_j2(tmp_path_factory) -> Path:
 def expected_targets() -> list[str]:
     config = yaml.safe_load(SMALL.read_text())
     figures = [f"results/figures/{n}.{e}" for n in ("fig1_synergy_postures", "fig2_example_grasps",
-               "fig3_rulegraph", "fig5a_hierarchy_success", "fig5b_hierarchy_force") for e in ("png", "pdf")]
+               "fig3_rulegraph", "fig5a_hierarchy_success", "fig5b_hierarchy_force", "grasp_realism")
+               for e in ("png", "pdf")]
     tables = [f"results/tables/{t}.{e}" for t in ("success_rates", "table2_success_rates", "hierarchy",
-              "minimum_preservation", "full_not_first7", "verdict_disagreements") for e in ("csv", "md")]
+              "minimum_preservation", "full_not_first7", "verdict_disagreements", "grasp_realism")
+              for e in ("csv", "md")]
     per_object = [f"results/objects/{o}/{f}" for o in config["objects"] for f in (
         "contacts.parquet", "gfo.parquet", "minima.parquet", "fig4_force_maps.png", "fig4_force_maps.pdf",
         "fig4_exploded.png", "fig4_exploded.pdf")]
@@ -124,5 +126,5 @@ def test_report_holds_every_figure_and_table(run_j2):
     for name in ("fig1_synergy_postures.png", "fig2_example_grasps.png", "fig3_rulegraph.png",
                  "fig4_force_maps.png", "fig4_exploded.png", "fig5a_hierarchy_success.png",
                  "fig5b_hierarchy_force.png", "table2_success_rates.csv", "minimum_preservation.csv",
-                 "full_not_first7.csv", "verdict_disagreements.csv"):
+                 "full_not_first7.csv", "verdict_disagreements.csv", "grasp_realism.png", "grasp_realism.csv"):
         assert name in html, name

@@ -379,6 +379,7 @@ STEP_KEYS: dict[str, tuple[str, ...]] = {
     "optimise": ("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg"),
     "minima": ("analyses.minima_radius_deg",),
     "tables": ("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max"),
+    "realism": ("hand", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2"),
     "fig1": ("hand", "synergies"),
     "fig2": ("hand", "objects.*.size_mm", "analyses.fig2_poses"),
     "fig4": ("analyses.fig4",),
@@ -460,7 +461,7 @@ class SimulateParams:
     hand: str | None
     synergies: str | None
     box: Box
-    placement: Any  # synergrasp.simulation.closure.Placement
+    placement: Any  # synergrasp.simulation.placement.Placement
     closure: Any    # synergrasp.simulation.closure.ClosureParams
 
 
@@ -487,6 +488,14 @@ class TablesParams:
 
 
 @dataclass(frozen=True)
+class RealismParams:
+    """The grasp-realism table: hand file, the full set's id, each object's weight (N)."""
+    hand: str | None
+    full_set_id: str
+    weights_N: dict[str, float]
+
+
+@dataclass(frozen=True)
 class FiguresParams:
     """Parameters of the figures (each figure's rule is given its own keys only)."""
     hand: str | None = None
@@ -502,7 +511,7 @@ class FiguresParams:
 #: Modules holding the typed parameter classes a step's parameters are built from (the
 #: step's script imports them itself; tests/test_config.py checks it).
 STEP_MODULES: dict[str, tuple[str, ...]] = {
-    "simulate": ("synergrasp.simulation.closure",),
+    "simulate": ("synergrasp.simulation.closure", "synergrasp.simulation.placement"),
     "optimise": ("synergrasp.optimisation.force_optimisation",),
 }
 
@@ -529,11 +538,12 @@ def _box(config: Mapping[str, Any], name: str) -> Any:
 
 def _simulate(config: Mapping[str, Any], obj: str) -> SimulateParams:
     closure = importlib.import_module("synergrasp.simulation.closure")
+    placing = importlib.import_module("synergrasp.simulation.placement")
     placement = overlay(config["placement"], config["objects"][obj].get("placement"))
     grid = {k: (v["start"], v["stop"], v["step"]) for k, v in config["grid"].items()}
     return SimulateParams(
         hand=config["hand"], synergies=config["synergies"], box=_box(config, obj),
-        placement=_build(closure.Placement, "placement", **_fields(closure.Placement, {**placement, **grid})),
+        placement=_build(placing.Placement, "placement", **_fields(placing.Placement, {**placement, **grid})),
         closure=_build(closure.ClosureParams, "closure", **_fields(closure.ClosureParams, config["closure"])))
 
 
@@ -580,7 +590,8 @@ def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) ->
 
     The one path from configuration to the parameters of every module: ``simulate`` →
     :class:`SimulateParams`, ``optimise`` → :class:`OptimiseParams`, ``minima`` →
-    :class:`MinimaParams`, ``tables`` → :class:`TablesParams`, ``fig1``/``fig2``/``fig4``/
+    :class:`MinimaParams`, ``tables`` → :class:`TablesParams`, ``realism`` →
+    :class:`RealismParams`, ``fig1``/``fig2``/``fig4``/
     ``fig5`` → :class:`FiguresParams`. A value a typed class rejects raises ConfigError
     naming the config key (not the class's field). Only the keys the step reads
     (:data:`STEP_KEYS`) are used, so its parameters cannot depend on any other.
@@ -595,6 +606,10 @@ def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) ->
     if step == "tables":
         return TablesParams(dict(config["synergy_sets"]), int(config["analyses"]["table2_k_max"]),
                             float(config["analyses"]["minima_radius_deg"]))
+    if step == "realism":
+        g = config["mechanics"]["g_m_per_s2"]
+        return RealismParams(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),
+                             {name: spec["mass_kg"] * g for name, spec in config["objects"].items()})
     if step in ("fig1", "fig2", "fig4", "fig5"):
         return _figures(config, step)
     raise ValueError(f"unknown step {step!r}; allowed values: {sorted(STEP_KEYS)}")

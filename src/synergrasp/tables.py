@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "write", "read", "empty"]
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "write", "read", "empty"]
 
 
 @dataclass(frozen=True)
@@ -103,7 +103,34 @@ MINIMA = Table("minima", "one row per local minimum of (object, synergy set)", (
     Column("force_norm", "float64", "N", "optimal contact-force norm at the minimum"),
 ))
 
-TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA)}
+def _realism_columns() -> tuple[Column, ...]:
+    bins = tuple(Column(f"pct_m{m}", "float64", "%", f"grasps with exactly {m} contacts") for m in range(6))
+    return (
+        Column("object", "string", "", "object name"),
+        Column("closure_model", "string", "", "closure model that made the grasps (kinematic unless the contacts say)"),
+        Column("poses", "int32", "", "poses of the grid"),
+        Column("simulated", "int32", "", "poses whose closure ran (status grasp)"),
+        Column("dropped", "int32", "", "poses not simulated (any other status)"),
+        Column("dropped_by", "string", "", "dropped poses per status"),
+        Column("contacts_median", "float64", "", "median contacts per simulated grasp"),
+    ) + bins + (
+        Column("pct_m6plus", "float64", "%", "grasps with 6 or more contacts"),
+        Column("pct_thumb", "float64", "%", "grasps with a contact on a thumb link"),
+        Column("pct_palm", "float64", "%", "grasps with a contact on the palm"),
+        Column("pct_proximal_or_middle", "float64", "%", "grasps with a contact on a proximal or middle phalanx"),
+        Column("pct_rank6", "float64", "%", "grasps whose grasp matrix G has rank 6"),
+        Column("pct_force_closure", "float64", "%", "grasps in force closure with every synergy enrolled"),
+        Column("median_force_per_weight", "float64", "",
+               "median optimal contact-force norm with every synergy, in multiples of the weight m*g"),
+        Column("loaded_contacts_median", "float64", "",
+               "median contacts per grasp carrying normal force (NaN without per-contact forces)"),
+    )
+
+
+#: Percentages are of the simulated grasps. Written as CSV and Markdown (results/tables).
+GRASP_REALISM = Table("grasp_realism", "one row per (object, closure model)", _realism_columns())
+
+TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM)}
 
 
 def _check(table: Table, frame: pd.DataFrame, where: str) -> None:

@@ -36,3 +36,31 @@ rule study_tables:
         "results/logs/study_tables.log",
     script:
         "../scripts/study_tables.py"
+
+
+rule grasp_realism:
+    input:
+        contacts=expand("results/objects/{object}/contacts.parquet", object=OBJECTS),
+        gfo=expand("results/objects/{object}/gfo.parquet", object=OBJECTS),
+        code=code("grasp_realism"),
+        data=SHIPPED_DATA,
+        user=user_files(),
+    output:
+        csv=report(
+            "results/tables/grasp_realism.csv",
+            caption="../report/grasp_realism_table.rst",
+            category="Tables",
+        ),
+        md="results/tables/grasp_realism.md",
+        png=report(
+            "results/figures/grasp_realism.png",
+            caption="../report/grasp_realism.rst",
+            category="Figures",
+        ),
+        pdf="results/figures/grasp_realism.pdf",
+    params:
+        cfg=step_cfg("realism"),
+    log:
+        "results/logs/grasp_realism.log",
+    script:
+        "../scripts/grasp_realism.py"

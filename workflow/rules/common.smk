@@ -128,9 +128,9 @@ def study_targets():
     figures = [
         f"results/figures/{name}.{ext}"
         for name in ("fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph",
-                     "fig5a_hierarchy_success", "fig5b_hierarchy_force")
+                     "fig5a_hierarchy_success", "fig5b_hierarchy_force", "grasp_realism")
         for ext in ("png", "pdf")
     ]
-    tables = [f"results/tables/{t}.{ext}" for t in TABLES for ext in ("csv", "md")]
+    tables = [f"results/tables/{t}.{ext}" for t in [*TABLES, "grasp_realism"] for ext in ("csv", "md")]
     per_object = [f for name in OBJECTS for f in object_targets(name)]
     return figures + tables + per_object

@@ -7,7 +7,7 @@ import pandas as pd
 from synergrasp.config import step_params
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.optimisation.batched import optimise_grasps
-from synergrasp.simulation.closure import read_grasps
+from synergrasp.simulation.contacts import read_grasps
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     opt = step_params(snakemake.params.cfg, "optimise", snakemake.wildcards.object)

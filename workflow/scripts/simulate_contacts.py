@@ -4,7 +4,8 @@ from contextlib import redirect_stderr
 from synergrasp.config import step_params
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
-from synergrasp.simulation.closure import simulate_object, write_contacts
+from synergrasp.simulation.closure import simulate_object
+from synergrasp.simulation.contacts import write_contacts
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     sim = step_params(snakemake.params.cfg, "simulate", snakemake.wildcards.object)

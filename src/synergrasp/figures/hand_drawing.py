@@ -44,7 +44,7 @@ def render_posture(hand: Any, q: NDArray, view: View = PALM_VIEW, box: tuple[NDA
                    body: Any | None = None) -> NDArray:
     """RGB image (h, w, 3) uint8 of the hand at q (rad), optionally with a box.
 
-    ``box`` = (size_mm, ObjectPose) as made by ``synergrasp.simulation.closure.object_pose``.
+    ``box`` = (size_mm, ObjectPose) as made by ``synergrasp.simulation.placement.object_pose``.
     """
     import pybullet as pb
 
@@ -318,7 +318,7 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[Any]
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from synergrasp.simulation.closure import ObjectPose
+    from synergrasp.simulation.placement import ObjectPose
 
     if len(boxes) != len(tables):
         raise ValueError(f"boxes and tables must have the same length, got {len(boxes)} and {len(tables)}")

@@ -32,7 +32,7 @@ __all__ = [
     "load_human_synergies",
     "load_synergy_mapping",
     "map_human_synergies",
-    "reference_posture",
+    "SynergyPath",
     "write_synergies",
     "shipped_path",
 ]
@@ -255,29 +255,45 @@ def map_human_synergies(human_table: Synergies, mapping: Mapping[str, Any],
     return Synergies(tuple(joint_names), mean, matrix, human_table.names)
 
 
-def reference_posture(synergies: Synergies, sigma: ArrayLike, lower: ArrayLike,
-                      upper: ArrayLike) -> NDArray[np.float64]:
-    """Joint reference of the closure along the first synergy: clip(q_m + σ·S1, lower, upper).
+@dataclass(frozen=True)
+class SynergyPath:
+    """The joint reference along one synergy: q_r(σ) = clip(q_m + σ·S_k, lower, upper), rad.
 
-    Parameters
-    ----------
-    sigma : scalar, or (m,) values of the first synergy coordinate.
-    lower, upper : (n,) joint limits, rad (from the hand model).
-
-    Returns
-    -------
-    (n,) for a scalar σ, (m, n) for an array of σ; rad.
+    mean (n,) q_m, rad; direction (n,) S_k, rad per unit σ; lower, upper (n,) joint limits, rad.
+    The closure follows it along S1 (:meth:`along`); Fig. 1 along S1…S7.
     """
-    sigma_arr = np.asarray(sigma, dtype=float)
-    lower_arr = np.asarray(lower, dtype=float)
-    upper_arr = np.asarray(upper, dtype=float)
-    n = len(synergies.joint_names)
-    if lower_arr.shape != (n,) or upper_arr.shape != (n,):
-        raise ValueError(f"lower and upper must have shape ({n},); got {lower_arr.shape} and {upper_arr.shape}")
-    if sigma_arr.ndim > 1:
-        raise ValueError(f"sigma must be a scalar or 1-D; got shape {sigma_arr.shape}")
-    q = synergies.mean + sigma_arr[..., None] * synergies.matrix[:, 0]
-    return np.clip(q, lower_arr, upper_arr)
+
+    mean: NDArray[np.float64]
+    direction: NDArray[np.float64]
+    lower: NDArray[np.float64]
+    upper: NDArray[np.float64]
+
+    @classmethod
+    def along(cls, synergies: Synergies, lower: ArrayLike, upper: ArrayLike, synergy: int = 1) -> SynergyPath:
+        """The path along synergy ``synergy`` (1-based) within the limits ``lower``, ``upper`` (rad)."""
+        n = len(synergies.joint_names)
+        lower_arr = np.asarray(lower, dtype=float)
+        upper_arr = np.asarray(upper, dtype=float)
+        if lower_arr.shape != (n,) or upper_arr.shape != (n,):
+            raise ValueError(f"lower and upper must have shape ({n},); got {lower_arr.shape} and {upper_arr.shape}")
+        direction = synergies.columns([synergy])[:, 0]
+        return cls(synergies.mean, direction, lower_arr, upper_arr)
+
+    def reference(self, sigma: ArrayLike) -> NDArray[np.float64]:
+        """q_r(σ), rad: (n,) for a scalar σ, (m, n) for (m,) values of σ."""
+        sigma_arr = np.asarray(sigma, dtype=float)
+        if sigma_arr.ndim > 1:
+            raise ValueError(f"sigma must be a scalar or 1-D; got shape {sigma_arr.shape}")
+        return np.clip(self.mean + sigma_arr[..., None] * self.direction, self.lower, self.upper)
+
+    def active_interval(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Per joint, the σ interval [lo, hi] on which its reference is inside its limits
+        (outside it the joint is clipped and does not move); (inf, −inf) where S_k is 0."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a = (self.lower - self.mean) / self.direction
+            b = (self.upper - self.mean) / self.direction
+        moving = self.direction != 0
+        return np.where(moving, np.minimum(a, b), np.inf), np.where(moving, np.maximum(a, b), -np.inf)
 
 
 def write_synergies(synergies: Synergies, path: str | Path) -> None:

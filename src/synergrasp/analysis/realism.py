@@ -1,0 +1,132 @@
+"""How much the simulated grasps look like grasps a hand makes: the grasp-realism table.
+
+Per object (and per closure model, when the contacts table says which one made a row):
+poses simulated and dropped, the distribution of contacts per grasp, the share of grasps
+that touch with the thumb, the palm, a proximal or middle phalanx, the share whose grasp
+matrix has full rank 6, and the median optimal force with every synergy enrolled as a
+multiple of the object's weight (‖f‖₂ / (m·g), dimensionless). When the contacts table
+carries per-contact normal forces (a dynamic closure), also how many contacts per grasp
+carry load. Columns: :data:`synergrasp.tables.GRASP_REALISM`. Pure functions: DataFrames
+in, a DataFrame out.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
+
+__all__ = ["CONTACT_BINS", "DEFAULT_CLOSURE_MODEL", "NORMAL_FORCE_COLUMN", "link_categories", "grasp_realism"]
+
+#: Contact-count bins of the table: 0, 1, …, 5 and "6 or more".
+CONTACT_BINS: tuple[int, ...] = (0, 1, 2, 3, 4, 5, 6)
+#: Closure model written in the table when the contacts table has no ``closure_model`` column.
+DEFAULT_CLOSURE_MODEL = "kinematic"
+#: Optional contacts column: normal force per contact, N (list<float64>, m per row).
+NORMAL_FORCE_COLUMN = "contact_normal_force_N"
+#: Segments (the part of a link name after the finger) counted as proximal or middle phalanges.
+_PROXIMAL_OR_MIDDLE = ("proximal", "middle")
+
+
+def link_categories(link_names: Sequence[str], link_finger: Sequence[str]) -> dict[str, frozenset[int]]:
+    """Hand link indices per category: ``thumb`` (every thumb link), ``palm`` (links of the
+    palm), ``proximal_or_middle`` (links named ``<finger>_proximal`` or ``<finger>_middle``)."""
+    thumb = frozenset(i for i, f in enumerate(link_finger) if f == "thumb")
+    palm = frozenset(i for i, f in enumerate(link_finger) if f == "palm")
+    phalanx = frozenset(i for i, (name, f) in enumerate(zip(link_names, link_finger))
+                        if f != "palm" and name.rsplit("_", 1)[-1] in _PROXIMAL_OR_MIDDLE)
+    return {"thumb": thumb, "palm": palm, "proximal_or_middle": phalanx}
+
+
+def _touches(links: pd.Series, category: frozenset[int]) -> pd.Series:
+    return links.map(lambda ls: bool(len(ls)) and any(int(i) in category for i in ls))
+
+
+def _loaded(contacts: pd.DataFrame, threshold_N: float) -> pd.Series:
+    """Contacts per row whose normal force exceeds ``threshold_N``; NaN where unknown."""
+    if NORMAL_FORCE_COLUMN not in contacts.columns:
+        return pd.Series(np.nan, index=contacts.index)
+
+    def count(forces) -> float:
+        if forces is None or (np.isscalar(forces) and pd.isna(forces)):
+            return np.nan
+        return float(np.count_nonzero(np.asarray(forces, dtype=float) > threshold_N))
+
+    return contacts[NORMAL_FORCE_COLUMN].map(count)
+
+
+def _weight_multiples(gfo: pd.DataFrame, full_set_id: str, weights_N: Mapping[str, float]) -> pd.DataFrame:
+    """Per (object, pose[, closure_model]) of the full set: rank_G, force_closure and ‖f‖₂ / (m·g)."""
+    full = gfo[gfo["set_id"].astype(str) == full_set_id]
+    missing = sorted(set(full["object"]) - set(weights_N))
+    if missing:
+        raise ValueError(f"weights_N: no weight for object(s) {missing}; given: {sorted(weights_N)}")
+    weight = full["object"].map(weights_N).astype(float)
+    fc = full["force_closure"].astype(bool)
+    out = pd.DataFrame({"object": full["object"], "pose": full["pose"].astype(int), "rank_G": full["rank_G"],
+                        "force_closure": fc, "force_per_weight": (full["force_norm"] / weight).where(fc)})
+    if "closure_model" in full.columns:  # results of several closure models side by side
+        out["closure_model"] = full["closure_model"]
+    return out.reset_index(drop=True)
+
+
+def _one_group(rows: pd.DataFrame, categories: dict[str, frozenset[int]]) -> dict[str, float]:
+    simulated = rows["status"] == "grasp"
+    grasps = rows[simulated]
+    n = len(grasps)
+    m = grasps["n_contacts"].astype(int).clip(upper=CONTACT_BINS[-1])
+    share = (lambda mask: 100.0 * float(mask.sum()) / n if n else np.nan)
+    dropped = rows.loc[~simulated, "status"].value_counts().sort_index()
+    out: dict[str, float] = {
+        "poses": len(rows), "simulated": n, "dropped": int((~simulated).sum()),
+        "dropped_by": ", ".join(f"{s}: {c}" for s, c in dropped.items()),
+        "contacts_median": float(grasps["n_contacts"].median()) if n else np.nan,
+    }
+    for b in CONTACT_BINS:
+        out[_bin_column(b)] = share(m == b)
+    for name, links in categories.items():
+        out[f"pct_{name}"] = share(_touches(grasps["contact_link"], links))
+    out["pct_rank6"] = share(grasps["rank_G"] == 6)
+    out["pct_force_closure"] = share(grasps["force_closure"].fillna(False).astype(bool))
+    out["median_force_per_weight"] = float(grasps["force_per_weight"].median()) if n else np.nan
+    loaded = grasps["loaded_contacts"]
+    out["loaded_contacts_median"] = float(loaded.median()) if loaded.notna().any() else np.nan
+    return out
+
+
+def _bin_column(b: int) -> str:
+    return f"pct_m{b}plus" if b == CONTACT_BINS[-1] else f"pct_m{b}"
+
+
+def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequence[str], link_finger: Sequence[str],
+                  full_set_id: str, weights_N: Mapping[str, float], load_threshold_N: float = 1e-3) -> pd.DataFrame:
+    """The grasp-realism table (columns of :data:`synergrasp.tables.GRASP_REALISM`).
+
+    ``contacts``: contacts tables of the objects (CONTACTS contract; an optional
+    ``closure_model`` column groups the rows, else every row is ``kinematic``; an optional
+    ``contact_normal_force_N`` column gives each contact's normal force, N).
+    ``gfo``: their optimisation results; rank(G), force closure and ‖f‖₂ are taken from the
+    full set ``full_set_id`` (e.g. ``"1-2-…-15"``). ``weights_N``: m·g per object, N.
+    ``link_names`` / ``link_finger``: the hand's links (``Hand.link_names``, ``Hand.link_finger``).
+    Shares are percent of the simulated grasps (status ``grasp``); a contact carries load if
+    its normal force exceeds ``load_threshold_N``. One row per (object, closure model).
+    """
+    for table, frame in ((CONTACTS, contacts), (GFO, gfo)):
+        absent = [c for c in table.names if c not in frame.columns]
+        if absent:
+            raise ValueError(f"{table.name} table: missing column(s) {absent}")
+    if full_set_id not in set(gfo["set_id"].astype(str)):
+        raise ValueError(f"full_set_id {full_set_id!r} is not in the gfo table")
+    model = contacts["closure_model"] if "closure_model" in contacts.columns else DEFAULT_CLOSURE_MODEL
+    work = contacts[["object", "pose", "status", "n_contacts", "contact_link"]].assign(
+        closure_model=model, pose=contacts["pose"].astype(int), loaded_contacts=_loaded(contacts, load_threshold_N))
+    full = _weight_multiples(gfo, full_set_id, weights_N)
+    keys = ["object", "pose", "closure_model"] if "closure_model" in full.columns else ["object", "pose"]
+    work = work.merge(full, on=keys, how="left", validate="many_to_one")
+    categories = link_categories(link_names, link_finger)
+    rows = [{"object": obj, "closure_model": cm, **_one_group(group, categories)}
+            for (obj, cm), group in work.groupby(["object", "closure_model"], sort=True)]
+    return pd.DataFrame(rows, columns=list(GRASP_REALISM.names))

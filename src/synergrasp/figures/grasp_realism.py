@@ -1,0 +1,112 @@
+"""The grasp-realism figure, drawn from the grasp-realism table (``synergrasp.analysis.realism``).
+
+Three panels, one bar (group) per object and closure model: (A) contacts per grasp, stacked
+shares 0 … 6+; (B) share of grasps touching with the thumb, the palm, a proximal or middle
+phalanx, and with rank(G) = 6; (C) the median optimal contact force with every synergy
+enrolled, in multiples of the object's weight (log scale).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from synergrasp.analysis.realism import CONTACT_BINS
+from synergrasp.figures.output import save_figure
+
+__all__ = ["figure_grasp_realism"]
+
+#: (column, legend label) of panel B.
+_SHARES = (("pct_thumb", "thumb"), ("pct_palm", "palm"), ("pct_proximal_or_middle", "proximal/middle phalanx"),
+           ("pct_rank6", "rank G = 6"))
+
+
+def _labels(table: pd.DataFrame) -> list[str]:
+    several = table["closure_model"].nunique() > 1
+    return [f"{o}\n{m}" if several else str(o) for o, m in zip(table["object"], table["closure_model"])]
+
+
+def _contacts_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
+    import matplotlib.pyplot as plt
+
+    columns = [f"pct_m{b}plus" if b == CONTACT_BINS[-1] else f"pct_m{b}" for b in CONTACT_BINS]
+    colours = plt.get_cmap("viridis")(np.linspace(0.05, 0.95, len(columns)))
+    y = np.arange(len(table))
+    left = np.zeros(len(table))
+    for b, column, colour in zip(CONTACT_BINS, columns, colours):
+        width = table[column].fillna(0.0).to_numpy(dtype=float)
+        ax.barh(y, width, left=left, color=colour, edgecolor="white", linewidth=0.5,
+                label=f"{b}+" if b == CONTACT_BINS[-1] else str(b))
+        for yi, (l, w) in enumerate(zip(left, width)):
+            if w >= 8.0:
+                ax.text(l + w / 2, yi, f"{w:.0f}", ha="center", va="center", fontsize=7,
+                        color="white" if b < 4 else "black")
+        left += width
+    ax.set_yticks(y, labels)
+    ax.invert_yaxis()
+    ax.set_xlim(0, 100)
+    ax.set_xlabel("share of simulated grasps (%)")
+    ax.set_title("A  contacts per grasp", loc="left", fontsize=10)
+    ax.legend(title="contacts", ncol=len(columns), fontsize=7, title_fontsize=7, loc="lower center",
+              bbox_to_anchor=(0.5, -0.5), frameon=False, handlelength=1.2, columnspacing=0.8)
+
+
+def _shares_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
+    y = np.arange(len(table))
+    height = 0.8 / len(_SHARES)
+    colours = ("#d95f02", "#a6761d", "#7570b3", "0.45")
+    for k, ((column, label), colour) in enumerate(zip(_SHARES, colours)):
+        value = table[column].to_numpy(dtype=float)
+        yk = y - 0.4 + (k + 0.5) * height
+        ax.barh(yk, np.nan_to_num(value), height=height, color=colour, label=label)
+        for yi, v in zip(yk, value):
+            ax.text(min(np.nan_to_num(v), 88.0), yi, f" {v:.0f}" if np.isfinite(v) else " –", va="center", fontsize=6)
+    ax.set_yticks(y, labels)
+    ax.invert_yaxis()
+    ax.set_xlim(0, 100)
+    ax.set_xlabel("share of simulated grasps (%)")
+    ax.set_title("B  grasps touching with …", loc="left", fontsize=10)
+    ax.legend(fontsize=7, ncol=2, loc="lower center", bbox_to_anchor=(0.5, -0.5), frameon=False)
+
+
+def _force_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
+    y = np.arange(len(table))
+    value = table["median_force_per_weight"].to_numpy(dtype=float)
+    shown = np.where(np.isfinite(value), value, np.nan)
+    ax.barh(y, shown, color="#4a78c2")
+    for yi, v in enumerate(value):
+        ax.text(v if np.isfinite(v) else 1.0, yi, f" {v:.3g}" if np.isfinite(v) else " no force closure",
+                va="center", fontsize=7)
+    ax.axvline(1.0, color="0.3", lw=0.8, ls="--")
+    ax.set_xscale("log")
+    finite = value[np.isfinite(value)]
+    hi = max(10.0, float(finite.max()) * 8) if finite.size else 10.0
+    lo = min(0.1, float(finite.min()) / 2) if finite.size else 0.1
+    ax.set_xlim(lo, hi)
+    ax.set_yticks(y, labels)
+    ax.invert_yaxis()
+    ax.set_xlabel("median ‖f‖ with all synergies / weight")
+    ax.set_title("C  force needed (dashed: the weight)", loc="left", fontsize=10)
+
+
+def figure_grasp_realism(table: pd.DataFrame, png_path: str | Path, pdf_path: str | Path) -> None:
+    """Write the grasp-realism figure of ``table`` (columns of ``synergrasp.tables.GRASP_REALISM``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    if table.empty:
+        raise ValueError("the grasp-realism table has no rows: no object was simulated")
+    labels = _labels(table)
+    fig, axes = plt.subplots(1, 3, figsize=(13.0, 1.6 + 0.55 * len(table)), sharey=True)
+    _contacts_panel(axes[0], table, labels)
+    _shares_panel(axes[1], table, labels)
+    _force_panel(axes[2], table, labels)
+    dropped = ", ".join(f"{o}: {int(d)} of {int(p)}" for o, d, p in zip(labels, table["dropped"], table["poses"]))
+    fig.suptitle(f"How realistic are the simulated grasps?   Poses dropped — {dropped}".replace("\n", " "),
+                 fontsize=10, x=0.01, ha="left")
+    fig.tight_layout()
+    save_figure(fig, png_path, pdf_path, tight=True)

@@ -1,0 +1,153 @@
+"""The outcome of one closure and the contacts table (``results/objects/<object>/contacts.parquet``).
+
+Every closure model returns a :class:`ClosureResult`; :func:`contacts_row` turns it into a
+row of the table whose columns, types and units are ``synergrasp.tables.CONTACTS``;
+:func:`read_grasps` turns rows back into grasps for the optimisation. Pure numpy and
+pandas: pybullet is never imported here.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from synergrasp import tables
+from synergrasp.simulation.placement import ObjectPose
+
+if TYPE_CHECKING:  # pragma: no cover
+    from synergrasp.hand.kinematics import Hand
+    from synergrasp.optimisation.mechanics import Grasp
+
+__all__ = [
+    "STATUSES",
+    "FINGER_STATES",
+    "ClosureResult",
+    "closure_result",
+    "contacts_row",
+    "contacts_table",
+    "write_contacts",
+    "read_grasps",
+]
+
+STATUSES: tuple[str, ...] = ("grasp", "intersects_open_hand", "no_contact")
+"""``grasp``: the closure ran and at least one link touches the box; ``intersects_open_hand``:
+the box overlaps the open hand (only the ``fixed`` placement can give it); ``no_contact``:
+the closure ran, nothing touches the box."""
+
+FINGER_STATES: tuple[str, ...] = ("contact", "limit", "self")
+"""How a finger ended: ``contact`` (one of its links touches the box), ``self`` (stopped by
+another part of the hand), ``limit`` (followed the reference to the end of the closure path)."""
+
+
+@dataclass(frozen=True)
+class ClosureResult:
+    """The outcome of one closure, palm frame.
+
+    status:        one of STATUSES
+    q:             (19,) final joint angles, rad
+    finger_state:  per finger thumb…little, one of FINGER_STATES (empty if the box
+                   intersects the open hand)
+    links:         (m,) hand link index per contact (0 = palm)
+    points:        (m, 3) contact points on the object surface, mm
+    normals:       (m, 3) object's inward unit normals
+    jacobian:      (3m, 19) translational Jacobian of the contact points, mm/rad
+    max_penetration_mm: deepest penetration among the contacts (0 if none)
+    """
+
+    status: str
+    q: NDArray
+    finger_state: tuple[str, ...]
+    links: NDArray
+    points: NDArray
+    normals: NDArray
+    jacobian: NDArray
+    max_penetration_mm: float
+
+
+def closure_result(hand: Hand, q: NDArray, finger_state: Sequence[str], links: NDArray, points: NDArray,
+                   normals: NDArray, max_penetration_mm: float,
+                   intersects_open_hand: bool = False) -> ClosureResult:
+    """The :class:`ClosureResult` of a final posture ``q`` (rad) and its contacts (links,
+    points mm, inward normals): the status follows from them, the Jacobian rows are
+    ``hand.contact_jacobian`` at q (zero rows for the palm)."""
+    from synergrasp.hand.kinematics import contact_jacobian
+
+    n = hand.n_joints
+    empty = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, n)))
+    if intersects_open_hand:
+        return ClosureResult("intersects_open_hand", q, tuple(finger_state), *empty, 0.0)
+    if len(links) == 0:
+        return ClosureResult("no_contact", q, tuple(finger_state), *empty, 0.0)
+    jac = contact_jacobian(hand, q, links, points)
+    return ClosureResult("grasp", q, tuple(finger_state), np.asarray(links), np.asarray(points),
+                         np.asarray(normals), jac, float(max_penetration_mm))
+
+
+def contacts_row(object_name: str, pose: int, alpha_deg: float, beta_deg: float, result: ClosureResult,
+                 placed: ObjectPose) -> dict[str, Any]:
+    """One row of the contacts table (``tables.CONTACTS``) from a closure result."""
+    return {
+        "object": object_name,
+        "pose": int(pose),
+        "alpha_deg": float(alpha_deg),
+        "beta_deg": float(beta_deg),
+        "status": result.status,
+        "q": [float(v) for v in result.q],
+        "finger_state": list(result.finger_state),
+        "n_contacts": int(len(result.links)),
+        "contact_link": [int(v) for v in result.links],
+        "contact_point": [float(v) for v in np.ravel(result.points)],
+        "contact_normal": [float(v) for v in np.ravel(result.normals)],
+        "jacobian": [float(v) for v in np.ravel(result.jacobian)],
+        "object_center": [float(v) for v in placed.center_mm],
+        "object_rotation": [float(v) for v in np.ravel(placed.rotation)],
+        "max_penetration_mm": float(result.max_penetration_mm),
+    }
+
+
+def contacts_table(rows: list[dict[str, Any]]) -> pd.DataFrame:
+    """The contacts table of a list of :func:`contacts_row` rows, in the contract's column order."""
+    table = pd.DataFrame(rows, columns=list(tables.CONTACTS.names))
+    for col in ("pose", "n_contacts"):
+        table[col] = table[col].astype(np.int32)
+    return table
+
+
+def write_contacts(table: pd.DataFrame, path: str | Path) -> None:
+    """Write a contacts table to Parquet with the exact column types of ``tables.CONTACTS``."""
+    tables.write(tables.CONTACTS, table, path)
+
+
+def read_grasps(table: pd.DataFrame) -> list[Grasp | None]:
+    """One :class:`synergrasp.optimisation.mechanics.Grasp` per row of a contacts table, in row order.
+
+    Rows whose status is not ``grasp`` or that have no contact give ``None``. Reads only
+    numbers: pybullet is not imported.
+    """
+    from synergrasp.optimisation.mechanics import Grasp
+
+    missing = [c for c in ("status", "n_contacts", "contact_link", "contact_point", "contact_normal",
+                           "jacobian", "object_center") if c not in table.columns]
+    if missing:
+        raise ValueError(f"contacts table: missing column(s) {missing}")
+    grasps: list[Grasp | None] = []
+    for row in table.itertuples(index=False):
+        m = int(row.n_contacts)
+        if row.status != "grasp" or m == 0:
+            grasps.append(None)
+            continue
+        jac = np.asarray(row.jacobian, dtype=float)
+        grasps.append(Grasp(
+            points=np.asarray(row.contact_point, dtype=float).reshape(m, 3),
+            normals=np.asarray(row.contact_normal, dtype=float).reshape(m, 3),
+            links=np.asarray(row.contact_link, dtype=np.int64),
+            jacobian=jac.reshape(3 * m, jac.size // (3 * m)),
+            center=np.asarray(row.object_center, dtype=float),
+        ))
+    return grasps

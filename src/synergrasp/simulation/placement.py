@@ -1,0 +1,181 @@
+"""Where the box sits relative to the hand: placement, the (α, β) pose grid, the placed box.
+
+Lengths in mm, angles in rad (degrees only in pose labels and grid ranges), palm frame
+(docs/design.md, docs/closure.md). Pure numpy: no pybullet here.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from synergrasp.hand.kinematics import axis_rotation
+
+__all__ = ["ROTATION_ORDERS", "FINGER_AXIS", "Placement", "PoseGrid", "ObjectPose", "pose_grid", "object_pose"]
+
+ROTATION_ORDERS: tuple[str, ...] = ("alpha_then_beta", "beta_then_alpha")
+
+#: Long-finger axis of the palm frame (β rotates about it).
+FINGER_AXIS = np.array([0.0, 0.0, 1.0])
+
+
+def _unit(v: Sequence[float]) -> NDArray:
+    a = np.asarray(v, dtype=float)
+    return a / np.linalg.norm(a)
+
+
+def _range_deg(start: float, stop: float, step: float, name: str) -> NDArray:
+    """Inclusive grid start, start+step, ... stop (deg); stop must lie on the grid."""
+    if not step > 0:
+        raise ValueError(f"{name}.step must be > 0 deg, got {step}")
+    n = (stop - start) / step
+    if n < 0 or abs(n - round(n)) > 1e-9:
+        raise ValueError(f"{name}: stop - start must be a non-negative multiple of step, "
+                         f"got start={start}, stop={stop}, step={step}")
+    return start + step * np.arange(int(round(n)) + 1, dtype=float)
+
+
+@dataclass(frozen=True)
+class Placement:
+    """Where the box sits relative to the palm before and while it is rotated.
+
+    center_mm:      box centre o in the palm frame (mm); α and β rotate about it, so it
+                    is the same for every pose.
+    box_axes:       ``box_axes[k]`` is the index (into ``size_mm``) of the box edge that
+                    lies along palm axis k (x = palm normal, y, z = long fingers) at
+                    α = β = 0; a permutation of (0, 1, 2).
+    rotation_order: ``alpha_then_beta``: R = R_z(β)·R_n(α)·R_0 (α about the palm normal
+                    n first, then β about the long-finger axis z, both palm-fixed axes);
+                    ``beta_then_alpha``: R = R_n(α)·R_z(β)·R_0. Only ``alpha_then_beta``
+                    keeps the α ↔ α + 180° symmetry of a box exact.
+    alpha_deg, beta_deg: (start, stop, step) of the inclusive grids, deg; α is periodic.
+    """
+
+    center_mm: tuple[float, float, float] = (38.0, 5.0, 112.0)
+    box_axes: tuple[int, int, int] = (0, 1, 2)
+    rotation_order: str = "alpha_then_beta"
+    alpha_deg: tuple[float, float, float] = (-180.0, 175.0, 5.0)
+    beta_deg: tuple[float, float, float] = (-60.0, 60.0, 5.0)
+
+    def __post_init__(self) -> None:
+        center = tuple(float(v) for v in self.center_mm)
+        if len(center) != 3 or not all(math.isfinite(v) for v in center):
+            raise ValueError(f"Placement.center_mm must be 3 finite numbers (mm), got {self.center_mm!r}")
+        axes = tuple(int(a) for a in self.box_axes)
+        if sorted(axes) != [0, 1, 2]:
+            raise ValueError(f"Placement.box_axes must be a permutation of (0, 1, 2), got {self.box_axes!r}")
+        if self.rotation_order not in ROTATION_ORDERS:
+            raise ValueError(f"Placement.rotation_order must be one of {list(ROTATION_ORDERS)}, "
+                             f"got {self.rotation_order!r}")
+        for name in ("alpha_deg", "beta_deg"):
+            rng = tuple(float(v) for v in getattr(self, name))
+            if len(rng) != 3:
+                raise ValueError(f"Placement.{name} must be (start, stop, step) in deg, got {rng!r}")
+            _range_deg(*rng, name=f"Placement.{name}")
+            object.__setattr__(self, name, rng)
+        alpha = _range_deg(*self.alpha_deg, name="Placement.alpha_deg")
+        if alpha[-1] - alpha[0] >= 360.0:
+            raise ValueError(f"Placement.alpha_deg spans {alpha[-1] - alpha[0]} deg; α is periodic, "
+                             f"the grid must span less than 360 deg")
+        object.__setattr__(self, "center_mm", center)
+        object.__setattr__(self, "box_axes", axes)
+
+
+@dataclass(frozen=True)
+class PoseGrid:
+    """The (α, β) grid: pose = alpha_index * n_beta + beta_index."""
+
+    alpha_deg: NDArray
+    beta_deg: NDArray
+
+    @property
+    def n_alpha(self) -> int:
+        return len(self.alpha_deg)
+
+    @property
+    def n_beta(self) -> int:
+        return len(self.beta_deg)
+
+    @property
+    def n_poses(self) -> int:
+        return self.n_alpha * self.n_beta
+
+    def angles_deg(self, pose: int) -> tuple[float, float]:
+        """(α, β) in deg of a pose index."""
+        if not 0 <= pose < self.n_poses:
+            raise ValueError(f"pose must be in 0 … {self.n_poses - 1}, got {pose}")
+        ia, ib = divmod(int(pose), self.n_beta)
+        return float(self.alpha_deg[ia]), float(self.beta_deg[ib])
+
+    def index(self, alpha_deg: float, beta_deg: float) -> int:
+        """Pose index of the grid point (α, β) in deg (α taken modulo 360)."""
+        da = (np.asarray(self.alpha_deg) - alpha_deg + 180.0) % 360.0 - 180.0
+        ia = np.flatnonzero(np.abs(da) < 1e-6)
+        ib = np.flatnonzero(np.abs(np.asarray(self.beta_deg) - beta_deg) < 1e-6)
+        if len(ia) != 1 or len(ib) != 1:
+            raise ValueError(f"(alpha_deg, beta_deg) = ({alpha_deg}, {beta_deg}) is not on the grid")
+        return int(ia[0]) * self.n_beta + int(ib[0])
+
+
+def pose_grid(placement: Placement) -> PoseGrid:
+    """The pose grid of a placement (72 × 25 = 1800 poses with the study's values)."""
+    return PoseGrid(_range_deg(*placement.alpha_deg, name="alpha_deg"),
+                    _range_deg(*placement.beta_deg, name="beta_deg"))
+
+
+@dataclass(frozen=True)
+class ObjectPose:
+    """A box placed in the palm frame: centre (mm) and rotation (box frame → palm frame)."""
+
+    center_mm: NDArray
+    rotation: NDArray
+    half_extents_mm: NDArray  # along the box's own axes (size_mm / 2)
+
+    def surface_point(self, point_mm: NDArray) -> tuple[NDArray, NDArray]:
+        """The point of the exact box surface nearest to ``point_mm`` (palm frame, mm) and the
+        box's inward unit normal there.
+
+        Outside the box: the nearest box point, normal from ``point_mm`` toward it. Inside
+        (penetration): the nearest face point, that face's inward normal. (pybullet rounds
+        box edges by its collision margin; contacts are projected onto the exact box.)
+        """
+        R, c, h = self.rotation, self.center_mm, self.half_extents_mm
+        local = R.T @ (np.asarray(point_mm, dtype=float) - c)
+        clamped = np.clip(local, -h, h)
+        gap = local - clamped
+        if np.linalg.norm(gap) > 1e-6:
+            n_local = -gap / np.linalg.norm(gap)
+        else:  # inside: leave through the nearest face
+            k = int(np.argmin(h - np.abs(local)))
+            clamped = local.copy()
+            sign = 1.0 if local[k] >= 0 else -1.0
+            clamped[k] = sign * h[k]
+            n_local = np.zeros(3)
+            n_local[k] = -sign
+        n = R @ n_local
+        return R @ clamped + c, n / np.linalg.norm(n)
+
+
+def object_pose(placement: Placement, size_mm: Sequence[float], alpha_deg: float, beta_deg: float,
+                palm_normal: Sequence[float] = (1.0, 0.0, 0.0)) -> ObjectPose:
+    """Centre and orientation of a box of ``size_mm`` at (α, β) deg.
+
+    α turns about ``palm_normal`` (``synergrasp.hand.kinematics.PALM_NORMAL``), β about the palm z
+    axis, both about the box centre; see :class:`Placement` for the order.
+    """
+    size = np.asarray(size_mm, dtype=float)
+    if size.shape != (3,) or not np.all(size > 0):
+        raise ValueError(f"size_mm must be 3 positive lengths (mm), got {size_mm!r}")
+    R0 = np.zeros((3, 3))
+    for k, edge in enumerate(placement.box_axes):
+        R0[k, edge] = 1.0  # box edge `edge` lies along palm axis k
+    if np.linalg.det(R0) < 0:  # an odd permutation: flip the box's z edge (a box is mirror-symmetric)
+        R0[:, placement.box_axes[2]] *= -1.0
+    Ra = axis_rotation(_unit(palm_normal), math.radians(alpha_deg))
+    Rb = axis_rotation(FINGER_AXIS, math.radians(beta_deg))
+    R = Rb @ Ra @ R0 if placement.rotation_order == "alpha_then_beta" else Ra @ Rb @ R0
+    return ObjectPose(np.array(placement.center_mm, dtype=float), R, size / 2.0)

@@ -1,0 +1,108 @@
+"""The grasp-realism table on hand-made contacts and gfo tables (counts checked by hand),
+and its figure."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from synergrasp import tables
+from synergrasp.analysis.realism import NORMAL_FORCE_COLUMN, grasp_realism, link_categories
+
+# Links of the shipped hand: 0 palm, 3 thumb_distal, 5 index_proximal, 6 index_middle,
+# 7 index_distal, 11 middle_distal, 15 ring_distal, 19 little_distal.
+_POSES = [  # (status, contact links, normal forces N)
+    ("grasp", [3, 7], [0.5, 0.0]),
+    ("grasp", [0, 3, 6, 11], [1.0, 2.0, 0.0, 3.0]),
+    ("intersects_open_hand", [], []),
+    ("grasp", [5, 7, 11, 15, 19, 3, 0], [0.0] * 7),
+]
+
+
+def _contacts(obj: str = "a", poses=_POSES) -> pd.DataFrame:
+    rows = []
+    for pose, (status, links, forces) in enumerate(poses):
+        m = len(links)
+        rows.append({"object": obj, "pose": pose, "alpha_deg": 5.0 * pose, "beta_deg": 0.0, "status": status,
+                     "q": [0.0] * 19, "finger_state": [], "n_contacts": m, "contact_link": links,
+                     "contact_point": [0.0] * 3 * m, "contact_normal": [1.0, 0.0, 0.0] * m,
+                     "jacobian": [0.0] * 57 * m, "object_center": [0.0] * 3, "object_rotation": list(np.eye(3).ravel()),
+                     "max_penetration_mm": 0.0, NORMAL_FORCE_COLUMN: forces})
+    return pd.DataFrame(rows)
+
+
+def _gfo(obj: str = "a") -> pd.DataFrame:
+    full = [(3, False, np.nan), (6, True, 10.0), (0, False, np.nan), (6, True, 30.0)]  # rank_G, fc, |f| N
+    rows = []
+    for pose, (rank, fc, force) in enumerate(full):
+        for set_id, values in (("1-2", (rank, fc, force)), ("1", (6, True, 1000.0))):  # "1" must not be read
+            rows.append({"object": obj, "pose": pose, "alpha_deg": 5.0 * pose, "beta_deg": 0.0, "set_id": set_id,
+                         "n_synergies": len(set_id.split("-")), "status": "force_closure" if values[1] else "infeasible",
+                         "force_closure": values[1], "strict_internal": values[1], "force_norm": values[2], "e_s": 1,
+                         "rank_G": values[0], "n_contacts": 0, "iterations": 1, "solver": "batched"})
+    return pd.DataFrame(rows)
+
+
+def _table(hand, contacts=None, gfo=None, **kw):
+    return grasp_realism(_contacts() if contacts is None else contacts, _gfo() if gfo is None else gfo,
+                         hand.link_names, hand.link_finger, "1-2", {"a": 10.0}, **kw)
+
+
+def test_counts_and_shares_by_hand(hand):
+    table = _table(hand)
+    assert list(table.columns) == list(tables.GRASP_REALISM.names)
+    row = table.iloc[0]
+    assert (row["object"], row["closure_model"]) == ("a", "kinematic")
+    assert (row["poses"], row["simulated"], row["dropped"]) == (4, 3, 1)
+    assert row["dropped_by"] == "intersects_open_hand: 1"
+    assert row["contacts_median"] == 4.0  # m = 2, 4, 7
+    third = 100.0 / 3.0
+    expected_bins = {"pct_m0": 0, "pct_m1": 0, "pct_m2": third, "pct_m3": 0, "pct_m4": third, "pct_m5": 0,
+                     "pct_m6plus": third}
+    for column, value in expected_bins.items():
+        assert row[column] == pytest.approx(value), column
+    assert row["pct_thumb"] == pytest.approx(100.0)  # link 3 in every grasp
+    assert row["pct_palm"] == pytest.approx(2 * third)  # poses 1 and 3
+    assert row["pct_proximal_or_middle"] == pytest.approx(2 * third)  # pose 1 (index_middle), 3 (index_proximal)
+    assert row["pct_rank6"] == pytest.approx(2 * third)  # full set: ranks 3, 6, 6 over the grasps
+    assert row["pct_force_closure"] == pytest.approx(2 * third)
+    assert row["median_force_per_weight"] == pytest.approx(2.0)  # 10/10 and 30/10
+    assert row["loaded_contacts_median"] == 1.0  # 1, 3, 0 contacts with a normal force > 0
+
+
+def test_without_normal_forces_the_loaded_count_is_nan_and_models_group(hand):
+    contacts = _contacts().drop(columns=[NORMAL_FORCE_COLUMN])
+    assert np.isnan(_table(hand, contacts)["loaded_contacts_median"].iloc[0])
+    two = pd.concat([contacts.assign(closure_model="kinematic"), contacts.assign(closure_model="dynamic")])
+    gfo = pd.concat([_gfo().assign(closure_model="kinematic"), _gfo().assign(closure_model="dynamic")])
+    table = _table(hand, two, gfo)
+    assert list(table["closure_model"]) == ["dynamic", "kinematic"]
+    assert list(table["simulated"]) == [3, 3]
+
+
+def test_link_categories_of_the_shipped_hand(hand):
+    cats = link_categories(hand.link_names, hand.link_finger)
+    assert cats["palm"] == {0}
+    assert cats["thumb"] == {1, 2, 3}
+    assert {hand.link_names[i] for i in cats["proximal_or_middle"]} == {
+        "thumb_proximal", *(f"{f}_{s}" for f in ("index", "middle", "ring", "little") for s in ("proximal", "middle"))}
+
+
+def test_missing_weight_or_full_set_is_one_clear_error(hand):
+    with pytest.raises(ValueError, match=r"no weight for object\(s\) \['a'\]"):
+        grasp_realism(_contacts(), _gfo(), hand.link_names, hand.link_finger, "1-2", {"b": 1.0})
+    with pytest.raises(ValueError, match="full_set_id '1-2-3'"):
+        grasp_realism(_contacts(), _gfo(), hand.link_names, hand.link_finger, "1-2-3", {"a": 1.0})
+
+
+def test_figure_is_written_and_the_same_on_rerun(hand, tmp_path):
+    from synergrasp.figures.grasp_realism import figure_grasp_realism
+
+    table = pd.concat([_table(hand), _table(hand).assign(object="b", median_force_per_weight=np.nan)])
+    for run in ("1", "2"):
+        figure_grasp_realism(table, tmp_path / f"r{run}.png", tmp_path / f"r{run}.pdf")
+    for ext in ("png", "pdf"):
+        first = (tmp_path / f"r1.{ext}").read_bytes()
+        assert len(first) > 5000
+        assert first == (tmp_path / f"r2.{ext}").read_bytes()
