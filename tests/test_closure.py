@@ -12,6 +12,7 @@ from synergrasp.simulation.closure import ClosureParams, simulate_object
 from synergrasp.simulation.contacts import read_grasps, write_contacts
 from synergrasp.simulation.placement import Placement, object_pose, pose_grid
 from synergrasp.hand.kinematics import forward_kinematics
+from synergrasp.hand.synergies import SynergyPath
 from synergrasp.simulation.objects import Box
 
 PARAMS = ClosureParams()
@@ -65,8 +66,8 @@ def test_bad_placement_names_the_field(kwargs, field):
 
 
 def test_bad_closure_params_name_the_field():
-    with pytest.raises(ValueError, match="sigma_closed"):
-        ClosureParams(sigma_open=1.0, sigma_closed=0.0)
+    with pytest.raises(ValueError, match="step_mm"):
+        ClosureParams(step_mm=0.1)
     with pytest.raises(ValueError, match="tolerance_mm"):
         ClosureParams(tolerance_mm=0.0)
 
@@ -189,18 +190,61 @@ def test_jacobian_rows_match_finite_differences_of_fk(hand, sample):
     assert checked > 0
 
 
-def test_closing_on_nothing_ends_at_limits_or_blocked_by_the_hand(hand, synergies):
+@pytest.fixture(scope="module")
+def empty_hand(hand, synergies):
+    """Closures with nothing to grasp (the box 600 mm away)."""
     far = Placement(center_mm=(600.0, 0.0, 0.0))
-    table = simulate_object(hand, synergies, CUBE, far, PARAMS, poses=[0, 900])
-    for _, row in table.iterrows():
+    return simulate_object(hand, synergies, CUBE, far, PARAMS, poses=[0, 900])
+
+
+def test_closing_on_nothing_ends_at_limits_or_blocked_by_the_hand(hand, synergies, empty_hand):
+    path = SynergyPath.along(synergies, hand.lower, hand.upper)
+    reference = path.reference(path.closure_range(hand.flexion_joints)[1])
+    for _, row in empty_hand.iterrows():
         assert row.status == "no_contact"
         assert row.n_contacts == 0
         assert set(row.finger_state) <= {"limit", "self"}
         q = np.asarray(row.q)
-        reference = np.clip(synergies.mean + PARAMS.sigma_closed * synergies.matrix[:, 0], hand.lower, hand.upper)
         for f, (state, joints) in enumerate(zip(row.finger_state, hand.finger_joints)):
-            if state == "limit":  # a free finger followed the reference to the end
+            if state == "limit":  # a free finger followed the reference to the end: every joint at a limit
                 np.testing.assert_allclose(q[list(joints)], reference[list(joints)], atol=1e-12)
+
+
+def _link_gap(hand, q, a, b):
+    """Distance (mm) between the capsules of links a and b at q, from the hand's own geometry."""
+    frames = forward_kinematics(hand, q)
+
+    def segment(link):
+        (shape,) = [s for s in hand.link_shapes[link] if s.kind == "capsule"]
+        pose = frames[link] @ shape.pose
+        half = 0.5 * shape.length * pose[:3, 2]
+        return pose[:3, 3] - half, pose[:3, 3] + half, shape.radius
+
+    (p0, p1, ra), (q0, q1, rb) = segment(a), segment(b)
+    t = np.linspace(0.0, 1.0, 401)
+    pa = p0 + t[:, None] * (p1 - p0)
+    pb = q0 + t[:, None] * (q1 - q0)
+    return float(np.min(np.linalg.norm(pa[:, None] - pb[None], axis=2))) - ra - rb
+
+
+def test_closing_on_nothing_pinches_thumb_and_index(hand, empty_hand):
+    """The opposing thumb: with no object the thumb's and the index's distal links end
+    within the contact distance of each other (independent capsule geometry, 401 samples
+    per axis: up to 0.05 mm above the exact distance)."""
+    thumb, index = hand.link_index("thumb_distal"), hand.link_index("index_distal")
+    for _, row in empty_hand.iterrows():
+        gap = _link_gap(hand, np.asarray(row.q), thumb, index)
+        assert -PARAMS.penetration_tolerance_mm <= gap <= PARAMS.contact_distance_mm + 0.05
+
+
+def test_open_path_pinches_thumb_with_index_and_middle(hand, synergies):
+    """Along q_r(σ) itself the thumb's distal link meets the index's and, at some σ, the middle's."""
+    path = SynergyPath.along(synergies, hand.lower, hand.upper)
+    lo, hi = path.closure_range(hand.flexion_joints)
+    thumb = hand.link_index("thumb_distal")
+    for other in ("index_distal", "middle_distal"):
+        gaps = [_link_gap(hand, path.reference(s), thumb, hand.link_index(other)) for s in np.linspace(lo, hi, 121)]
+        assert min(gaps) <= PARAMS.contact_distance_mm, other
 
 
 def test_box_through_the_palm_is_flagged(hand, synergies):
@@ -233,3 +277,45 @@ def test_table_round_trips_through_parquet_into_grasps(sample, tmp_path):
 def test_simulate_object_rejects_poses_off_the_grid(hand, synergies):
     with pytest.raises(ValueError, match="poses"):
         simulate_object(hand, synergies, CUBE, PLACEMENT, PARAMS, poses=[1800])
+
+
+def _final_rows(sample, empty_hand):
+    _, _, tables = sample
+    return [row for table in [*tables.values(), empty_hand] for _, row in table.iterrows()
+            if row.status != "intersects_open_hand"]
+
+
+def test_every_finger_ends_in_contact_blocked_by_the_hand_or_at_its_limits(hand, synergies, sample, empty_hand):
+    from synergrasp.simulation.closure import closure_model
+
+    path = SynergyPath.along(synergies, hand.lower, hand.upper)
+    closed = path.reference(path.closure_range(hand.flexion_joints)[1])
+    model = closure_model(hand, synergies, PARAMS)
+    try:
+        for row in _final_rows(sample, empty_hand):
+            q = np.asarray(row.q)
+            model.scene.set_posture(q)
+            near = model.scene.pair_distances(model.self_pairs, PARAMS.contact_distance_mm)
+            for f, (state, joints, links) in enumerate(zip(row.finger_state, hand.finger_joints, hand.finger_links)):
+                if state == "contact":
+                    assert set(links) & set(int(v) for v in row.contact_link)
+                elif state == "self":
+                    assert any(a in links or b in links for a, b in near), (row.pose, f)
+                else:
+                    assert state == "limit"
+                    np.testing.assert_allclose(q[list(joints)], closed[list(joints)], atol=1e-12)
+    finally:
+        model.close()
+
+
+def test_no_two_hand_links_overlap_at_the_end(hand, synergies, sample, empty_hand):
+    from synergrasp.simulation.closure import closure_model
+
+    model = closure_model(hand, synergies, PARAMS)
+    try:
+        for row in _final_rows(sample, empty_hand):
+            model.scene.set_posture(np.asarray(row.q))
+            gaps = model.scene.pair_distances(model.self_pairs, 0.0)
+            assert min(gaps.values(), default=0.0) >= -PARAMS.tolerance_mm, (row.object, row.pose, gaps)
+    finally:
+        model.close()

@@ -92,7 +92,7 @@ def _broken(path, value, config=SMALL):
         (("solver", "method"), "newton", "'solver': unknown key(s) ['method']"),
         (("analyses", "fig4", "object"), "obj4", "'analyses.fig4': unknown key(s) ['object']"),
         (("placement", "rotation_order"), "any", "allowed values: ['alpha_then_beta', 'beta_then_alpha']"),
-        (("closure", "sigma_closed"), -5.0, "'closure.sigma_closed': -5.0 must exceed closure.sigma_open"),
+        (("closure", "sigma_closed"), 3.0, "'closure': unknown key(s) ['sigma_closed']"),
         (("mechanics", "gravity_direction"), [0, 0, 0], "'mechanics.gravity_direction'"),
         (("synergy_sets", "incremental_max"), 16, "exceeds the 15 synergies"),
         (("hand",), "", "'hand': '' should be non-empty"),

@@ -15,6 +15,7 @@ from synergrasp.hand.synergies import (
     map_human_synergies,
     SynergyPath,
     shipped_path,
+    SHIPPED_TABLES,
     write_synergies,
 )
 
@@ -23,9 +24,10 @@ UPPER = np.radians([90, 90, 90] + [30, 90, 90, 90] * 4)
 LONG_FLEXIONS = [f"{f}_{j}" for f in ("index", "middle", "ring", "little") for j in ("mcp", "pip", "dip")]
 
 
-def test_shipped_file_equals_fresh_mapping():
-    shipped = load_synergies()
-    fresh = map_human_synergies(load_human_synergies(), load_synergy_mapping())
+@pytest.mark.parametrize("table", SHIPPED_TABLES)
+def test_shipped_file_equals_fresh_mapping(table):
+    shipped = load_synergies(table)
+    fresh = map_human_synergies(load_human_synergies(), load_synergy_mapping(table))
     assert shipped.joint_names == JOINT_NAMES == fresh.joint_names
     assert shipped.names == tuple(f"S{i}" for i in range(1, 16))
     np.testing.assert_array_equal(shipped.mean, fresh.mean)
@@ -55,8 +57,31 @@ def test_long_fingers_map_one_to_one_and_s1_closes():
     assert s1["index_abd"] < 0 < s1["ring_abd"] < s1["little_abd"]
 
 
+def test_default_is_softhand_opposed_and_names_resolve(tmp_path):
+    default = load_synergies()
+    np.testing.assert_array_equal(default.matrix, load_synergies("softhand_opposed").matrix)
+    assert not np.array_equal(default.matrix, load_synergies("legacy_thumb").matrix)
+    with pytest.raises(SynergyFileError, match="softhand_opposed"):
+        load_synergies("softhand")
+
+
+def test_softhand_thumb_follows_the_average_finger_flexion():
+    """Thumb rows = (1.3, 1.3, 1.0) x the mean of the 12 long-finger flexion rows, in the mean
+    posture and in every column (hand_model.md: the SoftHand's own synergy)."""
+    s = load_synergies("softhand_opposed")
+    flex = [JOINT_NAMES.index(n) for n in LONG_FLEXIONS]
+    human = load_human_synergies()
+    human_mean = np.mean([human.mean[HUMAN_JOINT_NAMES.index(n)] for n in LONG_FLEXIONS])
+    for name, ratio in (("thumb_abd", 1.3), ("thumb_flex1", 1.3), ("thumb_flex2", 1.0)):
+        j = JOINT_NAMES.index(name)
+        np.testing.assert_allclose(s.matrix[j], ratio * s.matrix[flex].mean(axis=0), atol=1e-12)
+        assert s.mean[j] == pytest.approx(ratio * human_mean)
+    assert s.matrix[JOINT_NAMES.index("thumb_abd"), 0] > 0  # S1 opposes the thumb
+
+
 def test_mean_posture_is_reachable_and_clipped_where_needed():
-    s = load_synergies()
+    assert np.all(load_synergies().mean >= LOWER) and np.all(load_synergies().mean <= UPPER)
+    s = load_synergies("legacy_thumb")
     assert np.all(s.mean >= LOWER) and np.all(s.mean <= UPPER)
     mean = dict(zip(JOINT_NAMES, s.mean))
     assert mean["little_abd"] == pytest.approx(-math.pi / 6)  # human -30.3 deg, clipped
@@ -172,7 +197,8 @@ def test_unreadable_file_gives_one_message_naming_it(tmp_path, name, content):
 
 
 def test_shipped_path_exists():
-    assert shipped_path().is_file()
+    for table in SHIPPED_TABLES:
+        assert shipped_path(table).is_file()
 
 
 def test_mapping_limits_agree_with_hand_model():

@@ -279,9 +279,6 @@ def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -
     of problems (empty: none). One line per problem, naming the key."""
     problems = _grid_problems(config["grid"])
     closure = config["closure"]
-    if "sigma_open" in closure and "sigma_closed" in closure and closure["sigma_closed"] <= closure["sigma_open"]:
-        problems.append(f"config error at 'closure.sigma_closed': {closure['sigma_closed']} must exceed "
-                        f"closure.sigma_open ({closure['sigma_open']})")
     if closure["contact_distance_mm"] < closure["tolerance_mm"]:
         problems.append(f"config error at 'closure.contact_distance_mm': {closure['contact_distance_mm']} "
                         f"must be at least closure.tolerance_mm ({closure['tolerance_mm']})")

@@ -94,8 +94,11 @@ def code(script):
 
 
 def user_files():
-    """User-supplied hand/synergy files: a change of their content reruns what uses them."""
-    return [p for p in (STUDY["hand"], STUDY["synergies"]) if p]
+    """User-supplied hand/synergy files: a change of their content reruns what uses them
+    (a shipped synergy table given by name is under SHIPPED_DATA)."""
+    from synergrasp.hand.synergies import SHIPPED_TABLES
+
+    return [p for p in (STUDY["hand"], STUDY["synergies"]) if p and p not in SHIPPED_TABLES]
 
 
 SHIPPED_DATA = sorted(str(p) for p in (SRC / "data").glob("*") if p.is_file())

@@ -100,6 +100,11 @@ class Hand:
     def n_links(self) -> int:
         return len(self.link_names)
 
+    @property
+    def flexion_joints(self) -> NDArray[np.bool_]:
+        """(n_joints,) True for flexion joints (every joint but the abductions ``*_abd``)."""
+        return np.array([not name.endswith("_abd") for name in self.joint_names])
+
     def link_index(self, name: str) -> int:
         """Index of a link by name; ValueError names the allowed values."""
         try:

@@ -2,10 +2,10 @@
 
 A synergy file is a CSV with one row per hand joint and the columns ``joint``,
 ``mean_rad`` (the mean posture q_m, rad) and ``syn1`` … ``synK`` (synergy vectors, rad per
-unit of the synergy coordinate σ). The shipped file ``data/synergies_19dof.csv`` is
-generated from the human synergies (``data/santello_synergies_20dof.csv``) and the mapping
-``data/synergy_mapping.yaml`` by :func:`map_human_synergies`; regenerate it with
-``python -m synergrasp.hand.synergies``.
+unit of the synergy coordinate σ). The shipped tables, by name (:data:`SHIPPED_TABLES`),
+``data/synergies_<name>.csv``, are generated from the human synergies
+(``data/santello_synergies_20dof.csv``) and the mappings ``data/synergy_mapping_<name>.yaml``
+by :func:`map_human_synergies`; regenerate them with ``python -m synergrasp.hand.synergies``.
 """
 
 from __future__ import annotations
@@ -35,6 +35,8 @@ __all__ = [
     "SynergyPath",
     "write_synergies",
     "shipped_path",
+    "SHIPPED_TABLES",
+    "DEFAULT_TABLE",
 ]
 
 HUMAN_JOINT_NAMES: tuple[str, ...] = (
@@ -46,9 +48,12 @@ HUMAN_JOINT_NAMES: tuple[str, ...] = (
 )
 """Joints of the 20-joint human hand of the human synergy data, in file order."""
 
-SHIPPED_SYNERGIES = "synergies_19dof.csv"
+SHIPPED_TABLES: tuple[str, ...] = ("softhand_opposed", "legacy_thumb")
+"""Shipped synergy tables, by name: the same long fingers; ``softhand_opposed`` couples the
+thumb to the fingers' flexion as on the real SoftHand (it opposes while the hand closes),
+``legacy_thumb`` drives it by the human thumb joints (docs/synergies.md)."""
+DEFAULT_TABLE = "softhand_opposed"
 HUMAN_SYNERGIES = "santello_synergies_20dof.csv"
-SYNERGY_MAPPING = "synergy_mapping.yaml"
 
 
 class SynergyFileError(ValueError):
@@ -105,9 +110,37 @@ def _data_file(name: str) -> Path:
     return Path(str(resources.files("synergrasp") / "data" / name))
 
 
-def shipped_path() -> Path:
-    """Path of the shipped 19-joint synergy file."""
-    return _data_file(SHIPPED_SYNERGIES)
+def _check_table_name(name: str) -> None:
+    if name not in SHIPPED_TABLES:
+        raise SynergyFileError(f"synergies: {name!r} is not a shipped table; allowed names: {list(SHIPPED_TABLES)} "
+                               "(or the path of a CSV file)")
+
+
+def shipped_path(name: str = DEFAULT_TABLE) -> Path:
+    """Path of the shipped 19-joint synergy table ``name`` (one of SHIPPED_TABLES)."""
+    _check_table_name(name)
+    return _data_file(f"synergies_{name}.csv")
+
+
+def mapping_path(name: str = DEFAULT_TABLE) -> Path:
+    """Path of the human-to-hand mapping of the shipped table ``name``."""
+    _check_table_name(name)
+    return _data_file(f"synergy_mapping_{name}.yaml")
+
+
+def resolve_synergies(source: str | Path | None) -> Path:
+    """The CSV file of a ``synergies:`` value: None (the default table), the name of a shipped
+    table (SHIPPED_TABLES) or a path. A value that is neither a name nor an existing file
+    raises SynergyFileError naming both the allowed names and the path tried."""
+    if source is None:
+        return shipped_path()
+    if str(source) in SHIPPED_TABLES:
+        return shipped_path(str(source))
+    path = Path(source)
+    if not path.is_file():
+        raise SynergyFileError(f"synergy file '{source}': is neither a shipped table {list(SHIPPED_TABLES)} "
+                               f"nor an existing CSV file")
+    return path
 
 
 def _syn_names(k: int) -> list[str]:
@@ -177,15 +210,15 @@ def load_synergies(path: str | Path | None = None,
                    joint_names: Sequence[str] = JOINT_NAMES) -> Synergies:
     """Load a synergy file (joint, mean_rad, syn1..synK; rad and rad per unit σ).
 
-    ``path=None`` loads the shipped 19-joint synergies. Rows may come in any order; the
-    result follows ``joint_names``.
+    ``path``: None (the default shipped table), a shipped table's name (SHIPPED_TABLES) or a
+    CSV path. Rows may come in any order; the result follows ``joint_names``.
 
     Raises
     ------
     SynergyFileError
         Naming the file, the field and what is allowed.
     """
-    path = shipped_path() if path is None else Path(path)
+    path = resolve_synergies(path)
     syn_cols, mean, matrix = _read_table(path, joint_names)
     return Synergies(tuple(joint_names), mean, matrix, tuple(f"S{i}" for i in range(1, len(syn_cols) + 1)))
 
@@ -196,8 +229,11 @@ def load_human_synergies(path: str | Path | None = None) -> Synergies:
 
 
 def load_synergy_mapping(path: str | Path | None = None) -> dict[str, Any]:
-    """The human-to-hand joint mapping (YAML, see data/synergy_mapping.yaml); None = shipped."""
-    with open(_data_file(SYNERGY_MAPPING) if path is None else path, encoding="utf-8") as handle:
+    """A human-to-hand joint mapping (YAML, see data/synergy_mapping_<name>.yaml): None (the
+    default table's), a shipped table's name or a path."""
+    if path is None or str(path) in SHIPPED_TABLES:
+        path = mapping_path(DEFAULT_TABLE if path is None else str(path))
+    with open(path, encoding="utf-8") as handle:
         return yaml.safe_load(handle)
 
 
@@ -286,6 +322,24 @@ class SynergyPath:
             raise ValueError(f"sigma must be a scalar or 1-D; got shape {sigma_arr.shape}")
         return np.clip(self.mean + sigma_arr[..., None] * self.direction, self.lower, self.upper)
 
+    def closure_range(self, flexion: ArrayLike) -> tuple[float, float]:
+        """(σ_open, σ_closed) of a closure along this path.
+
+        σ_open: the fully open hand, the largest σ at which every flexion joint (``flexion``,
+        (n,) bool) with a non-zero entry is at its lower limit. σ_closed: the end of the
+        path, the σ from which on every joint with a non-zero entry is clipped at a limit.
+        Raises ValueError if a flexion entry is negative: the synergy must close the hand.
+        """
+        flex = np.asarray(flexion, dtype=bool)
+        moving = self.direction != 0
+        if np.any(self.direction[flex] < 0):
+            raise ValueError("the closing synergy S1 must have flexion entries >= 0 (increasing σ closes "
+                             f"the hand); negative at joint indices {np.flatnonzero(flex & (self.direction < 0)).tolist()}")
+        if not np.any(flex & moving):
+            raise ValueError("the closing synergy S1 moves no flexion joint")
+        lo, hi = self.active_interval()
+        return float(np.min(lo[flex & moving])), float(np.max(hi[moving]))
+
     def active_interval(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Per joint, the σ interval [lo, hi] on which its reference is inside its limits
         (outside it the joint is clipped and does not move); (inf, −inf) where S_k is 0."""
@@ -305,6 +359,6 @@ def write_synergies(synergies: Synergies, path: str | Path) -> None:
 
 
 if __name__ == "__main__":
-    mapped = map_human_synergies(load_human_synergies(), load_synergy_mapping())
-    write_synergies(mapped, shipped_path())
-    print(f"wrote {shipped_path()}")
+    for table in SHIPPED_TABLES:
+        write_synergies(map_human_synergies(load_human_synergies(), load_synergy_mapping(table)), shipped_path(table))
+        print(f"wrote {shipped_path(table)}")

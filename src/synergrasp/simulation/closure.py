@@ -31,7 +31,8 @@ __all__ = ["ClosureParams", "simulate_object", "closure_model"]
 class ClosureParams:
     """Closure settings (docs/closure.md).
 
-    sigma_open, sigma_closed: S1 coordinate of the open and of the fully closed hand.
+    The path itself is not a setting: it runs from the fully open hand to the σ at which
+    every joint moved by S1 is at a limit (``SynergyPath.closure_range``).
     tolerance_mm:             a stopping link ends within this gap of what it touches
                               (the refinement stops once the gap is in [0, tolerance_mm]).
     contact_distance_mm:      a link at most this far from the object counts as touching.
@@ -41,23 +42,18 @@ class ClosureParams:
     step_mm:                  largest travel of any link point per coarse σ step, mm.
     """
 
-    sigma_open: float = -2.0
-    sigma_closed: float = 3.0
     tolerance_mm: float = 0.2
     contact_distance_mm: float = 0.5
     penetration_tolerance_mm: float = 0.5
     step_mm: float = 8.0
 
     def __post_init__(self) -> None:
-        for name in ("sigma_open", "sigma_closed", "tolerance_mm", "contact_distance_mm",
+        for name in ("tolerance_mm", "contact_distance_mm",
                      "penetration_tolerance_mm", "step_mm"):
             v = getattr(self, name)
             if not isinstance(v, (int, float)) or not math.isfinite(v):
                 raise ValueError(f"ClosureParams.{name} must be a finite number, got {v!r}")
             object.__setattr__(self, name, float(v))
-        if not self.sigma_closed > self.sigma_open:
-            raise ValueError(f"ClosureParams.sigma_closed ({self.sigma_closed}) must be greater than "
-                             f"sigma_open ({self.sigma_open})")
         if not 0 < self.tolerance_mm <= 1:
             raise ValueError(f"ClosureParams.tolerance_mm must be in (0, 1] mm, got {self.tolerance_mm}")
         if not self.tolerance_mm <= self.contact_distance_mm <= 5:

@@ -9,11 +9,13 @@ queried (``HandScene``). mm, rad, palm frame.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
+from synergrasp.hand.kinematics import FINGERS
 from synergrasp.hand.synergies import SynergyPath
 from synergrasp.simulation import bullet
 from synergrasp.simulation.contacts import ClosureResult, closure_result
@@ -46,6 +48,8 @@ class KinematicClosure:
         self.s1 = self.path.direction
         # σ interval on which each joint's reference is inside its limits (clipped outside)
         self.active_lo, self.active_hi = self.path.active_interval()
+        # the path: from the fully open hand to where every joint moved by S1 is at a limit
+        self.sigma_open, self.sigma_closed = self.path.closure_range(hand.flexion_joints)
         self.scene = HandScene(hand)
         self.fingers = [(tuple(j), tuple(li)) for j, li in zip(hand.finger_joints, hand.finger_links)]
         self.link_finger_index = np.full(hand.n_links, -1)
@@ -56,8 +60,9 @@ class KinematicClosure:
                 self.link_chain_pos[link] = i
         self.reach = self._finger_reach()
         self._profiles: dict[tuple[int, tuple[int, ...]], tuple[NDArray, NDArray]] = {}
-        self.q_open = self.reference(params.sigma_open)
+        self.q_open = self.reference(self.sigma_open)
         self.self_pairs = self._monitored_pairs()
+        self.long_fingers = {f for f, name in enumerate(FINGERS) if name in _LONG_FINGERS}
 
     def close(self) -> None:
         """Release the pybullet scene."""
@@ -98,19 +103,14 @@ class KinematicClosure:
         return reach
 
     def _monitored_pairs(self) -> tuple[tuple[int, int], ...]:
-        """Self-collision pairs that stop a finger: a finger link against the palm or against a
-        link of another finger, except long finger against long finger (they flex in
-        side-by-side planes and slide along each other) and pairs already overlapping at the
-        open posture (a property of the model, not an event)."""
+        """Hand–hand pairs checked during the closure: a finger link against the palm or
+        against a link of another finger, except the knuckles (they barely move) and pairs
+        already overlapping at the open posture (a property of the model, not an event)."""
         hand = self.hand
         pairs = []
         for i, j in bullet.self_collision_pairs(hand):
-            fi, fj = hand.link_finger[i], hand.link_finger[j]
-            if fi == fj:
+            if hand.link_finger[i] == hand.link_finger[j]:
                 continue
-            if fi in _LONG_FINGERS and fj in _LONG_FINGERS:
-                continue
-            # the knuckles barely move: only the outer links can run into the palm or the thumb
             if any(hand.link_names[k].endswith("_knuckle") for k in (i, j)):
                 continue
             pairs.append((i, j))
@@ -135,8 +135,8 @@ class KinematicClosure:
             idx = list(moving)
             lo, hi = self.active_lo[idx], self.active_hi[idx]
             rate = np.abs(self.s1[idx]) * self.reach[f]  # mm per unit σ while active
-            knots = np.unique(np.clip(np.concatenate([lo, hi, [p.sigma_open, p.sigma_closed]]),
-                                      p.sigma_open, p.sigma_closed))
+            knots = np.unique(np.clip(np.concatenate([lo, hi, [self.sigma_open, self.sigma_closed]]),
+                                      self.sigma_open, self.sigma_closed))
             mids = 0.5 * (knots[:-1] + knots[1:])
             speed = np.array([float(np.sum(rate[(lo <= m) & (hi >= m)])) for m in mids])
             profile = (knots, np.concatenate([[0.0], np.cumsum(speed * np.diff(knots))]))
@@ -146,7 +146,7 @@ class KinematicClosure:
     def advance(self, sigma: float, budget_mm: NDArray, held: NDArray) -> float:
         """Largest σ' ≤ σ_closed such that no point of finger f travels more than
         budget_mm[f] on [σ, σ'] (clipped joints do not move; held joints do not move)."""
-        best = self.params.sigma_closed
+        best = self.sigma_closed
         for f, (joints, _) in enumerate(self.fingers):
             moving = tuple(j for j in joints if not held[j])
             if not moving:
@@ -164,132 +164,178 @@ class KinematicClosure:
         return np.where(held, q_held, self.reference(sigma))
 
     def gaps(self, q: NDArray, moving_links: NDArray, pairs: tuple[tuple[int, int], ...],
-             margin_mm: float) -> tuple[NDArray, NDArray]:
-        """Per link: distance to the box and to the monitored hand links, at posture q (mm)."""
+             margin_mm: float) -> _Gaps:
+        """Per moving link: distance to the box and to the monitored hand links (and which),
+        at posture q (mm; +inf for links that do not move)."""
         self.scene.set_posture(q)
         d_obj = self.scene.object_distance(margin_mm)
-        d_self = self.scene.self_distance(pairs, margin_mm)
+        d_self, partner = self.scene.self_distance(pairs, margin_mm)
         d_obj[~moving_links] = np.inf
         d_self[~moving_links] = np.inf
-        return d_obj, d_self
+        return _Gaps(q, d_obj, d_self, partner)
 
     def run(self) -> tuple[NDArray, list[str], bool]:
-        """Close the hand on the placed box from σ_open. Returns (q, finger_state,
+        """Close the hand on the placed box from σ_open to σ_closed. Returns (q, finger_state,
         intersects_open_hand)."""
         p = self.params
-        hand = self.hand
-        n = hand.n_joints
-        held = np.zeros(n, dtype=bool)
-        q_held = np.zeros(n)
-        touched_obj = np.zeros(len(self.fingers), dtype=bool)
-        touched_self = np.zeros(len(self.fingers), dtype=bool)
+        state = _HoldState(self)
         q = self.q_open.copy()
         self.scene.set_posture(q)
         d_all = self.scene.object_distance(p.contact_distance_mm)
         if np.min(d_all) < -p.penetration_tolerance_mm:
             return q, [], True
-
-        def moving_links() -> NDArray:
-            mv = np.zeros(hand.n_links, dtype=bool)
-            for joints, links in self.fingers:
-                for i, link in enumerate(links):
-                    mv[link] = not held[joints[i]]  # a link moves unless its own joint (and so all proximal) is held
-            return mv
-
-        def hold(links_touching: NDArray, q_now: NDArray) -> None:
-            for link in np.flatnonzero(links_touching):
-                f = self.link_finger_index[link]
-                if f < 0:
-                    continue
-                joints = self.fingers[f][0][: self.link_chain_pos[link] + 1]
-                for j in joints:
-                    if not held[j]:
-                        held[j] = True
-                        q_held[j] = q_now[j]
-
         # links touching (or slightly penetrating) the box in the open posture hold at once
         touching = d_all <= p.contact_distance_mm
         touching[0] = False
-        hold(touching, q)
-        touched_obj[self.link_finger_index[np.flatnonzero(touching)]] = True
-
-        sigma = p.sigma_open
-        mv = moving_links()
-        pairs = tuple(pr for pr in self.self_pairs if mv[pr[0]] or mv[pr[1]])
-        # gaps (margin _QUERY_MARGIN_MM) at the posture of σ, when already known from the
-        # previous step's check or event: every query is made once
-        known: tuple[NDArray, NDArray] | None = None
-        while sigma < p.sigma_closed:
-            if not mv.any():
-                break
-            q = self.posture(sigma, held, q_held)
-            d_obj, d_self = known if known is not None else self.gaps(q, mv, pairs, _QUERY_MARGIN_MM)
-            budget = np.full(len(self.fingers), p.step_mm)
-            for f, (_, links) in enumerate(self.fingers):
-                free = min(float(np.min(d_obj[list(links)])), 0.5 * float(np.min(d_self[list(links)])))
-                budget[f] = max(p.step_mm, min(free, _QUERY_MARGIN_MM))
-            sigma_next = self.advance(sigma, budget, held)
+        state.touch_object(touching, q)
+        sigma = self.sigma_open
+        mv, pairs = self._moving(state)
+        known: _Gaps | None = None  # the gaps at σ when known from the previous step or event
+        while sigma < self.sigma_closed and mv.any():
+            now = known if known is not None else self.gaps(self.posture(sigma, state.held, state.q_held),
+                                                           mv, pairs, _QUERY_MARGIN_MM)
+            sigma_next = self.advance(sigma, self._budget(now), state.held)
             if sigma_next <= sigma:
                 break
-            q_next = self.posture(sigma_next, held, q_held)
-            o_next, s_next = self.gaps(q_next, mv, pairs, _QUERY_MARGIN_MM)
-            if min(o_next.min(), s_next.min()) >= 0.0:
-                sigma, known = sigma_next, (o_next, s_next)
+            after = self.gaps(self.posture(sigma_next, state.held, state.q_held), mv, pairs, _QUERY_MARGIN_MM)
+            if after.smallest >= 0.0:
+                sigma, known = sigma_next, after
                 continue
-            # a moving link crosses something in (σ, σ_next]: find where, to within tolerance_mm
-            lo, hi = sigma, sigma_next
-            d_lo = min(d_obj.min(), d_self.min())
-            d_hi = min(o_next.min(), s_next.min())
-            side = 0
-            o_at, s_at, q_at = None, None, None
-            for _ in range(_MAX_REFINE):
-                # Illinois false position on the smallest gap, bisection when it stalls
-                if np.isfinite(d_lo) and (hi - lo) > 1e-12:
-                    mid = hi - d_hi * (hi - lo) / (d_hi - d_lo)
-                    if not lo < mid < hi:
-                        mid = 0.5 * (lo + hi)
-                else:
-                    mid = 0.5 * (lo + hi)
-                q_mid = self.posture(mid, held, q_held)
-                o_mid, s_mid = self.gaps(q_mid, mv, pairs, _QUERY_MARGIN_MM)
-                d_mid = min(o_mid.min(), s_mid.min())
-                if d_mid < 0.0:
-                    hi, d_hi = mid, d_mid
-                    if side == -1:
-                        d_lo *= 0.5
-                    side = -1
-                else:
-                    lo, d_lo = mid, d_mid
-                    o_at, s_at, q_at = o_mid, s_mid, q_mid
-                    if d_mid <= p.tolerance_mm:
-                        break
-                    if side == +1:
-                        d_hi *= 0.5
-                    side = +1
-            if q_at is None:  # never left σ: the gaps at σ are the event
-                q_at, o_at, s_at = q, d_obj, d_self
-                lo = sigma
-            obj_touch = o_at <= p.contact_distance_mm
-            self_touch = s_at <= p.contact_distance_mm
-            if not (obj_touch.any() or self_touch.any()):
-                # refinement ran out of iterations: hold the closest link so the loop progresses
-                nearest = np.argmin(np.minimum(o_at, s_at))
-                (obj_touch if o_at[nearest] <= s_at[nearest] else self_touch)[nearest] = True
-            hold(obj_touch | self_touch, q_at)
-            for link in np.flatnonzero(obj_touch):
-                touched_obj[self.link_finger_index[link]] = True
-            for link in np.flatnonzero(self_touch):
-                touched_self[self.link_finger_index[link]] = True
-            sigma = lo
-            # the posture at σ is q_at again (the new holds keep q_at's values); a link that
+            sigma, event = self._refine(sigma, now, sigma_next, after, state, mv, pairs)
+            state.touch_object(event.d_obj <= p.contact_distance_mm, event.q)
+            state.touch_hand(event, p.contact_distance_mm)
+            # the posture at σ is the event's again (new holds keep its values); a link that
             # still moves keeps all its pairs, so its gaps are those of the event
-            mv = moving_links()
-            pairs = tuple(pr for pr in self.self_pairs if mv[pr[0]] or mv[pr[1]])
-            o_at, s_at = o_at.copy(), s_at.copy()
-            o_at[~mv] = np.inf
-            s_at[~mv] = np.inf
-            known = (o_at, s_at)
-        q_final = self.posture(min(sigma, p.sigma_closed), held, q_held)
-        state = ["contact" if touched_obj[f] else "self" if touched_self[f] else "limit"
-                 for f in range(len(self.fingers))]
-        return q_final, state, False
+            mv, pairs = self._moving(state)
+            known = event.masked(mv)
+        q_final = self.posture(min(sigma, self.sigma_closed), state.held, state.q_held)
+        return q_final, state.finger_states(), False
+
+    def _moving(self, state: _HoldState) -> tuple[NDArray, tuple[tuple[int, int], ...]]:
+        """Links that still move (their own joint is not held) and the monitored pairs with one."""
+        mv = np.zeros(self.hand.n_links, dtype=bool)
+        for joints, links in self.fingers:
+            for i, link in enumerate(links):
+                mv[link] = not state.held[joints[i]]
+        return mv, tuple(pr for pr in self.self_pairs if mv[pr[0]] or mv[pr[1]])
+
+    def _budget(self, gaps: _Gaps) -> NDArray:
+        """Travel budget (mm) per finger for the next step: max(step_mm, its free distance),
+        at most the query margin; hand gaps count half (both links may move)."""
+        budget = np.full(len(self.fingers), self.params.step_mm)
+        for f, (_, links) in enumerate(self.fingers):
+            free = min(float(np.min(gaps.d_obj[list(links)])), 0.5 * float(np.min(gaps.d_self[list(links)])))
+            budget[f] = max(self.params.step_mm, min(free, _QUERY_MARGIN_MM))
+        return budget
+
+    def _refine(self, sigma: float, now: _Gaps, sigma_next: float, after: _Gaps, state: _HoldState,
+                mv: NDArray, pairs: tuple[tuple[int, int], ...]) -> tuple[float, _Gaps]:
+        """A moving link crosses something in (σ, σ_next]: the last σ before it, where the
+        smallest gap is in [0, tolerance_mm] (Illinois false position, bisection when it
+        stalls), and the gaps there. If nothing is within the contact distance there (the
+        refinement ran out), the closest link is made to touch so the closure progresses."""
+        lo, hi, d_lo, d_hi = sigma, sigma_next, now.smallest, after.smallest
+        side, event = 0, now
+        for _ in range(_MAX_REFINE):
+            mid = 0.5 * (lo + hi)
+            if np.isfinite(d_lo) and (hi - lo) > 1e-12:
+                guess = hi - d_hi * (hi - lo) / (d_hi - d_lo)
+                mid = guess if lo < guess < hi else mid
+            at = self.gaps(self.posture(mid, state.held, state.q_held), mv, pairs, _QUERY_MARGIN_MM)
+            if at.smallest < 0.0:
+                hi, d_hi = mid, at.smallest
+                d_lo = 0.5 * d_lo if side == -1 else d_lo
+                side = -1
+                continue
+            lo, d_lo, event = mid, at.smallest, at
+            if at.smallest <= self.params.tolerance_mm:
+                break
+            d_hi = 0.5 * d_hi if side == +1 else d_hi
+            side = +1
+        touch = self.params.contact_distance_mm
+        if not (np.any(event.d_obj <= touch) or np.any(event.d_self <= touch)):
+            event = event.forced_touch(touch)
+        return (lo if event is not now else sigma), event
+
+
+@dataclass
+class _Gaps:
+    """Gaps of the moving links at posture q (mm): to the box, to the nearest monitored
+    hand link and which link that is (-1 if none)."""
+
+    q: NDArray
+    d_obj: NDArray
+    d_self: NDArray
+    partner: NDArray
+
+    @property
+    def smallest(self) -> float:
+        return float(min(self.d_obj.min(), self.d_self.min()))
+
+    def masked(self, moving: NDArray) -> _Gaps:
+        d_obj, d_self = self.d_obj.copy(), self.d_self.copy()
+        d_obj[~moving] = np.inf
+        d_self[~moving] = np.inf
+        return _Gaps(self.q, d_obj, d_self, self.partner)
+
+    def forced_touch(self, touch_mm: float) -> _Gaps:
+        """The same gaps with the closest link set to touch (``touch_mm``)."""
+        d_obj, d_self = self.d_obj.copy(), self.d_self.copy()
+        k = int(np.argmin(np.minimum(d_obj, d_self)))
+        if d_obj[k] <= d_self[k]:
+            d_obj[k] = min(d_obj[k], touch_mm)
+        else:
+            d_self[k] = min(d_self[k], touch_mm)
+        return _Gaps(self.q, d_obj, d_self, self.partner)
+
+
+class _HoldState:
+    """Which joints are held (and at what angle), and what each finger has touched.
+
+    A link touching the box, the palm or the thumb holds the joints of its chain up to
+    its own. Two long fingers touching each other hold only their abduction joints, and
+    flexion goes on (docs/closure.md); if they touch again with both abductions held, it
+    is a block like any other.
+    """
+
+    def __init__(self, closure: KinematicClosure) -> None:
+        self.c = closure
+        n = closure.hand.n_joints
+        self.held = np.zeros(n, dtype=bool)
+        self.q_held = np.zeros(n)
+        self.object = np.zeros(len(closure.fingers), dtype=bool)
+        self.hand = np.zeros(len(closure.fingers), dtype=bool)
+
+    def _hold(self, joints: tuple[int, ...], q: NDArray) -> None:
+        for j in joints:
+            if not self.held[j]:
+                self.held[j], self.q_held[j] = True, q[j]
+
+    def _hold_chain(self, link: int, q: NDArray) -> int:
+        f = int(self.c.link_finger_index[link])
+        if f >= 0:
+            self._hold(self.c.fingers[f][0][: self.c.link_chain_pos[link] + 1], q)
+        return f
+
+    def touch_object(self, touching: NDArray, q: NDArray) -> None:
+        for link in np.flatnonzero(touching):
+            f = self._hold_chain(int(link), q)
+            if f >= 0:
+                self.object[f] = True
+
+    def touch_hand(self, gaps: _Gaps, touch_mm: float) -> None:
+        c = self.c
+        for link in np.flatnonzero(gaps.d_self <= touch_mm):
+            other = int(gaps.partner[link])
+            fa, fb = int(c.link_finger_index[link]), int(c.link_finger_index[other]) if other >= 0 else -1
+            if fa in c.long_fingers and fb in c.long_fingers:
+                abd = (c.fingers[fa][0][0], c.fingers[fb][0][0])
+                if not (self.held[abd[0]] and self.held[abd[1]]):
+                    self._hold(abd, gaps.q)
+                    continue
+            if self._hold_chain(int(link), gaps.q) >= 0:
+                self.hand[fa] = True
+
+    def finger_states(self) -> list[str]:
+        return ["contact" if self.object[f] else "self" if self.hand[f] else "limit"
+                for f in range(len(self.c.fingers))]

@@ -67,16 +67,20 @@ class HandScene:
             np.minimum.at(d, pts.link_b, pts.distance)
         return d
 
-    def self_distance(self, pairs: tuple[tuple[int, int], ...], margin_mm: float) -> NDArray:
-        """(n_links,) per link the distance to the nearest link it is paired with in ``pairs``
-        at the current posture (mm, negative = overlap; +inf beyond ``margin_mm``)."""
+    def self_distance(self, pairs: tuple[tuple[int, int], ...], margin_mm: float) -> tuple[NDArray, NDArray]:
+        """Per link, the distance (mm, negative = overlap; +inf beyond ``margin_mm``) to the
+        nearest link it is paired with in ``pairs`` at the current posture, and that link
+        (-1 where none): two (n_links,) arrays."""
         d = np.full(self.hand.n_links, np.inf)
+        partner = np.full(self.hand.n_links, -1)
         if pairs:
             pts = bullet.self_closest_points(self.client, self.body, margin_mm, pairs)
-            if len(pts):
-                np.minimum.at(d, pts.link_a, pts.distance)
-                np.minimum.at(d, pts.link_b, pts.distance)
-        return d
+            for a, b, dist in zip(pts.link_a, pts.link_b, pts.distance):
+                if dist < d[a]:
+                    d[a], partner[a] = dist, b
+                if dist < d[b]:
+                    d[b], partner[b] = dist, a
+        return d, partner
 
     def pair_distances(self, pairs: tuple[tuple[int, int], ...], margin_mm: float) -> dict[tuple[int, int], float]:
         """Distance (mm) of each pair of hand links of ``pairs`` closer than ``margin_mm``."""
