@@ -2,7 +2,11 @@
 
 Prints per object the median and 90th-percentile time per grasp over a spread of poses,
 the status counts, the contact-count distribution and how many poses have at least two
-fingers in contact. Last line: ``closure_median_ms: N`` over all objects.
+fingers in contact; for the dynamic closure model (``closure.model: dynamic``, on fewer
+poses: it costs more) the same, then ``closure_dynamic_median_ms: N``. Last line:
+``closure_median_ms: N`` (kinematic model) over all objects.
+
+Usage: bench_closure.py [poses per object, kinematic (300)] [poses per object, dynamic (60)]
 """
 
 from __future__ import annotations
@@ -15,28 +19,28 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from synergrasp.config import defaults, step_params  # noqa: E402
+from synergrasp.config import defaults, step_params, validate_config  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
 from synergrasp.simulation.closure import closure_model  # noqa: E402
 from synergrasp.simulation.placement import object_pose, pose_grid  # noqa: E402
 
 
-#: The study's boxes, placements and closure settings: the configuration's defaults.
-STUDY = defaults()
-
-
-def main(n_poses: int = 300) -> None:
+def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_median_ms") -> None:
+    """The study's boxes, placements and closure settings (the configuration's defaults),
+    closed by ``model``."""
+    study = validate_config({**defaults(), "closure": {**defaults()["closure"], "model": model}})
     hand = load_hand()
     synergies = load_synergies(None, joint_names=hand.joint_names)
-    first = step_params(STUDY, "simulate", next(iter(STUDY["objects"])))
+    first = step_params(study, "simulate", next(iter(study["objects"])))
     grid = pose_grid(first.placement)
     poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
-    closer = closure_model(hand, synergies, first.closure)
+    print(f"closure model: {model}")
+    closer = closure_model(hand, synergies, first.closure, first.mechanics, first.box.mass_kg)
     all_times = []
     try:
-        for name in STUDY["objects"]:
-            sim = step_params(STUDY, "simulate", name)
+        for name in study["objects"]:
+            sim = step_params(study, "simulate", name)
             box, placement = sim.box, sim.placement
             size = np.asarray(box.size_mm, dtype=float)
             times, statuses, counts, two_fingers = [], [], [], 0
@@ -59,8 +63,9 @@ def main(n_poses: int = 300) -> None:
             print(f"  poses with >= 2 fingers in contact: {two_fingers} / {len(poses)}")
     finally:
         closer.close()
-    print(f"closure_median_ms: {np.median(all_times):.2f}")
+    print(f"{key}: {np.median(all_times):.2f}")
 
 
 if __name__ == "__main__":
+    main(int(sys.argv[2]) if len(sys.argv) > 2 else 60, "dynamic", "closure_dynamic_median_ms")
     main(int(sys.argv[1]) if len(sys.argv) > 1 else 300)

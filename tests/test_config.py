@@ -103,7 +103,6 @@ def _broken(path, value, config=SMALL):
         (("grid", "alpha_deg"), {"start": -180, "stop": 180, "step": 30}, "'grid.alpha_deg': alpha is periodic"),
         (("closure", "contact_distance_mm"), 0.1, "'closure.contact_distance_mm': 0.1 must be at least closure.tolerance_mm"),
         (("closure", "step_mm"), 0.2, "'closure.step_mm': 0.2 must exceed closure.tolerance_mm (0.2)"),
-        (("analyses", "fig2_poses"), [[0, 0], [-25, 20]], "'analyses.fig2_poses[1]': (-25, 20) is not a pose of the grid"),
         (("analyses", "fig4", "alpha_slice_deg"), -35, "'analyses.fig4.alpha_slice_deg': -35 is not on grid.alpha_deg"),
         (("analyses", "fig4", "beta_slice_deg"), 10, "'analyses.fig4.beta_slice_deg': 10 is not on grid.beta_deg"),
         (("analyses", "table2_k_max"), 16, "'analyses.table2_k_max': 16 exceeds synergy_sets.incremental_max (15)"),

@@ -28,7 +28,8 @@ def _contacts(obj: str = "a", poses=_POSES) -> pd.DataFrame:
                      "q": [0.0] * 19, "finger_state": [], "n_contacts": m, "contact_link": links,
                      "contact_point": [0.0] * 3 * m, "contact_normal": [1.0, 0.0, 0.0] * m,
                      "jacobian": [0.0] * 57 * m, "object_center": [0.0] * 3, "object_rotation": list(np.eye(3).ravel()),
-                     "max_penetration_mm": 0.0, NORMAL_FORCE_COLUMN: forces})
+                     "max_penetration_mm": 0.0, NORMAL_FORCE_COLUMN: forces, "closure_model": "kinematic",
+                     "object_translation_mm": [0.0] * 3, "object_rotation_deg": 0.0, "settled": True})
     return pd.DataFrame(rows)
 
 
@@ -72,7 +73,8 @@ def test_counts_and_shares_by_hand(hand):
 
 
 def test_without_normal_forces_the_loaded_count_is_nan_and_models_group(hand):
-    contacts = _contacts().drop(columns=[NORMAL_FORCE_COLUMN])
+    contacts = _contacts()  # the kinematic closure records no forces: NaN per contact
+    contacts[NORMAL_FORCE_COLUMN] = [[np.nan] * len(links) for links in contacts["contact_link"]]
     assert np.isnan(_table(hand, contacts)["loaded_contacts_median"].iloc[0])
     two = pd.concat([contacts.assign(closure_model="kinematic"), contacts.assign(closure_model="dynamic")])
     gfo = pd.concat([_gfo().assign(closure_model="kinematic"), _gfo().assign(closure_model="dynamic")])
@@ -106,3 +108,23 @@ def test_figure_is_written_and_the_same_on_rerun(hand, tmp_path):
         first = (tmp_path / f"r1.{ext}").read_bytes()
         assert len(first) > 5000
         assert first == (tmp_path / f"r2.{ext}").read_bytes()
+
+
+def test_representative_grasps_follow_the_stated_rule(hand):
+    from synergrasp.analysis.realism import representative_grasps
+
+    # Patterns: {3, 7} x 3 grasps, {3, 7, 11} x 2, {7, 11, 15} x 1, {3, 7, 11, 15} x 1, one dropped pose.
+    # Contacts 2, 2, 3 (two on link 7), 3, 3, 3, 4: median 3, the typical count.
+    poses = [("grasp", [3, 7], []), ("grasp", [7, 3], []), ("grasp", [3, 7, 7], []),
+             ("grasp", [3, 7, 11], []), ("grasp", [3, 7, 11], []), ("grasp", [7, 11, 15], []),
+             ("grasp", [3, 7, 11, 15], []), ("intersects_open_hand", [], [])]
+    contacts = _contacts(poses=poses)
+    contacts["alpha_deg"] = [40.0, -10.0, 5.0, 0.0, 180.0, 0.0, 0.0, 0.0]
+    contacts["beta_deg"] = [0.0, 0.0, 0.0, 20.0, 0.0, 0.0, 0.0, 0.0]
+    chosen = representative_grasps(contacts, n=3)
+    assert [tuple(p) for p in chosen["pattern"]] == [(3, 7), (3, 7, 11), (7, 11, 15)]
+    assert list(chosen["reason"]) == ["most common contacts", "typical count (m = 3)", "next most common"]
+    # (3, 7): poses 0, 1, 2 at |(α, β)| = 40, 10, 5 -> pose 2; (3, 7, 11): 20 vs 180 -> pose 3.
+    assert list(chosen["pose"]) == [2, 3, 5]
+    np.testing.assert_allclose(chosen["share_pct"], [100 * 3 / 7, 100 * 2 / 7, 100 / 7])
+    assert representative_grasps(contacts[contacts["status"] != "grasp"]).empty

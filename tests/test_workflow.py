@@ -44,8 +44,8 @@ def expected_targets() -> list[str]:
                "fig3_rulegraph", "fig5a_hierarchy_success", "fig5b_hierarchy_force", "grasp_realism")
                for e in ("png", "pdf")]
     tables = [f"results/tables/{t}.{e}" for t in ("success_rates", "table2_success_rates", "hierarchy",
-              "minimum_preservation", "full_not_first7", "verdict_disagreements", "grasp_realism")
-              for e in ("csv", "md")]
+              "minimum_preservation", "full_not_first7", "verdict_disagreements", "preservation_vs_chance",
+              "invariant_checks", "claims", "grasp_realism") for e in ("csv", "md")]
     per_object = [f"results/objects/{o}/{f}" for o in config["objects"] for f in (
         "contacts.parquet", "gfo.parquet", "minima.parquet", "fig4_force_maps.png", "fig4_force_maps.pdf",
         "fig4_exploded.png", "fig4_exploded.pdf")]
@@ -62,8 +62,8 @@ def test_every_target_exists_and_is_not_empty(run_j2):
 def test_tables_have_documented_columns_and_sane_values(run_j2):
     tables = run_j2 / "results" / "tables"
     rates = pd.read_csv(tables / "success_rates.csv")
-    for column in ("object", "set_id", "n_force_closure", "success_rate", "absolute_share",
-                   "mean_force", "median_force"):
+    for column in ("object", "set_id", "n_success", "success_rate", "absolute_share", "success_rate_force_closure",
+                   "success_rate_load_feasible", "force_ratio_median", "plain_mean_force_N", "plain_median_force_N"):
         assert column in rates.columns, column
     defined = rates["success_rate"].dropna()
     assert ((defined >= 0) & (defined <= 100)).all()
@@ -71,13 +71,18 @@ def test_tables_have_documented_columns_and_sane_values(run_j2):
     full = rates[rates["set_id"] == "-".join(str(i) for i in range(1, 16))]
     # the full set is the normalisation: 100 where it ever succeeds, undefined where it never does
     for _, row in full.iterrows():
-        if row["n_force_closure"] > 0:
+        if row["n_success"] > 0:
             assert row["success_rate"] == pytest.approx(100.0)
         else:
             assert pd.isna(row["success_rate"])
     preservation = pd.read_csv(tables / "minimum_preservation.csv")
     share = preservation["preserved_percent"].dropna()
     assert ((share >= 0) & (share <= 100)).all()
+    claims = pd.read_csv(tables / "claims.csv")
+    assert claims["claim"].tolist() == list(range(1, 8))
+    assert set(claims["verdict"]) <= {"holds", "does not hold", "undefined"}
+    checks = pd.read_csv(tables / "invariant_checks.csv")
+    assert (checks.loc[checks["check"] == "alpha_period", "count"] == 0).all()  # results repeat every 90 deg
     gfo = pd.read_parquet(run_j2 / "results" / "objects" / "obj4" / "gfo.parquet")
     assert set(gfo["status"]) <= {"force_closure", "infeasible", "rank_deficient", "no_grasp", "numerical_failure"}
     fc = gfo[gfo["force_closure"]]
@@ -126,5 +131,6 @@ def test_report_holds_every_figure_and_table(run_j2):
     for name in ("fig1_synergy_postures.png", "fig2_example_grasps.png", "fig3_rulegraph.png",
                  "fig4_force_maps.png", "fig4_exploded.png", "fig5a_hierarchy_success.png",
                  "fig5b_hierarchy_force.png", "table2_success_rates.csv", "minimum_preservation.csv",
-                 "full_not_first7.csv", "verdict_disagreements.csv", "grasp_realism.png", "grasp_realism.csv"):
+                 "full_not_first7.csv", "verdict_disagreements.csv", "claims.csv", "preservation_vs_chance.csv",
+                 "invariant_checks.csv", "grasp_realism.png", "grasp_realism.csv"):
         assert name in html, name

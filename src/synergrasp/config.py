@@ -47,6 +47,7 @@ __all__ = [
     "step_config",
     "step_hash",
     "step_params",
+    "placement_params",
     "grid_axis_deg",
     "synergy_sets",
     "incremental_set_id",
@@ -321,10 +322,6 @@ def _pose_problems(config: Mapping[str, Any]) -> list[str]:
     if not _on_grid(fig4["beta_slice_deg"], beta, periodic=False):
         problems.append(f"config error at 'analyses.fig4.beta_slice_deg': {fig4['beta_slice_deg']} is "
                         f"not on grid.beta_deg {grid_axis_deg(beta)}")
-    for i, (a, b) in enumerate(config["analyses"]["fig2_poses"]):
-        if not (_on_grid(a, alpha, periodic=True) and _on_grid(b, beta, periodic=False)):
-            problems.append(f"config error at 'analyses.fig2_poses[{i}]': ({a}, {b}) is not a pose of "
-                            "the grid (grid.alpha_deg, grid.beta_deg)")
     n_poses = len(grid_axis_deg(alpha)) * len(grid_axis_deg(beta))
     if config["solver"]["pose_shards"] > n_poses:
         problems.append(f"config error at 'solver.pose_shards': {config['solver']['pose_shards']} exceeds "
@@ -374,16 +371,19 @@ STEP_KEYS: dict[str, tuple[str, ...]] = {
     "simulate": ("hand", "synergies", "grid", "placement", "closure",
                  "objects.{object}.size_mm", "objects.{object}.placement"),
     "optimise": ("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg"),
-    "minima": ("analyses.minima_radius_deg",),
-    "tables": ("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max"),
+    "minima": ("analyses.minima_radius_deg", "analyses.success"),
+    "tables": ("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max", "analyses.success",
+               "analyses.marginal_weight_multiple", "analyses.success_rate_tolerance_percent",
+               "analyses.null_model", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
     "realism": ("hand", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2"),
     "fig1": ("hand", "synergies"),
-    "fig2": ("hand", "objects.*.size_mm", "analyses.fig2_poses"),
-    "fig4": ("analyses.fig4",),
-    "fig5": ("synergy_sets.hierarchy_first",),
+    "fig2": ("hand", "objects.*.size_mm"),
+    "fig4": ("analyses.fig4", "analyses.success"),
+    "fig5": ("synergy_sets.hierarchy_first", "analyses.success"),
 }
 #: Keys a step reads only when another key has a given value: step -> ((key, value, reads), ...).
 STEP_KEYS_WHEN: dict[str, tuple[tuple[str, Any, tuple[str, ...]], ...]] = {
+    # the dynamic closure: a free box of the object's mass, μ, k_ss and gravity of mechanics
     "simulate": (("closure.model", "dynamic", ("objects.{object}.mass_kg", "mechanics")),),
 }
 #: The step whose outputs a step reads (its hash includes that step's hash).
@@ -460,6 +460,7 @@ class SimulateParams:
     box: Box
     placement: Any  # synergrasp.simulation.placement.Placement
     closure: Any    # synergrasp.simulation.closure.ClosureParams
+    mechanics: dict[str, Any] | None = None  # the mechanics block, where the closure model reads it
 
 
 @dataclass(frozen=True)
@@ -474,14 +475,17 @@ class OptimiseParams:
 
 @dataclass(frozen=True)
 class MinimaParams:
+    """Local minima of one object: neighbourhood radius (deg) and the success verdict."""
     radius_deg: float
+    success: str
 
 
 @dataclass(frozen=True)
 class TablesParams:
+    """The study's tables: the synergy-set bounds, Table II's k_max and the analysis settings."""
     synergy_sets: dict[str, int]
     table2_k_max: int
-    minima_radius_deg: float
+    settings: Any  # synergrasp.analysis.summaries.AnalysisSettings
 
 
 @dataclass(frozen=True)
@@ -498,7 +502,7 @@ class FiguresParams:
     hand: str | None = None
     synergies: str | None = None
     boxes: tuple = ()
-    fig2_poses_deg: tuple[tuple[float, float], ...] = ()
+    success: str = ""
     fig4_panel_k: tuple[int, ...] = ()
     fig4_alpha_slice_deg: float = math.nan
     fig4_beta_slice_deg: float = math.nan
@@ -510,6 +514,7 @@ class FiguresParams:
 STEP_MODULES: dict[str, tuple[str, ...]] = {
     "simulate": ("synergrasp.simulation.closure", "synergrasp.simulation.placement"),
     "optimise": ("synergrasp.optimisation.force_optimisation",),
+    "tables": ("synergrasp.analysis.summaries",),
 }
 
 #: Field of a typed class -> the config key it comes from (messages name the key).
@@ -533,15 +538,22 @@ def _box(config: Mapping[str, Any], name: str) -> Any:
                   mass_kg=spec.get("mass_kg"))
 
 
+def placement_params(placement: Mapping[str, Any], grid: Mapping[str, Any]) -> Any:
+    """The :class:`synergrasp.simulation.placement.Placement` of an effective ``placement``
+    block (the global one with an object's override laid over it) and the ``grid`` block."""
+    placing = importlib.import_module("synergrasp.simulation.placement")
+    ranges = {k: (v["start"], v["stop"], v["step"]) for k, v in grid.items()}
+    return _build(placing.Placement, "placement", **_fields(placing.Placement, {**placement, **ranges}))
+
+
 def _simulate(config: Mapping[str, Any], obj: str) -> SimulateParams:
     closure = importlib.import_module("synergrasp.simulation.closure")
-    placing = importlib.import_module("synergrasp.simulation.placement")
     placement = overlay(config["placement"], config["objects"][obj].get("placement"))
-    grid = {k: (v["start"], v["stop"], v["step"]) for k, v in config["grid"].items()}
     return SimulateParams(
         hand=config["hand"], synergies=config["synergies"], box=_box(config, obj),
-        placement=_build(placing.Placement, "placement", **_fields(placing.Placement, {**placement, **grid})),
-        closure=_build(closure.ClosureParams, "closure", **_fields(closure.ClosureParams, config["closure"])))
+        placement=placement_params(placement, config["grid"]),
+        closure=_build(closure.ClosureParams, "closure", **_fields(closure.ClosureParams, config["closure"])),
+        mechanics=config.get("mechanics"))
 
 
 def _fields(cls: Any, values: Mapping[str, Any]) -> dict[str, Any]:
@@ -568,17 +580,29 @@ def _optimise(config: Mapping[str, Any], obj: str) -> OptimiseParams:
                           int(config["solver"]["pose_shards"]))
 
 
+def _tables(config: Mapping[str, Any]) -> TablesParams:
+    summaries = importlib.import_module("synergrasp.analysis.summaries")
+    objects = {name: {**spec, "placement": overlay(config["placement"], spec.get("placement"))}
+               for name, spec in config["objects"].items()}
+    try:
+        settings = summaries.AnalysisSettings.from_config(config["analyses"], objects, config["grid"], config["hand"],
+                                                          config["mechanics"]["g_m_per_s2"])
+    except (TypeError, ValueError) as err:
+        raise ConfigError(f"config error at 'analyses': {err}") from None
+    return TablesParams(dict(config["synergy_sets"]), int(config["analyses"]["table2_k_max"]), settings)
+
+
 def _figures(config: Mapping[str, Any], step: str) -> FiguresParams:
     if step == "fig1":
         return FiguresParams(hand=config["hand"], synergies=config["synergies"])
     if step == "fig2":
-        return FiguresParams(hand=config["hand"], boxes=tuple(_box(config, n) for n in config["objects"]),
-                             fig2_poses_deg=tuple(tuple(p) for p in config["analyses"]["fig2_poses"]))
+        return FiguresParams(hand=config["hand"], boxes=tuple(_box(config, n) for n in config["objects"]))
+    success = config["analyses"]["success"]
     if step == "fig4":
         fig4 = config["analyses"]["fig4"]
-        return FiguresParams(fig4_panel_k=tuple(fig4["panel_k"]), fig4_alpha_slice_deg=fig4["alpha_slice_deg"],
-                             fig4_beta_slice_deg=fig4["beta_slice_deg"])
-    return FiguresParams(hierarchy_first=config["synergy_sets"]["hierarchy_first"])
+        return FiguresParams(success=success, fig4_panel_k=tuple(fig4["panel_k"]),
+                             fig4_alpha_slice_deg=fig4["alpha_slice_deg"], fig4_beta_slice_deg=fig4["beta_slice_deg"])
+    return FiguresParams(success=success, hierarchy_first=config["synergy_sets"]["hierarchy_first"])
 
 
 def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) -> Any:
@@ -599,10 +623,9 @@ def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) ->
     if step == "optimise":
         return _optimise(config, obj)
     if step == "minima":
-        return MinimaParams(float(config["analyses"]["minima_radius_deg"]))
+        return MinimaParams(float(config["analyses"]["minima_radius_deg"]), config["analyses"]["success"])
     if step == "tables":
-        return TablesParams(dict(config["synergy_sets"]), int(config["analyses"]["table2_k_max"]),
-                            float(config["analyses"]["minima_radius_deg"]))
+        return _tables(config)
     if step == "realism":
         g = config["mechanics"]["g_m_per_s2"]
         return RealismParams(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),

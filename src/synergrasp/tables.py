@@ -77,6 +77,13 @@ CONTACTS = Table("contacts", "one row per pose", _pose_columns() + (
     Column("object_center", "list<float64>", "mm", "box centre, palm frame (3)"),
     Column("object_rotation", "list<float64>", "", "box orientation, row-major rotation matrix (9)"),
     Column("max_penetration_mm", "float64", "mm", "deepest contact penetration"),
+    Column("closure_model", "string", "", "closure model that made the row: kinematic or dynamic"),
+    Column("contact_normal_force_N", "list<float64>", "N",
+           "normal force each contact carries at the settled state (m; NaN for the kinematic model)"),
+    Column("object_translation_mm", "list<float64>", "mm",
+           "settled box centre minus its initial centre, palm frame (3; zero for the kinematic model)"),
+    Column("object_rotation_deg", "float64", "deg", "angle of the box's rotation from its initial orientation"),
+    Column("settled", "bool", "", "the closure ended at rest (false: at the dynamic model's time limit)"),
 ))
 
 GFO = Table("gfo", "one row per (pose, synergy set)", _pose_columns() + (

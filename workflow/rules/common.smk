@@ -124,6 +124,9 @@ TABLES = [
     "minimum_preservation",
     "full_not_first7",
     "verdict_disagreements",
+    "preservation_vs_chance",
+    "invariant_checks",
+    "claims",
 ]
 
 

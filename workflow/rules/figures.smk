@@ -32,7 +32,7 @@ rule fig4_force_maps:
 
 rule fig5_hierarchy:
     input:
-        rates="results/tables/success_rates.csv",
+        hierarchy="results/tables/hierarchy.csv",
         code=code("fig5_hierarchy"),
     output:
         success_png=report(

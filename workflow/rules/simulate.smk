@@ -43,6 +43,8 @@ rule fig2_example_grasps:
     input:
         contacts=expand("results/objects/{object}/contacts.parquet", object=OBJECTS),
         code=code("fig2_example_grasps"),
+        data=SHIPPED_DATA,
+        user=user_files(),
     output:
         png=report(
             "results/figures/fig2_example_grasps.png",

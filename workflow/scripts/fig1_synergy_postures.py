@@ -2,7 +2,7 @@
 from contextlib import redirect_stderr
 
 from synergrasp.config import step_params
-from synergrasp.figures.hand_drawing import figure_synergy_postures
+from synergrasp.figures.hand_figures import figure_synergy_postures
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 

@@ -3,14 +3,15 @@ from contextlib import redirect_stderr
 
 import pandas as pd
 
+from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.config import step_params
 from synergrasp.figures.study_figures import figure_exploded_views, figure_force_maps
 
 with open(snakemake.log[0], "w") as log, redirect_stderr(log):
-    params = step_params(snakemake.params.cfg, "fig4")
-    gfo = pd.read_parquet(snakemake.input.gfo)
+    p = step_params(snakemake.params.cfg, "fig4")
+    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), p.success)
     minima = pd.read_parquet(snakemake.input.minima)
-    name, out = snakemake.wildcards.object, snakemake.output
-    figure_force_maps(gfo, minima, list(params.fig4_panel_k), name, out.maps_png, out.maps_pdf)
-    figure_exploded_views(gfo, list(params.fig4_panel_k), params.fig4_alpha_slice_deg,
-                          params.fig4_beta_slice_deg, name, out.exploded_png, out.exploded_pdf)
+    name, out, panel_k = snakemake.wildcards.object, snakemake.output, list(p.fig4_panel_k)
+    figure_force_maps(gfo, minima, panel_k, name, out.maps_png, out.maps_pdf, p.success)
+    figure_exploded_views(gfo, panel_k, p.fig4_alpha_slice_deg, p.fig4_beta_slice_deg,
+                          name, out.exploded_png, out.exploded_pdf, p.success)

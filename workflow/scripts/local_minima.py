@@ -2,8 +2,9 @@
 import pandas as pd
 
 from synergrasp.analysis.minima import minima_table
+from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.config import step_params
 
 params = step_params(snakemake.params.cfg, "minima")
-gfo = pd.read_parquet(snakemake.input.gfo)
+gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), params.success)
 minima_table(gfo, radius_deg=params.radius_deg).to_parquet(snakemake.output[0], index=False)

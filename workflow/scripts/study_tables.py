@@ -1,16 +1,23 @@
 """The study's tables from every object's optimisation results and local minima."""
+import warnings
 from contextlib import redirect_stderr
 
 import pandas as pd
 
+from synergrasp.analysis.invariants import InvariantWarning
 from synergrasp.analysis.summaries import study_tables
 from synergrasp.config import step_params
 from synergrasp.figures.study_figures import write_table
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+with open(snakemake.log[0], "w") as log, redirect_stderr(log), warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always", InvariantWarning)
     params = step_params(snakemake.params.cfg, "tables")
-    gfo = pd.concat([pd.read_parquet(p) for p in snakemake.input.gfo], ignore_index=True)
-    minima = pd.concat([pd.read_parquet(p) for p in snakemake.input.minima], ignore_index=True)
-    tables = study_tables(gfo, minima, params.synergy_sets, params.table2_k_max, params.minima_radius_deg)
+    gfo = pd.concat([pd.read_parquet(path) for path in snakemake.input.gfo], ignore_index=True)
+    minima = pd.concat([pd.read_parquet(path) for path in snakemake.input.minima], ignore_index=True)
+    tables = study_tables(gfo, minima, params.synergy_sets, params.table2_k_max, params.settings)
     for name, (title, table) in tables.items():
         write_table(table, snakemake.output[f"{name}_csv"], snakemake.output[f"{name}_md"], title=title)
+    for warning in caught:  # the invariant checks on the console, everything in the log
+        print(f"{warning.category.__name__}: {warning.message}", file=log)
+        if issubclass(warning.category, InvariantWarning):
+            print(f"WARNING: {warning.message}")

@@ -115,23 +115,29 @@ def preserved(minima_alpha: ArrayLike, minima_beta: ArrayLike, next_alpha: Array
     return _within(a, b, na, nb, radius_deg, alpha_period_deg).any(axis=1)
 
 
-def minima_table(gfo: pd.DataFrame, radius_deg: float = 10.0, alpha_period_deg: float = 360.0) -> pd.DataFrame:
-    """Every local minimum of every (object, synergy set) of a gfo table, one row each.
+def minima_table(table: pd.DataFrame, radius_deg: float = 10.0, alpha_period_deg: float = 360.0) -> pd.DataFrame:
+    """Every local minimum of every (object, synergy set), one row each.
 
+    ``table``: a gfo table with the columns ``success`` and ``success_force`` of
+    :func:`synergrasp.analysis.verdicts.with_verdicts` (the chosen verdict and the optimal
+    force there, N); a success without an optimal force is left out of the map.
     Columns: object, set_id, n_synergies, pose, alpha_deg, beta_deg, force_norm (N);
     rows sorted by object, n_synergies, set_id, pose.
     """
     missing = [c for c in ("object", "set_id", "n_synergies", "pose", "alpha_deg", "beta_deg",
-                           "force_closure", "force_norm") if c not in gfo.columns]
+                           "success", "success_force") if c not in table.columns]
     if missing:
         raise ValueError(f"gfo table: missing columns {missing}")
     parts = []
-    for _, group in gfo.groupby(["object", "set_id"], sort=False):
-        mask = local_minima(group["alpha_deg"].to_numpy(), group["beta_deg"].to_numpy(),
-                            group["force_norm"].to_numpy(), group["force_closure"].to_numpy(dtype=bool),
+    for _, group in table.groupby(["object", "set_id"], sort=False):
+        force = group["success_force"].to_numpy(float)
+        success = group["success"].to_numpy(dtype=bool) & np.isfinite(force)
+        mask = local_minima(group["alpha_deg"].to_numpy(), group["beta_deg"].to_numpy(), force, success,
                             radius_deg, alpha_period_deg)
-        parts.append(group.loc[mask, list(MINIMA_COLUMNS)])
+        parts.append(group.loc[mask, list(MINIMA_COLUMNS[:-1]) + ["success_force"]]
+                     .rename(columns={"success_force": "force_norm"}))
     if not parts:
-        return pd.DataFrame({c: pd.Series(dtype=gfo[c].dtype) for c in MINIMA_COLUMNS})
+        return pd.DataFrame({c: pd.Series(dtype=table[c].dtype) for c in MINIMA_COLUMNS[:-1]}
+                            | {"force_norm": pd.Series(dtype=float)})
     out = pd.concat(parts, ignore_index=True)
     return out.sort_values(["object", "n_synergies", "set_id", "pose"], ignore_index=True)

@@ -19,7 +19,8 @@ import pandas as pd
 
 from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 
-__all__ = ["CONTACT_BINS", "DEFAULT_CLOSURE_MODEL", "NORMAL_FORCE_COLUMN", "link_categories", "grasp_realism"]
+__all__ = ["CONTACT_BINS", "DEFAULT_CLOSURE_MODEL", "NORMAL_FORCE_COLUMN", "link_categories", "grasp_realism",
+           "representative_grasps"]
 
 #: Contact-count bins of the table: 0, 1, …, 5 and "6 or more".
 CONTACT_BINS: tuple[int, ...] = (0, 1, 2, 3, 4, 5, 6)
@@ -46,14 +47,18 @@ def _touches(links: pd.Series, category: frozenset[int]) -> pd.Series:
 
 
 def _loaded(contacts: pd.DataFrame, threshold_N: float) -> pd.Series:
-    """Contacts per row whose normal force exceeds ``threshold_N``; NaN where unknown."""
+    """Contacts per row whose normal force exceeds ``threshold_N``; NaN where unknown (no
+    column, or NaN forces: the kinematic closure records none)."""
     if NORMAL_FORCE_COLUMN not in contacts.columns:
         return pd.Series(np.nan, index=contacts.index)
 
     def count(forces) -> float:
         if forces is None or (np.isscalar(forces) and pd.isna(forces)):
             return np.nan
-        return float(np.count_nonzero(np.asarray(forces, dtype=float) > threshold_N))
+        values = np.asarray(forces, dtype=float)
+        if np.isnan(values).any():
+            return np.nan
+        return float(np.count_nonzero(values > threshold_N))
 
     return contacts[NORMAL_FORCE_COLUMN].map(count)
 
@@ -130,3 +135,47 @@ def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequenc
     rows = [{"object": obj, "closure_model": cm, **_one_group(group, categories)}
             for (obj, cm), group in work.groupby(["object", "closure_model"], sort=True)]
     return pd.DataFrame(rows, columns=list(GRASP_REALISM.names))
+
+
+def _pattern(links) -> tuple[int, ...]:
+    return tuple(sorted({int(i) for i in links}))
+
+
+def representative_grasps(contacts: pd.DataFrame, n: int = 3) -> pd.DataFrame:
+    """Up to ``n`` grasps of one object that show what its grasps are like, chosen by rule.
+
+    A grasp's contact pattern is the set of hand links touching the box. The choices, in
+    order: (1) the most common pattern; (2) the most common pattern among the grasps with
+    the typical number of contacts (the count nearest the median, the larger on a tie) not
+    shown yet; (3…) the next most common patterns not shown yet. Each pattern is drawn at
+    its pose nearest (α, β) = (0°, 0°) (α wrapped; then the lower pose index). Only
+    simulated grasps (status ``grasp``) with at least one contact count.
+
+    Returns one row per choice: ``pose``, ``alpha_deg``, ``beta_deg``, ``pattern`` (tuple of
+    link indices), ``share_pct`` (percent of the simulated grasps with that pattern) and
+    ``reason`` ("most common contacts", "typical count (m = 4)", "next most common").
+    """
+    grasps = contacts[(contacts["status"] == "grasp") & (contacts["n_contacts"] > 0)]
+    if grasps.empty or n < 1:
+        return pd.DataFrame(columns=["pose", "alpha_deg", "beta_deg", "pattern", "share_pct", "reason"])
+    patterns = grasps["contact_link"].map(_pattern)
+    share = patterns.value_counts(sort=False)
+    order = sorted(share.index, key=lambda p: (-share[p], len(p), p))  # most common first, then fewer links
+    counts = grasps["n_contacts"].astype(int)
+    median = float(counts.median())
+    typical = min(sorted(counts.unique()), key=lambda c: (abs(c - median), -c))
+    chosen: list[tuple[tuple[int, ...], str]] = [(order[0], "most common contacts")]
+    among = [p for p in order if p != order[0] and (counts[patterns == p] == typical).any()]
+    if among:
+        chosen.append((among[0], f"typical count (m = {typical})"))
+    chosen += [(p, "next most common") for p in order if p not in {c for c, _ in chosen}]
+    wrapped = (grasps["alpha_deg"].to_numpy() + 180.0) % 360.0 - 180.0
+    distance = np.hypot(wrapped, grasps["beta_deg"].to_numpy())
+    rows = []
+    for pattern, reason in chosen[:n]:
+        mine = np.flatnonzero((patterns == pattern).to_numpy())
+        best = mine[np.lexsort((grasps["pose"].to_numpy()[mine], distance[mine]))[0]]
+        row = grasps.iloc[best]
+        rows.append({"pose": int(row["pose"]), "alpha_deg": float(row["alpha_deg"]), "beta_deg": float(row["beta_deg"]),
+                     "pattern": pattern, "share_pct": 100.0 * share[pattern] / len(grasps), "reason": reason})
+    return pd.DataFrame(rows)

@@ -5,15 +5,25 @@ documented in docs/analyses.md. Pure functions: DataFrames in, DataFrames out.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
-from synergrasp.config import incremental_set_id, set_id
+from synergrasp.analysis.chance import preservation_vs_chance
+from synergrasp.analysis.claims import claims_table
+from synergrasp.analysis.forces import force_summary
+from synergrasp.analysis.invariants import invariant_checks
 from synergrasp.analysis.minima import preserved
+from synergrasp.analysis.periods import distinct_pose_mask
+from synergrasp.analysis.verdicts import DEFAULT_VERDICT, success_verdict, with_verdicts
+from synergrasp.config import incremental_set_id, set_id
 
 __all__ = [
+    "AnalysisSettings",
     "success_rates",
     "mean_over_objects",
     "incrementality_table",
@@ -39,48 +49,123 @@ def _require(table: pd.DataFrame, name: str, columns: Iterable[str]) -> None:
         raise ValueError(f"{name}: missing columns {missing}")
 
 
-def success_rates(gfo: pd.DataFrame, full_set_id: str) -> pd.DataFrame:
-    """Success rate and force summaries per object and synergy set.
+@dataclass(frozen=True)
+class AnalysisSettings:
+    """What the study's tables need beyond the gfo and minima tables (config ``analyses``;
+    docs/analyses.md).
 
-    Returns one row per (object, set_id) with columns: object, set_id, n_synergies,
-    n_poses, n_force_closure, success_rate (percent of the full set's force-closure count;
-    NaN where the full set has none), full_set_empty (True there), absolute_share (percent
-    of all poses), mean_force and median_force (N, over force-closure poses; NaN if none).
+    success: the verdict the tables use (``force_closure`` | ``load_feasible``).
+    marginal_weight_multiple: a success is marginal above this multiple of the weight.
+    radius_deg: neighbourhood half-width of the local minima, deg.
+    null_draws, null_seed: draws and seed of the preservation null model.
+    success_rate_tolerance_percent: a success rate above 100 % by more than this stops the run.
+    weights_N: object → weight m·g, N. periods_deg: object → α-period, deg.
     """
-    _require(gfo, "gfo table", ("object", "set_id", "n_synergies", "force_closure", "force_norm"))
-    present = sorted(gfo["set_id"].unique(), key=lambda s: (len(s.split("-")), s))
+
+    success: str = DEFAULT_VERDICT
+    marginal_weight_multiple: float = 10.0
+    radius_deg: float = 10.0
+    null_draws: int = 1000
+    null_seed: int = 2018
+    success_rate_tolerance_percent: float = 1.0
+    weights_N: Mapping[str, float] = field(default_factory=dict)
+    periods_deg: Mapping[str, float] = field(default_factory=dict)
+
+    @classmethod
+    def from_config(cls, analyses: Mapping[str, Any], objects: Mapping[str, Mapping[str, Any]],
+                    grid: Mapping[str, Any], hand: str | None, g_m_per_s2: float) -> AnalysisSettings:
+        """From the config's ``analyses`` block, the objects (size_mm, mass_kg and effective
+        placement), the grid, the hand file and g (m/s²); keys absent from ``analyses`` take
+        the defaults above."""
+        from synergrasp.analysis.periods import object_periods
+
+        default = cls()
+        null = analyses.get("null_model", {})
+        return cls(success=success_verdict(analyses),
+                   marginal_weight_multiple=float(analyses.get("marginal_weight_multiple",
+                                                               default.marginal_weight_multiple)),
+                   radius_deg=float(analyses["minima_radius_deg"]),
+                   null_draws=int(null.get("draws", default.null_draws)),
+                   null_seed=int(null.get("seed", default.null_seed)),
+                   success_rate_tolerance_percent=float(analyses.get("success_rate_tolerance_percent",
+                                                                     default.success_rate_tolerance_percent)),
+                   weights_N={name: float(spec["mass_kg"]) * float(g_m_per_s2) for name, spec in objects.items()},
+                   periods_deg=object_periods(objects, grid, hand))
+
+
+def _rate_columns(table: pd.DataFrame, column: str, full_set_id: str) -> pd.DataFrame:
+    """Per (object, set): count of ``column`` and its rate relative to the full set (percent)."""
+    counts = table.groupby(["object", "set_id"], sort=False)[column].sum().rename("n").reset_index()
+    full = counts[counts["set_id"] == full_set_id].set_index("object")["n"]
+    ref = counts["object"].map(full).fillna(0).astype(float)
+    counts["rate"] = 100.0 * counts["n"] / ref.where(ref > 0)
+    return counts
+
+
+#: Columns of the success-rates table, in order (docs/analyses.md).
+RATE_COLUMNS = ("object", "set_id", "n_synergies", "n_poses", "n_success", "success_rate", "full_set_empty",
+                "absolute_share", "success_rate_force_closure", "success_rate_load_feasible", "n_success_distinct",
+                "success_rate_distinct", "n_marginal", "marginal_percent", "force_ratio_median",
+                "force_ratio_median_non_marginal", "n_ratio_undefined", "plain_mean_force_N", "plain_median_force_N",
+                "plain_mean_force_non_marginal_N", "plain_median_force_non_marginal_N")
+
+
+def _distinct_poses(table: pd.DataFrame, periods_deg: Mapping[str, float]) -> NDArray[np.bool_]:
+    """Per row: its pose lies in the first α-period of its object's grid."""
+    distinct = np.zeros(len(table), dtype=bool)
+    for obj, rows in table.groupby("object", sort=False).indices.items():
+        alpha = table["alpha_deg"].to_numpy(float)[rows]
+        distinct[rows] = distinct_pose_mask(alpha, periods_deg.get(obj, 360.0))
+    return distinct
+
+
+def success_rates(table: pd.DataFrame, full_set_id: str, periods_deg: Mapping[str, float] | None = None) -> pd.DataFrame:
+    """Success rates under both verdicts, per distinct pose, and force statistics, per object and set.
+
+    ``table``: a gfo table with the columns of :func:`synergrasp.analysis.verdicts.with_verdicts`;
+    ``periods_deg``: α-period per object (360 if absent). Returns one row per (object,
+    set_id) with the columns ``RATE_COLUMNS`` (docs/analyses.md): the normalised rate
+    (percent of the full set's successes; NaN where the full set has none) under the
+    verdict in use, under each verdict and per distinct pose, and the columns of
+    :func:`synergrasp.analysis.forces.force_summary`.
+    """
+    _require(table, "gfo table", ("object", "set_id", "n_synergies", "pose", "alpha_deg", "success",
+                                  "verdict_force_closure", "verdict_load_feasible", "success_force"))
+    present = sorted(table["set_id"].unique(), key=lambda s: (len(s.split("-")), s))
     if full_set_id not in present:
         raise ValueError(f"full_set_id {full_set_id!r} is not in the gfo table; allowed values: {present}")
-    fc = gfo["force_closure"].astype(bool)
-    work = pd.DataFrame({"object": gfo["object"], "set_id": gfo["set_id"], "n_synergies": gfo["n_synergies"],
-                         "fc": fc, "force": gfo["force_norm"].where(fc)})
-    grouped = work.groupby(["object", "set_id"], sort=False)
-    out = grouped.agg(n_synergies=("n_synergies", "first"), n_poses=("fc", "size"),
-                      n_force_closure=("fc", "sum"), mean_force=("force", "mean"),
-                      median_force=("force", "median")).reset_index()
-    full = out[out["set_id"] == full_set_id].set_index("object")["n_force_closure"]
-    full_count = out["object"].map(full).fillna(0).astype(float)
-    out["full_set_empty"] = full_count == 0
-    out["success_rate"] = np.where(full_count > 0, 100.0 * out["n_force_closure"] / full_count.where(full_count > 0),
-                                   np.nan)
-    out["absolute_share"] = 100.0 * out["n_force_closure"] / out["n_poses"]
-    out["n_force_closure"] = out["n_force_closure"].astype("int64")
-    out = out.sort_values(["object", "set_id"], key=lambda c: set_sort_key(c) if c.name == "set_id" else c,
-                          ignore_index=True)
-    return out[["object", "set_id", "n_synergies", "n_poses", "n_force_closure", "success_rate",
-                "full_set_empty", "absolute_share", "mean_force", "median_force"]]
+    work = table.assign(success_distinct=table["success"].astype(bool) & _distinct_poses(table, periods_deg or {}))
+    keys = ["object", "set_id"]
+    out = work.groupby(keys, sort=False).agg(n_synergies=("n_synergies", "first"),
+                                             n_poses=("success", "size")).reset_index()
+    for name, column in (("", "success"), ("_force_closure", "verdict_force_closure"),
+                         ("_load_feasible", "verdict_load_feasible"), ("_distinct", "success_distinct")):
+        rates = _rate_columns(work, column, full_set_id)
+        out = out.merge(rates.rename(columns={"n": f"n_success{name}", "rate": f"success_rate{name}"}), on=keys)
+    out["full_set_empty"] = out["success_rate"].isna()
+    out["absolute_share"] = 100.0 * out["n_success"] / out["n_poses"]
+    out = out.merge(force_summary(table, full_set_id).drop(columns="n_success"), on=keys)
+    out = out.sort_values(keys, key=lambda c: set_sort_key(c) if c.name == "set_id" else c, ignore_index=True)
+    return out[list(RATE_COLUMNS)].astype({c: "int64" for c in ("n_poses", "n_success", "n_success_distinct")})
+
+
+#: Columns of the success-rates table averaged over objects (mean_over_objects, Fig. 5).
+AVERAGED = ("success_rate", "success_rate_force_closure", "success_rate_load_feasible", "absolute_share",
+            "marginal_percent", "force_ratio_median", "force_ratio_median_non_marginal", "plain_mean_force_N")
 
 
 def mean_over_objects(rates: pd.DataFrame) -> pd.DataFrame:
-    """Per set: success_rate, absolute_share, mean_force averaged over the objects where each
-    is defined (NaN entries skipped), and n_objects (objects in the average of success_rate)."""
-    _require(rates, "rates table", ("set_id", "n_synergies", "success_rate", "absolute_share", "mean_force"))
+    """Per set: the columns of ``AVERAGED`` present in ``rates``, averaged over the objects
+    where each is defined (NaN entries skipped), and n_objects (objects in the average of
+    success_rate)."""
+    _require(rates, "rates table", ("set_id", "n_synergies", "success_rate"))
     rates = rates.assign(set_id=rates["set_id"].astype(str))  # a CSV round trip may read "1" as 1
+    present = [c for c in AVERAGED if c in rates.columns]
     grouped = rates.groupby("set_id", sort=False)
-    out = grouped.agg(n_synergies=("n_synergies", "first"), success_rate=("success_rate", "mean"),
-                      absolute_share=("absolute_share", "mean"), mean_force=("mean_force", "mean"),
-                      n_objects=("success_rate", "count")).reset_index()
-    return out.sort_values("set_id", key=set_sort_key, ignore_index=True)
+    out = grouped[present].mean()
+    out.insert(0, "n_synergies", grouped["n_synergies"].first())
+    out["n_objects"] = grouped["success_rate"].count()
+    return out.reset_index().sort_values("set_id", key=set_sort_key, ignore_index=True)
 
 
 def incrementality_table(rates: pd.DataFrame, k_max: int) -> pd.DataFrame:
@@ -98,14 +183,16 @@ def incrementality_table(rates: pd.DataFrame, k_max: int) -> pd.DataFrame:
     return table.reset_index().rename_axis(columns=None)
 
 
-def hierarchy_matrices(rates_mean_over_objects: pd.DataFrame, first: int = 7) -> pd.DataFrame:
+def hierarchy_matrices(rates_mean_over_objects: pd.DataFrame, first: int = 7,
+                       values: Sequence[str] = ("success_rate", "force_ratio_median", "plain_mean_force_N")
+                       ) -> pd.DataFrame:
     """Fig. 5 data: ``first`` matrices ``first`` × ``first`` in long form.
 
     Cell (i, j) of matrix k is the set {S_k, S_i, S_j}, duplicates collapsing ((k, k) is
     {S_k}; row k, column k and the diagonal are pairs). One row per (k, i, j), 1-based, with
-    set_id, success_rate (percent) and mean_force (N) of that set (NaN if absent).
+    set_id and the ``values`` columns of that set (NaN if absent).
     """
-    _require(rates_mean_over_objects, "rates table", ("set_id", "success_rate", "mean_force"))
+    _require(rates_mean_over_objects, "rates table", ("set_id", *values))
     if rates_mean_over_objects["set_id"].duplicated().any():
         raise ValueError("rates table: one row per set_id is required (average over objects first)")
     if not (isinstance(first, (int, np.integer)) and first >= 1):
@@ -116,129 +203,156 @@ def hierarchy_matrices(rates_mean_over_objects: pd.DataFrame, first: int = 7) ->
         for i in range(1, first + 1):
             for j in range(1, first + 1):
                 sid = set_id((k, i, j))
-                present = sid in by_set.index
-                rows.append({"k": k, "i": i, "j": j, "set_id": sid,
-                             "success_rate": by_set.at[sid, "success_rate"] if present else np.nan,
-                             "mean_force": by_set.at[sid, "mean_force"] if present else np.nan})
-    return pd.DataFrame(rows).astype({"success_rate": float, "mean_force": float})
+                row = {"k": k, "i": i, "j": j, "set_id": sid}
+                row.update({v: by_set.at[sid, v] if sid in by_set.index else np.nan for v in values})
+                rows.append(row)
+    return pd.DataFrame(rows).astype({v: float for v in values})
 
 
 def minimum_preservation(gfo: pd.DataFrame, minima_table: pd.DataFrame, k_max: int,
-                         radius_deg: float = 10.0, alpha_period_deg: float = 360.0) -> pd.DataFrame:
+                         radius_deg: float = 10.0, periods_deg: Mapping[str, float] | None = None) -> pd.DataFrame:
     """Preservation of the local minima of {S1..Sk} in {S1..Sk+1}, k = 1..k_max-1.
 
     One row per object and k, then per object a total over k (k = <NA>), then the same for
     all objects together (object = "all"). Columns: object, k, n_minima, n_preserved,
-    preserved_percent (NaN where there are no minima).
+    preserved_percent (NaN where there are no minima), n_minima_distinct,
+    n_preserved_distinct (the minima in one α-period of the grid, i.e. per distinct pose).
     """
     _require(gfo, "gfo table", ("object",))
     _require(minima_table, "minima table", ("object", "set_id", "alpha_deg", "beta_deg"))
     if not (isinstance(k_max, (int, np.integer)) and k_max >= 2):
         raise ValueError(f"k_max must be an integer >= 2; got {k_max!r}")
+    periods = dict(periods_deg or {})
     objects = sorted(set(gfo["object"]) | set(minima_table["object"]))
+    counts = ["n_minima", "n_preserved", "n_minima_distinct", "n_preserved_distinct"]
     rows = []
     for obj in objects:
         mins = minima_table[minima_table["object"] == obj]
+        alpha_start = float(gfo.loc[gfo["object"] == obj, "alpha_deg"].min()) if (gfo["object"] == obj).any() else None
         for k in range(1, k_max):
             this = mins[mins["set_id"] == incremental_set_id(k)]
             nxt = mins[mins["set_id"] == incremental_set_id(k + 1)]
             kept = preserved(this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float),
-                             nxt["alpha_deg"].to_numpy(float), nxt["beta_deg"].to_numpy(float),
-                             radius_deg, alpha_period_deg)
-            rows.append({"object": obj, "k": k, "n_minima": len(this), "n_preserved": int(kept.sum())})
-    per_k = pd.DataFrame(rows, columns=["object", "k", "n_minima", "n_preserved"])
-    totals = per_k.groupby("object", sort=True)[["n_minima", "n_preserved"]].sum().reset_index()
+                             nxt["alpha_deg"].to_numpy(float), nxt["beta_deg"].to_numpy(float), radius_deg)
+            one = distinct_pose_mask(this["alpha_deg"].to_numpy(float), periods.get(obj, 360.0), alpha_start)
+            rows.append({"object": obj, "k": k, "n_minima": len(this), "n_preserved": int(kept.sum()),
+                         "n_minima_distinct": int(one.sum()), "n_preserved_distinct": int((kept & one).sum())})
+    per_k = pd.DataFrame(rows, columns=["object", "k", *counts])
+    totals = per_k.groupby("object", sort=True)[counts].sum().reset_index()
     totals["k"] = pd.NA
-    all_k = per_k.groupby("k", sort=True)[["n_minima", "n_preserved"]].sum().reset_index()
+    all_k = per_k.groupby("k", sort=True)[counts].sum().reset_index()
     all_k["object"] = ALL_OBJECTS
-    grand = pd.DataFrame([{"object": ALL_OBJECTS, "k": pd.NA, "n_minima": per_k["n_minima"].sum(),
-                           "n_preserved": per_k["n_preserved"].sum()}])
+    grand = pd.DataFrame([{"object": ALL_OBJECTS, "k": pd.NA, **{c: per_k[c].sum() for c in counts}}])
     parts = []
     for obj in objects:
         parts += [per_k[per_k["object"] == obj], totals[totals["object"] == obj]]
     parts += [all_k, grand]
-    out = pd.concat([p for p in parts if len(p)], ignore_index=True)[["object", "k", "n_minima", "n_preserved"]]
-    out = out.astype({"k": "Int64", "n_minima": "int64", "n_preserved": "int64"})
+    out = pd.concat([p for p in parts if len(p)], ignore_index=True)[["object", "k", *counts]]
+    out = out.astype({"k": "Int64", **{c: "int64" for c in counts}})
     out["preserved_percent"] = (100.0 * out["n_preserved"] / out["n_minima"].where(out["n_minima"] > 0)).astype(float)
-    return out
+    return out[["object", "k", "n_minima", "n_preserved", "preserved_percent", "n_minima_distinct",
+                "n_preserved_distinct"]]
 
 
-def full_but_not_first7(gfo: pd.DataFrame, full_set_id: str, first7_set_id: str) -> pd.DataFrame:
-    """Poses where the full set reaches force closure and {S1..S7} does not.
+def full_but_not_first7(table: pd.DataFrame, full_set_id: str, first7_set_id: str) -> pd.DataFrame:
+    """Poses where the full set succeeds and {S1..S7} does not (the chosen verdict).
 
-    Columns: object, pose, alpha_deg, beta_deg, full_force_norm (N), first7_status
-    (the smaller set's status; "missing" if it was not computed at that pose).
+    ``table``: gfo table with the columns of ``with_verdicts``. Columns: object, pose,
+    alpha_deg, beta_deg, full_force_norm (N), first7_status (the smaller set's gfo status;
+    "missing" if it was not computed at that pose), first7_force_closure,
+    first7_load_feasible (its two verdicts).
     """
-    _require(gfo, "gfo table", ("object", "pose", "alpha_deg", "beta_deg", "set_id", "status",
-                                "force_closure", "force_norm"))
-    present = set(gfo["set_id"])
+    _require(table, "gfo table", ("object", "pose", "alpha_deg", "beta_deg", "set_id", "status", "success",
+                                  "force_norm", "verdict_force_closure", "verdict_load_feasible"))
+    present = set(table["set_id"])
     for name, sid in (("full_set_id", full_set_id), ("first7_set_id", first7_set_id)):
         if sid not in present:
             raise ValueError(f"{name} {sid!r} is not in the gfo table; allowed values: {sorted(present)}")
     keys = ["object", "pose"]
-    full = gfo[(gfo["set_id"] == full_set_id) & gfo["force_closure"].astype(bool)]
-    small = gfo.loc[gfo["set_id"] == first7_set_id, keys + ["status", "force_closure"]]
+    full = table[(table["set_id"] == full_set_id) & table["success"].astype(bool)]
+    small = table.loc[table["set_id"] == first7_set_id,
+                      keys + ["status", "success", "verdict_force_closure", "verdict_load_feasible"]]
     merged = full.merge(small, on=keys, how="left", suffixes=("", "_first7"))
-    missing = merged["force_closure_first7"].isna()
-    lost = merged[missing | ~merged["force_closure_first7"].fillna(False).astype(bool)]
+    lost = merged[~merged["success_first7"].astype("boolean").fillna(False).to_numpy(bool)]
     out = pd.DataFrame({
         "object": lost["object"], "pose": lost["pose"], "alpha_deg": lost["alpha_deg"],
         "beta_deg": lost["beta_deg"], "full_force_norm": lost["force_norm"],
         "first7_status": lost["status_first7"].fillna("missing"),
+        "first7_force_closure": lost["verdict_force_closure_first7"].astype("boolean").fillna(False).astype(bool),
+        "first7_load_feasible": lost["verdict_load_feasible_first7"].astype("boolean").fillna(False).astype(bool),
     })
     return out.sort_values(keys, ignore_index=True)
 
 
-def verdict_disagreements(gfo: pd.DataFrame) -> pd.DataFrame:
-    """Where the optimisation verdict (force_closure) and Bicchi's strict internal-force test
-    (strict_internal) disagree, per object and set (only groups with a disagreement).
+def verdict_disagreements(table: pd.DataFrame) -> pd.DataFrame:
+    """Where the two verdicts disagree, per object and set (only groups with a disagreement).
 
-    Columns: object, set_id, n_synergies, n_poses, n_disagree, n_fc_not_strict,
-    n_strict_not_fc, disagree_percent (of the group's poses).
+    Columns: object, set_id, n_synergies, n_poses, n_disagree, n_load_feasible_only
+    (optimisation under the weight feasible, no force closure: the weight helps through
+    f_p), n_force_closure_only (force closure without a feasible optimisation: a solver
+    disagreement, see the invariant checks), disagree_percent (of the group's poses).
     """
-    _require(gfo, "gfo table", ("object", "set_id", "n_synergies", "force_closure", "strict_internal"))
-    fc = gfo["force_closure"].astype(bool)
-    strict = gfo["strict_internal"].astype(bool)
-    work = pd.DataFrame({"object": gfo["object"], "set_id": gfo["set_id"], "n_synergies": gfo["n_synergies"],
-                         "fc_not_strict": fc & ~strict, "strict_not_fc": strict & ~fc})
+    _require(table, "gfo table", ("object", "set_id", "n_synergies", "verdict_force_closure",
+                                  "verdict_load_feasible"))
+    fc = table["verdict_force_closure"].astype(bool)
+    lf = table["verdict_load_feasible"].astype(bool)
+    work = pd.DataFrame({"object": table["object"], "set_id": table["set_id"], "n_synergies": table["n_synergies"],
+                         "lf_only": lf & ~fc, "fc_only": fc & ~lf})
     out = work.groupby(["object", "set_id"], sort=False).agg(
-        n_synergies=("n_synergies", "first"), n_poses=("fc_not_strict", "size"),
-        n_fc_not_strict=("fc_not_strict", "sum"), n_strict_not_fc=("strict_not_fc", "sum")).reset_index()
-    out["n_disagree"] = out["n_fc_not_strict"] + out["n_strict_not_fc"]
+        n_synergies=("n_synergies", "first"), n_poses=("lf_only", "size"),
+        n_load_feasible_only=("lf_only", "sum"), n_force_closure_only=("fc_only", "sum")).reset_index()
+    out["n_disagree"] = out["n_load_feasible_only"] + out["n_force_closure_only"]
     out = out[out["n_disagree"] > 0].copy()
     out["disagree_percent"] = 100.0 * out["n_disagree"] / out["n_poses"]
     out = out.sort_values(["object", "set_id"], key=lambda c: set_sort_key(c) if c.name == "set_id" else c,
                           ignore_index=True)
-    cols = ["object", "set_id", "n_synergies", "n_poses", "n_disagree", "n_fc_not_strict", "n_strict_not_fc",
-            "disagree_percent"]
+    cols = ["object", "set_id", "n_synergies", "n_poses", "n_disagree", "n_load_feasible_only",
+            "n_force_closure_only", "disagree_percent"]
     return out[cols].astype({c: "int64" for c in cols[3:7]})
 
 
-def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: dict, table2_k_max: int,
-                 radius_deg: float = 10.0) -> dict[str, tuple[str, pd.DataFrame]]:
+def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[str, int], table2_k_max: int,
+                 settings: AnalysisSettings = AnalysisSettings()) -> dict[str, tuple[str, pd.DataFrame]]:
     """Every study table by name: (title, table).
 
     ``sets_config`` is the configuration's ``synergy_sets`` (incremental_max,
     hierarchy_first, ...): the full set is {S1..S_incremental_max}, the hierarchy uses the
-    first ``hierarchy_first`` synergies.
+    first ``hierarchy_first`` synergies. Raises :class:`InvariantError` when a success
+    rate exceeds 100 % beyond the tolerance; warns on the other invariant checks.
     """
     k_max = int(sets_config["incremental_max"])
     first = int(sets_config["hierarchy_first"])
     full = incremental_set_id(k_max)
     first_n = incremental_set_id(first)
-    rates = success_rates(gfo, full)
-    if first_n in set(gfo["set_id"]):
-        lost = full_but_not_first7(gfo, full, first_n)
-    else:
-        lost = pd.DataFrame(columns=["object", "pose", "alpha_deg", "beta_deg", "full_force_norm", "first7_status"])
+    table = with_verdicts(gfo, settings.success, settings.weights_N, settings.marginal_weight_multiple)
+    periods = dict(settings.periods_deg)
+    rates = success_rates(table, full, periods)
+    checks = invariant_checks(table, rates, periods, settings.success_rate_tolerance_percent)
+    lost = (full_but_not_first7(table, full, first_n) if first_n in set(table["set_id"]) else None)
+    chance, pairs = preservation_vs_chance(table, minima, k_max, settings.radius_deg, periods,
+                                           settings.null_draws, settings.null_seed)
+    preservation = minimum_preservation(table, minima, k_max, settings.radius_deg, periods)
+    preservation = preservation.merge(pairs.astype({"k": "Int64"}), on=["object", "k"], how="left")
+    means = mean_over_objects(rates)
+    table2 = incrementality_table(rates, table2_k_max)
+    claims = claims_table(incrementality_table(rates, first), None if lost is None else len(lost), chance, means,
+                          rates, first)
+    verdict = f"success = {settings.success}"
     return {
-        "success_rates": ("Success rate and optimal force per object and synergy set", rates),
-        "table2_success_rates": (f"Table II: success rate (%) with {{S1..Sk}}, k = 1..{table2_k_max}",
-                                 incrementality_table(rates, table2_k_max)),
-        "hierarchy": (f"Hierarchy: sets {{S_k, S_i, S_j}} of the first {first} synergies, mean over objects",
-                      hierarchy_matrices(mean_over_objects(rates), first)),
-        "minimum_preservation": ("Local minima of {S1..Sk} preserved in {S1..Sk+1}",
-                                 minimum_preservation(gfo, minima, k_max, radius_deg)),
-        "full_not_first7": (f"Poses where {{S1..S{k_max}}} is force closure and {{S1..S{first}}} is not", lost),
-        "verdict_disagreements": ("Optimisation verdict vs strict internal-force test", verdict_disagreements(gfo)),
+        "success_rates": (f"Success rates (both verdicts) and forces per object and synergy set; {verdict}", rates),
+        "table2_success_rates": (f"Table II: success rate (%) with {{S1..Sk}}, k = 1..{table2_k_max}; {verdict}",
+                                 table2),
+        "hierarchy": (f"Hierarchy: sets {{S_k, S_i, S_j}} of the first {first} synergies, mean over objects; {verdict}",
+                      hierarchy_matrices(means, first)),
+        "minimum_preservation": (f"Local minima of {{S1..Sk}} preserved in {{S1..Sk+1}}; {verdict}", preservation),
+        "preservation_vs_chance": (f"Minimum preservation against the null model ({settings.null_draws} draws, "
+                                   f"seed {settings.null_seed}); {verdict}", chance),
+        "full_not_first7": (f"Poses where {{S1..S{k_max}}} succeeds and {{S1..S{first}}} does not; {verdict}",
+                            lost if lost is not None else pd.DataFrame(columns=[
+                                "object", "pose", "alpha_deg", "beta_deg", "full_force_norm", "first7_status",
+                                "first7_force_closure", "first7_load_feasible"])),
+        "verdict_disagreements": ("Force closure (Definition 1) vs feasibility under the weight",
+                                  verdict_disagreements(table)),
+        "invariant_checks": ("The pipeline's invariant checks on this run", checks),
+        "claims": (f"The study's claims tested on this run; {verdict}", claims),
     }

@@ -27,6 +27,7 @@ __all__ = [
     "figure_force_maps",
     "figure_exploded_views",
     "figure_hierarchy",
+    "FIG5B_RATIO_RANGE",
     "parse_rulegraph",
     "figure_rulegraph",
 ]
@@ -52,17 +53,18 @@ def write_table(table: pd.DataFrame, csv_path: str | Path, md_path: str | Path,
 def force_grid(gfo: pd.DataFrame, set_id: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Optimal force of one synergy set on the (β, α) grid.
 
+    ``gfo`` carries the columns of :func:`synergrasp.analysis.verdicts.with_verdicts`.
     Returns ``(alpha_deg, beta_deg, force)`` with ``force[i_beta, i_alpha]`` in N, NaN
-    where the pose is not force closure.
+    where the pose is not a success of the chosen verdict.
     """
     rows = gfo[gfo["set_id"] == set_id]
     alphas = np.sort(gfo["alpha_deg"].unique())
     betas = np.sort(gfo["beta_deg"].unique())
     force = np.full((betas.size, alphas.size), np.nan)
-    fc = rows[rows["force_closure"]]
+    fc = rows[rows["success"]]
     ia = np.searchsorted(alphas, fc["alpha_deg"].to_numpy())
     ib = np.searchsorted(betas, fc["beta_deg"].to_numpy())
-    force[ib, ia] = fc["force_norm"].to_numpy()
+    force[ib, ia] = fc["success_force"].to_numpy()
     return alphas, betas, force
 
 
@@ -70,10 +72,15 @@ def _set_label(k: int) -> str:
     return "{S1}" if k == 1 else f"{{S1..S{k}}}"
 
 
+def _verdict_label(verdict: str) -> str:
+    return verdict.replace("_", "-")
+
+
 def figure_force_maps(gfo: pd.DataFrame, minima: pd.DataFrame, panel_k: Sequence[int],
-                      object_name: str, png: str | Path, pdf: str | Path) -> None:
+                      object_name: str, png: str | Path, pdf: str | Path, verdict: str = "force_closure") -> None:
     """Fig. 4 (maps): log10 of the optimal force (N) over (α, β), one panel per {S1..Sk};
-    empty cells where there is no force closure, dots on the local minima."""
+    empty cells where the pose is not a success (``verdict``, the name of the success
+    verdict in use, labels the titles), dots on the local minima."""
     grids = [force_grid(gfo, incremental_set_id(k)) for k in panel_k]
     finite = np.concatenate([np.log10(g[2][np.isfinite(g[2])]) for g in grids] + [np.zeros(0)])
     vmin, vmax = (np.percentile(finite, [1, 99]) if finite.size else (0.0, 1.0))
@@ -93,7 +100,7 @@ def figure_force_maps(gfo: pd.DataFrame, minima: pd.DataFrame, panel_k: Sequence
         ax.plot(mins["alpha_deg"], mins["beta_deg"], "o", ms=3.5, mfc="none", mec="red", mew=0.8,
                 label="local minimum")
         n_fc = int(np.isfinite(force).sum())
-        ax.set_title(f"{object_name}, {_set_label(k)}: {n_fc} force-closure poses, "
+        ax.set_title(f"{object_name}, {_set_label(k)}: {n_fc} {_verdict_label(verdict)} poses, "
                      f"{len(mins)} local minima", fontsize=9)
         ax.set_ylabel("β (deg)")
         fig.colorbar(image, ax=ax, label="log10 ‖f‖ (N)", pad=0.01)
@@ -103,10 +110,10 @@ def figure_force_maps(gfo: pd.DataFrame, minima: pd.DataFrame, panel_k: Sequence
 
 def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: float,
                           beta_deg: float, object_name: str, png: str | Path,
-                          pdf: str | Path) -> None:
+                          pdf: str | Path, verdict: str = "force_closure") -> None:
     """Fig. 4 (exploded views): optimal force vs β at α = ``alpha_deg`` and vs α at
-    β = ``beta_deg`` (nearest grid values), one line per {S1..Sk}; gaps where there is no
-    force closure."""
+    β = ``beta_deg`` (nearest grid values), one line per {S1..Sk}; gaps where the pose is
+    not a success of ``verdict``."""
     fig, (ax_b, ax_a) = plt.subplots(1, 2, figsize=(11, 3.8))
     palette = sns.color_palette("viridis", len(panel_k))
     for colour, k in zip(palette, panel_k):
@@ -122,7 +129,7 @@ def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: 
         ax.set_xlim(grid[0], grid[-1])
         ax.set_xlabel(xlabel)
         if not any(np.isfinite(line.get_ydata()).any() for line in ax.get_lines()):
-            ax.text(0.5, 0.5, "no force-closure pose on this slice", transform=ax.transAxes,
+            ax.text(0.5, 0.5, f"no {_verdict_label(verdict)} pose on this slice", transform=ax.transAxes,
                     ha="center", va="center", fontsize=9, color="0.4")
             ax.set_yticks([])
             continue
@@ -134,23 +141,54 @@ def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: 
     _save(fig, png, pdf)
 
 
-def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str,
-                     fmt: str, png: str | Path, pdf: str | Path, log_scale: bool = False) -> None:
+#: Fixed grey range of Fig. 5B: paired force ratio 1 (the full set's force, black) to 10
+#: (white; larger ratios take white too). The ratio is >= 1 up to solver tolerance.
+FIG5B_RATIO_RANGE = (1.0, 10.0)
+#: Colour of hierarchy cells without a value (a set that never succeeds has no force).
+NO_VALUE_COLOUR = "#b9cde5"
+
+
+def _hierarchy_panel(ax: plt.Axes, grid: np.ndarray, norm: matplotlib.colors.Normalize, fmt: str,
+                     labels: list[str]) -> matplotlib.image.AxesImage:
+    """One 7 × 7 matrix in grey (black = low, white = high), its value printed in every cell
+    ("–" where it has none)."""
+    cmap = matplotlib.colormaps["Greys_r"].with_extremes(bad=NO_VALUE_COLOUR)
+    image = ax.imshow(np.ma.masked_invalid(grid), cmap=cmap, norm=norm)
+    for (i, j), value in np.ndenumerate(grid):
+        if np.isfinite(value):
+            shade = float(norm(np.clip(value, norm.vmin, norm.vmax)))
+            ax.text(j, i, format(value, fmt), ha="center", va="center", fontsize=6,
+                    color="black" if shade > 0.5 else "white")
+        else:
+            ax.text(j, i, "–", ha="center", va="center", fontsize=6, color="0.25")
+    ax.set_xticks(range(len(labels)), labels, fontsize=7)
+    ax.set_yticks(range(len(labels)), labels, fontsize=7)
+    ax.set_xticks(np.arange(len(labels) + 1) - 0.5, minor=True)
+    ax.set_yticks(np.arange(len(labels) + 1) - 0.5, minor=True)
+    ax.grid(which="minor", color="0.6", linewidth=0.3)
+    ax.tick_params(which="minor", length=0)
+    return image
+
+
+def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str, fmt: str,
+                     value_range: tuple[float, float], colorbar_label: str, png: str | Path, pdf: str | Path,
+                     log_scale: bool = False) -> None:
     """Fig. 5: ``first`` matrices ``first`` × ``first``, one per first synergy S_k; cell
-    (i, j) of matrix k is the set {S_k, S_i, S_j}. Grey scale, the value in each cell.
+    (i, j) of matrix k is the set {S_k, S_i, S_j}. Grey scale on the fixed ``value_range``
+    (black = its low end, white = its high end; values beyond it take the end's grey), the
+    value printed in every cell.
 
     ``matrices`` has one row per (k, i, j) with 1-based columns ``k``, ``i``, ``j`` and the
-    column ``value``. ``log_scale`` spreads the grey levels logarithmically (mean forces
-    span decades, and one near-infeasible set would otherwise whiten every other cell).
+    column ``value``. ``log_scale`` spaces the grey levels logarithmically.
     """
+    low, high = value_range
+    norm = (matplotlib.colors.LogNorm(vmin=low, vmax=high) if log_scale
+            else matplotlib.colors.Normalize(vmin=low, vmax=high))
     ncols = min(first, 4)
     nrows = int(np.ceil(first / ncols))
-    fig, axes = plt.subplots(nrows, ncols, figsize=(3.3 * ncols, 3.1 * nrows), squeeze=False)
-    values = matrices[value].to_numpy(dtype=float)
-    vmin, vmax = (np.nanmin(values), np.nanmax(values)) if np.isfinite(values).any() else (0, 1)
-    norm = (matplotlib.colors.LogNorm(vmin=max(vmin, 1e-9), vmax=max(vmax, 2e-9))
-            if log_scale else matplotlib.colors.Normalize(vmin=vmin, vmax=vmax))
+    fig, axes = plt.subplots(nrows, ncols, figsize=(3.1 * ncols + 0.8, 3.1 * nrows), squeeze=False)
     labels = [f"S{i}" for i in range(1, first + 1)]
+    image = None
     for index, ax in enumerate(axes.flat):
         if index >= first:
             ax.axis("off")
@@ -159,13 +197,16 @@ def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str,
         sub = matrices[matrices["k"] == k]
         grid = np.full((first, first), np.nan)
         grid[sub["i"].to_numpy() - 1, sub["j"].to_numpy() - 1] = sub[value].to_numpy(dtype=float)
-        sns.heatmap(grid, ax=ax, cmap="Greys", norm=norm, annot=True, fmt=fmt,
-                    annot_kws={"fontsize": 6}, cbar=False, square=True,
-                    xticklabels=labels, yticklabels=labels, linewidths=0.3, linecolor="0.8")
+        image = _hierarchy_panel(ax, grid, norm, fmt, labels)
         ax.set_title(f"first synergy S{k}", fontsize=9)
-        ax.tick_params(labelsize=7)
     fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 0.93, 1))
+    if image is not None:
+        bar = fig.colorbar(image, ax=list(axes.flat), label=colorbar_label, fraction=0.02, pad=0.02)
+        if log_scale:  # plain numbers, not powers of ten
+            ticks = [t for t in (1, 1.5, 2, 3, 5, 7, 10, 20, 50, 100) if low <= t <= high]
+            bar.set_ticks(ticks, labels=[f"{t:g}" for t in ticks])
+            bar.ax.minorticks_off()
     _save(fig, png, pdf)
 
 

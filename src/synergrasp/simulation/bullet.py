@@ -82,25 +82,7 @@ def load_hand_body(client: int, hand: Hand) -> HandBody:
         body = pb.loadURDF(str(path), basePosition=[0, 0, 0], baseOrientation=[0, 0, 0, 1],
                            useFixedBase=True, flags=pb.URDF_USE_INERTIA_FROM_FILE,
                            physicsClientId=client)
-    by_joint_name: dict[str, int] = {}
-    by_link_name: dict[str, int] = {}
-    for j in range(pb.getNumJoints(body, physicsClientId=client)):
-        info = pb.getJointInfo(body, j, physicsClientId=client)
-        by_joint_name[info[1].decode()] = j
-        by_link_name[info[12].decode()] = j
-    n_frames = len(hand.frame_names)
-    joint_indices = np.array([by_joint_name[hand.frame_joint_names[f]] for f in range(1, n_frames)])
-    link_index = np.array([-1] + [by_link_name[name] for name in hand.link_names[1:]])
-    hand_link = {int(b): i for i, b in enumerate(link_index)}
-    return HandBody(
-        body=body,
-        hand=hand,
-        joint_indices=joint_indices,
-        joint_q=hand.frame_joint[1:].copy(),
-        joint_scale=hand.frame_scale[1:].copy(),
-        link_index=link_index,
-        hand_link=hand_link,
-    )
+    return _hand_body(client, body, hand)
 
 
 def set_posture(client: int, body: HandBody, q: NDArray) -> None:
@@ -267,3 +249,192 @@ def self_closest_points(client: int, body: HandBody, distance_mm: float,
                                        linkIndexA=int(body.link_index[i]), linkIndexB=int(body.link_index[j]),
                                        physicsClientId=client))
     return _closest(body, body, pts)
+
+
+# --------------------------------------------------------------------------------------
+# Dynamics: the compliant hand and a free box (synergrasp.simulation.dynamic_closure)
+# --------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class ContactForces:
+    """Contact points of the last physics step between two bodies (m rows), mm, N, palm frame.
+
+    ``link_a`` / ``link_b`` as in :class:`ClosestPoints`; ``normal_on_b`` points from B toward
+    A; ``normal_force`` is the constraint force along it (N, ≥ 0).
+    """
+
+    link_a: NDArray[np.int64]
+    link_b: NDArray[np.int64]
+    point_a: NDArray[np.float64]
+    point_b: NDArray[np.float64]
+    normal_on_b: NDArray[np.float64]
+    distance: NDArray[np.float64]
+    normal_force: NDArray[np.float64]
+
+    def __len__(self) -> int:
+        return len(self.distance)
+
+
+def load_compliant_hand(client: int, hand: Hand, link_mass_kg: float, link_inertia_kg_mm2: float,
+                        friction: float) -> HandBody:
+    """Load ``hand`` for dynamics: fixed palm at the origin, self-collision possible (choose the
+    pairs with ``set_self_collision``), every elementary link
+    with mass ``link_mass_kg`` and inertia ``link_inertia_kg_mm2`` (kg·mm², about its own
+    frame), lateral friction ``friction``, no Bullet damping, joint motors released."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "hand.urdf"
+        write_urdf(hand, path)
+        uid = pb.loadURDF(str(path), basePosition=[0, 0, 0], baseOrientation=[0, 0, 0, 1], useFixedBase=True,
+                          flags=pb.URDF_USE_INERTIA_FROM_FILE | pb.URDF_USE_SELF_COLLISION,
+                          physicsClientId=client)
+    body = _hand_body(client, uid, hand)
+    n = pb.getNumJoints(uid, physicsClientId=client)
+    inertia = link_inertia_kg_mm2 * MM * MM
+    for link in range(-1, n):
+        pb.changeDynamics(uid, link, lateralFriction=float(friction), linearDamping=0.0, angularDamping=0.0,
+                          jointDamping=0.0, physicsClientId=client)
+        if link >= 0:
+            pb.changeDynamics(uid, link, mass=float(link_mass_kg), localInertiaDiagonal=[inertia] * 3,
+                              physicsClientId=client)
+    pb.setJointMotorControlArray(uid, list(range(n)), pb.VELOCITY_CONTROL, forces=[0.0] * n,
+                                 physicsClientId=client)
+    return body
+
+
+def set_self_collision(client: int, body: HandBody, pairs: tuple[tuple[int, int], ...]) -> None:
+    """Exactly the hand link pairs ``pairs`` (hand link indices) collide with each other during
+    dynamics (the hand must come from ``load_compliant_hand``)."""
+    wanted = {(min(i, j), max(i, j)) for i, j in pairs}
+    n = body.hand.n_links
+    for i in range(n):
+        for j in range(i + 1, n):
+            pb.setCollisionFilterPair(body.body, body.body, int(body.link_index[i]), int(body.link_index[j]),
+                                      int((i, j) in wanted), physicsClientId=client)
+
+
+def _hand_body(client: int, uid: int, hand: Hand) -> HandBody:
+    by_joint_name: dict[str, int] = {}
+    by_link_name: dict[str, int] = {}
+    for j in range(pb.getNumJoints(uid, physicsClientId=client)):
+        info = pb.getJointInfo(uid, j, physicsClientId=client)
+        by_joint_name[info[1].decode()] = j
+        by_link_name[info[12].decode()] = j
+    joint_indices = np.array([by_joint_name[hand.frame_joint_names[f]] for f in range(1, len(hand.frame_names))])
+    link_index = np.array([-1] + [by_link_name[name] for name in hand.link_names[1:]])
+    return HandBody(body=uid, hand=hand, joint_indices=joint_indices, joint_q=hand.frame_joint[1:].copy(),
+                    joint_scale=hand.frame_scale[1:].copy(), link_index=link_index,
+                    hand_link={int(b): i for i, b in enumerate(link_index)})
+
+
+def set_dynamics(client: int, time_step_s: float, solver_iterations: int) -> None:
+    """Time step (s) and constraint-solver iterations of the client; no gravity (a body's weight
+    is applied as an explicit force, ``apply_force``)."""
+    pb.setGravity(0.0, 0.0, 0.0, physicsClientId=client)
+    pb.setPhysicsEngineParameter(fixedTimeStep=float(time_step_s), numSolverIterations=int(solver_iterations),
+                                 numSubSteps=0, deterministicOverlappingPairs=1, physicsClientId=client)
+
+
+def apply_force(client: int, body: int, force_N: NDArray) -> None:
+    """Apply ``force_N`` (N, palm frame) at a body's centre of mass during the next step."""
+    pos, _ = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+    pb.applyExternalForce(body, -1, [float(v) for v in force_N], pos, pb.WORLD_FRAME, physicsClientId=client)
+
+
+def load_free_box(client: int, size_mm: NDArray, mass_kg: float, friction: float, damping_per_s: float) -> int:
+    """A free (dynamic) box of edge lengths ``size_mm`` and mass ``mass_kg``, uniform inertia,
+    lateral friction ``friction``, linear and angular drag at the rate ``damping_per_s`` (1/s).
+    Place it with ``move_body``; returns its body id."""
+    size = np.asarray(size_mm, dtype=float)
+    if size.shape != (3,) or np.any(size <= 0):
+        raise ValueError(f"size_mm must be 3 positive lengths (mm), got {size_mm!r}")
+    shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(0.5 * size * MM).tolist(), physicsClientId=client)
+    body = pb.createMultiBody(baseMass=float(mass_kg), baseCollisionShapeIndex=shape, physicsClientId=client)
+    pb.changeDynamics(body, -1, lateralFriction=float(friction), linearDamping=float(damping_per_s),
+                      angularDamping=float(damping_per_s), physicsClientId=client)
+    return body
+
+
+def reset_hand(client: int, body: HandBody, q: NDArray) -> None:
+    """Put the hand at joint angles q (19, rad) at rest (zero joint velocities)."""
+    q = np.asarray(q, dtype=float)
+    values = body.joint_scale * q[body.joint_q]
+    pb.resetJointStatesMultiDof(body.body, body.joint_indices.tolist(), [[float(v)] for v in values],
+                                targetVelocities=[[0.0]] * len(values), physicsClientId=client)
+
+
+def reset_body(client: int, body: int, center_mm: NDArray, rotation: NDArray) -> None:
+    """Place a free body at ``center_mm`` with orientation ``rotation`` (3 × 3), at rest."""
+    move_body(client, body, center_mm, rotation)
+    pb.resetBaseVelocity(body, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], physicsClientId=client)
+
+
+def axis_states(client: int, body: HandBody) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Angles (rad) and angular velocities (rad/s) of every elementary axis, HandBody order."""
+    states = pb.getJointStates(body.body, body.joint_indices.tolist(), physicsClientId=client)
+    return np.array([s[0] for s in states]), np.array([s[1] for s in states])
+
+
+def body_state(client: int, body: int) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Centre (mm), rotation (3 × 3), linear velocity (mm/s) and angular velocity (rad/s) of a body."""
+    pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+    lin, ang = pb.getBaseVelocity(body, physicsClientId=client)
+    rotation = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
+    return np.array(pos) / MM, rotation, np.array(lin) / MM, np.array(ang)
+
+
+def contact_forces(client: int, body_a: int | HandBody, body_b: HandBody) -> ContactForces:
+    """The contact points of the last step between body A and the hand B, with normal forces (N).
+    With the hand as A too: its contacts with itself (both link columns are hand links)."""
+    a = body_a.body if isinstance(body_a, HandBody) else body_a
+    pts = pb.getContactPoints(a, body_b.body, physicsClientId=client)
+    if not pts:
+        e = np.zeros((0, 3))
+        return ContactForces(np.zeros(0, np.int64), np.zeros(0, np.int64), e, e.copy(), e.copy(), np.zeros(0),
+                             np.zeros(0))
+    return ContactForces(
+        link_a=_to_hand_links(body_a, [p[3] for p in pts]),
+        link_b=_to_hand_links(body_b, [p[4] for p in pts]),
+        point_a=np.array([p[5] for p in pts]) / MM,
+        point_b=np.array([p[6] for p in pts]) / MM,
+        normal_on_b=np.array([p[7] for p in pts]),
+        distance=np.array([p[8] for p in pts]) / MM,
+        normal_force=np.array([p[9] for p in pts]),
+    )
+
+
+def step_with_motors(client: int, body: HandBody, targets_rad: NDArray, max_torques_Nmm: NDArray,
+                     position_gain: float) -> None:
+    """Drive every elementary axis toward ``targets_rad`` with the engine's position motor
+    (target speed ``position_gain`` · error / time step, velocity gain 1) whose torque is
+    bounded by ``max_torques_Nmm`` (N·mm, one per axis, HandBody order); take one step."""
+    n = len(body.joint_indices)
+    pb.setJointMotorControlArray(body.body, body.joint_indices.tolist(), pb.POSITION_CONTROL,
+                                 targetPositions=[float(v) for v in targets_rad],
+                                 targetVelocities=[0.0] * n,
+                                 forces=(np.asarray(max_torques_Nmm, dtype=float) * MM).tolist(),
+                                 positionGains=[float(position_gain)] * n, velocityGains=[1.0] * n,
+                                 physicsClientId=client)
+    pb.stepSimulation(physicsClientId=client)
+
+
+def step_with_torques(client: int, body: HandBody, torques_Nmm: NDArray) -> None:
+    """Apply ``torques_Nmm`` (N·mm, one per elementary axis, HandBody order) and take one step."""
+    pb.setJointMotorControlArray(body.body, body.joint_indices.tolist(), pb.TORQUE_CONTROL,
+                                 forces=(np.asarray(torques_Nmm, dtype=float) * MM).tolist(), physicsClientId=client)
+    pb.stepSimulation(physicsClientId=client)
+
+
+def contact_force_vectors(client: int, body_a: int | HandBody, body_b: HandBody) -> tuple[NDArray, NDArray, NDArray]:
+    """Per contact point of the last step between A and the hand B: hand links of A and B
+    (-1 where A is not the hand), the point on B (mm) and the total force B applies to A
+    (normal plus the two friction components, N, palm frame)."""
+    a = body_a.body if isinstance(body_a, HandBody) else body_a
+    pts = pb.getContactPoints(a, body_b.body, physicsClientId=client)
+    links_a = _to_hand_links(body_a, [p[3] for p in pts]) if isinstance(body_a, HandBody) else np.full(len(pts), -1)
+    links = np.stack([links_a, _to_hand_links(body_b, [p[4] for p in pts])], axis=1) if pts else np.zeros((0, 2), np.int64)
+    points = np.array([p[6] for p in pts]).reshape(-1, 3) / MM
+    # pybullet's friction components act on B along its lateral directions: on A, opposite
+    # (checked by the soft-synergy balance at rest, tests/test_dynamic_closure.py)
+    force = np.array([p[9] * np.array(p[7]) - p[10] * np.array(p[11]) - p[12] * np.array(p[13])
+                      for p in pts]).reshape(-1, 3)
+    return links, points, force

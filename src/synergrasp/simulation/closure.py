@@ -10,7 +10,7 @@ synergies and :class:`ClosureParams`, and gives a ``ClosureResult`` per placed b
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -18,13 +18,18 @@ import numpy as np
 import pandas as pd
 
 from synergrasp.simulation.contacts import contacts_row, contacts_table
+from synergrasp.simulation.dynamic_closure import DynamicParams
 from synergrasp.simulation.placement import Placement, object_pose, pose_grid
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
 
-__all__ = ["ClosureParams", "simulate_object", "closure_model"]
+__all__ = ["CLOSURE_MODELS", "ClosureParams", "simulate_object", "closure_model"]
+
+#: ``kinematic``: the quasi-static closure (links stop at first touch, the box fixed);
+#: ``dynamic``: the compliant hand closing on a free box (``dynamic_closure``).
+CLOSURE_MODELS: tuple[str, ...] = ("kinematic", "dynamic")
 
 
 @dataclass(frozen=True)
@@ -40,14 +45,22 @@ class ClosureParams:
                               the open hand deeper than this; also the largest accepted
                               penetration of a recorded contact.
     step_mm:                  largest travel of any link point per coarse σ step, mm.
+    model:                    one of CLOSURE_MODELS.
+    dynamic:                  settings of the dynamic model (``DynamicParams``).
     """
 
     tolerance_mm: float = 0.2
     contact_distance_mm: float = 0.5
     penetration_tolerance_mm: float = 0.5
     step_mm: float = 8.0
+    model: str = "kinematic"
+    dynamic: DynamicParams = DynamicParams()
 
     def __post_init__(self) -> None:
+        if self.model not in CLOSURE_MODELS:
+            raise ValueError(f"closure.model must be one of {list(CLOSURE_MODELS)}, got {self.model!r}")
+        if isinstance(self.dynamic, Mapping):
+            object.__setattr__(self, "dynamic", DynamicParams.from_config(self.dynamic))
         for name in ("tolerance_mm", "contact_distance_mm",
                      "penetration_tolerance_mm", "step_mm"):
             v = getattr(self, name)
@@ -66,15 +79,25 @@ class ClosureParams:
             raise ValueError(f"ClosureParams.step_mm must be greater than tolerance_mm, got {self.step_mm}")
 
 
-def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams):
-    """The closure model of ``params`` on a new pybullet scene of ``hand``."""
+def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams,
+                  mechanics: Mapping[str, Any] | None = None, mass_kg: float | None = None):
+    """The closure model of ``params`` on a new pybullet scene of ``hand``; the dynamic model
+    also needs the config's ``mechanics`` block (k_ss, μ, gravity) and the box's mass (kg)."""
+    if params.model == "dynamic":
+        from synergrasp.simulation.dynamic_closure import DynamicClosure
+
+        if mechanics is None or mass_kg is None:
+            raise ValueError("closure.model: dynamic needs the mechanics block (k_ss_Nmm_per_rad, mu, gravity) "
+                             "and the object's mass_kg")
+        return DynamicClosure(hand, synergies, params, mechanics, mass_kg)
     from synergrasp.simulation.kinematic_closure import KinematicClosure
 
     return KinematicClosure(hand, synergies, params)
 
 
 def simulate_object(hand: Hand, synergies: Synergies, box: Any, placement: Placement,
-                    closure_params: ClosureParams, poses: Iterable[int] | None = None) -> pd.DataFrame:
+                    closure_params: ClosureParams, poses: Iterable[int] | None = None,
+                    mechanics: Mapping[str, Any] | None = None) -> pd.DataFrame:
     """Close the hand on ``box`` at every pose of the placement's grid (or at ``poses``).
 
     Returns the contacts table (``synergrasp.tables.CONTACTS``, one row per pose, in the
@@ -86,7 +109,7 @@ def simulate_object(hand: Hand, synergies: Synergies, box: Any, placement: Place
         if not 0 <= v < grid.n_poses:
             raise ValueError(f"poses must be in 0 … {grid.n_poses - 1}, got {v}")
     size = np.asarray(box.size_mm, dtype=float)
-    model = closure_model(hand, synergies, closure_params)
+    model = closure_model(hand, synergies, closure_params, mechanics, getattr(box, "mass_kg", None))
     try:
         rows = []
         for pose in pose_list:

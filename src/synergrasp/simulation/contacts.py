@@ -35,10 +35,11 @@ __all__ = [
     "read_grasps",
 ]
 
-STATUSES: tuple[str, ...] = ("grasp", "intersects_open_hand", "no_contact")
+STATUSES: tuple[str, ...] = ("grasp", "intersects_open_hand", "no_contact", "lost")
 """``grasp``: the closure ran and at least one link touches the box; ``intersects_open_hand``:
 the box overlaps the open hand (only the ``fixed`` placement can give it); ``no_contact``:
-the closure ran, nothing touches the box."""
+the closure ran, nothing touches the box; ``lost`` (dynamic model only): the closing hand
+pushed the free box out of reach."""
 
 FINGER_STATES: tuple[str, ...] = ("contact", "limit", "self")
 """How a finger ended: ``contact`` (one of its links touches the box), ``self`` (stopped by
@@ -58,6 +59,11 @@ class ClosureResult:
     normals:       (m, 3) object's inward unit normals
     jacobian:      (3m, 19) translational Jacobian of the contact points, mm/rad
     max_penetration_mm: deepest penetration among the contacts (0 if none)
+    model:         closure model that made it (``kinematic`` or ``dynamic``)
+    normal_force_N: (m,) normal force per contact at the settled state, N (NaN if unknown)
+    settled_pose:  the box's final pose (``ObjectPose``) when it moved (dynamic model);
+                   None: it stayed where it was placed
+    settled:       the closure ended at rest (False: at the dynamic model's time limit)
     """
 
     status: str
@@ -68,6 +74,10 @@ class ClosureResult:
     normals: NDArray
     jacobian: NDArray
     max_penetration_mm: float
+    model: str = "kinematic"
+    normal_force_N: NDArray | None = None
+    settled_pose: ObjectPose | None = None
+    settled: bool = True
 
 
 def closure_result(hand: Hand, q: NDArray, finger_state: Sequence[str], links: NDArray, points: NDArray,
@@ -91,7 +101,13 @@ def closure_result(hand: Hand, q: NDArray, finger_state: Sequence[str], links: N
 
 def contacts_row(object_name: str, pose: int, alpha_deg: float, beta_deg: float, result: ClosureResult,
                  placed: ObjectPose) -> dict[str, Any]:
-    """One row of the contacts table (``tables.CONTACTS``) from a closure result."""
+    """One row of the contacts table (``tables.CONTACTS``) from a closure result; the box pose
+    columns hold its settled pose (``result.settled_pose``, else ``placed``)."""
+    final = placed if result.settled_pose is None else result.settled_pose
+    forces = (np.full(len(result.links), np.nan) if result.normal_force_N is None
+              else np.asarray(result.normal_force_N, dtype=float))
+    turn = final.rotation @ placed.rotation.T
+    angle = float(np.degrees(np.arccos(np.clip(0.5 * (np.trace(turn) - 1.0), -1.0, 1.0))))
     return {
         "object": object_name,
         "pose": int(pose),
@@ -105,9 +121,14 @@ def contacts_row(object_name: str, pose: int, alpha_deg: float, beta_deg: float,
         "contact_point": [float(v) for v in np.ravel(result.points)],
         "contact_normal": [float(v) for v in np.ravel(result.normals)],
         "jacobian": [float(v) for v in np.ravel(result.jacobian)],
-        "object_center": [float(v) for v in placed.center_mm],
-        "object_rotation": [float(v) for v in np.ravel(placed.rotation)],
+        "object_center": [float(v) for v in final.center_mm],
+        "object_rotation": [float(v) for v in np.ravel(final.rotation)],
         "max_penetration_mm": float(result.max_penetration_mm),
+        "closure_model": result.model,
+        "contact_normal_force_N": [float(v) for v in forces],
+        "object_translation_mm": [float(v) for v in final.center_mm - placed.center_mm],
+        "object_rotation_deg": angle,
+        "settled": bool(result.settled),
     }
 
 

@@ -1,0 +1,185 @@
+"""Fig. 1 (the hand along each synergy) and Fig. 2 (representative simulated grasps), from
+the shaded pictures of ``synergrasp.figures.hand_pictures``. Angles in rad (postures) and
+deg (pose labels), lengths in mm.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from synergrasp.analysis.realism import representative_grasps
+from synergrasp.figures.hand_pictures import (BOX, GRASP_CAMERA, PALM_CAMERA, SKIN, TOUCHING, BoxInPicture, Camera,
+                                              render)
+from synergrasp.figures.output import save_figure
+
+__all__ = ["figure_synergy_postures", "figure_example_grasps", "PANEL_PX"]
+
+#: Rendered panel size, pixels (width, height).
+PANEL_PX = (330, 330)
+_CONTACT = "#c2000b"
+NDArrayLike = Any  # anything np.asarray takes
+
+
+def _bare(ax: Any) -> None:
+    ax.set_xticks([])
+    ax.set_yticks([])
+    for spine in ax.spines.values():
+        spine.set_color("0.85")
+
+
+def _frame(axes: Sequence[Any], pictures: Sequence[Any], margin_px: float = 8.0) -> None:
+    """One square window for all ``axes``: the union of what their pictures show, plus a margin."""
+    drawn = np.zeros(pictures[0].rgb.shape[:2], dtype=bool)
+    for picture in pictures:
+        drawn |= np.any(picture.rgb < 0.985, axis=2)
+    rows, cols = np.flatnonzero(drawn.any(axis=1)), np.flatnonzero(drawn.any(axis=0))
+    if not len(rows):
+        return
+    half = 0.5 * max(rows[-1] - rows[0], cols[-1] - cols[0]) + margin_px
+    mid_r, mid_c = 0.5 * (rows[0] + rows[-1]), 0.5 * (cols[0] + cols[-1])
+    for ax in axes:
+        ax.set_xlim(mid_c - half, mid_c + half)
+        ax.set_ylim(mid_r + half, mid_r - half)
+
+
+def _label(ax: Any, name: str, at: NDArray, offset: tuple[float, float]) -> None:
+    """Name a part at image point ``at``; the text sits ``offset`` away, in fractions of the window."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()  # y runs downward in an image
+    text = (at[0] + offset[0] * (x1 - x0), at[1] + offset[1] * (y0 - y1))
+    ax.annotate(name, xy=at, xytext=text, fontsize=8, color="0.1", ha="center", va="center",
+                bbox=dict(boxstyle="round,pad=0.15", facecolor="white", edgecolor="none", alpha=0.8),
+                arrowprops=dict(arrowstyle="-", color="0.3", lw=0.7, shrinkA=0, shrinkB=1))
+
+
+def _label_parts(ax: Any, hand: Any, q: NDArrayLike, picture: Any) -> None:
+    """Name the thumb, index, little finger and palm on a picture of the hand at q (after framing)."""
+    from synergrasp.hand.kinematics import fingertip_positions
+
+    tips = picture.pixels(fingertip_positions(hand, np.asarray(q, dtype=float)))
+    _label(ax, "thumb", tips[0], (-0.02, 0.16))
+    _label(ax, "index", tips[1], (0.10, -0.08))
+    _label(ax, "little", tips[4], (-0.04, -0.16))
+    palm = picture.pixels(np.array([[12.0, -9.0, 45.0]]))[0]  # on the palm's front face, mm
+    ax.text(*palm, "palm", fontsize=8, color="0.1", ha="center", va="center")
+
+
+def figure_synergy_postures(hand: Any, synergies: Any, png_path: str | Path, pdf_path: str | Path,
+                            n_synergies: int = 7, sigmas: Sequence[float] = (-1.0, 0.0, 1.0),
+                            camera: Camera = PALM_CAMERA) -> None:
+    """Fig. 1: the hand at q_m + σ·S_k (joint limits clip) for k = 1..n_synergies (rows) and
+    σ in ``sigmas`` (columns), seen from the palm side; the mean posture q_m is the pale
+    silhouette behind the σ ≠ 0 pictures; the parts are named on the first mean posture."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    matrix = np.asarray(synergies.matrix, dtype=float)
+    if not 1 <= n_synergies <= matrix.shape[1]:
+        raise ValueError(f"n_synergies must be in 1 … {matrix.shape[1]}, got {n_synergies}")
+    mean = np.clip(np.asarray(synergies.mean, dtype=float), hand.lower, hand.upper)
+    panel = 2.35  # inches
+    fig, axes = plt.subplots(n_synergies, len(sigmas), figsize=(panel * len(sigmas) + 0.4, panel * n_synergies + 0.6),
+                             squeeze=False)
+    pictures, named = [], None  # named: the first mean posture's (axes, q, picture)
+    for k in range(n_synergies):
+        for c, sigma in enumerate(sigmas):
+            q = np.clip(mean + sigma * matrix[:, k], hand.lower, hand.upper)
+            ax = axes[k, c]
+            picture = render(hand, q, camera, PANEL_PX, ghost_q=None if sigma == 0 else mean)
+            pictures.append(picture)
+            ax.imshow(picture.rgb, interpolation="antialiased")
+            _bare(ax)
+            if sigma == 0 and named is None:
+                named = (ax, q, picture)
+            if k == 0:
+                ax.set_title(f"σ = {sigma:+g}" if sigma else "mean posture (σ = 0)", fontsize=10)
+            if c == 0:
+                ax.set_ylabel(f"S{k + 1}", fontsize=12, rotation=0, labelpad=14)
+    _frame(axes.ravel(), pictures)
+    if named is not None:
+        _label_parts(named[0], hand, named[1], named[2])
+    fig.suptitle("Right hand, palm toward the viewer, along each postural synergy (pale: the mean posture)",
+                 fontsize=10)
+    fig.tight_layout(rect=(0, 0, 1, 0.99), h_pad=0.3, w_pad=0.3)
+    save_figure(fig, png_path, pdf_path)
+
+
+def _box_of(row: pd.Series, size_mm: NDArrayLike) -> BoxInPicture:
+    return BoxInPicture(np.asarray(size_mm, dtype=float), np.asarray(row["object_center"], dtype=float),
+                        np.asarray(row["object_rotation"], dtype=float).reshape(3, 3))
+
+
+def _legend(fig: Any) -> None:
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    handles = [Patch(facecolor=SKIN, edgecolor="0.2", label="hand"),
+               Patch(facecolor=TOUCHING, edgecolor="0.2", label="link touching the box"),
+               Patch(facecolor=BOX, edgecolor="#1f3f7a", alpha=0.5, label="box (see-through)"),
+               Line2D([], [], ls="", marker="o", color=_CONTACT, markeredgecolor="white", label="contact point"),
+               Line2D([], [], ls="", marker="o", markerfacecolor="none", color=_CONTACT,
+                      label="contact point behind the hand")]
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
+
+
+def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.DataFrame], png_path: str | Path,
+                          pdf_path: str | Path, n_grasps: int = 3, camera: Camera = GRASP_CAMERA) -> None:
+    """Fig. 2: representative simulated grasps, one row per box, chosen by rule
+    (``synergrasp.analysis.realism.representative_grasps``: the most common set of touching
+    links, the most common one at the typical contact count, the next most common), each at
+    its pose nearest (α, β) = (0, 0). ``tables[i]`` is the contacts table of ``boxes[i]``.
+    Links touching the box are highlighted, contact points are dots (hollow where the hand
+    hides them); the box is see-through.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from synergrasp.hand.kinematics import fingertip_positions
+
+    if len(boxes) != len(tables):
+        raise ValueError(f"boxes and tables must have the same length, got {len(boxes)} and {len(tables)}")
+    panel = 2.6  # inches
+    fig, axes = plt.subplots(len(boxes), n_grasps, figsize=(panel * n_grasps + 0.5, panel * len(boxes) + 0.9),
+                             squeeze=False)
+    for r, (box, table) in enumerate(zip(boxes, tables)):
+        chosen = representative_grasps(table, n_grasps)
+        simulated = int((table["status"] == "grasp").sum())
+        pictures, thumbs = [], []
+        axes[r, 0].set_ylabel(f"{box.name}\n{' × '.join(f'{v:g}' for v in box.size_mm)} mm", fontsize=10)
+        for c in range(n_grasps):
+            ax = axes[r, c]
+            _bare(ax)
+            if c >= len(chosen):
+                ax.text(0.5, 0.5, "no other contact set" if c else f"no grasp with contacts\n({simulated} simulated)",
+                        ha="center", va="center", transform=ax.transAxes, fontsize=8, color="0.4")
+                continue
+            pick = chosen.iloc[c]
+            row = table[table["pose"] == pick["pose"]].iloc[0]
+            points = np.asarray(row["contact_point"], dtype=float).reshape(-1, 3)
+            picture = render(hand, np.asarray(row["q"], dtype=float), camera, PANEL_PX,
+                             box=_box_of(row, box.size_mm), touching=pick["pattern"])
+            ax.imshow(picture.rgb, interpolation="antialiased")
+            pictures.append(picture)
+            thumbs.append((picture, np.asarray(row["q"], dtype=float)))
+            px, hidden = picture.pixels(points), picture.hidden(points)
+            ax.scatter(px[~hidden, 0], px[~hidden, 1], s=16, c=_CONTACT, edgecolors="white", linewidths=0.6, zorder=3)
+            ax.scatter(px[hidden, 0], px[hidden, 1], s=16, facecolors="none", edgecolors=_CONTACT, linewidths=0.9,
+                       zorder=3)
+            ax.set_title(f"{pick['reason']}: {pick['share_pct']:.0f} % of grasps\n"
+                         f"α = {pick['alpha_deg']:g}°, β = {pick['beta_deg']:g}°, {int(row['n_contacts'])} contacts",
+                         fontsize=8)
+        if pictures:
+            _frame(axes[r, :len(pictures)], pictures)
+            for ax, (picture, q) in zip(axes[r], thumbs):
+                _label(ax, "thumb", picture.pixels(fingertip_positions(hand, q))[0], (0.13, 0.09))
+    _legend(fig)
+    fig.tight_layout(rect=(0, 0.035, 1, 1), h_pad=0.6, w_pad=0.3)
+    save_figure(fig, png_path, pdf_path)

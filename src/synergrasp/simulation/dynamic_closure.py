@@ -1,0 +1,325 @@
+"""The compliant dynamic closure: the soft-synergy hand closing on a free box (pybullet).
+
+The second closure model (``closure.model: dynamic``, docs/closure.md). Same inputs as the
+kinematic closure (hand, synergies, box, the placed object pose, the σ path) and the same
+result type. The 19 joints are springs of stiffness k_ss (N·mm/rad) about the synergy
+reference q_r(σ) = clip(q_m + σ·S1, lower, upper), realised as explicit joint torques on the
+elementary axes: axis i (scale s_i: 1, or 1/2 for each half of a rolling joint) gets
+(k_ss/s_i)·(s_i·q_r − θ_i) − c·θ̇_i. The two half axes of a rolling joint are thus two
+springs in series (2·k_ss each about q_r/2): the joint's stiffness is k_ss and at rest
+k_ss·(q_r − q) = J_qᵀ f with q = θ_a + θ_b and J_q = (J_a + J_b)/2, exactly the soft-synergy
+balance. (A gear constraint that would keep the halves equal is not usable on this
+multibody in pybullet 3.2.7: with several of them the joints leave their limits; under load
+the halves therefore differ by (J_b − J_a)ᵀ f / (2·k_ss), reported in docs/closure.md.)
+σ ramps over the path; the box is a free rigid body with friction μ against the hand. The
+run ends when hand and box have settled (every joint speed and the box's speed below their
+thresholds for ``settle_steps`` consecutive steps) or at the time limit.
+
+The dynamics are only the way to that equilibrium: link inertias, joint damping, time
+step, ramp time and the box's mass during the closure are chosen for speed (DynamicParams), and
+gravity is off by default. Units: mm, rad, N, N·mm, s; the palm frame. pybullet calls go
+through :mod:`synergrasp.simulation.bullet`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from synergrasp.hand.synergies import SynergyPath
+from synergrasp.simulation.contacts import ClosureResult
+from synergrasp.simulation.placement import ObjectPose
+
+if TYPE_CHECKING:  # pragma: no cover
+    from synergrasp.hand.kinematics import Hand
+    from synergrasp.hand.synergies import Synergies
+    from synergrasp.simulation.closure import ClosureParams
+
+__all__ = ["UNLOADED_CONTACTS", "DynamicParams", "DynamicClosure", "compliant_self_pairs"]
+
+#: What happens to a contact whose normal force at the settled state is below
+#: ``DynamicParams.load_threshold_N``: ``drop`` (not listed) or ``keep`` (listed).
+UNLOADED_CONTACTS: tuple[str, ...] = ("drop", "keep")
+_LONG_FINGERS = ("index", "middle", "ring", "little")
+
+
+@dataclass(frozen=True)
+class DynamicParams:
+    """Settings of the dynamic closure (config ``closure.dynamic``, docs/closure.md).
+
+    time_step_s:           physics time step, s.
+    solver_iterations:     constraint-solver iterations per step.
+    link_mass_kg:          mass of every elementary hand link during the closure, kg.
+    link_inertia_kg_mm2:   rotational inertia of every elementary hand link about its own
+                           frame, kg·mm² (sets the fastest joint mode: √(k_ss / I)).
+    position_gain:         motor gain: a free joint closes the fraction ``position_gain`` of
+                           its distance to the reference per step.
+    object_mass_kg:        mass of the box during the closure, kg (its weight, if gravity is
+                           on, is still mass_kg · g: see ``gravity``).
+    object_damping_per_s:  linear and angular drag rate of the box, 1/s.
+    ramp_time_s:           time over which σ runs from the open to the closed end, s.
+    time_limit_s:          the closure stops here if it has not settled, s.
+    settle_joint_speed_rad_per_s, settle_object_speed_mm_per_s: settled when every joint
+                           and every point of the box move slower than these ...
+    settle_steps:          ... for this many consecutive steps after the ramp.
+    hand_hand_mu:          friction between two hand links (hand–box friction is mechanics.mu).
+    gravity:               the box's weight acts during the closure (along
+                           mechanics.gravity_direction) if true.
+    lost_distance_mm:      a box with no contact at the end that moved farther than this from
+                           its initial pose was pushed out of the hand: status ``lost``.
+    load_threshold_N:      a contact carries load if its normal force is at least this, N.
+    unloaded_contacts:     ``drop`` or ``keep`` the contacts below the threshold.
+    """
+
+    time_step_s: float = 1.0 / 240.0
+    solver_iterations: int = 10
+    link_mass_kg: float = 0.01
+    link_inertia_kg_mm2: float = 50.0
+    joint_damping_Nmm_s_per_rad: float = 4.0
+    object_mass_kg: float = 0.5
+    object_damping_per_s: float = 50.0
+    ramp_time_s: float = 0.3
+    time_limit_s: float = 1.0
+    settle_joint_speed_rad_per_s: float = 0.1
+    settle_object_speed_mm_per_s: float = 5.0
+    settle_steps: int = 10
+    hand_hand_mu: float = 0.1
+    gravity: bool = False
+    lost_distance_mm: float = 1.0
+    load_threshold_N: float = 0.01
+    unloaded_contacts: str = "drop"
+
+    def __post_init__(self) -> None:
+        positive = ("time_step_s", "link_mass_kg", "link_inertia_kg_mm2", "joint_damping_Nmm_s_per_rad", "object_mass_kg",
+                    "ramp_time_s", "time_limit_s", "settle_joint_speed_rad_per_s",
+                    "settle_object_speed_mm_per_s", "hand_hand_mu", "lost_distance_mm")
+        for name in positive:
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
+                raise ValueError(f"closure.dynamic.{name} must be a positive number, got {v!r}")
+            object.__setattr__(self, name, float(v))
+        for name in ("object_damping_per_s", "load_threshold_N"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+                raise ValueError(f"closure.dynamic.{name} must be a number >= 0, got {v!r}")
+            object.__setattr__(self, name, float(v))
+        for name in ("solver_iterations", "settle_steps"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+                raise ValueError(f"closure.dynamic.{name} must be an integer >= 1, got {v!r}")
+        if not isinstance(self.gravity, bool):
+            raise ValueError(f"closure.dynamic.gravity must be true or false, got {self.gravity!r}")
+        if self.unloaded_contacts not in UNLOADED_CONTACTS:
+            raise ValueError(f"closure.dynamic.unloaded_contacts must be one of {list(UNLOADED_CONTACTS)}, "
+                             f"got {self.unloaded_contacts!r}")
+        if self.time_limit_s < self.ramp_time_s:
+            raise ValueError(f"closure.dynamic.time_limit_s ({self.time_limit_s}) must be at least "
+                             f"closure.dynamic.ramp_time_s ({self.ramp_time_s})")
+
+    @classmethod
+    def from_config(cls, dynamic: Mapping[str, Any]) -> DynamicParams:
+        """From the config's ``closure.dynamic`` block."""
+        allowed = {f.name for f in fields(cls)}
+        unknown = set(dynamic) - allowed
+        if unknown:
+            raise ValueError(f"closure.dynamic: unknown key(s) {sorted(unknown)}; allowed keys: {sorted(allowed)}")
+        return cls(**dict(dynamic))
+
+    @property
+    def ramp_steps(self) -> int:
+        return max(1, int(round(self.ramp_time_s / self.time_step_s)))
+
+    @property
+    def max_steps(self) -> int:
+        return max(self.ramp_steps, int(round(self.time_limit_s / self.time_step_s)))
+
+
+def compliant_self_pairs(hand: Any) -> tuple[tuple[int, int], ...]:
+    """Hand link pairs that collide during the dynamic closure: the pairs that can meet, i.e. a
+    finger link against the palm, the thumb against a long finger, and neighbouring long
+    fingers (index–middle, middle–ring, ring–little); never links of one finger, never
+    ``hand.ignored_link_pairs`` (parent and child touch by design)."""
+    from synergrasp.simulation.bullet import self_collision_pairs
+
+    pairs = []
+    for i, j in self_collision_pairs(hand):
+        fi, fj = hand.link_finger[i], hand.link_finger[j]
+        if fi == fj:
+            continue
+        if fi in _LONG_FINGERS and fj in _LONG_FINGERS and abs(_LONG_FINGERS.index(fi) - _LONG_FINGERS.index(fj)) != 1:
+            continue
+        pairs.append((i, j))
+    return tuple(pairs)
+
+
+class DynamicClosure:
+    """The compliant dynamic closure on one pybullet scene: the hand and a free box.
+
+    ``params`` is the closure's :class:`synergrasp.simulation.closure.ClosureParams` (contact
+    distance, penetration tolerance, ``params.dynamic``); the σ path is the kinematic
+    model's (``SynergyPath.closure_range``); ``mechanics`` the config's mechanics block (k_ss,
+    μ, gravity direction and g); ``mass_kg`` the box's mass (its weight, if gravity is on).
+    """
+
+    def __init__(self, hand: Hand, synergies: Synergies, params: ClosureParams, mechanics: Mapping[str, Any],
+                 mass_kg: float = 1.0) -> None:
+        from synergrasp.simulation import bullet
+
+        names = tuple(synergies.joint_names)
+        if names != tuple(hand.joint_names):
+            raise ValueError(f"synergies.joint_names must equal hand.joint_names {hand.joint_names}, got {names}")
+        missing = [k for k in ("mu", "k_ss_Nmm_per_rad", "gravity_direction", "g_m_per_s2") if k not in mechanics]
+        if missing:
+            raise ValueError(f"mechanics: the dynamic closure needs key(s) {missing}")
+        self.bullet = bullet
+        self.hand = hand
+        self.closure = params
+        self.params = p = params.dynamic
+        self.k_ss = float(mechanics["k_ss_Nmm_per_rad"])
+        self.mu = float(mechanics["mu"])
+        down = np.asarray(mechanics["gravity_direction"], dtype=float)
+        # weight of the box, N (palm frame), applied only when params.dynamic.gravity is true
+        self.weight = float(mass_kg) * float(mechanics["g_m_per_s2"]) * down / np.linalg.norm(down)
+        self.path = SynergyPath.along(synergies, hand.lower, hand.upper)
+        # the same path as the kinematic model: fully open hand to every S1 joint at a limit
+        self.sigma_open, self.sigma_closed = self.path.closure_range(hand.flexion_joints)
+        self.client = bullet.connect()
+        bullet.set_dynamics(self.client, p.time_step_s, p.solver_iterations)
+        # hand–hand friction = product of the two links' coefficients (Bullet's rule): √μ_hh on
+        # every hand link; the box's coefficient μ/√μ_hh makes hand–box friction exactly μ
+        self.link_friction = math.sqrt(p.hand_hand_mu)
+        self.body = bullet.load_compliant_hand(self.client, hand, p.link_mass_kg, p.link_inertia_kg_mm2,
+                                               self.link_friction)
+        self.axis_joint = self.body.joint_q
+        self.axis_scale = self.body.joint_scale
+        self.axis_sum = np.zeros((hand.n_joints, len(self.axis_joint)))  # q = axis_sum @ θ
+        self.axis_sum[self.axis_joint, np.arange(len(self.axis_joint))] = 1.0
+        self.q_open = self.path.reference(self.sigma_open)
+        self.self_pairs = self._colliding_pairs()
+        self.box: int | None = None
+        self.box_size: NDArray | None = None
+
+    def close(self) -> None:
+        self.bullet.disconnect(self.client)
+
+    def joint_values(self, axis_values: NDArray) -> NDArray:
+        """Joint angles (rad) from the elementary axes' angles: q_j = Σ θ_i over the axes of joint j."""
+        return self.axis_sum @ axis_values
+
+    def _place(self, size_mm: NDArray, placed: Any) -> None:
+        size = np.asarray(size_mm, dtype=float)
+        if self.box is None or self.box_size is None or not np.array_equal(size, self.box_size):
+            if self.box is not None:
+                self.bullet.remove_body(self.client, self.box)
+            self.box = self.bullet.load_free_box(self.client, size, self.params.object_mass_kg,
+                                                 self.mu / self.link_friction, self.params.object_damping_per_s)
+            self.box_size = size
+        self.bullet.reset_body(self.client, self.box, placed.center_mm, placed.rotation)
+
+    def _colliding_pairs(self) -> tuple[tuple[int, int], ...]:
+        """``compliant_self_pairs`` except those overlapping at the open posture (a property of
+        the model, not an event); set them in the engine."""
+        b = self.bullet
+        pairs = compliant_self_pairs(self.hand)
+        b.reset_hand(self.client, self.body, self.q_open)
+        pts = b.self_closest_points(self.client, self.body, 0.0, pairs)
+        bad = {(min(i, j), max(i, j)) for i, j, d in zip(pts.link_a, pts.link_b, pts.distance) if d < 0}
+        kept = tuple(pair for pair in pairs if pair not in bad)
+        b.set_self_collision(self.client, self.body, kept)
+        return kept
+
+    def grasp(self, size_mm: NDArray, placed: ObjectPose) -> ClosureResult:
+        """Close the hand from q_r(σ_open) to q_r(σ_closed) (the fully open hand to the end of S1) on a free box of ``size_mm`` (mm)
+        placed at ``placed``; the contacts of its settled state."""
+        p, b, c = self.params, self.bullet, self.closure
+        q_open = self.q_open
+        sigma_open, sigma_closed = self.sigma_open, self.sigma_closed
+        self._place(size_mm, placed)
+        b.reset_hand(self.client, self.body, q_open)
+        gaps = b.closest_points(self.client, self.box, self.body, c.contact_distance_mm)
+        if len(gaps) and float(gaps.distance.min()) < -c.penetration_tolerance_mm:
+            return self._result("intersects_open_hand", q_open, (), None, True)
+        weight = self.weight if p.gravity else None
+        radius = float(np.linalg.norm(placed.half_extents_mm))
+        calm, settled, steps = 0, False, p.max_steps
+        scale, axis_joint = self.axis_scale, self.axis_joint
+        target = scale * q_open[axis_joint]
+        axis_k = self.k_ss / scale  # N·mm/rad per axis (2·k_ss for each half of a rolling joint)
+        for step in range(p.max_steps):
+            theta, omega = b.axis_states(self.client, self.body)
+            if step >= p.ramp_steps:
+                _, _, v, w = b.body_state(self.client, self.box)
+                still = (np.max(np.abs(self.joint_values(omega))) < p.settle_joint_speed_rad_per_s
+                         and np.linalg.norm(v) + np.linalg.norm(w) * radius < p.settle_object_speed_mm_per_s)
+                calm = calm + 1 if still else 0
+                if calm >= p.settle_steps:
+                    settled, steps = True, step
+                    break
+            else:
+                sigma = sigma_open + (sigma_closed - sigma_open) * (step + 1) / p.ramp_steps
+                target = scale * self.path.reference(sigma)[axis_joint]
+            if weight is not None:
+                b.apply_force(self.client, self.box, weight)
+            b.step_with_torques(self.client, self.body, axis_k * (target - theta) - p.joint_damping_Nmm_s_per_rad * omega)
+        self.steps = steps
+        return self._settled(placed, settled)
+
+    def _result(self, status: str, q: NDArray, state: tuple[str, ...], settled_pose: ObjectPose | None,
+                settled: bool, links: list[int] = (), points: list = (), normals: list = (), loads: list = (),
+                depth: float = 0.0) -> ClosureResult:
+        from synergrasp.hand.kinematics import contact_jacobian
+
+        links_a = np.asarray(links, dtype=np.int64)
+        points_a = np.asarray(points, dtype=float).reshape(-1, 3)
+        jac = contact_jacobian(self.hand, q, links_a, points_a) if len(links_a) else np.zeros((0, self.hand.n_joints))
+        return ClosureResult(status, q, state, links_a, points_a, np.asarray(normals, dtype=float).reshape(-1, 3),
+                             jac, float(depth), model="dynamic", normal_force_N=np.asarray(loads, dtype=float),
+                             settled_pose=settled_pose, settled=settled)
+
+    def _finger_states(self, touching: list[int]) -> tuple[str, ...]:
+        """Per finger: ``contact`` (a link touches the box), ``self`` (a link touches the hand), ``limit``."""
+        on_hand = self.bullet.contact_forces(self.client, self.body, self.body)
+        self_links = set(on_hand.link_a.tolist()) | set(on_hand.link_b.tolist())
+        return tuple("contact" if any(li in touching for li in links)
+                     else "self" if any(li in self_links for li in links) else "limit"
+                     for links in self.hand.finger_links)
+
+    def _settled(self, placed: ObjectPose, settled: bool) -> ClosureResult:
+        """The settled state: q, the box pose, one contact per hand link touching the box (the
+        force-weighted mean of its engine contact points, projected onto the exact box)."""
+        b, p = self.bullet, self.params
+        theta, _ = b.axis_states(self.client, self.body)
+        q = self.joint_values(theta)
+        center, rotation, _, _ = b.body_state(self.client, self.box)
+        now = ObjectPose(center, rotation, placed.half_extents_mm)
+        forces = b.contact_forces(self.client, self.box, self.body)
+        near = b.closest_points(self.client, self.box, self.body, self.closure.contact_distance_mm)
+        touching = sorted({int(v) for v in near.link_b if v >= 0})
+        state = self._finger_states(touching)
+        links, points, normals, loads, depth = [], [], [], [], 0.0
+        for link in touching:
+            rows = np.flatnonzero(forces.link_b == link)
+            load = float(forces.normal_force[rows].sum()) if len(rows) else 0.0
+            if load < p.load_threshold_N and p.unloaded_contacts == "drop":
+                continue
+            if load > 0.0:
+                on_link = (forces.normal_force[rows] / load) @ forces.point_b[rows]
+            else:
+                k = np.flatnonzero(near.link_b == link)
+                on_link = near.point_b[k[np.argmin(near.distance[k])]]
+            point, normal = now.surface_point(on_link)
+            links.append(link)
+            points.append(point)
+            normals.append(normal)
+            loads.append(load)
+            depth = max(depth, -float(near.distance[near.link_b == link].min()))
+        if links:
+            return self._result("grasp", q, state, now, settled, links, points, normals, loads, max(depth, 0.0))
+        moved = float(np.linalg.norm(center - placed.center_mm))
+        status = "lost" if not touching and moved > p.lost_distance_mm else "no_contact"
+        return self._result(status, q, state, now, settled)
