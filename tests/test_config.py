@@ -358,3 +358,70 @@ def test_every_key_of_the_schema_is_described_in_config_readme():
         return any(f"| `{'.'.join(parts[:n])}` |" in text for n in range(len(parts), 0, -1))
     missing = [p for p in _leaf_paths(load_schema()) if not documented(p)]
     assert missing == []
+
+
+# ----------------------------------------------------------------------------- the workflow's view
+
+
+def _dry_run(tmp_path, target, scenarios):
+    """``snakemake -n target`` on the small config with ``scenarios``: (return code, output,
+    {rule: [output files]} of the jobs it would run)."""
+    import subprocess
+    import sys
+
+    config = tmp_path / "config.yaml"
+    config.write_text(yaml.safe_dump({**SMALL, "scenarios": scenarios}))
+    run = subprocess.run([sys.executable, "-m", "snakemake", target, "-n", "-s", str(ROOT / "Snakefile"),
+                          "--directory", str(tmp_path), "--configfile", str(config),
+                          "--replace-workflow-config"], capture_output=True, text=True, timeout=600)
+    jobs, rule = {}, None
+    for line in run.stdout.splitlines():
+        if line.startswith(("rule ", "localrule ")):
+            rule = line.split()[1].rstrip(":")
+        elif line.strip().startswith("output:") and rule:
+            jobs.setdefault(rule, []).extend(p.strip() for p in line.split(":", 1)[1].split(","))
+    return run.returncode, run.stdout + run.stderr, jobs
+
+
+def test_scenarios_differing_in_an_analysis_key_share_simulation_and_optimisation(tmp_path):
+    code, out, jobs = _dry_run(tmp_path, "scenario_wide", {"wide": {"analyses": {"minima_radius_deg": 60}},
+                                                           "mu1": {"mechanics": {"mu": 1.0}}})
+    assert code == 0, out[-3000:]
+    shared = jobs["simulate_contacts"] + jobs["optimise_shard"] + jobs["aggregate_gfo"]
+    assert sorted(shared) == sorted(
+        [f"results/objects/{o}/contacts.parquet" for o in ("obj1", "obj4")]
+        + [f"results/objects/{o}/gfo_shards/{i}.parquet" for o in ("obj1", "obj4") for i in (0, 1)]
+        + [f"results/objects/{o}/gfo.parquet" for o in ("obj1", "obj4")])
+    assert sorted(jobs["local_minima"]) == [f"results/scenarios/wide/objects/{o}/minima.parquet"
+                                            for o in ("obj1", "obj4")]
+    assert "results/scenarios/wide/tables/table2_success_rates.csv" in jobs["study_tables"]
+    # an optimisation key: the contacts are shared, the optimisation is its own
+    code, out, jobs = _dry_run(tmp_path, "scenario_mu1", {"mu1": {"mechanics": {"mu": 1.0}}})
+    assert code == 0, out[-3000:]
+    assert all(p.startswith("results/objects/") for p in jobs["simulate_contacts"])
+    assert all(p.startswith("results/scenarios/mu1/") for p in jobs["aggregate_gfo"] + jobs["optimise_shard"])
+
+
+@pytest.mark.parametrize("scenarios, expected", [
+    ({"s1": {"mechanics": {"muu": 1.0}}}, "scenario 's1': config error at 'mechanics': unknown key(s) ['muu']"),
+    ({"s1": {"synergy_sets": {"incremental_max": 20}}},
+     "scenario 's1': config error at 'synergy_sets.incremental_max': 20 exceeds the 15 synergies"),
+])
+def test_a_bad_scenario_stops_the_workflow_before_any_job(tmp_path, scenarios, expected):
+    code, out, jobs = _dry_run(tmp_path, "figures", scenarios)
+    assert code != 0 and jobs == {}
+    assert "Invalid input, nothing was run" in out and expected in out
+
+
+def test_a_synergy_table_that_cannot_close_the_hand_or_is_not_in_rad_is_named():
+    from synergrasp.config import synergy_problems
+
+    config = validate_config(SMALL)
+    mean, matrix = [0.1, 0.2], [[0.5, 0.1], [0.2, 0.0]]
+    assert synergy_problems(config, mean, matrix) == []
+    zero_s1 = synergy_problems(config, mean, [[0.0, 0.1], [0.0, 0.0]])
+    assert zero_s1 == ["config error at 'synergies' (the shipped table): S1 is zero for every joint; "
+                       "closing along S1 would move no joint"]
+    degrees = synergy_problems({**config, "synergies": "mine.csv"}, [10.0, 45.0], matrix)
+    assert len(degrees) == 1 and "'synergies' (mine.csv): values up to 45 exceed 2π" in degrees[0]
+    assert "exceed 2π" in synergy_problems(config, mean, [[1e300, 0.1], [0.2, 0.0]])[0]

@@ -43,6 +43,7 @@ __all__ = [
     "overlay",
     "validate_config",
     "check_relations",
+    "synergy_problems",
     "scenario_configs",
     "step_config",
     "step_hash",
@@ -308,6 +309,21 @@ def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -
                         f"synergy_sets.incremental_max ({k_max})")
     if not _grid_problems(config["grid"]):
         problems += _pose_problems(config)
+    return problems
+
+
+def synergy_problems(config: Mapping[str, Any], mean_rad: Any, matrix: Any) -> list[str]:
+    """What makes a readable synergy table unusable for the study: S1 moving no joint (the
+    hand would never close) or values no posture in rad can have (|value| > 2π: a table in
+    degrees, or a stray huge entry). ``mean_rad`` (n,), ``matrix`` (n, k) as loaded."""
+    where = f"config error at 'synergies' ({config['synergies'] or 'the shipped table'})"
+    mean, syn = np.asarray(mean_rad, dtype=float), np.asarray(matrix, dtype=float)
+    problems = []
+    if not np.any(np.abs(syn[:, 0]) > 0):
+        problems.append(f"{where}: S1 is zero for every joint; closing along S1 would move no joint")
+    if np.abs(mean).max() > 2 * math.pi or np.abs(syn).max() > 2 * math.pi:
+        problems.append(f"{where}: values up to {max(np.abs(mean).max(), np.abs(syn).max()):.4g} exceed "
+                        "2π; postures and synergies are in rad (is the table in degrees?)")
     return problems
 
 

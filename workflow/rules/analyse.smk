@@ -3,64 +3,64 @@
 
 rule local_minima:
     input:
-        gfo="results/objects/{object}/gfo.parquet",
+        gfo=step_input("optimise"),
         code=code("local_minima"),
     output:
-        "results/objects/{object}/minima.parquet",
+        "{root}/objects/{object}/minima.parquet",
     params:
         cfg=step_cfg("minima"),
     log:
-        "results/logs/local_minima/{object}.log",
+        "{root}/logs/local_minima/{object}.log",
     script:
         "../scripts/local_minima.py"
 
 
 rule study_tables:
     input:
-        gfo=expand("results/objects/{object}/gfo.parquet", object=OBJECTS),
-        minima=expand("results/objects/{object}/minima.parquet", object=OBJECTS),
+        gfo=step_inputs("optimise"),
+        minima=step_inputs("minima"),
         code=code("study_tables"),
     output:
         **{
             f"{t}_{ext}": report(
-                f"results/tables/{t}.{ext}", caption=f"../report/{t}.rst", category="Tables"
+                f"{{root}}/tables/{t}.{ext}", caption=f"../report/{t}.rst", category="Tables"
             )
             if ext == "csv"
-            else f"results/tables/{t}.{ext}"
+            else f"{{root}}/tables/{t}.{ext}"
             for t in TABLES
             for ext in ("csv", "md")
         },
     params:
         cfg=step_cfg("tables"),
     log:
-        "results/logs/study_tables.log",
+        "{root}/logs/study_tables.log",
     script:
         "../scripts/study_tables.py"
 
 
 rule grasp_realism:
     input:
-        contacts=expand("results/objects/{object}/contacts.parquet", object=OBJECTS),
-        gfo=expand("results/objects/{object}/gfo.parquet", object=OBJECTS),
+        contacts=step_inputs("simulate"),
+        gfo=step_inputs("optimise"),
         code=code("grasp_realism"),
         data=SHIPPED_DATA,
-        user=user_files(),
+        user=user_files,
     output:
         csv=report(
-            "results/tables/grasp_realism.csv",
+            "{root}/tables/grasp_realism.csv",
             caption="../report/grasp_realism_table.rst",
             category="Tables",
         ),
-        md="results/tables/grasp_realism.md",
+        md="{root}/tables/grasp_realism.md",
         png=report(
-            "results/figures/grasp_realism.png",
+            "{root}/figures/grasp_realism.png",
             caption="../report/grasp_realism.rst",
             category="Figures",
         ),
-        pdf="results/figures/grasp_realism.pdf",
+        pdf="{root}/figures/grasp_realism.pdf",
     params:
         cfg=step_cfg("realism"),
     log:
-        "results/logs/grasp_realism.log",
+        "{root}/logs/grasp_realism.log",
     script:
         "../scripts/grasp_realism.py"

@@ -1,11 +1,13 @@
 # Shared definitions: configuration checks (before any job runs), object and synergy-set
 # lists, code dependencies that trigger reruns, and the target lists.
+import functools
 import math
+import re
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from synergrasp.config import ConfigError, check_relations, scenario_configs, step_config
+from synergrasp.config import ConfigError, check_relations, scenario_configs, step_config, step_hash, synergy_problems
 
 ROOT = Path(workflow.basedir)
 SRC = ROOT / "src" / "synergrasp"
@@ -24,6 +26,7 @@ def _check_inputs(raw):
         synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
         where = "" if name == "default" else f"scenario '{name}': "
         problems += [where + p for p in check_relations(cfg, synergies.matrix.shape[1])]
+        problems += [where + p for p in synergy_problems(cfg, synergies.mean, synergies.matrix)]
     if problems:
         raise ConfigError("\n".join(problems))
     return scenarios
@@ -34,21 +37,54 @@ try:
 except ValueError as err:  # ConfigError, SynergyFileError, hand-file errors are ValueErrors
     raise WorkflowError(f"Invalid input, nothing was run:\n{err}") from None
 
-#: The main configuration, complete (defaults filled in) and checked.
+#: The main configuration (scenario `default`), complete (defaults filled in) and checked.
 STUDY = SCENARIOS["default"]
 OBJECTS = list(STUDY["objects"])
-SHARDS = list(range(STUDY["solver"]["pose_shards"]))
+
+# Scenarios (config/README.md): each one's outputs live under its root; the default keeps
+# results/. A per-object step's output is made once, under the root of the first scenario
+# (default first) whose step reads the same keys (synergrasp.config.step_hash), and shared.
+SCENARIO_ROOT = {name: "results" if name == "default" else f"results/scenarios/{name}" for name in SCENARIOS}
+_ROOT_SCENARIO = {root: name for name, root in SCENARIO_ROOT.items()}
+#: The file each per-object step writes under its root's objects/<object>/.
+STEP_FILES = {"simulate": "contacts.parquet", "optimise": "gfo.parquet", "minima": "minima.parquet"}
+
+
+def scenario_config(wildcards):
+    """The complete configuration of the scenario whose root a job's {root} names."""
+    return SCENARIOS[_ROOT_SCENARIO[wildcards.root]]
+
+
+@functools.cache
+def step_file(scenario, step, obj):
+    """Where ``scenario``'s output of per-object ``step`` for ``obj`` lives: under the root of
+    the first scenario that reads the same keys for it."""
+    key = step_hash(SCENARIOS[scenario], step, obj)
+    owner = next(name for name, cfg in SCENARIOS.items()
+                 if obj in cfg["objects"] and step_hash(cfg, step, obj) == key)
+    return f"{SCENARIO_ROOT[owner]}/objects/{obj}/{STEP_FILES[step]}"
+
+
+def step_input(step):
+    """Input function: the job's object's ``step`` output in the job's scenario."""
+    return lambda w: step_file(_ROOT_SCENARIO[w.root], step, w.object)
+
+
+def step_inputs(step):
+    """Input function: every object's ``step`` output in the job's scenario."""
+    return lambda w: [step_file(_ROOT_SCENARIO[w.root], step, o) for o in scenario_config(w)["objects"]]
 
 
 def step_cfg(step):
-    """A rule's ``params``: the part of the configuration its step reads (for the job's
-    object; synergrasp.config.STEP_KEYS), so that a job reruns only when a key it reads
-    changes. Its script turns it into typed parameters with synergrasp.config.step_params."""
-    return lambda wildcards: step_config(STUDY, step, wildcards.get("object"))
+    """A rule's ``params``: the part of the job's scenario configuration its step reads (for
+    the job's object; synergrasp.config.STEP_KEYS), so that a job reruns only when a key it
+    reads changes. Its script turns it into typed parameters with synergrasp.config.step_params."""
+    return lambda wildcards: step_config(scenario_config(wildcards), step, wildcards.get("object"))
 
 
 wildcard_constraints:
-    object="|".join(OBJECTS),
+    root="|".join(re.escape(r) for r in SCENARIO_ROOT.values()),
+    object="|".join(sorted({o for cfg in SCENARIOS.values() for o in cfg["objects"]})),
     shard=r"\d+",
 
 
@@ -93,28 +129,25 @@ def code(script):
     return sorted(str(f) for f in files) + [str(ROOT / "environment.lock")]
 
 
-def user_files():
-    """User-supplied hand/synergy files: a change of their content reruns what uses them
-    (a shipped synergy table given by name is under SHIPPED_DATA)."""
+def user_files(wildcards):
+    """Input function: the scenario's own hand/synergy files, so that a change of their
+    content reruns what uses them (a shipped synergy table given by name is under SHIPPED_DATA)."""
     from synergrasp.hand.synergies import SHIPPED_TABLES
 
-    return [p for p in (STUDY["hand"], STUDY["synergies"]) if p and p not in SHIPPED_TABLES]
+    cfg = scenario_config(wildcards)
+    return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in SHIPPED_TABLES]
 
 
 SHIPPED_DATA = sorted(str(p) for p in (SRC / "data").glob("*") if p.is_file())
 
 
-def object_dir(name):
-    return f"results/objects/{name}"
+def fig4_files(root, name):
+    return [f"{root}/objects/{name}/fig4_{kind}.{ext}" for kind in ("force_maps", "exploded") for ext in ("png", "pdf")]
 
 
-def fig4_files(name):
-    return [f"{object_dir(name)}/fig4_{kind}.{ext}" for kind in ("force_maps", "exploded") for ext in ("png", "pdf")]
-
-
-def object_targets(name):
-    d = object_dir(name)
-    return [f"{d}/contacts.parquet", f"{d}/gfo.parquet", f"{d}/minima.parquet", *fig4_files(name)]
+def object_targets(name, scenario="default"):
+    """One object's outputs in a scenario: its per-object tables (wherever shared) and Fig. 4."""
+    return [step_file(scenario, step, name) for step in STEP_FILES] + fig4_files(SCENARIO_ROOT[scenario], name)
 
 
 TABLES = [
@@ -130,13 +163,16 @@ TABLES = [
 ]
 
 
-def study_targets():
+def study_targets(scenario="default"):
+    """Every output of one scenario's study (Fig. 3, the rule graph, is the same for all)."""
+    root = SCENARIO_ROOT[scenario]
     figures = [
-        f"results/figures/{name}.{ext}"
-        for name in ("fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph",
+        f"{root}/figures/{name}.{ext}"
+        for name in ("fig1_synergy_postures", "fig2_example_grasps",
                      "fig5a_hierarchy_success", "fig5b_hierarchy_force", "grasp_realism")
         for ext in ("png", "pdf")
     ]
-    tables = [f"results/tables/{t}.{ext}" for t in [*TABLES, "grasp_realism"] for ext in ("csv", "md")]
-    per_object = [f for name in OBJECTS for f in object_targets(name)]
+    figures += [f"results/figures/fig3_rulegraph.{ext}" for ext in ("png", "pdf")]
+    tables = [f"{root}/tables/{t}.{ext}" for t in [*TABLES, "grasp_realism"] for ext in ("csv", "md")]
+    per_object = [f for name in SCENARIOS[scenario]["objects"] for f in object_targets(name, scenario)]
     return figures + tables + per_object

@@ -4,53 +4,53 @@
 
 rule fig4_force_maps:
     input:
-        gfo="results/objects/{object}/gfo.parquet",
-        minima="results/objects/{object}/minima.parquet",
+        gfo=step_input("optimise"),
+        minima=step_input("minima"),
         code=code("fig4_force_maps"),
     output:
         maps_png=report(
-            "results/objects/{object}/fig4_force_maps.png",
+            "{root}/objects/{object}/fig4_force_maps.png",
             caption="../report/fig4_force_maps.rst",
             category="Fig. 4",
             subcategory="{object}",
         ),
-        maps_pdf="results/objects/{object}/fig4_force_maps.pdf",
+        maps_pdf="{root}/objects/{object}/fig4_force_maps.pdf",
         exploded_png=report(
-            "results/objects/{object}/fig4_exploded.png",
+            "{root}/objects/{object}/fig4_exploded.png",
             caption="../report/fig4_exploded.rst",
             category="Fig. 4",
             subcategory="{object}",
         ),
-        exploded_pdf="results/objects/{object}/fig4_exploded.pdf",
+        exploded_pdf="{root}/objects/{object}/fig4_exploded.pdf",
     params:
         cfg=step_cfg("fig4"),
     log:
-        "results/logs/fig4/{object}.log",
+        "{root}/logs/fig4/{object}.log",
     script:
         "../scripts/fig4_force_maps.py"
 
 
 rule fig5_hierarchy:
     input:
-        hierarchy="results/tables/hierarchy.csv",
+        hierarchy="{root}/tables/hierarchy.csv",
         code=code("fig5_hierarchy"),
     output:
         success_png=report(
-            "results/figures/fig5a_hierarchy_success.png",
+            "{root}/figures/fig5a_hierarchy_success.png",
             caption="../report/fig5a.rst",
             category="Figures",
         ),
-        success_pdf="results/figures/fig5a_hierarchy_success.pdf",
+        success_pdf="{root}/figures/fig5a_hierarchy_success.pdf",
         force_png=report(
-            "results/figures/fig5b_hierarchy_force.png",
+            "{root}/figures/fig5b_hierarchy_force.png",
             caption="../report/fig5b.rst",
             category="Figures",
         ),
-        force_pdf="results/figures/fig5b_hierarchy_force.pdf",
+        force_pdf="{root}/figures/fig5b_hierarchy_force.pdf",
     params:
         cfg=step_cfg("fig5"),
     log:
-        "results/logs/fig5_hierarchy.log",
+        "{root}/logs/fig5_hierarchy.log",
     script:
         "../scripts/fig5_hierarchy.py"
 

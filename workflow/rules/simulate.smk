@@ -6,15 +6,15 @@ rule simulate_contacts:
     input:
         code=code("simulate_contacts"),
         data=SHIPPED_DATA,
-        user=user_files(),
+        user=user_files,
     output:
-        "results/objects/{object}/contacts.parquet",
+        "{root}/objects/{object}/contacts.parquet",
     params:
         cfg=step_cfg("simulate"),
     log:
-        "results/logs/simulate_contacts/{object}.log",
+        "{root}/logs/simulate_contacts/{object}.log",
     benchmark:
-        "results/benchmarks/simulate_contacts/{object}.tsv"
+        "{root}/benchmarks/simulate_contacts/{object}.tsv"
     script:
         "../scripts/simulate_contacts.py"
 
@@ -23,38 +23,38 @@ rule fig1_synergy_postures:
     input:
         code=code("fig1_synergy_postures"),
         data=SHIPPED_DATA,
-        user=user_files(),
+        user=user_files,
     output:
         png=report(
-            "results/figures/fig1_synergy_postures.png",
+            "{root}/figures/fig1_synergy_postures.png",
             caption="../report/fig1.rst",
             category="Figures",
         ),
-        pdf="results/figures/fig1_synergy_postures.pdf",
+        pdf="{root}/figures/fig1_synergy_postures.pdf",
     params:
         cfg=step_cfg("fig1"),
     log:
-        "results/logs/fig1_synergy_postures.log",
+        "{root}/logs/fig1_synergy_postures.log",
     script:
         "../scripts/fig1_synergy_postures.py"
 
 
 rule fig2_example_grasps:
     input:
-        contacts=expand("results/objects/{object}/contacts.parquet", object=OBJECTS),
+        contacts=step_inputs("simulate"),
         code=code("fig2_example_grasps"),
         data=SHIPPED_DATA,
-        user=user_files(),
+        user=user_files,
     output:
         png=report(
-            "results/figures/fig2_example_grasps.png",
+            "{root}/figures/fig2_example_grasps.png",
             caption="../report/fig2.rst",
             category="Figures",
         ),
-        pdf="results/figures/fig2_example_grasps.pdf",
+        pdf="{root}/figures/fig2_example_grasps.pdf",
     params:
         cfg=step_cfg("fig2"),
     log:
-        "results/logs/fig2_example_grasps.log",
+        "{root}/logs/fig2_example_grasps.log",
     script:
         "../scripts/fig2_example_grasps.py"
