@@ -15,7 +15,7 @@ $(BIN)/.installed: environment.lock pyproject.toml
 	touch $@
 
 # Compiled solver code is cached next to the source; build it once here, not in every job.
-WARM_UP = $(BIN)/python -c "from synergrasp.optimisation.batched import warm_up; warm_up()"
+WARM_UP = $(BIN)/python -c "from synergrasp.optimisation.gfo import warm_up; warm_up()"
 
 study: $(BIN)/.installed
 	$(WARM_UP)

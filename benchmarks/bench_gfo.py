@@ -1,10 +1,11 @@
-"""Throughput of grasp-force optimisation: batched vs per-problem Clarabel vs cvxpy.
+"""Throughput of grasp-force optimisation: the compiled interior-point back end vs
+per-problem Clarabel vs cvxpy, all through the front door `solve_gfo`.
 
 Realistic study mix: random grasps with 4-12 contacts (some on the palm) x the 75 synergy
-sets of the study (15 incremental + subsets of 1-3 of S1..S7). The batched figure includes
-mechanics, bases and matrix building (`optimise_grasps`, GFO only), measured after one
-warm-up call that loads the compiled solver (its one-time cost per process is printed
-separately). Run on one core with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1. The last two
+sets of the study (15 incremental + subsets of 1-3 of S1..S7). The "ipm" figure is the
+study's loop (`study.optimise_grasps`, GFO only): mechanics, bases, rows and solves,
+measured after one warm-up call that loads the compiled kernel (its one-time cost per
+process is printed separately). Run on one core with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1. The last two
 lines are machine-read.
 """
 
@@ -16,10 +17,10 @@ import time
 
 import numpy as np
 
-from synergrasp.optimisation.batched import optimise_grasps
-from synergrasp.optimisation.force_optimisation import GFOParams, mechanics_for, solve_gfo, solve_gfo_cvxpy
-from synergrasp.optimisation.mechanics import internal_force_basis
+from synergrasp.optimisation.gfo import solve_gfo
+from synergrasp.optimisation.problem import GraspSets, SynergySets
 from synergrasp.optimisation.problems import random_grasp, random_synergies
+from synergrasp.optimisation.study import GFOParams, mechanics_for, optimise_grasps
 
 
 def study_sets() -> list[tuple[int, ...]]:
@@ -41,51 +42,51 @@ def main() -> None:
     sets = study_sets()
     n_poses = max(1, args.problems // len(sets))
     grasps = [random_grasp(rng, int(rng.integers(4, 13)), palm_contacts=int(rng.integers(0, 2))) for _ in range(n_poses)]
-    S = random_synergies(rng)
     params = GFOParams(gravity_direction=(0.0, 0.0, -1.0))
+    synergies = SynergySets(random_synergies(rng), tuple(sets))
     n = n_poses * len(sets)
 
     t0 = time.perf_counter()
-    optimise_grasps(grasps[:1], S, sets[:1], params, strict=False)  # loads the compiled solver
+    optimise_grasps(grasps[:1], SynergySets(synergies.matrix, tuple(sets[:1])), params, strict=False)  # loads the kernel
     t_load = time.perf_counter() - t0
     t0 = time.perf_counter()
-    out = optimise_grasps(grasps, S, sets, params, strict=False)
-    t_batched = time.perf_counter() - t0
-    batched_rate = n / t_batched
+    out = optimise_grasps(grasps, synergies, params, strict=False)
+    t_ipm = time.perf_counter() - t0
+    ipm_rate = n / t_ipm
     fallback = float(np.mean(out["solver"] == "clarabel_fallback"))
 
     # The same problems, per problem (subset): mechanics once per pose, then E and the solve.
     problems = []
-    for p, grasp in enumerate(grasps):
+    for grasp in grasps:
         mech = mechanics_for(grasp, params)
-        for st in sets:
-            problems.append((mech, np.array(st) - 1))
+        if mech.rank_G == 6:
+            g = GraspSets(mech.f_p, mech.normals, mech.projector, synergies, params.f_min, params.cone,
+                          params.basis_rtol)
+            problems += [(g, j) for j in range(len(g))]
     pick = rng.permutation(len(problems))
 
-    def per_problem_rate(solve, count: int) -> float:
+    def per_problem_rate(method: str, count: int) -> float:
         sub = [problems[k] for k in pick[:count]]
         t0 = time.perf_counter()
-        for mech, cols in sub:
-            if mech.rank_G == 6:
-                E = internal_force_basis(mech.projector, S[:, cols], params.basis_rtol)
-                solve(mech.f_p, E, mech.normals, params.mu, params.f_min)
+        for g, j in sub:
+            solve_gfo([g.problem(j)], method)
         return len(sub) / (time.perf_counter() - t0)
 
-    exact_rate = per_problem_rate(solve_gfo, args.exact)
-    cvxpy_rate = per_problem_rate(solve_gfo_cvxpy, args.cvxpy)
+    exact_rate = per_problem_rate("clarabel", args.exact)
+    cvxpy_rate = per_problem_rate("cvxpy", args.cvxpy)
 
     statuses = {s: int(np.sum(out["status"] == s)) for s in sorted(set(out["status"]))}
     print(f"problems: {n} ({n_poses} grasps x {len(sets)} sets), statuses {statuses}")
-    print(f"mean batched iterations: {out['iterations'][out['solver'] == 'batched'].mean():.2f}")
-    print(f"compiled solver load (once per process): {t_load:.2f} s")
-    print(f"batched (incl. mechanics and building): {batched_rate:.0f} solves/s ({t_batched:.2f} s);"
-          f" with the load: {n / (t_batched + t_load):.0f} solves/s")
+    print(f"mean interior-point iterations: {out['iterations'][out['solver'] == 'ipm'].mean():.2f}")
+    print(f"compiled kernel load (once per process): {t_load:.2f} s")
+    print(f"ipm (incl. mechanics and building): {ipm_rate:.0f} solves/s ({t_ipm:.2f} s);"
+          f" with the load: {n / (t_ipm + t_load):.0f} solves/s")
     print(f"per-problem exact (Clarabel, {min(args.exact, n)} problems): {exact_rate:.0f} solves/s")
     print(f"per-problem cvxpy ({min(args.cvxpy, n)} problems): {cvxpy_rate:.1f} solves/s")
-    print(f"batched / exact: {batched_rate / exact_rate:.2f}x; batched / cvxpy: {batched_rate / cvxpy_rate:.0f}x")
+    print(f"ipm / exact: {ipm_rate / exact_rate:.2f}x; ipm / cvxpy: {ipm_rate / cvxpy_rate:.0f}x")
     print(f"fallback share: {fallback:.4f}")
-    print(f"gfo_solves_per_s: {batched_rate:.0f}")
-    print(f"gfo_speedup_vs_cvxpy: {batched_rate / cvxpy_rate:.0f}")
+    print(f"gfo_solves_per_s: {ipm_rate:.0f}")
+    print(f"gfo_speedup_vs_cvxpy: {ipm_rate / cvxpy_rate:.0f}")
 
 
 if __name__ == "__main__":

@@ -3,10 +3,11 @@
 import numpy as np
 import pytest
 
+from synergrasp.optimisation.cones import CircularCone
 from synergrasp.optimisation.mechanics import (
     Grasp,
+    contact_frames,
     contact_stiffness,
-    friction_cone_rows,
     grasp_matrix,
     grasp_mechanics,
     internal_force_basis,
@@ -144,19 +145,26 @@ def test_rank_of_known_grasps(points, rank):
         assert mech.GKR is None and mech.f_p is None and mech.projector is None
 
 
-def test_friction_cone_rows_tangents():
+def test_contact_frames_and_circular_cone_rows():
     n = _unit(np.random.default_rng(5).normal(size=(50, 3)))
     n[0] = [0, 0, 1.0]
-    R = friction_cone_rows(n, 1.5)
-    np.testing.assert_allclose(R[:, 0], 1.5 * n)
-    frames = np.stack([n, R[:, 1], R[:, 2]], axis=1)
+    frames = contact_frames(n)
+    np.testing.assert_array_equal(frames[:, 0], n)
     np.testing.assert_allclose(frames @ frames.transpose(0, 2, 1), np.broadcast_to(np.eye(3), (50, 3, 3)), atol=1e-12)
     np.testing.assert_allclose(np.linalg.det(frames), 1.0)
-    np.testing.assert_array_equal(R, friction_cone_rows(n, 1.5))  # deterministic
+    np.testing.assert_array_equal(frames, contact_frames(n))  # deterministic
+    R = CircularCone(1.5).soc_rows(frames)
+    np.testing.assert_allclose(R[:, 0], 1.5 * n)
+    np.testing.assert_array_equal(R[:, 1:], frames[:, 1:])
+    # a force at the cone's edge (tangential part mu times the normal part) is on the SOC boundary
+    f = frames[:, 0] + 1.5 * frames[:, 1]
+    Rf = np.einsum("iab,ib->ia", R, f)
+    np.testing.assert_allclose(Rf[:, 0], np.linalg.norm(Rf[:, 1:], axis=1))
+    assert CircularCone(1.5).violation(f.ravel(), n, 1.0) == pytest.approx(0.0, abs=1e-12)
     with pytest.raises(ValueError, match="unit vectors"):
-        friction_cone_rows(n * 2, 1.5)
-    with pytest.raises(ValueError, match="mu"):
-        friction_cone_rows(n, 0.0)
+        contact_frames(n * 2)
+    with pytest.raises(ValueError, match="cone.mu"):
+        CircularCone(0.0)
 
 
 def test_grasp_rejects_bad_shapes():

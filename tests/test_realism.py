@@ -41,7 +41,7 @@ def _gfo(obj: str = "a") -> pd.DataFrame:
             rows.append({"object": obj, "pose": pose, "alpha_deg": 5.0 * pose, "beta_deg": 0.0, "set_id": set_id,
                          "n_synergies": len(set_id.split("-")), "status": "force_closure" if values[1] else "infeasible",
                          "force_closure": values[1], "strict_internal": values[1], "force_norm": values[2], "e_s": 1,
-                         "rank_G": values[0], "n_contacts": 0, "iterations": 1, "solver": "batched"})
+                         "rank_G": values[0], "n_contacts": 0, "iterations": 1, "solver": "ipm"})
     return pd.DataFrame(rows)
 
 

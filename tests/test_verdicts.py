@@ -8,9 +8,9 @@ import pandas as pd
 import pytest
 
 from synergrasp.analysis.verdicts import success_verdict, verdict_columns, with_verdicts
-from synergrasp.optimisation.batched import optimise_grasps
-from synergrasp.optimisation.force_optimisation import GFOParams
 from synergrasp.optimisation.mechanics import Grasp
+from synergrasp.optimisation.problem import SynergySets
+from synergrasp.optimisation.study import GFOParams, optimise_grasps
 
 LEVER = 50.0  # mm per rad: a pushing joint moves its contact along the normal
 
@@ -46,7 +46,7 @@ def verdicts_of(grasp: Grasp, gravity: tuple[float, float, float]) -> pd.Series:
     synergies = np.zeros((19, 2))
     synergies[[4, 8, 12], 0] = 1.0           # all three contacts pushed together
     synergies[[4, 8, 12], 1] = [1.0, -1.0, 0.0]  # two pushed against each other
-    out = optimise_grasps([grasp], synergies, [(1, 2)], GFOParams(gravity_direction=gravity, mu=1.5))
+    out = optimise_grasps([grasp], SynergySets(synergies, ((1, 2),)), GFOParams(gravity_direction=gravity, mu=1.5))
     table = pd.DataFrame(out).assign(object="box")
     row = pd.concat([table, verdict_columns(table)[["load_feasible"]]], axis=1)
     return row.assign(force_closure_verdict=verdict_columns(table)["force_closure"]).iloc[0]
@@ -66,7 +66,7 @@ def test_resting_box_is_load_feasible_and_not_force_closure():
 def test_symmetric_tripod_with_friction_is_both(gravity):
     row = verdicts_of(tripod(), gravity)
     assert row["rank_G"] == 6 and row["force_closure_verdict"] and row["load_feasible"]
-    if gravity == (0.0, 0.0, -1.0):  # closed form of test_force_optimisation: a* = W / (3 mu)
+    if gravity == (0.0, 0.0, -1.0):  # closed form of tests/test_gfo.py: a* = W / (3 mu)
         a = 9.81 / (3 * 1.5)
         assert row["force_norm"] == pytest.approx(math.sqrt(3 * (a**2 + 9.81**2 / 9)), rel=1e-5)
 

@@ -485,7 +485,7 @@ class OptimiseParams:
     GFO parameters (mechanics and the object's weight) and the number of pose shards."""
     synergies: str | None
     sets: dict[str, tuple[int, ...]]
-    gfo: Any  # synergrasp.optimisation.force_optimisation.GFOParams
+    gfo: Any  # synergrasp.optimisation.study.GFOParams
     pose_shards: int
 
 
@@ -529,7 +529,7 @@ class FiguresParams:
 #: step's script imports them itself; tests/test_config.py checks it).
 STEP_MODULES: dict[str, tuple[str, ...]] = {
     "simulate": ("synergrasp.simulation.closure", "synergrasp.simulation.placement"),
-    "optimise": ("synergrasp.optimisation.force_optimisation",),
+    "optimise": ("synergrasp.optimisation.study",),
     "tables": ("synergrasp.analysis.summaries",),
 }
 
@@ -579,7 +579,7 @@ def _fields(cls: Any, values: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _optimise(config: Mapping[str, Any], obj: str) -> OptimiseParams:
-    gfo = importlib.import_module("synergrasp.optimisation.force_optimisation")
+    gfo = importlib.import_module("synergrasp.optimisation.study")
     mech = config["mechanics"]
     gravity = np.asarray(mech["gravity_direction"], dtype=float)
     kwargs = {field: float(mech[key]) for field, key in _GFO_FIELDS.items()}

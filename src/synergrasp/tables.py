@@ -97,7 +97,7 @@ GFO = Table("gfo", "one row per (pose, synergy set)", _pose_columns() + (
     Column("rank_G", "int32", "", "rank of the grasp matrix"),
     Column("n_contacts", "int32", "", "number of contacts"),
     Column("iterations", "int32", "", "interior-point iterations"),
-    Column("solver", "string", "", "back end that decided the problem"),
+    Column("solver", "string", "", "back end that decided the problem: ipm, clarabel_fallback, direct, none"),
 ))
 
 MINIMA = Table("minima", "one row per local minimum of (object, synergy set)", (

@@ -26,6 +26,7 @@ rule aggregate_gfo:
             f"{w.root}/objects/{w.object}/gfo_shards/{i}.parquet"
             for i in range(scenario_config(w)["solver"]["pose_shards"])
         ],
+        code=code("aggregate_gfo"),
     output:
         "{root}/objects/{object}/gfo.parquet",
     log:

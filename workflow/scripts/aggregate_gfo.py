@@ -1,6 +1,9 @@
-"""Concatenate one object's optimisation shards into its gfo table, in pose order (sets keep their configured order)."""
-import pandas as pd
+"""One object's gfo table from its optimisation shards, in pose order."""
+from contextlib import redirect_stderr
 
-table = pd.concat([pd.read_parquet(path) for path in snakemake.input.shards], ignore_index=True)
-table.sort_values("pose", kind="stable").to_parquet(
-    snakemake.output[0], index=False)
+from synergrasp import tables
+from synergrasp.optimisation.study import merge_shards
+
+with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+    shards = [tables.read(tables.GFO, path) for path in snakemake.input.shards]
+    tables.write(tables.GFO, merge_shards(shards), snakemake.output[0])

@@ -1,10 +1,13 @@
 """Local minima of the optimal force over one object's (alpha, beta) grid, every set."""
+from contextlib import redirect_stderr
+
 import pandas as pd
 
 from synergrasp.analysis.minima import minima_table
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.config import step_params
 
-params = step_params(snakemake.params.cfg, "minima")
-gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), params.success)
-minima_table(gfo, radius_deg=params.radius_deg).to_parquet(snakemake.output[0], index=False)
+with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+    params = step_params(snakemake.params.cfg, "minima")
+    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), params.success)
+    minima_table(gfo, radius_deg=params.radius_deg).to_parquet(snakemake.output[0], index=False)

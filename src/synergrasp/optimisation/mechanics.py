@@ -18,13 +18,12 @@ from numpy.typing import NDArray
 __all__ = [
     "Grasp",
     "GraspMechanics",
+    "contact_frames",
     "contact_stiffness",
-    "friction_cone_rows",
     "grasp_matrix",
     "grasp_mechanics",
     "internal_force_basis",
     "object_wrench",
-    "tangent_pairs",
 ]
 
 #: Relative tolerance of the rank decision on the dimensionless grasp matrix.
@@ -285,11 +284,13 @@ def _spectral_norm(A: NDArray) -> float:
     return float(np.linalg.norm(A, 2)) if A.size else 0.0
 
 
-def tangent_pairs(normals: NDArray) -> tuple[NDArray, NDArray]:
-    """A deterministic orthonormal tangent pair (t1, t2), each (m, 3), per unit normal.
+def contact_frames(normals: NDArray) -> NDArray:
+    """Orthonormal contact frames (m, 3, 3), rows [n; t1; t2] per contact (one per unit normal).
 
     t1 is the normalised cross product of n with the coordinate axis least aligned with n
-    (never nearly parallel to n), t2 = n x t1, so (n, t1, t2) is right-handed.
+    (never nearly parallel to n), t2 = n x t1, so (n, t1, t2) is right-handed and
+    deterministic. Every friction-cone model and every solver back end takes its rows from
+    these frames (`synergrasp.optimisation.cones`).
     """
     n = _unit_normals(normals, None, "normals")
     axis = np.zeros_like(n)
@@ -297,17 +298,4 @@ def tangent_pairs(normals: NDArray) -> tuple[NDArray, NDArray]:
     t1 = np.cross(n, axis)
     t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
     t2 = np.cross(n, t1)
-    return t1, t2
-
-
-def friction_cone_rows(normals: NDArray, mu: float) -> NDArray:
-    """Rows (m, 3, 3) [mu n; t1; t2] per contact.
-
-    The Coulomb cone of contact i is R_i f_i in the second-order cone
-    {(u, v): u >= ||v||}, i.e. ||tangential part of f_i|| <= mu n_i.f_i.
-    """
-    if not (np.isfinite(mu) and mu > 0):
-        raise ValueError(f"mu must be a finite number > 0, got {mu}")
-    n = _unit_normals(normals, None, "normals")
-    t1, t2 = tangent_pairs(n)
-    return np.stack([mu * n, t1, t2], axis=1)
+    return np.stack([n, t1, t2], axis=1)

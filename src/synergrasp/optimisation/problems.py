@@ -16,11 +16,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from synergrasp.optimisation.force_optimisation import solve_gfo
+from synergrasp.optimisation.cones import CircularCone
+from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.mechanics import Grasp, grasp_mechanics, internal_force_basis, object_wrench
+from synergrasp.optimisation.problem import GFOProblem
 
 __all__ = [
-    "GFOProblem",
+    "GeneratedProblem",
     "LINK_CHAINS",
     "N_JOINTS",
     "critical_friction",
@@ -49,8 +51,9 @@ _PHALANX_LINKS = np.array([k for k, chain in enumerate(LINK_CHAINS) if len(chain
 
 
 @dataclass(frozen=True)
-class GFOProblem:
-    """One grasp-force optimisation problem (the inputs of `solve_gfo`) and how it was made.
+class GeneratedProblem:
+    """One generated grasp-force optimisation problem (`problem` gives it to `solve_gfo`)
+    and how it was made.
 
     f_p: (c,) N; E: (c, e_s) orthonormal; normals: (m, 3); mu; f_min: N.
     kind: 'nominal' (mu as asked), 'feasible' / 'infeasible' (mu = mu* (1 + delta),
@@ -75,6 +78,11 @@ class GFOProblem:
     @property
     def n_contacts(self) -> int:
         return int(self.normals.shape[0])
+
+    @property
+    def problem(self) -> GFOProblem:
+        """The problem with the exact (circular) Coulomb cone of friction coefficient mu."""
+        return GFOProblem(self.f_p, self.E, self.normals, self.f_min, CircularCone(self.mu))
 
     @property
     def e_s(self) -> int:
@@ -163,7 +171,8 @@ def critical_friction(
     """
 
     def feasible(mu: float) -> bool:
-        return solve_gfo(f_p, E, normals, mu, f_min).status == "force_closure"
+        problem = GFOProblem(f_p, E, normals, f_min, CircularCone(mu))
+        return solve_gfo([problem], "clarabel").status[0] == "force_closure"
 
     if feasible(mu_start):
         hi, lo = mu_start, mu_start / 2
@@ -203,7 +212,7 @@ def random_gfo_problems(
     synergies: tuple[int, int] = (1, 15),
     max_palm: int = 2,
     near_delta: tuple[float, float] = (1e-6, 1e-2),
-) -> list[GFOProblem]:
+) -> list[GeneratedProblem]:
     """`count` GFO problems from random grasps, deterministic from `seed`.
 
     Each problem: m contacts uniform in `contacts` (up to `max_palm` of them on the palm,
@@ -217,7 +226,7 @@ def random_gfo_problems(
     """
     if not (isinstance(count, int) and count >= 0):
         raise ValueError(f"count must be an int >= 0, got {count!r}")
-    problems: list[GFOProblem] = []
+    problems: list[GeneratedProblem] = []
     for index in range(count):
         rng = np.random.default_rng([int(seed), index])
         u = rng.random()
@@ -232,11 +241,11 @@ def random_gfo_problems(
                 break
         common = dict(f_p=f_p, E=E, normals=normals, f_min=f_min, n_palm=n_palm, s=s, index=index)
         if u < _KIND_SHARES[0]:
-            problems.append(GFOProblem(mu=mu, kind="nominal", **common))
+            problems.append(GeneratedProblem(mu=mu, kind="nominal", **common))
         elif math.isinf(mu_star):
-            problems.append(GFOProblem(mu=mu, kind="infeasible_any_mu", delta=-1.0, mu_star=mu_star, **common))
+            problems.append(GeneratedProblem(mu=mu, kind="infeasible_any_mu", delta=-1.0, mu_star=mu_star, **common))
         elif mu_star == 0.0:
-            problems.append(GFOProblem(mu=mu, kind="feasible", delta=math.inf, mu_star=0.0, **common))
+            problems.append(GeneratedProblem(mu=mu, kind="feasible", delta=math.inf, mu_star=0.0, **common))
         else:
             sign = rng.choice([-1.0, 1.0])
             if u < _KIND_SHARES[0] + _KIND_SHARES[1]:
@@ -245,7 +254,7 @@ def random_gfo_problems(
             else:
                 delta = sign * math.exp(rng.uniform(math.log(near_delta[0]), math.log(near_delta[1])))
                 kind = "near_boundary"
-            problems.append(GFOProblem(mu=mu_star * (1.0 + delta), kind=kind, delta=float(delta), mu_star=mu_star,
+            problems.append(GeneratedProblem(mu=mu_star * (1.0 + delta), kind=kind, delta=float(delta), mu_star=mu_star,
                                        **common))
     return problems
 

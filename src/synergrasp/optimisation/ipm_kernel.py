@@ -1,62 +1,44 @@
-"""Batched grasp-force optimisation: one primal-dual interior-point method, compiled with
-numba, run over thousands of GFO problems (docs/batched_solver.md).
+"""Back end: the compiled interior-point kernel (numba) for GFO problems with circular cones
+(docs/batched_solver.md).
 
-Per problem (method.md §4), forces in N:
+Per problem, forces in N: minimise ||f_p + E y||_2 subject to, per contact i,
+n_i.f_i >= f_min and ||f_i - (n_i.f_i) n_i|| <= mu n_i.f_i. With E orthonormal,
+||f_p + E y||^2 = ||f_p - E a||^2 + ||y + a||^2 (a = E^T f_p), so the kernel minimises t
+subject to (t, y + a) in a second-order cone: a linear-objective SOCP in x = (t, y), solved
+through the homogeneous self-dual embedding (infeasibility ends in a certificate, not a
+time-out) with Nesterov-Todd scaling and Mehrotra's predictor-corrector. Each problem is
+solved on its own from its own sizes, so its numbers do not depend on what else is solved.
 
-    minimise ||f_p + E y||_2   subject to, per contact i,
-        n_i.f_i >= f_min,   ||f_i - (n_i.f_i) n_i|| <= mu n_i.f_i
-
-With E orthonormal, ||f_p + E y||^2 = ||f_p - E a||^2 + ||y + a||^2 (a = E^T f_p), so the
-solver minimises t subject to (t, y + a) in a second-order cone: a linear-objective SOCP
-in x = (t, y), solved through the homogeneous self-dual embedding (infeasibility ends in a
-certificate, not a time-out) with Nesterov-Todd scaling and Mehrotra's predictor-corrector.
-Each problem is solved on its own from its own sizes, so it gives the same numbers alone or
-inside any batch, padded or not.
+Results are codes (`OPTIMAL`, `INFEASIBLE`, `UNDECIDED`, `NOT_SOLVED` for e_s = 0); the
+front door `synergrasp.optimisation.gfo.solve_gfo` turns them into verdicts and sends the
+undecided problems to Clarabel.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from synergrasp.optimisation.force_optimisation import GFOParams, mechanics_for, solve_gfo, strict_internal_forces
-from synergrasp.optimisation.mechanics import Grasp, internal_force_basis, tangent_pairs
+__all__ = ["INFEASIBLE", "IPMSettings", "NOT_SOLVED", "OPTIMAL", "SetsResult", "UNDECIDED", "solve_problem", "solve_sets"]
 
-__all__ = [
-    "BatchResult",
-    "BatchSolution",
-    "GFOBatch",
-    "SolverSettings",
-    "gfo_batch",
-    "optimise_grasps",
-    "set_id",
-    "solve_batch",
-    "solve_gfo_batch",
-    "warm_up",
-]
-
-# Codes of the interior-point method (BatchResult.code); 0: e = 0, nothing to solve.
-_OPTIMAL, _INFEASIBLE, _UNDECIDED = 1, 2, 3
-
-#: Problems padded together by `solve_gfo_batch` (bounds its memory whatever the input size).
-_PIECE = 4096
+#: Codes of the kernel's verdicts.
+NOT_SOLVED, OPTIMAL, INFEASIBLE, UNDECIDED = 0, 1, 2, 3
 
 
 @dataclass(frozen=True, kw_only=True)
-class SolverSettings:
-    """Tolerances of the batched interior-point method.
+class IPMSettings:
+    """Tolerances of the compiled interior-point method.
 
     tol: relative primal/dual residual and duality-gap tolerance of an optimal point, and the
         residual tolerance of an infeasibility certificate (dimensionless; the data are
         scaled so that max(||f_p||, f_min) = 1)
     reduced_tol: the same tests, applied when the iteration stalls (step below
         `stall_step`) or reaches `max_iter`; failing them the problem is 'not decided'
-    max_iter: iteration cap; a problem not decided by then falls back to `solve_gfo`
+    max_iter: iteration cap; a problem not decided by then goes to the Clarabel fallback
     step_fraction: fraction of the step to the cone boundary taken each iteration
     stall_step: a step below this ends the iteration (judged with `reduced_tol`)
     refine: iterative-refinement steps on the full KKT system per linear solve (0: none)
@@ -84,109 +66,6 @@ class SolverSettings:
             value = getattr(self, name)
             if not (isinstance(value, int) and 0 <= value <= 10):
                 raise ValueError(f"{name} must be an int in 0..10, got {value!r}")
-
-
-@dataclass(frozen=True)
-class GFOBatch:
-    """B GFO problems padded to a common contact count m and basis size e, batch first.
-
-    frames:     (B, m, 3, 3)  rows [n; t1/mu; t2/mu] per contact (Coulomb cone: frames @ f_i in SOC(3))
-    E:          (B, 3m, e)    orthonormal internal-force bases
-    f_p:        (B, 3m)       particular forces, N
-    mu, f_min:  (B,)          friction coefficient; least normal force, N
-    n_contacts: (B,)          contacts of each problem (the first ones; the rest is zero padding)
-    n_basis:    (B,)          basis columns of each problem (the first ones)
-    """
-
-    frames: NDArray
-    E: NDArray
-    f_p: NDArray
-    mu: NDArray
-    f_min: NDArray
-    n_contacts: NDArray
-    n_basis: NDArray
-
-    @property
-    def size(self) -> int:
-        return int(self.f_p.shape[0])
-
-
-@dataclass(frozen=True)
-class BatchResult:
-    """Outcome of `solve_batch`, one entry per problem.
-
-    code: 1 optimal, 2 infeasible (certificate), 3 not decided; 0 for e = 0 (nothing to solve)
-    y: (B, e) optimal internal-force coordinates, N (NaN unless optimal, and in padding)
-    force_norm: optimal ||f_p + E y||, N (NaN unless optimal)
-    max_violation: worst constraint violation of those forces, N (NaN unless optimal)
-    iterations: (B,) interior-point iterations
-    """
-
-    code: NDArray
-    y: NDArray
-    force_norm: NDArray
-    max_violation: NDArray
-    iterations: NDArray
-
-
-# --------------------------------------------------------------------------- building
-
-
-def gfo_batch(
-    f_p: Sequence[NDArray],
-    E: Sequence[NDArray],
-    normals: Sequence[NDArray],
-    mu: float | Sequence[float],
-    f_min: float | Sequence[float],
-    m_pad: int | None = None,
-    e_pad: int | None = None,
-) -> GFOBatch:
-    """Pad and stack GFO problems (f_p (3m,) N, E (3m, e) orthonormal, normals (m, 3)).
-
-    Each problem is solved from its own sizes only, so it has the same iterates alone or in
-    any batch, padded or not.
-    """
-    B = len(f_p)
-    mus, fmins = _problem_parameters(f_p, E, normals, mu, f_min)
-    bases = [np.asarray(Ek, dtype=float).reshape(np.asarray(Ek).shape[0], -1) for Ek in E]
-    ms = np.array([np.asarray(n).reshape(-1, 3).shape[0] for n in normals], dtype=np.int64)
-    es = np.array([Ek.shape[1] for Ek in bases], dtype=np.int64)
-    m = max(int(ms.max(initial=0)), 1) if m_pad is None else m_pad
-    e = max(int(es.max(initial=0)), 1) if e_pad is None else e_pad
-    if ms.max(initial=0) > m or es.max(initial=0) > e:
-        raise ValueError(f"m_pad={m_pad} / e_pad={e_pad} smaller than the largest problem")
-    frames = np.zeros((B, m, 3, 3))
-    Eb = np.zeros((B, 3 * m, e))
-    fp = np.zeros((B, 3 * m))
-    for k in range(B):
-        mk, ek = ms[k], es[k]
-        if bases[k].shape[0] != 3 * mk or np.size(f_p[k]) != 3 * mk:
-            raise ValueError(f"problem {k}: f_p and E must have 3m = {3 * mk} rows")
-        frames[k, :mk] = _contact_frames(np.asarray(normals[k], dtype=float).reshape(mk, 3), mus[k])
-        Eb[k, :3 * mk, :ek] = bases[k]
-        fp[k, :3 * mk] = np.asarray(f_p[k], dtype=float).ravel()
-    return GFOBatch(frames=frames, E=Eb, f_p=fp, mu=mus, f_min=fmins, n_contacts=ms, n_basis=es)
-
-
-def _problem_parameters(f_p, E, normals, mu, f_min) -> tuple[NDArray, NDArray]:
-    """Check that the problem lists agree in length; mu and f_min (N) as checked (B,) arrays."""
-    B = len(f_p)
-    if not (len(E) == len(normals) == B):
-        raise ValueError(f"f_p, E and normals must have the same length, got {B}, {len(E)}, {len(normals)}")
-    mus = np.array(np.broadcast_to(np.asarray(mu, dtype=float), (B,)))
-    fmins = np.array(np.broadcast_to(np.asarray(f_min, dtype=float), (B,)))
-    if not np.all(np.isfinite(mus) & (mus > 0)):
-        raise ValueError("mu must be finite and > 0")
-    if not np.all(np.isfinite(fmins) & (fmins >= 0)):
-        raise ValueError("f_min must be finite and >= 0 (N)")
-    return mus, fmins
-
-
-def _contact_frames(normals: NDArray, mu: float | NDArray) -> NDArray:
-    """(m, 3, 3) rows [n; t1/mu; t2/mu]: the Coulomb cone is rows @ f_i in SOC(3)."""
-    t1, t2 = tangent_pairs(normals)
-    mu = np.asarray(mu, dtype=float)[..., None]
-    return np.stack([normals, t1 / mu, t2 / mu], axis=1)
 
 
 # --------------------------------------------------------------------------- cone algebra
@@ -544,11 +423,11 @@ def _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, 
         if optimal:
             for j in range(e):
                 y[j] = x[1 + j] / tau * rho
-            return _OPTIMAL, it
+            return OPTIMAL, it
         if infeasible:
-            return _INFEASIBLE, it
+            return INFEASIBLE, it
         if last or not (math.isfinite(mu) and math.isfinite(tau) and tau > 0.0):
-            return _UNDECIDED, it
+            return UNDECIDED, it
 
         # Nesterov-Todd scaling and the normal matrix M = G^T (W^T W)^-1 G, (e+1, e+1).
         for i in range(m):
@@ -641,7 +520,7 @@ def _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, 
             z[k] += alpha * dz[k]
         tau += alpha * dtau
         kappa += alpha * dkappa
-    return _UNDECIDED, max_iter
+    return UNDECIDED, max_iter
 
 
 @_jit
@@ -688,10 +567,10 @@ def _direction(D, m, e, sigma, dsv, d_kappa, s, z, lam, h, r_x, r_z, r_tau, tau,
 
 
 @_jit
-def _solve_one(frames, E, fp, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine,
+def _solve_one(rows, E, fp, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine,
                retry_refine, violation_tol, y):
-    """Build the contact rows of one GFO problem from its frames (m, 3, 3), basis E (3m, e) and
-    f_p (3m,) (N) and solve it. Returns (code, ||f|| N, worst violation N, iterations); fills y.
+    """Build the contact rows of one GFO problem from its cone rows (m, 3, 3) (`_cone_rows`),
+    basis E (3m, e) and f_p (3m,) (N) and solve it. Returns (code, ||f|| N, worst violation N, iterations); fills y.
 
     An optimal point whose forces violate a constraint by more than violation_tol max(1 N, ||f||)
     is 'not decided' (the rule of `solve_gfo` for reduced accuracy).
@@ -703,12 +582,12 @@ def _solve_one(frames, E, fp, mu, f_min, m, e, tol, reduced_tol, max_iter, step_
         for r in range(3):
             acc = 0.0
             for q in range(3):
-                acc += frames[i, r, q] * fp[3 * i + q]
+                acc += rows[i, r, q] * fp[3 * i + q]
             hv[i, r] = acc
             for k in range(e):
                 acc = 0.0
                 for q in range(3):
-                    acc += frames[i, r, q] * E[3 * i + q, k]
+                    acc += rows[i, r, q] * E[3 * i + q, k]
                 D[i, r, k] = acc
     for c in range(3 * m):
         for k in range(e):
@@ -722,7 +601,7 @@ def _solve_one(frames, E, fp, mu, f_min, m, e, tol, reduced_tol, max_iter, step_
     r0 = math.sqrt(r0)
     code, norm, viol, it = _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction,
                                     stall_step, refine, violation_tol, y)
-    if code == _UNDECIDED and retry_refine > refine:
+    if code == UNDECIDED and retry_refine > refine:
         # Undecided problems are mostly stalls at a degenerate optimum, where the normal
         # equations lose accuracy: a second attempt with iterative refinement decides most.
         code, norm, viol, it2 = _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction,
@@ -736,7 +615,7 @@ def _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fra
              violation_tol, y):
     """`_hsde`, then the force check of an optimal point: (code, ||f|| N, violation N, iterations)."""
     code, it = _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine, y)
-    if code != _OPTIMAL:
+    if code != OPTIMAL:
         return code, math.nan, math.nan, it
     # f = f_p + E y in the contact frames: [n.f, t1.f/mu, t2.f/mu]
     norm = 0.0
@@ -753,32 +632,36 @@ def _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fra
         viol = max(viol, f_min - fr[0], ft - mu * fr[0])
     norm = math.sqrt(norm)
     if viol > violation_tol * max(1.0, norm):
-        return _UNDECIDED, math.nan, math.nan, it
+        return UNDECIDED, math.nan, math.nan, it
     return code, norm, viol, it
 
 
 @_jit
-def _solve_given(frames, E, fp, mu, f_min, n_contacts, n_basis, tol, reduced_tol, max_iter, step_fraction,
-                 stall_step, refine, retry_refine, violation_tol, code, y, norm, viol, iters):
-    """`_solve_one` for each problem of a padded batch (each reads only its own sizes)."""
-    for b in range(fp.shape[0]):
-        if n_basis[b] == 0:
-            code[b] = 0
-            continue
-        code[b], norm[b], viol[b], iters[b] = _solve_one(
-            frames[b], E[b], fp[b], mu[b], f_min[b], n_contacts[b], n_basis[b], tol, reduced_tol, max_iter,
-            step_fraction, stall_step, refine, retry_refine, violation_tol, y[b])
+def _cone_rows(frames, mu, rows):
+    """Kernel form of the circular cone from the contact frames (m, 3, 3) [n; t1; t2]:
+    rows [n; t1/mu; t2/mu], so that the cone is rows @ f_i in SOC(3) and the linear row
+    n.f - f_min >= 0 is its first row."""
+    for i in range(frames.shape[0]):
+        for q in range(3):
+            rows[i, 0, q] = frames[i, 0, q]
+            rows[i, 1, q] = frames[i, 1, q] / mu
+            rows[i, 2, q] = frames[i, 2, q] / mu
 
 
 @_jit
-def _solve_pose(F_all, fp, frames, frames_strict, cols, n_cols, thresholds, mu, mu_strict, f_min, strict,
+def _solve_sets(F_all, fp, frames, cols, n_cols, thresholds, mu, mu_strict, f_min, strict,
                 tol, reduced_tol, max_iter, step_fraction, stall_step, refine, retry_refine, violation_tol,
-                code, norm, viol, iters, e_s, strict_code):
-    """Every synergy set of one pose: E_s from the SVD of F_s = F_all[:, set] (columns with a
-    singular value above the set's threshold), then the GFO and, if `strict`, the strict
-    internal-force test (f_p = 0, f_min = 1 N, mu_strict). Sets with e_s = 0 get code 0."""
+                code, norm, viol, iters, e_s, strict_code, forces):
+    """Every synergy set of one grasp: E_s from the SVD of F_s = F_all[:, set] (columns with a
+    singular value above the set's threshold), then the GFO, its forces f_p + E_s y (N) and,
+    if `strict`, the strict internal-force test (f_p = 0, f_min = 1 N, mu_strict). Sets with
+    e_s = 0 get code NOT_SOLVED."""
     c = F_all.shape[0]
     m = c // 3
+    rows = np.empty((m, 3, 3))
+    rows_strict = np.empty((m, 3, 3))
+    _cone_rows(frames, mu, rows)
+    _cone_rows(frames, mu_strict, rows_strict)
     zero = np.zeros(c)
     y = np.empty(cols.shape[1])
     for j in range(cols.shape[0]):
@@ -793,240 +676,74 @@ def _solve_pose(F_all, fp, frames, frames_strict, cols, n_cols, thresholds, mu, 
                 rank += 1
         e_s[j] = rank
         if rank == 0:
-            code[j] = 0
+            code[j] = NOT_SOLVED
             continue
         E = np.ascontiguousarray(U[:, :rank])
         code[j], norm[j], viol[j], iters[j] = _solve_one(
-            frames, E, fp, mu, f_min, m, rank, tol, reduced_tol, max_iter, step_fraction, stall_step, refine,
+            rows, E, fp, mu, f_min, m, rank, tol, reduced_tol, max_iter, step_fraction, stall_step, refine,
             retry_refine, violation_tol, y)
+        if code[j] == OPTIMAL:
+            for k in range(c):
+                acc = fp[k]
+                for q in range(rank):
+                    acc += E[k, q] * y[q]
+                forces[j, k] = acc
         if strict:
-            strict_code[j] = _solve_one(frames_strict, E, zero, mu_strict, 1.0, m, rank, tol, reduced_tol, max_iter,
+            strict_code[j] = _solve_one(rows_strict, E, zero, mu_strict, 1.0, m, rank, tol, reduced_tol, max_iter,
                                         step_fraction, stall_step, refine, retry_refine, violation_tol, y)[0]
 
 
-def _kernel_settings(settings: SolverSettings) -> tuple:
-    from synergrasp.optimisation.force_optimisation import ALMOST_SOLVED_TOL
-
+def _kernel_settings(settings: IPMSettings, violation_tol: float) -> tuple:
     return (float(settings.tol), float(settings.reduced_tol), int(settings.max_iter), float(settings.step_fraction),
-            float(settings.stall_step), int(settings.refine), int(settings.retry_refine), float(ALMOST_SOLVED_TOL))
+            float(settings.stall_step), int(settings.refine), int(settings.retry_refine), float(violation_tol))
 
 
-# --------------------------------------------------------------------------- many problems
-
-
-def solve_batch(batch: GFOBatch, settings: SolverSettings = SolverSettings()) -> BatchResult:
-    """Solve every problem of the batch with the homogeneous self-dual interior-point method.
-
-    The data are scaled per problem by rho = max(||f_p||, f_min) (reported y in N).
-    Verdicts: optimal when the scaled primal and dual residuals and the duality gap are below
-    `tol` and the forces pass the violation check; infeasible when the dual iterate is a
-    Farkas certificate (h^T z < 0 and ||G^T z|| <= tol |h^T z|); otherwise 'not decided'
-    (iteration cap, stall, breakdown, or an optimal point that fails the violation check).
-    """
-    B = batch.size
-    code = np.zeros(B, dtype=np.int8)
-    y = np.full(batch.E.shape[::2], np.nan)
-    norm = np.full(B, np.nan)
-    viol = np.full(B, np.nan)
-    iters = np.zeros(B, dtype=np.int32)
-    _solve_given(batch.frames, batch.E, batch.f_p, batch.mu, batch.f_min, batch.n_contacts, batch.n_basis,
-                 *_kernel_settings(settings), code, y, norm, viol, iters)
-    y[code != _OPTIMAL] = np.nan
-    return BatchResult(code=code, y=y, force_norm=norm, max_violation=viol, iterations=iters)
+def solve_problem(frames: NDArray, E: NDArray, f_p: NDArray, mu: float, f_min: float, settings: IPMSettings,
+                  violation_tol: float) -> tuple[int, float, NDArray, int]:
+    """One problem: frames (m, 3, 3) from `mechanics.contact_frames`, E (3m, e) orthonormal
+    with e >= 1, f_p (3m,) N, mu, f_min N. An optimal point whose forces violate a
+    constraint by more than violation_tol max(1 N, ||f||) is UNDECIDED.
+    Returns (code, ||f|| N, y (e,) N (NaN unless OPTIMAL), iterations)."""
+    m, e = frames.shape[0], E.shape[1]
+    rows = np.empty((m, 3, 3))
+    _cone_rows(frames, float(mu), rows)
+    y = np.full(e, np.nan)
+    code, norm, _, iters = _solve_one(rows, np.ascontiguousarray(E, dtype=float), np.ascontiguousarray(f_p, dtype=float),
+                                      float(mu), float(f_min), m, e, *_kernel_settings(settings, violation_tol), y)
+    if code != OPTIMAL:
+        y[:] = np.nan
+    return int(code), float(norm), y, int(iters)
 
 
 @dataclass(frozen=True)
-class BatchSolution:
-    """Verdicts of many GFO problems, in the caller's order (columnar).
+class SetsResult:
+    """Kernel output for the sets of one grasp (arrays over the sets): code, ||f|| N,
+    worst constraint violation N, iterations, e_s, strict_code (INFEASIBLE where not
+    tested), forces (n_sets, 3m) N (rows of OPTIMAL sets only)."""
 
-    status: 'force_closure' | 'infeasible' | 'numerical_failure'
-    force_norm: optimal ||f||_2, N (NaN unless force closure)
-    iterations: interior-point iterations (of the fallback solver where it was used)
-    solver: 'batched' | 'clarabel_fallback'
-    max_violation: worst constraint violation of the optimal forces, N (NaN unless force closure)
-    """
-
-    status: NDArray
+    code: NDArray
     force_norm: NDArray
-    iterations: NDArray
-    solver: NDArray
     max_violation: NDArray
+    iterations: NDArray
+    e_s: NDArray
+    strict_code: NDArray
+    forces: NDArray
 
 
-def solve_gfo_batch(
-    f_p: Sequence[NDArray],
-    E: Sequence[NDArray],
-    normals: Sequence[NDArray],
-    mu: float | Sequence[float],
-    f_min: float | Sequence[float],
-    *,
-    settings: SolverSettings = SolverSettings(),
-    tol: float = 1e-8,
-    max_iter: int = 200,
-) -> BatchSolution:
-    """Solve many GFO problems (f_p (3m,) N, E (3m, e) orthonormal, normals (m, 3)) at once.
-
-    Problems the batched method does not decide (iteration cap, stall, or an optimal point
-    violating a constraint by more than 1e-6 max(1 N, ||f||)) are solved by `solve_gfo`
-    (tolerance `tol`, cap `max_iter`) and marked 'clarabel_fallback'. Problems with e = 0
-    are judged directly by `solve_gfo` (f = f_p), as the per-problem path does.
-    """
-    B = len(f_p)
-    mus, fmins = _problem_parameters(f_p, E, normals, mu, f_min)
-    out = BatchSolution(status=np.full(B, "numerical_failure", dtype=object), force_norm=np.full(B, np.nan),
-                        iterations=np.zeros(B, dtype=np.int32), solver=np.full(B, "batched", dtype=object),
-                        max_violation=np.full(B, np.nan))
-    for start in range(0, B, _PIECE):  # fixed-size pieces: the padded copy stays small
-        part = slice(start, min(B, start + _PIECE))
-        batch = gfo_batch(f_p[part], E[part], normals[part], mus[part], fmins[part])
-        res = solve_batch(batch, settings)
-        out.status[part] = np.where(res.code == _OPTIMAL, "force_closure",
-                                    np.where(res.code == _INFEASIBLE, "infeasible", "numerical_failure"))
-        out.force_norm[part], out.max_violation[part], out.iterations[part] = \
-            res.force_norm, res.max_violation, res.iterations
-        for k in np.flatnonzero((res.code != _OPTIMAL) & (res.code != _INFEASIBLE)):
-            g = start + int(k)
-            r = solve_gfo(f_p[g], E[g], normals[g], mus[g], fmins[g], tol=tol, max_iter=max_iter)
-            _record(out, g, r, fallback=batch.n_basis[k] > 0)
+def solve_sets(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_columns: NDArray,
+               thresholds: NDArray, mu: float, mu_strict: float, f_min: float, strict: bool,
+               settings: IPMSettings, violation_tol: float) -> SetsResult:
+    """Every set of one grasp in one compiled call. F_all: (3m, k) projector @ S, N per
+    unit activation; columns: (n_sets, max size) 0-based columns of F_all per set (the first
+    n_columns[j] of row j); thresholds: (n_sets,) rank thresholds of the singular values."""
+    n_sets = columns.shape[0]
+    out = SetsResult(code=np.zeros(n_sets, dtype=np.int8), force_norm=np.full(n_sets, np.nan),
+                     max_violation=np.full(n_sets, np.nan),
+                     iterations=np.zeros(n_sets, dtype=np.int32), e_s=np.zeros(n_sets, dtype=np.int64),
+                     strict_code=np.full(n_sets, INFEASIBLE, dtype=np.int8),
+                     forces=np.full((n_sets, f_p.size), np.nan))
+    _solve_sets(np.ascontiguousarray(F_all), np.ascontiguousarray(f_p, dtype=float), frames, columns, n_columns,
+                thresholds, float(mu), float(mu_strict), float(f_min), bool(strict),
+                *_kernel_settings(settings, violation_tol), out.code, out.force_norm, out.max_violation, out.iterations,
+                out.e_s, out.strict_code, out.forces)
     return out
-
-
-def _record(out: BatchSolution, k: int, r, fallback: bool) -> None:
-    """Store the per-problem result r (GFOResult) in row k."""
-    out.status[k], out.force_norm[k] = r.status, r.force_norm
-    out.max_violation[k] = r.max_violation if r.status == "force_closure" else np.nan
-    out.iterations[k] = r.iterations if fallback else 0
-    if fallback:
-        out.solver[k] = "clarabel_fallback"
-
-
-def set_id(subset: Sequence[int]) -> str:
-    """'1-2-3' for the 1-based synergy indices of a set (sorted)."""
-    return "-".join(str(int(k)) for k in sorted(subset))
-
-
-def _check_sets(sets: Sequence[tuple[int, ...]], k: int) -> list[NDArray]:
-    out = []
-    for s in sets:
-        idx = np.asarray(sorted(int(v) for v in s), dtype=int)
-        if idx.size == 0 or idx[0] < 1 or idx[-1] > k or np.unique(idx).size != idx.size:
-            raise ValueError(f"sets: each set must hold distinct 1-based synergy indices in 1..{k}, got {tuple(s)!r}")
-        out.append(idx - 1)
-    return out
-
-
-def optimise_grasps(
-    grasps: Sequence[Grasp | None],
-    synergies: NDArray,
-    sets: Sequence[tuple[int, ...]],
-    params: GFOParams,
-    *,
-    strict: bool = True,
-    settings: SolverSettings = SolverSettings(),
-) -> dict[str, NDArray]:
-    """GFO verdict, optimal force and strict internal-force test for every (grasp, set).
-
-    grasps: poses (None or no contacts: 'no_grasp'); synergies: (n, k) synergy matrix,
-    rad per unit activation; sets: 1-based synergy indices. Mechanics once per pose; E_s by
-    the rule of `internal_force_basis` (singular values above
-    basis_rtol ||projector||_2 ||S_set||_2); both SOCPs (GFO and strict test) solved by the
-    compiled interior-point method, one pose at a time (memory does not grow with the study).
-    Problems it does not decide are solved by `solve_gfo` / `strict_internal_forces` and
-    marked solver 'clarabel_fallback'. strict=False skips the strict test (column all False).
-    Returns columns (one row per (pose, set), pose-major): pose, set_id, n_synergies,
-    status, force_closure, strict_internal, force_norm (N), e_s, rank_G, n_contacts,
-    iterations, solver.
-    """
-    S = np.asarray(synergies, dtype=float)
-    if S.ndim != 2:
-        raise ValueError(f"synergies must be an (n, k) matrix, got shape {S.shape}")
-    cols = _check_sets(sets, S.shape[1])
-    n_sets, n_poses = len(cols), len(grasps)
-    total = n_sets * n_poses
-    out = {
-        "pose": np.repeat(np.arange(n_poses, dtype=np.int32), n_sets),
-        "set_id": np.array([set_id(c + 1) for c in cols] * n_poses, dtype=object),
-        "n_synergies": np.tile(np.array([c.size for c in cols], dtype=np.int32), n_poses),
-        "status": np.full(total, "no_grasp", dtype=object),
-        "force_closure": np.zeros(total, dtype=bool),
-        "strict_internal": np.zeros(total, dtype=bool),
-        "force_norm": np.full(total, np.nan),
-        "e_s": np.zeros(total, dtype=np.int32),
-        "rank_G": np.zeros(total, dtype=np.int32),
-        "n_contacts": np.zeros(total, dtype=np.int32),
-        "iterations": np.zeros(total, dtype=np.int32),
-        "solver": np.full(total, "batched", dtype=object),
-    }
-    if total == 0:
-        return out
-    set_norms = np.array([np.linalg.norm(S[:, c], 2) for c in cols])
-    col_table = np.zeros((n_sets, max(c.size for c in cols)), dtype=np.int64)
-    for j, c in enumerate(cols):
-        col_table[j, :c.size] = c
-    n_cols = np.array([c.size for c in cols], dtype=np.int64)
-    mu_strict = params.mu * (1.0 - params.strict_shrink)
-    kernel = _kernel_settings(settings)
-    code = np.zeros(n_sets, dtype=np.int8)
-    strict_code = np.zeros(n_sets, dtype=np.int8)
-    norm, viol = np.empty(n_sets), np.empty(n_sets)
-    iters, e_s = np.zeros(n_sets, dtype=np.int32), np.zeros(n_sets, dtype=np.int64)
-
-    for p, grasp in enumerate(grasps):
-        if grasp is None or grasp.n_contacts == 0:
-            continue
-        rows = slice(p * n_sets, (p + 1) * n_sets)
-        mech = mechanics_for(grasp, params)
-        out["rank_G"][rows] = mech.rank_G
-        out["n_contacts"][rows] = mech.n_contacts
-        if mech.rank_G < 6 or mech.projector is None:
-            out["status"][rows] = "rank_deficient"
-            continue
-        P = mech.projector
-        thresholds = params.basis_rtol * (float(np.linalg.norm(P, 2)) if P.size else 0.0) * set_norms
-        code[:], strict_code[:], iters[:] = 0, _INFEASIBLE, 0
-        _solve_pose(np.ascontiguousarray(P @ S), np.ascontiguousarray(mech.f_p, dtype=float),
-                    _contact_frames(mech.normals, params.mu), _contact_frames(mech.normals, mu_strict), col_table,
-                    n_cols, thresholds, float(params.mu), float(mu_strict), float(params.f_min), bool(strict),
-                    *kernel, code, norm, viol, iters, e_s, strict_code)
-        status = np.where(code == _OPTIMAL, "force_closure", np.where(code == _INFEASIBLE, "infeasible", ""))
-        out["status"][rows] = status
-        out["force_norm"][rows] = np.where(code == _OPTIMAL, norm, np.nan)
-        out["iterations"][rows] = iters
-        out["e_s"][rows] = e_s
-        out["strict_internal"][rows] = strict_code == _OPTIMAL
-        for j in np.flatnonzero(status == ""):
-            _pose_fallback(out, p * n_sets + j, mech, S[:, cols[j]], params)
-        if strict:
-            for j in np.flatnonzero((strict_code != _OPTIMAL) & (strict_code != _INFEASIBLE) & (e_s > 0)):
-                E = internal_force_basis(P, S[:, cols[j]], params.basis_rtol)
-                out["strict_internal"][p * n_sets + j] = strict_internal_forces(
-                    E, mech.normals, params.mu, params.strict_shrink, tol=params.tol, max_iter=params.max_iter).strict
-    out["force_closure"] = out["status"] == "force_closure"
-    return out
-
-
-def _pose_fallback(out: dict[str, NDArray], row: int, mech, S_set: NDArray, params: GFOParams) -> None:
-    """Row not decided by the compiled method (or e_s = 0: f = f_p judged directly): `solve_gfo`."""
-    E = internal_force_basis(mech.projector, S_set, params.basis_rtol)
-    r = solve_gfo(mech.f_p, E, mech.normals, params.mu, params.f_min, tol=params.tol, max_iter=params.max_iter)
-    out["status"][row], out["force_norm"][row] = r.status, r.force_norm
-    if E.shape[1] > 0:
-        out["iterations"][row], out["solver"][row] = r.iterations, "clarabel_fallback"
-    else:
-        out["iterations"][row] = 0
-
-
-def warm_up() -> None:
-    """Compile the solver's machine code, or load it from the cache next to this file.
-
-    Called once after installation (Makefile) so that no workflow job pays the compilation
-    (about a minute on one core) and parallel jobs do not compile it side by side.
-    """
-    normals = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])
-    E = np.array([[1.0], [0.0], [0.0], [-1.0], [0.0], [0.0]]) / np.sqrt(2.0)  # a squeeze
-    solve_gfo_batch([np.zeros(6)], [E], [normals], 1.0, 0.5)
-    frames = _contact_frames(normals, 1.0)
-    n = np.zeros(1, dtype=np.int8)
-    _solve_pose(E.copy(), np.zeros(6), frames, frames, np.zeros((1, 1), dtype=np.int64), np.ones(1, dtype=np.int64),
-                np.full(1, 1e-9), 1.0, 0.99, 0.5, True, *_kernel_settings(SolverSettings()), n, np.empty(1),
-                np.empty(1), np.zeros(1, dtype=np.int32), np.zeros(1, dtype=np.int64), n.copy())

@@ -1,22 +1,20 @@
-"""Grasp-force optimisation: hand-derived cases, the strict test, and agreement of the
-Clarabel formulation with the independent cvxpy reference on generated problems."""
+"""Grasp-force optimisation through the front door `solve_gfo`: hand-derived cases for every
+method, the strict test, bad input, and agreement of the Clarabel formulation with the
+independent cvxpy reference on generated problems."""
 
 import math
 import warnings
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from synergrasp.optimisation.force_optimisation import (
-    GFOParams,
-    mechanics_for,
-    optimise_grasp,
-    solve_gfo,
-    solve_gfo_cvxpy,
-    strict_internal_forces,
-)
+from synergrasp.optimisation.cones import CircularCone
+from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.mechanics import Grasp
+from synergrasp.optimisation.problem import STRICT_SHRINK, GFOProblem, GraspSets, SynergySets
 from synergrasp.optimisation.problems import critical_friction, random_gfo_problems
+from synergrasp.optimisation.study import GFOParams, mechanics_for, optimise_grasps
 
 W = 9.81  # N, weight of 1 kg
 MU = 1.5
@@ -24,6 +22,34 @@ SQUEEZE = np.array([[1.0, 0, 0, -1.0, 0, 0]]).T / math.sqrt(2)  # internal force
 #: Problems with |delta| = |mu / mu* - 1| below this may get different verdicts from the
 #: two solvers (they are counted and reported); above it every verdict must agree.
 BOUNDARY_BAND = 1e-3
+METHODS = ("clarabel", "cvxpy", "ipm")
+
+
+def row(sol, k=0):
+    """Row k of a GFOSolution as one record."""
+    fields = ("status", "force_norm", "forces", "e_s", "iterations", "solver", "max_violation")
+    out = {f: getattr(sol, f)[k] for f in fields}
+    out["strict"] = None if sol.strict_internal is None else bool(sol.strict_internal[k])
+    return SimpleNamespace(force_closure=out["status"] == "force_closure", **out)
+
+
+def solve_gfo_one(f_p, E, normals, mu, f_min, method="clarabel"):
+    return row(solve_gfo([GFOProblem(f_p, E, normals, f_min, CircularCone(mu))], method))
+
+
+def strict_internal_forces(E, normals, mu, method="clarabel"):
+    """Bicchi's strict test of the internal forces E y (f_p and f_min play no part)."""
+    E = np.asarray(E, dtype=float).reshape(np.shape(E)[0], -1)
+    sol = solve_gfo([GFOProblem(np.zeros(E.shape[0]), E, normals, 0.0, CircularCone(mu))], method,
+                    strict_shrink=STRICT_SHRINK)
+    return bool(sol.strict_internal[0])
+
+
+def optimise_grasp(mech, synergy_subset, params, method="clarabel"):
+    """GFO and strict test of one grasp (rank(G) = 6) for the set of all given columns."""
+    sets = SynergySets(synergy_subset, (tuple(range(1, synergy_subset.shape[1] + 1)),))
+    problems = GraspSets(mech.f_p, mech.normals, mech.projector, sets, params.f_min, params.cone, params.basis_rtol)
+    return row(solve_gfo(problems, method, strict_shrink=params.strict_shrink))
 
 
 def wedge_normals(theta):
@@ -31,8 +57,9 @@ def wedge_normals(theta):
     return np.array([[math.cos(theta), 0, -math.sin(theta)], [-math.cos(theta), 0, -math.sin(theta)]])
 
 
+@pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("f_min", [0.1, 5.0])
-def test_pinch_closed_form(f_min):
+def test_pinch_closed_form(f_min, method):
     """Antipodal pinch at (-a,0,0), (a,0,0), normals +-x; the contacts must carry W along +z.
 
     f_p = (0,0,W/2, 0,0,W/2) and E = squeeze, so f_1 = (u,0,W/2), f_2 = (-u,0,W/2) with
@@ -40,28 +67,26 @@ def test_pinch_closed_form(f_min):
     2u² + W²/2 grows with u, so u* = max(f_min, W/(2 mu)) and ||f*|| = sqrt(2u*² + W²/2).
     """
     fp = np.array([0, 0, W / 2, 0, 0, W / 2])
-    res = solve_gfo(fp, SQUEEZE, wedge_normals(0.0), MU, f_min)
+    res = solve_gfo_one(fp, SQUEEZE, wedge_normals(0.0), MU, f_min, method)
     u = max(f_min, W / (2 * MU))
-    assert res.status == "force_closure" and res.solver == "clarabel" and res.e_s == 1
+    assert res.status == "force_closure" and res.solver.startswith(method) and res.e_s == 1
     assert res.force_norm == pytest.approx(math.sqrt(2 * u**2 + W**2 / 2), rel=1e-6)
     np.testing.assert_allclose(res.forces, [u, 0, W / 2, -u, 0, W / 2], atol=1e-5)
-    ref = solve_gfo_cvxpy(fp, SQUEEZE, wedge_normals(0.0), MU, f_min)
-    assert ref.force_norm == pytest.approx(res.force_norm, rel=1e-6)
 
 
-def test_wedge_needs_friction_beyond_mu():
+@pytest.mark.parametrize("method", METHODS)
+def test_wedge_needs_friction_beyond_mu(method):
     """Wedge (normals tilted by theta below the squeeze line): squeezing pushes the object
     down, so the force f_1 = (u,0,W/2) makes the angle atan(W/2u) + theta with n_1. Feasible
     iff some u gives atan(W/2u) + theta <= atan(mu), i.e. iff theta < atan(mu) (56.3 deg for
     mu = 1.5); then u* = W / (2 tan(atan(mu) - theta)) (the normal bound is slack)."""
     fp = np.array([0, 0, W / 2, 0, 0, W / 2])
-    steep = solve_gfo(fp, SQUEEZE, wedge_normals(math.radians(60)), MU, 0.1)
+    steep = solve_gfo_one(fp, SQUEEZE, wedge_normals(math.radians(60)), MU, 0.1, method)
     assert steep.status == "infeasible" and math.isnan(steep.force_norm) and steep.forces is None
-    assert solve_gfo_cvxpy(fp, SQUEEZE, wedge_normals(math.radians(60)), MU, 0.1).status == "infeasible"
     # More friction than tan(60 deg) = 1.73 makes it feasible.
-    assert solve_gfo(fp, SQUEEZE, wedge_normals(math.radians(60)), 2.0, 0.1).status == "force_closure"
+    assert solve_gfo_one(fp, SQUEEZE, wedge_normals(math.radians(60)), 2.0, 0.1, method).status == "force_closure"
     theta = math.radians(45)
-    res = solve_gfo(fp, SQUEEZE, wedge_normals(theta), MU, 0.1)
+    res = solve_gfo_one(fp, SQUEEZE, wedge_normals(theta), MU, 0.1, method)
     u = W / (2 * math.tan(math.atan(MU) - theta))  # = W / 0.4
     assert res.status == "force_closure"
     assert res.force_norm == pytest.approx(math.sqrt(2 * u**2 + W**2 / 2), rel=1e-6)
@@ -78,10 +103,10 @@ def test_pinch_as_grasp_is_rank_deficient():
     """Two point contacts cannot resist a torque about the line joining them: rank(G) = 5."""
     params = GFOParams(gravity_direction=(0.0, 0.0, -1.0))
     mech = mechanics_for(pinch_grasp(), params)
-    assert mech.rank_G == 5
-    res, strict = optimise_grasp(mech, np.eye(19)[:, [1, 4]], params)
-    assert res.status == "rank_deficient" and not res.force_closure and math.isnan(res.force_norm)
-    assert not strict.strict and strict.status == "rank_deficient"
+    assert mech.rank_G == 5 and mech.projector is None
+    out = optimise_grasps([pinch_grasp()], SynergySets(np.eye(19), ((2, 5),)), params)
+    assert out["status"][0] == "rank_deficient" and not out["force_closure"][0] and math.isnan(out["force_norm"][0])
+    assert not out["strict_internal"][0] and out["solver"][0] == "none" and out["rank_G"][0] == 5
 
 
 def test_collinear_contacts_rank_deficient():
@@ -89,8 +114,7 @@ def test_collinear_contacts_rank_deficient():
     n = np.array([[1.0, 0, 0], [0, 0, 1.0], [-1.0, 0, 0]])
     g = Grasp(p, n, np.array([5, 9, 2]), np.ones((9, 19)), np.array([0.0, 0.0, 5.0]))
     params = GFOParams(gravity_direction=(0.0, 1.0, 0.0))
-    res, _ = optimise_grasp(mechanics_for(g, params), np.eye(19)[:, :3], params)
-    assert res.status == "rank_deficient"
+    assert optimise_grasps([g], SynergySets(np.eye(19), ((1, 2, 3),)), params)["status"][0] == "rank_deficient"
 
 
 def tripod_grasp(radius=30.0, lever=50.0):
@@ -104,8 +128,9 @@ def tripod_grasp(radius=30.0, lever=50.0):
     return Grasp(radius * out, -out, np.array([5, 9, 13]), J, np.zeros(3))
 
 
+@pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("f_min", [0.1, 4.0])
-def test_symmetric_tripod_closed_form(f_min):
+def test_symmetric_tripod_closed_form(f_min, method):
     """Tripod holding W along +z (gravity -z, normal to the contact plane), rank(G) = 6.
 
     The problem is convex and invariant under the 120 deg rotation that permutes the
@@ -120,50 +145,58 @@ def test_symmetric_tripod_closed_form(f_min):
     assert mech.rank_G == 6
     synergy = np.zeros((19, 1))
     synergy[[4, 8, 12], 0] = 1.0
-    res, strict = optimise_grasp(mech, synergy, params)
+    res = optimise_grasp(mech, synergy, params, method)
     a = max(f_min, W / (3 * MU))
     assert res.status == "force_closure" and res.e_s == 1
     assert res.force_norm == pytest.approx(math.sqrt(3 * (a**2 + W**2 / 9)), rel=1e-6)
     np.testing.assert_allclose(res.forces.reshape(3, 3), a * g.normals + [0, 0, W / 3], atol=1e-5)
-    assert strict.strict
+    assert res.strict
     # Enrolling a joint that moves no contact: e_s = 0, f = f_p. By symmetry f_p has no
     # squeeze (the K-weighted least norm adds none), so it is purely tangential: infeasible.
     np.testing.assert_allclose(mech.f_p.reshape(3, 3), np.tile([0, 0, W / 3], (3, 1)), atol=1e-9)
-    res0, strict0 = optimise_grasp(mech, np.eye(19)[:, [0]], params)
-    assert (res0.status, res0.e_s, res0.solver) == ("infeasible", 0, "direct")
-    assert not strict0.strict
+    res0 = optimise_grasp(mech, np.eye(19)[:, [0]], params, method)
+    assert (res0.status, res0.e_s) == ("infeasible", 0)
+    assert res0.solver == ("cvxpy:none" if method == "cvxpy" else "direct")
+    assert not res0.strict
 
 
-def test_zero_internal_forces_judged_directly():
+@pytest.mark.parametrize("method", METHODS)
+def test_zero_internal_forces_judged_directly(method):
     n = np.array([[0.0, 0, 1]])
-    ok = solve_gfo(np.array([1.0, 0.0, 2.0]), np.zeros((3, 0)), n, MU, 0.1)  # |t|/f_n = 0.5
+    ok = solve_gfo_one(np.array([1.0, 0.0, 2.0]), np.zeros((3, 0)), n, MU, 0.1, method)  # |t|/f_n = 0.5
     assert ok.status == "force_closure" and ok.force_norm == pytest.approx(math.sqrt(5))
-    bad = solve_gfo(np.array([4.0, 0.0, 2.0]), np.zeros((3, 0)), n, MU, 0.1)  # |t|/f_n = 2
+    bad = solve_gfo_one(np.array([4.0, 0.0, 2.0]), np.zeros((3, 0)), n, MU, 0.1, method)  # |t|/f_n = 2
     assert bad.status == "infeasible"
-    assert solve_gfo_cvxpy(np.array([4.0, 0.0, 2.0]), np.zeros((3, 0)), n, MU, 0.1).status == "infeasible"
 
 
-def test_strict_internal_forces_hand_cases():
+@pytest.mark.parametrize("method", METHODS)
+def test_strict_internal_forces_hand_cases(method):
     """E y strictly inside both cones: the squeeze of a pinch (angle 0 to the normals) is;
     in a wedge the squeeze makes the angle theta with each normal, strictly inside iff
     theta < atan(mu); exactly on the boundary (theta = atan mu) is not strict. A purely
     tangential internal force (opposite shear, normals +-z) and no internal force are not."""
-    assert strict_internal_forces(SQUEEZE, wedge_normals(0.0), MU).strict
-    assert strict_internal_forces(SQUEEZE, wedge_normals(math.atan(MU) - 0.01), MU).strict
-    assert not strict_internal_forces(SQUEEZE, wedge_normals(math.atan(MU)), MU).strict
-    assert not strict_internal_forces(SQUEEZE, wedge_normals(math.radians(60)), MU).strict
+    assert strict_internal_forces(SQUEEZE, wedge_normals(0.0), MU, method)
+    assert strict_internal_forces(SQUEEZE, wedge_normals(math.atan(MU) - 0.01), MU, method)
+    assert not strict_internal_forces(SQUEEZE, wedge_normals(math.atan(MU)), MU, method)
+    assert not strict_internal_forces(SQUEEZE, wedge_normals(math.radians(60)), MU, method)
     shear_normals = np.array([[0.0, 0, 1], [0.0, 0, -1]])
-    assert not strict_internal_forces(SQUEEZE, shear_normals, MU).strict
-    assert not strict_internal_forces(np.zeros((6, 0)), wedge_normals(0.0), MU).strict
+    assert not strict_internal_forces(SQUEEZE, shear_normals, MU, method)
+    assert not strict_internal_forces(np.zeros((6, 0)), wedge_normals(0.0), MU, method)
 
 
 def test_bad_input_names_the_field():
     with pytest.raises(ValueError, match="f_p"):
-        solve_gfo(np.zeros(5), SQUEEZE, wedge_normals(0.0), MU, 0.1)
+        solve_gfo_one(np.zeros(5), SQUEEZE, wedge_normals(0.0), MU, 0.1)
     with pytest.raises(ValueError, match="mu"):
-        solve_gfo(np.zeros(6), SQUEEZE, wedge_normals(0.0), -1.0, 0.1)
+        solve_gfo_one(np.zeros(6), SQUEEZE, wedge_normals(0.0), -1.0, 0.1)
     with pytest.raises(ValueError, match="f_min"):
-        solve_gfo(np.zeros(6), SQUEEZE, wedge_normals(0.0), MU, float("nan"))
+        solve_gfo_one(np.zeros(6), SQUEEZE, wedge_normals(0.0), MU, float("nan"))
+    with pytest.raises(ValueError, match="method must be one of"):
+        solve_gfo_one(np.zeros(6), SQUEEZE, wedge_normals(0.0), MU, 0.1, method="newton")
+    with pytest.raises(ValueError, match="sets: each set"):
+        SynergySets(np.eye(19, 15), ((0, 1),))
+    with pytest.raises(ValueError, match="synergies"):
+        SynergySets(np.ones(19), ((1,),))
     with pytest.raises(ValueError, match="gravity_direction"):
         GFOParams(gravity_direction=(0.0, 0.0, 2.0))
     with pytest.raises(TypeError):
@@ -173,11 +206,11 @@ def test_bad_input_names_the_field():
 @pytest.fixture(scope="module")
 def generated():
     problems = random_gfo_problems(2018, 1000)
-    ours = [solve_gfo(p.f_p, p.E, p.normals, p.mu, p.f_min) for p in problems]
+    ours = solve_gfo([p.problem for p in problems], "clarabel")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # cvxpy's "may be inaccurate" near the boundary
-        ref = [solve_gfo_cvxpy(p.f_p, p.E, p.normals, p.mu, p.f_min) for p in problems]
-    return problems, ours, ref
+        ref = solve_gfo([p.problem for p in problems], "cvxpy")
+    return problems, [row(ours, k) for k in range(len(ours))], [row(ref, k) for k in range(len(ref))]
 
 
 def test_generated_problems_cover_the_cases(generated):
@@ -213,8 +246,8 @@ def test_clarabel_agrees_with_cvxpy_reference(generated):
             if a.status != b.status or (a.force_closure and abs(a.force_norm - b.force_norm) > 1e-4 * b.force_norm):
                 disagree_in_band.append((p.index, delta, a.status, b.status, a.force_norm, b.force_norm))
             continue
-        assert a.status == b.status, (p.index, p.kind, delta, a.solver_status, b.solver_status)
-        assert a.status in ("force_closure", "infeasible"), (p.index, a.solver_status)
+        assert a.status == b.status, (p.index, p.kind, delta, a.status, b.status)
+        assert a.status in ("force_closure", "infeasible"), (p.index, a.status)
         if not math.isnan(delta) and not math.isinf(delta) and delta != -1.0:
             assert a.force_closure == (delta > 0), (p.index, delta, a.status)
         if a.force_closure:

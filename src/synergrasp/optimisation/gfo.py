@@ -1,0 +1,178 @@
+"""The one front door of the grasp-force optimisation: `solve_gfo(problems, method=...)`.
+
+In the style of `scipy.optimize.linprog`: the problems (`problem.GFOProblem` or, for one
+grasp and many synergy sets, `problem.GraspSets`) carry their friction-cone model; the
+method picks the back end; every back end returns one `problem.GFOSolution`.
+
+- "ipm": the compiled interior-point kernel (`ipm_kernel`); the problems it leaves undecided
+  are solved again by Clarabel and marked 'clarabel_fallback' (nothing is dropped).
+- "clarabel": Clarabel per problem (`clarabel_solver`), the exact reference of the study.
+- "cvxpy": the cvxpy reference (`cvxpy_reference`), for tests and benchmarks.
+- "piqp": PIQP per problem (`piqp_solver`), for pyramid cones (a QP).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from synergrasp.optimisation import clarabel_solver, cvxpy_reference, ipm_kernel, piqp_solver
+from synergrasp.optimisation.cones import CircularCone
+from synergrasp.optimisation.ipm_kernel import IPMSettings
+from synergrasp.optimisation.mechanics import contact_frames
+from synergrasp.optimisation.problem import (
+    ALMOST_SOLVED_TOL,
+    DEFAULT_TOL,
+    GFOProblem,
+    GFOSolution,
+    GraspSets,
+    Outcome,
+    SynergySets,
+    as_problems,
+)
+
+__all__ = ["METHODS", "solve_gfo", "warm_up"]
+
+#: Methods of `solve_gfo` and the friction-cone kinds each accepts.
+METHODS: dict[str, tuple[str, ...]] = {
+    "ipm": ("circular",),
+    "clarabel": ("circular", "pyramid"),
+    "cvxpy": ("circular",),
+    "piqp": ("pyramid",),
+}
+
+#: Verdict of each kernel code; '' marks the problems that go to the Clarabel fallback.
+_STATUS_OF_CODE = np.array(["", "force_closure", "infeasible", ""], dtype=object)
+
+
+def solve_gfo(
+    problems: Sequence[GFOProblem] | GraspSets,
+    method: str = "ipm",
+    *,
+    strict_shrink: float | None = None,
+    tol: float = DEFAULT_TOL,
+    max_iter: int = 200,
+    ipm: IPMSettings = IPMSettings(),
+) -> GFOSolution:
+    """Solve GFO problems; one row of the result per problem, in order.
+
+    strict_shrink: if given, also Bicchi's strict internal-force test of every problem
+        (`GFOProblem.strict_test`, the cone narrowed by this relative amount), else
+        `strict_internal` is None.
+    tol, max_iter: tolerance and iteration cap of Clarabel and PIQP (methods "clarabel",
+        "piqp" and the fallback of "ipm"); ipm: settings of the interior-point kernel.
+    Bad input (unknown method, a cone the method does not accept) raises ValueError before
+    any solve; a failure on one problem is its status.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {list(METHODS)}, got {method!r}")
+    cones = {problems.cone.kind} if isinstance(problems, GraspSets) else {p.cone.kind for p in problems}
+    if not cones <= set(METHODS[method]):
+        raise ValueError(f"method {method!r} accepts the friction cones {list(METHODS[method])}, "
+                         f"got {sorted(cones - set(METHODS[method]))}")
+    if strict_shrink is not None and not (0 < strict_shrink < 1):
+        raise ValueError(f"strict_shrink must be in (0, 1), got {strict_shrink}")
+    if method == "ipm" and isinstance(problems, GraspSets):
+        return _ipm_sets(problems, strict_shrink, tol, max_iter, ipm)
+    items = as_problems(problems)
+    sol = GFOSolution.empty(len(items), strict_shrink is not None)
+    solve = _per_problem(method, tol, max_iter)
+    for k, problem in enumerate(items):
+        sol.e_s[k] = problem.e_s
+        if method == "ipm":
+            _ipm_one(sol, k, problem, strict_shrink, tol, max_iter, ipm)
+            continue
+        sol.record(k, solve(problem))
+        if strict_shrink is not None:
+            sol.strict_internal[k] = solve(problem.strict_test(strict_shrink)).status == "force_closure"
+    return sol
+
+
+def _per_problem(method: str, tol: float, max_iter: int):
+    if method == "clarabel":
+        return lambda p: clarabel_solver.solve(p, tol=tol, max_iter=max_iter)
+    if method == "piqp":
+        return lambda p: piqp_solver.solve(p, tol=tol, max_iter=max_iter)
+    return cvxpy_reference.solve
+
+
+def _fallback(sol: GFOSolution, k: int, problem: GFOProblem, tol: float, max_iter: int) -> None:
+    """Row k, left undecided by the kernel (or with e_s = 0, where f = f_p is judged
+    directly): Clarabel's verdict, marked 'clarabel_fallback' when it solved something."""
+    out = clarabel_solver.solve(problem, tol=tol, max_iter=max_iter)
+    sol.record(k, out, solver="clarabel_fallback" if problem.e_s > 0 else "direct")
+
+
+def _strict_fallback(problem: GFOProblem, shrink: float, tol: float, max_iter: int) -> bool:
+    return clarabel_solver.solve(problem.strict_test(shrink), tol=tol, max_iter=max_iter).status == "force_closure"
+
+
+def _ipm_one(sol: GFOSolution, k: int, problem: GFOProblem, shrink: float | None, tol: float, max_iter: int,
+             ipm: IPMSettings) -> None:
+    """Row k of a sequence of problems by the kernel, undecided ones by the fallback."""
+    if problem.e_s == 0:
+        _fallback(sol, k, problem, tol, max_iter)
+        if shrink is not None:
+            sol.strict_internal[k] = _strict_fallback(problem, shrink, tol, max_iter)
+        return
+    frames = contact_frames(problem.normals)
+    mu = problem.cone.mu
+    code, norm, y, iters = ipm_kernel.solve_problem(frames, problem.E, problem.f_p, mu, problem.f_min, ipm,
+                                                    ALMOST_SOLVED_TOL)
+    status = _STATUS_OF_CODE[code]
+    if status == "force_closure":
+        forces = problem.f_p + problem.E @ y
+        sol.record(k, Outcome(status, norm, forces, iters, "ipm", "",
+                              problem.cone.violation(forces, problem.normals, problem.f_min)))
+    elif status == "infeasible":
+        sol.record(k, Outcome(status, float("nan"), None, iters, "ipm"))
+    else:
+        _fallback(sol, k, problem, tol, max_iter)
+    if shrink is not None:
+        strict = problem.strict_test(shrink)
+        code = ipm_kernel.solve_problem(frames, strict.E, strict.f_p, strict.cone.mu, strict.f_min, ipm,
+                                        ALMOST_SOLVED_TOL)[0]
+        sol.strict_internal[k] = (code == ipm_kernel.OPTIMAL if code in (ipm_kernel.OPTIMAL, ipm_kernel.INFEASIBLE)
+                                  else _strict_fallback(problem, shrink, tol, max_iter))
+
+
+def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm: IPMSettings) -> GFOSolution:
+    """All sets of one grasp in one compiled call (bases, rows, both SOCPs, forces), then the
+    fallback for the undecided ones."""
+    P, S = g.projector, g.synergies
+    thresholds = g.basis_rtol * (float(np.linalg.norm(P, 2)) if P.size else 0.0) * S.norms
+    strict = shrink is not None
+    mu_strict = g.cone.narrowed(shrink).mu if strict else g.cone.mu
+    res = ipm_kernel.solve_sets(P @ S.matrix, g.f_p, contact_frames(g.normals), S.table, S.sizes, thresholds,
+                                g.cone.mu, mu_strict, g.f_min, strict, ipm, ALMOST_SOLVED_TOL)
+    n = len(g)
+    status = _STATUS_OF_CODE[res.code]
+    optimal = res.code == ipm_kernel.OPTIMAL
+    forces = np.full(n, None, dtype=object)
+    for j in np.flatnonzero(optimal):
+        forces[j] = res.forces[j]
+    sol = GFOSolution(status=status, force_norm=np.where(optimal, res.force_norm, np.nan), forces=forces,
+                      e_s=res.e_s.astype(np.int32), iterations=res.iterations,
+                      strict_internal=res.strict_code == ipm_kernel.OPTIMAL if strict else None,
+                      solver=np.full(n, "ipm", dtype=object), max_violation=np.where(optimal, res.max_violation, np.nan))
+    for j in np.flatnonzero(status == ""):
+        _fallback(sol, j, g.problem(j), tol, max_iter)
+    if strict:
+        undecided = (res.strict_code != ipm_kernel.OPTIMAL) & (res.strict_code != ipm_kernel.INFEASIBLE) & (res.e_s > 0)
+        for j in np.flatnonzero(undecided):
+            sol.strict_internal[j] = _strict_fallback(g.problem(j), shrink, tol, max_iter)
+    return sol
+
+
+def warm_up() -> None:
+    """Compile the interior-point kernel's machine code, or load it from the cache next to
+    its source. Called once after installation (Makefile) so that no workflow job pays the
+    compilation (about a minute on one core) and parallel jobs do not compile side by side.
+    """
+    normals = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])
+    squeeze = np.array([[1.0], [0.0], [0.0], [-1.0], [0.0], [0.0]]) / np.sqrt(2.0)
+    cone = CircularCone(1.0)
+    solve_gfo([GFOProblem(np.zeros(6), squeeze, normals, 0.5, cone)], strict_shrink=1e-5)
+    sets = SynergySets(np.eye(1), ((1,),))
+    solve_gfo(GraspSets(np.zeros(6), normals, squeeze, sets, 0.5, cone, basis_rtol=1e-9), strict_shrink=1e-5)

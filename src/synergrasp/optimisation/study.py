@@ -1,0 +1,180 @@
+"""The study's optimisation step: every (pose, synergy set) of one shard of an object's
+poses, through the front door `gfo.solve_gfo`, into the gfo table (`tables.GFO`).
+
+Per pose the mechanics (G, K, G_K^R, f_p, the internal-force projector) is built once;
+the pose's sets are then one `GraspSets` problem. Poses without a grasp give 'no_grasp',
+grasps with rank(G) < 6 'rank_deficient', both without any solve (solver 'none').
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from synergrasp.config import set_id
+from synergrasp.optimisation.cones import CircularCone
+from synergrasp.optimisation.gfo import solve_gfo
+from synergrasp.optimisation.ipm_kernel import IPMSettings
+from synergrasp.optimisation.mechanics import (
+    BASIS_RTOL,
+    GRASP_RANK_RTOL,
+    Grasp,
+    GraspMechanics,
+    grasp_mechanics,
+    object_wrench,
+)
+from synergrasp.optimisation.problem import DEFAULT_TOL, STRICT_SHRINK, GraspSets, SynergySets
+from synergrasp.simulation.contacts import read_grasps
+
+__all__ = ["GFOParams", "gfo_table", "mechanics_for", "merge_shards", "optimise_grasps", "optimise_shard",
+           "shard_rows"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class GFOParams:
+    """Parameters of the grasp-force optimisation of the study.
+
+    gravity_direction: unit vector of gravity in the palm frame (required: the placement
+        decides it, the configuration holds it)
+    mu: Coulomb friction coefficient; f_min: least normal force, N
+    k_stru: structural contact stiffness, N/mm; k_ss: joint stiffness, N·mm/rad
+    mass_kg, g (m/s²): the object's weight
+    basis_rtol: rank tolerance of E_s; grasp_rank_rtol: rank tolerance of G
+    strict_shrink: relative narrowing of the cone in the strict internal-force test
+    tol: Clarabel feasibility and gap tolerance; max_iter: its iteration cap
+    """
+
+    gravity_direction: tuple[float, float, float]
+    mu: float = 1.5
+    f_min: float = 0.1
+    k_stru: float = 1.0
+    k_ss: float = 200.0
+    mass_kg: float = 1.0
+    g: float = 9.81
+    basis_rtol: float = BASIS_RTOL
+    grasp_rank_rtol: float = GRASP_RANK_RTOL
+    strict_shrink: float = STRICT_SHRINK
+    tol: float = DEFAULT_TOL
+    max_iter: int = 200
+
+    def __post_init__(self) -> None:
+        d = np.asarray(self.gravity_direction, dtype=float)
+        if d.shape != (3,) or not np.all(np.isfinite(d)) or abs(np.linalg.norm(d) - 1.0) > 1e-6:
+            raise ValueError(f"gravity_direction must be a unit 3-vector, got {self.gravity_direction!r}")
+        object.__setattr__(self, "gravity_direction", tuple(float(v) for v in d))
+        for name in ("mu", "k_stru", "k_ss"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a finite number > 0, got {value}")
+        for name in ("f_min", "mass_kg", "g"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"{name} must be a finite number >= 0, got {value}")
+        for name in ("basis_rtol", "grasp_rank_rtol", "strict_shrink", "tol"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and 0 < value < 1):
+                raise ValueError(f"{name} must be in (0, 1), got {value}")
+        if not (isinstance(self.max_iter, int) and self.max_iter > 0):
+            raise ValueError(f"max_iter must be a positive int, got {self.max_iter!r}")
+
+    def wrench(self) -> NDArray:
+        """w_e (6,) the contacts must apply against the weight, N and N·mm."""
+        return object_wrench(self.mass_kg, np.asarray(self.gravity_direction), self.g)
+
+    @property
+    def cone(self) -> CircularCone:
+        """The friction-cone model of every contact."""
+        return CircularCone(self.mu)
+
+
+def mechanics_for(grasp: Grasp, params: GFOParams) -> GraspMechanics:
+    """`grasp_mechanics` with the weight, stiffnesses and rank tolerance of `params`."""
+    return grasp_mechanics(grasp, params.wrench(), params.k_stru, params.k_ss, rank_rtol=params.grasp_rank_rtol)
+
+
+def optimise_grasps(
+    grasps: Sequence[Grasp | None],
+    synergies: SynergySets,
+    params: GFOParams,
+    *,
+    strict: bool = True,
+    ipm: IPMSettings = IPMSettings(),
+) -> dict[str, NDArray]:
+    """GFO verdict, optimal force and strict internal-force test of every (grasp, set).
+
+    grasps: poses (None or no contacts: 'no_grasp'). Solved with method "ipm" (the
+    compiled kernel, Clarabel for what it leaves undecided). strict=False skips the strict
+    test (column all False). Returns columns, one row per (grasp, set), grasp-major:
+    set_id, n_synergies, status, force_closure, strict_internal, force_norm (N), e_s,
+    rank_G, n_contacts, iterations, solver.
+    """
+    n_sets, n_poses = len(synergies), len(grasps)
+    total = n_sets * n_poses
+    out = {
+        "set_id": np.array([set_id(s) for s in synergies.sets] * n_poses, dtype=object),
+        "n_synergies": np.tile(synergies.sizes.astype(np.int32), n_poses),
+        "status": np.full(total, "no_grasp", dtype=object),
+        "force_closure": np.zeros(total, dtype=bool),
+        "strict_internal": np.zeros(total, dtype=bool),
+        "force_norm": np.full(total, np.nan),
+        "e_s": np.zeros(total, dtype=np.int32),
+        "rank_G": np.zeros(total, dtype=np.int32),
+        "n_contacts": np.zeros(total, dtype=np.int32),
+        "iterations": np.zeros(total, dtype=np.int32),
+        "solver": np.full(total, "none", dtype=object),
+    }
+    cone = params.cone
+    for p, grasp in enumerate(grasps):
+        if grasp is None or grasp.n_contacts == 0:
+            continue
+        rows = slice(p * n_sets, (p + 1) * n_sets)
+        mech = mechanics_for(grasp, params)
+        out["rank_G"][rows] = mech.rank_G
+        out["n_contacts"][rows] = mech.n_contacts
+        if mech.rank_G < 6 or mech.projector is None:
+            out["status"][rows] = "rank_deficient"
+            continue
+        problems = GraspSets(mech.f_p, mech.normals, mech.projector, synergies, params.f_min, cone, params.basis_rtol)
+        sol = solve_gfo(problems, "ipm", strict_shrink=params.strict_shrink if strict else None, tol=params.tol,
+                        max_iter=params.max_iter, ipm=ipm)
+        out["status"][rows], out["force_norm"][rows], out["e_s"][rows] = sol.status, sol.force_norm, sol.e_s
+        out["iterations"][rows], out["solver"][rows] = sol.iterations, sol.solver
+        if strict:
+            out["strict_internal"][rows] = sol.strict_internal
+    out["force_closure"] = out["status"] == "force_closure"
+    return out
+
+
+def gfo_table(contacts: pd.DataFrame, synergies: SynergySets, params: GFOParams, *, strict: bool = True) -> pd.DataFrame:
+    """The gfo table (columns of `tables.GFO`) of the poses of a contacts table, pose-major,
+    each pose's sets in their given order."""
+    n_sets = len(synergies)
+    table = pd.DataFrame({c: np.repeat(contacts[c].to_numpy(), n_sets) for c in ("object", "pose", "alpha_deg", "beta_deg")})
+    for name, column in optimise_grasps(read_grasps(contacts), synergies, params, strict=strict).items():
+        table[name] = column
+    return table
+
+
+def shard_rows(contacts: pd.DataFrame, shard: int, n_shards: int) -> pd.DataFrame:
+    """The poses of shard `shard` of `n_shards`: consecutive rows, sizes differing by at most one."""
+    if not (isinstance(n_shards, (int, np.integer)) and n_shards >= 1):
+        raise ValueError(f"n_shards (solver.pose_shards) must be an int >= 1, got {n_shards!r}")
+    if not (isinstance(shard, (int, np.integer)) and 0 <= shard < n_shards):
+        raise ValueError(f"shard must be an int in 0..{n_shards - 1}, got {shard!r}")
+    return contacts.iloc[np.array_split(np.arange(len(contacts)), n_shards)[shard]]
+
+
+def optimise_shard(contacts: pd.DataFrame, shard: int, n_shards: int, synergies: SynergySets,
+                   params: GFOParams) -> pd.DataFrame:
+    """The gfo table of one shard of an object's contacts table."""
+    return gfo_table(shard_rows(contacts, shard, n_shards), synergies, params)
+
+
+def merge_shards(shards: Sequence[pd.DataFrame]) -> pd.DataFrame:
+    """One object's gfo table from its shards, in pose order (each pose's sets keep their order)."""
+    return pd.concat(shards, ignore_index=True).sort_values("pose", kind="stable", ignore_index=True)

@@ -1,0 +1,166 @@
+"""The compiled interior-point back end ("ipm") against the per-problem exact solver
+(Clarabel) and the cvxpy reference, all through the front door `solve_gfo`."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from synergrasp.optimisation.cones import CircularCone
+from synergrasp.optimisation.gfo import solve_gfo
+from synergrasp.optimisation.ipm_kernel import IPMSettings
+from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_basis, object_wrench
+from synergrasp.optimisation.problem import GFOProblem, GraspSets, SynergySets
+from synergrasp.optimisation.problems import random_gfo_problems, random_grasp, random_synergies, random_unit_vector
+
+#: Near-boundary band (docs/batched_solver.md): problems whose friction coefficient is within
+#: this relative distance of the critical one may get either verdict.
+BAND = 1e-4
+RTOL_NORM = 1e-4
+
+
+def _study_sized_problems(count: int, seed: int = 11) -> list[GFOProblem]:
+    """GFO problems from random grasps: 3-20 contacts (up to 2 on the palm), s = 1..15."""
+    rng = np.random.default_rng(seed)
+    out = []
+    while len(out) < count:
+        m = int(rng.integers(3, 21))
+        grasp = random_grasp(rng, m, palm_contacts=int(rng.integers(0, 3)))
+        mech = grasp_mechanics(grasp, object_wrench(1.0, random_unit_vector(rng)), 1.0, 200.0)
+        if mech.rank_G < 6:
+            continue
+        S = random_synergies(rng)
+        for s in rng.choice(np.arange(1, 16), size=5, replace=False):
+            cols = np.sort(rng.choice(15, size=int(s), replace=False))
+            E = internal_force_basis(mech.projector, S[:, cols])
+            out.append(GFOProblem(mech.f_p, E, grasp.normals, 0.1, CircularCone(1.5)))
+    return out[:count]
+
+
+@pytest.fixture(scope="module")
+def generated():
+    return random_gfo_problems(7, 250)
+
+
+def test_5000_study_sized_problems_match_the_exact_solver():
+    problems = _study_sized_problems(5000)
+    sol = solve_gfo(problems, "ipm")
+    ref = solve_gfo(problems, "clarabel")
+    assert {"force_closure", "infeasible"} <= set(ref.status)
+    np.testing.assert_array_equal(sol.status, ref.status)
+    fc = ref.force_closure
+    np.testing.assert_allclose(sol.force_norm[fc], ref.force_norm[fc], rtol=RTOL_NORM)
+    assert np.all(sol.max_violation[fc] <= 1e-6 * np.maximum(1.0, sol.force_norm[fc]))
+    for k in np.flatnonzero(fc):  # the optimal forces are unique (least norm over a convex set)
+        assert np.linalg.norm(sol.forces[k]) == pytest.approx(sol.force_norm[k], rel=1e-12)
+        assert np.linalg.norm(sol.forces[k] - ref.forces[k]) <= 1e-2 * ref.force_norm[k]
+    assert np.mean(sol.solver == "clarabel_fallback") < 0.05
+    assert set(sol.solver) <= {"ipm", "clarabel_fallback"}
+
+
+def test_generated_kinds_match_exact_solver_outside_the_band_and_cvxpy_on_a_subset(generated):
+    problems = [p.problem for p in generated]
+    sol = solve_gfo(problems, "ipm")
+    ref = solve_gfo(problems, "clarabel")
+    in_band_differ = 0
+    for k, p in enumerate(generated):
+        if sol.status[k] != ref.status[k]:
+            # Only near-boundary problems inside the stated band may differ; they are counted.
+            assert p.kind == "near_boundary" and abs(p.delta) <= BAND, (k, p.kind, p.delta, sol.status[k], ref.status[k])
+            in_band_differ += 1
+        elif ref.status[k] == "force_closure":
+            assert sol.force_norm[k] == pytest.approx(ref.force_norm[k], rel=RTOL_NORM)
+    assert {"nominal", "feasible", "infeasible", "near_boundary"} <= {p.kind for p in generated}
+    assert in_band_differ <= 0.05 * len(generated)
+    # cvxpy (a different formulation and canonicalisation) on a subset
+    subset = list(range(0, len(generated), 3))
+    cvx = solve_gfo([problems[k] for k in subset], "cvxpy")
+    for i, k in enumerate(subset):
+        p = generated[k]
+        if sol.status[k] != cvx.status[i]:
+            assert p.kind == "near_boundary" and abs(p.delta) <= BAND
+        elif cvx.status[i] == "force_closure":
+            assert sol.force_norm[k] == pytest.approx(cvx.force_norm[i], rel=RTOL_NORM)
+
+
+def test_second_attempt_with_refinement_decides_problems_the_first_leaves_open():
+    problems = _study_sized_problems(1500, seed=13)
+    once = solve_gfo(problems, ipm=IPMSettings(retry_refine=0))
+    twice = solve_gfo(problems)
+    n_once = int(np.sum(once.solver == "clarabel_fallback"))
+    n_twice = int(np.sum(twice.solver == "clarabel_fallback"))
+    assert n_once > 0  # the premise: the first attempt leaves some problems open
+    assert n_twice < n_once
+    np.testing.assert_array_equal(once.status, twice.status)
+    both = twice.force_closure
+    np.testing.assert_allclose(twice.force_norm[both], once.force_norm[both], rtol=RTOL_NORM)
+
+
+def test_hand_derivable_problem():
+    # One contact pair squeezing along x, f_p = 0, E = the squeeze direction: the optimum is
+    # the least squeeze with n.f = f_min at both contacts, ||f|| = sqrt(2) f_min.
+    normals = np.array([[1.0, 0, 0], [-1.0, 0, 0]])
+    E = np.array([1.0, 0, 0, -1.0, 0, 0])[:, None] / np.sqrt(2)
+    sol = solve_gfo([GFOProblem(np.zeros(6), E, normals, 0.5, CircularCone(1.0))])
+    assert sol.status[0] == "force_closure" and sol.solver[0] == "ipm"
+    assert sol.force_norm[0] == pytest.approx(np.sqrt(2) * 0.5, rel=1e-7)
+    np.testing.assert_allclose(sol.forces[0], [0.5, 0, 0, -0.5, 0, 0], atol=1e-7)
+    # An internal force that loads only the first contact leaves n.f = 0 < f_min at the second.
+    sol = solve_gfo([GFOProblem(np.zeros(6), np.eye(6)[:, :1], normals, 0.5, CircularCone(1.0))])
+    assert sol.status[0] == "infeasible" and sol.forces[0] is None
+
+
+def test_fallback_path_when_the_iteration_cap_is_tiny():
+    problems = _study_sized_problems(40, seed=5)
+    sol = solve_gfo(problems, ipm=IPMSettings(max_iter=2), strict_shrink=1e-5)
+    ref = solve_gfo(problems, "clarabel", strict_shrink=1e-5)
+    assert np.all(sol.solver == "clarabel_fallback")
+    np.testing.assert_array_equal(sol.status, ref.status)
+    np.testing.assert_array_equal(sol.strict_internal, ref.strict_internal)
+    np.testing.assert_array_equal(sol.iterations, ref.iterations)
+    fc = ref.force_closure
+    np.testing.assert_allclose(sol.force_norm[fc], ref.force_norm[fc], rtol=1e-12)
+
+
+def test_a_problem_gives_the_same_numbers_alone_and_among_others():
+    problems = _study_sized_problems(30, seed=9)
+    alone = solve_gfo(problems[:1])
+    together = solve_gfo(problems[::-1])
+    k = len(problems) - 1
+    assert (together.status[k], together.iterations[k]) == (alone.status[0], alone.iterations[0])
+    np.testing.assert_array_equal(together.force_norm[k], alone.force_norm[0])
+    np.testing.assert_array_equal(together.forces[k], alone.forces[0])
+
+
+def test_sets_of_one_grasp_match_the_same_problems_one_by_one():
+    """The fused per-grasp path (bases and rows built in the kernel) against the problems
+    built in numpy and solved one by one, by the kernel and by Clarabel."""
+    rng = np.random.default_rng(3)
+    S = random_synergies(rng)
+    sets = SynergySets(S, tuple(tuple(range(1, k + 1)) for k in range(1, 16)) + ((2,), (3, 5), (1, 4, 7)))
+    for _ in range(4):
+        grasp = random_grasp(rng, int(rng.integers(4, 13)), palm_contacts=1)
+        mech = grasp_mechanics(grasp, object_wrench(1.0, random_unit_vector(rng)), 1.0, 200.0)
+        if mech.rank_G < 6:
+            continue
+        g = GraspSets(mech.f_p, mech.normals, mech.projector, sets, 0.1, CircularCone(1.5))
+        fused = solve_gfo(g, strict_shrink=1e-5)
+        each = [g.problem(j) for j in range(len(g))]
+        for method in ("ipm", "clarabel"):
+            ref = solve_gfo(each, method, strict_shrink=1e-5)
+            np.testing.assert_array_equal(fused.status, ref.status)
+            np.testing.assert_array_equal(fused.e_s, ref.e_s)
+            np.testing.assert_array_equal(fused.strict_internal, ref.strict_internal)
+            fc = ref.force_closure
+            np.testing.assert_allclose(fused.force_norm[fc], ref.force_norm[fc], rtol=RTOL_NORM)
+            for j in np.flatnonzero(fc):  # unique optimum; its accuracy is that of the solvers' tolerances
+                assert np.linalg.norm(fused.forces[j] - ref.forces[j]) <= 1e-2 * ref.force_norm[j]
+
+
+def test_bad_settings_name_the_field():
+    with pytest.raises(ValueError, match="max_iter"):
+        IPMSettings(max_iter=0)
+    with pytest.raises(ValueError, match="retry_refine"):
+        IPMSettings(retry_refine=-1)
+    with pytest.raises(ValueError, match="strict_shrink"):
+        solve_gfo([], strict_shrink=1.5)

@@ -1,0 +1,64 @@
+"""The study's optimisation step: the loop over poses against the per-problem path, the
+shards, and the gfo table contract."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from synergrasp import tables
+from synergrasp.optimisation.gfo import solve_gfo
+from synergrasp.optimisation.problem import GraspSets, SynergySets
+from synergrasp.optimisation.problems import random_grasp, random_synergies
+from synergrasp.optimisation.study import GFOParams, mechanics_for, merge_shards, optimise_grasps, shard_rows
+
+RTOL_NORM = 1e-4
+PARAMS = GFOParams(gravity_direction=(0.0, 0.0, -1.0))
+
+
+def test_optimise_grasps_matches_clarabel_per_grasp():
+    rng = np.random.default_rng(21)
+    grasps = [random_grasp(rng, int(rng.integers(3, 13)), palm_contacts=int(rng.integers(0, 2))) for _ in range(5)]
+    grasps.insert(2, None)
+    sets = SynergySets(random_synergies(rng), tuple([tuple(range(1, k + 1)) for k in (1, 2, 3, 7, 15)]
+                                                    + list(itertools.combinations(range(1, 8), 2))[:6]))
+    out = optimise_grasps(grasps, sets, PARAMS)
+    n = len(sets)
+    assert len(out["status"]) == len(grasps) * n
+    for p, grasp in enumerate(grasps):
+        rows = slice(p * n, (p + 1) * n)
+        assert list(out["set_id"][rows]) == ["-".join(map(str, s)) for s in sets.sets]
+        if grasp is None:
+            assert set(out["status"][rows]) == {"no_grasp"} and not out["force_closure"][rows].any()
+            continue
+        mech = mechanics_for(grasp, PARAMS)
+        ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, sets, PARAMS.f_min, PARAMS.cone),
+                        "clarabel", strict_shrink=PARAMS.strict_shrink)
+        np.testing.assert_array_equal(out["status"][rows], ref.status)
+        np.testing.assert_array_equal(out["e_s"][rows], ref.e_s)
+        np.testing.assert_array_equal(out["strict_internal"][rows], ref.strict_internal)
+        np.testing.assert_array_equal(out["force_closure"][rows], ref.status == "force_closure")
+        fc = ref.force_closure
+        np.testing.assert_allclose(out["force_norm"][rows][fc], ref.force_norm[fc], rtol=RTOL_NORM)
+        assert np.isnan(out["force_norm"][rows][~fc]).all()
+
+
+def test_shards_partition_the_poses_in_order():
+    contacts = pd.DataFrame({"pose": np.arange(10)})
+    parts = [shard_rows(contacts, k, 3)["pose"].tolist() for k in range(3)]
+    assert parts == [[0, 1, 2, 3], [4, 5, 6], [7, 8, 9]]
+    with pytest.raises(ValueError, match="shard must be an int in 0..2"):
+        shard_rows(contacts, 3, 3)
+    with pytest.raises(ValueError, match="solver.pose_shards"):
+        shard_rows(contacts, 0, 0)
+
+
+def test_merge_shards_orders_poses_and_keeps_the_set_order():
+    gfo = tables.empty(tables.GFO)
+    a = pd.DataFrame({"pose": [2, 2, 0, 0], "set_id": ["1", "1-2", "1", "1-2"]})
+    merged = merge_shards([a.iloc[:2], a.iloc[2:]])
+    assert merged[["pose", "set_id"]].values.tolist() == [[0, "1"], [0, "1-2"], [2, "1"], [2, "1-2"]]
+    assert list(gfo.columns) == list(tables.GFO.names)
