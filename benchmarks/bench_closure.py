@@ -22,8 +22,9 @@ import numpy as np  # noqa: E402
 from synergrasp.config import defaults, step_params, validate_config  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
-from synergrasp.simulation.closure import closure_model  # noqa: E402
-from synergrasp.simulation.placement import object_pose, pose_grid  # noqa: E402
+from synergrasp.simulation.closure import closure_model, place_box  # noqa: E402
+from synergrasp.simulation.placement import pose_grid  # noqa: E402
+from synergrasp.simulation.scene import HandScene  # noqa: E402
 
 
 def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_median_ms") -> None:
@@ -37,18 +38,21 @@ def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_media
     poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
     print(f"closure model: {model}")
     closer = closure_model(hand, synergies, first.closure, first.mechanics, first.box.mass_kg)
+    placer = HandScene(hand)
     all_times = []
     try:
         for name in study["objects"]:
             sim = step_params(study, "simulate", name)
             box, placement = sim.box, sim.placement
             size = np.asarray(box.size_mm, dtype=float)
-            times, statuses, counts, two_fingers = [], [], [], 0
+            times, placing, statuses, counts, two_fingers = [], [], [], [], 0
             for pose in poses:
-                placed = object_pose(placement, size, *grid.angles_deg(int(pose)), hand.palm_normal)
                 t0 = time.perf_counter()
+                placed = place_box(placer, closer.q_open, placement, size, *grid.angles_deg(int(pose)))
+                t1 = time.perf_counter()
                 result = closer.grasp(size, placed)
                 times.append(time.perf_counter() - t0)
+                placing.append(t1 - t0)
                 statuses.append(result.status)
                 counts.append(len(result.links))
                 two_fingers += sum(s == "contact" for s in result.finger_state) >= 2
@@ -56,13 +60,15 @@ def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_media
             all_times.extend(t)
             status, n_status = np.unique(statuses, return_counts=True)
             m, n_m = np.unique(counts, return_counts=True)
-            print(f"{box.name} {tuple(size.tolist())} centre {placement.center_mm} axes {placement.box_axes}: {len(poses)} poses, median {np.median(t):.2f} ms, "
-                  f"p90 {np.percentile(t, 90):.2f} ms per grasp")
+            print(f"{box.name} {tuple(size.tolist())} {placement.mode} axes {placement.box_axes}: {len(poses)} poses, median {np.median(t):.2f} ms, "
+                  f"p90 {np.percentile(t, 90):.2f} ms per grasp "
+                  f"(placement median {1e3 * np.median(placing):.2f} ms)")
             print(f"  status: {dict(zip(status.tolist(), n_status.tolist()))}")
             print(f"  contacts m: {dict(zip(m.tolist(), n_m.tolist()))}")
             print(f"  poses with >= 2 fingers in contact: {two_fingers} / {len(poses)}")
     finally:
         closer.close()
+        placer.close()
     print(f"{key}: {np.median(all_times):.2f}")
 
 

@@ -10,7 +10,7 @@ import pytest
 
 from synergrasp.simulation.closure import ClosureParams, simulate_object
 from synergrasp.simulation.contacts import read_grasps, write_contacts
-from synergrasp.simulation.placement import Placement, object_pose, pose_grid
+from synergrasp.simulation.placement import Placement, approach_line, object_pose, palm_centre, pose_grid
 from synergrasp.hand.kinematics import forward_kinematics
 from synergrasp.hand.synergies import SynergyPath
 from synergrasp.simulation.objects import Box
@@ -55,6 +55,9 @@ def test_grid_has_72_by_25_poses_and_index_round_trips(grid):
 
 @pytest.mark.parametrize("kwargs, field", [
     ({"box_axes": (0, 0, 2)}, "box_axes"),
+    ({"mode": "drop"}, "mode"),
+    ({"clearance_mm": -1.0}, "clearance_mm"),
+    ({"approach_point_mm": (1.0, 2.0)}, "approach_point_mm"),
     ({"rotation_order": "xyz"}, "rotation_order"),
     ({"center_mm": (1.0, 2.0)}, "center_mm"),
     ({"alpha_deg": (-180.0, 180.0, 5.0)}, "alpha_deg"),
@@ -193,7 +196,7 @@ def test_jacobian_rows_match_finite_differences_of_fk(hand, sample):
 @pytest.fixture(scope="module")
 def empty_hand(hand, synergies):
     """Closures with nothing to grasp (the box 600 mm away)."""
-    far = Placement(center_mm=(600.0, 0.0, 0.0))
+    far = Placement(mode="fixed", center_mm=(600.0, 0.0, 0.0))
     return simulate_object(hand, synergies, CUBE, far, PARAMS, poses=[0, 900])
 
 
@@ -248,7 +251,7 @@ def test_open_path_pinches_thumb_with_index_and_middle(hand, synergies):
 
 
 def test_box_through_the_palm_is_flagged(hand, synergies):
-    inside = Placement(center_mm=(0.0, 0.0, 50.0))
+    inside = Placement(mode="fixed", center_mm=(0.0, 0.0, 50.0))
     table = simulate_object(hand, synergies, CUBE, inside, PARAMS, poses=[0])
     assert table.status.iloc[0] == "intersects_open_hand"
     assert table.n_contacts.iloc[0] == 0
@@ -295,7 +298,8 @@ def test_every_finger_ends_in_contact_blocked_by_the_hand_or_at_its_limits(hand,
         for row in _final_rows(sample, empty_hand):
             q = np.asarray(row.q)
             model.scene.set_posture(q)
-            near = model.scene.pair_distances(model.self_pairs, PARAMS.contact_distance_mm)
+            gaps = model.scene.pair_distances(model.self_pairs)
+            near = [pair for pair, gap in zip(model.self_pairs, gaps) if gap <= PARAMS.contact_distance_mm]
             for f, (state, joints, links) in enumerate(zip(row.finger_state, hand.finger_joints, hand.finger_links)):
                 if state == "contact":
                     assert set(links) & set(int(v) for v in row.contact_link)
@@ -309,13 +313,61 @@ def test_every_finger_ends_in_contact_blocked_by_the_hand_or_at_its_limits(hand,
 
 
 def test_no_two_hand_links_overlap_at_the_end(hand, synergies, sample, empty_hand):
+    """Independent check with pybullet's collision pipeline: no monitored pair of hand links
+    overlaps by more than the tolerance at the end of a closure."""
+    from synergrasp.simulation import bullet
     from synergrasp.simulation.closure import closure_model
 
     model = closure_model(hand, synergies, PARAMS)
+    client = bullet.connect()
+    body = bullet.load_hand_body(client, hand)
     try:
         for row in _final_rows(sample, empty_hand):
-            model.scene.set_posture(np.asarray(row.q))
-            gaps = model.scene.pair_distances(model.self_pairs, 0.0)
-            assert min(gaps.values(), default=0.0) >= -PARAMS.tolerance_mm, (row.object, row.pose, gaps)
+            bullet.set_posture(client, body, np.asarray(row.q))
+            pts = bullet.self_closest_points(client, body, 0.0, model.self_pairs)
+            assert np.all(pts.distance >= -PARAMS.tolerance_mm - 0.05), (row.object, row.pose, pts.distance.min())
     finally:
         model.close()
+        bullet.disconnect(client)
+
+
+# ------------------------------------------------------------------ approach placement
+
+def test_palm_centre_is_the_middle_of_the_palm_face(hand):
+    """The shipped palm is one box: centre (-2.5, -9, 52), 24 mm thick along the palm normal x."""
+    np.testing.assert_allclose(palm_centre(hand), [9.5, -9.0, 52.0], atol=1e-9)
+
+
+@pytest.mark.parametrize("clearance", [0.0, 3.0])
+def test_approach_brings_the_box_to_the_open_hand(hand, synergies, clearance):
+    """At every pose the box ends on the approach line, ``clearance`` from the open hand
+    (independent check: pybullet distance at the open posture), never intersecting it."""
+    from synergrasp.simulation.closure import closure_model, place_box
+
+    placement = Placement(clearance_mm=clearance)
+    point, normal = approach_line(placement, hand)
+    model = closure_model(hand, synergies, PARAMS)
+    try:
+        for alpha, beta in [(0.0, 0.0), (-30.0, 0.0), (45.0, 20.0), (90.0, -60.0)]:
+            placed = place_box(model.scene, model.q_open, placement, np.asarray(PLATE.size_mm), alpha, beta)
+            offset = placed.center_mm - point
+            np.testing.assert_allclose(offset - (offset @ normal) * normal, 0.0, atol=1e-9)
+            model.scene.set_posture(model.q_open)
+            gap = float(np.min(model.scene.object_distance(100.0)))
+            assert clearance - 1e-6 <= gap <= clearance + 0.02
+    finally:
+        model.close()
+
+
+def test_large_box_brought_to_the_palm_ends_with_a_palm_contact(hand, synergies):
+    cube = Box("obj3", (60.0, 60.0, 60.0), 1.0)
+    table = simulate_object(hand, synergies, cube, PLACEMENT, PARAMS, poses=[pose_grid(PLACEMENT).index(0.0, 0.0)])
+    row = table.iloc[0]
+    assert row.status == "grasp"
+    assert 0 in list(row.contact_link)  # link 0 is the palm
+
+
+def test_approach_never_drops_a_pose(sample):
+    _, _, tables = sample
+    for table in tables.values():
+        assert "intersects_open_hand" not in set(table.status)

@@ -128,3 +128,14 @@ def test_representative_grasps_follow_the_stated_rule(hand):
     assert list(chosen["pose"]) == [2, 3, 5]
     np.testing.assert_allclose(chosen["share_pct"], [100 * 3 / 7, 100 * 2 / 7, 100 / 7])
     assert representative_grasps(contacts[contacts["status"] != "grasp"]).empty
+
+
+def test_a_closure_without_contact_is_simulated_not_dropped(hand):
+    poses = _POSES + [("no_contact", [], [])]
+    gfo = pd.concat([_gfo(), _gfo().iloc[:2].assign(pose=4, rank_G=0, force_closure=False, force_norm=np.nan)])
+    row = _table(hand, _contacts(poses=poses), gfo).iloc[0]
+    assert (row["poses"], row["simulated"], row["dropped"]) == (5, 4, 1)
+    assert row["pct_m0"] == pytest.approx(25.0)
+    assert row["pct_thumb"] == pytest.approx(75.0)
+    assert row["median_force_per_weight"] == pytest.approx(2.0)
+

@@ -10,6 +10,7 @@ import pandas as pd
 import pytest
 
 from synergrasp import tables
+from synergrasp.optimisation.cones import PyramidCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.problem import GraspSets, SynergySets
 from synergrasp.optimisation.problems import random_grasp, random_synergies
@@ -62,3 +63,27 @@ def test_merge_shards_orders_poses_and_keeps_the_set_order():
     merged = merge_shards([a.iloc[:2], a.iloc[2:]])
     assert merged[["pose", "set_id"]].values.tolist() == [[0, "1"], [0, "1-2"], [2, "1"], [2, "1-2"]]
     assert list(gfo.columns) == list(tables.GFO.names)
+
+
+def test_pyramid_cone_study_runs_through_piqp_and_matches_clarabel():
+    rng = np.random.default_rng(5)
+    grasps = [random_grasp(rng, int(rng.integers(4, 10)), palm_contacts=1) for _ in range(3)]
+    sets = SynergySets(random_synergies(rng), ((1,), (1, 2, 3), tuple(range(1, 16))))
+    params = GFOParams(gravity_direction=(0.0, 0.0, -1.0), friction_cone="pyramid8_circumscribed")
+    assert params.cone == PyramidCone(1.5, 8, inscribed=False)
+    out = optimise_grasps(grasps, sets, params)
+    n = len(sets)
+    for p, grasp in enumerate(grasps):
+        rows = slice(p * n, (p + 1) * n)
+        mech = mechanics_for(grasp, params)
+        if mech.rank_G < 6:
+            continue
+        ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, sets, params.f_min, params.cone),
+                        "clarabel", strict_shrink=params.strict_shrink)
+        np.testing.assert_array_equal(out["status"][rows], ref.status)
+        np.testing.assert_array_equal(out["strict_internal"][rows], ref.strict_internal)
+        assert set(out["solver"][rows]) <= {"piqp", "direct"}
+        fc = ref.force_closure
+        np.testing.assert_allclose(out["force_norm"][rows][fc], ref.force_norm[fc], rtol=RTOL_NORM)
+    with pytest.raises(ValueError, match="friction_cone must be one of"):
+        GFOParams(gravity_direction=(0.0, 0.0, -1.0), friction_cone="pyramid6")

@@ -89,6 +89,19 @@ def test_tables_have_documented_columns_and_sane_values(run_j2):
     assert (fc["force_norm"] > 0).all() and gfo.loc[~gfo["force_closure"], "force_norm"].isna().all()
 
 
+def test_no_pose_is_dropped(run_j2):
+    """The approach placement: every pose of the small grid is a closure (none intersects the open hand)."""
+    config = yaml.safe_load(SMALL.read_text())
+    n_poses = 1
+    for axis in ("alpha_deg", "beta_deg"):
+        g = config["grid"][axis]
+        n_poses *= int(round((g["stop"] - g["start"]) / g["step"])) + 1
+    for name in config["objects"]:
+        contacts = pd.read_parquet(run_j2 / "results" / "objects" / name / "contacts.parquet")
+        assert len(contacts) == n_poses and contacts["pose"].nunique() == n_poses
+        assert set(contacts["status"]) <= {"grasp", "no_contact"}
+
+
 def test_second_run_does_nothing(run_j2):
     before = digest([p for p in (run_j2 / "results").rglob("*") if p.is_file()])
     out = snakemake(run_j2, "-j2", "figures")

@@ -68,7 +68,7 @@ def _pose_columns() -> tuple[Column, ...]:
 CONTACTS = Table("contacts", "one row per pose", _pose_columns() + (
     Column("status", "string", "", "closure outcome (see synergrasp.simulation)"),
     Column("q", "list<float64>", "rad", "final joint angles (19)"),
-    Column("finger_state", "list<string>", "", "per finger thumb..little: contact, limit, self"),
+    Column("finger_state", "list<string>", "", "per finger thumb..little: contact (box), self (blocked by the hand), limit (end of the closure path)"),
     Column("n_contacts", "int32", "", "number of contacts m"),
     Column("contact_link", "list<int32>", "", "link index per contact (Hand.link_names)"),
     Column("contact_point", "list<float64>", "mm", "contact points on the box surface, palm frame, 3m row-major"),
@@ -114,10 +114,10 @@ def _realism_columns() -> tuple[Column, ...]:
     bins = tuple(Column(f"pct_m{m}", "float64", "%", f"grasps with exactly {m} contacts") for m in range(6))
     return (
         Column("object", "string", "", "object name"),
-        Column("closure_model", "string", "", "closure model that made the grasps (kinematic unless the contacts say)"),
+        Column("closure_model", "string", "", "closure model that made the grasps (contacts table)"),
         Column("poses", "int32", "", "poses of the grid"),
-        Column("simulated", "int32", "", "poses whose closure ran (status grasp)"),
-        Column("dropped", "int32", "", "poses not simulated (any other status)"),
+        Column("simulated", "int32", "", "poses whose closure ran (status grasp or no_contact)"),
+        Column("dropped", "int32", "", "poses whose closure did not run (any other status)"),
         Column("dropped_by", "string", "", "dropped poses per status"),
         Column("contacts_median", "float64", "", "median contacts per simulated grasp"),
     ) + bins + (

@@ -1,12 +1,11 @@
 """How much the simulated grasps look like grasps a hand makes: the grasp-realism table.
 
-Per object (and per closure model, when the contacts table says which one made a row):
+Per object and closure model (the contacts table's ``closure_model``):
 poses simulated and dropped, the distribution of contacts per grasp, the share of grasps
 that touch with the thumb, the palm, a proximal or middle phalanx, the share whose grasp
 matrix has full rank 6, and the median optimal force with every synergy enrolled as a
-multiple of the object's weight (‖f‖₂ / (m·g), dimensionless). When the contacts table
-carries per-contact normal forces (a dynamic closure), also how many contacts per grasp
-carry load. Columns: :data:`synergrasp.tables.GRASP_REALISM`. Pure functions: DataFrames
+multiple of the object's weight (‖f‖₂ / (m·g), dimensionless); where the closure model
+records per-contact normal forces (the dynamic one), how many contacts per grasp carry load. Columns: :data:`synergrasp.tables.GRASP_REALISM`. Pure functions: DataFrames
 in, a DataFrame out.
 """
 
@@ -19,14 +18,15 @@ import pandas as pd
 
 from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 
-__all__ = ["CONTACT_BINS", "DEFAULT_CLOSURE_MODEL", "NORMAL_FORCE_COLUMN", "link_categories", "grasp_realism",
+__all__ = ["SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "link_categories", "grasp_realism",
            "representative_grasps"]
 
+#: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.STATUSES): a
+#: ``no_contact`` closure is a simulated grasp with 0 contacts; any other status is a dropped pose.
+SIMULATED_STATUSES: tuple[str, ...] = ("grasp", "no_contact")
 #: Contact-count bins of the table: 0, 1, …, 5 and "6 or more".
 CONTACT_BINS: tuple[int, ...] = (0, 1, 2, 3, 4, 5, 6)
-#: Closure model written in the table when the contacts table has no ``closure_model`` column.
-DEFAULT_CLOSURE_MODEL = "kinematic"
-#: Optional contacts column: normal force per contact, N (list<float64>, m per row).
+#: Contacts column: normal force per contact, N (NaN entries where the model computes none).
 NORMAL_FORCE_COLUMN = "contact_normal_force_N"
 #: Segments (the part of a link name after the finger) counted as proximal or middle phalanges.
 _PROXIMAL_OR_MIDDLE = ("proximal", "middle")
@@ -47,18 +47,14 @@ def _touches(links: pd.Series, category: frozenset[int]) -> pd.Series:
 
 
 def _loaded(contacts: pd.DataFrame, threshold_N: float) -> pd.Series:
-    """Contacts per row whose normal force exceeds ``threshold_N``; NaN where unknown (no
-    column, or NaN forces: the kinematic closure records none)."""
-    if NORMAL_FORCE_COLUMN not in contacts.columns:
-        return pd.Series(np.nan, index=contacts.index)
+    """Contacts per row whose normal force exceeds ``threshold_N``; NaN where the forces are
+    unknown (NaN entries, as the kinematic model writes them)."""
 
     def count(forces) -> float:
         if forces is None or (np.isscalar(forces) and pd.isna(forces)):
             return np.nan
         values = np.asarray(forces, dtype=float)
-        if np.isnan(values).any():
-            return np.nan
-        return float(np.count_nonzero(values > threshold_N))
+        return np.nan if np.isnan(values).any() else float(np.count_nonzero(values > threshold_N))
 
     return contacts[NORMAL_FORCE_COLUMN].map(count)
 
@@ -79,7 +75,7 @@ def _weight_multiples(gfo: pd.DataFrame, full_set_id: str, weights_N: Mapping[st
 
 
 def _one_group(rows: pd.DataFrame, categories: dict[str, frozenset[int]]) -> dict[str, float]:
-    simulated = rows["status"] == "grasp"
+    simulated = rows["status"].isin(SIMULATED_STATUSES)
     grasps = rows[simulated]
     n = len(grasps)
     m = grasps["n_contacts"].astype(int).clip(upper=CONTACT_BINS[-1])
@@ -98,7 +94,8 @@ def _one_group(rows: pd.DataFrame, categories: dict[str, frozenset[int]]) -> dic
     out["pct_force_closure"] = share(grasps["force_closure"].fillna(False).astype(bool))
     out["median_force_per_weight"] = float(grasps["force_per_weight"].median()) if n else np.nan
     loaded = grasps["loaded_contacts"]
-    out["loaded_contacts_median"] = float(loaded.median()) if loaded.notna().any() else np.nan
+    known = loaded[grasps["n_contacts"] > 0].notna().any()  # forces recorded where there are contacts
+    out["loaded_contacts_median"] = float(loaded.median()) if known else np.nan
     return out
 
 
@@ -110,13 +107,12 @@ def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequenc
                   full_set_id: str, weights_N: Mapping[str, float], load_threshold_N: float = 1e-3) -> pd.DataFrame:
     """The grasp-realism table (columns of :data:`synergrasp.tables.GRASP_REALISM`).
 
-    ``contacts``: contacts tables of the objects (CONTACTS contract; an optional
-    ``closure_model`` column groups the rows, else every row is ``kinematic``; an optional
-    ``contact_normal_force_N`` column gives each contact's normal force, N).
-    ``gfo``: their optimisation results; rank(G), force closure and ‖f‖₂ are taken from the
-    full set ``full_set_id`` (e.g. ``"1-2-…-15"``). ``weights_N``: m·g per object, N.
+    ``contacts``: contacts tables of the objects (CONTACTS contract; rows are grouped by
+    ``closure_model``, loads read from ``contact_normal_force_N``, N).
+    ``gfo``: their optimisation results (joined on ``closure_model`` too when it has that
+    column); rank(G), force closure and ‖f‖₂ are taken from the full set ``full_set_id`` (e.g. ``"1-2-…-15"``). ``weights_N``: m·g per object, N.
     ``link_names`` / ``link_finger``: the hand's links (``Hand.link_names``, ``Hand.link_finger``).
-    Shares are percent of the simulated grasps (status ``grasp``); a contact carries load if
+    Shares are percent of the simulated poses (``SIMULATED_STATUSES``); a contact carries load if
     its normal force exceeds ``load_threshold_N``. One row per (object, closure model).
     """
     for table, frame in ((CONTACTS, contacts), (GFO, gfo)):
@@ -125,9 +121,8 @@ def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequenc
             raise ValueError(f"{table.name} table: missing column(s) {absent}")
     if full_set_id not in set(gfo["set_id"].astype(str)):
         raise ValueError(f"full_set_id {full_set_id!r} is not in the gfo table")
-    model = contacts["closure_model"] if "closure_model" in contacts.columns else DEFAULT_CLOSURE_MODEL
-    work = contacts[["object", "pose", "status", "n_contacts", "contact_link"]].assign(
-        closure_model=model, pose=contacts["pose"].astype(int), loaded_contacts=_loaded(contacts, load_threshold_N))
+    work = contacts[["object", "closure_model", "pose", "status", "n_contacts", "contact_link"]].assign(
+        pose=contacts["pose"].astype(int), loaded_contacts=_loaded(contacts, load_threshold_N))
     full = _weight_multiples(gfo, full_set_id, weights_N)
     keys = ["object", "pose", "closure_model"] if "closure_model" in full.columns else ["object", "pose"]
     work = work.merge(full, on=keys, how="left", validate="many_to_one")

@@ -11,10 +11,11 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import ArrayLike, NDArray
 
-from synergrasp.analysis.realism import representative_grasps
-from synergrasp.figures.hand_pictures import (BOX, GRASP_CAMERA, PALM_CAMERA, SKIN, TOUCHING, BoxInPicture, Camera,
-                                              render)
+from synergrasp.analysis.realism import SIMULATED_STATUSES, representative_grasps
+from synergrasp.figures.hand_pictures import (BOX, PALM_CAMERA, SKIN, TOUCHING, BoxInPicture, Camera, box_corners,
+                                              hand_shapes, render)
 from synergrasp.figures.output import save_figure
 
 __all__ = ["figure_synergy_postures", "figure_example_grasps", "PANEL_PX"]
@@ -22,7 +23,6 @@ __all__ = ["figure_synergy_postures", "figure_example_grasps", "PANEL_PX"]
 #: Rendered panel size, pixels (width, height).
 PANEL_PX = (330, 330)
 _CONTACT = "#c2000b"
-NDArrayLike = Any  # anything np.asarray takes
 
 
 def _bare(ax: Any) -> None:
@@ -47,24 +47,60 @@ def _frame(axes: Sequence[Any], pictures: Sequence[Any], margin_px: float = 8.0)
         ax.set_ylim(mid_r + half, mid_r - half)
 
 
-def _label(ax: Any, name: str, at: NDArray, offset: tuple[float, float]) -> None:
-    """Name a part at image point ``at``; the text sits ``offset`` away, in fractions of the window."""
-    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()  # y runs downward in an image
-    text = (at[0] + offset[0] * (x1 - x0), at[1] + offset[1] * (y0 - y1))
+def _palm_point(hand: Any) -> NDArray:
+    """Centre of the palm box's face toward the palm normal (mm, palm frame; the origin if the
+    palm has no box): where "palm" is written and what the other labels point away from."""
+    boxes = hand_shapes(hand, np.zeros(hand.n_joints)).boxes  # the palm does not move
+    if not boxes:
+        return np.zeros(3)
+    normal = np.asarray(hand.palm_normal, dtype=float)
+    front = [np.asarray(b.center_mm) + (np.abs(np.asarray(b.rotation).T @ normal) @ (np.asarray(b.size_mm) / 2.0)) * normal
+             for b in boxes]
+    return max(front, key=lambda p: float(p @ normal))
+
+
+def _fit(camera: Camera, hand: Any, postures: Sequence[NDArray], boxes: Sequence[BoxInPicture] = ()) -> Camera:
+    """``camera`` centred on and sized to the hand at every posture and the boxes."""
+    points, radii = [], []
+    for q in postures:
+        p, r = hand_shapes(hand, q).extent()
+        points.append(p)
+        radii.append(r)
+    for box in boxes:
+        points.append(box_corners(box))
+        radii.append(np.zeros(8))
+    return camera.fitted(np.vstack(points), np.concatenate(radii))
+
+
+def _label(ax: Any, name: str, at: NDArray, away_from: NDArray, distance: float = 0.2) -> None:
+    """Name a part at image point ``at``; the text sits ``distance`` (fraction of the window)
+    further along the direction from ``away_from`` to ``at``, inside the window."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()  # y runs downward in an image: y0 > y1
+    direction = np.asarray(at, float) - np.asarray(away_from, float)
+    direction = direction / max(float(np.linalg.norm(direction)), 1e-9)
+    text = np.asarray(at, float) + distance * (x1 - x0) * direction
+    text = (np.clip(text[0], x0 + 0.1 * (x1 - x0), x1 - 0.1 * (x1 - x0)),
+            np.clip(text[1], y1 + 0.05 * (y0 - y1), y0 - 0.05 * (y0 - y1)))
     ax.annotate(name, xy=at, xytext=text, fontsize=8, color="0.1", ha="center", va="center",
                 bbox=dict(boxstyle="round,pad=0.15", facecolor="white", edgecolor="none", alpha=0.8),
                 arrowprops=dict(arrowstyle="-", color="0.3", lw=0.7, shrinkA=0, shrinkB=1))
 
 
-def _label_parts(ax: Any, hand: Any, q: NDArrayLike, picture: Any) -> None:
+def _thumb_point(hand: Any, q: ArrayLike) -> NDArray:
+    """Centre of the thumb's proximal phalanx (mm): the thumb's middle, seen even when it is flexed."""
+    caps = hand_shapes(hand, np.asarray(q, dtype=float))
+    return caps.ends[caps.link == hand.link_index("thumb_proximal")][0].mean(axis=0)
+
+
+def _label_parts(ax: Any, hand: Any, q: ArrayLike, picture: Any) -> None:
     """Name the thumb, index, little finger and palm on a picture of the hand at q (after framing)."""
     from synergrasp.hand.kinematics import fingertip_positions
 
     tips = picture.pixels(fingertip_positions(hand, np.asarray(q, dtype=float)))
-    _label(ax, "thumb", tips[0], (-0.02, 0.16))
-    _label(ax, "index", tips[1], (0.10, -0.08))
-    _label(ax, "little", tips[4], (-0.04, -0.16))
-    palm = picture.pixels(np.array([[12.0, -9.0, 45.0]]))[0]  # on the palm's front face, mm
+    palm = picture.pixels(_palm_point(hand)[None])[0]
+    _label(ax, "thumb", picture.pixels(_thumb_point(hand, q)[None])[0], palm)
+    _label(ax, "index", tips[1], palm, 0.12)
+    _label(ax, "little", tips[4], palm, 0.12)
     ax.text(*palm, "palm", fontsize=8, color="0.1", ha="center", va="center")
 
 
@@ -86,10 +122,13 @@ def figure_synergy_postures(hand: Any, synergies: Any, png_path: str | Path, pdf
     panel = 2.35  # inches
     fig, axes = plt.subplots(n_synergies, len(sigmas), figsize=(panel * len(sigmas) + 0.4, panel * n_synergies + 0.6),
                              squeeze=False)
+    postures = [[np.clip(mean + sigma * matrix[:, k], hand.lower, hand.upper) for sigma in sigmas]
+                for k in range(n_synergies)]
+    camera = _fit(camera, hand, [q for row in postures for q in row] + [mean])
     pictures, named = [], None  # named: the first mean posture's (axes, q, picture)
     for k in range(n_synergies):
         for c, sigma in enumerate(sigmas):
-            q = np.clip(mean + sigma * matrix[:, k], hand.lower, hand.upper)
+            q = postures[k][c]
             ax = axes[k, c]
             picture = render(hand, q, camera, PANEL_PX, ghost_q=None if sigma == 0 else mean)
             pictures.append(picture)
@@ -110,7 +149,21 @@ def figure_synergy_postures(hand: Any, synergies: Any, png_path: str | Path, pdf
     save_figure(fig, png_path, pdf_path)
 
 
-def _box_of(row: pd.Series, size_mm: NDArrayLike) -> BoxInPicture:
+def _touching_words(hand: Any, links: Sequence[int]) -> str:
+    """The touching links in words, finger by finger: "palm, thumb tip, index middle + tip"."""
+    import textwrap
+
+    parts = []
+    for finger in ("palm", "thumb", "index", "middle", "ring", "little"):
+        segments = [hand.link_names[i].split("_", 1)[-1] for i in sorted(links) if hand.link_finger[i] == finger]
+        if finger == "palm" and segments:
+            parts.append("palm")
+        elif segments:
+            parts.append(f"{finger} " + " + ".join("tip" if s == "distal" else s for s in segments))
+    return "\n".join(textwrap.wrap("touching: " + ", ".join(parts), 48))
+
+
+def _box_of(row: pd.Series, size_mm: ArrayLike) -> BoxInPicture:
     return BoxInPicture(np.asarray(size_mm, dtype=float), np.asarray(row["object_center"], dtype=float),
                         np.asarray(row["object_rotation"], dtype=float).reshape(3, 3))
 
@@ -129,11 +182,12 @@ def _legend(fig: Any) -> None:
 
 
 def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.DataFrame], png_path: str | Path,
-                          pdf_path: str | Path, n_grasps: int = 3, camera: Camera = GRASP_CAMERA) -> None:
+                          pdf_path: str | Path, n_grasps: int = 3, camera: Camera = PALM_CAMERA) -> None:
     """Fig. 2: representative simulated grasps, one row per box, chosen by rule
     (``synergrasp.analysis.realism.representative_grasps``: the most common set of touching
     links, the most common one at the typical contact count, the next most common), each at
-    its pose nearest (α, β) = (0, 0). ``tables[i]`` is the contacts table of ``boxes[i]``.
+    its pose nearest (α, β) = (0, 0), all in the view of Fig. 1. ``tables[i]`` is the contacts
+    table of ``boxes[i]``.
     Links touching the box are highlighted, contact points are dots (hollow where the hand
     hides them); the box is see-through.
     """
@@ -142,8 +196,6 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.D
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from synergrasp.hand.kinematics import fingertip_positions
-
     if len(boxes) != len(tables):
         raise ValueError(f"boxes and tables must have the same length, got {len(boxes)} and {len(tables)}")
     panel = 2.6  # inches
@@ -151,7 +203,10 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.D
                              squeeze=False)
     for r, (box, table) in enumerate(zip(boxes, tables)):
         chosen = representative_grasps(table, n_grasps)
-        simulated = int((table["status"] == "grasp").sum())
+        simulated = int(table["status"].isin(SIMULATED_STATUSES).sum())
+        rows = [table[table["pose"] == pose].iloc[0] for pose in chosen["pose"]]
+        row_camera = _fit(camera, hand, [np.asarray(row["q"], dtype=float) for row in rows],
+                          [_box_of(row, box.size_mm) for row in rows]) if rows else camera
         pictures, thumbs = [], []
         axes[r, 0].set_ylabel(f"{box.name}\n{' × '.join(f'{v:g}' for v in box.size_mm)} mm", fontsize=10)
         for c in range(n_grasps):
@@ -161,10 +216,9 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.D
                 ax.text(0.5, 0.5, "no other contact set" if c else f"no grasp with contacts\n({simulated} simulated)",
                         ha="center", va="center", transform=ax.transAxes, fontsize=8, color="0.4")
                 continue
-            pick = chosen.iloc[c]
-            row = table[table["pose"] == pick["pose"]].iloc[0]
+            pick, row = chosen.iloc[c], rows[c]
             points = np.asarray(row["contact_point"], dtype=float).reshape(-1, 3)
-            picture = render(hand, np.asarray(row["q"], dtype=float), camera, PANEL_PX,
+            picture = render(hand, np.asarray(row["q"], dtype=float), row_camera, PANEL_PX,
                              box=_box_of(row, box.size_mm), touching=pick["pattern"])
             ax.imshow(picture.rgb, interpolation="antialiased")
             pictures.append(picture)
@@ -176,10 +230,12 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.D
             ax.set_title(f"{pick['reason']}: {pick['share_pct']:.0f} % of grasps\n"
                          f"α = {pick['alpha_deg']:g}°, β = {pick['beta_deg']:g}°, {int(row['n_contacts'])} contacts",
                          fontsize=8)
+            ax.set_xlabel(_touching_words(hand, pick["pattern"]), fontsize=7, labelpad=2)
         if pictures:
             _frame(axes[r, :len(pictures)], pictures)
             for ax, (picture, q) in zip(axes[r], thumbs):
-                _label(ax, "thumb", picture.pixels(fingertip_positions(hand, q))[0], (0.13, 0.09))
+                _label(ax, "thumb", picture.pixels(_thumb_point(hand, q)[None])[0],
+                       picture.pixels(_palm_point(hand)[None])[0])
     _legend(fig)
     fig.tight_layout(rect=(0, 0.035, 1, 1), h_pad=0.6, w_pad=0.3)
     save_figure(fig, png_path, pdf_path)

@@ -20,6 +20,7 @@ import pandas as pd  # noqa: E402
 import seaborn as sns  # noqa: E402
 
 from synergrasp.config import incremental_set_id  # noqa: E402
+from synergrasp.figures.output import save_figure  # noqa: E402
 
 __all__ = [
     "write_table",
@@ -34,9 +35,7 @@ __all__ = [
 
 
 def _save(fig: plt.Figure, png: str | Path, pdf: str | Path) -> None:
-    fig.savefig(png, dpi=150, bbox_inches="tight")
-    fig.savefig(pdf, bbox_inches="tight")
-    plt.close(fig)
+    save_figure(fig, png, pdf, tight=True)  # same bytes on every run
 
 
 def write_table(table: pd.DataFrame, csv_path: str | Path, md_path: str | Path,

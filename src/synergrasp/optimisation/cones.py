@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from synergrasp.optimisation.mechanics import contact_frames
 
-__all__ = ["CircularCone", "FrictionCone", "PyramidCone"]
+__all__ = ["CONE_MODELS", "CircularCone", "FrictionCone", "PyramidCone", "cone_model"]
 
 
 def _check_mu(mu: float) -> None:
@@ -117,3 +117,19 @@ class PyramidCone:
 
 #: Every friction-cone model a problem may carry.
 FrictionCone = CircularCone | PyramidCone
+
+#: The study's friction-cone models by name (`GFOParams.friction_cone`).
+CONE_MODELS: dict[str, tuple[type, dict]] = {
+    "circular": (CircularCone, {}),
+    "pyramid4_inscribed": (PyramidCone, {"sides": 4, "inscribed": True}),
+    "pyramid8_inscribed": (PyramidCone, {"sides": 8, "inscribed": True}),
+    "pyramid8_circumscribed": (PyramidCone, {"sides": 8, "inscribed": False}),
+}
+
+
+def cone_model(name: str, mu: float) -> FrictionCone:
+    """The friction-cone model `name` (one of CONE_MODELS) with friction coefficient mu."""
+    if name not in CONE_MODELS:
+        raise ValueError(f"friction_cone must be one of {list(CONE_MODELS)}, got {name!r}")
+    cls, options = CONE_MODELS[name]
+    return cls(mu, **options)

@@ -32,7 +32,7 @@ from synergrasp.optimisation.problem import (
     as_problems,
 )
 
-__all__ = ["METHODS", "solve_gfo", "warm_up"]
+__all__ = ["FASTEST_METHOD", "METHODS", "solve_gfo", "warm_up"]
 
 #: Methods of `solve_gfo` and the friction-cone kinds each accepts.
 METHODS: dict[str, tuple[str, ...]] = {
@@ -41,6 +41,9 @@ METHODS: dict[str, tuple[str, ...]] = {
     "cvxpy": ("circular",),
     "piqp": ("pyramid",),
 }
+
+#: The fastest method for each cone kind (the study's choice).
+FASTEST_METHOD: dict[str, str] = {"circular": "ipm", "pyramid": "piqp"}
 
 #: Verdict of each kernel code; '' marks the problems that go to the Clarabel fallback.
 _STATUS_OF_CODE = np.array(["", "force_closure", "infeasible", ""], dtype=object)

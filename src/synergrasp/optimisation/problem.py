@@ -112,13 +112,15 @@ class SynergySets:
     """Synergy sets enrolled in the optimisation: the synergy matrix and each set's columns.
 
     matrix: (n, k) synergies, rad per unit activation; sets: 1-based synergy indices per set.
-    Derived once: `columns` (0-based, sorted, per set), `norms` (||S_set||_2 per set) and
-    `table` (n_sets, largest set) of the columns, padded with 0 after each set's size.
+    Derived once: `columns` (0-based, sorted, per set), `sizes` (synergies per set), `norms`
+    (||S_set||_2 per set) and `table` (n_sets, largest set) of the columns, padded with 0
+    after each set's size.
     """
 
     matrix: NDArray
     sets: tuple[tuple[int, ...], ...]
     columns: tuple[NDArray, ...] = field(init=False, repr=False)
+    sizes: NDArray = field(init=False, repr=False)
     norms: NDArray = field(init=False, repr=False)
     table: NDArray = field(init=False, repr=False)
 
@@ -141,11 +143,7 @@ class SynergySets:
         for j, c in enumerate(columns):
             table[j, :c.size] = c
         object.__setattr__(self, "table", table)
-
-    @property
-    def sizes(self) -> NDArray:
-        """Number of synergies of every set."""
-        return np.array([c.size for c in self.columns], dtype=np.int64)
+        object.__setattr__(self, "sizes", np.array([c.size for c in columns], dtype=np.int64))
 
     def __len__(self) -> int:
         return len(self.columns)

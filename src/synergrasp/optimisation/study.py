@@ -17,8 +17,8 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp.config import set_id
-from synergrasp.optimisation.cones import CircularCone
-from synergrasp.optimisation.gfo import solve_gfo
+from synergrasp.optimisation.cones import CONE_MODELS, FrictionCone, cone_model
+from synergrasp.optimisation.gfo import FASTEST_METHOD, solve_gfo
 from synergrasp.optimisation.ipm_kernel import IPMSettings
 from synergrasp.optimisation.mechanics import (
     BASIS_RTOL,
@@ -42,6 +42,9 @@ class GFOParams:
     gravity_direction: unit vector of gravity in the palm frame (required: the placement
         decides it, the configuration holds it)
     mu: Coulomb friction coefficient; f_min: least normal force, N
+    friction_cone: the friction-cone model, one of cones.CONE_MODELS ('circular', the exact
+        Coulomb cone, solved by the compiled interior-point kernel; the pyramids, solved as
+        QPs by PIQP)
     k_stru: structural contact stiffness, N/mm; k_ss: joint stiffness, N·mm/rad
     mass_kg, g (m/s²): the object's weight
     basis_rtol: rank tolerance of E_s; grasp_rank_rtol: rank tolerance of G
@@ -52,6 +55,7 @@ class GFOParams:
     gravity_direction: tuple[float, float, float]
     mu: float = 1.5
     f_min: float = 0.1
+    friction_cone: str = "circular"
     k_stru: float = 1.0
     k_ss: float = 200.0
     mass_kg: float = 1.0
@@ -81,15 +85,17 @@ class GFOParams:
                 raise ValueError(f"{name} must be in (0, 1), got {value}")
         if not (isinstance(self.max_iter, int) and self.max_iter > 0):
             raise ValueError(f"max_iter must be a positive int, got {self.max_iter!r}")
+        if self.friction_cone not in CONE_MODELS:
+            raise ValueError(f"friction_cone must be one of {list(CONE_MODELS)}, got {self.friction_cone!r}")
 
     def wrench(self) -> NDArray:
         """w_e (6,) the contacts must apply against the weight, N and N·mm."""
         return object_wrench(self.mass_kg, np.asarray(self.gravity_direction), self.g)
 
     @property
-    def cone(self) -> CircularCone:
+    def cone(self) -> FrictionCone:
         """The friction-cone model of every contact."""
-        return CircularCone(self.mu)
+        return cone_model(self.friction_cone, self.mu)
 
 
 def mechanics_for(grasp: Grasp, params: GFOParams) -> GraspMechanics:
@@ -107,8 +113,9 @@ def optimise_grasps(
 ) -> dict[str, NDArray]:
     """GFO verdict, optimal force and strict internal-force test of every (grasp, set).
 
-    grasps: poses (None or no contacts: 'no_grasp'). Solved with method "ipm" (the
-    compiled kernel, Clarabel for what it leaves undecided). strict=False skips the strict
+    grasps: poses (None or no contacts: 'no_grasp'). Solved with the fastest method for the
+    cone (`gfo.FASTEST_METHOD`: the compiled kernel with Clarabel for what it leaves
+    undecided for the circular cone, PIQP for pyramids). strict=False skips the strict
     test (column all False). Returns columns, one row per (grasp, set), grasp-major:
     set_id, n_synergies, status, force_closure, strict_internal, force_norm (N), e_s,
     rank_G, n_contacts, iterations, solver.
@@ -129,6 +136,7 @@ def optimise_grasps(
         "solver": np.full(total, "none", dtype=object),
     }
     cone = params.cone
+    method = FASTEST_METHOD[cone.kind]
     for p, grasp in enumerate(grasps):
         if grasp is None or grasp.n_contacts == 0:
             continue
@@ -140,7 +148,7 @@ def optimise_grasps(
             out["status"][rows] = "rank_deficient"
             continue
         problems = GraspSets(mech.f_p, mech.normals, mech.projector, synergies, params.f_min, cone, params.basis_rtol)
-        sol = solve_gfo(problems, "ipm", strict_shrink=params.strict_shrink if strict else None, tol=params.tol,
+        sol = solve_gfo(problems, method, strict_shrink=params.strict_shrink if strict else None, tol=params.tol,
                         max_iter=params.max_iter, ipm=ipm)
         out["status"][rows], out["force_norm"][rows], out["e_s"][rows] = sol.status, sol.force_norm, sol.e_s
         out["iterations"][rows], out["solver"][rows] = sol.iterations, sol.solver

@@ -103,14 +103,19 @@ def joint_positions(client: int, body: HandBody) -> NDArray[np.float64]:
 
 def link_frames(client: int, body: HandBody) -> NDArray[np.float64]:
     """(n_links, 4, 4) hand link frames as pybullet has them, palm frame, mm (single precision)."""
-    out = np.empty((body.hand.n_links, 4, 4))
-    out[0] = np.eye(4)
     states = pb.getLinkStates(body.body, body.link_index[1:].tolist(), computeForwardKinematics=1,
                               physicsClientId=client)
-    for i, s in enumerate(states, start=1):
-        out[i] = np.eye(4)
-        out[i, :3, :3] = np.array(pb.getMatrixFromQuaternion(s[5])).reshape(3, 3)
-        out[i, :3, 3] = np.array(s[4]) / MM
+    pos = np.array([s[4] for s in states]) / MM
+    x, y, z, w = np.array([s[5] for s in states]).T  # pybullet quaternions (x, y, z, w)
+    out = np.zeros((body.hand.n_links, 4, 4))
+    out[:, 3, 3] = 1.0
+    out[0, :3, :3] = np.eye(3)
+    out[1:, :3, :3] = np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=-1),
+        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=-1),
+        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=-1),
+    ], axis=1)
+    out[1:, :3, 3] = pos
     return out
 
 

@@ -1,10 +1,11 @@
 """Closing the hand on an object at every pose: the closure settings and the study loop.
 
-``simulate_object`` places the box at each pose of the grid (``placement``), runs a
-closure model on it and collects one contacts-table row per pose (``contacts``). The
-closure model (today the kinematic one, ``kinematic_closure``) takes the hand, the
-synergies and :class:`ClosureParams`, and gives a ``ClosureResult`` per placed box through
-``grasp(size_mm, placed)``; ``close()`` releases it. mm, rad, palm frame (docs/closure.md).
+``simulate_object`` places the box at each pose of the grid (:func:`place_box`: fixed, or
+brought to the open hand), runs a closure model on it and collects one contacts-table row
+per pose (``contacts``). A closure model (``kinematic_closure``, ``dynamic_closure``) takes
+the hand, the synergies and :class:`ClosureParams`; it has the open posture ``q_open``
+(rad) its closure starts from, ``grasp(size_mm, placed) -> ClosureResult`` and ``close()``.
+mm, rad, palm frame (docs/closure.md).
 """
 
 from __future__ import annotations
@@ -16,16 +17,18 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
 from synergrasp.simulation.contacts import contacts_row, contacts_table
 from synergrasp.simulation.dynamic_closure import DynamicParams
-from synergrasp.simulation.placement import Placement, object_pose, pose_grid
+from synergrasp.simulation.placement import ObjectPose, Placement, approach_line, object_pose, pose_grid
+from synergrasp.simulation.scene import HandScene
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
 
-__all__ = ["CLOSURE_MODELS", "ClosureParams", "simulate_object", "closure_model"]
+__all__ = ["CLOSURE_MODELS", "ClosureParams", "simulate_object", "closure_model", "place_box"]
 
 #: ``kinematic``: the quasi-static closure (links stop at first touch, the box fixed);
 #: ``dynamic``: the compliant hand closing on a free box (``dynamic_closure``).
@@ -95,6 +98,19 @@ def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams,
     return KinematicClosure(hand, synergies, params)
 
 
+def place_box(scene: HandScene, q_open: NDArray, placement: Placement, size_mm: NDArray, alpha_deg: float,
+              beta_deg: float) -> ObjectPose:
+    """The box of ``size_mm`` at pose (α, β) deg: at the fixed centre (``fixed``), or turned
+    by (α, β) and brought along the palm normal to the open hand (posture ``q_open``, rad)
+    of ``scene`` (``approach``)."""
+    hand = scene.hand
+    turned = object_pose(placement, size_mm, alpha_deg, beta_deg, hand.palm_normal)
+    if placement.mode == "fixed":
+        return turned
+    point, direction = approach_line(placement, hand)
+    return scene.bring_box(size_mm, turned.rotation, point, direction, q_open, placement.clearance_mm)
+
+
 def simulate_object(hand: Hand, synergies: Synergies, box: Any, placement: Placement,
                     closure_params: ClosureParams, poses: Iterable[int] | None = None,
                     mechanics: Mapping[str, Any] | None = None) -> pd.DataFrame:
@@ -110,12 +126,14 @@ def simulate_object(hand: Hand, synergies: Synergies, box: Any, placement: Place
             raise ValueError(f"poses must be in 0 … {grid.n_poses - 1}, got {v}")
     size = np.asarray(box.size_mm, dtype=float)
     model = closure_model(hand, synergies, closure_params, mechanics, getattr(box, "mass_kg", None))
+    placer = HandScene(hand)  # the open hand the box is brought to (placement)
     try:
         rows = []
         for pose in pose_list:
             a, b = grid.angles_deg(pose)
-            placed = object_pose(placement, size, a, b, hand.palm_normal)
+            placed = place_box(placer, model.q_open, placement, size, a, b)
             rows.append(contacts_row(str(box.name), pose, a, b, model.grasp(size, placed), placed))
     finally:
         model.close()
+        placer.close()
     return contacts_table(rows)

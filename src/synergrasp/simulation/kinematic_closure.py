@@ -9,6 +9,7 @@ queried (``HandScene``). mm, rad, palm frame.
 
 from __future__ import annotations
 
+from bisect import bisect_left, bisect_right
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -58,10 +59,13 @@ class KinematicClosure:
             for i, link in enumerate(links):
                 self.link_finger_index[link] = f
                 self.link_chain_pos[link] = i
-        self.reach = self._finger_reach()
-        self._profiles: dict[tuple[int, tuple[int, ...]], tuple[NDArray, NDArray]] = {}
+        self.reach = self._joint_reach()
+        self._profiles: dict[tuple[int, tuple[int, ...]], tuple[list[float], list[float]]] = {}
         self.q_open = self.reference(self.sigma_open)
         self.self_pairs = self._monitored_pairs()
+        self.finger_link_mask = np.zeros((len(self.fingers), hand.n_links), dtype=bool)
+        for f, (_, links) in enumerate(self.fingers):
+            self.finger_link_mask[f, list(links)] = True
         self.long_fingers = {f for f, name in enumerate(FINGERS) if name in _LONG_FINGERS}
 
     def close(self) -> None:
@@ -83,48 +87,56 @@ class KinematicClosure:
         """q_r(σ), rad (``SynergyPath.reference``)."""
         return self.path.reference(sigma)
 
-    def _finger_reach(self) -> NDArray:
-        """Per finger, an upper bound (mm) on the distance of any point of its links from any
-        of its joint axes: the extended chain (q = 0) from the finger's first axis, plus radius."""
+    def _joint_reach(self) -> NDArray:
+        """Per joint, an upper bound (mm) on the distance of any point of the links it moves
+        from its axis: from the joint's first axis to the farthest shape point of its link
+        and the links distal to it in the extended chain (q = 0, where a chain is longest),
+        plus one rolling gap (a joint's first axis sits that far before its link frame)."""
         from synergrasp.hand.kinematics import forward_kinematics
 
-        frames = forward_kinematics(self.hand, np.zeros(self.hand.n_joints))
-        reach = np.zeros(len(self.fingers))
-        for f, (_, links) in enumerate(self.fingers):
-            base = frames[links[0], :3, 3]
-            r = 0.0
-            for link in links:
-                for shape in self.hand.link_shapes[link]:
-                    centre = frames[link] @ shape.pose
-                    half = 0.5 * shape.length if shape.kind == "capsule" else 0.5 * float(np.linalg.norm(shape.size))
-                    ext = half + shape.radius
-                    r = max(r, float(np.linalg.norm(centre[:3, 3] - base)) + ext)
-            reach[f] = r + 10.0  # the first axis sits up to one rolling gap before the base frame
+        hand = self.hand
+        frames = forward_kinematics(hand, np.zeros(hand.n_joints))
+        reach = np.zeros(hand.n_joints)
+        for joints, links in self.fingers:
+            for i, (joint, link) in enumerate(zip(joints, links)):
+                base = frames[link, :3, 3]
+                r = 0.0
+                for distal in links[i:]:
+                    for shape in hand.link_shapes[distal]:
+                        centre = frames[distal] @ shape.pose
+                        half = 0.5 * shape.length if shape.kind == "capsule" else 0.5 * float(np.linalg.norm(shape.size))
+                        r = max(r, float(np.linalg.norm(centre[:3, 3] - base)) + half + shape.radius)
+                reach[joint] = r + 10.0
         return reach
 
     def _monitored_pairs(self) -> tuple[tuple[int, int], ...]:
-        """Hand–hand pairs checked during the closure: a finger link against the palm or
-        against a link of another finger, except the knuckles (they barely move) and pairs
-        already overlapping at the open posture (a property of the model, not an event)."""
+        """Hand–hand pairs checked during the closure: a finger link against the palm, the
+        thumb or a neighbouring long finger (the long fingers lie side by side: one cannot
+        reach a finger beyond its neighbour without touching the neighbour), except the
+        knuckles (they barely move) and pairs already overlapping at the open posture (a
+        property of the model, not an event)."""
         hand = self.hand
         pairs = []
+        order = {name: k for k, name in enumerate(_LONG_FINGERS)}
         for i, j in bullet.self_collision_pairs(hand):
-            if hand.link_finger[i] == hand.link_finger[j]:
+            fi, fj = hand.link_finger[i], hand.link_finger[j]
+            if fi == fj:
                 continue
+            if fi in order and fj in order and abs(order[fi] - order[fj]) > 1:
+                continue  # long fingers side by side: only neighbours can touch
             if any(hand.link_names[k].endswith("_knuckle") for k in (i, j)):
                 continue
             pairs.append((i, j))
         self.scene.set_posture(self.q_open)
-        overlap = bullet.self_closest_points(self.scene.client, self.scene.body, 0.0, tuple(pairs))
-        bad = {(int(a), int(b)) for a, b, d in zip(overlap.link_a, overlap.link_b, overlap.distance) if d < 0}
-        return tuple(p for p in pairs if p not in bad and (p[1], p[0]) not in bad)
+        gaps = self.scene.pair_distances(tuple(pairs))
+        return tuple(p for p, gap in zip(pairs, gaps) if gap >= 0.0)
 
     # -- the closure ------------------------------------------------------------------------
-    def _travel_profile(self, f: int, moving: tuple[int, ...]) -> tuple[NDArray, NDArray]:
+    def _travel_profile(self, f: int, moving: tuple[int, ...]) -> tuple[list[float], list[float]]:
         """Knots σ_k on [σ_open, σ_closed] and the travel bound T(σ_k) (mm) accumulated from
         σ_open by any point of finger f when only the joints ``moving`` follow the reference.
 
-        T is piecewise linear: joint j adds |S1_j| · reach(f) mm per unit σ while its
+        T is piecewise linear: joint j adds |S1_j| · reach_j mm per unit σ while its
         reference is inside its limits (a clipped joint does not move). Cached per
         (finger, moving joints): there are only a few such sets per finger.
         """
@@ -134,12 +146,12 @@ class KinematicClosure:
             p = self.params
             idx = list(moving)
             lo, hi = self.active_lo[idx], self.active_hi[idx]
-            rate = np.abs(self.s1[idx]) * self.reach[f]  # mm per unit σ while active
+            rate = np.abs(self.s1[idx]) * self.reach[idx]  # mm per unit σ while active
             knots = np.unique(np.clip(np.concatenate([lo, hi, [self.sigma_open, self.sigma_closed]]),
                                       self.sigma_open, self.sigma_closed))
             mids = 0.5 * (knots[:-1] + knots[1:])
             speed = np.array([float(np.sum(rate[(lo <= m) & (hi >= m)])) for m in mids])
-            profile = (knots, np.concatenate([[0.0], np.cumsum(speed * np.diff(knots))]))
+            profile = (knots.tolist(), np.concatenate([[0.0], np.cumsum(speed * np.diff(knots))]).tolist())
             self._profiles[key] = profile
         return profile
 
@@ -147,15 +159,18 @@ class KinematicClosure:
         """Largest σ' ≤ σ_closed such that no point of finger f travels more than
         budget_mm[f] on [σ, σ'] (clipped joints do not move; held joints do not move)."""
         best = self.sigma_closed
+        held_list = held.tolist()
         for f, (joints, _) in enumerate(self.fingers):
-            moving = tuple(j for j in joints if not held[j])
+            moving = tuple(j for j in joints if not held_list[j])
             if not moving:
                 continue
-            knots, travel = self._travel_profile(f, moving)
-            level = float(np.interp(sigma, knots, travel)) + budget_mm[f]
+            knots, travel = self._travel_profile(f, moving)  # Python lists: scalar work is cheaper
+            i = min(max(bisect_right(knots, sigma), 1), len(knots) - 1)
+            level = travel[i - 1] + (sigma - knots[i - 1]) / (knots[i] - knots[i - 1]) * (travel[i] - travel[i - 1])
+            level += float(budget_mm[f])
             if level > travel[-1]:
                 continue  # the budget outlasts the closure
-            k = int(np.searchsorted(travel, level, side="left"))  # travel[k-1] < level <= travel[k]
+            k = bisect_left(travel, level)  # travel[k-1] < level <= travel[k]
             t0, t1 = travel[k - 1], travel[k]
             best = min(best, knots[k - 1] + (level - t0) / (t1 - t0) * (knots[k] - knots[k - 1]))
         return best
@@ -166,12 +181,10 @@ class KinematicClosure:
     def gaps(self, q: NDArray, moving_links: NDArray, pairs: tuple[tuple[int, int], ...],
              margin_mm: float) -> _Gaps:
         """Per moving link: distance to the box and to the monitored hand links (and which),
-        at posture q (mm; +inf for links that do not move)."""
-        self.scene.set_posture(q)
-        d_obj = self.scene.object_distance(margin_mm)
-        d_self, partner = self.scene.self_distance(pairs, margin_mm)
-        d_obj[~moving_links] = np.inf
-        d_self[~moving_links] = np.inf
+        at posture q (mm; +inf for links that do not move and beyond ``margin_mm``)."""
+        d_obj, d_self, partner = self.scene.posture_gaps(q, pairs)
+        d_obj[~moving_links | (d_obj > margin_mm)] = np.inf
+        d_self[~moving_links | (d_self > margin_mm)] = np.inf
         return _Gaps(q, d_obj, d_self, partner)
 
     def run(self) -> tuple[NDArray, list[str], bool]:
@@ -222,11 +235,8 @@ class KinematicClosure:
     def _budget(self, gaps: _Gaps) -> NDArray:
         """Travel budget (mm) per finger for the next step: max(step_mm, its free distance),
         at most the query margin; hand gaps count half (both links may move)."""
-        budget = np.full(len(self.fingers), self.params.step_mm)
-        for f, (_, links) in enumerate(self.fingers):
-            free = min(float(np.min(gaps.d_obj[list(links)])), 0.5 * float(np.min(gaps.d_self[list(links)])))
-            budget[f] = max(self.params.step_mm, min(free, _QUERY_MARGIN_MM))
-        return budget
+        free = np.min(np.where(self.finger_link_mask, np.minimum(gaps.d_obj, 0.5 * gaps.d_self), np.inf), axis=1)
+        return np.maximum(self.params.step_mm, np.minimum(free, _QUERY_MARGIN_MM))
 
     def _refine(self, sigma: float, now: _Gaps, sigma_next: float, after: _Gaps, state: _HoldState,
                 mv: NDArray, pairs: tuple[tuple[int, int], ...]) -> tuple[float, _Gaps]:

@@ -9,15 +9,20 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from synergrasp.hand.kinematics import axis_rotation
 
-__all__ = ["ROTATION_ORDERS", "FINGER_AXIS", "Placement", "PoseGrid", "ObjectPose", "pose_grid", "object_pose"]
+if TYPE_CHECKING:  # pragma: no cover
+    from synergrasp.hand.kinematics import Hand
+
+__all__ = ["ROTATION_ORDERS", "PLACEMENT_MODES", "palm_centre", "approach_line", "FINGER_AXIS", "Placement", "PoseGrid", "ObjectPose", "pose_grid", "object_pose"]
 
 ROTATION_ORDERS: tuple[str, ...] = ("alpha_then_beta", "beta_then_alpha")
+PLACEMENT_MODES: tuple[str, ...] = ("approach", "fixed")
 
 #: Long-finger axis of the palm frame (β rotates about it).
 FINGER_AXIS = np.array([0.0, 0.0, 1.0])
@@ -41,10 +46,17 @@ def _range_deg(start: float, stop: float, step: float, name: str) -> NDArray:
 
 @dataclass(frozen=True)
 class Placement:
-    """Where the box sits relative to the palm before and while it is rotated.
+    """Where the box sits relative to the palm (docs/closure.md).
 
-    center_mm:      box centre o in the palm frame (mm); α and β rotate about it, so it
-                    is the same for every pose.
+    mode:           ``approach`` (default): the box, turned by (α, β), comes along the palm
+                    normal toward ``approach_point_mm`` until it is ``clearance_mm`` from the
+                    open hand (``HandScene.bring_box``), so it never intersects the open hand.
+                    ``fixed``: the box centre is ``center_mm`` at every pose.
+    approach_point_mm: the point of the palm the box comes toward (palm frame, mm); None =
+                    the centre of the palm's face (:func:`palm_centre`).
+    clearance_mm:   gap (mm, ≥ 0) left between the box and the open hand in ``approach`` mode.
+    center_mm:      ``fixed`` mode: box centre o in the palm frame (mm); α and β rotate
+                    about it, so it is the same for every pose.
     box_axes:       ``box_axes[k]`` is the index (into ``size_mm``) of the box edge that
                     lies along palm axis k (x = palm normal, y, z = long fingers) at
                     α = β = 0; a permutation of (0, 1, 2).
@@ -55,6 +67,9 @@ class Placement:
     alpha_deg, beta_deg: (start, stop, step) of the inclusive grids, deg; α is periodic.
     """
 
+    mode: str = "approach"
+    approach_point_mm: tuple[float, float, float] | None = None
+    clearance_mm: float = 0.0
     center_mm: tuple[float, float, float] = (38.0, 5.0, 112.0)
     box_axes: tuple[int, int, int] = (0, 1, 2)
     rotation_order: str = "alpha_then_beta"
@@ -62,6 +77,17 @@ class Placement:
     beta_deg: tuple[float, float, float] = (-60.0, 60.0, 5.0)
 
     def __post_init__(self) -> None:
+        if self.mode not in PLACEMENT_MODES:
+            raise ValueError(f"placement.mode must be one of {list(PLACEMENT_MODES)}, got {self.mode!r}")
+        if self.approach_point_mm is not None:
+            point = tuple(float(v) for v in self.approach_point_mm)
+            if len(point) != 3 or not all(math.isfinite(v) for v in point):
+                raise ValueError(f"placement.approach_point_mm must be 3 finite numbers (mm) or null, "
+                                 f"got {self.approach_point_mm!r}")
+            object.__setattr__(self, "approach_point_mm", point)
+        if not (isinstance(self.clearance_mm, (int, float)) and 0.0 <= self.clearance_mm <= 50.0):
+            raise ValueError(f"placement.clearance_mm must be a number in [0, 50] mm, got {self.clearance_mm!r}")
+        object.__setattr__(self, "clearance_mm", float(self.clearance_mm))
         center = tuple(float(v) for v in self.center_mm)
         if len(center) != 3 or not all(math.isfinite(v) for v in center):
             raise ValueError(f"Placement.center_mm must be 3 finite numbers (mm), got {self.center_mm!r}")
@@ -179,3 +205,33 @@ def object_pose(placement: Placement, size_mm: Sequence[float], alpha_deg: float
     Rb = axis_rotation(FINGER_AXIS, math.radians(beta_deg))
     R = Rb @ Ra @ R0 if placement.rotation_order == "alpha_then_beta" else Ra @ Rb @ R0
     return ObjectPose(np.array(placement.center_mm, dtype=float), R, size / 2.0)
+
+
+def palm_centre(hand: Hand) -> NDArray:
+    """The centre of the palm's face (palm frame, mm): the centre of the palm link's
+    collision shapes' bounding box, moved along the palm normal onto their outermost
+    point. The default approach point (docs/closure.md: where a hand takes an object it
+    holds against the palm; a property of the hand alone)."""
+    corners = []
+    for shape in hand.link_shapes[0]:
+        if shape.kind == "box":
+            signs = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], dtype=float)
+            local = 0.5 * signs * shape.size
+        else:
+            r = shape.radius
+            ends = np.array([[0.0, 0.0, -0.5 * shape.length], [0.0, 0.0, 0.5 * shape.length]])
+            local = np.concatenate([ends + d for d in r * np.vstack([np.eye(3), -np.eye(3)])])
+        corners.append(local @ shape.pose[:3, :3].T + shape.pose[:3, 3])
+    if not corners:
+        raise ValueError("the hand's palm has no collision shape: give placement.approach_point_mm")
+    pts = np.vstack(corners)
+    n = _unit(hand.palm_normal)
+    centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    return centre + (float(np.max(pts @ n)) - float(centre @ n)) * n
+
+
+def approach_line(placement: Placement, hand: Hand) -> tuple[NDArray, NDArray]:
+    """The approach point (mm) and the unit direction from the palm outward (the palm
+    normal): the box centre moves on point + t·direction toward the palm."""
+    point = palm_centre(hand) if placement.approach_point_mm is None else np.asarray(placement.approach_point_mm)
+    return np.asarray(point, dtype=float), _unit(hand.palm_normal)

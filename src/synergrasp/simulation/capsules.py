@@ -1,0 +1,348 @@
+"""The hand as capsules and boxes: forward kinematics and exact distances (compiled, mm).
+
+The shipped hand is a palm box and one capsule per finger link (docs/hand.md). The
+kinematic closure asks, at every posture it tries, how far each link is from the box and
+from the hand links it may run into; the closed forms here answer for all of them at once
+on the exact shapes (the box has no collision margin, so contact points lie on its
+surface). They are compiled with numba (cached next to the source, like the batched
+solver): a posture costs a few microseconds instead of the milliseconds of a collision
+library's per-pair queries. Signed distances: negative = overlap (a capsule crossing a
+box: minus its deepest penetration among the breaks, the pieces' middles and nine points
+of its axis; the closure only needs the sign there).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numba
+import numpy as np
+from numpy.typing import NDArray
+
+if TYPE_CHECKING:  # pragma: no cover
+    from synergrasp.hand.kinematics import Hand
+
+__all__ = ["HandCapsules", "segment_segment_distance", "segment_box_distance", "capsule_box", "pair_gaps",
+           "nearest_per_link", "posture_gaps"]
+
+_EPS = 1e-12
+_FLAT_MM2 = 1e-9  # squared distances (mm²) this close count as equal (flat stretch of a segment)
+
+
+@numba.njit(cache=True)
+def _dot(a0: float, a1: float, a2: float, b0: float, b1: float, b2: float) -> float:
+    return a0 * b0 + a1 * b1 + a2 * b2
+
+
+@numba.njit(cache=True)
+def _seg_seg(p0: NDArray, p1: NDArray, q0: NDArray, q1: NDArray) -> float:
+    """Distance (mm) between segments p0–p1 and q0–q1: the clamped closed form."""
+    d10, d11, d12 = p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]
+    d20, d21, d22 = q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]
+    r0, r1, r2 = p0[0] - q0[0], p0[1] - q0[1], p0[2] - q0[2]
+    a, e = _dot(d10, d11, d12, d10, d11, d12), _dot(d20, d21, d22, d20, d21, d22)
+    f, c = _dot(d20, d21, d22, r0, r1, r2), _dot(d10, d11, d12, r0, r1, r2)
+    b = _dot(d10, d11, d12, d20, d21, d22)
+    denom = a * e - b * b
+    s = 0.0
+    if denom > _EPS * max(a * e, 1.0):
+        s = min(max((b * f - c * e) / denom, 0.0), 1.0)
+    t = (b * s + f) / e if e > _EPS else 0.0
+    if t < 0.0:
+        t = 0.0
+        s = min(max(-c / a, 0.0), 1.0) if a > _EPS else 0.0
+    elif t > 1.0:
+        t = 1.0
+        s = min(max((b - c) / a, 0.0), 1.0) if a > _EPS else 0.0
+    g0, g1, g2 = r0 + s * d10 - t * d20, r1 + s * d11 - t * d21, r2 + s * d12 - t * d22
+    return np.sqrt(_dot(g0, g1, g2, g0, g1, g2))
+
+
+@numba.njit(cache=True)
+def _sq_excess(p0: NDArray, d: NDArray, half: NDArray, t: float) -> float:
+    total = 0.0
+    for i in range(3):
+        e = abs(p0[i] + t * d[i]) - half[i]
+        if e > 0.0:
+            total += e * e
+    return total
+
+
+@numba.njit(cache=True)
+def _depth(p0: NDArray, d: NDArray, half: NDArray, t: float) -> float:
+    slack = np.inf
+    for i in range(3):
+        slack = min(slack, half[i] - abs(p0[i] + t * d[i]))
+    return slack
+
+
+@numba.njit(cache=True)
+def _seg_box(p0: NDArray, p1: NDArray, half: NDArray) -> tuple[float, float]:
+    """See ``_seg_box_into`` (allocates its own work arrays)."""
+    return _seg_box_into(p0, p1 - p0, half, np.empty(8))
+
+
+@numba.njit(cache=True)
+def _seg_box_into(p0: NDArray, d: NDArray, half: NDArray, knots: NDArray) -> tuple[float, float]:
+    """Signed distance (mm) from segment p0–p1 (box frame) to the box [-half, half] and the
+    segment parameter t in [0, 1] attaining it. The squared distance along the segment is
+    convex and piecewise quadratic with breaks where a coordinate crosses ±half: its
+    minimum is at a break, an end, or the vertex of one piece. ``d`` = p1 − p0; ``knots`` is
+    work space of 8 values."""
+    knots[0], knots[1] = 0.0, 1.0
+    n = 2
+    for i in range(3):
+        if abs(d[i]) > _EPS:
+            for k in range(2):
+                tb = ((half[i] if k == 0 else -half[i]) - p0[i]) / d[i]
+                if 0.0 < tb < 1.0:
+                    knots[n] = tb
+                    n += 1
+    for k in range(1, n):  # insertion sort of at most 8 values
+        v, j = knots[k], k - 1
+        while j >= 0 and knots[j] > v:
+            knots[j + 1] = knots[j]
+            j -= 1
+        knots[j + 1] = v
+    best_sq, best_t = np.inf, 0.0
+    for k in range(n):
+        sq = _sq_excess(p0, d, half, knots[k])
+        if sq < best_sq:
+            best_sq, best_t = sq, knots[k]
+    for k in range(n - 1):
+        lo, hi = knots[k], knots[k + 1]
+        mid = 0.5 * (lo + hi)
+        num, den = 0.0, 0.0
+        for i in range(3):
+            x = p0[i] + mid * d[i]
+            if x > half[i] or x < -half[i]:
+                a = p0[i] - (half[i] if x > 0.0 else -half[i])
+                num -= a * d[i]
+                den += d[i] * d[i]
+        tv = min(max(num / den, lo), hi) if den > _EPS else mid
+        sq = _sq_excess(p0, d, half, tv)
+        if sq < best_sq:
+            best_sq, best_t = sq, tv
+    if best_sq > 0.0:
+        # a segment parallel to a face or edge is nearest along an interval (bounded by
+        # knots): take its middle, which does not depend on the box's own axes
+        t_lo, t_hi = best_t, best_t
+        for k in range(n):
+            if _sq_excess(p0, d, half, knots[k]) <= best_sq + _FLAT_MM2:
+                t_lo, t_hi = min(t_lo, knots[k]), max(t_hi, knots[k])
+        return np.sqrt(best_sq), 0.5 * (t_lo + t_hi)
+    deepest, at = 0.0, best_t  # crossing the box: minus the deepest penetration found
+    for k in range(2 * n):
+        tc = knots[k // 2] if k % 2 == 0 else 0.5 * (knots[k // 2] + knots[min(k // 2 + 1, n - 1)])
+        dep = _depth(p0, d, half, tc)
+        if dep > deepest:
+            deepest, at = dep, tc
+    for j in range(9):
+        dep = _depth(p0, d, half, j / 8.0)
+        if dep > deepest:
+            deepest, at = dep, j / 8.0
+    return -deepest, at
+
+
+@numba.njit(cache=True)
+def segment_box_distance(p0: NDArray, p1: NDArray, half: NDArray) -> tuple[NDArray, NDArray]:
+    """Signed distances (k,) from segments p0–p1 ((k, 3), each in its box's frame) to the
+    boxes [-half, half] ((k, 3)), and the segment parameters (k,) attaining them."""
+    k = p0.shape[0]
+    dist, t = np.empty(k), np.empty(k)
+    for i in range(k):
+        dist[i], t[i] = _seg_box(p0[i], p1[i], half[i])
+    return dist, t
+
+
+@numba.njit(cache=True)
+def segment_segment_distance(p0: NDArray, p1: NDArray, q0: NDArray, q1: NDArray) -> NDArray:
+    """(k,) distances (mm) between the segments p0–p1 and q0–q1 ((k, 3) each)."""
+    out = np.empty(p0.shape[0])
+    for i in range(p0.shape[0]):
+        out[i] = _seg_seg(p0[i], p1[i], q0[i], q1[i])
+    return out
+
+
+@numba.njit(cache=True)
+def _frames(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: NDArray,
+            scale: NDArray) -> NDArray:
+    """(n_frames, 4, 4) frame transforms at q (the same chain as ``hand.frame_transforms``)."""
+    n = parent.shape[0]
+    out = np.empty((n, 4, 4))
+    out[0] = np.eye(4)
+    rot, local = np.empty((3, 3)), np.empty((4, 4))
+    for f in range(1, n):
+        angle = scale[f] * q[joint[f]]
+        c, s = np.cos(angle), np.sin(angle)
+        x, y, z = axis[f, 0], axis[f, 1], axis[f, 2]
+        v = 1.0 - c
+        rot[0, 0], rot[0, 1], rot[0, 2] = c + x * x * v, x * y * v - z * s, x * z * v + y * s
+        rot[1, 0], rot[1, 1], rot[1, 2] = y * x * v + z * s, c + y * y * v, y * z * v - x * s
+        rot[2, 0], rot[2, 1], rot[2, 2] = z * x * v - y * s, z * y * v + x * s, c + z * z * v
+        local[:, :] = offset[f]
+        for i in range(3):
+            for j in range(3):
+                local[i, j] = offset[f, i, 0] * rot[0, j] + offset[f, i, 1] * rot[1, j] + offset[f, i, 2] * rot[2, j]
+        top = out[parent[f]]
+        for i in range(4):
+            for j in range(4):
+                out[f, i, j] = (top[i, 0] * local[0, j] + top[i, 1] * local[1, j] + top[i, 2] * local[2, j]
+                                + top[i, 3] * local[3, j])
+    return out
+
+
+@numba.njit(cache=True)
+def _segments(frames: NDArray, cap_frame: NDArray, ends: NDArray) -> tuple[NDArray, NDArray]:
+    c = cap_frame.shape[0]
+    p0, p1 = np.empty((c, 3)), np.empty((c, 3))
+    for i in range(c):
+        f = frames[cap_frame[i]]
+        for r in range(3):
+            p0[i, r] = f[r, 0] * ends[i, 0, 0] + f[r, 1] * ends[i, 0, 1] + f[r, 2] * ends[i, 0, 2] + f[r, 3]
+            p1[i, r] = f[r, 0] * ends[i, 1, 0] + f[r, 1] * ends[i, 1, 1] + f[r, 2] * ends[i, 1, 2] + f[r, 3]
+    return p0, p1
+
+
+@numba.njit(cache=True)
+def _to_box(p: NDArray, rotation: NDArray, centre: NDArray, out: NDArray) -> None:
+    """p (palm frame) in the frame of a box at (rotation, centre): out = rotationᵀ (p − centre)."""
+    for j in range(3):
+        out[j] = ((p[0] - centre[0]) * rotation[0, j] + (p[1] - centre[1]) * rotation[1, j]
+                  + (p[2] - centre[2]) * rotation[2, j])
+
+
+@numba.njit(cache=True)
+def _capsule_to_box(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray, half: NDArray,
+                    work: NDArray) -> tuple[float, float]:
+    """Signed distance of the axis p0–p1 (palm frame) to a box at (rotation, centre) and its
+    parameter; ``work`` (4, 8) is scratch space."""
+    _to_box(p0, rotation, centre, work[0])
+    _to_box(p1, rotation, centre, work[1])
+    for i in range(3):
+        work[1, i] -= work[0, i]
+    return _seg_box_into(work[0, :3], work[1, :3], half, work[2])
+
+
+@numba.njit(cache=True)
+def capsule_box(p0: NDArray, p1: NDArray, radius: NDArray, rotation: NDArray, centre: NDArray,
+                half: NDArray) -> tuple[NDArray, NDArray]:
+    """Signed distance (c,) of every capsule to a box (palm frame pose) and the parameter of
+    the closest point of its axis."""
+    c = p0.shape[0]
+    dist, t = np.empty(c), np.empty(c)
+    work = np.empty((3, 8))
+    for i in range(c):
+        d, ti = _capsule_to_box(p0[i], p1[i], rotation, centre, half, work)
+        dist[i], t[i] = d - radius[i], ti
+    return dist, t
+
+
+@numba.njit(cache=True)
+def pair_gaps(p0: NDArray, p1: NDArray, radius: NDArray, first: NDArray, second: NDArray,
+              palm_rotation: NDArray, palm_centre: NDArray, palm_half: NDArray) -> NDArray:
+    """Signed distance (p,) of pairs of capsules (rows ``first``, ``second``); ``second`` = -1:
+    the capsule against the palm boxes (b, ...) instead."""
+    out = np.empty(first.shape[0])
+    work = np.empty((3, 8))
+    for k in range(first.shape[0]):
+        i, j = first[k], second[k]
+        if j >= 0:
+            out[k] = _seg_seg(p0[i], p1[i], p0[j], p1[j]) - radius[i] - radius[j]
+        else:
+            best = np.inf
+            for b in range(palm_half.shape[0]):
+                d, _ = _capsule_to_box(p0[i], p1[i], palm_rotation[b], palm_centre[b], palm_half[b], work)
+                best = min(best, d - radius[i])
+            out[k] = best
+    return out
+
+
+@numba.njit(cache=True)
+def nearest_per_link(gaps: NDArray, ends: NDArray, n_links: int) -> tuple[NDArray, NDArray]:
+    """Per link, the smallest gap (mm) of the pairs ``ends`` (p, 2) it belongs to and the other
+    link of that pair: (n_links,) distances (+inf where none) and partners (-1 where none)."""
+    d = np.full(n_links, np.inf)
+    partner = np.full(n_links, -1)
+    for k in range(gaps.shape[0]):
+        for side in range(2):
+            link = ends[k, side]
+            if gaps[k] < d[link]:
+                d[link], partner[link] = gaps[k], ends[k, 1 - side]
+    return d, partner
+
+
+@numba.njit(cache=True)
+def posture_gaps(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: NDArray, scale: NDArray,
+                 cap_frame: NDArray, ends: NDArray, radius: NDArray, cap_link: NDArray, palm_gap: float,
+                 box_rotation: NDArray, box_centre: NDArray, box_half: NDArray, first: NDArray, second: NDArray,
+                 pair_ends: NDArray, palm_rotation: NDArray, palm_centre: NDArray, palm_half: NDArray,
+                 n_links: int) -> tuple[NDArray, NDArray, NDArray]:
+    """Everything the closure asks at one posture q (rad), in one call: per link the signed
+    distance to the box (the palm's, ``palm_gap``, does not change with q), the distance to
+    the nearest link it is paired with and that link (mm; see ``pair_gaps``)."""
+    p0, p1 = _segments(_frames(q, parent, offset, axis, joint, scale), cap_frame, ends)
+    d_obj = np.full(n_links, np.inf)
+    d_obj[0] = palm_gap
+    dist, _ = capsule_box(p0, p1, radius, box_rotation, box_centre, box_half)
+    for i in range(cap_link.shape[0]):
+        d_obj[cap_link[i]] = dist[i]
+    gaps = pair_gaps(p0, p1, radius, first, second, palm_rotation, palm_centre, palm_half)
+    d_self, partner = nearest_per_link(gaps, pair_ends, n_links)
+    return d_obj, d_self, partner
+
+
+@dataclass(frozen=True)
+class HandCapsules:
+    """The hand as capsules (one per finger link) and the palm's boxes, with its frame tree.
+
+    ``links`` (c,) link index of each capsule; ``frame`` (c,) the frame it is attached to;
+    ``ends`` (c, 2, 3) its axis end points in that frame (mm); ``radius`` (c,) mm.
+    ``palm_rotation`` (b, 3, 3), ``palm_centre`` (b, 3), ``palm_half`` (b, 3): the palm's
+    boxes in the palm frame (mm).
+    """
+
+    hand: Hand
+    links: NDArray[np.int64]
+    frame: NDArray[np.int64]
+    ends: NDArray[np.float64]
+    radius: NDArray[np.float64]
+    palm_rotation: NDArray[np.float64]
+    palm_centre: NDArray[np.float64]
+    palm_half: NDArray[np.float64]
+
+    @classmethod
+    def of(cls, hand: Hand) -> HandCapsules:
+        """The shapes of ``hand``; ValueError unless every finger link is one capsule and the
+        palm is made of boxes (the shipped hand)."""
+        links, ends, radius = [], [], []
+        for link in range(1, hand.n_links):
+            shapes = hand.link_shapes[link]
+            if len(shapes) != 1 or shapes[0].kind != "capsule":
+                raise ValueError(f"the kinematic closure needs one capsule per finger link; link "
+                                 f"{hand.link_names[link]!r} has {[s.kind for s in shapes]}")
+            shape = shapes[0]
+            axis = 0.5 * shape.length * shape.pose[:3, 2]
+            links.append(link)
+            ends.append([shape.pose[:3, 3] - axis, shape.pose[:3, 3] + axis])
+            radius.append(shape.radius)
+        palm = hand.link_shapes[0]
+        if not palm or any(s.kind != "box" for s in palm):
+            raise ValueError("the kinematic closure needs a palm made of boxes")
+        links_arr = np.asarray(links, dtype=np.int64)
+        return cls(hand, links_arr, np.asarray(hand.link_frame, dtype=np.int64)[links_arr], np.asarray(ends),
+                   np.asarray(radius), np.stack([s.pose[:3, :3] for s in palm]),
+                   np.stack([s.pose[:3, 3] for s in palm]), np.stack([0.5 * s.size for s in palm]))
+
+    @property
+    def tree(self) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray]:
+        """The hand's frame tree as arrays (parent, offset, axis, joint, scale) for ``_frames``."""
+        h = self.hand
+        return (np.asarray(h.frame_parent, dtype=np.int64), np.ascontiguousarray(h.frame_offset),
+                np.ascontiguousarray(h.frame_axis), np.asarray(h.frame_joint, dtype=np.int64),
+                np.ascontiguousarray(h.frame_scale))
+
+    def segments(self, q: NDArray) -> tuple[NDArray, NDArray]:
+        """Axis end points (c, 3) and (c, 3) of every capsule in the palm frame at q (rad)."""
+        return _segments(_frames(np.asarray(q, dtype=float), *self.tree), self.frame, self.ends)

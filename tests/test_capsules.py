@@ -1,0 +1,60 @@
+"""Exact capsule/box distances of the closure against brute-force sampling and the hand's own kinematics."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from synergrasp.hand.kinematics import forward_kinematics
+from synergrasp.simulation.capsules import HandCapsules, segment_box_distance, segment_segment_distance
+
+RNG = np.random.default_rng(7)
+
+
+def _segments(k: int, spread: float = 40.0, length: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
+    p0 = RNG.normal(size=(k, 3)) * spread
+    return p0, p0 + RNG.normal(size=(k, 3)) * length
+
+
+def test_segment_box_distance_matches_dense_sampling():
+    p0, p1 = _segments(400)
+    half = np.abs(RNG.normal(size=(400, 3))) * 20 + 2
+    dist, t = segment_box_distance(p0, p1, half)
+    ts = np.linspace(0.0, 1.0, 20001)
+    for i in range(len(p0)):
+        x = p0[i] + ts[:, None] * (p1[i] - p0[i])
+        sampled = np.linalg.norm(np.maximum(np.abs(x) - half[i], 0.0), axis=1).min()
+        if sampled > 1e-6:  # outside: exact, and t attains it
+            assert abs(dist[i] - sampled) < 1e-5
+            at = p0[i] + t[i] * (p1[i] - p0[i])
+            assert abs(np.linalg.norm(np.maximum(np.abs(at) - half[i], 0.0)) - dist[i]) < 1e-9
+        else:  # crossing: minus a penetration depth, at most the deepest of the segment's points
+            depth = np.max(np.min(half[i] - np.abs(x), axis=1))  # sampled: within 1e-3 mm of the true one
+            assert -depth - 1e-3 <= dist[i] < 0.0
+
+
+def test_segment_segment_distance_matches_dense_sampling():
+    p0, p1 = _segments(200)
+    q0, q1 = _segments(200, spread=30.0)
+    exact = segment_segment_distance(p0, p1, q0, q1)
+    s = np.linspace(0.0, 1.0, 801)
+    for i in range(len(p0)):
+        a = p0[i] + s[:, None] * (p1[i] - p0[i])
+        b = q0[i] + s[:, None] * (q1[i] - q0[i])
+        sampled = np.min(np.linalg.norm(a[:, None] - b[None], axis=2))
+        assert exact[i] <= sampled + 1e-9 and sampled - exact[i] < 0.1
+    parallel = segment_segment_distance(np.array([[0.0, 0, 0]]), np.array([[10.0, 0, 0]]),
+                                        np.array([[5.0, 3, 0]]), np.array([[15.0, 3, 0]]))
+    np.testing.assert_allclose(parallel, [3.0])
+
+
+def test_capsule_segments_follow_the_hands_forward_kinematics(hand):
+    caps = HandCapsules.of(hand)
+    for q in (np.zeros(hand.n_joints), 0.5 * (hand.lower + hand.upper), hand.upper):
+        p0, p1 = caps.segments(q)
+        frames = forward_kinematics(hand, q)
+        for row, link in enumerate(caps.links):
+            (shape,) = hand.link_shapes[link]
+            pose = frames[link] @ shape.pose
+            half = 0.5 * shape.length * pose[:3, 2]
+            np.testing.assert_allclose(p0[row], pose[:3, 3] - half, atol=1e-9)
+            np.testing.assert_allclose(p1[row], pose[:3, 3] + half, atol=1e-9)
