@@ -289,7 +289,7 @@ def test_step_params_are_built_from_the_steps_own_keys_only():
         assert step_params(full, step, obj) == step_params(step_config(full, step, obj), step, obj) or step in (
             "simulate", "fig2")  # Box compares arrays by value below
     sim = step_params(step_config(full, "simulate", "obj4"), "simulate", "obj4")
-    assert sim.placement.center_mm == (90.0, 5.0, 112.0) and sim.placement.box_axes == (1, 0, 2)
+    assert sim.placement.mode == "approach" and sim.placement.box_axes == (1, 0, 2)
     assert sim.placement.alpha_deg == (-180.0, 175.0, 5.0)
     assert sim.closure.step_mm == 8.0 and sim.box.mass_kg is None
 
