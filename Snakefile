@@ -2,7 +2,7 @@
 #   snakemake -j2 figures            every table and figure of the study
 #   snakemake -j2 object_obj4        one object's own outputs (contacts, forces, minima, Fig. 4)
 #   snakemake -j2 scenario_<name>    one scenario of `scenarios:` (config/README.md); `scenarios`: all
-#   snakemake --report results/report.html
+#   snakemake --report results/report.html   (or results/report.zip)
 from snakemake.utils import min_version
 
 min_version("9.0")
@@ -13,7 +13,11 @@ min_version("9.0")
 configfile: f"{workflow.basedir}/config/config.yaml"
 
 
+report: "workflow/report/workflow.rst"
+
+
 include: "workflow/rules/common.smk"
+include: "workflow/rules/resources.smk"
 include: "workflow/rules/simulate.smk"
 include: "workflow/rules/optimise.smk"
 include: "workflow/rules/analyse.smk"

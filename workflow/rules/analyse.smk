@@ -7,10 +7,16 @@ rule local_minima:
         code=code("local_minima"),
     output:
         "{root}/objects/{object}/minima.parquet",
-    params:
-        cfg=step_cfg("minima"),
     log:
         "{root}/logs/local_minima/{object}.log",
+    benchmark:
+        "{root}/benchmarks/local_minima/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("local_minima"),
+        runtime=runtime_min("local_minima"),
+    params:
+        cfg=step_cfg("minima"),
     script:
         "../scripts/local_minima.py"
 
@@ -22,18 +28,28 @@ rule study_tables:
         code=code("study_tables"),
     output:
         **{
-            f"{t}_{ext}": report(
-                f"{{root}}/tables/{t}.{ext}", caption=f"../report/{t}.rst", category="Tables"
+            f"{t}_{ext}": (
+                report(
+                    f"{{root}}/tables/{t}.{ext}",
+                    caption=f"../report/{t}.rst",
+                    category="Tables",
+                )
+                if ext == "csv"
+                else f"{{root}}/tables/{t}.{ext}"
             )
-            if ext == "csv"
-            else f"{{root}}/tables/{t}.{ext}"
             for t in TABLES
             for ext in ("csv", "md")
         },
-    params:
-        cfg=step_cfg("tables"),
     log:
         "{root}/logs/study_tables.log",
+    benchmark:
+        "{root}/benchmarks/study_tables.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("study_tables"),
+        runtime=runtime_min("study_tables"),
+    params:
+        cfg=step_cfg("tables"),
     script:
         "../scripts/study_tables.py"
 
@@ -58,9 +74,15 @@ rule grasp_realism:
             category="Figures",
         ),
         pdf="{root}/figures/grasp_realism.pdf",
-    params:
-        cfg=step_cfg("realism"),
     log:
         "{root}/logs/grasp_realism.log",
+    benchmark:
+        "{root}/benchmarks/grasp_realism.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("grasp_realism"),
+        runtime=runtime_min("grasp_realism"),
+    params:
+        cfg=step_cfg("realism"),
     script:
         "../scripts/grasp_realism.py"

@@ -96,7 +96,11 @@ def _imported_modules(path):
     for node in ast.walk(ast.parse(Path(path).read_text())):
         if isinstance(node, ast.Import):
             found |= {a.name for a in node.names if a.name.startswith("synergrasp")}
-        elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("synergrasp"):
+        elif (
+            isinstance(node, ast.ImportFrom)
+            and node.module
+            and node.module.startswith("synergrasp")
+        ):
             found.add(node.module)
             found |= {f"{node.module}.{a.name}" for a in node.names}  # `from pkg import module`
     return found
@@ -105,15 +109,18 @@ def _imported_modules(path):
 def _module_file(name):
     """Source file of a synergrasp module or package, or None for a name that is not one."""
     rel = Path(*name.split("."))
-    for candidate in (SRC.parent / rel.with_suffix(".py"), SRC.parent / rel / "__init__.py"):
+    for candidate in (
+        SRC.parent / rel.with_suffix(".py"),
+        SRC.parent / rel / "__init__.py",
+    ):
         if candidate.is_file():
             return candidate
     return None
 
 
 def code(script):
-    """Source files whose change must rerun the rule running ``workflow/scripts/<script>.py``:
-    the synergrasp modules it imports, transitively (lazy imports inside functions
+    """Source files whose change must rerun the rule that runs ``workflow/scripts/<script>.py``,
+    i.e. the synergrasp modules it imports, transitively (lazy imports inside functions
     included), their packages' ``__init__.py``, and the lock. Derived from the code, so a
     new import cannot be missed; Snakemake itself does not track src/."""
     todo = [ROOT / "workflow" / "scripts" / f"{script}.py"]

@@ -22,10 +22,16 @@ rule fig4_force_maps:
             subcategory="{object}",
         ),
         exploded_pdf="{root}/objects/{object}/fig4_exploded.pdf",
-    params:
-        cfg=step_cfg("fig4"),
     log:
         "{root}/logs/fig4/{object}.log",
+    benchmark:
+        "{root}/benchmarks/fig4/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("fig4_force_maps"),
+        runtime=runtime_min("fig4_force_maps"),
+    params:
+        cfg=step_cfg("fig4"),
     script:
         "../scripts/fig4_force_maps.py"
 
@@ -47,10 +53,16 @@ rule fig5_hierarchy:
             category="Figures",
         ),
         force_pdf="{root}/figures/fig5b_hierarchy_force.pdf",
-    params:
-        cfg=step_cfg("fig5"),
     log:
         "{root}/logs/fig5_hierarchy.log",
+    benchmark:
+        "{root}/benchmarks/fig5_hierarchy.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("fig5_hierarchy"),
+        runtime=runtime_min("fig5_hierarchy"),
+    params:
+        cfg=step_cfg("fig5"),
     script:
         "../scripts/fig5_hierarchy.py"
 
@@ -68,12 +80,17 @@ rule fig3_rulegraph:
         ),
         pdf="results/figures/fig3_rulegraph.pdf",
         dot="results/figures/fig3_rulegraph.dot",
+    log:
+        "results/logs/fig3_rulegraph.log",
+    benchmark:
+        "results/benchmarks/fig3_rulegraph.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("fig3_rulegraph"),
+        runtime=runtime_min("fig3_rulegraph"),
     params:
-        snakefile=str(ROOT / "Snakefile"),
         # the rule graph does not depend on the configuration's values: drawn with the
         # shipped one, so that neither a config value nor a config file's path reruns it
         configfile=str(ROOT / "config" / "config.yaml"),
-    log:
-        "results/logs/fig3_rulegraph.log",
     script:
         "../scripts/fig3_rulegraph.py"

@@ -10,12 +10,16 @@ rule optimise_shard:
         user=user_files,
     output:
         temp("{root}/objects/{object}/gfo_shards/{shard}.parquet"),
-    params:
-        cfg=step_cfg("optimise"),
     log:
         "{root}/logs/optimise/{object}_{shard}.log",
     benchmark:
         "{root}/benchmarks/optimise/{object}_{shard}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("optimise_shard"),
+        runtime=runtime_min("optimise_shard"),
+    params:
+        cfg=step_cfg("optimise"),
     script:
         "../scripts/optimise_shard.py"
 
@@ -31,5 +35,11 @@ rule aggregate_gfo:
         "{root}/objects/{object}/gfo.parquet",
     log:
         "{root}/logs/aggregate_gfo/{object}.log",
+    benchmark:
+        "{root}/benchmarks/aggregate_gfo/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("aggregate_gfo"),
+        runtime=runtime_min("aggregate_gfo"),
     script:
         "../scripts/aggregate_gfo.py"

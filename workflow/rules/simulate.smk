@@ -9,12 +9,16 @@ rule simulate_contacts:
         user=user_files,
     output:
         "{root}/objects/{object}/contacts.parquet",
-    params:
-        cfg=step_cfg("simulate"),
     log:
         "{root}/logs/simulate_contacts/{object}.log",
     benchmark:
         "{root}/benchmarks/simulate_contacts/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("simulate_contacts"),
+        runtime=runtime_min("simulate_contacts"),
+    params:
+        cfg=step_cfg("simulate"),
     script:
         "../scripts/simulate_contacts.py"
 
@@ -31,10 +35,16 @@ rule fig1_synergy_postures:
             category="Figures",
         ),
         pdf="{root}/figures/fig1_synergy_postures.pdf",
-    params:
-        cfg=step_cfg("fig1"),
     log:
         "{root}/logs/fig1_synergy_postures.log",
+    benchmark:
+        "{root}/benchmarks/fig1_synergy_postures.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("fig1_synergy_postures"),
+        runtime=runtime_min("fig1_synergy_postures"),
+    params:
+        cfg=step_cfg("fig1"),
     script:
         "../scripts/fig1_synergy_postures.py"
 
@@ -52,9 +62,15 @@ rule fig2_example_grasps:
             category="Figures",
         ),
         pdf="{root}/figures/fig2_example_grasps.pdf",
-    params:
-        cfg=step_cfg("fig2"),
     log:
         "{root}/logs/fig2_example_grasps.log",
+    benchmark:
+        "{root}/benchmarks/fig2_example_grasps.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("fig2_example_grasps"),
+        runtime=runtime_min("fig2_example_grasps"),
+    params:
+        cfg=step_cfg("fig2"),
     script:
         "../scripts/fig2_example_grasps.py"

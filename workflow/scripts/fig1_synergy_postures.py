@@ -1,12 +1,12 @@
 """Fig. 1: the hand along each of the first seven synergies, sigma = -1, 0, +1."""
-from contextlib import redirect_stderr
 
 from synergrasp.config import step_params
 from synergrasp.figures.hand_figures import figure_synergy_postures
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
+from synergrasp.job_log import job_log
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+with job_log(snakemake.log[0]):
     params = step_params(snakemake.params.cfg, "fig1")
     hand = load_hand(params.hand)
     synergies = load_synergies(params.synergies, joint_names=hand.joint_names)

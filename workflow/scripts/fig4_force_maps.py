@@ -1,13 +1,13 @@
 """Fig. 4 for one object: force maps over (alpha, beta) and exploded views."""
-from contextlib import redirect_stderr
 
 import pandas as pd
 
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.config import step_params
 from synergrasp.figures.study_figures import figure_exploded_views, figure_force_maps
+from synergrasp.job_log import job_log
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+with job_log(snakemake.log[0]):
     p = step_params(snakemake.params.cfg, "fig4")
     gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), p.success)
     minima = pd.read_parquet(snakemake.input.minima)

@@ -1,12 +1,12 @@
 """Fig. 5A/5B: success rate and paired force ratio of every set {S_k, S_i, S_j}, mean over objects."""
-from contextlib import redirect_stderr
 
 import pandas as pd
 
 from synergrasp.config import step_params
 from synergrasp.figures.study_figures import FIG5B_RATIO_RANGE, figure_hierarchy
+from synergrasp.job_log import job_log
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+with job_log(snakemake.log[0]):
     p, out = step_params(snakemake.params.cfg, "fig5"), snakemake.output
     first, success = p.hierarchy_first, p.success
     matrices = pd.read_csv(snakemake.input.hierarchy)
