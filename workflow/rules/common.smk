@@ -7,7 +7,14 @@ from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from synergrasp.config import ConfigError, check_relations, scenario_configs, step_config, step_hash, synergy_problems
+from synergrasp.config import (
+    ConfigError,
+    check_relations,
+    scenario_configs,
+    step_config,
+    step_hash,
+    synergy_problems,
+)
 
 ROOT = Path(workflow.basedir)
 SRC = ROOT / "src" / "synergrasp"
@@ -44,7 +51,9 @@ OBJECTS = list(STUDY["objects"])
 # Scenarios (config/README.md): each one's outputs live under its root; the default keeps
 # results/. A per-object step's output is made once, under the root of the first scenario
 # (default first) whose step reads the same keys (synergrasp.config.step_hash), and shared.
-SCENARIO_ROOT = {name: "results" if name == "default" else f"results/scenarios/{name}" for name in SCENARIOS}
+SCENARIO_ROOT = {
+    name: "results" if name == "default" else f"results/scenarios/{name}" for name in SCENARIOS
+}
 _ROOT_SCENARIO = {root: name for name, root in SCENARIO_ROOT.items()}
 #: The file each per-object step writes under its root's objects/<object>/.
 STEP_FILES = {"simulate": "contacts.parquet", "optimise": "gfo.parquet", "minima": "minima.parquet"}
@@ -60,8 +69,11 @@ def step_file(scenario, step, obj):
     """Where ``scenario``'s output of per-object ``step`` for ``obj`` lives: under the root of
     the first scenario that reads the same keys for it."""
     key = step_hash(SCENARIOS[scenario], step, obj)
-    owner = next(name for name, cfg in SCENARIOS.items()
-                 if obj in cfg["objects"] and step_hash(cfg, step, obj) == key)
+    owner = next(
+        name
+        for name, cfg in SCENARIOS.items()
+        if obj in cfg["objects"] and step_hash(cfg, step, obj) == key
+    )
     return f"{SCENARIO_ROOT[owner]}/objects/{obj}/{STEP_FILES[step]}"
 
 
@@ -72,7 +84,9 @@ def step_input(step):
 
 def step_inputs(step):
     """Input function: every object's ``step`` output in the job's scenario."""
-    return lambda w: [step_file(_ROOT_SCENARIO[w.root], step, o) for o in scenario_config(w)["objects"]]
+    return lambda w: [
+        step_file(_ROOT_SCENARIO[w.root], step, o) for o in scenario_config(w)["objects"]
+    ]
 
 
 def step_cfg(step):
@@ -149,12 +163,18 @@ SHIPPED_DATA = sorted(str(p) for p in (SRC / "data").glob("*") if p.is_file())
 
 
 def fig4_files(root, name):
-    return [f"{root}/objects/{name}/fig4_{kind}.{ext}" for kind in ("force_maps", "exploded") for ext in ("png", "pdf")]
+    return [
+        f"{root}/objects/{name}/fig4_{kind}.{ext}"
+        for kind in ("force_maps", "exploded")
+        for ext in ("png", "pdf")
+    ]
 
 
 def object_targets(name, scenario="default"):
     """One object's outputs in a scenario: its per-object tables (wherever shared) and Fig. 4."""
-    return [step_file(scenario, step, name) for step in STEP_FILES] + fig4_files(SCENARIO_ROOT[scenario], name)
+    return [step_file(scenario, step, name) for step in STEP_FILES] + fig4_files(
+        SCENARIO_ROOT[scenario], name
+    )
 
 
 TABLES = [
@@ -175,11 +195,20 @@ def study_targets(scenario="default"):
     root = SCENARIO_ROOT[scenario]
     figures = [
         f"{root}/figures/{name}.{ext}"
-        for name in ("fig1_synergy_postures", "fig2_example_grasps",
-                     "fig5a_hierarchy_success", "fig5b_hierarchy_force", "grasp_realism")
+        for name in (
+            "fig1_synergy_postures",
+            "fig2_example_grasps",
+            "fig5a_hierarchy_success",
+            "fig5b_hierarchy_force",
+            "grasp_realism",
+        )
         for ext in ("png", "pdf")
     ]
     figures += [f"results/figures/fig3_rulegraph.{ext}" for ext in ("png", "pdf")]
-    tables = [f"{root}/tables/{t}.{ext}" for t in [*TABLES, "grasp_realism"] for ext in ("csv", "md")]
-    per_object = [f for name in SCENARIOS[scenario]["objects"] for f in object_targets(name, scenario)]
+    tables = [
+        f"{root}/tables/{t}.{ext}" for t in [*TABLES, "grasp_realism"] for ext in ("csv", "md")
+    ]
+    per_object = [
+        f for name in SCENARIOS[scenario]["objects"] for f in object_targets(name, scenario)
+    ]
     return figures + tables + per_object

@@ -82,7 +82,9 @@ RUNTIME_MARGIN, MEMORY_MARGIN = 3.0, 1.5
 
 # Sizes of the default scenario (the largest scenarios of a sweep should set their own
 # resources through a profile if they are much larger).
-N_POSES = len(grid_axis_deg(STUDY["grid"]["alpha_deg"])) * len(grid_axis_deg(STUDY["grid"]["beta_deg"]))
+N_POSES = len(grid_axis_deg(STUDY["grid"]["alpha_deg"])) * len(
+    grid_axis_deg(STUDY["grid"]["beta_deg"])
+)
 N_SETS = len(synergy_sets(STUDY["synergy_sets"]))
 SHARD_POSES = math.ceil(N_POSES / STUDY["solver"]["pose_shards"])
 CLOSURE_FACTOR = CLOSURE_COST_FACTOR.get(STUDY["closure"]["model"], CLOSURE_UNMEASURED_FACTOR)
