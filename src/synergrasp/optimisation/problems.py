@@ -1,7 +1,8 @@
 """Realistic random grasp and grasp-force problems for tests and benchmarks.
 
 Everything is deterministic from a seed. Magnitudes follow the hand: boxes of 30-100 mm,
-contact lever arms about the joints of 20-90 mm, stiffnesses and weight of method.md §4.
+contact lever arms about the joints of 20-90 mm, stiffnesses and weight of the study
+(docs/force_optimisation.md).
 Link layout used here (one link per joint, distal to proximal along a chain):
 link 0 = palm; links 1-3 = thumb (joints 0..k-1 move link k); links 4-7 index,
 8-11 middle, 12-15 ring, 16-19 little (link 4f+4+k is moved by the first k+1 joints of
