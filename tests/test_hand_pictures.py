@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from synergrasp.figures import hand_pictures as hp
-from synergrasp.figures.hand_pictures import PALM_CAMERA, SKIN, TOUCHING, BoxInPicture, Camera, hand_capsules, render
+from synergrasp.figures.hand_pictures import PALM_CAMERA, SKIN, TOUCHING, BoxInPicture, Camera, hand_shapes, render
 
 # Looking along -x (from the palm side), 100 mm wide image of 200 px: 0.5 mm per pixel.
 _CAMERA = Camera(direction=(-1.0, 0.0, 0.0), up=(0.0, 0.0, 1.0), center_mm=(0.0, 0.0, 0.0), width_mm=100.0)
@@ -45,13 +45,28 @@ def test_rotated_box_covers_its_projected_area():
     assert rays.depth[100, 100] == pytest.approx(rays.depth_of(np.array([[5.0, 0.0, 0.0]]))[0], abs=1e-6)
 
 
+def test_a_fitted_camera_frames_the_spheres_with_its_margin():
+    points = np.array([[0.0, -30.0, 10.0], [5.0, 40.0, 90.0], [-20.0, 0.0, 50.0]])
+    radii = np.array([5.0, 8.0, 0.0])
+    camera = _CAMERA.fitted(points, radii, margin_mm=4.0)
+    # Seen along -x: image right is +y, up is +z. Extents y -35 … 48, z 5 … 98 -> 93 + 2 x 4 mm wide.
+    assert camera.width_mm == pytest.approx(101.0)
+    rays = hp._Rays(camera, 202, 202)  # 0.5 mm per pixel
+    px = rays.to_image(points)
+    assert px[:, 1].min() - 8.0 / 0.5 == pytest.approx(4.0 / 0.5)  # top sphere: 8 mm radius, 4 mm margin
+    assert px[:, 0].min() - 5.0 / 0.5 == pytest.approx((101.0 - 83.0) / 2.0 / 0.5)  # centred across
+
+
 def test_the_hand_is_where_its_kinematics_puts_it(hand):
-    """At the flat posture, the pixel of every distal capsule's centre and of the palm's front
-    face shows that link."""
+    """At the flat posture, the pixel halfway between each distal link's frame origin and its
+    fingertip (hand.kinematics, independent of the drawn shapes) and the pixel of the palm
+    box's front face show that link."""
+    from synergrasp.hand.kinematics import fingertip_positions, forward_kinematics
+
     q = np.zeros(hand.n_joints)
     picture = render(hand, q, PALM_CAMERA, (200, 200))
-    caps = hand_capsules(hand, q)
-    points = [caps.ends[caps.link == link][0].mean(axis=0) for link in hand.fingertip_link]
+    frames, tips = forward_kinematics(hand, q), fingertip_positions(hand, q)
+    points = [0.5 * (frames[link][:3, 3] + tip) for link, tip in zip(hand.fingertip_link, tips)]
     links = list(hand.fingertip_link)
     points.append(np.array([9.5, -9.0, 52.0]))  # the palm box's front face (x = 9.5 mm) centre
     links.append(0)
@@ -64,8 +79,8 @@ def test_the_hand_is_where_its_kinematics_puts_it(hand):
 def test_a_touching_link_gets_the_highlight_colour(hand):
     q = np.zeros(hand.n_joints)
     index_tip = hand.link_index("index_distal")
-    centre = hand_capsules(hand, q)
-    centre = centre.ends[centre.link == index_tip][0].mean(axis=0)
+    shapes = hand_shapes(hand, q)
+    centre = shapes.ends[shapes.link == index_tip][0].mean(axis=0)
     plain = render(hand, q, PALM_CAMERA, (200, 200))
     lit = render(hand, q, PALM_CAMERA, (200, 200), touching=[index_tip])
     c, r = np.floor(lit.pixels(centre[None])[0]).astype(int)

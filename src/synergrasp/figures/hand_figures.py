@@ -13,9 +13,9 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
-from synergrasp.analysis.realism import representative_grasps
-from synergrasp.figures.hand_pictures import (BOX, GRASP_CAMERA, PALM_CAMERA, SKIN, TOUCHING, BoxInPicture, Camera,
-                                              hand_capsules, render)
+from synergrasp.analysis.realism import SIMULATED_STATUSES, representative_grasps
+from synergrasp.figures.hand_pictures import (BOX, PALM_CAMERA, SKIN, TOUCHING, BoxInPicture, Camera, box_corners,
+                                              hand_shapes, render)
 from synergrasp.figures.output import save_figure
 
 __all__ = ["figure_synergy_postures", "figure_example_grasps", "PANEL_PX"]
@@ -47,8 +47,29 @@ def _frame(axes: Sequence[Any], pictures: Sequence[Any], margin_px: float = 8.0)
         ax.set_ylim(mid_r + half, mid_r - half)
 
 
-#: A point on the palm's front face (mm, palm frame): the centre labels point away from.
-_PALM_POINT = np.array([12.0, -9.0, 45.0])
+def _palm_point(hand: Any) -> NDArray:
+    """Centre of the palm box's face toward the palm normal (mm, palm frame; the origin if the
+    palm has no box): where "palm" is written and what the other labels point away from."""
+    boxes = hand_shapes(hand, np.zeros(hand.n_joints)).boxes  # the palm does not move
+    if not boxes:
+        return np.zeros(3)
+    normal = np.asarray(hand.palm_normal, dtype=float)
+    front = [np.asarray(b.center_mm) + (np.abs(np.asarray(b.rotation).T @ normal) @ (np.asarray(b.size_mm) / 2.0)) * normal
+             for b in boxes]
+    return max(front, key=lambda p: float(p @ normal))
+
+
+def _fit(camera: Camera, hand: Any, postures: Sequence[NDArray], boxes: Sequence[BoxInPicture] = ()) -> Camera:
+    """``camera`` centred on and sized to the hand at every posture and the boxes."""
+    points, radii = [], []
+    for q in postures:
+        p, r = hand_shapes(hand, q).extent()
+        points.append(p)
+        radii.append(r)
+    for box in boxes:
+        points.append(box_corners(box))
+        radii.append(np.zeros(8))
+    return camera.fitted(np.vstack(points), np.concatenate(radii))
 
 
 def _label(ax: Any, name: str, at: NDArray, away_from: NDArray, distance: float = 0.2) -> None:
@@ -67,7 +88,7 @@ def _label(ax: Any, name: str, at: NDArray, away_from: NDArray, distance: float 
 
 def _thumb_point(hand: Any, q: ArrayLike) -> NDArray:
     """Centre of the thumb's proximal phalanx (mm): the thumb's middle, seen even when it is flexed."""
-    caps = hand_capsules(hand, np.asarray(q, dtype=float))
+    caps = hand_shapes(hand, np.asarray(q, dtype=float))
     return caps.ends[caps.link == hand.link_index("thumb_proximal")][0].mean(axis=0)
 
 
@@ -76,7 +97,7 @@ def _label_parts(ax: Any, hand: Any, q: ArrayLike, picture: Any) -> None:
     from synergrasp.hand.kinematics import fingertip_positions
 
     tips = picture.pixels(fingertip_positions(hand, np.asarray(q, dtype=float)))
-    palm = picture.pixels(_PALM_POINT[None])[0]
+    palm = picture.pixels(_palm_point(hand)[None])[0]
     _label(ax, "thumb", picture.pixels(_thumb_point(hand, q)[None])[0], palm)
     _label(ax, "index", tips[1], palm, 0.12)
     _label(ax, "little", tips[4], palm, 0.12)
@@ -101,10 +122,13 @@ def figure_synergy_postures(hand: Any, synergies: Any, png_path: str | Path, pdf
     panel = 2.35  # inches
     fig, axes = plt.subplots(n_synergies, len(sigmas), figsize=(panel * len(sigmas) + 0.4, panel * n_synergies + 0.6),
                              squeeze=False)
+    postures = [[np.clip(mean + sigma * matrix[:, k], hand.lower, hand.upper) for sigma in sigmas]
+                for k in range(n_synergies)]
+    camera = _fit(camera, hand, [q for row in postures for q in row] + [mean])
     pictures, named = [], None  # named: the first mean posture's (axes, q, picture)
     for k in range(n_synergies):
         for c, sigma in enumerate(sigmas):
-            q = np.clip(mean + sigma * matrix[:, k], hand.lower, hand.upper)
+            q = postures[k][c]
             ax = axes[k, c]
             picture = render(hand, q, camera, PANEL_PX, ghost_q=None if sigma == 0 else mean)
             pictures.append(picture)
@@ -158,11 +182,12 @@ def _legend(fig: Any) -> None:
 
 
 def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.DataFrame], png_path: str | Path,
-                          pdf_path: str | Path, n_grasps: int = 3, camera: Camera = GRASP_CAMERA) -> None:
+                          pdf_path: str | Path, n_grasps: int = 3, camera: Camera = PALM_CAMERA) -> None:
     """Fig. 2: representative simulated grasps, one row per box, chosen by rule
     (``synergrasp.analysis.realism.representative_grasps``: the most common set of touching
     links, the most common one at the typical contact count, the next most common), each at
-    its pose nearest (α, β) = (0, 0). ``tables[i]`` is the contacts table of ``boxes[i]``.
+    its pose nearest (α, β) = (0, 0), all in the view of Fig. 1. ``tables[i]`` is the contacts
+    table of ``boxes[i]``.
     Links touching the box are highlighted, contact points are dots (hollow where the hand
     hides them); the box is see-through.
     """
@@ -178,7 +203,10 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.D
                              squeeze=False)
     for r, (box, table) in enumerate(zip(boxes, tables)):
         chosen = representative_grasps(table, n_grasps)
-        simulated = int((table["status"] == "grasp").sum())
+        simulated = int(table["status"].isin(SIMULATED_STATUSES).sum())
+        rows = [table[table["pose"] == pose].iloc[0] for pose in chosen["pose"]]
+        row_camera = _fit(camera, hand, [np.asarray(row["q"], dtype=float) for row in rows],
+                          [_box_of(row, box.size_mm) for row in rows]) if rows else camera
         pictures, thumbs = [], []
         axes[r, 0].set_ylabel(f"{box.name}\n{' × '.join(f'{v:g}' for v in box.size_mm)} mm", fontsize=10)
         for c in range(n_grasps):
@@ -188,10 +216,9 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.D
                 ax.text(0.5, 0.5, "no other contact set" if c else f"no grasp with contacts\n({simulated} simulated)",
                         ha="center", va="center", transform=ax.transAxes, fontsize=8, color="0.4")
                 continue
-            pick = chosen.iloc[c]
-            row = table[table["pose"] == pick["pose"]].iloc[0]
+            pick, row = chosen.iloc[c], rows[c]
             points = np.asarray(row["contact_point"], dtype=float).reshape(-1, 3)
-            picture = render(hand, np.asarray(row["q"], dtype=float), camera, PANEL_PX,
+            picture = render(hand, np.asarray(row["q"], dtype=float), row_camera, PANEL_PX,
                              box=_box_of(row, box.size_mm), touching=pick["pattern"])
             ax.imshow(picture.rgb, interpolation="antialiased")
             pictures.append(picture)
@@ -208,7 +235,7 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.D
             _frame(axes[r, :len(pictures)], pictures)
             for ax, (picture, q) in zip(axes[r], thumbs):
                 _label(ax, "thumb", picture.pixels(_thumb_point(hand, q)[None])[0],
-                       picture.pixels(_PALM_POINT[None])[0])
+                       picture.pixels(_palm_point(hand)[None])[0])
     _legend(fig)
     fig.tight_layout(rect=(0, 0.035, 1, 1), h_pad=0.6, w_pad=0.3)
     save_figure(fig, png_path, pdf_path)

@@ -1,7 +1,7 @@
 """Shaded pictures of the hand and of a box, ray-cast from the bodies the simulation uses.
 
-The hand is what pybullet collides: a capsule per phalanx (two end-sphere centres and a
-radius, from the hand's forward kinematics) and the palm box; the object is its box. Every
+The hand is what the closure collides (``synergrasp.simulation.capsules``): a capsule per
+phalanx (axis end points and radius at the posture) and the palm box; the object is its box. Every
 pixel of an orthographic camera casts a ray and the nearest exact intersection with a
 capsule or box gives its depth, surface normal and link (a z-buffer). The picture is then
 shaded (ambient + diffuse + a little specular light from the upper left of the viewer),
@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Camera", "BoxInPicture", "HandCapsules", "Picture", "hand_capsules", "render", "SKIN", "TOUCHING",
-           "BOX", "PALM_CAMERA", "GRASP_CAMERA"]
+__all__ = ["Camera", "BoxInPicture", "HandShapes", "Picture", "hand_shapes", "box_corners", "render", "SKIN", "TOUCHING",
+           "BOX", "PALM_CAMERA"]
 
 #: Colours (r, g, b in [0, 1]): the hand, a link touching the box, the box.
 SKIN = (0.96, 0.80, 0.67)
@@ -46,6 +46,18 @@ class Camera:
     center_mm: tuple[float, float, float] = (20.0, -5.0, 85.0)
     width_mm: float = 200.0
 
+    def fitted(self, points_mm: NDArray, radii_mm: NDArray | None = None, margin_mm: float = 4.0) -> Camera:
+        """The same view, centred on and just wide enough for spheres at ``points_mm`` (n, 3)
+        of ``radii_mm`` (n,; 0 if None) plus ``margin_mm`` on every side."""
+        basis = self.basis()
+        pts = np.asarray(points_mm, dtype=float).reshape(-1, 3)
+        r = np.zeros(len(pts)) if radii_mm is None else np.asarray(radii_mm, dtype=float)
+        uv = pts @ basis[:2].T
+        lo, hi = (uv - r[:, None]).min(axis=0), (uv + r[:, None]).max(axis=0)
+        mid = 0.5 * (lo + hi)
+        center = mid[0] * basis[0] + mid[1] * basis[1] + float(np.mean(pts @ basis[2])) * basis[2]
+        return Camera(self.direction, self.up, tuple(center), float(max(hi - lo)) + 2.0 * margin_mm)
+
     def basis(self) -> NDArray:
         """Rows: image right, image up, viewing direction (unit vectors, palm frame)."""
         forward = np.asarray(self.direction, dtype=float)
@@ -57,11 +69,9 @@ class Camera:
 
 #: The palm seen from in front, a little from the little-finger side and from below, fingers
 #: up: a right hand with its thumb to the image right, as one sees one's own right hand held
-#: up with the palm toward the face. Flexing fingers come toward the viewer.
+#: up with the palm toward the face. Flexing fingers come toward the viewer. The figures fit
+#: its centre and width to what they show (``Camera.fitted``).
 PALM_CAMERA = Camera(direction=(-1.0, 0.32, 0.22), center_mm=(10.0, -2.0, 92.0), width_mm=205.0)
-#: Grasps: the same view as PALM_CAMERA, wider and centred further in front of the palm,
-#: where the boxes are.
-GRASP_CAMERA = Camera(direction=PALM_CAMERA.direction, center_mm=(35.0, -2.0, 95.0), width_mm=240.0)
 
 @dataclass(frozen=True)
 class BoxInPicture:
@@ -73,37 +83,35 @@ class BoxInPicture:
 
 
 @dataclass(frozen=True)
-class HandCapsules:
-    """The hand's shapes at a posture, palm frame, mm: ``ends`` (n, 2, 3) end-sphere centres,
-    ``radius`` (n,), ``link`` (n,) hand link of each capsule, ``boxes`` the links' boxes
-    (the palm) with their ``box_link``."""
+class HandShapes:
+    """The hand's shapes at a posture, palm frame, mm: ``ends`` (n, 2, 3) capsule axis end
+    points, ``radius`` (n,), ``link`` (n,) hand link of each capsule, ``boxes`` the palm's
+    boxes (hand link 0)."""
 
     ends: NDArray
     radius: NDArray
     link: NDArray
     boxes: tuple[BoxInPicture, ...]
-    box_link: tuple[int, ...]
+
+    def extent(self) -> tuple[NDArray, NDArray]:
+        """Points (k, 3) and radii (k,) whose spheres cover every shape (for ``Camera.fitted``)."""
+        corners = [box_corners(b) for b in self.boxes]
+        points = np.vstack([self.ends.reshape(-1, 3), *corners]) if corners else self.ends.reshape(-1, 3)
+        radii = np.concatenate([np.repeat(self.radius, 2), np.zeros(8 * len(corners))])
+        return points, radii
 
 
-def hand_capsules(hand: Any, q: NDArray) -> HandCapsules:
-    """Capsules and boxes of ``hand`` at joint angles q (rad), from its forward kinematics."""
-    from synergrasp.hand.kinematics import forward_kinematics
+def hand_shapes(hand: Any, q: NDArray) -> HandShapes:
+    """The shapes the closure collides (``synergrasp.simulation.capsules.HandCapsules``) at
+    joint angles q (rad)."""
+    from synergrasp.simulation.capsules import HandCapsules
 
-    frames = forward_kinematics(hand, np.asarray(q, dtype=float))
-    ends, radius, link, boxes, box_link = [], [], [], [], []
-    for i, shapes in enumerate(hand.link_shapes):
-        for shape in shapes:
-            pose = frames[i] @ shape.pose
-            if shape.kind == "capsule":
-                half = 0.5 * shape.length * pose[:3, 2]  # capsules lie along their local z
-                ends.append((pose[:3, 3] - half, pose[:3, 3] + half))
-                radius.append(shape.radius)
-                link.append(i)
-            else:
-                boxes.append(BoxInPicture(np.asarray(shape.size, dtype=float), pose[:3, 3].copy(), pose[:3, :3].copy()))
-                box_link.append(i)
-    return HandCapsules(np.asarray(ends, dtype=float).reshape(-1, 2, 3), np.asarray(radius, dtype=float),
-                        np.asarray(link, dtype=np.int64), tuple(boxes), tuple(box_link))
+    capsules = HandCapsules.of(hand)
+    start, end = capsules.segments(np.asarray(q, dtype=float))
+    boxes = tuple(BoxInPicture(2.0 * half, centre, rotation) for rotation, centre, half
+                  in zip(capsules.palm_rotation, capsules.palm_centre, capsules.palm_half))
+    return HandShapes(np.stack([start, end], axis=1), np.asarray(capsules.radius, dtype=float),
+                      np.asarray(capsules.links, dtype=np.int64), boxes)
 
 
 # ------------------------------------------------------------------------------ ray casting
@@ -185,7 +193,8 @@ def _cast_capsule(rays: _Rays, a: NDArray, b: NDArray, r: float, label: int) -> 
     rays.keep(rows, cols, t, normal, label)
 
 
-def _box_corners(box: BoxInPicture) -> NDArray:
+def box_corners(box: BoxInPicture) -> NDArray:
+    """(8, 3) corners of a box, mm, palm frame."""
     signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
     return (signs * np.asarray(box.size_mm, float) / 2.0) @ np.asarray(box.rotation, float).T + box.center_mm
 
@@ -193,7 +202,7 @@ def _box_corners(box: BoxInPicture) -> NDArray:
 def _cast_box(rays: _Rays, box: BoxInPicture, label: int) -> NDArray | None:
     """Nearest hit of every ray with the box (slabs); returns the face index (axis·2 + side)
     hit at each pixel of the window (-1: missed), or None when the box is out of the image."""
-    corners = rays.to_image(_box_corners(box))
+    corners = rays.to_image(box_corners(box))
     win = rays.window(corners.min(axis=0) - 1.0, corners.max(axis=0) + 1.0)
     if win is None:
         return None
@@ -218,9 +227,9 @@ def _cast_box(rays: _Rays, box: BoxInPicture, label: int) -> NDArray | None:
     return full
 
 
-def _cast_hand(rays: _Rays, caps: HandCapsules) -> None:
-    for box, link in zip(caps.boxes, caps.box_link):
-        _cast_box(rays, box, link)
+def _cast_hand(rays: _Rays, caps: HandShapes) -> None:
+    for box in caps.boxes:
+        _cast_box(rays, box, 0)
     for (a, b), r, link in zip(caps.ends, caps.radius, caps.link):
         _cast_capsule(rays, a, b, float(r), int(link))
 
@@ -290,7 +299,7 @@ def render(hand: Any, q: NDArray, camera: Camera, size_px: tuple[int, int] = (36
     """
     w, h, k = int(size_px[0]) * supersample, int(size_px[1]) * supersample, int(supersample)
     rays = _Rays(camera, w, h)
-    _cast_hand(rays, hand_capsules(hand, q))
+    _cast_hand(rays, hand_shapes(hand, q))
     basis = rays.basis
     palette = np.tile(np.asarray(SKIN), (hand.n_links, 1))
     for link in touching:
@@ -300,7 +309,7 @@ def render(hand: Any, q: NDArray, camera: Camera, size_px: tuple[int, int] = (36
     rgb[on_hand] = _shade(palette[rays.label[on_hand]], rays.normal[on_hand], basis)
     if ghost_q is not None:
         ghost = _Rays(camera, w, h)
-        _cast_hand(ghost, hand_capsules(hand, ghost_q))
+        _cast_hand(ghost, hand_shapes(hand, ghost_q))
         pale = (ghost.label >= 0) & ~on_hand
         rgb[pale] = _GHOST
         rgb[_edges(ghost.label >= 0) & ~on_hand] = 0.72
