@@ -33,7 +33,7 @@ def test_settings_name_the_key_and_allowed_values():
     with pytest.raises(ValueError, match=r"closure.dynamic.unloaded_contacts must be one of \['drop', 'keep'\]"):
         DynamicParams(unloaded_contacts="ignore")
     with pytest.raises(ValueError, match="closure.dynamic: unknown key"):
-        ClosureParams.from_config({"model": "dynamic", "dynamic": {"timestep": 0.01}})
+        ClosureParams(model="dynamic", dynamic={"timestep": 0.01})
     with pytest.raises(ValueError, match="needs the mechanics block"):
         closure_model(None, None, PARAMS)  # type: ignore[arg-type]
 
