@@ -1,18 +1,23 @@
-# Two entry points for a fresh machine with Python 3.11 (see README):
-#   make study   - build .venv from environment.lock, then run the full study
-#   make test    - build .venv from environment.lock, then run the test suite
+# Entry points for a fresh machine with Python 3.11 (see README):
+#   make venv           - build .venv from environment.lock only
+#   make study          - build .venv from environment.lock, then run the full study
+#   make test           - build .venv from environment.lock, then run the test suite
+#   make lint           - snakefmt --check and snakemake --lint (conda/container advice aside)
+#   make cluster-test   - the small study on a single-node SLURM started here (root; installs SLURM)
 PYTHON ?= python3.11
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 CORES  ?= 2
 
-.PHONY: study test bench lock report clean-venv
+.PHONY: venv study test lint cluster-test bench lock report clean-venv
 
 $(BIN)/.installed: environment.lock pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --require-hashes --no-deps -r environment.lock
 	$(BIN)/python -m pip install --quiet --no-deps --no-build-isolation -e .
 	touch $@
+
+venv: $(BIN)/.installed
 
 # Compiled solver code is cached next to the source; build it once here, not in every job.
 WARM_UP = $(BIN)/python -c "from synergrasp.optimisation.gfo import warm_up; warm_up()"
@@ -23,10 +28,19 @@ study: $(BIN)/.installed
 
 report: $(BIN)/.installed
 	$(BIN)/snakemake --report results/report.html
+	$(BIN)/snakemake --report results/report.zip
 
 test: $(BIN)/.installed
 	$(WARM_UP)
 	$(BIN)/python -m pytest; rc=$$?; if [ $$rc -eq 5 ]; then echo "no tests collected"; exit 0; fi; exit $$rc
+
+lint: $(BIN)/.installed
+	$(BIN)/snakefmt --check Snakefile workflow
+	$(BIN)/python tools/check_lint.py
+
+cluster-test: $(BIN)/.installed
+	$(WARM_UP)
+	tools/cluster_test.sh $(BIN)
 
 # One core, as the targets are stated per core.
 bench: $(BIN)/.installed

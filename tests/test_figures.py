@@ -3,7 +3,8 @@ import numpy as np
 import pandas as pd
 
 from synergrasp.figures.study_figures import (figure_exploded_views, figure_force_maps, figure_hierarchy,
-                                force_grid, parse_rulegraph, write_table)
+                                force_grid, parse_rulegraph)
+from synergrasp.tables import write_study_table
 
 
 def _gfo() -> pd.DataFrame:
@@ -44,7 +45,7 @@ def test_figures_and_tables_are_written(tmp_path):
                              "force_ratio_median": [3.0, 3000.0, np.nan]})
     figure_hierarchy(matrices, "force_ratio_median", 2, "t", ".1f", (1.0, 10.0), "ratio", tmp_path / "h.png",
                      tmp_path / "h.pdf", log_scale=True)
-    write_table(pd.DataFrame({"a": [1.23456]}), tmp_path / "t.csv", tmp_path / "t.md", title="T")
+    write_study_table(pd.DataFrame({"a": [1.23456]}), tmp_path / "t.csv", tmp_path / "t.md", title="T")
     for name in ("m.png", "m.pdf", "e.png", "e.pdf", "h.png", "h.pdf"):
         assert (tmp_path / name).stat().st_size > 1000, name
     assert (tmp_path / "t.md").read_text().startswith("# T\n")

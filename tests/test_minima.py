@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.analysis.minima import local_minima, minima_table, preserved
+from synergrasp.analysis.minima import FORCE_TIE_RTOL, local_minima, minima_table, preserved
 
 
 def ring(forces: dict[float, float], default: float = 5.0):
@@ -25,6 +25,10 @@ def test_alpha_wraps_around():
 
 def test_ties_discard_both():
     alpha, beta, force, fc = ring({0.0: 1.0, 10.0: 1.0, 100.0: 2.0})
+    got = local_minima(alpha, beta, force, fc)
+    assert alpha[got].tolist() == [100.0]
+    # forces within the optimiser's accuracy are a tie too; a clear difference is not
+    alpha, beta, force, fc = ring({0.0: 1.0, 10.0: 1.0 + 2e-6, 100.0: 2.0, 110.0: 2.0 * (1 + 1e-4)})
     got = local_minima(alpha, beta, force, fc)
     assert alpha[got].tolist() == [100.0]
 
@@ -58,6 +62,14 @@ def test_square_neighbourhood_3x3():
     assert np.flatnonzero(local_minima(*args, radius_deg=5.0)).tolist() == [0, 4, 6, 8]
 
 
+def test_copies_at_the_median_are_decided_alike():
+    """Four isolated copies of one grasp whose forces differ by round-off (1e-8): whether
+    they lie below the median must not depend on it, so all or none are minima."""
+    alpha, beta, force, fc = ring({-180.0: 3.0, -90.0: 3.0 + 1e-8, 0.0: 3.0 - 1e-8, 90.0: 3.0 + 2e-8}, default=np.nan)
+    fc = np.isfinite(force)
+    assert local_minima(alpha, beta, force, fc).sum() in (0, 4)
+
+
 def test_no_force_closure_at_all():
     alpha, beta, force, fc = ring({})
     assert not local_minima(alpha, beta, force, np.zeros_like(fc)).any()
@@ -76,13 +88,14 @@ def brute_force(alpha, beta, force, fc, radius):
     out = np.zeros(alpha.size, bool)
     median = np.median(force[fc])
     for i in range(alpha.size):
-        if not fc[i] or not force[i] < median:
+        if not fc[i] or not force[i] < median * (1 - FORCE_TIE_RTOL):
             continue
         lower_or_equal = False
         for j in range(alpha.size):
             da = abs(alpha[i] - alpha[j]) % 360
             da = min(da, 360 - da)
-            if j != i and fc[j] and da <= radius and abs(beta[i] - beta[j]) <= radius and force[j] <= force[i]:
+            near = da <= radius and abs(beta[i] - beta[j]) <= radius
+            if j != i and fc[j] and near and force[i] >= force[j] * (1 - FORCE_TIE_RTOL):
                 lower_or_equal = True
         out[i] = not lower_or_equal
     return out

@@ -3,11 +3,20 @@
 Checks every target exists and is non-empty, tables carry their documented columns and
 sane values, a second run does nothing, -j1 gives the same tables as -j2, and a broken
 config stops with the schema message and leaves earlier results untouched, and
-`snakemake --report` gathers every figure and table.
+`snakemake --report` gathers every figure and table. Then the rerun guarantees: every
+synergrasp module a job loads is among its rule's code inputs, a changed module reruns
+exactly the rules that load it, and a run killed mid-way (SIGINT, SIGKILL) reruns only
+what did not finish and ends with the same tables as an uninterrupted run.
 """
+import base64
 import hashlib
+import os
+import shutil
+import signal
 import subprocess
 import sys
+import time
+import zipfile
 from pathlib import Path
 
 import pandas as pd
@@ -20,20 +29,53 @@ SMALL = ROOT / "tests" / "config" / "small.yaml"
 pytestmark = pytest.mark.workflow
 
 
-def snakemake(workdir: Path, *args: str, configfile: Path = SMALL) -> subprocess.CompletedProcess:
-    command = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "--directory",
-               str(workdir), "--configfile", str(configfile), "--replace-workflow-config", *args]
-    return subprocess.run(command, capture_output=True, text=True, timeout=1800)
+def command(workdir: Path, *args: str, configfile: Path = SMALL, root: Path = ROOT) -> list[str]:
+    return [sys.executable, "-m", "snakemake", "-s", str(root / "Snakefile"), "--directory",
+            str(workdir), "--configfile", str(configfile), "--replace-workflow-config", *args]
+
+
+def snakemake(workdir: Path, *args: str, configfile: Path = SMALL, root: Path = ROOT,
+              env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run(command(workdir, *args, configfile=configfile, root=root), capture_output=True,
+                          text=True, timeout=1800, env=env)
 
 
 def digest(paths: list[Path]) -> dict[str, str]:
     return {str(p): hashlib.sha256(p.read_bytes()).hexdigest() for p in paths}
 
 
+# Loaded into every Python process of a run (as sitecustomize): at exit, a workflow script's
+# process writes the synergrasp source files it loaded, relative to the package's parent.
+_RECORD_MODULES = """
+import atexit, os, sys
+
+def _record():
+    script = os.path.basename(sys.argv[0]) if sys.argv else ""
+    if "/.snakemake/scripts/" not in (sys.argv[0] if sys.argv else "") or "synergrasp" not in sys.modules:
+        return
+    base = os.path.dirname(os.path.dirname(sys.modules["synergrasp"].__file__))
+    files = sorted(os.path.relpath(m.__file__, base) for name, m in list(sys.modules.items())
+                   if name.split(".")[0] == "synergrasp" and getattr(m, "__file__", None))
+    with open(os.path.join(os.environ["SYNERGRASP_RECORD_MODULES"], f"{os.getpid()}.txt"), "w") as out:
+        out.write("\\n".join([script.split(".")[-2]] + files))
+
+atexit.register(_record)
+"""
+
+
+def _recording_env(hook_dir: Path, record_dir: Path) -> dict[str, str]:
+    record_dir.mkdir()
+    (hook_dir / "sitecustomize.py").write_text(_RECORD_MODULES)
+    paths = [str(hook_dir), os.environ.get("PYTHONPATH", "")]
+    return {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in paths if p),
+            "SYNERGRASP_RECORD_MODULES": str(record_dir)}
+
+
 @pytest.fixture(scope="module")
 def run_j2(tmp_path_factory) -> Path:
     workdir = tmp_path_factory.mktemp("j2")
-    out = snakemake(workdir, "-j2", "figures")
+    hooks = tmp_path_factory.mktemp("hooks")
+    out = snakemake(workdir, "-j2", "figures", env=_recording_env(hooks, workdir / "module_records"))
     assert out.returncode == 0, out.stderr[-5000:]
     return workdir
 
@@ -119,6 +161,11 @@ def test_j1_gives_the_same_tables(run_j2, tmp_path):
     for parquet in sorted((run_j2 / "results" / "objects").rglob("*.parquet")):
         other = tmp_path / parquet.relative_to(run_j2)
         pd.testing.assert_frame_equal(pd.read_parquet(parquet), pd.read_parquet(other))
+    # figures too: Fig. 3's rule graph in a fixed order, PDFs without creation dates
+    figures = [p for p in (run_j2 / "results").rglob("*") if p.suffix in (".png", ".pdf", ".dot")]
+    assert len(figures) >= 11
+    for figure in figures:
+        assert figure.read_bytes() == (tmp_path / figure.relative_to(run_j2)).read_bytes(), figure.name
 
 
 def test_broken_config_fails_before_work_and_keeps_results(run_j2, tmp_path):
@@ -147,3 +194,186 @@ def test_report_holds_every_figure_and_table(run_j2):
                  "full_not_first7.csv", "verdict_disagreements.csv", "claims.csv", "preservation_vs_chance.csv",
                  "invariant_checks.csv", "grasp_realism.png", "grasp_realism.csv"):
         assert name in html, name
+    assert "Pisa/IIT SoftHand" in html  # the workflow's description page (report: in the Snakefile)
+    out = snakemake(run_j2, "--report", "results/report.zip")
+    assert out.returncode == 0, out.stderr[-3000:]
+    with zipfile.ZipFile(run_j2 / "results" / "report.zip") as archive:
+        names = archive.namelist()
+    assert "report/report.html" in names
+    assert any(name.endswith("fig3_rulegraph.png") for name in names)
+
+
+def planned_jobs(workdir: Path, root: Path = ROOT, env: dict[str, str] | None = None) -> dict[str, int]:
+    """Rule -> number of jobs that `snakemake -n figures` would run (its job stats table)."""
+    out = snakemake(workdir, "-n", "figures", root=root, env=env)
+    assert out.returncode == 0, out.stderr[-3000:]
+    lines = (out.stdout + out.stderr).splitlines()
+    if "Job stats:" not in lines:
+        return {}
+    jobs = {}
+    for line in lines[lines.index("Job stats:") + 3:]:
+        fields = line.split()
+        if len(fields) != 2 or fields[0] == "total":
+            break
+        jobs[fields[0]] = int(fields[1])
+    return jobs
+
+
+def declared_code_inputs(workdir: Path) -> dict[str, set[str]]:
+    """Rule -> its input files inside the synergrasp package (relative to src/), from a dry run."""
+    out = snakemake(workdir, "-n", "--forceall", "figures")
+    assert out.returncode == 0, out.stderr[-3000:]
+    declared: dict[str, set[str]] = {}
+    rule = None
+    src = str(ROOT / "src") + os.sep
+    for line in (out.stdout + out.stderr).splitlines():
+        if line.startswith(("rule ", "localrule ")) and line.endswith(":"):
+            rule = line.split()[1].rstrip(":")
+        elif rule and line.strip().startswith("input:"):
+            files = line.strip()[len("input:"):].split(", ")
+            declared.setdefault(rule, set()).update(f.strip()[len(src):] for f in files if f.strip().startswith(src))
+    return declared
+
+
+def test_code_inputs_hold_every_module_a_job_loads(run_j2):
+    """For every rule, the synergrasp files its script had in sys.modules when it ran are among
+    the rule's code inputs (lazy imports included), so editing any of them reruns the rule."""
+    declared = declared_code_inputs(run_j2)
+    loaded: dict[str, set[str]] = {}
+    for record in (run_j2 / "module_records").glob("*.txt"):
+        script, *files = record.read_text().splitlines()
+        loaded.setdefault(script, set()).update(files)
+    assert set(loaded) == {"simulate_contacts", "optimise_shard", "aggregate_gfo", "local_minima",
+                           "study_tables", "fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph",
+                           "fig4_force_maps", "fig5_hierarchy", "grasp_realism"}
+    for script, files in loaded.items():
+        assert files, script
+        assert files <= declared[script], (script, sorted(files - declared[script]))
+
+
+def _log_paths(workdir: Path) -> list[str]:
+    out = snakemake(workdir, "-n", "--forceall", "figures")
+    return [line.split(":", 1)[1].strip() for line in (out.stdout + out.stderr).splitlines()
+            if line.strip().startswith("log:")]
+
+
+def test_every_declared_log_is_written(run_j2):
+    logs = _log_paths(run_j2)
+    assert len(logs) >= 10
+    for log in logs:
+        assert (run_j2 / log.split(" (")[0]).is_file(), log
+
+
+def test_a_failed_job_has_its_traceback_in_its_log(run_j2, tmp_path):
+    shutil.copytree(run_j2 / "results", tmp_path / "results")
+    (tmp_path / "results" / "objects" / "obj1" / "gfo.parquet").write_bytes(b"not a parquet file")
+    out = snakemake(tmp_path, "-j1", "results/objects/obj1/minima.parquet")
+    assert out.returncode != 0
+    log = (tmp_path / "results" / "logs" / "local_minima" / "obj1.log").read_text()
+    assert "Traceback (most recent call last)" in log and "Parquet" in log
+
+
+@pytest.fixture(scope="module")
+def project_copy(tmp_path_factory) -> tuple[Path, Path, dict[str, str]]:
+    """A copy of the workflow and its sources (modification times kept, compiled-solver cache
+    included) and a finished run of the small config made with that copy's code."""
+    root = tmp_path_factory.mktemp("project")
+    for name in ("Snakefile", "environment.lock"):
+        shutil.copy2(ROOT / name, root / name)
+    for name in ("workflow", "src", "config", "profiles"):
+        shutil.copytree(ROOT / name, root / name, copy_function=shutil.copy2,
+                        ignore=shutil.ignore_patterns("*.egg-info"))
+    env = {**os.environ, "PYTHONPATH": str(root / "src")}
+    workdir = root / "run"
+    out = snakemake(workdir, "-j2", "figures", root=root, env=env)
+    assert out.returncode == 0, out.stderr[-5000:]
+    return root, workdir, env
+
+
+def _planned_after_edit(project_copy, module: str) -> dict[str, int]:
+    """Jobs a dry run plans after one line is added to ``module`` (the file is then restored,
+    modification time included)."""
+    root, workdir, env = project_copy
+    path = root / "src" / "synergrasp" / module
+    text, stat = path.read_text(), path.stat()
+    try:
+        path.write_text(text + "# one more line\n")
+        return planned_jobs(workdir, root=root, env=env)
+    finally:
+        path.write_text(text)
+        os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))
+
+
+FIGURE_RULES = {"fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph", "fig4_force_maps",
+                "fig5_hierarchy", "grasp_realism", "figures"}
+
+
+def test_changing_the_config_module_reruns_the_optimisation(project_copy):
+    root, workdir, env = project_copy
+    assert planned_jobs(workdir, root=root, env=env) == {}
+    planned = _planned_after_edit(project_copy, "config.py")
+    assert planned.get("optimise_shard") == 4, planned  # 2 objects x 2 shards
+    assert planned_jobs(workdir, root=root, env=env) == {}
+
+
+@pytest.mark.parametrize("module", ["figures/study_figures.py", "figures/hand_figures.py"])
+def test_changing_a_figure_module_reruns_only_figures(project_copy, module):
+    planned = _planned_after_edit(project_copy, module)
+    assert planned and set(planned) <= FIGURE_RULES, planned
+
+
+def _outputs(workdir: Path) -> dict[str, tuple[int, str]]:
+    """Every result file (logs and benchmarks aside): modification time and content digest."""
+    files = [p for p in (workdir / "results").rglob("*") if p.is_file()
+             and p.relative_to(workdir / "results").parts[0] not in ("logs", "benchmarks")]
+    return {str(p.relative_to(workdir)): (p.stat().st_mtime_ns, hashlib.sha256(p.read_bytes()).hexdigest())
+            for p in files}
+
+
+def _incomplete(workdir: Path) -> set[str]:
+    """Outputs Snakemake marked as incomplete (jobs that started and did not finish)."""
+    marks = workdir / ".snakemake" / "incomplete"
+    names = set()
+    for mark in marks.rglob("*") if marks.exists() else []:
+        if mark.is_file():  # the path, URL-safe base64, split in '@'-prefixed parts when long
+            encoded = "".join(part.lstrip("@") for part in mark.relative_to(marks).parts)
+            names.add(base64.urlsafe_b64decode(encoded).decode())
+    return names
+
+
+@pytest.mark.parametrize("kill", [signal.SIGINT, signal.SIGKILL], ids=["SIGINT", "SIGKILL"])
+def test_a_killed_run_reruns_only_what_did_not_finish(run_j2, tmp_path, kill):
+    with open(tmp_path / "killed.log", "w") as log:
+        run = subprocess.Popen(command(tmp_path, "-j2", "figures"), stdout=log, stderr=subprocess.STDOUT,
+                               start_new_session=True)
+        deadline = time.monotonic() + 900
+        while not list((tmp_path / "results" / "objects").glob("*/gfo_shards/*.parquet")):
+            assert run.poll() is None, "the run ended before its first optimisation output"
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        missing = [t for t in expected_targets() if not (tmp_path / t).exists()]
+        os.killpg(run.pid, kill)  # the whole session: Snakemake and its running jobs
+        run.wait(timeout=300)
+    assert missing, "every target existed when the run was killed"
+    assert run.returncode != 0
+    finished = _outputs(tmp_path)
+    unfinished = _incomplete(tmp_path)
+
+    rerun = snakemake(tmp_path, "-j2", "figures")
+    if kill == signal.SIGKILL:  # the lock of the killed run stays: the README says --unlock
+        assert rerun.returncode != 0 and "--unlock" in rerun.stdout + rerun.stderr
+        assert snakemake(tmp_path, "--unlock").returncode == 0
+        rerun = snakemake(tmp_path, "-j2", "figures")
+    assert rerun.returncode == 0, rerun.stderr[-5000:]
+
+    after = _outputs(tmp_path)
+    kept = {path for path in finished if path not in unfinished and path in after}
+    assert kept, "nothing had finished before the kill"
+    for path in kept:  # finished work is not recomputed
+        assert after[path] == finished[path], path
+    for rel in missing:  # what was missing is made
+        assert (tmp_path / rel).is_file(), rel
+    for table in sorted((run_j2 / "results" / "tables").iterdir()):
+        assert table.read_bytes() == (tmp_path / "results" / "tables" / table.name).read_bytes(), table.name
+    for parquet in sorted((run_j2 / "results" / "objects").rglob("*.parquet")):
+        assert parquet.read_bytes() == (tmp_path / parquet.relative_to(run_j2)).read_bytes(), parquet

@@ -14,7 +14,8 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "write", "read", "empty"]
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "write", "read", "empty",
+           "write_study_table"]
 
 
 @dataclass(frozen=True)
@@ -167,3 +168,15 @@ def read(table: Table, path: str | Path) -> pd.DataFrame:
     frame = pd.read_parquet(path)
     _check(table, frame, str(path))
     return frame
+
+
+def write_study_table(table: pd.DataFrame, csv_path: str | Path, md_path: str | Path,
+                      title: str | None = None, floatfmt: str = ".4g") -> None:
+    """Write one of the study's result tables as CSV (full precision) and as Markdown (for
+    reading, numbers to ``floatfmt``, under the heading ``title``)."""
+    table.to_csv(csv_path, index=False)
+    text = table.to_markdown(index=False, floatfmt=floatfmt) if len(table) else "(no rows)"
+    with open(md_path, "w", encoding="utf-8") as handle:
+        if title:
+            handle.write(f"# {title}\n\n")
+        handle.write(text + "\n")

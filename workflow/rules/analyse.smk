@@ -8,11 +8,17 @@ rule local_minima:
         code=code("local_minima"),
     output:
         "results/objects/{object}/minima.parquet",
+    log:
+        "results/logs/local_minima/{object}.log",
+    benchmark:
+        "results/benchmarks/local_minima/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("local_minima"),
+        runtime=runtime_min("local_minima"),
     params:
         radius_deg=config["analyses"]["minima_radius_deg"],
         success=success_verdict(config["analyses"]),
-    log:
-        "results/logs/local_minima/{object}.log",
     script:
         "../scripts/local_minima.py"
 
@@ -24,14 +30,26 @@ rule study_tables:
         code=code("study_tables"),
     output:
         **{
-            f"{t}_{ext}": report(
-                f"results/tables/{t}.{ext}", caption=f"../report/{t}.rst", category="Tables"
+            f"{t}_{ext}": (
+                report(
+                    f"results/tables/{t}.{ext}",
+                    caption=f"../report/{t}.rst",
+                    category="Tables",
+                )
+                if ext == "csv"
+                else f"results/tables/{t}.{ext}"
             )
-            if ext == "csv"
-            else f"results/tables/{t}.{ext}"
             for t in TABLES
             for ext in ("csv", "md")
         },
+    log:
+        "results/logs/study_tables.log",
+    benchmark:
+        "results/benchmarks/study_tables.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("study_tables"),
+        runtime=runtime_min("study_tables"),
     params:
         sets=config["synergy_sets"],
         table2_k_max=config["analyses"]["table2_k_max"],
@@ -40,8 +58,6 @@ rule study_tables:
         grid=config["grid"],
         hand=config["hand"],
         g_m_per_s2=config["mechanics"]["g_m_per_s2"],
-    log:
-        "results/logs/study_tables.log",
     script:
         "../scripts/study_tables.py"
 
@@ -66,6 +82,14 @@ rule grasp_realism:
             category="Figures",
         ),
         pdf="results/figures/grasp_realism.pdf",
+    log:
+        "results/logs/grasp_realism.log",
+    benchmark:
+        "results/benchmarks/grasp_realism.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("grasp_realism"),
+        runtime=runtime_min("grasp_realism"),
     params:
         hand=config["hand"],
         full_set_id=incremental_set_id(config["synergy_sets"]["incremental_max"]),
@@ -73,7 +97,5 @@ rule grasp_realism:
             name: spec["mass_kg"] * config["mechanics"]["g_m_per_s2"]
             for name, spec in config["objects"].items()
         },
-    log:
-        "results/logs/grasp_realism.log",
     script:
         "../scripts/grasp_realism.py"

@@ -5,7 +5,13 @@ from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
-from synergrasp.config import ConfigError, incremental_set_id, merge_config, synergy_sets, validate_config
+from synergrasp.config import (
+    ConfigError,
+    incremental_set_id,
+    merge_config,
+    synergy_sets,
+    validate_config,
+)
 
 ROOT = Path(workflow.basedir)
 SRC = ROOT / "src" / "synergrasp"
@@ -26,8 +32,8 @@ def _check_inputs(cfg):
 
 
 try:
-    _check_inputs(config)
-except (ValueError, FileNotFoundError) as err:  # ConfigError, SynergyFileError, ... are ValueErrors
+    _check_inputs(config)  # ConfigError, SynergyFileError, ... are ValueErrors
+except (ValueError, FileNotFoundError) as err:
     raise WorkflowError(f"Invalid input, nothing was run:\n{err}") from None
 
 
@@ -50,7 +56,11 @@ def _imported_modules(path):
     for node in ast.walk(ast.parse(Path(path).read_text())):
         if isinstance(node, ast.Import):
             found |= {a.name for a in node.names if a.name.startswith("synergrasp")}
-        elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("synergrasp"):
+        elif (
+            isinstance(node, ast.ImportFrom)
+            and node.module
+            and node.module.startswith("synergrasp")
+        ):
             found.add(node.module)
             found |= {f"{node.module}.{a.name}" for a in node.names}  # `from pkg import module`
     return found
@@ -59,15 +69,18 @@ def _imported_modules(path):
 def _module_file(name):
     """Source file of a synergrasp module or package, or None for a name that is not one."""
     rel = Path(*name.split("."))
-    for candidate in (SRC.parent / rel.with_suffix(".py"), SRC.parent / rel / "__init__.py"):
+    for candidate in (
+        SRC.parent / rel.with_suffix(".py"),
+        SRC.parent / rel / "__init__.py",
+    ):
         if candidate.is_file():
             return candidate
     return None
 
 
 def code(script):
-    """Source files whose change must rerun the rule running ``workflow/scripts/<script>.py``:
-    the synergrasp modules it imports, transitively (lazy imports inside functions
+    """Source files whose change must rerun the rule that runs ``workflow/scripts/<script>.py``,
+    i.e. the synergrasp modules it imports, transitively (lazy imports inside functions
     included), their packages' ``__init__.py``, and the lock. Derived from the code, so a
     new import cannot be missed; Snakemake itself does not track src/."""
     todo = [ROOT / "workflow" / "scripts" / f"{script}.py"]
@@ -128,12 +141,21 @@ def object_dir(name):
 
 
 def fig4_files(name):
-    return [f"{object_dir(name)}/fig4_{kind}.{ext}" for kind in ("force_maps", "exploded") for ext in ("png", "pdf")]
+    return [
+        f"{object_dir(name)}/fig4_{kind}.{ext}"
+        for kind in ("force_maps", "exploded")
+        for ext in ("png", "pdf")
+    ]
 
 
 def object_targets(name):
     d = object_dir(name)
-    return [f"{d}/contacts.parquet", f"{d}/gfo.parquet", f"{d}/minima.parquet", *fig4_files(name)]
+    return [
+        f"{d}/contacts.parquet",
+        f"{d}/gfo.parquet",
+        f"{d}/minima.parquet",
+        *fig4_files(name),
+    ]
 
 
 TABLES = [
@@ -152,10 +174,18 @@ TABLES = [
 def study_targets():
     figures = [
         f"results/figures/{name}.{ext}"
-        for name in ("fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph",
-                     "fig5a_hierarchy_success", "fig5b_hierarchy_force", "grasp_realism")
+        for name in (
+            "fig1_synergy_postures",
+            "fig2_example_grasps",
+            "fig3_rulegraph",
+            "fig5a_hierarchy_success",
+            "fig5b_hierarchy_force",
+            "grasp_realism",
+        )
         for ext in ("png", "pdf")
     ]
-    tables = [f"results/tables/{t}.{ext}" for t in [*TABLES, "grasp_realism"] for ext in ("csv", "md")]
+    tables = [
+        f"results/tables/{t}.{ext}" for t in [*TABLES, "grasp_realism"] for ext in ("csv", "md")
+    ]
     per_object = [f for name in OBJECTS for f in object_targets(name)]
     return figures + tables + per_object

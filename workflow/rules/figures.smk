@@ -22,11 +22,17 @@ rule fig4_force_maps:
             subcategory="{object}",
         ),
         exploded_pdf="results/objects/{object}/fig4_exploded.pdf",
+    log:
+        "results/logs/fig4/{object}.log",
+    benchmark:
+        "results/benchmarks/fig4/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("fig4_force_maps"),
+        runtime=runtime_min("fig4_force_maps"),
     params:
         fig4=config["analyses"]["fig4"],
         success=success_verdict(config["analyses"]),
-    log:
-        "results/logs/fig4/{object}.log",
     script:
         "../scripts/fig4_force_maps.py"
 
@@ -48,11 +54,17 @@ rule fig5_hierarchy:
             category="Figures",
         ),
         force_pdf="results/figures/fig5b_hierarchy_force.pdf",
+    log:
+        "results/logs/fig5_hierarchy.log",
+    benchmark:
+        "results/benchmarks/fig5_hierarchy.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("fig5_hierarchy"),
+        runtime=runtime_min("fig5_hierarchy"),
     params:
         first=config["synergy_sets"]["hierarchy_first"],
         success=success_verdict(config["analyses"]),
-    log:
-        "results/logs/fig5_hierarchy.log",
     script:
         "../scripts/fig5_hierarchy.py"
 
@@ -70,10 +82,15 @@ rule fig3_rulegraph:
         ),
         pdf="results/figures/fig3_rulegraph.pdf",
         dot="results/figures/fig3_rulegraph.dot",
-    params:
-        snakefile=str(ROOT / "Snakefile"),
-        configfiles=workflow.configfiles,
     log:
         "results/logs/fig3_rulegraph.log",
+    benchmark:
+        "results/benchmarks/fig3_rulegraph.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("fig3_rulegraph"),
+        runtime=runtime_min("fig3_rulegraph"),
+    params:
+        configfiles=workflow.configfiles,
     script:
         "../scripts/fig3_rulegraph.py"

@@ -10,13 +10,17 @@ rule optimise_shard:
         user=user_files(),
     output:
         temp("results/objects/{object}/gfo_shards/{shard}.parquet"),
-    params:
-        opt=optimisation_params,
-        n_shards=len(SHARDS),
     log:
         "results/logs/optimise/{object}_{shard}.log",
     benchmark:
         "results/benchmarks/optimise/{object}_{shard}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("optimise_shard"),
+        runtime=runtime_min("optimise_shard"),
+    params:
+        opt=optimisation_params,
+        n_shards=len(SHARDS),
     script:
         "../scripts/optimise_shard.py"
 
@@ -29,5 +33,11 @@ rule aggregate_gfo:
         "results/objects/{object}/gfo.parquet",
     log:
         "results/logs/aggregate_gfo/{object}.log",
+    benchmark:
+        "results/benchmarks/aggregate_gfo/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("aggregate_gfo"),
+        runtime=runtime_min("aggregate_gfo"),
     script:
         "../scripts/aggregate_gfo.py"

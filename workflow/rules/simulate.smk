@@ -9,12 +9,16 @@ rule simulate_contacts:
         user=user_files(),
     output:
         "results/objects/{object}/contacts.parquet",
-    params:
-        sim=simulation_params,
     log:
         "results/logs/simulate_contacts/{object}.log",
     benchmark:
         "results/benchmarks/simulate_contacts/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("simulate_contacts"),
+        runtime=runtime_min("simulate_contacts"),
+    params:
+        sim=simulation_params,
     script:
         "../scripts/simulate_contacts.py"
 
@@ -31,11 +35,17 @@ rule fig1_synergy_postures:
             category="Figures",
         ),
         pdf="results/figures/fig1_synergy_postures.pdf",
+    log:
+        "results/logs/fig1_synergy_postures.log",
+    benchmark:
+        "results/benchmarks/fig1_synergy_postures.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("fig1_synergy_postures"),
+        runtime=runtime_min("fig1_synergy_postures"),
     params:
         hand=config["hand"],
         synergies=config["synergies"],
-    log:
-        "results/logs/fig1_synergy_postures.log",
     script:
         "../scripts/fig1_synergy_postures.py"
 
@@ -53,10 +63,16 @@ rule fig2_example_grasps:
             category="Figures",
         ),
         pdf="results/figures/fig2_example_grasps.pdf",
+    log:
+        "results/logs/fig2_example_grasps.log",
+    benchmark:
+        "results/benchmarks/fig2_example_grasps.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("fig2_example_grasps"),
+        runtime=runtime_min("fig2_example_grasps"),
     params:
         objects=[object_config(name) for name in OBJECTS],
         hand=config["hand"],
-    log:
-        "results/logs/fig2_example_grasps.log",
     script:
         "../scripts/fig2_example_grasps.py"

@@ -1,12 +1,12 @@
 """Fig. 3: the workflow's own rule graph, drawn from `snakemake --rulegraph`."""
 import subprocess
 import sys
-from contextlib import redirect_stderr
 
-from synergrasp.figures.study_figures import figure_rulegraph
+from synergrasp.figures.study_figures import canonical_rulegraph, figure_rulegraph
+from synergrasp.job_log import job_log
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
-    command = [sys.executable, "-m", "snakemake", "figures", "-s", snakemake.params.snakefile,
+with job_log(snakemake.log[0]) as log:
+    command = [sys.executable, "-m", "snakemake", "figures", "-s", snakemake.input.snakefile,
                "--nolock", "--quiet", "all", "--rulegraph", "dot"]
     for path in snakemake.params.configfiles:
         command += ["--configfile", str(path)]
@@ -15,7 +15,7 @@ with open(snakemake.log[0], "w") as log, redirect_stderr(log):
     run = subprocess.run(command, capture_output=True, text=True)
     log.write(run.stderr)
     run.check_returncode()
-    dot = run.stdout
+    dot = canonical_rulegraph(run.stdout)
     with open(snakemake.output.dot, "w") as handle:
         handle.write(dot)
     figure_rulegraph(dot, snakemake.output.png, snakemake.output.pdf)

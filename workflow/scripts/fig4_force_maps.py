@@ -1,12 +1,12 @@
 """Fig. 4 for one object: force maps over (alpha, beta) and exploded views."""
-from contextlib import redirect_stderr
 
 import pandas as pd
 
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.figures.study_figures import figure_exploded_views, figure_force_maps
+from synergrasp.job_log import job_log
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+with job_log(snakemake.log[0]):
     success = snakemake.params.success
     gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), success)
     minima = pd.read_parquet(snakemake.input.minima)

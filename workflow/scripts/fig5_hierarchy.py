@@ -1,11 +1,11 @@
 """Fig. 5A/5B: success rate and paired force ratio of every set {S_k, S_i, S_j}, mean over objects."""
-from contextlib import redirect_stderr
 
 import pandas as pd
 
 from synergrasp.figures.study_figures import FIG5B_RATIO_RANGE, figure_hierarchy
+from synergrasp.job_log import job_log
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+with job_log(snakemake.log[0]):
     first, out, success = snakemake.params.first, snakemake.output, snakemake.params.success
     matrices = pd.read_csv(snakemake.input.hierarchy)
     figure_hierarchy(matrices, "success_rate", first, f"Fig. 5A: success rate (%, {success}), mean over objects",

@@ -1,11 +1,11 @@
 """Local minima of the optimal force over one object's (alpha, beta) grid, every set."""
-from contextlib import redirect_stderr
 
 import pandas as pd
 
 from synergrasp.analysis.minima import minima_table
 from synergrasp.analysis.verdicts import with_verdicts
+from synergrasp.job_log import job_log
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+with job_log(snakemake.log[0]):
     gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), snakemake.params.success)
     minima_table(gfo, radius_deg=snakemake.params.radius_deg).to_parquet(snakemake.output[0], index=False)

@@ -1,14 +1,14 @@
 """Close the hand on one object at every pose of the grid; write its contacts table."""
-from contextlib import redirect_stderr
 
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
+from synergrasp.job_log import job_log
 from synergrasp.simulation.closure import ClosureParams, simulate_object
 from synergrasp.simulation.contacts import write_contacts
 from synergrasp.simulation.objects import boxes_from_config
 from synergrasp.simulation.placement import Placement
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log):
+with job_log(snakemake.log[0]):
     sim = snakemake.params.sim
     obj = dict(sim["object"])
     placement = Placement.from_config(obj.pop("placement"), sim["grid"])

@@ -1,14 +1,14 @@
 """The study's tables from every object's optimisation results and local minima."""
 import warnings
-from contextlib import redirect_stderr
 
 import pandas as pd
 
 from synergrasp.analysis.invariants import InvariantWarning
 from synergrasp.analysis.summaries import AnalysisSettings, study_tables
-from synergrasp.figures.study_figures import write_table
+from synergrasp.job_log import job_log
+from synergrasp.tables import write_study_table
 
-with open(snakemake.log[0], "w") as log, redirect_stderr(log), warnings.catch_warnings(record=True) as caught:
+with job_log(snakemake.log[0]) as log, warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always", InvariantWarning)
     p = snakemake.params
     settings = AnalysisSettings.from_config(p.analyses, p.objects, p.grid, p.hand, p.g_m_per_s2)
@@ -16,7 +16,7 @@ with open(snakemake.log[0], "w") as log, redirect_stderr(log), warnings.catch_wa
     minima = pd.concat([pd.read_parquet(path) for path in snakemake.input.minima], ignore_index=True)
     tables = study_tables(gfo, minima, p.sets, p.table2_k_max, settings)
     for name, (title, table) in tables.items():
-        write_table(table, snakemake.output[f"{name}_csv"], snakemake.output[f"{name}_md"], title=title)
+        write_study_table(table, snakemake.output[f"{name}_csv"], snakemake.output[f"{name}_md"], title=title)
     for warning in caught:  # the invariant checks on the console, everything in the log
         print(f"{warning.category.__name__}: {warning.message}", file=log)
         if issubclass(warning.category, InvariantWarning):

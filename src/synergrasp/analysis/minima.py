@@ -3,11 +3,12 @@
 Method (docs/analyses.md, method.md §5): for one object and one synergy set,
 
 1. candidates are force-closure poses whose optimal force is below the median optimal
-   force of that set's force-closure poses;
+   force of that set's force-closure poses (by more than FORCE_TIE_RTOL, relative);
 2. the neighbourhood of a pose is every *other* grid pose within ±radius in α (α is an
    angle: distances wrap around the period) and ±radius in β (no wrap);
 3. a candidate is a local minimum if no neighbour is force closure, or if its force is
-   strictly lower than the force of every force-closure neighbour (a tie discards it).
+   lower than the force of every force-closure neighbour by more than FORCE_TIE_RTOL
+   (relative; a closer force is a tie, and a tie discards it).
 
 A minimum of {S1..Sk} is *preserved* if {S1..Sk+1} has a minimum within ±radius in α
 (wrapping) and in β.
@@ -19,11 +20,15 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["local_minima", "preserved", "minima_table", "MINIMA_COLUMNS"]
+__all__ = ["local_minima", "preserved", "minima_table", "MINIMA_COLUMNS", "FORCE_TIE_RTOL"]
 
 # Grid angles are multiples of a step; the tolerance makes "within ±radius" inclusive
 # despite rounding in the stored degrees.
 _TOL_DEG = 1e-6
+#: Forces closer than this (relative) are a tie: the optimiser decides forces to about
+#: 1e-6 relative (the same grasp at α and α + period differs by up to ~2e-6), so a smaller
+#: difference must not decide which of two poses is the minimum.
+FORCE_TIE_RTOL = 1e-5
 
 MINIMA_COLUMNS = ("object", "set_id", "n_synergies", "pose", "alpha_deg", "beta_deg", "force_norm")
 
@@ -79,7 +84,7 @@ def local_minima(alpha_deg: ArrayLike, beta_deg: ArrayLike, force: ArrayLike, fo
     result = np.zeros(p, dtype=bool)
     if not fc.any():
         return result
-    candidates = np.flatnonzero(fc & (f < np.median(f[fc])))
+    candidates = np.flatnonzero(fc & (f < np.median(f[fc]) * (1.0 - FORCE_TIE_RTOL)))
     closure = np.flatnonzero(fc)
     if candidates.size == 0:
         return result
@@ -88,7 +93,7 @@ def local_minima(alpha_deg: ArrayLike, beta_deg: ArrayLike, force: ArrayLike, fo
     near &= candidates[:, None] != closure[None, :]  # a pose is not its own neighbour
     # lowest force among each candidate's force-closure neighbours (inf if none)
     lowest = np.where(near, f[closure][None, :], np.inf).min(axis=1)
-    result[candidates] = f[candidates] < lowest
+    result[candidates] = f[candidates] < lowest * (1.0 - FORCE_TIE_RTOL)
     return result
 
 

@@ -1,5 +1,5 @@
 """Figures of the study drawn from its tables: Fig. 3 (rule graph), Fig. 4 (force maps and
-exploded views), Fig. 5 (hierarchy matrices); and Markdown rendering of tables.
+exploded views), Fig. 5 (hierarchy matrices).
 
 Every figure function takes tables (pandas) and output paths, and writes PNG and PDF.
 Forces are in N; angles in deg.
@@ -23,30 +23,15 @@ from synergrasp.config import incremental_set_id  # noqa: E402
 from synergrasp.figures.output import save_figure  # noqa: E402
 
 __all__ = [
-    "write_table",
     "force_grid",
     "figure_force_maps",
     "figure_exploded_views",
     "figure_hierarchy",
     "FIG5B_RATIO_RANGE",
     "parse_rulegraph",
+    "canonical_rulegraph",
     "figure_rulegraph",
 ]
-
-
-def _save(fig: plt.Figure, png: str | Path, pdf: str | Path) -> None:
-    save_figure(fig, png, pdf, tight=True)  # same bytes on every run
-
-
-def write_table(table: pd.DataFrame, csv_path: str | Path, md_path: str | Path,
-                title: str | None = None, floatfmt: str = ".4g") -> None:
-    """Write a table as CSV (full precision) and as Markdown (for reading)."""
-    table.to_csv(csv_path, index=False)
-    text = table.to_markdown(index=False, floatfmt=floatfmt) if len(table) else "(no rows)"
-    with open(md_path, "w", encoding="utf-8") as handle:
-        if title:
-            handle.write(f"# {title}\n\n")
-        handle.write(text + "\n")
 
 
 def force_grid(gfo: pd.DataFrame, set_id: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -104,7 +89,7 @@ def figure_force_maps(gfo: pd.DataFrame, minima: pd.DataFrame, panel_k: Sequence
         ax.set_ylabel("β (deg)")
         fig.colorbar(image, ax=ax, label="log10 ‖f‖ (N)", pad=0.01)
     axes[-1, 0].set_xlabel("α (deg)")
-    _save(fig, png, pdf)
+    save_figure(fig, png, pdf, tight=True)
 
 
 def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: float,
@@ -137,7 +122,7 @@ def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: 
         ax.grid(alpha=0.3, which="both")
     ax_a.legend(fontsize=8, frameon=False)
     fig.tight_layout()
-    _save(fig, png, pdf)
+    save_figure(fig, png, pdf, tight=True)
 
 
 #: Fixed grey range of Fig. 5B: paired force ratio 1 (the full set's force, black) to 10
@@ -206,7 +191,7 @@ def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str,
             ticks = [t for t in (1, 1.5, 2, 3, 5, 7, 10, 20, 50, 100) if low <= t <= high]
             bar.set_ticks(ticks, labels=[f"{t:g}" for t in ticks])
             bar.ax.minorticks_off()
-    _save(fig, png, pdf)
+    save_figure(fig, png, pdf, tight=True)
 
 
 _NODE = re.compile(r'^\s*(\d+)\s*\[.*?label\s*=\s*"([^"]+)"')
@@ -223,6 +208,28 @@ def parse_rulegraph(dot: str) -> tuple[dict[int, str], list[tuple[int, int]]]:
         elif (match := _NODE.match(line)) is not None:
             nodes[int(match.group(1))] = match.group(2)
     return nodes, edges
+
+
+def canonical_rulegraph(dot: str) -> str:
+    """Snakemake's ``--rulegraph`` DOT text in one fixed order: nodes numbered by rule name,
+    edges sorted, header and node attributes kept. Snakemake's own numbering and edge order
+    depend on set iteration, which varies from run to run."""
+    nodes, edges = parse_rulegraph(dot)
+    new_id = {old: new for new, old in enumerate(sorted(nodes, key=lambda n: nodes[n]))}
+    header: list[str] = []
+    node_lines: dict[int, str] = {}
+    for line in dot.splitlines():
+        if _EDGE.match(line) is not None or line.strip() == "}":
+            continue
+        if (match := _NODE.match(line)) is not None:
+            old = int(match.group(1))
+            node_lines[new_id[old]] = line[:match.start(1)] + str(new_id[old]) + line[match.end(1):]
+        else:
+            header.append(line)
+    indent = "\t"
+    body = [node_lines[n] for n in sorted(node_lines)]
+    body += [f"{indent}{a} -> {b}" for a, b in sorted({(new_id[a], new_id[b]) for a, b in edges})]
+    return "\n".join(header + body + ["}"]) + "\n"
 
 
 def figure_rulegraph(dot: str, png: str | Path, pdf: str | Path) -> None:
@@ -256,4 +263,4 @@ def figure_rulegraph(dot: str, png: str | Path, pdf: str | Path) -> None:
     ax.set_xlim(-0.2, width + 0.2)
     ax.set_ylim(-n_layers + 0.4, 0.6)
     ax.axis("off")
-    _save(fig, png, pdf)
+    save_figure(fig, png, pdf, tight=True)

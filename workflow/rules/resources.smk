@@ -1,0 +1,133 @@
+# Threads, memory and run time of every job, computed from the job's size and a measured
+# cost per unit of work, so that the requests follow the config (grid, objects, synergy
+# sets, shards, closure model) instead of going stale. docs/cluster.md gives the method.
+import math
+
+from synergrasp.simulation.placement import Placement, pose_grid
+
+# Measured cost of one job: fixed wall time (s) and memory (MB) of the job itself (imports,
+# reading inputs), plus wall time and memory per unit of work. From results/benchmarks/*.tsv
+# (columns s, cpu_time and max_rss) of the default study and of tests/config/small.yaml on a
+# 2-core x86_64 machine running two jobs at a time; the slope is between the two sizes. The
+# closure's cost per pose is CPU time per pose of the closure to the end of S1 (docs/cluster.md).
+#   unit = pose (closure), pose x synergy set (optimisation, minima, Fig. 4, tables), none (figures)
+JOB_COST = {
+    "simulate_contacts": {
+        "fixed_s": 1.5,
+        "unit_s": 4.5e-2,
+        "fixed_mb": 178,
+        "unit_mb": 7.6e-3,
+    },
+    "optimise_shard": {
+        "fixed_s": 2.2,
+        "unit_s": 6.1e-5,
+        "fixed_mb": 271,
+        "unit_mb": 1.1e-3,
+    },
+    "aggregate_gfo": {
+        "fixed_s": 0.6,
+        "unit_s": 2.0e-6,
+        "fixed_mb": 134,
+        "unit_mb": 6.0e-4,
+    },
+    "local_minima": {
+        "fixed_s": 0.6,
+        "unit_s": 1.35e-5,
+        "fixed_mb": 136,
+        "unit_mb": 6.0e-4,
+    },
+    "fig4_force_maps": {
+        "fixed_s": 4.3,
+        "unit_s": 5.1e-6,
+        "fixed_mb": 257,
+        "unit_mb": 4.0e-4,
+    },
+    "study_tables": {
+        "fixed_s": 2.3,
+        "unit_s": 3.2e-6,
+        "fixed_mb": 231,
+        "unit_mb": 2.2e-4,
+    },
+    "grasp_realism": {
+        "fixed_s": 4.0,
+        "unit_s": 4.0e-6,
+        "fixed_mb": 300,
+        "unit_mb": 3.0e-4,
+    },
+    "fig1_synergy_postures": {
+        "fixed_s": 3.0,
+        "unit_s": 0.0,
+        "fixed_mb": 565,
+        "unit_mb": 0.0,
+    },
+    "fig2_example_grasps": {
+        "fixed_s": 2.3,
+        "unit_s": 0.0,
+        "fixed_mb": 311,
+        "unit_mb": 0.0,
+    },
+    "fig3_rulegraph": {"fixed_s": 5.3, "unit_s": 0.0, "fixed_mb": 380, "unit_mb": 0.0},
+    "fig5_hierarchy": {"fixed_s": 9.6, "unit_s": 0.0, "fixed_mb": 268, "unit_mb": 0.0},
+}
+# Closure cost per pose relative to the kinematic closure measured above, per closure model;
+# a model not listed is charged CLOSURE_UNMEASURED_FACTOR until its cost is measured.
+CLOSURE_COST_FACTOR = {"kinematic": 1.0, "dynamic": 1.8}
+CLOSURE_UNMEASURED_FACTOR = 20.0
+# A cold compiled-solver cache (a node whose CPU model has no cached build) compiles the
+# solver once in the job: about 50 s and 150 MB on the measuring machine.
+SOLVER_COMPILE_S, SOLVER_COMPILE_MB = 60.0, 150
+# Requests are the measured cost times a margin (slower nodes, shared file systems),
+# rounded up to whole minutes and to 100 MB.
+RUNTIME_MARGIN, MEMORY_MARGIN = 3.0, 1.5
+
+N_POSES = pose_grid(Placement.from_config(config["placement"], config["grid"])).n_poses
+N_SETS = len(SETS)
+SHARD_POSES = math.ceil(N_POSES / len(SHARDS))
+CLOSURE_FACTOR = CLOSURE_COST_FACTOR.get(
+    config["closure"].get("model", "kinematic"), CLOSURE_UNMEASURED_FACTOR
+)
+
+
+def job_size(step):
+    """Units of work of one job of rule ``step`` under the current config (see JOB_COST)."""
+    return {
+        "simulate_contacts": N_POSES * CLOSURE_FACTOR,
+        "optimise_shard": SHARD_POSES * N_SETS,
+        "aggregate_gfo": N_POSES * N_SETS,
+        "local_minima": N_POSES * N_SETS,
+        "fig4_force_maps": N_POSES * N_SETS,
+        "study_tables": len(OBJECTS) * N_POSES * N_SETS,
+        "grasp_realism": len(OBJECTS) * N_POSES * N_SETS,
+    }.get(step, 0)
+
+
+def runtime_min(step):
+    """Wall-time request of one job of rule ``step``, in whole minutes (at least 1)."""
+    cost = JOB_COST[step]
+    seconds = cost["fixed_s"] + cost["unit_s"] * job_size(step)
+    if step == "optimise_shard":
+        seconds += SOLVER_COMPILE_S
+    return max(1, math.ceil(RUNTIME_MARGIN * seconds / 60.0))
+
+
+def mem_mb(step):
+    """Memory request of one job of rule ``step``, in MB rounded up to 100 MB."""
+    cost = JOB_COST[step]
+    mb = cost["fixed_mb"] + cost["unit_mb"] * job_size(step)
+    if step == "optimise_shard":
+        mb += SOLVER_COMPILE_MB
+    return 100 * math.ceil(MEMORY_MARGIN * mb / 100.0)
+
+
+# Jobs of a few seconds and a few hundred MB for the default study run where Snakemake runs:
+# submitting them would cost more queue time than they take.
+localrules:
+    aggregate_gfo,
+    local_minima,
+    study_tables,
+    grasp_realism,
+    fig1_synergy_postures,
+    fig2_example_grasps,
+    fig3_rulegraph,
+    fig4_force_maps,
+    fig5_hierarchy,
