@@ -1,13 +1,16 @@
 # synergrasp: incrementality and hierarchy of postural synergies in grasp-force planning.
 #   snakemake -j2 figures            every table and figure of the study
 #   snakemake -j2 object_obj4        one object's own outputs (contacts, forces, minima, Fig. 4)
+#   snakemake -j2 scenario_<name>    one scenario of `scenarios:` (config/README.md); `scenarios`: all
 #   snakemake --report results/report.html   (or results/report.zip)
 from snakemake.utils import min_version
 
 min_version("9.0")
 
 
-configfile: "config/config.yaml"
+# The study's configuration. `--configfile my.yaml` is an overlay on it (config/README.md:
+# mappings merge key by key, other values replace, null removes a key).
+configfile: f"{workflow.basedir}/config/config.yaml"
 
 
 report: "workflow/report/workflow.rst"
@@ -40,3 +43,19 @@ for _name in OBJECTS:
             f"object_{_name}"
         input:
             object_targets(_name),
+
+
+# One target per scenario (config/README.md): `snakemake -j2 scenario_<name>`; `scenarios`
+# builds them all. scenario_default is the same study as `figures`.
+for _scenario in SCENARIOS:
+
+    rule:
+        name:
+            f"scenario_{_scenario}"
+        input:
+            study_targets(_scenario),
+
+
+rule scenarios:
+    input:
+        [f for _scenario in SCENARIOS for f in study_targets(_scenario)],

@@ -14,48 +14,37 @@ from __future__ import annotations
 import os
 import sys
 import time
-from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
+from synergrasp.config import defaults, step_params, validate_config  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
-from synergrasp.simulation.closure import ClosureParams, closure_model, place_box  # noqa: E402
+from synergrasp.simulation.closure import closure_model, place_box  # noqa: E402
+from synergrasp.simulation.placement import pose_grid  # noqa: E402
 from synergrasp.simulation.scene import HandScene  # noqa: E402
-from synergrasp.simulation.objects import STUDY_BOXES  # noqa: E402
-from synergrasp.simulation.placement import Placement, pose_grid  # noqa: E402
 
 
-#: Per-object placements: the study's default (approach to the palm centre); obj4 with its
-#: 100 x 100 face toward the palm (config/config.yaml).
-PLACEMENTS = {"obj4": Placement(box_axes=(1, 0, 2))}
-
-
-def study_mechanics() -> dict:
-    """The study's mechanics block (config/config.yaml): k_ss, μ and gravity of the dynamic model."""
-    import yaml
-
-    with open(Path(__file__).resolve().parents[1] / "config" / "config.yaml", encoding="utf-8") as handle:
-        return yaml.safe_load(handle)["mechanics"]
-
-
-def main(n_poses: int = 300, params: ClosureParams = ClosureParams(), key: str = "closure_median_ms") -> None:
+def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_median_ms") -> None:
+    """The study's boxes, placements and closure settings (the configuration's defaults),
+    closed by ``model``."""
+    study = validate_config({**defaults(), "closure": {**defaults()["closure"], "model": model}})
     hand = load_hand()
     synergies = load_synergies(None, joint_names=hand.joint_names)
-    placement = Placement()
-    grid = pose_grid(placement)
+    first = step_params(study, "simulate", next(iter(study["objects"])))
+    grid = pose_grid(first.placement)
     poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
-    mechanics = study_mechanics() if params.model == "dynamic" else None
-    print(f"closure model: {params.model}")
-    closer = closure_model(hand, synergies, params, mechanics)
+    print(f"closure model: {model}")
+    closer = closure_model(hand, synergies, first.closure, first.mechanics, first.box.mass_kg)
     placer = HandScene(hand)
     all_times = []
     try:
-        for box in STUDY_BOXES:
+        for name in study["objects"]:
+            sim = step_params(study, "simulate", name)
+            box, placement = sim.box, sim.placement
             size = np.asarray(box.size_mm, dtype=float)
-            placement = PLACEMENTS.get(box.name, Placement())
             times, placing, statuses, counts, two_fingers = [], [], [], [], 0
             for pose in poses:
                 t0 = time.perf_counter()
@@ -84,5 +73,5 @@ def main(n_poses: int = 300, params: ClosureParams = ClosureParams(), key: str =
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[2]) if len(sys.argv) > 2 else 60, ClosureParams(model="dynamic"), "closure_dynamic_median_ms")
+    main(int(sys.argv[2]) if len(sys.argv) > 2 else 60, "dynamic", "closure_dynamic_median_ms")
     main(int(sys.argv[1]) if len(sys.argv) > 1 else 300)

@@ -33,7 +33,7 @@ def test_settings_name_the_key_and_allowed_values():
     with pytest.raises(ValueError, match=r"closure.dynamic.unloaded_contacts must be one of \['drop', 'keep'\]"):
         DynamicParams(unloaded_contacts="ignore")
     with pytest.raises(ValueError, match="closure.dynamic: unknown key"):
-        ClosureParams.from_config({"model": "dynamic", "dynamic": {"timestep": 0.01}})
+        ClosureParams(model="dynamic", dynamic={"timestep": 0.01})
     with pytest.raises(ValueError, match="needs the mechanics block"):
         closure_model(None, None, PARAMS)  # type: ignore[arg-type]
 
@@ -156,3 +156,16 @@ def test_settled_box_carries_a_near_zero_net_contact_wrench(model, hand):
     assert np.linalg.norm(forces.sum(axis=0)) <= 0.05 * scale
     moment = np.cross(points - result.settled_pose.center_mm, forces).sum(axis=0)
     assert np.linalg.norm(moment) <= 0.05 * scale * 30.0
+
+
+def test_a_box_pushed_out_of_the_hand_is_lost(hand, synergies):
+    """obj4 placed 50 mm in front of the palm (fixed placement, centre (90, 5, 112) mm): at α = −180°,
+    β = −40° the closing fingers push it away and nothing holds it (no gravity)."""
+    box = Box("obj4", (100.0, 60.0, 100.0), 1.0)
+    placement = Placement(mode="fixed", center_mm=(90.0, 5.0, 112.0), box_axes=(1, 0, 2))
+    row = simulate_object(hand, synergies, box, placement, ClosureParams(model="dynamic"), poses=[4],
+                          mechanics=MECHANICS).iloc[0]
+    assert (row["alpha_deg"], row["beta_deg"]) == (-180.0, -40.0)
+    assert row["status"] == "lost" and row["n_contacts"] == 0
+    assert np.linalg.norm(row["object_translation_mm"]) > 10.0
+    assert np.allclose(row["object_center"], np.asarray(placement.center_mm) + row["object_translation_mm"])

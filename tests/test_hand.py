@@ -260,13 +260,33 @@ def test_loading_explicit_path_equals_default(hand):
     (lambda d: d["fingers"]["little"]["joints"][0]["shapes"][0]["capsule"].update(radius_mm=-1),
      "fingers.little.joints[0].shapes[0].capsule.radius_mm"),
     (lambda d: d.update(palm_normal=[1, 1, 0]), "palm_normal"),
+    # a misspelt optional key is an error, not a silent default (rolling joints would vanish)
+    (lambda d: d["fingers"]["index"]["joints"][1].update(rolling_gap=13.0), "fingers.index.joints[1]: unknown key"),
+    (lambda d: d.update(palm_normals=[1, 0, 0]), "<top level>: unknown key"),
+    (lambda d: d["fingers"]["thumb"].update(tip=[1, 0, 0]), "fingers.thumb: unknown key"),
+    (lambda d: d["fingers"]["thumb"]["knuckle"].update(rpy=[0, 0, 0]), "fingers.thumb.knuckle: unknown key"),
+    (lambda d: d["palm"]["shapes"][0]["box"].update(centre_mm=[0, 0, 0]), "palm.shapes[0].box: unknown key"),
 ])
-def test_load_hand_rejects_malformed_file_naming_the_field(tmp_path, mutate, field):
+def test_load_hand_rejects_malformed_file_naming_the_file_and_field(tmp_path, mutate, field):
     doc = copy.deepcopy(_doc())
     mutate(doc)
     path = tmp_path / "bad.yaml"
     path.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
-    with pytest.raises(ValueError, match=field.replace("[", r"\[").replace("]", r"\]").replace(".", r"\.")):
+    with pytest.raises(ValueError) as info:
+        load_hand(path)
+    assert str(info.value).startswith(f"hand file '{path}': ")
+    assert field in str(info.value)
+
+
+@pytest.mark.parametrize("content, reason", [(None, "No such file"), ("dir", "Is a directory"), (b"", "is empty"),
+                                             (bytes(range(256)), "not a readable YAML file")])
+def test_unreadable_hand_file_gives_one_message_naming_it(tmp_path, content, reason):
+    path = tmp_path / "hand.yaml"
+    if content == "dir":
+        path.mkdir()
+    elif content is not None:
+        path.write_bytes(content)
+    with pytest.raises(ValueError, match=f"hand file '{path}': .*{reason}"):
         load_hand(path)
 
 

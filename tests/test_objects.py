@@ -3,26 +3,27 @@ import math
 import numpy as np
 import pytest
 
-from synergrasp.simulation.objects import STUDY_BOXES, Box, ObjectError, boxes_from_config
+from synergrasp.config import defaults, step_params
+from synergrasp.simulation.objects import Box, ObjectError
 
 
-def test_study_boxes():
-    assert [b.name for b in STUDY_BOXES] == ["obj1", "obj2", "obj3", "obj4"]
-    np.testing.assert_array_equal(STUDY_BOXES[3].size_mm, [100, 60, 100])
-    np.testing.assert_array_equal(STUDY_BOXES[1].half_extents_mm, [15, 30, 30])
-    assert all(b.mass_kg == 1.0 for b in STUDY_BOXES)
-
-
-def test_from_config_matches_and_ignores_placement():
-    boxes = boxes_from_config([{"name": "obj4", "size_mm": [100, 60, 100], "mass_kg": 1,
-                                "placement": {"center_mm": [0, 0, 0]}}])
-    assert boxes == (STUDY_BOXES[3],)
-    assert isinstance(boxes[0].mass_kg, float)
+def test_study_boxes_from_the_config_defaults():
+    boxes = step_params(defaults(), "fig2").boxes
+    assert [b.name for b in boxes] == ["obj1", "obj2", "obj3", "obj4"]
+    np.testing.assert_array_equal(boxes[3].size_mm, [100, 60, 100])
+    np.testing.assert_array_equal(boxes[1].half_extents_mm, [15, 30, 30])
+    assert all(b.mass_kg is None for b in boxes)  # Fig. 2 does not read the masses
+    assert all(step_params(defaults(), "optimise", b.name).gfo.mass_kg == 1.0 for b in boxes)
+    assert Box("a", [1, 2, 3], 1).mass_kg == 1.0 and isinstance(Box("a", [1, 2, 3], 1).mass_kg, float)
 
 
 def test_size_is_read_only():
     with pytest.raises(ValueError):
-        STUDY_BOXES[0].size_mm[0] = 1.0
+        Box("a", [1, 2, 3], 1.0).size_mm[0] = 1.0
+
+
+def test_mass_may_be_left_out_where_a_step_does_not_read_it():
+    assert Box("a", [1, 2, 3]).mass_kg is None
 
 
 GOOD = {"name": "cube", "size_mm": [10, 20, 30], "mass_kg": 0.5}
@@ -43,18 +44,10 @@ GOOD = {"name": "cube", "size_mm": [10, 20, 30], "mass_kg": 0.5}
     ({"name": "my box"}, r"\[A-Za-z0-9_\]\+"),
     ({"name": "../x"}, "field 'name'"),
     ({"name": ""}, "field 'name'"),
-    ({"colour": "red"}, r"unknown fields \['colour'\]"),
 ])
 def test_bad_entries_raise_one_clear_error(change, match):
     with pytest.raises(ObjectError, match=match):
-        boxes_from_config([{**GOOD, **change}])
-
-
-def test_missing_field_and_duplicates():
-    with pytest.raises(ObjectError, match=r"missing fields \['mass_kg'\]"):
-        boxes_from_config([{"name": "a", "size_mm": [1, 1, 1]}])
-    with pytest.raises(ObjectError, match="object 'cube': field 'name' is duplicated"):
-        boxes_from_config([GOOD, dict(GOOD)])
+        Box(**{**GOOD, **change})
 
 
 def test_box_constructor_validates_too():

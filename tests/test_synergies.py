@@ -61,7 +61,7 @@ def test_default_is_softhand_opposed_and_names_resolve(tmp_path):
     default = load_synergies()
     np.testing.assert_array_equal(default.matrix, load_synergies("softhand_opposed").matrix)
     assert not np.array_equal(default.matrix, load_synergies("legacy_thumb").matrix)
-    with pytest.raises(FileNotFoundError, match="softhand_opposed"):
+    with pytest.raises(SynergyFileError, match="softhand_opposed"):
         load_synergies("softhand")
 
 
@@ -184,9 +184,16 @@ def test_no_synergy_columns_and_too_many(tmp_path):
         load_synergies(path)
 
 
-def test_missing_file_is_file_not_found(tmp_path):
-    with pytest.raises(FileNotFoundError):
-        load_synergies(tmp_path / "nope.csv")
+@pytest.mark.parametrize("name, content", [("nope.csv", None), ("folder", "dir"), ("empty.csv", b""),
+                                           ("binary.csv", bytes(range(256)))])
+def test_unreadable_file_gives_one_message_naming_it(tmp_path, name, content):
+    path = tmp_path / name
+    if content == "dir":
+        path.mkdir()
+    elif content is not None:
+        path.write_bytes(content)
+    with pytest.raises(SynergyFileError, match=f"synergy file '{path}'"):
+        load_synergies(path)
 
 
 def test_shipped_path_exists():

@@ -1,33 +1,173 @@
-"""Loading and validating the study configuration.
+"""The one configuration model of the study.
 
-The schema (``workflow/schemas/config.schema.yaml``) fixes keys, types and ranges; the
-checks here add what a schema cannot say (cross-references between keys). Every problem
-is reported as one :class:`ConfigError` naming the key, before any work starts.
+- **Defaults** live in one place: the ``default:`` values of the schema
+  (``workflow/schemas/config.schema.yaml``); :func:`defaults` builds the full default
+  configuration from them and :func:`validate_config` fills every key a config leaves out.
+- **Overlays** (a user's config file, a scenario) follow one rule, :func:`overlay`: a mapping
+  merges key by key, any other value replaces, ``null`` removes the key (which then takes
+  its default, or, for an object, drops it).
+- **Checks** run once, before any job: the schema (keys, types, ranges; no NaN or inf; whole
+  numbers for integers; text names), then :func:`check_relations` (every relation between
+  values). Each problem is one line naming the config key and what is allowed.
+- **Steps**: :data:`STEP_KEYS` says which keys each step of the workflow reads;
+  :func:`step_config` cuts a configuration down to them (the workflow passes only that to a
+  rule, so a step reruns only when a key it reads changes, and scenarios share a step's
+  outputs when its keys agree, :func:`step_hash`), and :func:`step_params` turns it into
+  the step's typed parameters (units kept in the names).
 """
 
 from __future__ import annotations
 
+import copy
+import functools
+import hashlib
+import importlib
 import itertools
+import json
+import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
+
+from synergrasp.simulation.objects import Box
 
 __all__ = [
     "ConfigError",
+    "SCHEMA_PATH",
+    "STEP_KEYS",
+    "defaults",
+    "overlay",
     "validate_config",
+    "check_relations",
+    "synergy_problems",
+    "scenario_configs",
+    "step_config",
+    "step_hash",
+    "step_params",
+    "placement_params",
+    "grid_axis_deg",
     "synergy_sets",
     "incremental_set_id",
     "set_id",
-    "merge_config",
-    "gfo_params",
 ]
+
+#: The schema: keys, types, ranges, descriptions and every default.
+SCHEMA_PATH = Path(__file__).resolve().parents[2] / "workflow" / "schemas" / "config.schema.yaml"
+#: Name of the main configuration among the scenarios.
+DEFAULT_SCENARIO = "default"
 
 
 class ConfigError(ValueError):
-    """A configuration value is missing, unknown or out of range."""
+    """A configuration value is missing, unknown or out of range (one line per problem)."""
 
+
+# --------------------------------------------------------------------------- schema walk
+
+@functools.cache
+def load_schema() -> dict[str, Any]:
+    with open(SCHEMA_PATH, encoding="utf-8") as handle:
+        return yaml.safe_load(handle)
+
+
+def _resolve(node: Mapping[str, Any]) -> dict[str, Any]:
+    """A schema node with ``$ref`` followed and ``allOf`` parts merged (properties deeply)."""
+    out: dict[str, Any] = {}
+    parts = [node]
+    while parts:
+        part = parts.pop(0)
+        if "$ref" in part:
+            target: Any = load_schema()
+            for name in part["$ref"].removeprefix("#/").split("/"):
+                target = target[name]
+            parts.insert(0, target)
+        parts.extend(part.get("allOf", []))
+        for key, value in part.items():
+            if key in ("$ref", "allOf"):
+                continue
+            if key == "properties":
+                props = out.setdefault("properties", {})
+                for name, sub in value.items():
+                    props[name] = {"allOf": [props[name], sub]} if name in props else sub
+            else:
+                out.setdefault(key, value)
+    return out
+
+
+def _fill(node: Mapping[str, Any], value: Any) -> Any:
+    """``value`` with schema defaults filled in where keys are missing, and whole-number
+    floats turned into ints where the schema wants an integer."""
+    schema = _resolve(node)
+    types = schema.get("type")
+    if isinstance(value, float) and value.is_integer() and "integer" in (
+            types if isinstance(types, list) else [types]):
+        return int(value)
+    if isinstance(value, list) and isinstance(schema.get("items"), Mapping):
+        return [_fill(schema["items"], v) for v in value]
+    if not isinstance(value, Mapping):
+        return value
+    out = dict(value)
+    for name, sub in schema.get("properties", {}).items():
+        if name in out:
+            out[name] = _fill(sub, out[name])
+        else:
+            default = _default(sub)
+            if default is not _MISSING:
+                out[name] = default
+    extra = schema.get("additionalProperties")
+    if isinstance(extra, Mapping):
+        for name in out:
+            if name not in schema.get("properties", {}):
+                out[name] = _fill(extra, out[name])
+    return out
+
+
+_MISSING = object()
+
+
+def _default(node: Mapping[str, Any]) -> Any:
+    """The default of a schema node: its ``default:``, or an object built from its
+    properties' defaults (if any has one); _MISSING if it has none."""
+    schema = _resolve(node)
+    if "default" in schema:
+        return _fill(schema, copy.deepcopy(schema["default"]))
+    built = _fill(schema, {}) if "properties" in schema else None
+    return built if built else _MISSING
+
+
+def defaults() -> dict[str, Any]:
+    """The full default configuration (the study of Averta et al. 2018), from the schema."""
+    return _default(load_schema())
+
+
+# --------------------------------------------------------------------------- overlays
+
+def overlay(base: Mapping[str, Any], over: Mapping[str, Any] | None) -> dict[str, Any]:
+    """``base`` overlaid with ``over``: a mapping merges key by key, any other value (lists
+    included) replaces, and ``None`` removes the key. Neither argument is changed."""
+    out = copy.deepcopy(dict(base))
+    for key, value in (over or {}).items():
+        if value is None:
+            out.pop(key, None)
+        elif isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = overlay(out[key], value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+def _drop_nulls(config: Mapping[str, Any], top: bool = True) -> dict[str, Any]:
+    """Keys whose value is None removed at every depth (the overlay rule applied to a
+    configuration that Snakemake merged from several files); scenarios keep theirs, as
+    they are overlays still to be applied."""
+    return {k: v if top and k == "scenarios" else _drop_nulls(v, False) if isinstance(v, Mapping) else v
+            for k, v in config.items() if v is not None}
+
+
+# --------------------------------------------------------------------------- validation
 
 def _key_path(path: Sequence[Any]) -> str:
     out = ""
@@ -36,39 +176,53 @@ def _key_path(path: Sequence[Any]) -> str:
     return out or "<top level>"
 
 
+def _raw_problems(value: Any, path: tuple = ()) -> list[str]:
+    """What a JSON schema cannot see: non-text keys and NaN/inf numbers, by key."""
+    problems = []
+    if isinstance(value, Mapping):
+        for key, sub in value.items():
+            if not isinstance(key, str):
+                problems.append(f"config error at '{_key_path(path)}': name {key!r} "
+                                f"({type(key).__name__}) is not allowed; names are text "
+                                "(letters, digits and '_'; quote a name such as '1')")
+            elif path or key != "scenarios" or not isinstance(sub, Mapping):
+                problems += _raw_problems(sub, (*path, key))
+            else:  # scenarios: their names here, their values as configurations of their own
+                problems += _raw_problems(dict.fromkeys(sub), (key,))
+    elif isinstance(value, list):
+        for i, sub in enumerate(value):
+            problems += _raw_problems(sub, (*path, i))
+    elif isinstance(value, float) and not math.isfinite(value):
+        problems.append(f"config error at '{_key_path(path)}': {value} is not allowed; "
+                        "a finite number is required")
+    return problems
+
+
 def _describe(error: Any) -> str:
-    """One sentence for one jsonschema error, naming the key and what is allowed."""
+    """One line for one jsonschema error, naming the key and what is allowed."""
     where = _key_path(list(error.absolute_path))
     schema = error.schema
-    if error.validator == "additionalProperties":
+    if error.validator == "additionalProperties" and isinstance(error.instance, Mapping):
         allowed = sorted(schema.get("properties", {}))
         extra = sorted(set(error.instance) - set(allowed))
         return f"config error at '{where}': unknown key(s) {extra}; allowed keys: {allowed}"
-    if error.validator == "required":
-        return f"config error at '{where}': {error.message}"
     if error.validator == "enum":
         return (f"config error at '{where}': {error.instance!r} is not allowed; "
                 f"allowed values: {schema['enum']}")
-    if error.validator == "propertyNames":
+    if "propertyNames" in error.schema_path:
         return (f"config error at '{where}': name {error.instance!r} is not allowed; "
-                "names may use letters, digits and '_' only")
+                "names may use letters, digits and '_' only (and not 'default' for a scenario)")
     return f"config error at '{where}': {error.message}"
 
 
-def load_schema(schema_path: str | Path) -> dict[str, Any]:
-    with open(schema_path, encoding="utf-8") as handle:
-        return yaml.safe_load(handle)
-
-
-def validate_config(config: Mapping[str, Any], schema_path: str | Path,
-                    n_synergies: int | None = None) -> None:
-    """Validate ``config`` against the schema and the cross-key rules.
+def validate_config(config: Mapping[str, Any], n_synergies: int | None = None) -> dict[str, Any]:
+    """The complete, checked configuration: ``config`` (None values removed, see
+    :func:`overlay`) with every missing key filled from the schema's defaults.
 
     Parameters
     ----------
-    config : the merged configuration (as Snakemake holds it).
-    schema_path : path of the JSON schema (YAML form).
-    n_synergies : number of synergy columns of the synergy file in use, if known; the
+    config : a configuration as read from YAML (or as Snakemake merged it).
+    n_synergies : number of synergies of the synergy file in use, if known; the
         synergy-set bounds are checked against it.
 
     Raises
@@ -78,42 +232,426 @@ def validate_config(config: Mapping[str, Any], schema_path: str | Path,
     """
     from jsonschema import Draft202012Validator
 
-    validator = Draft202012Validator(load_schema(schema_path))
-    errors = sorted(validator.iter_errors(dict(config)), key=lambda e: list(e.absolute_path))
+    if not isinstance(config, Mapping):
+        raise ConfigError(f"config error at '<top level>': a mapping of keys is required, got {config!r}")
+    problems = _raw_problems(config)
+    if problems:
+        raise ConfigError("\n".join(problems))
+    full = _fill(load_schema(), _drop_nulls(config))
+    errors = sorted(Draft202012Validator(load_schema()).iter_errors(full), key=lambda e: list(e.absolute_path))
     if errors:
         raise ConfigError("\n".join(_describe(e) for e in errors))
+    problems = check_relations(full, n_synergies)
+    if problems:
+        raise ConfigError("\n".join(problems))
+    return full
 
-    problems: list[str] = []
-    for axis in ("alpha_deg", "beta_deg"):
-        rng = config["grid"][axis]
-        if rng["stop"] < rng["start"]:
-            problems.append(f"config error at 'grid.{axis}': stop ({rng['stop']}) is below start ({rng['start']})")
-    if config["grid"]["alpha_deg"]["stop"] - config["grid"]["alpha_deg"]["start"] >= 360:
-        problems.append("config error at 'grid.alpha_deg': alpha is periodic; the range must span less than 360 deg")
+
+def grid_axis_deg(axis: Mapping[str, float]) -> list[float]:
+    """The inclusive grid start, start + step, ..., stop of a ``grid`` axis (deg)."""
+    n = round((axis["stop"] - axis["start"]) / axis["step"])
+    return [axis["start"] + i * axis["step"] for i in range(n + 1)]
+
+
+def _grid_problems(grid: Mapping[str, Any]) -> list[str]:
+    problems = []
+    for name, rng in grid.items():
+        span, step = rng["stop"] - rng["start"], rng["step"]
+        if span < 0:
+            problems.append(f"config error at 'grid.{name}.stop': {rng['stop']} is below start ({rng['start']})")
+        elif abs(span / step - round(span / step)) > 1e-9:
+            problems.append(f"config error at 'grid.{name}.step': {step} does not divide stop - start "
+                            f"({span}); the grid must end on stop")
+    alpha = grid["alpha_deg"]
+    if alpha["stop"] - alpha["start"] >= 360:
+        problems.append("config error at 'grid.alpha_deg': alpha is periodic; stop - start must be "
+                        "below 360 deg")
+    return problems
+
+
+def _on_grid(value: float, axis: Mapping[str, float], periodic: bool) -> bool:
+    def gap(a: float) -> float:
+        d = value - a
+        return abs((d + 180.0) % 360.0 - 180.0) if periodic else abs(d)
+    return min(gap(a) for a in grid_axis_deg(axis)) < 1e-6
+
+
+def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -> list[str]:
+    """Every relation between values of a schema-valid, complete configuration, as a list
+    of problems (empty: none). One line per problem, naming the key."""
+    problems = _grid_problems(config["grid"])
+    closure = config["closure"]
+    if closure["contact_distance_mm"] < closure["tolerance_mm"]:
+        problems.append(f"config error at 'closure.contact_distance_mm': {closure['contact_distance_mm']} "
+                        f"must be at least closure.tolerance_mm ({closure['tolerance_mm']})")
+    if closure["step_mm"] <= closure["tolerance_mm"]:
+        problems.append(f"config error at 'closure.step_mm': {closure['step_mm']} must exceed "
+                        f"closure.tolerance_mm ({closure['tolerance_mm']})")
     if all(abs(v) < 1e-12 for v in config["mechanics"]["gravity_direction"]):
         problems.append("config error at 'mechanics.gravity_direction': must be a non-zero vector")
-    objects = sorted(config["objects"])
-    fig4 = config["analyses"]["fig4"]
-    if fig4["object"] not in config["objects"]:
-        problems.append(f"config error at 'analyses.fig4.object': unknown object {fig4['object']!r}; "
-                        f"allowed values: {objects}")
     sets = config["synergy_sets"]
     k_max = sets["incremental_max"]
     if sets["hierarchy_max_size"] > sets["hierarchy_first"]:
-        problems.append("config error at 'synergy_sets.hierarchy_max_size': cannot exceed hierarchy_first")
+        problems.append(f"config error at 'synergy_sets.hierarchy_max_size': {sets['hierarchy_max_size']} "
+                        f"exceeds synergy_sets.hierarchy_first ({sets['hierarchy_first']})")
     if n_synergies is not None:
         for key in ("incremental_max", "hierarchy_first"):
             if sets[key] > n_synergies:
                 problems.append(f"config error at 'synergy_sets.{key}': {sets[key]} exceeds the "
                                 f"{n_synergies} synergies of the synergy file")
-    if config["analyses"]["table2_k_max"] > k_max:
-        problems.append(f"config error at 'analyses.table2_k_max': must be at most synergy_sets.incremental_max ({k_max})")
-    bad_k = [k for k in fig4["panel_k"] if k > k_max]
+    analyses = config["analyses"]
+    if analyses["table2_k_max"] > k_max:
+        problems.append(f"config error at 'analyses.table2_k_max': {analyses['table2_k_max']} exceeds "
+                        f"synergy_sets.incremental_max ({k_max})")
+    bad_k = [k for k in analyses["fig4"]["panel_k"] if k > k_max]
     if bad_k:
-        problems.append(f"config error at 'analyses.fig4.panel_k': {bad_k} exceed synergy_sets.incremental_max ({k_max})")
+        problems.append(f"config error at 'analyses.fig4.panel_k': {bad_k} exceed "
+                        f"synergy_sets.incremental_max ({k_max})")
+    if not _grid_problems(config["grid"]):
+        problems += _pose_problems(config)
+    return problems
+
+
+def synergy_problems(config: Mapping[str, Any], mean_rad: Any, matrix: Any) -> list[str]:
+    """What makes a readable synergy table unusable for the study: S1 moving no joint (the
+    hand would never close) or values no posture in rad can have (|value| > 2π: a table in
+    degrees, or a stray huge entry). ``mean_rad`` (n,), ``matrix`` (n, k) as loaded."""
+    where = f"config error at 'synergies' ({config['synergies'] or 'the shipped table'})"
+    mean, syn = np.asarray(mean_rad, dtype=float), np.asarray(matrix, dtype=float)
+    problems = []
+    if not np.any(np.abs(syn[:, 0]) > 0):
+        problems.append(f"{where}: S1 is zero for every joint; closing along S1 would move no joint")
+    if np.abs(mean).max() > 2 * math.pi or np.abs(syn).max() > 2 * math.pi:
+        problems.append(f"{where}: values up to {max(np.abs(mean).max(), np.abs(syn).max()):.4g} exceed "
+                        "2π; postures and synergies are in rad (is the table in degrees?)")
+    return problems
+
+
+def _pose_problems(config: Mapping[str, Any]) -> list[str]:
+    """Poses named by the analyses lie on the grid; no more shards than poses."""
+    problems = []
+    alpha, beta = config["grid"]["alpha_deg"], config["grid"]["beta_deg"]
+    fig4 = config["analyses"]["fig4"]
+    if not _on_grid(fig4["alpha_slice_deg"], alpha, periodic=True):
+        problems.append(f"config error at 'analyses.fig4.alpha_slice_deg': {fig4['alpha_slice_deg']} is "
+                        f"not on grid.alpha_deg {grid_axis_deg(alpha)}")
+    if not _on_grid(fig4["beta_slice_deg"], beta, periodic=False):
+        problems.append(f"config error at 'analyses.fig4.beta_slice_deg': {fig4['beta_slice_deg']} is "
+                        f"not on grid.beta_deg {grid_axis_deg(beta)}")
+    n_poses = len(grid_axis_deg(alpha)) * len(grid_axis_deg(beta))
+    if config["solver"]["pose_shards"] > n_poses:
+        problems.append(f"config error at 'solver.pose_shards': {config['solver']['pose_shards']} exceeds "
+                        f"the {n_poses} poses of the grid; allowed values: 1..{n_poses}")
+    return problems
+
+
+# --------------------------------------------------------------------------- scenarios
+
+def scenario_configs(config: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
+    """Every scenario's complete configuration by name, ``default`` (the configuration
+    itself) first, then the ``scenarios:`` in their given order.
+
+    Each scenario is the configuration (without ``scenarios``) overlaid with the scenario's
+    mapping (:func:`overlay`), validated like the configuration itself. Synergy-count
+    bounds are checked by the caller (they need the synergy file).
+
+    Raises
+    ------
+    ConfigError
+        Naming the scenario and the key.
+    """
+    main = validate_config(config)
+    base = {k: v for k, v in config.items() if k != "scenarios"}
+    out = {DEFAULT_SCENARIO: {**main, "scenarios": {}}}
+    problems = []
+    for name, changes in main["scenarios"].items():
+        if "scenarios" in changes:
+            problems.append(f"scenario '{name}': config error at 'scenarios': a scenario cannot define scenarios")
+            continue
+        try:
+            out[name] = validate_config(overlay(base, changes))
+        except ConfigError as err:
+            problems += [f"scenario '{name}': {line}" for line in str(err).splitlines()]
     if problems:
         raise ConfigError("\n".join(problems))
+    return out
 
+
+# --------------------------------------------------------------------------- steps
+
+#: The configuration keys each step reads ("objects.{object}" is the step's object,
+#: "objects.*" every object). A step's rule is given only these (step_config), so it reruns
+#: only when one of them changes, and two scenarios share its outputs when they agree on
+#: them. A new key: one schema entry, plus its path here if a step reads it.
+STEP_KEYS: dict[str, tuple[str, ...]] = {
+    "simulate": ("hand", "synergies", "grid", "placement", "closure",
+                 "objects.{object}.size_mm", "objects.{object}.placement"),
+    "optimise": ("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg"),
+    "minima": ("analyses.minima_radius_deg", "analyses.success"),
+    "tables": ("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max", "analyses.success",
+               "analyses.marginal_weight_multiple", "analyses.success_rate_tolerance_percent",
+               "analyses.null_model", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
+    "realism": ("hand", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2"),
+    "fig1": ("hand", "synergies"),
+    "fig2": ("hand", "objects.*.size_mm"),
+    "fig4": ("analyses.fig4", "analyses.success"),
+    "fig5": ("synergy_sets.hierarchy_first", "analyses.success"),
+}
+#: Keys a step reads only when another key has a given value: step -> ((key, value, reads), ...).
+STEP_KEYS_WHEN: dict[str, tuple[tuple[str, Any, tuple[str, ...]], ...]] = {
+    # the dynamic closure: a free box of the object's mass, μ, k_ss and gravity of mechanics
+    "simulate": (("closure.model", "dynamic", ("objects.{object}.mass_kg", "mechanics")),),
+}
+#: The step whose outputs a step reads (its hash includes that step's hash).
+UPSTREAM: dict[str, str] = {"optimise": "simulate", "minima": "optimise"}
+#: Keys read by the workflow itself, not by a step.
+WORKFLOW_KEYS: tuple[str, ...] = ("scenarios",)
+
+
+def _get(config: Mapping[str, Any], path: str) -> Any:
+    node: Any = config
+    for part in path.split("."):
+        if not isinstance(node, Mapping) or part not in node:
+            return _MISSING
+        node = node[part]
+    return node
+
+
+def _put(out: dict[str, Any], path: str, value: Any) -> None:
+    *parents, last = path.split(".")
+    for part in parents:
+        out = out.setdefault(part, {})
+    out[last] = copy.deepcopy(value)
+
+
+def step_keys(config: Mapping[str, Any], step: str, obj: str | None = None) -> list[str]:
+    """The key paths ``step`` reads in ``config`` (for object ``obj`` where it matters)."""
+    if step not in STEP_KEYS:
+        raise ValueError(f"unknown step {step!r}; allowed values: {sorted(STEP_KEYS)}")
+    paths = list(STEP_KEYS[step])
+    for key, value, reads in STEP_KEYS_WHEN.get(step, ()):
+        if _get(config, key) == value:
+            paths += reads
+    out = []
+    for path in paths:
+        if path.startswith("objects.*"):
+            out += [path.replace("*", name, 1) for name in config["objects"]]
+        elif "{object}" in path:
+            if obj is None:
+                raise ValueError(f"step {step!r} reads {path}: an object is required")
+            out.append(path.format(object=obj))
+        else:
+            out.append(path)
+    return out
+
+
+def step_config(config: Mapping[str, Any], step: str, obj: str | None = None) -> dict[str, Any]:
+    """The part of ``config`` that ``step`` reads, in the configuration's own shape."""
+    out: dict[str, Any] = {}
+    for path in step_keys(config, step, obj):
+        value = _get(config, path)
+        if value is not _MISSING:
+            _put(out, path, value)
+    return out
+
+
+def step_hash(config: Mapping[str, Any], step: str, obj: str | None = None) -> str:
+    """Hash of what a step's outputs depend on: the keys it reads and, through
+    :data:`UPSTREAM`, those of the steps before it (12 hex digits)."""
+    parts = [step_config(config, step, obj)]
+    if step in UPSTREAM:
+        parts.append(step_hash(config, UPSTREAM[step], obj))
+    text = json.dumps(parts, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+# --------------------------------------------------------------------------- typed parameters
+
+@dataclass(frozen=True)
+class SimulateParams:
+    """The closure of one object: hand and synergy files (None = shipped), the box, its
+    effective placement (with the pose grid) and the closure settings."""
+    hand: str | None
+    synergies: str | None
+    box: Box
+    placement: Any  # synergrasp.simulation.placement.Placement
+    closure: Any    # synergrasp.simulation.closure.ClosureParams
+    mechanics: dict[str, Any] | None = None  # the mechanics block, where the closure model reads it
+
+
+@dataclass(frozen=True)
+class OptimiseParams:
+    """The optimisation of one object: synergy file, the study's synergy sets by id, the
+    GFO parameters (mechanics and the object's weight) and the number of pose shards."""
+    synergies: str | None
+    sets: dict[str, tuple[int, ...]]
+    gfo: Any  # synergrasp.optimisation.study.GFOParams
+    pose_shards: int
+
+
+@dataclass(frozen=True)
+class MinimaParams:
+    """Local minima of one object: neighbourhood radius (deg) and the success verdict."""
+    radius_deg: float
+    success: str
+
+
+@dataclass(frozen=True)
+class TablesParams:
+    """The study's tables: the synergy-set bounds, Table II's k_max and the analysis settings."""
+    synergy_sets: dict[str, int]
+    table2_k_max: int
+    settings: Any  # synergrasp.analysis.summaries.AnalysisSettings
+
+
+@dataclass(frozen=True)
+class RealismParams:
+    """The grasp-realism table: hand file, the full set's id, each object's weight (N)."""
+    hand: str | None
+    full_set_id: str
+    weights_N: dict[str, float]
+
+
+@dataclass(frozen=True)
+class FiguresParams:
+    """Parameters of the figures (each figure's rule is given its own keys only)."""
+    hand: str | None = None
+    synergies: str | None = None
+    boxes: tuple = ()
+    success: str = ""
+    fig4_panel_k: tuple[int, ...] = ()
+    fig4_alpha_slice_deg: float = math.nan
+    fig4_beta_slice_deg: float = math.nan
+    hierarchy_first: int = 0
+
+
+#: Modules holding the typed parameter classes a step's parameters are built from (the
+#: step's script imports them itself; tests/test_config.py checks it).
+STEP_MODULES: dict[str, tuple[str, ...]] = {
+    "simulate": ("synergrasp.simulation.closure", "synergrasp.simulation.placement"),
+    "optimise": ("synergrasp.optimisation.study",),
+    "tables": ("synergrasp.analysis.summaries",),
+}
+
+#: Field of a typed class -> the config key it comes from (messages name the key).
+_GFO_FIELDS = {"mu": "mu", "f_min": "f_min_N", "k_stru": "k_stru_N_per_mm",
+               "k_ss": "k_ss_Nmm_per_rad", "g": "g_m_per_s2"}
+
+
+def _build(cls: Any, where: str, **kwargs: Any) -> Any:
+    """``cls(**kwargs)``; a rejected value becomes a ConfigError naming the config key."""
+    try:
+        return cls(**kwargs)
+    except (TypeError, ValueError) as err:
+        message = str(err).replace(f"{cls.__name__}.", f"{where}.")
+        raise ConfigError(f"config error at '{where}': {message}") from None
+
+
+def _box(config: Mapping[str, Any], name: str) -> Any:
+    """The object ``name`` as a Box; its mass is None where the step does not read it."""
+    spec = config["objects"][name]
+    return _build(Box, f"objects.{name}", name=name, size_mm=spec["size_mm"],
+                  mass_kg=spec.get("mass_kg"))
+
+
+def placement_params(placement: Mapping[str, Any], grid: Mapping[str, Any]) -> Any:
+    """The :class:`synergrasp.simulation.placement.Placement` of an effective ``placement``
+    block (the global one with an object's override laid over it) and the ``grid`` block."""
+    placing = importlib.import_module("synergrasp.simulation.placement")
+    ranges = {k: (v["start"], v["stop"], v["step"]) for k, v in grid.items()}
+    return _build(placing.Placement, "placement", **_fields(placing.Placement, {**placement, **ranges}))
+
+
+def _simulate(config: Mapping[str, Any], obj: str) -> SimulateParams:
+    closure = importlib.import_module("synergrasp.simulation.closure")
+    placement = overlay(config["placement"], config["objects"][obj].get("placement"))
+    return SimulateParams(
+        hand=config["hand"], synergies=config["synergies"], box=_box(config, obj),
+        placement=placement_params(placement, config["grid"]),
+        closure=_build(closure.ClosureParams, "closure", **_fields(closure.ClosureParams, config["closure"])),
+        mechanics=config.get("mechanics"))
+
+
+def _fields(cls: Any, values: Mapping[str, Any]) -> dict[str, Any]:
+    """The entries of ``values`` that are fields of the dataclass ``cls``, lists as tuples."""
+    names = set(cls.__dataclass_fields__)
+    return {k: tuple(v) if isinstance(v, list) else v for k, v in values.items() if k in names}
+
+
+def _optimise(config: Mapping[str, Any], obj: str) -> OptimiseParams:
+    gfo = importlib.import_module("synergrasp.optimisation.study")
+    mech = config["mechanics"]
+    gravity = np.asarray(mech["gravity_direction"], dtype=float)
+    kwargs = {field: float(mech[key]) for field, key in _GFO_FIELDS.items()}
+    try:
+        params = gfo.GFOParams(gravity_direction=tuple(gravity / np.linalg.norm(gravity)),
+                               mass_kg=float(config["objects"][obj]["mass_kg"]), **kwargs)
+    except (TypeError, ValueError) as err:
+        message = str(err)
+        for field, key in _GFO_FIELDS.items():
+            if message.startswith(f"{field} "):
+                raise ConfigError(f"config error at 'mechanics.{key}': {message}") from None
+        raise ConfigError(f"config error at 'mechanics' / 'objects.{obj}.mass_kg': {message}") from None
+    return OptimiseParams(config["synergies"], synergy_sets(config["synergy_sets"]), params,
+                          int(config["solver"]["pose_shards"]))
+
+
+def _tables(config: Mapping[str, Any]) -> TablesParams:
+    summaries = importlib.import_module("synergrasp.analysis.summaries")
+    objects = {name: {**spec, "placement": overlay(config["placement"], spec.get("placement"))}
+               for name, spec in config["objects"].items()}
+    try:
+        settings = summaries.AnalysisSettings.from_config(config["analyses"], objects, config["grid"], config["hand"],
+                                                          config["mechanics"]["g_m_per_s2"])
+    except (TypeError, ValueError) as err:
+        raise ConfigError(f"config error at 'analyses': {err}") from None
+    return TablesParams(dict(config["synergy_sets"]), int(config["analyses"]["table2_k_max"]), settings)
+
+
+def _figures(config: Mapping[str, Any], step: str) -> FiguresParams:
+    if step == "fig1":
+        return FiguresParams(hand=config["hand"], synergies=config["synergies"])
+    if step == "fig2":
+        return FiguresParams(hand=config["hand"], boxes=tuple(_box(config, n) for n in config["objects"]))
+    success = config["analyses"]["success"]
+    if step == "fig4":
+        fig4 = config["analyses"]["fig4"]
+        return FiguresParams(success=success, fig4_panel_k=tuple(fig4["panel_k"]),
+                             fig4_alpha_slice_deg=fig4["alpha_slice_deg"], fig4_beta_slice_deg=fig4["beta_slice_deg"])
+    return FiguresParams(success=success, hierarchy_first=config["synergy_sets"]["hierarchy_first"])
+
+
+def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) -> Any:
+    """The typed parameters of ``step`` (for object ``obj`` where it has one), from a
+    complete configuration or from the step's own part of it (:func:`step_config`).
+
+    The one path from configuration to the parameters of every module: ``simulate`` →
+    :class:`SimulateParams`, ``optimise`` → :class:`OptimiseParams`, ``minima`` →
+    :class:`MinimaParams`, ``tables`` → :class:`TablesParams`, ``realism`` →
+    :class:`RealismParams`, ``fig1``/``fig2``/``fig4``/
+    ``fig5`` → :class:`FiguresParams`. A value a typed class rejects raises ConfigError
+    naming the config key (not the class's field). Only the keys the step reads
+    (:data:`STEP_KEYS`) are used, so its parameters cannot depend on any other.
+    """
+    config = step_config(config, step, obj)
+    if step == "simulate":
+        return _simulate(config, obj)
+    if step == "optimise":
+        return _optimise(config, obj)
+    if step == "minima":
+        return MinimaParams(float(config["analyses"]["minima_radius_deg"]), config["analyses"]["success"])
+    if step == "tables":
+        return _tables(config)
+    if step == "realism":
+        g = config["mechanics"]["g_m_per_s2"]
+        return RealismParams(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),
+                             {name: spec["mass_kg"] * g for name, spec in config["objects"].items()})
+    if step in ("fig1", "fig2", "fig4", "fig5"):
+        return _figures(config, step)
+    raise ValueError(f"unknown step {step!r}; allowed values: {sorted(STEP_KEYS)}")
+
+
+# --------------------------------------------------------------------------- synergy sets
 
 def set_id(synergies: Sequence[int]) -> str:
     """Canonical id of a synergy set: 1-based indices, sorted, joined by '-' ("1-2-3")."""
@@ -140,33 +678,3 @@ def synergy_sets(sets_config: Mapping[str, int]) -> dict[str, tuple[int, ...]]:
         for combo in itertools.combinations(range(1, first + 1), size):
             out.setdefault(set_id(combo), combo)
     return out
-
-
-def merge_config(base: Mapping[str, Any], override: Mapping[str, Any]) -> dict[str, Any]:
-    """Recursive merge of two config mappings (override wins; lists are replaced)."""
-    out = dict(base)
-    for key, value in override.items():
-        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
-            out[key] = merge_config(out[key], value)
-        else:
-            out[key] = value
-    return out
-
-
-def gfo_params(mechanics: Mapping[str, Any], mass_kg: float):
-    """:class:`synergrasp.optimisation.study.GFOParams` from the config's ``mechanics``
-    block (units in its key names) and the object's mass (kg); gravity is normalised."""
-    import numpy as np
-
-    from synergrasp.optimisation.study import GFOParams
-
-    gravity = np.asarray(mechanics["gravity_direction"], dtype=float)
-    return GFOParams(
-        gravity_direction=tuple(gravity / np.linalg.norm(gravity)),
-        mu=float(mechanics["mu"]),
-        f_min=float(mechanics["f_min_N"]),
-        k_stru=float(mechanics["k_stru_N_per_mm"]),
-        k_ss=float(mechanics["k_ss_Nmm_per_rad"]),
-        mass_kg=float(mass_kg),
-        g=float(mechanics["g_m_per_s2"]),
-    )

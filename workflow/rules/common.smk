@@ -1,50 +1,104 @@
 # Shared definitions: configuration checks (before any job runs), object and synergy-set
 # lists, code dependencies that trigger reruns, and the target lists.
+import functools
 import math
+import re
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
 
 from synergrasp.config import (
     ConfigError,
-    incremental_set_id,
-    merge_config,
-    synergy_sets,
-    validate_config,
+    check_relations,
+    scenario_configs,
+    step_config,
+    step_hash,
+    synergy_problems,
 )
 
 ROOT = Path(workflow.basedir)
 SRC = ROOT / "src" / "synergrasp"
-SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
 
-def _check_inputs(cfg):
-    """Validate config, hand, synergies and objects; return the synergy count."""
+def _check_inputs(raw):
+    """Every scenario's complete configuration (``default`` first), checked with its hand
+    and synergy files before any job runs (config/README.md)."""
     from synergrasp.hand.kinematics import load_hand
-    from synergrasp.simulation.objects import boxes_from_config
     from synergrasp.hand.synergies import load_synergies
 
-    validate_config(cfg, SCHEMA)
-    hand = load_hand(cfg["hand"])
-    synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
-    boxes_from_config([{"name": name, **spec} for name, spec in cfg["objects"].items()])
-    validate_config(cfg, SCHEMA, n_synergies=synergies.matrix.shape[1])
+    scenarios = scenario_configs(raw)
+    problems = []
+    for name, cfg in scenarios.items():
+        hand = load_hand(cfg["hand"])
+        synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
+        where = "" if name == "default" else f"scenario '{name}': "
+        problems += [where + p for p in check_relations(cfg, synergies.matrix.shape[1])]
+        problems += [where + p for p in synergy_problems(cfg, synergies.mean, synergies.matrix)]
+    if problems:
+        raise ConfigError("\n".join(problems))
+    return scenarios
 
 
 try:
-    _check_inputs(config)  # ConfigError, SynergyFileError, ... are ValueErrors
-except (ValueError, FileNotFoundError) as err:
+    SCENARIOS = _check_inputs(config)
+except ValueError as err:  # ConfigError, SynergyFileError, hand-file errors are ValueErrors
     raise WorkflowError(f"Invalid input, nothing was run:\n{err}") from None
 
+#: The main configuration (scenario `default`), complete (defaults filled in) and checked.
+STUDY = SCENARIOS["default"]
+OBJECTS = list(STUDY["objects"])
 
-OBJECTS = list(config["objects"])
-SETS = synergy_sets(config["synergy_sets"])
-SHARDS = list(range(config["solver"]["pose_shards"]))
-FIG4_OBJECT = config["analyses"]["fig4"]["object"]
+# Scenarios (config/README.md): each one's outputs live under its root; the default keeps
+# results/. A per-object step's output is made once, under the root of the first scenario
+# (default first) whose step reads the same keys (synergrasp.config.step_hash), and shared.
+SCENARIO_ROOT = {
+    name: "results" if name == "default" else f"results/scenarios/{name}" for name in SCENARIOS
+}
+_ROOT_SCENARIO = {root: name for name, root in SCENARIO_ROOT.items()}
+#: The file each per-object step writes under its root's objects/<object>/.
+STEP_FILES = {"simulate": "contacts.parquet", "optimise": "gfo.parquet", "minima": "minima.parquet"}
+
+
+def scenario_config(wildcards):
+    """The complete configuration of the scenario whose root a job's {root} names."""
+    return SCENARIOS[_ROOT_SCENARIO[wildcards.root]]
+
+
+@functools.cache
+def step_file(scenario, step, obj):
+    """Where ``scenario``'s output of per-object ``step`` for ``obj`` lives: under the root of
+    the first scenario that reads the same keys for it."""
+    key = step_hash(SCENARIOS[scenario], step, obj)
+    owner = next(
+        name
+        for name, cfg in SCENARIOS.items()
+        if obj in cfg["objects"] and step_hash(cfg, step, obj) == key
+    )
+    return f"{SCENARIO_ROOT[owner]}/objects/{obj}/{STEP_FILES[step]}"
+
+
+def step_input(step):
+    """Input function: the job's object's ``step`` output in the job's scenario."""
+    return lambda w: step_file(_ROOT_SCENARIO[w.root], step, w.object)
+
+
+def step_inputs(step):
+    """Input function: every object's ``step`` output in the job's scenario."""
+    return lambda w: [
+        step_file(_ROOT_SCENARIO[w.root], step, o) for o in scenario_config(w)["objects"]
+    ]
+
+
+def step_cfg(step):
+    """A rule's ``params``: the part of the job's scenario configuration its step reads (for
+    the job's object; synergrasp.config.STEP_KEYS), so that a job reruns only when a key it
+    reads changes. Its script turns it into typed parameters with synergrasp.config.step_params."""
+    return lambda wildcards: step_config(scenario_config(wildcards), step, wildcards.get("object"))
 
 
 wildcard_constraints:
-    object="|".join(OBJECTS),
+    root="|".join(re.escape(r) for r in SCENARIO_ROOT.values()),
+    object="|".join(sorted({o for cfg in SCENARIOS.values() for o in cfg["objects"]})),
     shard=r"\d+",
 
 
@@ -96,66 +150,31 @@ def code(script):
     return sorted(str(f) for f in files) + [str(ROOT / "environment.lock")]
 
 
-def user_files():
-    """User-supplied hand/synergy files: a change of their content reruns what uses them
-    (a shipped synergy table given by name is under SHIPPED_DATA)."""
+def user_files(wildcards):
+    """Input function: the scenario's own hand/synergy files, so that a change of their
+    content reruns what uses them (a shipped synergy table given by name is under SHIPPED_DATA)."""
     from synergrasp.hand.synergies import SHIPPED_TABLES
 
-    return [p for p in (config["hand"], config["synergies"]) if p and p not in SHIPPED_TABLES]
+    cfg = scenario_config(wildcards)
+    return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in SHIPPED_TABLES]
 
 
 SHIPPED_DATA = sorted(str(p) for p in (SRC / "data").glob("*") if p.is_file())
 
 
-def object_config(name):
-    """The object's box and its effective placement (global placement + its override)."""
-    spec = dict(config["objects"][name])
-    placement = merge_config(config["placement"], spec.pop("placement", {}))
-    return {"name": name, **spec, "placement": placement}
-
-
-def simulation_params(wildcards):
-    return {
-        "object": object_config(wildcards.object),
-        "grid": config["grid"],
-        "closure": config["closure"],
-        "hand": config["hand"],
-        "synergies": config["synergies"],
-        # the dynamic closure needs k_ss, mu and gravity; the kinematic one does not rerun on them
-        "mechanics": config["mechanics"] if config["closure"].get("model") == "dynamic" else None,
-    }
-
-
-def optimisation_params(wildcards):
-    return {
-        "mechanics": config["mechanics"],
-        "mass_kg": config["objects"][wildcards.object]["mass_kg"],
-        "sets": SETS,
-        "synergies": config["synergies"],
-        "shard": int(wildcards.shard),
-    }
-
-
-def object_dir(name):
-    return f"results/objects/{name}"
-
-
-def fig4_files(name):
+def fig4_files(root, name):
     return [
-        f"{object_dir(name)}/fig4_{kind}.{ext}"
+        f"{root}/objects/{name}/fig4_{kind}.{ext}"
         for kind in ("force_maps", "exploded")
         for ext in ("png", "pdf")
     ]
 
 
-def object_targets(name):
-    d = object_dir(name)
-    return [
-        f"{d}/contacts.parquet",
-        f"{d}/gfo.parquet",
-        f"{d}/minima.parquet",
-        *fig4_files(name),
-    ]
+def object_targets(name, scenario="default"):
+    """One object's outputs in a scenario: its per-object tables (wherever shared) and Fig. 4."""
+    return [step_file(scenario, step, name) for step in STEP_FILES] + fig4_files(
+        SCENARIO_ROOT[scenario], name
+    )
 
 
 TABLES = [
@@ -171,21 +190,25 @@ TABLES = [
 ]
 
 
-def study_targets():
+def study_targets(scenario="default"):
+    """Every output of one scenario's study (Fig. 3, the rule graph, is the same for all)."""
+    root = SCENARIO_ROOT[scenario]
     figures = [
-        f"results/figures/{name}.{ext}"
+        f"{root}/figures/{name}.{ext}"
         for name in (
             "fig1_synergy_postures",
             "fig2_example_grasps",
-            "fig3_rulegraph",
             "fig5a_hierarchy_success",
             "fig5b_hierarchy_force",
             "grasp_realism",
         )
         for ext in ("png", "pdf")
     ]
+    figures += [f"results/figures/fig3_rulegraph.{ext}" for ext in ("png", "pdf")]
     tables = [
-        f"results/tables/{t}.{ext}" for t in [*TABLES, "grasp_realism"] for ext in ("csv", "md")
+        f"{root}/tables/{t}.{ext}" for t in [*TABLES, "grasp_realism"] for ext in ("csv", "md")
     ]
-    per_object = [f for name in OBJECTS for f in object_targets(name)]
+    per_object = [
+        f for name in SCENARIOS[scenario]["objects"] for f in object_targets(name, scenario)
+    ]
     return figures + tables + per_object

@@ -4,67 +4,65 @@
 
 rule fig4_force_maps:
     input:
-        gfo="results/objects/{object}/gfo.parquet",
-        minima="results/objects/{object}/minima.parquet",
+        gfo=step_input("optimise"),
+        minima=step_input("minima"),
         code=code("fig4_force_maps"),
     output:
         maps_png=report(
-            "results/objects/{object}/fig4_force_maps.png",
+            "{root}/objects/{object}/fig4_force_maps.png",
             caption="../report/fig4_force_maps.rst",
             category="Fig. 4",
             subcategory="{object}",
         ),
-        maps_pdf="results/objects/{object}/fig4_force_maps.pdf",
+        maps_pdf="{root}/objects/{object}/fig4_force_maps.pdf",
         exploded_png=report(
-            "results/objects/{object}/fig4_exploded.png",
+            "{root}/objects/{object}/fig4_exploded.png",
             caption="../report/fig4_exploded.rst",
             category="Fig. 4",
             subcategory="{object}",
         ),
-        exploded_pdf="results/objects/{object}/fig4_exploded.pdf",
+        exploded_pdf="{root}/objects/{object}/fig4_exploded.pdf",
     log:
-        "results/logs/fig4/{object}.log",
+        "{root}/logs/fig4/{object}.log",
     benchmark:
-        "results/benchmarks/fig4/{object}.tsv"
+        "{root}/benchmarks/fig4/{object}.tsv"
     threads: 1
     resources:
         mem_mb=mem_mb("fig4_force_maps"),
         runtime=runtime_min("fig4_force_maps"),
     params:
-        fig4=config["analyses"]["fig4"],
-        success=success_verdict(config["analyses"]),
+        cfg=step_cfg("fig4"),
     script:
         "../scripts/fig4_force_maps.py"
 
 
 rule fig5_hierarchy:
     input:
-        hierarchy="results/tables/hierarchy.csv",
+        hierarchy="{root}/tables/hierarchy.csv",
         code=code("fig5_hierarchy"),
     output:
         success_png=report(
-            "results/figures/fig5a_hierarchy_success.png",
+            "{root}/figures/fig5a_hierarchy_success.png",
             caption="../report/fig5a.rst",
             category="Figures",
         ),
-        success_pdf="results/figures/fig5a_hierarchy_success.pdf",
+        success_pdf="{root}/figures/fig5a_hierarchy_success.pdf",
         force_png=report(
-            "results/figures/fig5b_hierarchy_force.png",
+            "{root}/figures/fig5b_hierarchy_force.png",
             caption="../report/fig5b.rst",
             category="Figures",
         ),
-        force_pdf="results/figures/fig5b_hierarchy_force.pdf",
+        force_pdf="{root}/figures/fig5b_hierarchy_force.pdf",
     log:
-        "results/logs/fig5_hierarchy.log",
+        "{root}/logs/fig5_hierarchy.log",
     benchmark:
-        "results/benchmarks/fig5_hierarchy.tsv"
+        "{root}/benchmarks/fig5_hierarchy.tsv"
     threads: 1
     resources:
         mem_mb=mem_mb("fig5_hierarchy"),
         runtime=runtime_min("fig5_hierarchy"),
     params:
-        first=config["synergy_sets"]["hierarchy_first"],
-        success=success_verdict(config["analyses"]),
+        cfg=step_cfg("fig5"),
     script:
         "../scripts/fig5_hierarchy.py"
 
@@ -91,6 +89,8 @@ rule fig3_rulegraph:
         mem_mb=mem_mb("fig3_rulegraph"),
         runtime=runtime_min("fig3_rulegraph"),
     params:
-        configfiles=workflow.configfiles,
+        # the rule graph does not depend on the configuration's values: drawn with the
+        # shipped one, so that neither a config value nor a config file's path reruns it
+        configfile=str(ROOT / "config" / "config.yaml"),
     script:
         "../scripts/fig3_rulegraph.py"

@@ -4,37 +4,39 @@
 
 rule optimise_shard:
     input:
-        contacts="results/objects/{object}/contacts.parquet",
+        contacts=step_input("simulate"),
         code=code("optimise_shard"),
         data=SHIPPED_DATA,
-        user=user_files(),
+        user=user_files,
     output:
-        temp("results/objects/{object}/gfo_shards/{shard}.parquet"),
+        temp("{root}/objects/{object}/gfo_shards/{shard}.parquet"),
     log:
-        "results/logs/optimise/{object}_{shard}.log",
+        "{root}/logs/optimise/{object}_{shard}.log",
     benchmark:
-        "results/benchmarks/optimise/{object}_{shard}.tsv"
+        "{root}/benchmarks/optimise/{object}_{shard}.tsv"
     threads: 1
     resources:
         mem_mb=mem_mb("optimise_shard"),
         runtime=runtime_min("optimise_shard"),
     params:
-        opt=optimisation_params,
-        n_shards=len(SHARDS),
+        cfg=step_cfg("optimise"),
     script:
         "../scripts/optimise_shard.py"
 
 
 rule aggregate_gfo:
     input:
-        shards=expand("results/objects/{{object}}/gfo_shards/{shard}.parquet", shard=SHARDS),
+        shards=lambda w: [
+            f"{w.root}/objects/{w.object}/gfo_shards/{i}.parquet"
+            for i in range(scenario_config(w)["solver"]["pose_shards"])
+        ],
         code=code("aggregate_gfo"),
     output:
-        "results/objects/{object}/gfo.parquet",
+        "{root}/objects/{object}/gfo.parquet",
     log:
-        "results/logs/aggregate_gfo/{object}.log",
+        "{root}/logs/aggregate_gfo/{object}.log",
     benchmark:
-        "results/benchmarks/aggregate_gfo/{object}.tsv"
+        "{root}/benchmarks/aggregate_gfo/{object}.tsv"
     threads: 1
     resources:
         mem_mb=mem_mb("aggregate_gfo"),

@@ -3,7 +3,7 @@
 # sets, shards, closure model) instead of going stale. docs/cluster.md gives the method.
 import math
 
-from synergrasp.simulation.placement import Placement, pose_grid
+from synergrasp.config import grid_axis_deg, synergy_sets
 
 # Measured cost of one job: fixed wall time (s) and memory (MB) of the job itself (imports,
 # reading inputs), plus wall time and memory per unit of work. From results/benchmarks/*.tsv
@@ -80,12 +80,14 @@ SOLVER_COMPILE_S, SOLVER_COMPILE_MB = 60.0, 150
 # rounded up to whole minutes and to 100 MB.
 RUNTIME_MARGIN, MEMORY_MARGIN = 3.0, 1.5
 
-N_POSES = pose_grid(Placement.from_config(config["placement"], config["grid"])).n_poses
-N_SETS = len(SETS)
-SHARD_POSES = math.ceil(N_POSES / len(SHARDS))
-CLOSURE_FACTOR = CLOSURE_COST_FACTOR.get(
-    config["closure"].get("model", "kinematic"), CLOSURE_UNMEASURED_FACTOR
+# Sizes of the default scenario (the largest scenarios of a sweep should set their own
+# resources through a profile if they are much larger).
+N_POSES = len(grid_axis_deg(STUDY["grid"]["alpha_deg"])) * len(
+    grid_axis_deg(STUDY["grid"]["beta_deg"])
 )
+N_SETS = len(synergy_sets(STUDY["synergy_sets"]))
+SHARD_POSES = math.ceil(N_POSES / STUDY["solver"]["pose_shards"])
+CLOSURE_FACTOR = CLOSURE_COST_FACTOR.get(STUDY["closure"]["model"], CLOSURE_UNMEASURED_FACTOR)
 
 
 def job_size(step):

@@ -6,19 +6,19 @@ rule simulate_contacts:
     input:
         code=code("simulate_contacts"),
         data=SHIPPED_DATA,
-        user=user_files(),
+        user=user_files,
     output:
-        "results/objects/{object}/contacts.parquet",
+        "{root}/objects/{object}/contacts.parquet",
     log:
-        "results/logs/simulate_contacts/{object}.log",
+        "{root}/logs/simulate_contacts/{object}.log",
     benchmark:
-        "results/benchmarks/simulate_contacts/{object}.tsv"
+        "{root}/benchmarks/simulate_contacts/{object}.tsv"
     threads: 1
     resources:
         mem_mb=mem_mb("simulate_contacts"),
         runtime=runtime_min("simulate_contacts"),
     params:
-        sim=simulation_params,
+        cfg=step_cfg("simulate"),
     script:
         "../scripts/simulate_contacts.py"
 
@@ -27,52 +27,50 @@ rule fig1_synergy_postures:
     input:
         code=code("fig1_synergy_postures"),
         data=SHIPPED_DATA,
-        user=user_files(),
+        user=user_files,
     output:
         png=report(
-            "results/figures/fig1_synergy_postures.png",
+            "{root}/figures/fig1_synergy_postures.png",
             caption="../report/fig1.rst",
             category="Figures",
         ),
-        pdf="results/figures/fig1_synergy_postures.pdf",
+        pdf="{root}/figures/fig1_synergy_postures.pdf",
     log:
-        "results/logs/fig1_synergy_postures.log",
+        "{root}/logs/fig1_synergy_postures.log",
     benchmark:
-        "results/benchmarks/fig1_synergy_postures.tsv"
+        "{root}/benchmarks/fig1_synergy_postures.tsv"
     threads: 1
     resources:
         mem_mb=mem_mb("fig1_synergy_postures"),
         runtime=runtime_min("fig1_synergy_postures"),
     params:
-        hand=config["hand"],
-        synergies=config["synergies"],
+        cfg=step_cfg("fig1"),
     script:
         "../scripts/fig1_synergy_postures.py"
 
 
 rule fig2_example_grasps:
     input:
-        contacts=expand("results/objects/{object}/contacts.parquet", object=OBJECTS),
+        contacts=step_inputs("simulate"),
         code=code("fig2_example_grasps"),
         data=SHIPPED_DATA,
-        user=user_files(),
+        user=user_files,
     output:
         png=report(
-            "results/figures/fig2_example_grasps.png",
+            "{root}/figures/fig2_example_grasps.png",
             caption="../report/fig2.rst",
             category="Figures",
         ),
-        pdf="results/figures/fig2_example_grasps.pdf",
+        pdf="{root}/figures/fig2_example_grasps.pdf",
     log:
-        "results/logs/fig2_example_grasps.log",
+        "{root}/logs/fig2_example_grasps.log",
     benchmark:
-        "results/benchmarks/fig2_example_grasps.tsv"
+        "{root}/benchmarks/fig2_example_grasps.tsv"
     threads: 1
     resources:
         mem_mb=mem_mb("fig2_example_grasps"),
         runtime=runtime_min("fig2_example_grasps"),
     params:
-        objects=[object_config(name) for name in OBJECTS],
-        hand=config["hand"],
+        cfg=step_cfg("fig2"),
     script:
         "../scripts/fig2_example_grasps.py"

@@ -1,12 +1,14 @@
 """Fig. 1: the hand along each of the first seven synergies, sigma = -1, 0, +1."""
 
+from synergrasp.config import step_params
 from synergrasp.figures.hand_figures import figure_synergy_postures
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
-    hand = load_hand(snakemake.params.hand)
-    synergies = load_synergies(snakemake.params.synergies, joint_names=hand.joint_names)
+    params = step_params(snakemake.params.cfg, "fig1")
+    hand = load_hand(params.hand)
+    synergies = load_synergies(params.synergies, joint_names=hand.joint_names)
     figure_synergy_postures(hand, synergies, snakemake.output.png, snakemake.output.pdf,
                             n_synergies=min(7, synergies.matrix.shape[1]))

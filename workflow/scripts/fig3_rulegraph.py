@@ -8,10 +8,7 @@ from synergrasp.job_log import job_log
 with job_log(snakemake.log[0]) as log:
     command = [sys.executable, "-m", "snakemake", "figures", "-s", snakemake.input.snakefile,
                "--nolock", "--quiet", "all", "--rulegraph", "dot"]
-    for path in snakemake.params.configfiles:
-        command += ["--configfile", str(path)]
-    if snakemake.params.configfiles:
-        command.append("--replace-workflow-config")
+    command += ["--configfile", snakemake.params.configfile, "--replace-workflow-config"]
     run = subprocess.run(command, capture_output=True, text=True)
     log.write(run.stderr)
     run.check_returncode()

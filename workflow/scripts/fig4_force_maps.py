@@ -3,14 +3,15 @@
 import pandas as pd
 
 from synergrasp.analysis.verdicts import with_verdicts
+from synergrasp.config import step_params
 from synergrasp.figures.study_figures import figure_exploded_views, figure_force_maps
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
-    success = snakemake.params.success
-    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), success)
+    p = step_params(snakemake.params.cfg, "fig4")
+    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), p.success)
     minima = pd.read_parquet(snakemake.input.minima)
-    fig4, name, out = snakemake.params.fig4, snakemake.wildcards.object, snakemake.output
-    figure_force_maps(gfo, minima, fig4["panel_k"], name, out.maps_png, out.maps_pdf, success)
-    figure_exploded_views(gfo, fig4["panel_k"], fig4["alpha_slice_deg"], fig4["beta_slice_deg"],
-                          name, out.exploded_png, out.exploded_pdf, success)
+    name, out, panel_k = snakemake.wildcards.object, snakemake.output, list(p.fig4_panel_k)
+    figure_force_maps(gfo, minima, panel_k, name, out.maps_png, out.maps_pdf, p.success)
+    figure_exploded_views(gfo, panel_k, p.fig4_alpha_slice_deg, p.fig4_beta_slice_deg,
+                          name, out.exploded_png, out.exploded_pdf, p.success)

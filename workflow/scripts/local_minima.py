@@ -4,8 +4,10 @@ import pandas as pd
 
 from synergrasp.analysis.minima import minima_table
 from synergrasp.analysis.verdicts import with_verdicts
+from synergrasp.config import step_params
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
-    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), snakemake.params.success)
-    minima_table(gfo, radius_deg=snakemake.params.radius_deg).to_parquet(snakemake.output[0], index=False)
+    params = step_params(snakemake.params.cfg, "minima")
+    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), params.success)
+    minima_table(gfo, radius_deg=params.radius_deg).to_parquet(snakemake.output[0], index=False)

@@ -4,17 +4,17 @@ import warnings
 import pandas as pd
 
 from synergrasp.analysis.invariants import InvariantWarning
-from synergrasp.analysis.summaries import AnalysisSettings, study_tables
+from synergrasp.analysis.summaries import study_tables
+from synergrasp.config import step_params
 from synergrasp.job_log import job_log
 from synergrasp.tables import write_study_table
 
 with job_log(snakemake.log[0]) as log, warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always", InvariantWarning)
-    p = snakemake.params
-    settings = AnalysisSettings.from_config(p.analyses, p.objects, p.grid, p.hand, p.g_m_per_s2)
+    p = step_params(snakemake.params.cfg, "tables")
     gfo = pd.concat([pd.read_parquet(path) for path in snakemake.input.gfo], ignore_index=True)
     minima = pd.concat([pd.read_parquet(path) for path in snakemake.input.minima], ignore_index=True)
-    tables = study_tables(gfo, minima, p.sets, p.table2_k_max, settings)
+    tables = study_tables(gfo, minima, p.synergy_sets, p.table2_k_max, p.settings)
     for name, (title, table) in tables.items():
         write_study_table(table, snakemake.output[f"{name}_csv"], snakemake.output[f"{name}_md"], title=title)
     for warning in caught:  # the invariant checks on the console, everything in the log

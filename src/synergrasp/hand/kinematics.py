@@ -204,9 +204,25 @@ def _number(node: dict, key: str, field: str, minimum: float | None = None) -> f
     return float(value)
 
 
-def _mapping(node: Any, field: str) -> dict:
+#: The keys allowed at each level of a hand file (a misspelt optional key is an error).
+_HAND_KEYS: dict[str, tuple[str, ...]] = {
+    "<top level>": ("name", "palm_normal", "palm", "fingers"),
+    "palm": ("shapes",),
+    "finger": ("knuckle", "tip_mm", "joints"),
+    "knuckle": ("xyz_mm", "rpy_rad"),
+    "joint": ("name", "offset_mm", "rpy_rad", "axis", "rolling_gap_mm", "limits_deg", "link", "shapes"),
+    "capsule": ("from_mm", "to_mm", "radius_mm"),
+    "box": ("center_mm", "size_mm", "rpy_rad"),
+}
+
+
+def _mapping(node: Any, field: str, kind: str | None = None) -> dict:
     if not isinstance(node, dict):
         raise _err(field, f"must be a mapping, got {type(node).__name__}")
+    allowed = _HAND_KEYS.get(kind or "", None)
+    unknown = [k for k in node if k not in allowed] if allowed else []
+    if unknown:
+        raise _err(field, f"unknown key(s) {unknown}; allowed keys: {list(allowed)}")
     return node
 
 
@@ -215,7 +231,7 @@ def _shape(node: Any, field: str) -> Shape:
     if len(node) != 1 or next(iter(node)) not in SHAPE_KINDS:
         raise _err(field, f"must be a single key, one of {SHAPE_KINDS}, got {list(node)}")
     kind = next(iter(node))
-    spec = _mapping(node[kind], f"{field}.{kind}")
+    spec = _mapping(node[kind], f"{field}.{kind}", kind)
     f = f"{field}.{kind}"
     if kind == "capsule":
         a = _vector(spec, "from_mm", f)
@@ -254,17 +270,22 @@ def load_hand(path: str | Path | None = None) -> Hand:
     Raises ValueError naming the offending field.
     """
     path = default_hand_path() if path is None else Path(path)
-    with open(path, encoding="utf-8") as fh:
-        try:
-            doc = yaml.safe_load(fh)
-        except yaml.YAMLError as exc:
-            raise ValueError(f"hand file {path}: not valid YAML: {exc}") from None
-    return hand_from_dict(doc)
+    try:
+        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc).splitlines()[0]
+        raise ValueError(f"hand file '{path}': not a readable YAML file ({reason})") from None
+    if doc is None:
+        raise ValueError(f"hand file '{path}': is empty; the format is in docs/hand.md")
+    try:
+        return hand_from_dict(doc)
+    except ValueError as exc:
+        raise ValueError(str(exc).replace("hand file:", f"hand file '{path}':", 1)) from None
 
 
 def hand_from_dict(doc: Any) -> Hand:
     """Build a Hand from the parsed content of a hand file (see ``load_hand``)."""
-    doc = _mapping(doc, "<top level>")
+    doc = _mapping(doc, "<top level>", "<top level>")
     for key in ("palm", "fingers"):
         if key not in doc:
             raise _err(key, "missing")
@@ -288,7 +309,7 @@ def hand_from_dict(doc: Any) -> Hand:
     link_frame = [0]
     link_parent = [-1]
     link_parent_joint = [-1]
-    link_shapes = [_shapes(_mapping(doc["palm"], "palm"), "palm")]
+    link_shapes = [_shapes(_mapping(doc["palm"], "palm", "palm"), "palm")]
     joint_names: list[str] = []
     lower: list[float] = []
     upper: list[float] = []
@@ -309,8 +330,8 @@ def hand_from_dict(doc: Any) -> Hand:
 
     for finger in FINGERS:
         ff = f"fingers.{finger}"
-        fnode = _mapping(fingers[finger], ff)
-        knuckle = _mapping(fnode.get("knuckle"), f"{ff}.knuckle")
+        fnode = _mapping(fingers[finger], ff, "finger")
+        knuckle = _mapping(fnode.get("knuckle"), f"{ff}.knuckle", "knuckle")
         knuckle_pose = pose_matrix(_vector(knuckle, "xyz_mm", f"{ff}.knuckle"), _vector(knuckle, "rpy_rad", f"{ff}.knuckle"))
         tips.append(_vector(fnode, "tip_mm", ff))
         joints = fnode.get("joints")
@@ -322,7 +343,7 @@ def hand_from_dict(doc: Any) -> Hand:
         fl: list[int] = []
         for i, jnode in enumerate(joints):
             jf = f"{ff}.joints[{i}]"
-            jnode = _mapping(jnode, jf)
+            jnode = _mapping(jnode, jf, "joint")
             jname = jnode.get("name")
             k = len(joint_names)
             if k >= len(JOINT_NAMES) or jname != JOINT_NAMES[k]:

@@ -131,15 +131,15 @@ def mapping_path(name: str = DEFAULT_TABLE) -> Path:
 def resolve_synergies(source: str | Path | None) -> Path:
     """The CSV file of a ``synergies:`` value: None (the default table), the name of a shipped
     table (SHIPPED_TABLES) or a path. A value that is neither a name nor an existing file
-    raises FileNotFoundError naming both the allowed names and the path tried."""
+    raises SynergyFileError naming both the allowed names and the path tried."""
     if source is None:
         return shipped_path()
     if str(source) in SHIPPED_TABLES:
         return shipped_path(str(source))
     path = Path(source)
     if not path.is_file():
-        raise FileNotFoundError(f"synergies: {str(source)!r} is neither a shipped table {list(SHIPPED_TABLES)} "
-                                f"nor an existing CSV file")
+        raise SynergyFileError(f"synergy file '{source}': is neither a shipped table {list(SHIPPED_TABLES)} "
+                               f"nor an existing CSV file")
     return path
 
 
@@ -152,8 +152,8 @@ def _read_table(path: str | Path, joint_names: Sequence[str]) -> tuple[list[str]
     where = f"synergy file '{path}'"
     try:
         table = pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True)
-    except FileNotFoundError:
-        raise
+    except OSError as err:
+        raise SynergyFileError(f"{where}: cannot be read ({err.strerror or err})") from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as err:
         raise SynergyFileError(f"{where}: not a readable CSV table ({err})") from None
     columns = [str(c).strip() for c in table.columns]
@@ -217,8 +217,6 @@ def load_synergies(path: str | Path | None = None,
     ------
     SynergyFileError
         Naming the file, the field and what is allowed.
-    FileNotFoundError
-        If ``path`` does not exist.
     """
     path = resolve_synergies(path)
     syn_cols, mean, matrix = _read_table(path, joint_names)

@@ -81,27 +81,17 @@ class ClosureParams:
         if not self.step_mm > self.tolerance_mm:
             raise ValueError(f"ClosureParams.step_mm must be greater than tolerance_mm, got {self.step_mm}")
 
-    @classmethod
-    def from_config(cls, closure: Mapping[str, Any]) -> ClosureParams:
-        """From the config's ``closure`` block."""
-        allowed = {"tolerance_mm", "contact_distance_mm",
-                   "penetration_tolerance_mm", "step_mm", "model", "dynamic"}
-        unknown = set(closure) - allowed
-        if unknown:
-            raise ValueError(f"closure: unknown key(s) {sorted(unknown)}; allowed keys: {sorted(allowed)}")
-        return cls(**dict(closure))
-
-
 
 def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams,
-                  mechanics: Mapping[str, Any] | None = None, mass_kg: float = 1.0):
+                  mechanics: Mapping[str, Any] | None = None, mass_kg: float | None = None):
     """The closure model of ``params`` on a new pybullet scene of ``hand``; the dynamic model
     also needs the config's ``mechanics`` block (k_ss, μ, gravity) and the box's mass (kg)."""
     if params.model == "dynamic":
         from synergrasp.simulation.dynamic_closure import DynamicClosure
 
-        if mechanics is None:
-            raise ValueError("closure.model: dynamic needs the mechanics block (k_ss_Nmm_per_rad, mu, gravity)")
+        if mechanics is None or mass_kg is None:
+            raise ValueError("closure.model: dynamic needs the mechanics block (k_ss_Nmm_per_rad, mu, gravity) "
+                             "and the object's mass_kg")
         return DynamicClosure(hand, synergies, params, mechanics, mass_kg)
     from synergrasp.simulation.kinematic_closure import KinematicClosure
 
@@ -135,7 +125,7 @@ def simulate_object(hand: Hand, synergies: Synergies, box: Any, placement: Place
         if not 0 <= v < grid.n_poses:
             raise ValueError(f"poses must be in 0 … {grid.n_poses - 1}, got {v}")
     size = np.asarray(box.size_mm, dtype=float)
-    model = closure_model(hand, synergies, closure_params, mechanics, float(getattr(box, "mass_kg", 1.0)))
+    model = closure_model(hand, synergies, closure_params, mechanics, getattr(box, "mass_kg", None))
     placer = HandScene(hand)  # the open hand the box is brought to (placement)
     try:
         rows = []

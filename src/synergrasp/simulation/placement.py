@@ -7,9 +7,9 @@ Lengths in mm, angles in rad (degrees only in pose labels and grid ranges), palm
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -109,20 +109,6 @@ class Placement:
                              f"the grid must span less than 360 deg")
         object.__setattr__(self, "center_mm", center)
         object.__setattr__(self, "box_axes", axes)
-
-    @classmethod
-    def from_config(cls, placement: Mapping[str, Any], grid: Mapping[str, Any] | None = None) -> Placement:
-        """From the config's ``placement`` block and (optionally) its ``grid`` block."""
-        allowed = ("mode", "approach_point_mm", "clearance_mm", "center_mm", "box_axes", "rotation_order")
-        unknown = set(placement) - set(allowed)
-        if unknown:
-            raise ValueError(f"placement: unknown key(s) {sorted(unknown)}; allowed keys: {sorted(allowed)}")
-        kwargs: dict[str, Any] = {key: placement[key] for key in allowed if key in placement}
-        for key in ("alpha_deg", "beta_deg"):
-            if grid is not None and key in grid:
-                g = grid[key]
-                kwargs[key] = (g["start"], g["stop"], g["step"])
-        return cls(**kwargs)
 
 
 @dataclass(frozen=True)

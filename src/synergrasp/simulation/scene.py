@@ -75,17 +75,19 @@ class HandScene:
         self.placed = placed
         best = (np.inf, np.zeros(3))
         box_pose, box_half = _pose(placed), placed.half_extents_mm
+        b0, b1 = _box_edges(box_pose, box_half)
         for pose, half in self._palm_boxes():
             # two convex boxes: the closest points lie on an edge of one of them
             a0, a1 = _box_edges(pose, half)
-            b0, b1 = _box_edges(box_pose, box_half)
             d_ab, t_ab = segment_box_distance(*_to_local(a0, a1, box_pose), np.tile(box_half, (12, 1)))
-            d_ba, _ = segment_box_distance(*_to_local(b0, b1, pose), np.tile(half, (12, 1)))
-            k = int(np.argmin(d_ab))
-            d = min(float(d_ab[k]), float(np.min(d_ba)))
+            d_ba, t_ba = segment_box_distance(*_to_local(b0, b1, pose), np.tile(half, (12, 1)))
+            d = min(float(d_ab.min()), float(d_ba.min()))
             if d < best[0]:
-                point = a0[k] + t_ab[k] * (a1[k] - a0[k]) if d_ab[k] <= np.min(d_ba) else _nearest_on(b0, b1, pose, half)
-                best = (d, point)
+                # every edge at that distance (ties are common: parallel edges and faces), so
+                # that the point does not depend on the order of the edges
+                ends = np.concatenate([a0 + t_ab[:, None] * (a1 - a0), b0 + t_ba[:, None] * (b1 - b0)])
+                tied = np.concatenate([d_ab, d_ba]) <= d + 1e-6
+                best = (d, ends[tied].mean(axis=0))
         self._palm_gap = best
 
     def _palm_boxes(self) -> list[tuple[NDArray, NDArray]]:
@@ -99,7 +101,8 @@ class HandScene:
     def _palm_patch_centre(self, contact_distance_mm: float) -> NDArray:
         """The middle of the palm–box contact patch: the mean of the sample points (corners,
         edge middles, face centres) of either box within the gap + ``contact_distance_mm`` of
-        the other; the closest palm point when no sample is that close (edge across edge)."""
+        the other; when no sample is that close (an edge across an edge or a face), the mean
+        of the closest points of the closest edges."""
         box_pose, box_half = _pose(self.placed), self.placed.half_extents_mm
         reach = max(self._palm_gap[0], 0.0) + contact_distance_mm
         near = []
@@ -111,16 +114,25 @@ class HandScene:
         return near.mean(axis=0) if len(near) else self._palm_gap[1]
 
     def _palm_face_normal(self, point: NDArray, reach_mm: float, otherwise: NDArray) -> NDArray:
-        """The outward normal of the one palm face within ``reach_mm`` of ``point`` (the
-        object's inward normal at a contact on that face); ``otherwise`` if the point is near
-        no face or near several (a palm edge: then the box's face decides)."""
-        faces = []
+        """The object's inward normal at a palm contact at ``point``: the outward normal of
+        the palm face within ``reach_mm`` of it if there is exactly one (the box lies on that
+        face, with a face, an edge or a corner); else (the contact is at a palm edge) the
+        mean inward normal of the box faces within reach, normalised; ``otherwise`` if none.
+        Faces are found by distance, never by the order of the axes, so the normal is the
+        same for every orientation of the box that fills the same region."""
+        palm = []
         for pose, half in self._palm_boxes():
             local = pose[:3, :3].T @ (np.asarray(point) - pose[:3, 3])
-            for k in range(3):
-                if abs(abs(local[k]) - half[k]) <= reach_mm:
-                    faces.append(np.sign(local[k]) * pose[:3, k])
-        return faces[0] if len(faces) == 1 else otherwise
+            palm += [np.sign(local[k]) * pose[:3, k] for k in range(3) if abs(abs(local[k]) - half[k]) <= reach_mm]
+        if len(palm) == 1:
+            return palm[0]
+        R, half = self.placed.rotation, self.placed.half_extents_mm
+        local = R.T @ (np.asarray(point) - self.placed.center_mm)
+        box = [-np.sign(local[k]) * R[:, k] for k in range(3) if abs(abs(local[k]) - half[k]) <= reach_mm]
+        if not box:
+            return otherwise
+        mean = np.sum(box, axis=0)
+        return mean / np.linalg.norm(mean)
 
     def _capsule_box(self) -> tuple[NDArray, NDArray]:
         """Signed distance (c,) of every capsule to the box (mm) and the closest axis points (c, 3)."""
@@ -254,12 +266,3 @@ def _pose(placed: ObjectPose) -> NDArray:
 def _to_local(p0: NDArray, p1: NDArray, pose: NDArray) -> tuple[NDArray, NDArray]:
     R, c = pose[:3, :3], pose[:3, 3]
     return (p0 - c) @ R, (p1 - c) @ R
-
-
-def _nearest_on(b0: NDArray, b1: NDArray, pose: NDArray, half: NDArray) -> NDArray:
-    """The point of the palm box nearest to the box edges b0–b1 (palm frame)."""
-    l0, l1 = _to_local(b0, b1, pose)
-    d, t = segment_box_distance(l0, l1, np.tile(half, (len(l0), 1)))
-    k = int(np.argmin(d))
-    local = np.clip(l0[k] + t[k] * (l1[k] - l0[k]), -half, half)
-    return pose[:3, :3] @ local + pose[:3, 3]
