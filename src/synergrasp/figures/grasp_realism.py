@@ -56,13 +56,15 @@ def _contacts_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
 def _shares_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
     y = np.arange(len(table))
     height = 0.8 / len(_SHARES)
-    colours = ("#d95f02", "#a6761d", "#7570b3", "0.45")
+    colours = ("#d95f02", "#1b9e77", "#7570b3", "0.45")
     for k, ((column, label), colour) in enumerate(zip(_SHARES, colours)):
         value = table[column].to_numpy(dtype=float)
         yk = y - 0.4 + (k + 0.5) * height
         ax.barh(yk, np.nan_to_num(value), height=height, color=colour, label=label)
         for yi, v in zip(yk, value):
-            ax.text(min(np.nan_to_num(v), 88.0), yi, f" {v:.0f}" if np.isfinite(v) else " –", va="center", fontsize=6)
+            inside = np.isfinite(v) and v >= 15.0  # the number at the bar's end, inside it when it fits
+            ax.text(v - 1.0 if inside else np.nan_to_num(v) + 1.0, yi, f"{v:.0f}" if np.isfinite(v) else "–",
+                    va="center", ha="right" if inside else "left", fontsize=6, color="white" if inside else "black")
     ax.set_yticks(y, labels)
     ax.invert_yaxis()
     ax.set_xlim(0, 100)
