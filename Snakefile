@@ -2,6 +2,7 @@
 #   snakemake -j2 figures            every table and figure of the study
 #   snakemake -j2 object_obj4        one object's own outputs (contacts, forces, minima, Fig. 4)
 #   snakemake -j2 scenario_<name>    one scenario of `scenarios:` (config/README.md); `scenarios`: all
+#   snakemake -j2 sensitivity        every scenario and the summary across them (docs/sensitivity.md)
 #   snakemake --report results/report.html   (or results/report.zip)
 from snakemake.utils import min_version
 
@@ -11,6 +12,8 @@ min_version("9.0")
 # The study's configuration. `--configfile my.yaml` is an overlay on it (config/README.md:
 # mappings merge key by key, other values replace, null removes a key).
 configfile: f"{workflow.basedir}/config/config.yaml"
+# The default sensitivity sweep (docs/sensitivity.md): scenarios only, one factor at a time.
+configfile: f"{workflow.basedir}/config/sensitivity.yaml"
 
 
 report: "workflow/report/workflow.rst"
@@ -22,6 +25,7 @@ include: "workflow/rules/simulate.smk"
 include: "workflow/rules/optimise.smk"
 include: "workflow/rules/analyse.smk"
 include: "workflow/rules/figures.smk"
+include: "workflow/rules/sensitivity.smk"
 
 
 rule all:
@@ -59,3 +63,10 @@ for _scenario in SCENARIOS:
 rule scenarios:
     input:
         [f for _scenario in SCENARIOS for f in study_targets(_scenario)],
+
+
+# Every scenario and the summary across them (docs/sensitivity.md).
+rule sensitivity:
+    input:
+        [f for _scenario in SCENARIOS for f in study_targets(_scenario)],
+        SENSITIVITY_FILES,

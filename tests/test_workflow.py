@@ -377,3 +377,24 @@ def test_a_killed_run_reruns_only_what_did_not_finish(run_j2, tmp_path, kill):
         assert table.read_bytes() == (tmp_path / "results" / "tables" / table.name).read_bytes(), table.name
     for parquet in sorted((run_j2 / "results" / "objects").rglob("*.parquet")):
         assert parquet.read_bytes() == (tmp_path / parquet.relative_to(run_j2)).read_bytes(), parquet
+
+
+def test_small_sweep_summary_has_one_row_per_scenario(run_j2, tmp_path):
+    """The small config with two scenarios: `sensitivity` builds every scenario from the
+    default's results and a summary with one row per scenario, default first."""
+    config = yaml.safe_load(SMALL.read_text())
+    config.update(yaml.safe_load((ROOT / "tests" / "config" / "small_sweep.yaml").read_text()))
+    path = tmp_path / "sweep.yaml"
+    path.write_text(yaml.safe_dump(config))
+    workdir = tmp_path / "work"
+    shutil.copytree(run_j2 / "results", workdir / "results")
+    out = snakemake(workdir, "-j2", "sensitivity", configfile=path)
+    assert out.returncode == 0, out.stderr[-5000:]
+    summary = pd.read_csv(workdir / "results" / "sensitivity" / "claims.csv")
+    assert list(summary["scenario"]) == ["default", *config["scenarios"]]
+    claims = pd.read_csv(workdir / "results" / "tables" / "claims.csv")
+    assert {f"claim{c}_verdict" for c in claims["claim"]} <= set(summary.columns)
+    for name in ("claims_grid", "table2_curves"):
+        assert (workdir / "results" / "sensitivity" / f"{name}.png").stat().st_size > 0
+    # both scenarios share the default's simulation: no contacts of their own
+    assert not list((workdir / "results" / "scenarios").glob("*/objects/*/contacts.parquet"))

@@ -48,6 +48,12 @@ JOB_COST = {
         "fixed_mb": 231,
         "unit_mb": 2.2e-4,
     },
+    "sensitivity_summary": {
+        "fixed_s": 5.0,
+        "unit_s": 0.0,
+        "fixed_mb": 300,
+        "unit_mb": 0.0,
+    },
     "grasp_realism": {
         "fixed_s": 4.0,
         "unit_s": 4.0e-6,
@@ -125,6 +131,7 @@ def mem_mb(step):
 # submitting them would cost more queue time than they take.
 localrules:
     aggregate_gfo,
+    sensitivity_summary,
     local_minima,
     study_tables,
     grasp_realism,

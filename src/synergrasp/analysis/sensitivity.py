@@ -1,0 +1,95 @@
+"""The study's findings across scenarios: one row per scenario of a sensitivity sweep.
+
+Each scenario (config/README.md) is a complete study; this module gathers, from each one's
+claims table, Table II, success-rate table and minimum-preservation table, the figures a
+reader needs to see which findings survive which modelling choice (docs/sensitivity.md).
+Success rates and shares are in percent.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+__all__ = ["ScenarioTables", "scenario_row", "sensitivity_table", "table2_long",
+           "TABLE2_ROWS", "SINGLE_SYNERGIES"]
+
+#: Table II's k shown in the summary (k = 1, 2, 3: where the study's curves rise).
+TABLE2_ROWS: tuple[int, ...] = (1, 2, 3)
+#: Single-synergy success rates S1..S7 shown in the summary.
+SINGLE_SYNERGIES: tuple[int, ...] = tuple(range(1, 8))
+
+
+@dataclass(frozen=True)
+class ScenarioTables:
+    """One scenario's study tables, as read from its tables/*.csv."""
+
+    claims: pd.DataFrame  #: claim, statement, tested_by, measured, verdict
+    table2: pd.DataFrame  #: object, then one column per k (success rate, %)
+    success_rates: pd.DataFrame  #: object, set_id, n_synergies, success_rate (%), ...
+    preservation: pd.DataFrame  #: object, pairs, preserved_percent, ...
+
+
+def _k_column(table2: pd.DataFrame, k: int) -> pd.Series:
+    """Table II's column k (CSV headers are text), indexed by object; empty when absent."""
+    table = table2.set_index("object")
+    for name in (k, str(k)):
+        if name in table.columns:
+            return table[name].astype(float)
+    return pd.Series(dtype=float)
+
+
+def _single_rate(success_rates: pd.DataFrame, synergy: int) -> float:
+    """Success rate (%) of the set {S<synergy>} alone, averaged over objects; NaN if absent."""
+    rows = success_rates[success_rates["set_id"].astype(str) == str(synergy)]
+    return float(rows["success_rate"].mean()) if len(rows) else np.nan
+
+
+def _preservation_share(preservation: pd.DataFrame) -> float:
+    """Share (%) of local minima preserved over all objects and pairs; NaN if none."""
+    if "pairs" in preservation.columns:
+        row = preservation[(preservation["object"] == "all") & (preservation["pairs"] == "all")]
+        if len(row):
+            return float(row["preserved_percent"].iloc[0])
+    total = preservation["n_minima"].sum() if "n_minima" in preservation.columns else 0
+    return float(100.0 * preservation["n_preserved"].sum() / total) if total else np.nan
+
+
+def scenario_row(name: str, tables: ScenarioTables) -> dict[str, object]:
+    """One scenario's summary: per claim its verdict and the figure behind it; Table II at
+    k = 1, 2, 3 per object; S1..S7 alone (mean over objects); minima preserved (%)."""
+    row: dict[str, object] = {"scenario": name}
+    for claim in tables.claims.itertuples(index=False):
+        row[f"claim{claim.claim}_verdict"] = claim.verdict
+        row[f"claim{claim.claim}_measured"] = claim.measured
+    for k in TABLE2_ROWS:
+        column = _k_column(tables.table2, k)
+        for obj, rate in column.items():
+            row[f"table2_k{k}_{obj}"] = float(rate)
+    for synergy in SINGLE_SYNERGIES:
+        row[f"S{synergy}_success_percent"] = _single_rate(tables.success_rates, synergy)
+    row["minima_preserved_percent"] = _preservation_share(tables.preservation)
+    return row
+
+
+def sensitivity_table(scenarios: Mapping[str, ScenarioTables]) -> pd.DataFrame:
+    """One row per scenario (in the given order, ``default`` first by convention); a claim or
+    object a scenario lacks is empty (NaN) in its row."""
+    if not scenarios:
+        raise ValueError("sensitivity summary: no scenarios given")
+    return pd.DataFrame([scenario_row(name, tables) for name, tables in scenarios.items()])
+
+
+def table2_long(scenarios: Mapping[str, ScenarioTables]) -> pd.DataFrame:
+    """Table II of every scenario in long form: scenario, object, k, success_rate (%)."""
+    frames = []
+    for name, tables in scenarios.items():
+        long = tables.table2.melt(id_vars="object", var_name="k", value_name="success_rate")
+        long.insert(0, "scenario", name)
+        frames.append(long)
+    out = pd.concat(frames, ignore_index=True)
+    out["k"] = out["k"].astype(int)
+    return out

@@ -1,0 +1,91 @@
+"""Figures of a sensitivity sweep: the claims' verdicts across scenarios, and Table II's
+curves per object across scenarios (docs/sensitivity.md)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from synergrasp.analysis.claims import FAILS, HOLDS, UNDEFINED  # noqa: E402
+from synergrasp.figures.output import save_figure  # noqa: E402
+
+__all__ = ["figure_claims_grid", "figure_table2_curves", "VERDICT_COLOURS"]
+
+#: Cell colour per verdict; a claim a scenario did not produce is grey.
+VERDICT_COLOURS = {HOLDS: "#9fd89f", FAILS: "#f19c9c", UNDEFINED: "#f3e08a"}
+_MISSING = "#dddddd"
+
+
+def _claim_ids(summary: pd.DataFrame) -> list[str]:
+    return [c[len("claim"):-len("_verdict")] for c in summary.columns
+            if c.startswith("claim") and c.endswith("_verdict")]
+
+
+def figure_claims_grid(summary: pd.DataFrame, png: str | Path, pdf: str | Path) -> None:
+    """Claims (columns) × scenarios (rows), each cell coloured by the verdict and holding the
+    figure behind it (the claims table's ``measured``, wrapped)."""
+    claims = _claim_ids(summary)
+    n_rows, n_cols = len(summary), max(len(claims), 1)
+    fig, ax = plt.subplots(figsize=(2.6 * n_cols + 1.8, 0.75 * n_rows + 1.2))
+    for i in range(n_rows):
+        for j, claim in enumerate(claims):
+            verdict = summary.iloc[i][f"claim{claim}_verdict"]
+            measured = summary.iloc[i][f"claim{claim}_measured"]
+            colour = VERDICT_COLOURS.get(verdict, _MISSING) if isinstance(verdict, str) else _MISSING
+            ax.add_patch(plt.Rectangle((j, i), 1, 1, facecolor=colour, edgecolor="white"))
+            text = str(measured) if isinstance(measured, str) else "—"
+            ax.text(j + 0.5, i + 0.5, _wrap(text, 34), ha="center", va="center", fontsize=5)
+    ax.set_xlim(0, n_cols)
+    ax.set_ylim(n_rows, 0)
+    ax.set_xticks(np.arange(n_cols) + 0.5, [f"claim {c}" for c in claims])
+    ax.set_yticks(np.arange(n_rows) + 0.5, list(summary["scenario"]))
+    ax.xaxis.tick_top()
+    handles = [plt.Rectangle((0, 0), 1, 1, facecolor=c) for c in VERDICT_COLOURS.values()]
+    ax.legend(handles, list(VERDICT_COLOURS), loc="upper center", bbox_to_anchor=(0.5, -0.01),
+              ncol=3, frameon=False, fontsize=7)
+    fig.tight_layout()
+    save_figure(fig, png, pdf)
+
+
+def _wrap(text: str, width: int) -> str:
+    words, lines, line = text.split(), [], ""
+    for word in words:
+        if line and len(line) + 1 + len(word) > width:
+            lines.append(line)
+            line = word
+        else:
+            line = f"{line} {word}".strip()
+    return "\n".join([*lines, line])
+
+
+def figure_table2_curves(table2: pd.DataFrame, png: str | Path, pdf: str | Path, k_max: int = 7) -> None:
+    """One panel per object: Table II's success rate (%) of {S1..Sk}, k = 1..``k_max``, one
+    line per scenario (the default drawn thick and black). ``table2``: scenario, object, k,
+    success_rate (analysis.sensitivity.table2_long)."""
+    data = table2[table2["k"] <= k_max]
+    objects = sorted(data["object"].unique())
+    fig, axes = plt.subplots(1, len(objects), figsize=(3.2 * len(objects), 3.4), sharey=True,
+                             squeeze=False)
+    scenarios = list(dict.fromkeys(data["scenario"]))
+    colours = plt.get_cmap("tab20")(np.linspace(0, 1, max(len(scenarios), 2)))
+    for ax, obj in zip(axes[0], objects):
+        for colour, name in zip(colours, scenarios):
+            curve = data[(data["object"] == obj) & (data["scenario"] == name)].sort_values("k")
+            default = name == "default"
+            ax.plot(curve["k"], curve["success_rate"], marker=".", label=name,
+                    color="black" if default else colour, lw=2.2 if default else 1.0,
+                    zorder=3 if default else 2)
+        ax.set_title(obj)
+        ax.set_xlabel("k of {S1..Sk}")
+        ax.set_xticks(range(1, k_max + 1))
+        ax.set_ylim(0, 102)
+    axes[0][0].set_ylabel("success rate (%)")
+    axes[0][-1].legend(fontsize=6, loc="lower right", ncol=1 + len(scenarios) // 12)
+    fig.tight_layout()
+    save_figure(fig, png, pdf)
