@@ -303,6 +303,11 @@ def test_optimise_params_keep_the_mechanics_and_the_objects_weight():
     assert (gfo.mu, gfo.f_min, gfo.k_stru, gfo.k_ss) == (1.5, 0.1, 1.0, 200.0)
     assert gfo.wrench()[2] == pytest.approx(0.5 * 9.81)  # the contacts hold the weight: +z
     assert len(params.sets) == 75 and params.pose_shards == 4
+    assert gfo.friction_cone == "circular"
+    pyramid = validate_config(_broken(("mechanics", "friction_cone"), "pyramid8_circumscribed", STUDY))
+    assert step_params(pyramid, "optimise", "obj1").gfo.cone.kind == "pyramid"
+    with pytest.raises(ConfigError, match=r"mechanics.friction_cone.*allowed values: \['circular', 'pyramid4_inscribed'"):
+        validate_config(_broken(("mechanics", "friction_cone"), "pyramid6", STUDY))
 
 
 @pytest.mark.parametrize("path, value, key", [

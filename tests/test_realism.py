@@ -72,6 +72,17 @@ def test_counts_and_shares_by_hand(hand):
     assert row["loaded_contacts_median"] == 1.0  # 1, 3, 0 contacts with a normal force > 0
 
 
+def test_force_closure_is_the_studys_definition_not_load_feasibility(hand):
+    """Pose 1 holds its load only with the weight's help (feasible, strict test fails): it is
+    load-feasible, not in force closure, and its force does not enter the force median."""
+    gfo = _gfo()
+    gfo.loc[(gfo["pose"] == 1) & (gfo["set_id"] == "1-2"), "strict_internal"] = False
+    row = _table(hand, gfo=gfo).iloc[0]
+    assert row["pct_force_closure"] == pytest.approx(100.0 / 3.0)
+    assert row["pct_load_feasible"] == pytest.approx(200.0 / 3.0)
+    assert row["median_force_per_weight"] == pytest.approx(3.0)  # pose 3 only: 30 N / 10 N
+
+
 def test_without_normal_forces_the_loaded_count_is_nan_and_models_group(hand):
     contacts = _contacts()  # the kinematic closure records no forces: NaN per contact
     contacts[NORMAL_FORCE_COLUMN] = [[np.nan] * len(links) for links in contacts["contact_link"]]

@@ -585,7 +585,8 @@ def _optimise(config: Mapping[str, Any], obj: str) -> OptimiseParams:
     kwargs = {field: float(mech[key]) for field, key in _GFO_FIELDS.items()}
     try:
         params = gfo.GFOParams(gravity_direction=tuple(gravity / np.linalg.norm(gravity)),
-                               mass_kg=float(config["objects"][obj]["mass_kg"]), **kwargs)
+                               mass_kg=float(config["objects"][obj]["mass_kg"]),
+                               friction_cone=str(mech["friction_cone"]), **kwargs)
     except (TypeError, ValueError) as err:
         message = str(err)
         for field, key in _GFO_FIELDS.items():

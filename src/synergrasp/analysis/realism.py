@@ -16,6 +16,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
+from synergrasp.analysis.verdicts import verdict_columns
 from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 
 __all__ = ["SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "link_categories", "grasp_realism",
@@ -60,15 +61,19 @@ def _loaded(contacts: pd.DataFrame, threshold_N: float) -> pd.Series:
 
 
 def _weight_multiples(gfo: pd.DataFrame, full_set_id: str, weights_N: Mapping[str, float]) -> pd.DataFrame:
-    """Per (object, pose[, closure_model]) of the full set: rank_G, force_closure and ‖f‖₂ / (m·g)."""
+    """Per (object, pose[, closure_model]) of the full set: rank_G, force_closure (the study's
+    definition: rank(G) = 6 and the strict internal-force test, see analysis.verdicts),
+    load_feasible, and the optimal ‖f‖₂ under the weight / (m·g) where in force closure."""
     full = gfo[gfo["set_id"].astype(str) == full_set_id]
     missing = sorted(set(full["object"]) - set(weights_N))
     if missing:
         raise ValueError(f"weights_N: no weight for object(s) {missing}; given: {sorted(weights_N)}")
     weight = full["object"].map(weights_N).astype(float)
-    fc = full["force_closure"].astype(bool)
+    verdicts = verdict_columns(full)
+    fc = verdicts["force_closure"]
     out = pd.DataFrame({"object": full["object"], "pose": full["pose"].astype(int), "rank_G": full["rank_G"],
-                        "force_closure": fc, "force_per_weight": (full["force_norm"] / weight).where(fc)})
+                        "force_closure": fc, "load_feasible": verdicts["load_feasible"],
+                        "force_per_weight": (full["force_norm"] / weight).where(fc)})
     if "closure_model" in full.columns:  # results of several closure models side by side
         out["closure_model"] = full["closure_model"]
     return out.reset_index(drop=True)
@@ -92,6 +97,7 @@ def _one_group(rows: pd.DataFrame, categories: dict[str, frozenset[int]]) -> dic
         out[f"pct_{name}"] = share(_touches(grasps["contact_link"], links))
     out["pct_rank6"] = share(grasps["rank_G"] == 6)
     out["pct_force_closure"] = share(grasps["force_closure"].fillna(False).astype(bool))
+    out["pct_load_feasible"] = share(grasps["load_feasible"].fillna(False).astype(bool))
     out["median_force_per_weight"] = float(grasps["force_per_weight"].median()) if n else np.nan
     loaded = grasps["loaded_contacts"]
     known = loaded[grasps["n_contacts"] > 0].notna().any()  # forces recorded where there are contacts
