@@ -1,22 +1,6 @@
 # The sensitivity sweep's summary across every scenario (docs/sensitivity.md).
 
 
-def scenario_tables(table):
-    """Every scenario's (default first) study table ``table``.csv."""
-    return [f"{SCENARIO_ROOT[s]}/tables/{table}.csv" for s in SCENARIOS]
-
-
-SENSITIVITY_FILES = [
-    f"results/sensitivity/{name}.{ext}"
-    for name, exts in (
-        ("claims", ("csv", "md")),
-        ("claims_grid", ("png", "pdf")),
-        ("table2_curves", ("png", "pdf")),
-    )
-    for ext in exts
-]
-
-
 rule sensitivity_summary:
     input:
         claims=scenario_tables("claims"),
