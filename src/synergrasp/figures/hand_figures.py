@@ -17,6 +17,7 @@ from synergrasp.analysis.realism import SIMULATED_STATUSES, representative_grasp
 from synergrasp.figures.hand_pictures import (BOX, PALM_CAMERA, SKIN, TOUCHING, BoxInPicture, Camera, box_corners,
                                               hand_shapes, render)
 from synergrasp.figures.output import save_figure
+from synergrasp.hand.synergies import SynergyPath
 
 __all__ = ["figure_synergy_postures", "figure_example_grasps", "PANEL_PX"]
 
@@ -118,12 +119,12 @@ def figure_synergy_postures(hand: Any, synergies: Any, png_path: str | Path, pdf
     matrix = np.asarray(synergies.matrix, dtype=float)
     if not 1 <= n_synergies <= matrix.shape[1]:
         raise ValueError(f"n_synergies must be in 1 … {matrix.shape[1]}, got {n_synergies}")
-    mean = np.clip(np.asarray(synergies.mean, dtype=float), hand.lower, hand.upper)
+    paths = [SynergyPath.along(synergies, hand.lower, hand.upper, synergy=k + 1) for k in range(n_synergies)]
+    mean = paths[0].reference(0.0)
     panel = 2.35  # inches
     fig, axes = plt.subplots(n_synergies, len(sigmas), figsize=(panel * len(sigmas) + 0.4, panel * n_synergies + 0.6),
                              squeeze=False)
-    postures = [[np.clip(mean + sigma * matrix[:, k], hand.lower, hand.upper) for sigma in sigmas]
-                for k in range(n_synergies)]
+    postures = [[path.reference(sigma) for sigma in sigmas] for path in paths]
     camera = _fit(camera, hand, [q for row in postures for q in row] + [mean])
     pictures, named = [], None  # named: the first mean posture's (axes, q, picture)
     for k in range(n_synergies):
