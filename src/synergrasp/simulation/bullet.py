@@ -261,23 +261,14 @@ def self_closest_points(client: int, body: HandBody, distance_mm: float,
 # --------------------------------------------------------------------------------------
 
 @dataclass(frozen=True)
-class ContactForces:
+class ContactForces(ClosestPoints):
     """Contact points of the last physics step between two bodies (m rows), mm, N, palm frame.
 
-    ``link_a`` / ``link_b`` as in :class:`ClosestPoints`; ``normal_on_b`` points from B toward
-    A; ``normal_force`` is the constraint force along it (N, ≥ 0).
+    Fields as in :class:`ClosestPoints`; ``normal_force`` is the constraint force along
+    ``normal_on_b`` (N, ≥ 0).
     """
 
-    link_a: NDArray[np.int64]
-    link_b: NDArray[np.int64]
-    point_a: NDArray[np.float64]
-    point_b: NDArray[np.float64]
-    normal_on_b: NDArray[np.float64]
-    distance: NDArray[np.float64]
     normal_force: NDArray[np.float64]
-
-    def __len__(self) -> int:
-        return len(self.distance)
 
 
 def load_compliant_hand(client: int, hand: Hand, link_mass_kg: float, link_inertia_kg_mm2: float,
