@@ -8,7 +8,7 @@ pybullet's world frame *is* the palm frame, scaled by 1/1000.
 from __future__ import annotations
 
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
@@ -383,19 +383,9 @@ def contact_forces(client: int, body_a: int | HandBody, body_b: HandBody) -> Con
     With the hand as A too: its contacts with itself (both link columns are hand links)."""
     a = body_a.body if isinstance(body_a, HandBody) else body_a
     pts = pb.getContactPoints(a, body_b.body, physicsClientId=client)
-    if not pts:
-        e = np.zeros((0, 3))
-        return ContactForces(np.zeros(0, np.int64), np.zeros(0, np.int64), e, e.copy(), e.copy(), np.zeros(0),
-                             np.zeros(0))
-    return ContactForces(
-        link_a=_to_hand_links(body_a, [p[3] for p in pts]),
-        link_b=_to_hand_links(body_b, [p[4] for p in pts]),
-        point_a=np.array([p[5] for p in pts]) / MM,
-        point_b=np.array([p[6] for p in pts]) / MM,
-        normal_on_b=np.array([p[7] for p in pts]),
-        distance=np.array([p[8] for p in pts]) / MM,
-        normal_force=np.array([p[9] for p in pts]),
-    )
+    closest = _closest(body_a, body_b, pts)  # the shared fields, read the same way
+    shared = {f.name: getattr(closest, f.name) for f in fields(ClosestPoints)}
+    return ContactForces(**shared, normal_force=np.array([p[9] for p in pts], dtype=float).reshape(-1))
 
 
 def step_with_motors(client: int, body: HandBody, targets_rad: NDArray, max_torques_Nmm: NDArray,
