@@ -530,13 +530,8 @@ class FiguresParams:
 STEP_MODULES: dict[str, tuple[str, ...]] = {
     "simulate": ("synergrasp.simulation.closure", "synergrasp.simulation.placement"),
     "optimise": ("synergrasp.optimisation.study",),
-    "tables": ("synergrasp.analysis.summaries",),
+    "tables": ("synergrasp.analysis.summaries", "synergrasp.analysis.periods"),
 }
-
-#: Field of a typed class -> the config key it comes from (messages name the key).
-_GFO_FIELDS = {"mu": "mu", "f_min": "f_min_N", "k_stru": "k_stru_N_per_mm",
-               "k_ss": "k_ss_Nmm_per_rad", "g": "g_m_per_s2"}
-
 
 def _build(cls: Any, where: str, **kwargs: Any) -> Any:
     """``cls(**kwargs)``; a rejected value becomes a ConfigError naming the config key."""
@@ -580,33 +575,30 @@ def _fields(cls: Any, values: Mapping[str, Any]) -> dict[str, Any]:
 
 def _optimise(config: Mapping[str, Any], obj: str) -> OptimiseParams:
     gfo = importlib.import_module("synergrasp.optimisation.study")
-    mech = config["mechanics"]
-    gravity = np.asarray(mech["gravity_direction"], dtype=float)
-    kwargs = {field: float(mech[key]) for field, key in _GFO_FIELDS.items()}
-    try:
-        params = gfo.GFOParams(gravity_direction=tuple(gravity / np.linalg.norm(gravity)),
-                               mass_kg=float(config["objects"][obj]["mass_kg"]),
-                               friction_cone=str(mech["friction_cone"]), **kwargs)
-    except (TypeError, ValueError) as err:
-        message = str(err)
-        for field, key in _GFO_FIELDS.items():
-            if message.startswith(f"{field} "):
-                raise ConfigError(f"config error at 'mechanics.{key}': {message}") from None
-        raise ConfigError(f"config error at 'mechanics' / 'objects.{obj}.mass_kg': {message}") from None
+    params = _build(gfo.GFOParams, "mechanics", **_fields(gfo.GFOParams, config["mechanics"]),
+                    mass_kg=float(config["objects"][obj]["mass_kg"]))
     return OptimiseParams(config["synergies"], synergy_sets(config["synergy_sets"]), params,
                           int(config["solver"]["pose_shards"]))
 
 
 def _tables(config: Mapping[str, Any]) -> TablesParams:
     summaries = importlib.import_module("synergrasp.analysis.summaries")
+    periods = importlib.import_module("synergrasp.analysis.periods")
+    analyses, g = config["analyses"], config["mechanics"]["g_m_per_s2"]
     objects = {name: {**spec, "placement": overlay(config["placement"], spec.get("placement"))}
                for name, spec in config["objects"].items()}
     try:
-        settings = summaries.AnalysisSettings.from_config(config["analyses"], objects, config["grid"], config["hand"],
-                                                          config["mechanics"]["g_m_per_s2"])
+        periods_deg = periods.object_periods(objects, config["grid"], config["hand"])
     except (TypeError, ValueError) as err:
-        raise ConfigError(f"config error at 'analyses': {err}") from None
-    return TablesParams(dict(config["synergy_sets"]), int(config["analyses"]["table2_k_max"]), settings)
+        raise ConfigError(f"config error at 'objects' / 'placement': {err}") from None
+    settings = summaries.AnalysisSettings(
+        success=analyses["success"], marginal_weight_multiple=float(analyses["marginal_weight_multiple"]),
+        radius_deg=float(analyses["minima_radius_deg"]), null_draws=int(analyses["null_model"]["draws"]),
+        null_seed=int(analyses["null_model"]["seed"]),
+        success_rate_tolerance_percent=float(analyses["success_rate_tolerance_percent"]),
+        weights_N={name: float(spec["mass_kg"]) * float(g) for name, spec in objects.items()},
+        periods_deg=periods_deg)
+    return TablesParams(dict(config["synergy_sets"]), int(analyses["table2_k_max"]), settings)
 
 
 def _figures(config: Mapping[str, Any], step: str) -> FiguresParams:
