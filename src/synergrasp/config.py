@@ -402,8 +402,14 @@ STEP_KEYS_WHEN: dict[str, tuple[tuple[str, Any, tuple[str, ...]], ...]] = {
     # the dynamic closure: a free box of the object's mass, μ, k_ss and gravity of mechanics
     "simulate": (("closure.model", "dynamic", ("objects.{object}.mass_kg", "mechanics")),),
 }
-#: The step whose outputs a step reads (its hash includes that step's hash).
-UPSTREAM: dict[str, str] = {"optimise": "simulate", "minima": "optimise"}
+#: The steps whose outputs a step reads (its hash includes theirs): for a step run per object
+#: (OBJECT_STEPS), that object's; for a step run once per scenario, every object's.
+UPSTREAM: dict[str, tuple[str, ...]] = {
+    "optimise": ("simulate",), "minima": ("optimise",), "tables": ("optimise", "minima"),
+    "realism": ("simulate", "optimise"), "fig2": ("simulate",), "fig4": ("optimise", "minima"),
+    "fig5": ("tables",)}
+#: Steps run once per object (the others once per scenario).
+OBJECT_STEPS: frozenset[str] = frozenset({"simulate", "optimise", "minima", "fig4"})
 #: Keys read by the workflow itself, not by a step.
 WORKFLOW_KEYS: tuple[str, ...] = ("scenarios",)
 
@@ -457,10 +463,14 @@ def step_config(config: Mapping[str, Any], step: str, obj: str | None = None) ->
 
 def step_hash(config: Mapping[str, Any], step: str, obj: str | None = None) -> str:
     """Hash of what a step's outputs depend on: the keys it reads and, through
-    :data:`UPSTREAM`, those of the steps before it (12 hex digits)."""
-    parts = [step_config(config, step, obj)]
-    if step in UPSTREAM:
-        parts.append(step_hash(config, UPSTREAM[step], obj))
+    :data:`UPSTREAM`, those of the steps before it (12 hex digits). ``obj``: the object of
+    a step of :data:`OBJECT_STEPS`; None for a step run once per scenario."""
+    parts: list[Any] = [step_config(config, step, obj)]
+    for upstream in UPSTREAM.get(step, ()):
+        if upstream in OBJECT_STEPS and obj is None:
+            parts.append([[name, step_hash(config, upstream, name)] for name in config["objects"]])
+        else:
+            parts.append(step_hash(config, upstream, obj if upstream in OBJECT_STEPS else None))
     text = json.dumps(parts, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:12]
 
