@@ -63,7 +63,7 @@ def main() -> None:
     for grasp in grasps:
         mech = mechanics_for(grasp, params)
         if mech.rank_G == 6:
-            g = GraspSets(mech.f_p, mech.normals, mech.projector, synergies, params.f_min_N, params.cone,
+            g = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, synergies, params.f_min_N, params.cone,
                           params.basis_rtol)
             problems += [(g, j) for j in range(len(g))]
     pick = rng.permutation(len(problems))

@@ -37,7 +37,7 @@ def test_optimise_grasps_matches_clarabel_per_grasp():
             assert set(out["status"][rows]) == {"no_grasp"} and not out["force_closure"][rows].any()
             continue
         mech = mechanics_for(grasp, PARAMS)
-        ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, sets, PARAMS.f_min_N, PARAMS.cone),
+        ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, PARAMS.f_min_N, PARAMS.cone),
                         "clarabel", strict_shrink=PARAMS.strict_shrink)
         np.testing.assert_array_equal(out["status"][rows], ref.status)
         np.testing.assert_array_equal(out["e_s"][rows], ref.e_s)
@@ -79,7 +79,7 @@ def test_pyramid_cone_study_runs_through_piqp_and_matches_clarabel():
         mech = mechanics_for(grasp, params)
         if mech.rank_G < 6:
             continue
-        ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, sets, params.f_min_N, params.cone),
+        ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, params.f_min_N, params.cone),
                         "clarabel", strict_shrink=params.strict_shrink)
         np.testing.assert_array_equal(out["status"][rows], ref.status)
         np.testing.assert_array_equal(out["strict_internal"][rows], ref.strict_internal)
