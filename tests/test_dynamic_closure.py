@@ -7,6 +7,7 @@ import numpy as np
 import pybullet as pb
 import pytest
 
+from synergrasp.config import ConfigError, defaults, step_params, validate_config
 from synergrasp.simulation.closure import ClosureParams, closure_model, simulate_object
 from synergrasp.simulation.dynamic_closure import DynamicParams
 from synergrasp.simulation.objects import Box
@@ -27,13 +28,26 @@ def model(hand, synergies):
     m.close()
 
 
+def _with_dynamic(**values):
+    closure = defaults()["closure"]
+    return {**defaults(), "closure": {**closure, "model": "dynamic", "dynamic": {**closure["dynamic"], **values}}}
+
+
 def test_settings_name_the_key_and_allowed_values():
+    """The dynamic settings are checked once, by the schema and the relations of the config."""
     with pytest.raises(ValueError, match=r"closure.model must be one of \['kinematic', 'dynamic'\]"):
         ClosureParams(model="soft")
-    with pytest.raises(ValueError, match=r"closure.dynamic.unloaded_contacts must be one of \['drop', 'keep'\]"):
-        DynamicParams(unloaded_contacts="ignore")
-    with pytest.raises(ValueError, match="closure.dynamic: unknown key"):
-        ClosureParams(model="dynamic", dynamic={"timestep": 0.01})
+    with pytest.raises(ConfigError, match=r"'closure.dynamic.unloaded_contacts': 'ignore' is not allowed; allowed values: \['drop', 'keep'\]"):
+        validate_config(_with_dynamic(unloaded_contacts="ignore"))
+    with pytest.raises(ConfigError, match=r"'closure.dynamic'.*'timestep'"):
+        validate_config(_with_dynamic(timestep=0.01))
+    with pytest.raises(ConfigError, match=r"'closure.dynamic.time_limit_s': 0.2 must be at least "
+                                          r"closure.dynamic.ramp_time_s \(0.3\)"):
+        validate_config(_with_dynamic(time_limit_s=0.2))
+    # the workflow's one path from the config to the parameters
+    config = validate_config(_with_dynamic(settle_window_s=0.1))
+    params = step_params(config, "simulate", "obj1").closure.dynamic
+    assert isinstance(params, DynamicParams) and params.settle_window_s == 0.1 and params.window_steps == 24
     with pytest.raises(ValueError, match="needs the mechanics block"):
         closure_model(None, None, PARAMS)  # type: ignore[arg-type]
 
@@ -103,8 +117,7 @@ def test_at_rest_the_springs_balance_the_contact_forces(hand, synergies):
     equilibrium is the model's; to check it rather than the solver's convergence the rest is
     reached with 50 solver iterations and a stricter settle criterion (with the defaults the
     residual is reported in docs/dynamic_closure.md)."""
-    tight = DynamicParams(time_limit_s=6.0, solver_iterations=50, settle_joint_speed_rad_per_s=0.03,
-                          settle_object_speed_mm_per_s=2.0)
+    tight = DynamicParams(time_limit_s=6.0, settle_joint_change_rad=0.0015, settle_object_change_mm=0.1)
     params = ClosureParams(model="dynamic", dynamic=tight)
     model = closure_model(hand, synergies, params, MECHANICS, 1.0)
     placed = object_pose(AGAINST_PALM, CUBE60, 0.0, 0.0, hand.palm_normal)
