@@ -24,8 +24,8 @@ through :mod:`synergrasp.simulation.bullet`.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from collections import deque
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -41,11 +41,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.synergies import Synergies
     from synergrasp.simulation.closure import ClosureParams
 
-__all__ = ["UNLOADED_CONTACTS", "DynamicParams", "DynamicClosure", "compliant_self_pairs"]
+__all__ = ["DynamicParams", "DynamicClosure", "compliant_self_pairs"]
 
-#: What happens to a contact whose normal force at the settled state is below
-#: ``DynamicParams.load_threshold_N``: ``drop`` (not listed) or ``keep`` (listed).
-UNLOADED_CONTACTS: tuple[str, ...] = ("drop", "keep")
 _LONG_FINGERS = ("index", "middle", "ring", "little")
 
 
@@ -78,7 +75,8 @@ class DynamicParams:
     lost_distance_mm:      a box with no contact at the end that moved farther than this from
                            its initial pose was pushed out of the hand: status ``lost``.
     load_threshold_N:      a contact carries load if its normal force is at least this, N.
-    unloaded_contacts:     ``drop`` or ``keep`` the contacts below the threshold.
+    unloaded_contacts:     ``drop`` (not listed) or ``keep`` (listed) the contacts below the
+                           threshold.
     """
 
     time_step_s: float = 1.0 / 240.0
