@@ -1,5 +1,6 @@
 """The compliant dynamic closure (closure.model: dynamic): settings, outcomes, the
-soft-synergy balance at rest, determinism."""
+soft-synergy balance at rest, the net wrench on a held box (palm grasp and pinch),
+determinism."""
 
 from __future__ import annotations
 
@@ -7,10 +8,12 @@ import numpy as np
 import pybullet as pb
 import pytest
 
+from synergrasp.config import ConfigError, defaults, step_params, validate_config
+from synergrasp.hand.synergies import Synergies, SynergyPath
 from synergrasp.simulation.closure import ClosureParams, closure_model, simulate_object
 from synergrasp.simulation.dynamic_closure import DynamicParams
 from synergrasp.simulation.objects import Box
-from synergrasp.simulation.placement import Placement, object_pose
+from synergrasp.simulation.placement import ObjectPose, Placement, object_pose
 
 MECHANICS = {"mu": 1.5, "k_ss_Nmm_per_rad": 200.0, "gravity_direction": [1.0, 0.0, 0.0], "g_m_per_s2": 9.81}
 PARAMS = ClosureParams(model="dynamic", dynamic=DynamicParams(time_limit_s=3.0))
@@ -27,13 +30,26 @@ def model(hand, synergies):
     m.close()
 
 
+def _with_dynamic(**values):
+    closure = defaults()["closure"]
+    return {**defaults(), "closure": {**closure, "model": "dynamic", "dynamic": {**closure["dynamic"], **values}}}
+
+
 def test_settings_name_the_key_and_allowed_values():
+    """The dynamic settings are checked once, by the schema and the relations of the config."""
     with pytest.raises(ValueError, match=r"closure.model must be one of \['kinematic', 'dynamic'\]"):
         ClosureParams(model="soft")
-    with pytest.raises(ValueError, match=r"closure.dynamic.unloaded_contacts must be one of \['drop', 'keep'\]"):
-        DynamicParams(unloaded_contacts="ignore")
-    with pytest.raises(ValueError, match="closure.dynamic: unknown key"):
-        ClosureParams(model="dynamic", dynamic={"timestep": 0.01})
+    with pytest.raises(ConfigError, match=r"'closure.dynamic.unloaded_contacts': 'ignore' is not allowed; allowed values: \['drop', 'keep'\]"):
+        validate_config(_with_dynamic(unloaded_contacts="ignore"))
+    with pytest.raises(ConfigError, match=r"'closure.dynamic'.*'timestep'"):
+        validate_config(_with_dynamic(timestep=0.01))
+    with pytest.raises(ConfigError, match=r"'closure.dynamic.time_limit_s': 0.2 must be at least "
+                                          r"closure.dynamic.ramp_time_s \(0.3\)"):
+        validate_config(_with_dynamic(time_limit_s=0.2))
+    # the workflow's one path from the config to the parameters
+    config = validate_config(_with_dynamic(settle_window_s=0.1))
+    params = step_params(config, "simulate", "obj1").closure.dynamic
+    assert isinstance(params, DynamicParams) and params.settle_window_s == 0.1 and params.window_steps == 24
     with pytest.raises(ValueError, match="needs the mechanics block"):
         closure_model(None, None, PARAMS)  # type: ignore[arg-type]
 
@@ -103,8 +119,7 @@ def test_at_rest_the_springs_balance_the_contact_forces(hand, synergies):
     equilibrium is the model's; to check it rather than the solver's convergence the rest is
     reached with 50 solver iterations and a stricter settle criterion (with the defaults the
     residual is reported in docs/dynamic_closure.md)."""
-    tight = DynamicParams(time_limit_s=6.0, solver_iterations=50, settle_joint_speed_rad_per_s=0.03,
-                          settle_object_speed_mm_per_s=2.0)
+    tight = DynamicParams(time_limit_s=6.0, settle_joint_change_rad=0.0015, settle_object_change_mm=0.1)
     params = ClosureParams(model="dynamic", dynamic=tight)
     model = closure_model(hand, synergies, params, MECHANICS, 1.0)
     placed = object_pose(AGAINST_PALM, CUBE60, 0.0, 0.0, hand.palm_normal)
@@ -169,3 +184,49 @@ def test_a_box_pushed_out_of_the_hand_is_lost(hand, synergies):
     assert row["status"] == "lost" and row["n_contacts"] == 0
     assert np.linalg.norm(row["object_translation_mm"]) > 10.0
     assert np.allclose(row["object_center"], np.asarray(placement.center_mm) + row["object_translation_mm"])
+
+
+def test_thumb_index_pinch_of_a_small_box_settles_with_a_near_zero_net_wrench(hand, synergies):
+    """Gravity off: a 20 mm cube on the thumb's pad, pressed by the closing index, ends held
+    by the two fingertips alone, with a near-zero net contact wrench (force within 5 % of the
+    summed contact-force magnitudes, moment about its centre within 5 % of that sum times the
+    half edge). The set-up is the pinch's: the thumb (compliant, k_ss) is held at q_r(σ = 1)
+    of S1, the other fingers extended, and only the index closes, along its S1 entries. (Closing
+    both along S1 makes the tips cross past each other and roll the box out between them.)"""
+    thumb, index = list(hand.finger_joints[0]), list(hand.finger_joints[1])
+    mean = np.where(hand.flexion_joints, hand.lower, synergies.mean)
+    mean[thumb] = SynergyPath.along(synergies, hand.lower, hand.upper).reference(1.0)[thumb]
+    mean[index] = synergies.mean[index]
+    closing = np.zeros(hand.n_joints)
+    closing[index] = synergies.matrix[index, 0]
+    pinch = Synergies(synergies.joint_names, mean, closing[:, None], ("S1",))
+    model = closure_model(hand, pinch, PARAMS, MECHANICS, 1.0)
+    try:
+        # the box's face on the thumb's pad, toward the index tip where the tips are 25 mm apart
+        b, edge = model.bullet, 20.0
+        tip_t, tip_i = hand.finger_links[0][-1], hand.finger_links[1][-1]
+        for sigma in np.linspace(model.sigma_open, model.sigma_closed, 400):
+            b.reset_hand(model.client, model.body, model.path.reference(sigma))
+            near = b.self_closest_points(model.client, model.body, 500.0, ((tip_t, tip_i),))
+            if near.distance.min() <= edge + 5.0:
+                break
+        k = int(np.argmin(near.distance))
+        x = near.point_b[k] - near.point_a[k]
+        x /= np.linalg.norm(x)
+        y = np.cross(x, [0.0, 0.0, 1.0])
+        y /= np.linalg.norm(y)
+        placed = ObjectPose(near.point_a[k] + (edge / 2 + 0.3) * x, np.stack([x, y, np.cross(x, y)], axis=1),
+                            np.full(3, edge / 2))
+        result = model.grasp(np.full(3, edge), placed)
+        assert result.status == "grasp" and result.settled
+        fingertips = set(hand.finger_links[0]) | set(hand.finger_links[1])
+        links, points, forces = b.contact_force_vectors(model.client, model.box, model.body)
+        assert set(links[:, 1].tolist()) <= fingertips and set(result.links.tolist()) <= fingertips
+        assert {hand.link_finger[link] for link in result.links} == {"thumb", "index"}
+        scale = np.linalg.norm(forces, axis=1).sum()
+        assert scale > 1.0
+        assert np.linalg.norm(forces.sum(axis=0)) <= 0.05 * scale
+        moment = np.cross(points - result.settled_pose.center_mm, forces).sum(axis=0)
+        assert np.linalg.norm(moment) <= 0.05 * scale * edge / 2
+    finally:
+        model.close()

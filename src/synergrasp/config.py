@@ -287,6 +287,10 @@ def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -
     if closure["step_mm"] <= closure["tolerance_mm"]:
         problems.append(f"config error at 'closure.step_mm': {closure['step_mm']} must exceed "
                         f"closure.tolerance_mm ({closure['tolerance_mm']})")
+    dynamic = closure["dynamic"]
+    if dynamic["time_limit_s"] < dynamic["ramp_time_s"]:
+        problems.append(f"config error at 'closure.dynamic.time_limit_s': {dynamic['time_limit_s']} must be "
+                        f"at least closure.dynamic.ramp_time_s ({dynamic['ramp_time_s']})")
     if all(abs(v) < 1e-12 for v in config["mechanics"]["gravity_direction"]):
         problems.append("config error at 'mechanics.gravity_direction': must be a non-zero vector")
     sets = config["synergy_sets"]
@@ -573,7 +577,9 @@ def _simulate(config: Mapping[str, Any], obj: str) -> SimulateParams:
     return SimulateParams(
         hand=config["hand"], synergies=config["synergies"], box=_box(config, obj),
         placement=placement_params(placement, config["grid"]),
-        closure=_build(closure.ClosureParams, "closure", **_fields(closure.ClosureParams, config["closure"])),
+        closure=_build(closure.ClosureParams, "closure", **{
+            **_fields(closure.ClosureParams, config["closure"]),
+            "dynamic": closure.DynamicParams(**config["closure"]["dynamic"])}),
         mechanics=config.get("mechanics"))
 
 

@@ -388,21 +388,6 @@ def contact_forces(client: int, body_a: int | HandBody, body_b: HandBody) -> Con
     return ContactForces(**shared, normal_force=np.array([p[9] for p in pts], dtype=float).reshape(-1))
 
 
-def step_with_motors(client: int, body: HandBody, targets_rad: NDArray, max_torques_Nmm: NDArray,
-                     position_gain: float) -> None:
-    """Drive every elementary axis toward ``targets_rad`` with the engine's position motor
-    (target speed ``position_gain`` · error / time step, velocity gain 1) whose torque is
-    bounded by ``max_torques_Nmm`` (N·mm, one per axis, HandBody order); take one step."""
-    n = len(body.joint_indices)
-    pb.setJointMotorControlArray(body.body, body.joint_indices.tolist(), pb.POSITION_CONTROL,
-                                 targetPositions=[float(v) for v in targets_rad],
-                                 targetVelocities=[0.0] * n,
-                                 forces=(np.asarray(max_torques_Nmm, dtype=float) * MM).tolist(),
-                                 positionGains=[float(position_gain)] * n, velocityGains=[1.0] * n,
-                                 physicsClientId=client)
-    pb.stepSimulation(physicsClientId=client)
-
-
 def step_with_torques(client: int, body: HandBody, torques_Nmm: NDArray) -> None:
     """Apply ``torques_Nmm`` (N·mm, one per elementary axis, HandBody order) and take one step."""
     pb.setJointMotorControlArray(body.body, body.joint_indices.tolist(), pb.TORQUE_CONTROL,

@@ -62,8 +62,6 @@ class ClosureParams:
     def __post_init__(self) -> None:
         if self.model not in CLOSURE_MODELS:
             raise ValueError(f"closure.model must be one of {list(CLOSURE_MODELS)}, got {self.model!r}")
-        if isinstance(self.dynamic, Mapping):
-            object.__setattr__(self, "dynamic", DynamicParams.from_config(self.dynamic))
         for name in ("tolerance_mm", "contact_distance_mm",
                      "penetration_tolerance_mm", "step_mm"):
             v = getattr(self, name)
