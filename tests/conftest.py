@@ -26,6 +26,22 @@ def study_gfo_params(**changes):
     return replace(step_params(defaults(), "optimise", "obj1").gfo, **changes)
 
 
+def study_placement(obj="obj1", **changes):
+    """The study's placement of ``obj`` with its pose grid (the configuration's defaults),
+    with ``changes`` replacing fields."""
+    return replace(step_params(defaults(), "simulate", obj).placement, **changes)
+
+
+def study_dynamic_params(**changes):
+    """The dynamic closure's settings of the configuration's defaults, ``changes`` replaced."""
+    return replace(step_params(defaults(), "simulate", "obj1").closure.dynamic, **changes)
+
+
+def study_closure_params(**changes):
+    """The study's closure settings (the configuration's defaults), ``changes`` replaced."""
+    return replace(step_params(defaults(), "simulate", "obj1").closure, **changes)
+
+
 def study_analysis_settings(**changes):
     """The study's analysis settings (the configuration's defaults) for tables of made-up
     objects (no weights, no α-periods), with ``changes`` replacing fields."""

@@ -8,15 +8,17 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.simulation.closure import ClosureParams, simulate_object
+from conftest import study_closure_params, study_placement
+from synergrasp.config import ConfigError, defaults, validate_config
+from synergrasp.simulation.closure import simulate_object
 from synergrasp.simulation.contacts import read_grasps, write_contacts
-from synergrasp.simulation.placement import Placement, approach_line, object_pose, palm_centre, pose_grid
+from synergrasp.simulation.placement import approach_line, object_pose, palm_centre, pose_grid
 from synergrasp.hand.kinematics import forward_kinematics
 from synergrasp.hand.synergies import SynergyPath, load_synergies
 from synergrasp.simulation.objects import Box
 
-PARAMS = ClosureParams()
-PLACEMENT = Placement()
+PARAMS = study_closure_params()
+PLACEMENT = study_placement()
 CUBE = Box("obj1", (30.0, 30.0, 30.0), 1.0)
 PLATE = Box("obj2", (30.0, 60.0, 60.0), 1.0)
 
@@ -53,30 +55,29 @@ def test_grid_has_72_by_25_poses_and_index_round_trips(grid):
     assert grid.index(180.0, 0.0) == grid.index(-180.0, 0.0)  # α is periodic
 
 
-@pytest.mark.parametrize("kwargs, field", [
-    ({"box_axes": (0, 0, 2)}, "box_axes"),
-    ({"mode": "drop"}, "mode"),
-    ({"clearance_mm": -1.0}, "clearance_mm"),
-    ({"approach_point_mm": (1.0, 2.0)}, "approach_point_mm"),
-    ({"rotation_order": "xyz"}, "rotation_order"),
-    ({"center_mm": (1.0, 2.0)}, "center_mm"),
-    ({"alpha_deg": (-180.0, 180.0, 5.0)}, "alpha_deg"),
-    ({"beta_deg": (-60.0, 61.0, 5.0)}, "beta_deg"),
+@pytest.mark.parametrize("block, key, value, message", [
+    ("placement", "box_axes", [0, 0, 2], "'placement.box_axes'"),
+    ("placement", "mode", "drop", "'placement.mode'"),
+    ("placement", "clearance_mm", -1.0, "'placement.clearance_mm'"),
+    ("placement", "approach_point_mm", [1.0, 2.0], "'placement.approach_point_mm'"),
+    ("placement", "rotation_order", "xyz", "'placement.rotation_order'"),
+    ("placement", "center_mm", [1.0, 2.0], "'placement.center_mm'"),
+    ("grid", "alpha_deg", {"start": -180, "stop": 180, "step": 5}, "'grid.alpha_deg'"),
+    ("grid", "beta_deg", {"start": -60, "stop": 61, "step": 5}, "'grid.beta_deg.step'"),
+    ("closure", "step_mm", 0.1, "'closure.step_mm'"),
+    ("closure", "tolerance_mm", 0.0, "'closure.tolerance_mm'"),
 ])
-def test_bad_placement_names_the_field(kwargs, field):
-    with pytest.raises(ValueError, match=field):
-        Placement(**kwargs)
-
-
-def test_bad_closure_params_name_the_field():
-    with pytest.raises(ValueError, match="step_mm"):
-        ClosureParams(step_mm=0.1)
-    with pytest.raises(ValueError, match="tolerance_mm"):
-        ClosureParams(tolerance_mm=0.0)
+def test_bad_placement_and_closure_values_name_the_key(block, key, value, message):
+    """Placement and closure values are checked once, before any job (the schema and the
+    relations of the configuration); the typed classes only carry them."""
+    config = defaults()
+    config[block] = {**config[block], key: value}
+    with pytest.raises(ConfigError, match=message):
+        validate_config(config)
 
 
 def test_zero_pose_maps_box_edges_to_palm_axes():
-    placed = object_pose(Placement(box_axes=(2, 0, 1)), (10.0, 20.0, 30.0), 0.0, 0.0)
+    placed = object_pose(study_placement(box_axes=(2, 0, 1)), (10.0, 20.0, 30.0), 0.0, 0.0)
     extent = np.abs(placed.rotation) @ placed.half_extents_mm  # half extent along palm x, y, z
     np.testing.assert_allclose(extent, [15.0, 5.0, 10.0])
 
@@ -196,7 +197,7 @@ def test_jacobian_rows_match_finite_differences_of_fk(hand, sample):
 @pytest.fixture(scope="module")
 def empty_hand(hand, synergies):
     """Closures with nothing to grasp (the box 600 mm away)."""
-    far = Placement(mode="fixed", center_mm=(600.0, 0.0, 0.0))
+    far = study_placement(mode="fixed", center_mm=(600.0, 0.0, 0.0))
     return simulate_object(hand, synergies, CUBE, far, PARAMS, poses=[0, 900])
 
 
@@ -257,7 +258,7 @@ def test_open_path_pinches_thumb_with_index_and_middle(hand, table):
 
 
 def test_box_through_the_palm_is_flagged(hand, synergies):
-    inside = Placement(mode="fixed", center_mm=(0.0, 0.0, 50.0))
+    inside = study_placement(mode="fixed", center_mm=(0.0, 0.0, 50.0))
     table = simulate_object(hand, synergies, CUBE, inside, PARAMS, poses=[0])
     assert table.status.iloc[0] == "intersects_open_hand"
     assert table.n_contacts.iloc[0] == 0
@@ -350,7 +351,7 @@ def test_approach_brings_the_box_to_the_open_hand(hand, synergies, clearance):
     (independent check: pybullet distance at the open posture), never intersecting it."""
     from synergrasp.simulation.closure import closure_model, place_box
 
-    placement = Placement(clearance_mm=clearance)
+    placement = study_placement(clearance_mm=clearance)
     point, normal = approach_line(placement, hand)
     model = closure_model(hand, synergies, PARAMS)
     try:

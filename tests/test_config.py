@@ -327,17 +327,12 @@ def test_optimise_params_keep_the_mechanics_and_the_objects_weight():
         validate_config(_broken(("mechanics", "friction_cone"), "pyramid6", STUDY))
 
 
-@pytest.mark.parametrize("path, value, key", [
-    (("mechanics", "gravity_direction"), [0.0, 0.0, 0.0], "mechanics"),
-    (("closure", "step_mm"), 0.1, "closure"),
-])
-def test_errors_of_the_typed_parameters_name_the_config_key(path, value, key):
+def test_errors_of_the_typed_parameters_name_the_config_key():
     # a job is handed only checked values (each checked once, by the schema and
     # check_relations); what a typed class must still refuse names the config key
-    config = _broken(path, value, defaults())
-    step = path[0] == "closure" and "simulate" or "optimise"
-    with pytest.raises(ConfigError, match=f"config error at '{key}'"):
-        step_params(config, step, "obj1")
+    config = _broken(("mechanics", "gravity_direction"), [0.0, 0.0, 0.0], defaults())
+    with pytest.raises(ConfigError, match="config error at 'mechanics'"):
+        step_params(config, "optimise", "obj1")
 
 
 def _imports(path):

@@ -8,19 +8,20 @@ import numpy as np
 import pybullet as pb
 import pytest
 
+from conftest import study_closure_params, study_dynamic_params, study_placement
 from synergrasp.config import ConfigError, defaults, step_params, validate_config
 from synergrasp.hand.synergies import Synergies, SynergyPath
-from synergrasp.simulation.closure import ClosureParams, closure_model, simulate_object
+from synergrasp.simulation.closure import closure_model, simulate_object
 from synergrasp.simulation.dynamic_closure import DynamicParams
 from synergrasp.simulation.objects import Box
-from synergrasp.simulation.placement import ObjectPose, Placement, object_pose
+from synergrasp.simulation.placement import ObjectPose, object_pose
 
 MECHANICS = {"mu": 1.5, "k_ss_Nmm_per_rad": 200.0, "gravity_direction": [1.0, 0.0, 0.0], "g_m_per_s2": 9.81}
-PARAMS = ClosureParams(model="dynamic", dynamic=DynamicParams(time_limit_s=3.0))
+PARAMS = study_closure_params(model="dynamic", dynamic=study_dynamic_params(time_limit_s=3.0))
 CUBE60 = np.array([60.0, 60.0, 60.0])
 #: A 60 mm cube against the palm: the palm's surface is at x = 9.5 mm (hand.yaml), the
 #: cube's palm-side face 0.3 mm in front of it, centred on the palm's width.
-AGAINST_PALM = Placement(center_mm=(9.5 + 30.0 + 0.3, -9.0, 75.0))
+AGAINST_PALM = study_placement(center_mm=(9.5 + 30.0 + 0.3, -9.0, 75.0))
 
 
 @pytest.fixture(scope="module")
@@ -37,8 +38,8 @@ def _with_dynamic(**values):
 
 def test_settings_name_the_key_and_allowed_values():
     """The dynamic settings are checked once, by the schema and the relations of the config."""
-    with pytest.raises(ValueError, match=r"closure.model must be one of \['kinematic', 'dynamic'\]"):
-        ClosureParams(model="soft")
+    with pytest.raises(ConfigError, match=r"'closure.model': 'soft' is not allowed; allowed values: \['kinematic', 'dynamic'\]"):
+        validate_config({**defaults(), "closure": {**defaults()["closure"], "model": "soft"}})
     with pytest.raises(ConfigError, match=r"'closure.dynamic.unloaded_contacts': 'ignore' is not allowed; allowed values: \['drop', 'keep'\]"):
         validate_config(_with_dynamic(unloaded_contacts="ignore"))
     with pytest.raises(ConfigError, match=r"'closure.dynamic'.*'timestep'"):
@@ -55,7 +56,7 @@ def test_settings_name_the_key_and_allowed_values():
 
 
 def test_no_object_every_finger_closes_to_its_limits_or_to_the_hand(model, hand):
-    far = object_pose(Placement(center_mm=(600.0, 0.0, 100.0)), CUBE60, 0.0, 0.0, hand.palm_normal)
+    far = object_pose(study_placement(center_mm=(600.0, 0.0, 100.0)), CUBE60, 0.0, 0.0, hand.palm_normal)
     result = model.grasp(CUBE60, far)
     assert result.status == "no_contact" and result.settled
     assert np.allclose(result.settled_pose.center_mm, far.center_mm)
@@ -119,8 +120,8 @@ def test_at_rest_the_springs_balance_the_contact_forces(hand, synergies):
     equilibrium is the model's; to check it rather than the solver's convergence the rest is
     reached with 50 solver iterations and a stricter settle criterion (with the defaults the
     residual is reported in docs/dynamic_closure.md)."""
-    tight = DynamicParams(time_limit_s=6.0, settle_joint_change_rad=0.0015, settle_object_change_mm=0.1)
-    params = ClosureParams(model="dynamic", dynamic=tight)
+    tight = study_dynamic_params(time_limit_s=6.0, settle_joint_change_rad=0.0015, settle_object_change_mm=0.1)
+    params = study_closure_params(model="dynamic", dynamic=tight)
     model = closure_model(hand, synergies, params, MECHANICS, 1.0)
     placed = object_pose(AGAINST_PALM, CUBE60, 0.0, 0.0, hand.palm_normal)
     try:
@@ -149,8 +150,8 @@ def _check_balance(model, hand, params, result):
 
 
 def test_deterministic_on_rerun_and_whatever_ran_before(hand, synergies):
-    params = ClosureParams(model="dynamic", dynamic=DynamicParams(time_limit_s=0.4))
-    box, placement = Box("obj1", (30.0, 30.0, 30.0), 1.0), Placement()
+    params = study_closure_params(model="dynamic", dynamic=study_dynamic_params(time_limit_s=0.4))
+    box, placement = Box("obj1", (30.0, 30.0, 30.0), 1.0), study_placement()
     alone = simulate_object(hand, synergies, box, placement, params, poses=[300], mechanics=MECHANICS)
     after = simulate_object(hand, synergies, box, placement, params, poses=[0, 150, 300], mechanics=MECHANICS)
     for column in ("status", "q", "contact_link", "contact_point", "contact_normal_force_N", "object_center"):
@@ -177,8 +178,8 @@ def test_a_box_pushed_out_of_the_hand_is_lost(hand, synergies):
     """obj4 placed 50 mm in front of the palm (fixed placement, centre (90, 5, 112) mm): at α = −180°,
     β = −40° the closing fingers push it away and nothing holds it (no gravity)."""
     box = Box("obj4", (100.0, 60.0, 100.0), 1.0)
-    placement = Placement(mode="fixed", center_mm=(90.0, 5.0, 112.0), box_axes=(1, 0, 2))
-    row = simulate_object(hand, synergies, box, placement, ClosureParams(model="dynamic"), poses=[4],
+    placement = study_placement(mode="fixed", center_mm=(90.0, 5.0, 112.0), box_axes=(1, 0, 2))
+    row = simulate_object(hand, synergies, box, placement, study_closure_params(model="dynamic"), poses=[4],
                           mechanics=MECHANICS).iloc[0]
     assert (row["alpha_deg"], row["beta_deg"]) == (-180.0, -40.0)
     assert row["status"] == "lost" and row["n_contacts"] == 0

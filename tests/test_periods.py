@@ -4,8 +4,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from conftest import study_placement
+from synergrasp.config import defaults
 from synergrasp.analysis.periods import alpha_period_deg, distinct_pose_mask, object_periods, period_violations
-from synergrasp.simulation.placement import Placement
 
 GRID = dict(alpha_deg=(-180.0, 175.0, 5.0), beta_deg=(-60.0, 60.0, 5.0))
 
@@ -21,14 +22,15 @@ GRID = dict(alpha_deg=(-180.0, 175.0, 5.0), beta_deg=(-60.0, 60.0, 5.0))
     ((30, 30, 30), (0, 1, 2), "beta_then_alpha", (0.0, 0.0, 5.0), 90.0),     # ... unless beta is always 0
 ])
 def test_period_of_boxes(size, axes, order, beta, period):
-    placement = Placement(center_mm=(40.0, 5.0, 110.0), box_axes=axes, rotation_order=order,
-                          alpha_deg=GRID["alpha_deg"], beta_deg=beta)
+    placement = study_placement(center_mm=(40.0, 5.0, 110.0), box_axes=axes, rotation_order=order,
+                                alpha_deg=GRID["alpha_deg"], beta_deg=beta)
     assert alpha_period_deg(placement, size) == period
 
 
 def test_object_periods_from_the_config():
-    objects = {"cube": {"size_mm": [30, 30, 30], "placement": {"center_mm": [38, 5, 112]}},
-               "slab": {"size_mm": [30, 60, 100], "placement": {"center_mm": [38, 5, 112], "box_axes": [0, 1, 2]}}}
+    placement = {**defaults()["placement"], "mode": "fixed", "center_mm": [38, 5, 112]}  # the effective placement
+    objects = {"cube": {"size_mm": [30, 30, 30], "placement": placement},
+               "slab": {"size_mm": [30, 60, 100], "placement": {**placement, "box_axes": [0, 1, 2]}}}
     grid = {"alpha_deg": {"start": -180, "stop": 175, "step": 5}, "beta_deg": {"start": -60, "stop": 60, "step": 5}}
     assert object_periods(objects, grid) == {"cube": 90.0, "slab": 180.0}
 

@@ -10,7 +10,6 @@ mm, rad, palm frame (docs/closure.md).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -28,16 +27,12 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
 
-__all__ = ["CLOSURE_MODELS", "ClosureParams", "simulate_object", "closure_model", "place_box"]
-
-#: ``kinematic``: the quasi-static closure (links stop at first touch, the box fixed);
-#: ``dynamic``: the compliant hand closing on a free box (``dynamic_closure``).
-CLOSURE_MODELS: tuple[str, ...] = ("kinematic", "dynamic")
-
+__all__ = ["ClosureParams", "simulate_object", "closure_model", "place_box"]
 
 @dataclass(frozen=True)
 class ClosureParams:
-    """Closure settings (docs/closure.md).
+    """Closure settings (docs/closure.md), built by :func:`synergrasp.config.step_params`
+    (``"simulate"``) from the configuration, whose schema holds the defaults and checks them.
 
     The path itself is not a setting: it runs from the fully open hand to the σ at which
     every joint moved by S1 is at a limit (``SynergyPath.closure_range``).
@@ -48,36 +43,23 @@ class ClosureParams:
                               the open hand deeper than this; also the largest accepted
                               penetration of a recorded contact.
     step_mm:                  largest travel of any link point per coarse σ step, mm.
-    model:                    one of CLOSURE_MODELS.
+    model:                    ``kinematic`` (the quasi-static closure: links stop at first
+                              touch, the box fixed) or ``dynamic`` (the compliant hand
+                              closing on a free box, ``dynamic_closure``).
     dynamic:                  settings of the dynamic model (``DynamicParams``).
     """
 
-    tolerance_mm: float = 0.2
-    contact_distance_mm: float = 0.5
-    penetration_tolerance_mm: float = 0.5
-    step_mm: float = 8.0
-    model: str = "kinematic"
-    dynamic: DynamicParams = DynamicParams()
+    tolerance_mm: float
+    contact_distance_mm: float
+    penetration_tolerance_mm: float
+    step_mm: float
+    model: str
+    dynamic: DynamicParams
 
     def __post_init__(self) -> None:
-        if self.model not in CLOSURE_MODELS:
-            raise ValueError(f"closure.model must be one of {list(CLOSURE_MODELS)}, got {self.model!r}")
-        for name in ("tolerance_mm", "contact_distance_mm",
-                     "penetration_tolerance_mm", "step_mm"):
-            v = getattr(self, name)
-            if not isinstance(v, (int, float)) or not math.isfinite(v):
-                raise ValueError(f"ClosureParams.{name} must be a finite number, got {v!r}")
-            object.__setattr__(self, name, float(v))
-        if not 0 < self.tolerance_mm <= 1:
-            raise ValueError(f"ClosureParams.tolerance_mm must be in (0, 1] mm, got {self.tolerance_mm}")
-        if not self.tolerance_mm <= self.contact_distance_mm <= 5:
-            raise ValueError(f"ClosureParams.contact_distance_mm must be in [tolerance_mm, 5] mm, "
-                             f"got {self.contact_distance_mm}")
-        if not 0 <= self.penetration_tolerance_mm <= 5:
-            raise ValueError(f"ClosureParams.penetration_tolerance_mm must be in [0, 5] mm, "
-                             f"got {self.penetration_tolerance_mm}")
-        if not self.step_mm > self.tolerance_mm:
-            raise ValueError(f"ClosureParams.step_mm must be greater than tolerance_mm, got {self.step_mm}")
+        # Checked once, by the schema and config.check_relations (built by config.step_params).
+        for name in ("tolerance_mm", "contact_distance_mm", "penetration_tolerance_mm", "step_mm"):
+            object.__setattr__(self, name, float(getattr(self, name)))
 
 
 def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams,

@@ -79,23 +79,23 @@ class DynamicParams:
                            threshold.
     """
 
-    time_step_s: float = 1.0 / 240.0
-    solver_iterations: int = 50
-    link_mass_kg: float = 0.01
-    link_inertia_kg_mm2: float = 50.0
-    joint_damping_Nmm_s_per_rad: float = 4.0
-    object_mass_kg: float = 0.5
-    object_damping_per_s: float = 50.0
-    ramp_time_s: float = 0.3
-    time_limit_s: float = 1.0
-    settle_window_s: float = 0.05
-    settle_joint_change_rad: float = 0.005
-    settle_object_change_mm: float = 0.25
-    hand_hand_mu: float = 0.1
-    gravity: bool = False
-    lost_distance_mm: float = 1.0
-    load_threshold_N: float = 0.01
-    unloaded_contacts: str = "drop"
+    time_step_s: float
+    solver_iterations: int
+    link_mass_kg: float
+    link_inertia_kg_mm2: float
+    joint_damping_Nmm_s_per_rad: float
+    object_mass_kg: float
+    object_damping_per_s: float
+    ramp_time_s: float
+    time_limit_s: float
+    settle_window_s: float
+    settle_joint_change_rad: float
+    settle_object_change_mm: float
+    hand_hand_mu: float
+    gravity: bool
+    lost_distance_mm: float
+    load_threshold_N: float
+    unloaded_contacts: str
 
     @property
     def ramp_steps(self) -> int:

@@ -19,10 +19,8 @@ from synergrasp.hand.kinematics import axis_rotation
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
 
-__all__ = ["ROTATION_ORDERS", "PLACEMENT_MODES", "palm_centre", "approach_line", "FINGER_AXIS", "Placement", "PoseGrid", "ObjectPose", "pose_grid", "object_pose"]
+__all__ = ["palm_centre", "approach_line", "FINGER_AXIS", "Placement", "PoseGrid", "ObjectPose", "pose_grid", "object_pose"]
 
-ROTATION_ORDERS: tuple[str, ...] = ("alpha_then_beta", "beta_then_alpha")
-PLACEMENT_MODES: tuple[str, ...] = ("approach", "fixed")
 
 #: Long-finger axis of the palm frame (β rotates about it).
 FINGER_AXIS = np.array([0.0, 0.0, 1.0])
@@ -48,7 +46,10 @@ def _range_deg(start: float, stop: float, step: float, name: str) -> NDArray:
 class Placement:
     """Where the box sits relative to the palm (docs/closure.md).
 
-    mode:           ``approach`` (default): the box, turned by (α, β), comes along the palm
+    Built by :func:`synergrasp.config.step_params` (``"simulate"``) from the configuration,
+    whose schema holds the defaults and checks the values.
+
+    mode:           ``approach``: the box, turned by (α, β), comes along the palm
                     normal toward ``approach_point_mm`` until it is ``clearance_mm`` from the
                     open hand (``HandScene.bring_box``), so it never intersects the open hand.
                     ``fixed``: the box centre is ``center_mm`` at every pose.
@@ -67,48 +68,25 @@ class Placement:
     alpha_deg, beta_deg: (start, stop, step) of the inclusive grids, deg; α is periodic.
     """
 
-    mode: str = "approach"
-    approach_point_mm: tuple[float, float, float] | None = None
-    clearance_mm: float = 0.0
-    center_mm: tuple[float, float, float] = (38.0, 5.0, 112.0)
-    box_axes: tuple[int, int, int] = (0, 1, 2)
-    rotation_order: str = "alpha_then_beta"
-    alpha_deg: tuple[float, float, float] = (-180.0, 175.0, 5.0)
-    beta_deg: tuple[float, float, float] = (-60.0, 60.0, 5.0)
+    mode: str
+    approach_point_mm: tuple[float, float, float] | None
+    clearance_mm: float
+    center_mm: tuple[float, float, float]
+    box_axes: tuple[int, int, int]
+    rotation_order: str
+    alpha_deg: tuple[float, float, float]
+    beta_deg: tuple[float, float, float]
 
     def __post_init__(self) -> None:
-        if self.mode not in PLACEMENT_MODES:
-            raise ValueError(f"placement.mode must be one of {list(PLACEMENT_MODES)}, got {self.mode!r}")
+        # Values are checked once, by the schema and config.check_relations; built by
+        # config.step_params, which holds the defaults. Here only the types are settled.
         if self.approach_point_mm is not None:
-            point = tuple(float(v) for v in self.approach_point_mm)
-            if len(point) != 3 or not all(math.isfinite(v) for v in point):
-                raise ValueError(f"placement.approach_point_mm must be 3 finite numbers (mm) or null, "
-                                 f"got {self.approach_point_mm!r}")
-            object.__setattr__(self, "approach_point_mm", point)
-        if not (isinstance(self.clearance_mm, (int, float)) and 0.0 <= self.clearance_mm <= 50.0):
-            raise ValueError(f"placement.clearance_mm must be a number in [0, 50] mm, got {self.clearance_mm!r}")
+            object.__setattr__(self, "approach_point_mm", tuple(float(v) for v in self.approach_point_mm))
         object.__setattr__(self, "clearance_mm", float(self.clearance_mm))
-        center = tuple(float(v) for v in self.center_mm)
-        if len(center) != 3 or not all(math.isfinite(v) for v in center):
-            raise ValueError(f"Placement.center_mm must be 3 finite numbers (mm), got {self.center_mm!r}")
-        axes = tuple(int(a) for a in self.box_axes)
-        if sorted(axes) != [0, 1, 2]:
-            raise ValueError(f"Placement.box_axes must be a permutation of (0, 1, 2), got {self.box_axes!r}")
-        if self.rotation_order not in ROTATION_ORDERS:
-            raise ValueError(f"Placement.rotation_order must be one of {list(ROTATION_ORDERS)}, "
-                             f"got {self.rotation_order!r}")
+        object.__setattr__(self, "center_mm", tuple(float(v) for v in self.center_mm))
+        object.__setattr__(self, "box_axes", tuple(int(a) for a in self.box_axes))
         for name in ("alpha_deg", "beta_deg"):
-            rng = tuple(float(v) for v in getattr(self, name))
-            if len(rng) != 3:
-                raise ValueError(f"Placement.{name} must be (start, stop, step) in deg, got {rng!r}")
-            _range_deg(*rng, name=f"Placement.{name}")
-            object.__setattr__(self, name, rng)
-        alpha = _range_deg(*self.alpha_deg, name="Placement.alpha_deg")
-        if alpha[-1] - alpha[0] >= 360.0:
-            raise ValueError(f"Placement.alpha_deg spans {alpha[-1] - alpha[0]} deg; α is periodic, "
-                             f"the grid must span less than 360 deg")
-        object.__setattr__(self, "center_mm", center)
-        object.__setattr__(self, "box_axes", axes)
+            object.__setattr__(self, name, tuple(float(v) for v in getattr(self, name)))
 
 
 @dataclass(frozen=True)
