@@ -14,13 +14,15 @@ from __future__ import annotations
 import argparse
 import itertools
 import time
+from dataclasses import replace
 
 import numpy as np
 
+from synergrasp.config import defaults, step_params
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.problem import GraspSets, SynergySets
 from synergrasp.optimisation.problems import random_grasp, random_synergies
-from synergrasp.optimisation.study import GFOParams, mechanics_for, optimise_grasps
+from synergrasp.optimisation.study import mechanics_for, optimise_grasps
 
 
 def study_sets() -> list[tuple[int, ...]]:
@@ -42,7 +44,8 @@ def main() -> None:
     sets = study_sets()
     n_poses = max(1, args.problems // len(sets))
     grasps = [random_grasp(rng, int(rng.integers(4, 13)), palm_contacts=int(rng.integers(0, 2))) for _ in range(n_poses)]
-    params = GFOParams(gravity_direction=(0.0, 0.0, -1.0))
+    # the study's mechanics (configuration defaults), gravity along the benchmark grasps' -z
+    params = replace(step_params(defaults(), "optimise", "obj1").gfo, gravity_direction=(0.0, 0.0, -1.0))
     synergies = SynergySets(random_synergies(rng), tuple(sets))
     n = n_poses * len(sets)
 
@@ -60,7 +63,7 @@ def main() -> None:
     for grasp in grasps:
         mech = mechanics_for(grasp, params)
         if mech.rank_G == 6:
-            g = GraspSets(mech.f_p, mech.normals, mech.projector, synergies, params.f_min, params.cone,
+            g = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, synergies, params.f_min_N, params.cone,
                           params.basis_rtol)
             problems += [(g, j) for j in range(len(g))]
     pick = rng.permutation(len(problems))

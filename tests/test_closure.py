@@ -12,7 +12,7 @@ from synergrasp.simulation.closure import ClosureParams, simulate_object
 from synergrasp.simulation.contacts import read_grasps, write_contacts
 from synergrasp.simulation.placement import Placement, approach_line, object_pose, palm_centre, pose_grid
 from synergrasp.hand.kinematics import forward_kinematics
-from synergrasp.hand.synergies import SynergyPath
+from synergrasp.hand.synergies import SynergyPath, load_synergies
 from synergrasp.simulation.objects import Box
 
 PARAMS = ClosureParams()
@@ -240,14 +240,20 @@ def test_closing_on_nothing_pinches_thumb_and_index(hand, empty_hand):
         assert -PARAMS.penetration_tolerance_mm <= gap <= PARAMS.contact_distance_mm + 0.05
 
 
-def test_open_path_pinches_thumb_with_index_and_middle(hand, synergies):
-    """Along q_r(σ) itself the thumb's distal link meets the index's and, at some σ, the middle's."""
-    path = SynergyPath.along(synergies, hand.lower, hand.upper)
+@pytest.mark.parametrize("table", ["softhand_opposed", "softhand_human_higher"])
+def test_open_path_pinches_thumb_with_index_and_middle(hand, table):
+    """Along q_r(σ) itself the thumb's distal link meets the index's and the middle's while
+    the index is still bending (a pinch, not a fist on the curled index: docs/synergies.md)."""
+    path = SynergyPath.along(load_synergies(table, joint_names=hand.joint_names), hand.lower, hand.upper)
     lo, hi = path.closure_range(hand.flexion_joints)
     thumb = hand.link_index("thumb_distal")
+    index = [hand.joint_names.index(f"index_{j}") for j in ("mcp", "pip", "dip")]
     for other in ("index_distal", "middle_distal"):
-        gaps = [_link_gap(hand, path.reference(s), thumb, hand.link_index(other)) for s in np.linspace(lo, hi, 121)]
-        assert min(gaps) <= PARAMS.contact_distance_mm, other
+        sigmas = np.linspace(lo, hi, 121)
+        gaps = np.array([_link_gap(hand, path.reference(s), thumb, hand.link_index(other)) for s in sigmas])
+        assert gaps.min() <= PARAMS.contact_distance_mm, other
+        first = sigmas[np.argmax(gaps <= PARAMS.contact_distance_mm)]
+        assert np.all(path.reference(first)[index] < hand.upper[index] - 0.05), (other, first)
 
 
 def test_box_through_the_palm_is_flagged(hand, synergies):

@@ -282,6 +282,23 @@ def test_a_step_hash_follows_its_upstream_step():
     assert step_hash(full, "optimise", "obj1") != step_hash(other_grid, "optimise", "obj1")
 
 
+def test_a_scenario_wide_step_hash_follows_every_objects_upstream_step():
+    """Fig. 1 reads no step's output; the tables read every object's minima; Fig. 5 the tables;
+    Fig. 2 every object's contacts, which a heavier obj1 leaves alone."""
+    full = validate_config(STUDY)
+    wider = validate_config(_broken(("analyses", "minima_radius_deg"), 20, STUDY))
+    heavier = validate_config(_broken(("objects", "obj1", "mass_kg"), 2.0, STUDY))
+    assert step_config(full, "tables") != step_config(wider, "tables")  # reads the radius itself
+    assert step_config(full, "fig5") == step_config(wider, "fig5")
+    assert step_hash(full, "fig5") != step_hash(wider, "fig5")  # through the tables
+    for step in ("fig1", "fig2", "realism"):
+        assert step_hash(full, step) == step_hash(wider, step), step
+    assert step_hash(full, "fig2") == step_hash(heavier, "fig2")
+    assert step_config(full, "fig4", "obj2") == step_config(heavier, "fig4", "obj2")
+    assert step_hash(full, "fig4", "obj1") != step_hash(heavier, "fig4", "obj1")  # its optimisation
+    assert step_hash(full, "fig4", "obj2") == step_hash(heavier, "fig4", "obj2")
+
+
 def test_step_params_are_built_from_the_steps_own_keys_only():
     full = validate_config(STUDY)
     for step in STEP_KEYS:
@@ -300,7 +317,7 @@ def test_optimise_params_keep_the_mechanics_and_the_objects_weight():
     params = step_params(config, "optimise", "obj1")
     gfo = params.gfo
     assert gfo.gravity_direction == (0.0, 0.0, -1.0)
-    assert (gfo.mu, gfo.f_min, gfo.k_stru, gfo.k_ss) == (1.5, 0.1, 1.0, 200.0)
+    assert (gfo.mu, gfo.f_min_N, gfo.k_stru_N_per_mm, gfo.k_ss_Nmm_per_rad, gfo.g_m_per_s2) == (1.5, 0.1, 1.0, 200.0, 9.81)
     assert gfo.wrench()[2] == pytest.approx(0.5 * 9.81)  # the contacts hold the weight: +z
     assert len(params.sets) == 75 and params.pose_shards == 4
     assert gfo.friction_cone == "circular"
@@ -311,12 +328,12 @@ def test_optimise_params_keep_the_mechanics_and_the_objects_weight():
 
 
 @pytest.mark.parametrize("path, value, key", [
-    (("mechanics", "f_min_N"), -1.0, "mechanics.f_min_N"),
-    (("mechanics", "k_stru_N_per_mm"), 0.0, "mechanics.k_stru_N_per_mm"),
+    (("mechanics", "gravity_direction"), [0.0, 0.0, 0.0], "mechanics"),
     (("closure", "step_mm"), 0.1, "closure"),
 ])
 def test_errors_of_the_typed_parameters_name_the_config_key(path, value, key):
-    # a job is handed only checked values; should one slip through, the message names the key
+    # a job is handed only checked values (each checked once, by the schema and
+    # check_relations); what a typed class must still refuse names the config key
     config = _broken(path, value, defaults())
     step = path[0] == "closure" and "simulate" or "optimise"
     with pytest.raises(ConfigError, match=f"config error at '{key}'"):
@@ -405,6 +422,40 @@ def test_scenarios_differing_in_an_analysis_key_share_simulation_and_optimisatio
     assert code == 0, out[-3000:]
     assert all(p.startswith("results/objects/") for p in jobs["simulate_contacts"])
     assert all(p.startswith("results/scenarios/mu1/") for p in jobs["aggregate_gfo"] + jobs["optimise_shard"])
+
+
+def _target_inputs(out, rule):
+    """The input files of the target rule ``rule`` in a dry run's output."""
+    lines = out.splitlines()
+    start = lines.index(f"rule {rule}:") if f"rule {rule}:" in lines else lines.index(f"localrule {rule}:")
+    line = next(x for x in lines[start:] if x.strip().startswith("input:"))
+    return [p.strip() for p in line.split(":", 1)[1].split(",")]
+
+
+def test_scenarios_differing_in_an_analysis_key_draw_each_shared_figure_once(tmp_path):
+    """Fig. 1 (hand, synergies) and Fig. 2 (hand, box sizes, contacts) are made once, under the
+    default's root, for scenarios that change only analysis keys; a scenario changing only
+    Fig. 4's keys shares the tables, the realism table and Fig. 5 too; each scenario's target
+    still lists every file of its study."""
+    scenarios = {"wide": {"analyses": {"minima_radius_deg": 60}}, "panels": {"analyses": {"fig4": {"panel_k": [1, 15]}}}}
+    code, out, jobs = _dry_run(tmp_path, "scenarios", scenarios)
+    assert code == 0, out[-3000:]
+    assert jobs["fig1_synergy_postures"] == [f"results/figures/fig1_synergy_postures.{e}" for e in ("png", "pdf")]
+    assert jobs["fig2_example_grasps"] == [f"results/figures/fig2_example_grasps.{e}" for e in ("png", "pdf")]
+    # the minima radius changes the tables and Fig. 5 (they read the minima), not the realism table
+    roots = lambda rule, name: sorted(p.rsplit("/", 2)[0] for p in jobs[rule] if p.endswith(name))  # noqa: E731
+    assert roots("study_tables", "/claims.csv") == ["results", "results/scenarios/wide"]
+    assert roots("fig5_hierarchy", "/fig5a_hierarchy_success.png") == ["results", "results/scenarios/wide"]
+    assert roots("grasp_realism", "/grasp_realism.csv") == ["results"]
+    fig4 = sorted(p for p in jobs["fig4_force_maps"] if p.endswith("obj1/fig4_force_maps.png"))
+    assert fig4 == [f"{r}/objects/obj1/fig4_force_maps.png" for r in
+                    ("results", "results/scenarios/panels", "results/scenarios/wide")]
+    default, panels = (_target_inputs(_dry_run(tmp_path, f"scenario_{name}", scenarios)[1], f"scenario_{name}")
+                       for name in ("default", "panels"))
+    assert len(panels) == len(default) == len(set(default))
+    assert [p for p in panels if p not in default] == [
+        f"results/scenarios/panels/objects/{o}/fig4_{k}.{e}" for o in ("obj1", "obj4")
+        for k in ("force_maps", "exploded") for e in ("png", "pdf")]
 
 
 @pytest.mark.parametrize("scenarios, expected", [

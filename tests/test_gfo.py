@@ -9,6 +9,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from conftest import study_gfo_params
 from synergrasp.optimisation.cones import CircularCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.mechanics import Grasp
@@ -48,7 +49,7 @@ def strict_internal_forces(E, normals, mu, method="clarabel"):
 def optimise_grasp(mech, synergy_subset, params, method="clarabel"):
     """GFO and strict test of one grasp (rank(G) = 6) for the set of all given columns."""
     sets = SynergySets(synergy_subset, (tuple(range(1, synergy_subset.shape[1] + 1)),))
-    problems = GraspSets(mech.f_p, mech.normals, mech.projector, sets, params.f_min, params.cone, params.basis_rtol)
+    problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, params.f_min_N, params.cone, params.basis_rtol)
     return row(solve_gfo(problems, method, strict_shrink=params.strict_shrink))
 
 
@@ -101,7 +102,7 @@ def pinch_grasp():
 
 def test_pinch_as_grasp_is_rank_deficient():
     """Two point contacts cannot resist a torque about the line joining them: rank(G) = 5."""
-    params = GFOParams(gravity_direction=(0.0, 0.0, -1.0))
+    params = study_gfo_params(gravity_direction=(0.0, 0.0, -1.0))
     mech = mechanics_for(pinch_grasp(), params)
     assert mech.rank_G == 5 and mech.projector is None
     out = optimise_grasps([pinch_grasp()], SynergySets(np.eye(19), ((2, 5),)), params)
@@ -113,7 +114,7 @@ def test_collinear_contacts_rank_deficient():
     p = np.array([[-15.0, 0, 0], [0.0, 0, 0], [15.0, 0, 0]])
     n = np.array([[1.0, 0, 0], [0, 0, 1.0], [-1.0, 0, 0]])
     g = Grasp(p, n, np.array([5, 9, 2]), np.ones((9, 19)), np.array([0.0, 0.0, 5.0]))
-    params = GFOParams(gravity_direction=(0.0, 1.0, 0.0))
+    params = study_gfo_params(gravity_direction=(0.0, 1.0, 0.0))
     assert optimise_grasps([g], SynergySets(np.eye(19), ((1, 2, 3),)), params)["status"][0] == "rank_deficient"
 
 
@@ -139,7 +140,7 @@ def test_symmetric_tripod_closed_form(f_min, method):
     and a >= f_min, so a* = max(f_min, W/(3 mu)) and ||f*|| = sqrt(3 (a*² + W²/9)). The
     synergy driving the three pushing joints together yields exactly the symmetric squeeze.
     """
-    params = GFOParams(gravity_direction=(0.0, 0.0, -1.0), f_min=f_min)
+    params = study_gfo_params(gravity_direction=(0.0, 0.0, -1.0), f_min_N=f_min)
     g = tripod_grasp()
     mech = mechanics_for(g, params)
     assert mech.rank_G == 6
@@ -198,9 +199,10 @@ def test_bad_input_names_the_field():
     with pytest.raises(ValueError, match="synergies"):
         SynergySets(np.ones(19), ((1,),))
     with pytest.raises(ValueError, match="gravity_direction"):
-        GFOParams(gravity_direction=(0.0, 0.0, 2.0))
+        study_gfo_params(gravity_direction=(0.0, 0.0, 0.0))
+    assert study_gfo_params(gravity_direction=(0.0, 0.0, 2.0)).gravity_direction == (0.0, 0.0, 1.0)
     with pytest.raises(TypeError):
-        GFOParams()  # gravity has no default: the configuration decides it
+        GFOParams(gravity_direction=(0.0, 0.0, 1.0))  # no study value has a default here: the schema holds them
 
 
 @pytest.fixture(scope="module")

@@ -32,7 +32,7 @@ def _study_sized_problems(count: int, seed: int = 11) -> list[GFOProblem]:
         S = random_synergies(rng)
         for s in rng.choice(np.arange(1, 16), size=5, replace=False):
             cols = np.sort(rng.choice(15, size=int(s), replace=False))
-            E = internal_force_basis(mech.projector, S[:, cols])
+            E = internal_force_basis(mech.projector, S[:, cols], mech.response_norm)
             out.append(GFOProblem(mech.f_p, E, grasp.normals, 0.1, CircularCone(1.5)))
     return out[:count]
 
@@ -143,7 +143,7 @@ def test_sets_of_one_grasp_match_the_same_problems_one_by_one():
         mech = grasp_mechanics(grasp, object_wrench(1.0, random_unit_vector(rng)), 1.0, 200.0)
         if mech.rank_G < 6:
             continue
-        g = GraspSets(mech.f_p, mech.normals, mech.projector, sets, 0.1, CircularCone(1.5))
+        g = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, 0.1, CircularCone(1.5))
         fused = solve_gfo(g, strict_shrink=1e-5)
         each = [g.problem(j) for j in range(len(g))]
         for method in ("ipm", "clarabel"):

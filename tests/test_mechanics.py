@@ -86,14 +86,33 @@ def test_particular_solution_and_projector(grasp):
 def test_internal_force_basis_orthonormal_and_spans_fs(grasp):
     mech = grasp_mechanics(grasp, object_wrench(1.0, [0, 0, -1]), 1.0, 200.0)
     S = random_synergies(np.random.default_rng(3))[:, :5]
-    E = internal_force_basis(mech.projector, S)
+    E = internal_force_basis(mech.projector, S, mech.response_norm)
     F = mech.projector @ S
     assert E.shape == (24, 5)
     np.testing.assert_allclose(E.T @ E, np.eye(5), atol=1e-12)
     # Same range: projecting F on range(E) leaves it unchanged, and dimensions agree.
     np.testing.assert_allclose(E @ (E.T @ F), F, atol=1e-10 * np.abs(F).max())
     # A repeated synergy column adds no direction.
-    assert internal_force_basis(mech.projector, np.c_[S, S[:, :2] @ [1.0, -2.0]]).shape[1] == 5
+    assert internal_force_basis(mech.projector, np.c_[S, S[:, :2] @ [1.0, -2.0]], mech.response_norm).shape[1] == 5
+
+
+def test_no_internal_force_when_every_hand_motion_moves_the_object_rigidly():
+    """Every joint moves all five contacts as one rigid body (J's columns are Gᵀ·twist), so
+    the hand can only carry the object along: F_s = 0 exactly, and P = (I − G_K^R G) K J is
+    round-off. A rank cut-off relative to ||P|| would take that round-off for five internal
+    forces; relative to ||K J|| (the forces the joints produce at all) e_s = 0."""
+    rng = np.random.default_rng(1)
+    points = np.array([[15.0, 0, 0], [-15.0, 0, 0], [0, 15.0, 0], [0, -15.0, 5.0], [0, 0, 15.0]])
+    center = np.zeros(3)
+    twists = rng.normal(size=(6, 19)) * np.r_[np.ones(3), np.full(3, 0.02)][:, None]  # mm/rad, rad/rad
+    rigid = Grasp(points, -_unit(points), np.arange(5), grasp_matrix(points, center).T @ twists, center)
+    mech = grasp_mechanics(rigid, object_wrench(1.0, [0, 0, -1]), 1.0, 200.0)
+    S = random_synergies(rng)[:, :5]
+    assert mech.rank_G == 6
+    noise = np.linalg.svd(mech.projector @ S, compute_uv=False)
+    assert noise.max() < 1e-12 * mech.response_norm * np.linalg.norm(S, 2)  # round-off of K J S ...
+    assert np.sum(noise > 1e-9 * np.linalg.norm(mech.projector, 2) * np.linalg.norm(S, 2)) == 5  # ... yet large vs ||P||
+    assert internal_force_basis(mech.projector, S, mech.response_norm).shape[1] == 0
 
 
 def test_internal_force_basis_rank_decision_on_null_synergies(grasp):
@@ -103,12 +122,12 @@ def test_internal_force_basis_rank_decision_on_null_synergies(grasp):
     null = Vt[np.sum(sv > 1e-12 * sv[0]):].T  # joint motions with no internal force
     if null.shape[1] == 0:  # with 6 finger contacts the projector is full column rank
         null = np.zeros((19, 1))
-    assert internal_force_basis(mech.projector, null[:, :1]).shape[1] == 0
+    assert internal_force_basis(mech.projector, null[:, :1], mech.response_norm).shape[1] == 0
     # Mixed: one null direction with one genuine direction gives exactly one.
     S = np.c_[null[:, 0], Vt[0]]
-    assert internal_force_basis(mech.projector, S).shape[1] == 1
+    assert internal_force_basis(mech.projector, S, mech.response_norm).shape[1] == 1
     with pytest.raises(ValueError, match="agree in n"):
-        internal_force_basis(mech.projector, np.ones((18, 2)))
+        internal_force_basis(mech.projector, np.ones((18, 2)), mech.response_norm)
 
 
 def test_random_grasp_jacobian_structure():

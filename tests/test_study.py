@@ -9,15 +9,16 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from conftest import study_gfo_params
 from synergrasp import tables
 from synergrasp.optimisation.cones import PyramidCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.problem import GraspSets, SynergySets
 from synergrasp.optimisation.problems import random_grasp, random_synergies
-from synergrasp.optimisation.study import GFOParams, mechanics_for, merge_shards, optimise_grasps, shard_rows
+from synergrasp.optimisation.study import mechanics_for, merge_shards, optimise_grasps, shard_rows
 
 RTOL_NORM = 1e-4
-PARAMS = GFOParams(gravity_direction=(0.0, 0.0, -1.0))
+PARAMS = study_gfo_params(gravity_direction=(0.0, 0.0, -1.0))
 
 
 def test_optimise_grasps_matches_clarabel_per_grasp():
@@ -36,7 +37,7 @@ def test_optimise_grasps_matches_clarabel_per_grasp():
             assert set(out["status"][rows]) == {"no_grasp"} and not out["force_closure"][rows].any()
             continue
         mech = mechanics_for(grasp, PARAMS)
-        ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, sets, PARAMS.f_min, PARAMS.cone),
+        ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, PARAMS.f_min_N, PARAMS.cone),
                         "clarabel", strict_shrink=PARAMS.strict_shrink)
         np.testing.assert_array_equal(out["status"][rows], ref.status)
         np.testing.assert_array_equal(out["e_s"][rows], ref.e_s)
@@ -69,7 +70,7 @@ def test_pyramid_cone_study_runs_through_piqp_and_matches_clarabel():
     rng = np.random.default_rng(5)
     grasps = [random_grasp(rng, int(rng.integers(4, 10)), palm_contacts=1) for _ in range(3)]
     sets = SynergySets(random_synergies(rng), ((1,), (1, 2, 3), tuple(range(1, 16))))
-    params = GFOParams(gravity_direction=(0.0, 0.0, -1.0), friction_cone="pyramid8_circumscribed")
+    params = study_gfo_params(gravity_direction=(0.0, 0.0, -1.0), friction_cone="pyramid8_circumscribed")
     assert params.cone == PyramidCone(1.5, 8, inscribed=False)
     out = optimise_grasps(grasps, sets, params)
     n = len(sets)
@@ -78,7 +79,7 @@ def test_pyramid_cone_study_runs_through_piqp_and_matches_clarabel():
         mech = mechanics_for(grasp, params)
         if mech.rank_G < 6:
             continue
-        ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, sets, params.f_min, params.cone),
+        ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, params.f_min_N, params.cone),
                         "clarabel", strict_shrink=params.strict_shrink)
         np.testing.assert_array_equal(out["status"][rows], ref.status)
         np.testing.assert_array_equal(out["strict_internal"][rows], ref.strict_internal)
@@ -86,4 +87,4 @@ def test_pyramid_cone_study_runs_through_piqp_and_matches_clarabel():
         fc = ref.force_closure
         np.testing.assert_allclose(out["force_norm"][rows][fc], ref.force_norm[fc], rtol=RTOL_NORM)
     with pytest.raises(ValueError, match="friction_cone must be one of"):
-        GFOParams(gravity_direction=(0.0, 0.0, -1.0), friction_cone="pyramid6")
+        study_gfo_params(friction_cone="pyramid6").cone

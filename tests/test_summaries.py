@@ -4,9 +4,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from conftest import study_analysis_settings
 from synergrasp.analysis.invariants import InvariantError
 from synergrasp.analysis.summaries import (
-    AnalysisSettings,
     full_but_not_first7,
     hierarchy_matrices,
     incrementality_table,
@@ -44,7 +44,7 @@ def gfo() -> pd.DataFrame:
 
 
 def test_success_rates_by_hand(gfo):
-    r = success_rates(with_verdicts(gfo), FULL).set_index(["object", "set_id"])
+    r = success_rates(with_verdicts(gfo, "force_closure"), FULL).set_index(["object", "set_id"])
     assert r.loc[("a", "1-2"), "n_success"] == 2
     assert r.loc[("a", "1-2"), "success_rate"] == pytest.approx(50.0)  # 2 of the full set's 4
     assert r.loc[("a", "1"), "success_rate"] == pytest.approx(25.0)
@@ -81,7 +81,7 @@ def test_distinct_poses_count_one_period():
     """Eight poses 0..315 deg step 45 with period 90: two distinct poses (0 and 45)."""
     table = pd.DataFrame(gfo_rows("a", "1", [1.0, None] * 4, step_deg=45.0)
                          + gfo_rows("a", "1-2", [1.0, 1.0] * 4, step_deg=45.0))
-    r = success_rates(with_verdicts(table), "1-2", {"a": 90.0}).set_index("set_id")
+    r = success_rates(with_verdicts(table, "force_closure"), "1-2", {"a": 90.0}).set_index("set_id")
     assert r.loc["1", "n_success"] == 4 and r.loc["1", "n_success_distinct"] == 1
     assert r.loc["1", "success_rate_distinct"] == pytest.approx(50.0) == r.loc["1", "success_rate"]
 
@@ -89,7 +89,7 @@ def test_distinct_poses_count_one_period():
 def test_marginal_grasps_flagged_and_excluded():
     """Weight 1 N, multiple 10: forces 5, 20 and 50 N -> two marginal successes."""
     table = pd.DataFrame(gfo_rows("a", "1", [5.0, 20.0, 50.0]) + gfo_rows("a", "1-2", [5.0, 10.0, 10.0]))
-    r = success_rates(with_verdicts(table, weights_N={"a": 1.0}, marginal_multiple=10.0), "1-2").set_index("set_id")
+    r = success_rates(with_verdicts(table, "force_closure", weights_N={"a": 1.0}, marginal_multiple=10.0), "1-2").set_index("set_id")
     assert r.loc["1", "n_marginal"] == 2 and r.loc["1", "marginal_percent"] == pytest.approx(200 / 3)
     assert r.loc["1", "plain_mean_force_N"] == pytest.approx(25.0)
     assert r.loc["1", "plain_mean_force_non_marginal_N"] == pytest.approx(5.0)
@@ -99,18 +99,18 @@ def test_marginal_grasps_flagged_and_excluded():
 
 def test_success_rates_unknown_full_set(gfo):
     with pytest.raises(ValueError, match="full_set_id '9' .*allowed values"):
-        success_rates(with_verdicts(gfo), "9")
+        success_rates(with_verdicts(gfo, "force_closure"), "9")
 
 
 def test_incrementality_table(gfo):
-    t = incrementality_table(success_rates(with_verdicts(gfo), FULL), 4)
+    t = incrementality_table(success_rates(with_verdicts(gfo, "force_closure"), FULL), 4)
     assert list(t.columns) == ["object", 1, 2, 3, 4]
     assert t.set_index("object").loc["a", [1, 2, 3]].tolist() == [25.0, 50.0, 100.0]
     assert np.isnan(t.set_index("object").loc["a", 4])  # set 1-2-3-4 not computed
 
 
 def test_mean_over_objects_skips_undefined(gfo):
-    m = mean_over_objects(success_rates(with_verdicts(gfo), FULL)).set_index("set_id")
+    m = mean_over_objects(success_rates(with_verdicts(gfo, "force_closure"), FULL)).set_index("set_id")
     assert m.loc["1-2", "success_rate"] == pytest.approx(50.0)  # b is undefined, not 0
     assert m.loc["1-2", "n_objects"] == 1
     assert m.loc["1-2", "plain_mean_force_N"] == pytest.approx((3.0 + 5.0) / 2)
@@ -167,21 +167,21 @@ def test_minimum_preservation_by_hand(gfo):
 
 
 def test_full_but_not_first7(gfo):
-    out = full_but_not_first7(with_verdicts(gfo), FULL, "1-2")
+    out = full_but_not_first7(with_verdicts(gfo, "force_closure"), FULL, "1-2")
     assert out[["object", "pose"]].values.tolist() == [["a", 2], ["a", 3]]
     assert out["full_force_norm"].tolist() == [3.0, 10.0]
     assert set(out["first7_status"]) == {"infeasible"}
     partial = gfo[~((gfo["set_id"] == "1-2") & (gfo["pose"] == 3))]
-    assert full_but_not_first7(with_verdicts(partial), FULL, "1-2")["first7_status"].tolist() == ["infeasible",
+    assert full_but_not_first7(with_verdicts(partial, "force_closure"), FULL, "1-2")["first7_status"].tolist() == ["infeasible",
                                                                                                   "missing"]
     with pytest.raises(ValueError, match="first7_set_id"):
-        full_but_not_first7(with_verdicts(gfo), FULL, "1-2-3-4-5-6-7")
+        full_but_not_first7(with_verdicts(gfo, "force_closure"), FULL, "1-2-3-4-5-6-7")
 
 
 def test_verdict_disagreements():
     rows = (gfo_rows("a", "1", [1.0, 2.0, None, None], strict=[True, False, True, False])
             + gfo_rows("a", "1-2", [1.0, None], strict=[True, False]))
-    out = verdict_disagreements(with_verdicts(pd.DataFrame(rows)))
+    out = verdict_disagreements(with_verdicts(pd.DataFrame(rows), "force_closure"))
     assert len(out) == 1  # 1-2 agrees everywhere
     row = out.iloc[0]
     assert (row["set_id"], row["n_poses"], row["n_disagree"], row["n_load_feasible_only"],
@@ -191,7 +191,7 @@ def test_verdict_disagreements():
 
 def test_study_tables_names_and_csv_round_trip(gfo, tmp_path):
     minima = pd.DataFrame([dict(object="a", set_id="1", alpha_deg=0.0, beta_deg=0.0)])
-    settings = AnalysisSettings(null_draws=20)
+    settings = study_analysis_settings(null_draws=20)
     with pytest.warns(UserWarning):  # b's set 1-2 succeeds where its full set does not
         tables = study_tables(gfo, minima, {"incremental_max": 3, "hierarchy_first": 2, "hierarchy_max_size": 2}, 3,
                               settings)
@@ -213,4 +213,4 @@ def test_study_tables_stop_on_a_rate_far_above_100(gfo):
     with pytest.raises(InvariantError, match=r"success_rate_tolerance_percent \(1.0\).*a \{1\}: 200 %"):
         study_tables(broken, broken.iloc[:0].assign(alpha_deg=[], beta_deg=[]),
                      {"incremental_max": 2, "hierarchy_first": 2, "hierarchy_max_size": 1}, 2,
-                     AnalysisSettings(null_draws=5))
+                     study_analysis_settings(null_draws=5))

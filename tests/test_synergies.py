@@ -210,3 +210,41 @@ def test_mapping_limits_agree_with_hand_model():
     np.testing.assert_allclose(np.radians([joints[j]["limits_deg"][1] for j in hand.joint_names]), hand.upper)
     s = load_synergies(joint_names=hand.joint_names)
     assert np.all((s.mean >= hand.lower) & (s.mean <= hand.upper))
+
+
+def test_softhand_human_higher_couples_s1_and_follows_the_human_thumb_above():
+    """Mean posture and S1 as softhand_opposed (the same closure); the thumb rows of S2..S15
+    are the human thumb joints' (j1, j2, j3) with weight -1, read from the human table."""
+    s, opposed = load_synergies("softhand_human_higher"), load_synergies("softhand_opposed")
+    human = load_human_synergies()
+    np.testing.assert_array_equal(s.mean, opposed.mean)
+    np.testing.assert_array_equal(s.matrix[:, 0], opposed.matrix[:, 0])
+    thumb = [JOINT_NAMES.index(n) for n in ("thumb_abd", "thumb_flex1", "thumb_flex2")]
+    others = [j for j in range(len(JOINT_NAMES)) if j not in thumb]
+    np.testing.assert_array_equal(s.matrix[others], opposed.matrix[others])
+    for j, source in zip(thumb, ("thumb_j1", "thumb_j2", "thumb_j3")):
+        np.testing.assert_allclose(s.matrix[j, 1:], -human.matrix[HUMAN_JOINT_NAMES.index(source), 1:], atol=1e-15)
+
+
+def test_column_terms_replace_the_terms_in_their_columns_only():
+    human = Synergies(HUMAN_JOINT_NAMES, np.linspace(0.2, 0.4, 20), np.arange(60.0).reshape(20, 3) / 100,
+                      ("S1", "S2", "S3"))
+    mapping = load_synergy_mapping("legacy_thumb")
+    mapping["column_sign"] = {"syn3": -1}
+    mapping["joints"]["thumb_flex2"]["column_terms"] = [{"columns": [2, 3],
+                                                         "terms": [{"human": "thumb_j4", "weight": 2.0}]}]
+    out = map_human_synergies(human, mapping)
+    j = JOINT_NAMES.index("thumb_flex2")
+    assert out.mean[j] == pytest.approx(-human.mean[2] if -human.mean[2] > 0 else 0.0)  # mean from `terms`
+    assert out.matrix[j, 0] == pytest.approx(-0.06)   # S1 from `terms`: -thumb_j3
+    assert out.matrix[j, 1] == pytest.approx(2 * 0.10)  # S2: 2 * thumb_j4
+    assert out.matrix[j, 2] == pytest.approx(-2 * 0.11)  # S3: 2 * thumb_j4, column sign -1
+
+
+@pytest.mark.parametrize("columns", [[0, 3], [2, 4], [3, 2], [2], "2-3", [1.5, 3]])
+def test_column_terms_reject_a_bad_range(columns):
+    human = Synergies(HUMAN_JOINT_NAMES, np.zeros(20), np.ones((20, 3)), ("S1", "S2", "S3"))
+    mapping = load_synergy_mapping("legacy_thumb")
+    mapping["joints"]["thumb_abd"]["column_terms"] = [{"columns": columns, "terms": []}]
+    with pytest.raises(SynergyFileError, match=r"thumb_abd.*column_terms\.columns.*1 <= first <= last <= 3"):
+        map_human_synergies(human, mapping)

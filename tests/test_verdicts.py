@@ -7,10 +7,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.analysis.verdicts import success_verdict, verdict_columns, with_verdicts
+from conftest import study_gfo_params
+from synergrasp.analysis.verdicts import verdict_columns, with_verdicts
 from synergrasp.optimisation.mechanics import Grasp
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.study import GFOParams, optimise_grasps
+from synergrasp.optimisation.study import optimise_grasps
 
 LEVER = 50.0  # mm per rad: a pushing joint moves its contact along the normal
 
@@ -46,7 +47,7 @@ def verdicts_of(grasp: Grasp, gravity: tuple[float, float, float]) -> pd.Series:
     synergies = np.zeros((19, 2))
     synergies[[4, 8, 12], 0] = 1.0           # all three contacts pushed together
     synergies[[4, 8, 12], 1] = [1.0, -1.0, 0.0]  # two pushed against each other
-    out = optimise_grasps([grasp], SynergySets(synergies, ((1, 2),)), GFOParams(gravity_direction=gravity, mu=1.5))
+    out = optimise_grasps([grasp], SynergySets(synergies, ((1, 2),)), study_gfo_params(gravity_direction=gravity, mu=1.5))
     table = pd.DataFrame(out).assign(object="box")
     row = pd.concat([table, verdict_columns(table)[["load_feasible"]]], axis=1)
     return row.assign(force_closure_verdict=verdict_columns(table)["force_closure"]).iloc[0]
@@ -81,6 +82,5 @@ def test_with_verdicts_picks_the_success_column_and_flags_marginal_grasps():
     assert lf["success"].tolist() == [True, True, True, False]
     assert lf["marginal"].tolist() == [False, True, False, False]  # 200 N > 98.1 N
     assert np.isnan(fc.loc[1, "success_force"]) and lf.loc[1, "success_force"] == 200.0
-    with pytest.raises(ValueError, match=r"analyses.success.*allowed values: \['force_closure', 'load_feasible'\]"):
-        success_verdict({"success": "feasible"})
-    assert success_verdict({}) == "force_closure"
+    with pytest.raises(ValueError, match=r"success must be one of \['force_closure', 'load_feasible'\]"):
+        with_verdicts(gfo, "feasible")

@@ -402,8 +402,14 @@ STEP_KEYS_WHEN: dict[str, tuple[tuple[str, Any, tuple[str, ...]], ...]] = {
     # the dynamic closure: a free box of the object's mass, μ, k_ss and gravity of mechanics
     "simulate": (("closure.model", "dynamic", ("objects.{object}.mass_kg", "mechanics")),),
 }
-#: The step whose outputs a step reads (its hash includes that step's hash).
-UPSTREAM: dict[str, str] = {"optimise": "simulate", "minima": "optimise"}
+#: The steps whose outputs a step reads (its hash includes theirs): for a step run per object
+#: (OBJECT_STEPS), that object's; for a step run once per scenario, every object's.
+UPSTREAM: dict[str, tuple[str, ...]] = {
+    "optimise": ("simulate",), "minima": ("optimise",), "tables": ("optimise", "minima"),
+    "realism": ("simulate", "optimise"), "fig2": ("simulate",), "fig4": ("optimise", "minima"),
+    "fig5": ("tables",)}
+#: Steps run once per object (the others once per scenario).
+OBJECT_STEPS: frozenset[str] = frozenset({"simulate", "optimise", "minima", "fig4"})
 #: Keys read by the workflow itself, not by a step.
 WORKFLOW_KEYS: tuple[str, ...] = ("scenarios",)
 
@@ -457,10 +463,14 @@ def step_config(config: Mapping[str, Any], step: str, obj: str | None = None) ->
 
 def step_hash(config: Mapping[str, Any], step: str, obj: str | None = None) -> str:
     """Hash of what a step's outputs depend on: the keys it reads and, through
-    :data:`UPSTREAM`, those of the steps before it (12 hex digits)."""
-    parts = [step_config(config, step, obj)]
-    if step in UPSTREAM:
-        parts.append(step_hash(config, UPSTREAM[step], obj))
+    :data:`UPSTREAM`, those of the steps before it (12 hex digits). ``obj``: the object of
+    a step of :data:`OBJECT_STEPS`; None for a step run once per scenario."""
+    parts: list[Any] = [step_config(config, step, obj)]
+    for upstream in UPSTREAM.get(step, ()):
+        if upstream in OBJECT_STEPS and obj is None:
+            parts.append([[name, step_hash(config, upstream, name)] for name in config["objects"]])
+        else:
+            parts.append(step_hash(config, upstream, obj if upstream in OBJECT_STEPS else None))
     text = json.dumps(parts, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:12]
 
@@ -530,13 +540,8 @@ class FiguresParams:
 STEP_MODULES: dict[str, tuple[str, ...]] = {
     "simulate": ("synergrasp.simulation.closure", "synergrasp.simulation.placement"),
     "optimise": ("synergrasp.optimisation.study",),
-    "tables": ("synergrasp.analysis.summaries",),
+    "tables": ("synergrasp.analysis.summaries", "synergrasp.analysis.periods"),
 }
-
-#: Field of a typed class -> the config key it comes from (messages name the key).
-_GFO_FIELDS = {"mu": "mu", "f_min": "f_min_N", "k_stru": "k_stru_N_per_mm",
-               "k_ss": "k_ss_Nmm_per_rad", "g": "g_m_per_s2"}
-
 
 def _build(cls: Any, where: str, **kwargs: Any) -> Any:
     """``cls(**kwargs)``; a rejected value becomes a ConfigError naming the config key."""
@@ -580,33 +585,30 @@ def _fields(cls: Any, values: Mapping[str, Any]) -> dict[str, Any]:
 
 def _optimise(config: Mapping[str, Any], obj: str) -> OptimiseParams:
     gfo = importlib.import_module("synergrasp.optimisation.study")
-    mech = config["mechanics"]
-    gravity = np.asarray(mech["gravity_direction"], dtype=float)
-    kwargs = {field: float(mech[key]) for field, key in _GFO_FIELDS.items()}
-    try:
-        params = gfo.GFOParams(gravity_direction=tuple(gravity / np.linalg.norm(gravity)),
-                               mass_kg=float(config["objects"][obj]["mass_kg"]),
-                               friction_cone=str(mech["friction_cone"]), **kwargs)
-    except (TypeError, ValueError) as err:
-        message = str(err)
-        for field, key in _GFO_FIELDS.items():
-            if message.startswith(f"{field} "):
-                raise ConfigError(f"config error at 'mechanics.{key}': {message}") from None
-        raise ConfigError(f"config error at 'mechanics' / 'objects.{obj}.mass_kg': {message}") from None
+    params = _build(gfo.GFOParams, "mechanics", **_fields(gfo.GFOParams, config["mechanics"]),
+                    mass_kg=float(config["objects"][obj]["mass_kg"]))
     return OptimiseParams(config["synergies"], synergy_sets(config["synergy_sets"]), params,
                           int(config["solver"]["pose_shards"]))
 
 
 def _tables(config: Mapping[str, Any]) -> TablesParams:
     summaries = importlib.import_module("synergrasp.analysis.summaries")
+    periods = importlib.import_module("synergrasp.analysis.periods")
+    analyses, g = config["analyses"], config["mechanics"]["g_m_per_s2"]
     objects = {name: {**spec, "placement": overlay(config["placement"], spec.get("placement"))}
                for name, spec in config["objects"].items()}
     try:
-        settings = summaries.AnalysisSettings.from_config(config["analyses"], objects, config["grid"], config["hand"],
-                                                          config["mechanics"]["g_m_per_s2"])
+        periods_deg = periods.object_periods(objects, config["grid"], config["hand"])
     except (TypeError, ValueError) as err:
-        raise ConfigError(f"config error at 'analyses': {err}") from None
-    return TablesParams(dict(config["synergy_sets"]), int(config["analyses"]["table2_k_max"]), settings)
+        raise ConfigError(f"config error at 'objects' / 'placement': {err}") from None
+    settings = summaries.AnalysisSettings(
+        success=analyses["success"], marginal_weight_multiple=float(analyses["marginal_weight_multiple"]),
+        radius_deg=float(analyses["minima_radius_deg"]), null_draws=int(analyses["null_model"]["draws"]),
+        null_seed=int(analyses["null_model"]["seed"]),
+        success_rate_tolerance_percent=float(analyses["success_rate_tolerance_percent"]),
+        weights_N={name: float(spec["mass_kg"]) * float(g) for name, spec in objects.items()},
+        periods_deg=periods_deg)
+    return TablesParams(dict(config["synergy_sets"]), int(analyses["table2_k_max"]), settings)
 
 
 def _figures(config: Mapping[str, Any], step: str) -> FiguresParams:

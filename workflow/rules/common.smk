@@ -49,8 +49,9 @@ STUDY = SCENARIOS["default"]
 OBJECTS = list(STUDY["objects"])
 
 # Scenarios (config/README.md): each one's outputs live under its root; the default keeps
-# results/. A per-object step's output is made once, under the root of the first scenario
-# (default first) whose step reads the same keys (synergrasp.config.step_hash), and shared.
+# results/. A step's output (per object or per scenario) is made once, under the root of the
+# first scenario (default first) whose step reads the same keys and the same upstream
+# outputs (synergrasp.config.step_hash), and shared.
 SCENARIO_ROOT = {
     name: "results" if name == "default" else f"results/scenarios/{name}" for name in SCENARIOS
 }
@@ -65,16 +66,21 @@ def scenario_config(wildcards):
 
 
 @functools.cache
-def step_file(scenario, step, obj):
-    """Where ``scenario``'s output of per-object ``step`` for ``obj`` lives: under the root of
-    the first scenario that reads the same keys for it."""
+def step_root(scenario, step, obj=None):
+    """The root under which ``scenario``'s output of ``step`` (for ``obj``, a per-object
+    step's object) lives: that of the first scenario whose step has the same hash."""
     key = step_hash(SCENARIOS[scenario], step, obj)
     owner = next(
         name
         for name, cfg in SCENARIOS.items()
-        if obj in cfg["objects"] and step_hash(cfg, step, obj) == key
+        if (obj is None or obj in cfg["objects"]) and step_hash(cfg, step, obj) == key
     )
-    return f"{SCENARIO_ROOT[owner]}/objects/{obj}/{STEP_FILES[step]}"
+    return SCENARIO_ROOT[owner]
+
+
+def step_file(scenario, step, obj):
+    """Where ``scenario``'s output of per-object ``step`` (STEP_FILES) for ``obj`` lives."""
+    return f"{step_root(scenario, step, obj)}/objects/{obj}/{STEP_FILES[step]}"
 
 
 def step_input(step):
@@ -162,19 +168,18 @@ def user_files(wildcards):
 SHIPPED_DATA = sorted(str(p) for p in (SRC / "data").glob("*") if p.is_file())
 
 
-def fig4_files(root, name):
+def fig4_files(scenario, name):
+    """Fig. 4 of object ``name`` in ``scenario`` (wherever shared)."""
     return [
-        f"{root}/objects/{name}/fig4_{kind}.{ext}"
+        f"{step_root(scenario, 'fig4', name)}/objects/{name}/fig4_{kind}.{ext}"
         for kind in ("force_maps", "exploded")
         for ext in ("png", "pdf")
     ]
 
 
 def object_targets(name, scenario="default"):
-    """One object's outputs in a scenario: its per-object tables (wherever shared) and Fig. 4."""
-    return [step_file(scenario, step, name) for step in STEP_FILES] + fig4_files(
-        SCENARIO_ROOT[scenario], name
-    )
+    """One object's outputs in a scenario: its per-object tables and Fig. 4 (wherever shared)."""
+    return [step_file(scenario, step, name) for step in STEP_FILES] + fig4_files(scenario, name)
 
 
 TABLES = [
@@ -190,34 +195,46 @@ TABLES = [
 ]
 
 
-def study_targets(scenario="default"):
-    """Every output of one scenario's study (Fig. 3, the rule graph, is the same for all)."""
-    root = SCENARIO_ROOT[scenario]
-    figures = [
-        f"{root}/figures/{name}.{ext}"
-        for name in (
-            "fig1_synergy_postures",
-            "fig2_example_grasps",
-            "fig5a_hierarchy_success",
-            "fig5b_hierarchy_force",
-            "grasp_realism",
-        )
+#: The files each step run once per scenario writes under its root.
+STUDY_FILES = {
+    "fig1": [f"figures/fig1_synergy_postures.{ext}" for ext in ("png", "pdf")],
+    "fig2": [f"figures/fig2_example_grasps.{ext}" for ext in ("png", "pdf")],
+    "tables": [f"tables/{t}.{ext}" for t in TABLES for ext in ("csv", "md")],
+    "realism": [f"tables/grasp_realism.{ext}" for ext in ("csv", "md")]
+    + [f"figures/grasp_realism.{ext}" for ext in ("png", "pdf")],
+    "fig5": [
+        f"figures/{name}.{ext}"
+        for name in ("fig5a_hierarchy_success", "fig5b_hierarchy_force")
         for ext in ("png", "pdf")
-    ]
-    figures += [f"results/figures/fig3_rulegraph.{ext}" for ext in ("png", "pdf")]
-    tables = [
-        f"{root}/tables/{t}.{ext}" for t in [*TABLES, "grasp_realism"] for ext in ("csv", "md")
-    ]
+    ],
+}
+
+
+def study_file(scenario, step, rel):
+    """Where ``scenario``'s file ``rel`` (one of STUDY_FILES[step]) lives (wherever shared)."""
+    return f"{step_root(scenario, step)}/{rel}"
+
+
+def study_input(step, rel):
+    """Input function: the job's scenario's file ``rel`` of the per-scenario ``step``."""
+    return lambda w: study_file(_ROOT_SCENARIO[w.root], step, rel)
+
+
+def study_targets(scenario="default"):
+    """Every output of one scenario's study, each where it is made (a shared file counts;
+    Fig. 3, the rule graph, is the same for all)."""
+    files = [study_file(scenario, step, rel) for step, rels in STUDY_FILES.items() for rel in rels]
+    files += [f"results/figures/fig3_rulegraph.{ext}" for ext in ("png", "pdf")]
     per_object = [
         f for name in SCENARIOS[scenario]["objects"] for f in object_targets(name, scenario)
     ]
-    return figures + tables + per_object
+    return files + per_object
 
 
 # The sensitivity sweep's summary across every scenario (docs/sensitivity.md).
 def scenario_tables(table):
     """Every scenario's (default first) study table ``table``.csv."""
-    return [f"{SCENARIO_ROOT[s]}/tables/{table}.csv" for s in SCENARIOS]
+    return [study_file(s, "tables", f"tables/{table}.csv") for s in SCENARIOS]
 
 
 SENSITIVITY_FILES = [

@@ -38,7 +38,7 @@ rule fig4_force_maps:
 
 rule fig5_hierarchy:
     input:
-        hierarchy="{root}/tables/hierarchy.csv",
+        hierarchy=study_input("tables", "tables/hierarchy.csv"),
         code=code("fig5_hierarchy"),
     output:
         success_png=report(

@@ -19,7 +19,7 @@ from synergrasp.analysis.forces import force_summary
 from synergrasp.analysis.invariants import invariant_checks
 from synergrasp.analysis.minima import preserved
 from synergrasp.analysis.periods import distinct_pose_mask
-from synergrasp.analysis.verdicts import DEFAULT_VERDICT, success_verdict, with_verdicts
+from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.config import incremental_set_id, set_id
 
 __all__ = [
@@ -52,7 +52,8 @@ def _require(table: pd.DataFrame, name: str, columns: Iterable[str]) -> None:
 @dataclass(frozen=True)
 class AnalysisSettings:
     """What the study's tables need beyond the gfo and minima tables (config ``analyses``;
-    docs/analyses.md).
+    docs/analyses.md), built by :func:`synergrasp.config.step_params` (``"tables"``), which
+    holds the defaults (the schema) and checks the values.
 
     success: the verdict the tables use (``force_closure`` | ``load_feasible``).
     marginal_weight_multiple: a success is marginal above this multiple of the weight.
@@ -62,35 +63,14 @@ class AnalysisSettings:
     weights_N: object → weight m·g, N. periods_deg: object → α-period, deg.
     """
 
-    success: str = DEFAULT_VERDICT
-    marginal_weight_multiple: float = 10.0
-    radius_deg: float = 10.0
-    null_draws: int = 1000
-    null_seed: int = 2018
-    success_rate_tolerance_percent: float = 1.0
+    success: str
+    marginal_weight_multiple: float
+    radius_deg: float
+    null_draws: int
+    null_seed: int
+    success_rate_tolerance_percent: float
     weights_N: Mapping[str, float] = field(default_factory=dict)
     periods_deg: Mapping[str, float] = field(default_factory=dict)
-
-    @classmethod
-    def from_config(cls, analyses: Mapping[str, Any], objects: Mapping[str, Mapping[str, Any]],
-                    grid: Mapping[str, Any], hand: str | None, g_m_per_s2: float) -> AnalysisSettings:
-        """From the config's ``analyses`` block, the objects (size_mm, mass_kg and effective
-        placement), the grid, the hand file and g (m/s²); keys absent from ``analyses`` take
-        the defaults above."""
-        from synergrasp.analysis.periods import object_periods
-
-        default = cls()
-        null = analyses.get("null_model", {})
-        return cls(success=success_verdict(analyses),
-                   marginal_weight_multiple=float(analyses.get("marginal_weight_multiple",
-                                                               default.marginal_weight_multiple)),
-                   radius_deg=float(analyses["minima_radius_deg"]),
-                   null_draws=int(null.get("draws", default.null_draws)),
-                   null_seed=int(null.get("seed", default.null_seed)),
-                   success_rate_tolerance_percent=float(analyses.get("success_rate_tolerance_percent",
-                                                                     default.success_rate_tolerance_percent)),
-                   weights_N={name: float(spec["mass_kg"]) * float(g_m_per_s2) for name, spec in objects.items()},
-                   periods_deg=object_periods(objects, grid, hand))
 
 
 def _rate_columns(table: pd.DataFrame, column: str, full_set_id: str) -> pd.DataFrame:
@@ -312,7 +292,7 @@ def verdict_disagreements(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[str, int], table2_k_max: int,
-                 settings: AnalysisSettings = AnalysisSettings()) -> dict[str, tuple[str, pd.DataFrame]]:
+                 settings: AnalysisSettings) -> dict[str, tuple[str, pd.DataFrame]]:
     """Every study table by name: (title, table).
 
     ``sets_config`` is the configuration's ``synergy_sets`` (incremental_max,

@@ -23,33 +23,16 @@ A success whose optimal force exceeds ``marginal_multiple`` times the object's w
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
-import numpy as np
 import pandas as pd
 
-__all__ = ["VERDICTS", "DEFAULT_VERDICT", "success_verdict", "verdict_columns", "with_verdicts"]
+__all__ = ["VERDICTS", "verdict_columns", "with_verdicts"]
 
 #: The success verdicts the tables can use (config ``analyses.success``).
 VERDICTS: tuple[str, ...] = ("force_closure", "load_feasible")
-#: Default: the study's definition of force closure (docs/analyses.md says why).
-DEFAULT_VERDICT = "force_closure"
-
 _NEEDED = ("object", "set_id", "status", "force_closure", "strict_internal", "rank_G", "force_norm")
-
-
-def _check_verdict(success: str) -> None:
-    if success not in VERDICTS:
-        raise ValueError(f"config error at 'analyses.success': {success!r} is not allowed; "
-                         f"allowed values: {list(VERDICTS)}")
-
-
-def success_verdict(analyses: Mapping[str, object]) -> str:
-    """The verdict the tables use, from the config's ``analyses`` block (key ``success``,
-    default :data:`DEFAULT_VERDICT`); an unknown value raises naming the key."""
-    success = str(analyses.get("success", DEFAULT_VERDICT))
-    _check_verdict(success)
-    return success
 
 
 def verdict_columns(gfo: pd.DataFrame) -> pd.DataFrame:
@@ -64,8 +47,8 @@ def verdict_columns(gfo: pd.DataFrame) -> pd.DataFrame:
                         index=gfo.index)
 
 
-def with_verdicts(gfo: pd.DataFrame, success: str = DEFAULT_VERDICT,
-                  weights_N: Mapping[str, float] | None = None, marginal_multiple: float = 10.0) -> pd.DataFrame:
+def with_verdicts(gfo: pd.DataFrame, success: str,
+                  weights_N: Mapping[str, float] | None = None, marginal_multiple: float = math.inf) -> pd.DataFrame:
     """A copy of the gfo table with the analysis columns added.
 
     Columns added: ``verdict_force_closure``, ``verdict_load_feasible`` (bool, see the
@@ -76,14 +59,13 @@ def with_verdicts(gfo: pd.DataFrame, success: str = DEFAULT_VERDICT,
 
     Parameters
     ----------
-    success : "force_closure" or "load_feasible".
+    success : one of :data:`VERDICTS` (config ``analyses.success``).
     weights_N : object name → weight m·g of the object, N.
-    marginal_multiple : a success is marginal above this multiple of the weight (> 0).
+    marginal_multiple : a success is marginal above this multiple of the weight
+        (config ``analyses.marginal_weight_multiple``; none is marginal by default).
     """
-    _check_verdict(success)
-    if not (np.isfinite(marginal_multiple) and marginal_multiple > 0):
-        raise ValueError(f"config error at 'analyses.marginal_weight_multiple': must be a number > 0; "
-                         f"got {marginal_multiple!r}")
+    if success not in VERDICTS:
+        raise ValueError(f"success must be one of {list(VERDICTS)}, got {success!r}")
     verdicts = verdict_columns(gfo)
     out = gfo.copy()
     out["verdict_force_closure"] = verdicts["force_closure"]

@@ -48,10 +48,11 @@ HUMAN_JOINT_NAMES: tuple[str, ...] = (
 )
 """Joints of the 20-joint human hand of the human synergy data, in file order."""
 
-SHIPPED_TABLES: tuple[str, ...] = ("softhand_opposed", "legacy_thumb")
+SHIPPED_TABLES: tuple[str, ...] = ("softhand_opposed", "legacy_thumb", "softhand_human_higher")
 """Shipped synergy tables, by name: the same long fingers; ``softhand_opposed`` couples the
 thumb to the fingers' flexion as on the real SoftHand (it opposes while the hand closes),
-``legacy_thumb`` drives it by the human thumb joints (docs/synergies.md)."""
+``legacy_thumb`` drives it by the human thumb joints, ``softhand_human_higher`` couples it in
+the mean posture and S1 and drives it by the human thumb joints in S2…S15 (docs/synergies.md)."""
 DEFAULT_TABLE = "softhand_opposed"
 HUMAN_SYNERGIES = "santello_synergies_20dof.csv"
 
@@ -242,9 +243,11 @@ def map_human_synergies(human_table: Synergies, mapping: Mapping[str, Any],
     """Map human synergies onto the hand's joints.
 
     For each hand joint j (``mapping["joints"][j]``: ``terms`` [{human, weight}],
-    ``offset_rad``, ``limits_deg`` [lower, upper]):
+    ``offset_rad``, ``limits_deg`` [lower, upper], optionally ``column_terms``
+    [{columns: [first, last], terms}]):
     q_m[j] = clip(offset + Σ weight · q_m,human, limits) and
-    S[j, c] = column_sign[c] · Σ weight · S_human[·, c].
+    S[j, c] = column_sign[c] · Σ weight · S_human[·, c], with the weights of the
+    ``column_terms`` entry whose 1-based column range [first, last] holds c, else ``terms``.
     Clipping the mean keeps the origin of the synergy coordinates reachable.
 
     Parameters
@@ -271,24 +274,49 @@ def map_human_synergies(human_table: Synergies, mapping: Mapping[str, Any],
 
     n = len(joint_names)
     weights = np.zeros((n, len(human_table.joint_names)))
+    overrides = []  # (hand joint, first column, last column, weights), columns 1-based
     offsets = np.zeros(n)
     lower = np.zeros(n)
     upper = np.zeros(n)
     for j, name in enumerate(joint_names):
         spec = joints[name]
-        for term in spec["terms"]:
-            if term["human"] not in human_table.joint_names:
-                raise SynergyFileError(f"synergy mapping: joint '{name}': human joint {term['human']!r} "
-                                       f"is not allowed; allowed: {list(human_table.joint_names)}")
-            weights[j, human_table.joint_names.index(term["human"])] += float(term["weight"])
+        weights[j] = _term_weights(spec["terms"], name, human_table.joint_names)
+        for entry in spec.get("column_terms") or ():
+            overrides.append((j, *_column_range(entry, name, k),
+                              _term_weights(entry["terms"], name, human_table.joint_names)))
         offsets[j] = float(spec.get("offset_rad", 0.0))
         lower[j], upper[j] = np.radians(spec["limits_deg"])
         if not lower[j] < upper[j]:
             raise SynergyFileError(f"synergy mapping: joint '{name}': limits_deg {spec['limits_deg']} "
                                    "must be [lower, upper] with lower < upper")
     mean = np.clip(offsets + weights @ human_table.mean, lower, upper)
-    matrix = (weights @ human_table.matrix) * signs + 0.0  # + 0.0 turns -0.0 into 0.0
+    combined = weights @ human_table.matrix
+    for j, first, last, row in overrides:
+        combined[j, first - 1:last] = row @ human_table.matrix[:, first - 1:last]
+    matrix = combined * signs + 0.0  # + 0.0 turns -0.0 into 0.0
     return Synergies(tuple(joint_names), mean, matrix, human_table.names)
+
+
+def _term_weights(terms: Sequence[Mapping[str, Any]], joint: str,
+                  human_names: Sequence[str]) -> NDArray[np.float64]:
+    """The weights on the human joints of one hand joint's ``terms`` [{human, weight}]."""
+    out = np.zeros(len(human_names))
+    for term in terms:
+        if term["human"] not in human_names:
+            raise SynergyFileError(f"synergy mapping: joint '{joint}': human joint {term['human']!r} "
+                                   f"is not allowed; allowed: {list(human_names)}")
+        out[list(human_names).index(term["human"])] += float(term["weight"])
+    return out
+
+
+def _column_range(entry: Mapping[str, Any], joint: str, k: int) -> tuple[int, int]:
+    """The 1-based inclusive column range [first, last] of a ``column_terms`` entry."""
+    cols = entry.get("columns")
+    if (not isinstance(cols, Sequence) or len(cols) != 2 or not all(isinstance(c, int) for c in cols)
+            or not 1 <= cols[0] <= cols[1] <= k):
+        raise SynergyFileError(f"synergy mapping: joint '{joint}': field 'column_terms.columns' is {cols!r}; "
+                               f"allowed: [first, last], whole numbers with 1 <= first <= last <= {k}")
+    return cols[0], cols[1]
 
 
 @dataclass(frozen=True)

@@ -144,7 +144,7 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
     """All sets of one grasp in one compiled call (bases, rows, both SOCPs, forces), then the
     fallback for the undecided ones."""
     P, S = g.projector, g.synergies
-    thresholds = g.basis_rtol * (float(np.linalg.norm(P, 2)) if P.size else 0.0) * S.norms
+    thresholds = g.basis_rtol * g.response_norm * S.norms
     strict = shrink is not None
     mu_strict = g.cone.narrowed(shrink).mu if strict else g.cone.mu
     res = ipm_kernel.solve_sets(P @ S.matrix, g.f_p, contact_frames(g.normals), S.table, S.sizes, thresholds,
@@ -178,4 +178,4 @@ def warm_up() -> None:
     cone = CircularCone(1.0)
     solve_gfo([GFOProblem(np.zeros(6), squeeze, normals, 0.5, cone)], strict_shrink=1e-5)
     sets = SynergySets(np.eye(1), ((1,),))
-    solve_gfo(GraspSets(np.zeros(6), normals, squeeze, sets, 0.5, cone, basis_rtol=1e-9), strict_shrink=1e-5)
+    solve_gfo(GraspSets(np.zeros(6), normals, squeeze, 1.0, sets, 0.5, cone, basis_rtol=1e-9), strict_shrink=1e-5)

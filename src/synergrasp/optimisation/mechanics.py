@@ -191,6 +191,8 @@ class GraspMechanics:
     links:      (m,) link index per contact
     wrench:     (6,) w_e, N and N·mm
     KJ:         (c, n) K J, N/rad (the contact-force response to joint motion)
+    response_norm: ||K J||_2, N/rad: the scale of the rank decision of E_s
+                (`internal_force_basis`)
     """
 
     G: NDArray
@@ -203,6 +205,7 @@ class GraspMechanics:
     links: NDArray
     wrench: NDArray
     KJ: NDArray
+    response_norm: float
 
     @property
     def n_contacts(self) -> int:
@@ -244,22 +247,26 @@ def grasp_mechanics(
         projector = KJ - GKR @ (G @ KJ)
     return GraspMechanics(
         G=G, K=K, GKR=GKR, f_p=f_p, projector=projector, rank_G=rank,
-        normals=grasp.normals, links=grasp.links, wrench=w, KJ=KJ,
+        normals=grasp.normals, links=grasp.links, wrench=w, KJ=KJ, response_norm=_spectral_norm(KJ),
     )
 
 
 def internal_force_basis(
     projector: NDArray,
     synergy_matrix: NDArray,
+    response_norm: float,
     rtol: float = BASIS_RTOL,
 ) -> NDArray:
     """Orthonormal basis E_s (c, e_s) of range(F_s), F_s = projector @ synergy_matrix.
 
-    synergy_matrix: (n, s) the enrolled synergy columns S (rad per unit activation).
+    synergy_matrix: (n, s) the enrolled synergy columns S (rad per unit activation);
+    response_norm: ||K J||_2 (N/rad, `GraspMechanics.response_norm`).
     Rank decision: a singular value of F_s counts if it exceeds
-    rtol * ||projector||_2 * ||S||_2. This scale bounds ||F_s||_2 from above and does not
-    depend on how much the particular subset cancels, so a subset whose internal forces
-    are pure round-off gets e_s = 0 instead of a basis of noise (docs/force_optimisation.md).
+    rtol * ||K J||_2 * ||S||_2, the size of the contact forces the enrolled synergies can
+    produce at all. The scale depends neither on how much the subset cancels nor on how much
+    the projection (I - G_K^R G) removes, so internal forces that are round-off of K J S get
+    e_s = 0 instead of a basis of noise, also where every motion of the hand moves the object
+    rigidly and the projector itself is round-off (docs/force_optimisation.md).
     """
     P = np.asarray(projector, dtype=float)
     S = np.asarray(synergy_matrix, dtype=float)
@@ -272,7 +279,7 @@ def internal_force_basis(
     c = P.shape[0]
     if S.shape[1] == 0 or c == 0:
         return np.zeros((c, 0))
-    scale = _spectral_norm(P) * _spectral_norm(S)
+    scale = float(response_norm) * _spectral_norm(S)
     if scale == 0.0:
         return np.zeros((c, 0))
     U, sv, _ = np.linalg.svd(P @ S, full_matrices=False)

@@ -154,14 +154,15 @@ class GraspSets:
     """The GFO problems of one grasp, one per synergy set.
 
     f_p: (c,) particular forces, N; normals: (m, 3); projector: (c, n) internal-force
-    projector (I - G_K^R G) K J, N/rad; synergies: the sets; f_min: N; cone: friction model;
-    basis_rtol: rank rule of E_s (singular values of projector S_set above
-    basis_rtol ||projector||_2 ||S_set||_2, as `mechanics.internal_force_basis`).
+    projector (I - G_K^R G) K J, N/rad; response_norm: ||K J||_2, N/rad; synergies: the
+    sets; f_min: N; cone: friction model; basis_rtol: rank rule of E_s (singular values of
+    projector S_set above basis_rtol ||K J||_2 ||S_set||_2, as `mechanics.internal_force_basis`).
     """
 
     f_p: NDArray
     normals: NDArray
     projector: NDArray
+    response_norm: float
     synergies: SynergySets
     f_min: float
     cone: FrictionCone
@@ -172,7 +173,8 @@ class GraspSets:
 
     def problem(self, j: int) -> GFOProblem:
         """The problem of set j, with E_s from `internal_force_basis`."""
-        E = internal_force_basis(self.projector, self.synergies.matrix[:, self.synergies.columns[j]], self.basis_rtol)
+        E = internal_force_basis(self.projector, self.synergies.matrix[:, self.synergies.columns[j]],
+                                 self.response_norm, self.basis_rtol)
         return GFOProblem(self.f_p, E, self.normals, self.f_min, self.cone)
 
 

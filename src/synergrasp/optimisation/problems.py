@@ -275,5 +275,5 @@ def _random_instance(rng, contacts, synergies, max_palm, k_stru, k_ss):
     s = int(rng.integers(synergies[0], synergies[1] + 1))
     S = random_synergies(rng)
     subset = np.sort(rng.choice(S.shape[1], size=s, replace=False))
-    E = internal_force_basis(mech.projector, S[:, subset])
+    E = internal_force_basis(mech.projector, S[:, subset], mech.response_norm)
     return mech.f_p, E, grasp.normals, n_palm, s

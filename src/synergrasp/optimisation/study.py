@@ -8,7 +8,6 @@ grasps with rank(G) < 6 'rank_deficient', both without any solve (solver 'none')
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -17,7 +16,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp.config import set_id
-from synergrasp.optimisation.cones import CONE_MODELS, FrictionCone, cone_model
+from synergrasp.optimisation.cones import FrictionCone, cone_model
 from synergrasp.optimisation.gfo import FASTEST_METHOD, solve_gfo
 from synergrasp.optimisation.ipm_kernel import IPMSettings
 from synergrasp.optimisation.mechanics import (
@@ -37,29 +36,33 @@ __all__ = ["GFOParams", "gfo_table", "mechanics_for", "merge_shards", "optimise_
 
 @dataclass(frozen=True, kw_only=True)
 class GFOParams:
-    """Parameters of the grasp-force optimisation of the study.
+    """Parameters of the grasp-force optimisation of one object.
 
-    gravity_direction: unit vector of gravity in the palm frame (required: the placement
-        decides it, the configuration holds it)
-    mu: Coulomb friction coefficient; f_min: least normal force, N
+    The study's values come from the configuration's ``mechanics`` block and the object's
+    ``mass_kg`` through :func:`synergrasp.config.step_params` (``"optimise"``), which holds
+    their defaults (the schema) and checks them; the field names are the config keys.
+
+    gravity_direction: unit vector of gravity in the palm frame
+    mu: Coulomb friction coefficient; f_min_N: least normal force at every contact, N
     friction_cone: the friction-cone model, one of cones.CONE_MODELS ('circular', the exact
         Coulomb cone, solved by the compiled interior-point kernel; the pyramids, solved as
         QPs by PIQP)
-    k_stru: structural contact stiffness, N/mm; k_ss: joint stiffness, N·mm/rad
-    mass_kg, g (m/s²): the object's weight
+    k_stru_N_per_mm: structural contact stiffness, N/mm; k_ss_Nmm_per_rad: joint stiffness, N·mm/rad
+    mass_kg, g_m_per_s2: the object's weight is mass_kg · g_m_per_s2, N
     basis_rtol: rank tolerance of E_s; grasp_rank_rtol: rank tolerance of G
     strict_shrink: relative narrowing of the cone in the strict internal-force test
     tol: Clarabel feasibility and gap tolerance; max_iter: its iteration cap
+    (the last five are numerical settings of the solvers, not choices of the study)
     """
 
     gravity_direction: tuple[float, float, float]
-    mu: float = 1.5
-    f_min: float = 0.1
-    friction_cone: str = "circular"
-    k_stru: float = 1.0
-    k_ss: float = 200.0
-    mass_kg: float = 1.0
-    g: float = 9.81
+    mu: float
+    f_min_N: float
+    friction_cone: str
+    k_stru_N_per_mm: float
+    k_ss_Nmm_per_rad: float
+    mass_kg: float
+    g_m_per_s2: float
     basis_rtol: float = BASIS_RTOL
     grasp_rank_rtol: float = GRASP_RANK_RTOL
     strict_shrink: float = STRICT_SHRINK
@@ -67,30 +70,19 @@ class GFOParams:
     max_iter: int = 200
 
     def __post_init__(self) -> None:
+        # The configuration is checked by its schema; a direction is normalised here
+        # because every consumer relies on |d| = 1.
         d = np.asarray(self.gravity_direction, dtype=float)
-        if d.shape != (3,) or not np.all(np.isfinite(d)) or abs(np.linalg.norm(d) - 1.0) > 1e-6:
-            raise ValueError(f"gravity_direction must be a unit 3-vector, got {self.gravity_direction!r}")
-        object.__setattr__(self, "gravity_direction", tuple(float(v) for v in d))
-        for name in ("mu", "k_stru", "k_ss"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a finite number > 0, got {value}")
-        for name in ("f_min", "mass_kg", "g"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {value}")
-        for name in ("basis_rtol", "grasp_rank_rtol", "strict_shrink", "tol"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and 0 < value < 1):
-                raise ValueError(f"{name} must be in (0, 1), got {value}")
-        if not (isinstance(self.max_iter, int) and self.max_iter > 0):
-            raise ValueError(f"max_iter must be a positive int, got {self.max_iter!r}")
-        if self.friction_cone not in CONE_MODELS:
-            raise ValueError(f"friction_cone must be one of {list(CONE_MODELS)}, got {self.friction_cone!r}")
+        norm = float(np.linalg.norm(d)) if d.shape == (3,) and np.all(np.isfinite(d)) else 0.0
+        if norm == 0.0:
+            raise ValueError(f"gravity_direction must be a finite non-zero 3-vector, got {self.gravity_direction!r}")
+        object.__setattr__(self, "gravity_direction", tuple(float(v) for v in d / norm))
+        for name in ("mu", "f_min_N", "k_stru_N_per_mm", "k_ss_Nmm_per_rad", "mass_kg", "g_m_per_s2"):
+            object.__setattr__(self, name, float(getattr(self, name)))
 
     def wrench(self) -> NDArray:
         """w_e (6,) the contacts must apply against the weight, N and N·mm."""
-        return object_wrench(self.mass_kg, np.asarray(self.gravity_direction), self.g)
+        return object_wrench(self.mass_kg, np.asarray(self.gravity_direction), self.g_m_per_s2)
 
     @property
     def cone(self) -> FrictionCone:
@@ -100,7 +92,8 @@ class GFOParams:
 
 def mechanics_for(grasp: Grasp, params: GFOParams) -> GraspMechanics:
     """`grasp_mechanics` with the weight, stiffnesses and rank tolerance of `params`."""
-    return grasp_mechanics(grasp, params.wrench(), params.k_stru, params.k_ss, rank_rtol=params.grasp_rank_rtol)
+    return grasp_mechanics(grasp, params.wrench(), params.k_stru_N_per_mm, params.k_ss_Nmm_per_rad,
+                           rank_rtol=params.grasp_rank_rtol)
 
 
 def optimise_grasps(
@@ -147,7 +140,7 @@ def optimise_grasps(
         if mech.rank_G < 6 or mech.projector is None:
             out["status"][rows] = "rank_deficient"
             continue
-        problems = GraspSets(mech.f_p, mech.normals, mech.projector, synergies, params.f_min, cone, params.basis_rtol)
+        problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, synergies, params.f_min_N, cone, params.basis_rtol)
         sol = solve_gfo(problems, method, strict_shrink=params.strict_shrink if strict else None, tol=params.tol,
                         max_iter=params.max_iter, ipm=ipm)
         out["status"][rows], out["force_norm"][rows], out["e_s"][rows] = sol.status, sol.force_norm, sol.e_s
