@@ -171,7 +171,7 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
 def warm_up() -> None:
     """Compile the interior-point kernel's machine code, or load it from the cache next to
     its source. Called once after installation (Makefile) so that no workflow job pays the
-    compilation (about a minute on one core) and parallel jobs do not compile side by side.
+    compilation (about two minutes of CPU time) and parallel jobs do not compile side by side.
     """
     normals = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])
     squeeze = np.array([[1.0], [0.0], [0.0], [-1.0], [0.0], [0.0]]) / np.sqrt(2.0)

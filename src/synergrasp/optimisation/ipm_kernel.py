@@ -17,7 +17,9 @@ undecided problems to Clarabel.
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -68,105 +70,154 @@ class IPMSettings:
                 raise ValueError(f"{name} must be an int in 0..10, got {value!r}")
 
 
-# --------------------------------------------------------------------------- cone algebra
+# --------------------------------------------------------------------------- data layout
 # Compiled with numba: one problem at a time, so a problem's numbers never depend on the
 # batch it arrives in, and the ~10 iterations of a tiny problem cost microseconds instead of
 # the hundreds of numpy calls a vectorised iteration needs. A cone vector v has v[0] >= ||v[1:]||.
-# Flat layout of a problem's cone vectors (length 4m + e + 2): m linear slacks n.f - f_min,
-# then m Coulomb cones SOC(3) [n.f, t1.f/mu, t2.f/mu], then the objective cone (t, r0, y + a).
+# Flat layout of a problem's cone vectors (length N = 4m + e + 2): m linear slacks
+# n.f - f_min, then m Coulomb cones SOC(3) [n.f, t1.f/mu, t2.f/mu] at m + 3i, then the
+# objective cone (t, r0, y + a) at o = 4m. x = (t, y) has length n = e + 1.
+# The cone functions address one cone as (array, offset k, dimension d), never as a slice.
+# Every array is allocated once per pose (`_workspace`); the functions that allocate or
+# return arrays are compiled with numba's reference counting (`_jit_alloc`), the iteration
+# without it (`_jit`, `_jit_small`: `_nrt=False`). With it, every slice, argument and tuple
+# field taken in a loop cost an atomic increment and decrement, about half of the iteration's
+# time; without it the arithmetic is the same, in the same order.
 
-_jit = numba.njit(cache=True, nogil=True, error_model="numpy")
-_jit_small = numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+_jit_alloc = numba.njit(cache=True, nogil=True, error_model="numpy")
+_jit = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+_jit_small = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False, inline="always")
+
+#: The settings as the compiled code takes them: `IPMSettings` and the force-check tolerance.
+_Settings = namedtuple("_Settings", "tol reduced_tol max_iter step_fraction stall_step refine retry_refine violation_tol")
+
+#: One problem as the iteration sees it: contact rows D (m, 3, >= e) applied to E, hv (m, 3)
+#: the rows applied to f_p (N), a = E^T f_p (N), r0 = ||f_p - E a|| (N), mu, f_min (N),
+#: m contacts, e = e_s.
+_Problem = namedtuple("_Problem", "D hv a r0 mu f_min m e")
+
+#: Work arrays for problems of m contacts and e_s <= e_max (`_workspace`), allocated once
+#: and reused by every problem of a pose; a problem uses the leading N (cone layout) or
+#: n (x layout) entries of each vector.
+_Work = namedtuple("_Work", [
+    "D", "hv", "a",                          # the problem's data (`_Problem` refers to them)
+    "h", "x", "s", "z",                      # scaled h (cone layout); the iterate
+    "w", "beta", "w_lin", "s_over_z", "lam",  # NT scaling: points w (cone layout), beta per SOC (objective last)
+    "H3", "H_obj", "T", "M", "L",            # (W^T W)^-1 blocks (3m, 3), (e+2, e+2); normal matrix, its factor
+    "r_x", "r_z", "x1", "z1", "x2", "z2", "bx", "q", "dsv",  # residuals and right-hand sides
+    "dx", "dz", "ds", "dx_a", "dz_a", "ds_a",                # corrector and predictor directions
+    "wn", "wn2", "ex", "wN", "wN2", "wN3", "ez",             # scratch of the linear solves
+])
+
+#: The homogenising pair (tau, kappa), the tau-row residual and c^T x1 + h^T z1 of the tau
+#: column, shared by the predictor and the corrector of an iteration.
+_Homogeneous = namedtuple("_Homogeneous", "tau kappa r_tau cx1_hz1")
+
+
+@_jit_alloc
+def _workspace(m, e_max):
+    N, n = 4 * m + e_max + 2, e_max + 1
+    return _Work(np.empty((m, 3, e_max)), np.empty((m, 3)), np.empty(e_max),
+                 np.empty(N), np.empty(n), np.empty(N), np.empty(N),
+                 np.empty(N), np.empty(m + 1), np.empty(m), np.empty(m), np.empty(N),
+                 np.empty((3 * m, 3)), np.empty((e_max + 2, e_max + 2)), np.empty((m, 3, e_max)),
+                 np.empty((n, n)), np.empty((n, n)),
+                 np.empty(n), np.empty(N), np.empty(n), np.empty(N), np.empty(n), np.empty(N), np.empty(n),
+                 np.empty(N), np.empty(N),
+                 np.empty(n), np.empty(N), np.empty(N), np.empty(n), np.empty(N), np.empty(N),
+                 np.empty(n), np.empty(n), np.empty(n), np.empty(N), np.empty(N), np.empty(N), np.empty(N))
+
+
+# --------------------------------------------------------------------------- cone algebra
 
 
 @_jit_small
-def _soc_det(v):
+def _soc_det(v, k, d):
     """v^T J v = v0^2 - ||v1||^2, as a product to keep relative accuracy near the boundary."""
     r = 0.0
-    for i in range(1, v.size):
+    for i in range(k + 1, k + d):
         r += v[i] * v[i]
     r = math.sqrt(r)
-    return (v[0] - r) * (v[0] + r)
+    return (v[k] - r) * (v[k] + r)
 
 
 @_jit_small
-def _soc_nt(s, z, w):
+def _soc_nt(s, z, w, k, d):
     """Nesterov-Todd scaling point of the interior pair (s, z): fills w (w^T J w = 1) and
     returns beta, with W z = W^-1 s = lambda and (W^T W)^-1 = beta^-2 (2 (Jw)(Jw)^T - J)."""
-    sd = math.sqrt(_soc_det(s))
-    zd = math.sqrt(_soc_det(z))
+    sd = math.sqrt(_soc_det(s, k, d))
+    zd = math.sqrt(_soc_det(z, k, d))
     dot = 0.0
-    for i in range(s.size):
+    for i in range(k, k + d):
         dot += (s[i] / sd) * (z[i] / zd)
     gamma2 = 2.0 * math.sqrt(0.5 * (1.0 + dot))
-    w[0] = (s[0] / sd + z[0] / zd) / gamma2
-    for i in range(1, s.size):
+    w[k] = (s[k] / sd + z[k] / zd) / gamma2
+    for i in range(k + 1, k + d):
         w[i] = (s[i] / sd - z[i] / zd) / gamma2
     return math.sqrt(sd / zd)
 
 
 @_jit_small
-def _soc_apply(w, beta, v, out, inverse):
+def _soc_apply(w, beta, v, out, k, d, inverse):
     """out = W v (or W^-1 v) for the NT scaling (w, beta)."""
     sign = -1.0 if inverse else 1.0
     scale = 1.0 / beta if inverse else beta
     w1v1 = 0.0
-    for i in range(1, v.size):
+    for i in range(k + 1, k + d):
         w1v1 += w[i] * v[i]
-    c = sign * v[0] + w1v1 / (1.0 + w[0])
-    out[0] = (w[0] * v[0] + sign * w1v1) * scale
-    for i in range(1, v.size):
+    c = sign * v[k] + w1v1 / (1.0 + w[k])
+    out[k] = (w[k] * v[k] + sign * w1v1) * scale
+    for i in range(k + 1, k + d):
         out[i] = (v[i] + w[i] * c) * scale
 
 
 @_jit_small
-def _soc_hessian(w, beta, H):
-    """H = (W^T W)^-1 = beta^-2 (2 u u^T - J), u = J w."""
-    d = w.size
+def _soc_hessian(w, beta, k, d, H, r0):
+    """H[r0:r0 + d, :d] = (W^T W)^-1 = beta^-2 (2 u u^T - J), u = J w."""
     ib2 = 1.0 / (beta * beta)
     for i in range(d):
-        ui = w[i] if i == 0 else -w[i]
+        ui = w[k + i] if i == 0 else -w[k + i]
         for j in range(d):
-            uj = w[j] if j == 0 else -w[j]
-            H[i, j] = 2.0 * ui * uj
-        H[i, i] += -1.0 if i == 0 else 1.0
+            uj = w[k + j] if j == 0 else -w[k + j]
+            H[r0 + i, j] = 2.0 * ui * uj
+        H[r0 + i, i] += -1.0 if i == 0 else 1.0
         for j in range(d):
-            H[i, j] *= ib2
+            H[r0 + i, j] *= ib2
 
 
 @_jit_small
-def _soc_prod(u, v, out):
+def _soc_prod(u, v, out, k, d):
     """Jordan product u o v = (u^T v, u0 v1 + v0 u1)."""
     acc = 0.0
-    for i in range(u.size):
+    for i in range(k, k + d):
         acc += u[i] * v[i]
-    for i in range(1, u.size):
-        out[i] = u[0] * v[i] + v[0] * u[i]
-    out[0] = acc
+    for i in range(k + 1, k + d):
+        out[i] = u[k] * v[i] + v[k] * u[i]
+    out[k] = acc
 
 
 @_jit_small
-def _soc_div(lam, w, out):
+def _soc_div(lam, w, out, k, d):
     """out = x with lam o x = w (lam in the interior)."""
-    rho = _soc_det(lam)
+    rho = _soc_det(lam, k, d)
     nu = 0.0
-    for i in range(1, lam.size):
+    for i in range(k + 1, k + d):
         nu += lam[i] * w[i]
-    c = (nu / lam[0] - w[0]) / rho
-    out[0] = (lam[0] * w[0] - nu) / rho
-    for i in range(1, lam.size):
-        out[i] = c * lam[i] + w[i] / lam[0]
+    c = (nu / lam[k] - w[k]) / rho
+    out[k] = (lam[k] * w[k] - nu) / rho
+    for i in range(k + 1, k + d):
+        out[i] = c * lam[i] + w[i] / lam[k]
 
 
 @_jit_small
-def _soc_max_step(v, d):
-    """Largest alpha >= 0 with v + alpha d in the cone (inf if unbounded); v interior."""
-    a = d[0] * d[0]
-    b = v[0] * d[0]
-    for i in range(1, v.size):
-        a -= d[i] * d[i]
-        b -= v[i] * d[i]
-    c = _soc_det(v)
+def _soc_max_step(v, dv, k, d):
+    """Largest alpha >= 0 with v + alpha dv in the cone (inf if unbounded); v interior."""
+    a = dv[k] * dv[k]
+    b = v[k] * dv[k]
+    for i in range(k + 1, k + d):
+        a -= dv[i] * dv[i]
+        b -= v[i] * dv[i]
+    c = _soc_det(v, k, d)
     disc = b * b - a * c
     denom = -b + math.sqrt(max(disc, 0.0))
     if disc >= 0.0 and denom > 0.0:
@@ -179,12 +230,13 @@ def _lin_max_step(v, d):
     return -v / d if d < 0.0 else math.inf
 
 
-# --------------------------------------------------------------------------- one problem
+# --------------------------------------------------------------------------- linear algebra
 
 
-@_jit
-def _G_mul(D, m, e, x, out):
+@_jit_small
+def _G_mul(P, x, out):
     """out = G x for x = (t, y): linear rows -D0 y, Coulomb rows -D y, objective -(t, 0, y)."""
+    D, m, e = P.D, P.m, P.e
     for i in range(m):
         for r in range(3):
             acc = 0.0
@@ -199,9 +251,10 @@ def _G_mul(D, m, e, x, out):
         out[o + 2 + j] = -x[1 + j]
 
 
-@_jit
-def _GT_mul(D, m, e, z, out):
+@_jit_small
+def _GT_mul(P, z, out):
     """out = G^T z."""
+    D, m, e = P.D, P.m, P.e
     o = 4 * m
     out[0] = -z[o]
     for j in range(e):
@@ -212,15 +265,16 @@ def _GT_mul(D, m, e, z, out):
         out[1 + j] = -z[o + 2 + j] - acc
 
 
-@_jit
-def _H_mul(m, e, w_lin, H_soc, H_obj, v, out):
+@_jit_small
+def _H_mul(P, W, v, out):
     """out = (W^T W)^-1 v, with the same matrices as the normal matrix (a closed form
     rounds differently, and that mismatch costs accuracy near the optimum)."""
+    m, e, H3, H_obj = P.m, P.e, W.H3, W.H_obj
     for i in range(m):
-        out[i] = w_lin[i] * v[i]
+        out[i] = W.w_lin[i] * v[i]
         c = m + 3 * i
         for r in range(3):
-            out[c + r] = H_soc[i, r, 0] * v[c] + H_soc[i, r, 1] * v[c + 1] + H_soc[i, r, 2] * v[c + 2]
+            out[c + r] = H3[3 * i + r, 0] * v[c] + H3[3 * i + r, 1] * v[c + 1] + H3[3 * i + r, 2] * v[c + 2]
     o = 4 * m
     for r in range(e + 2):
         acc = 0.0
@@ -229,23 +283,23 @@ def _H_mul(m, e, w_lin, H_soc, H_obj, v, out):
         out[o + r] = acc
 
 
-@_jit
-def _V_mul(m, e, s_over_z, w_soc, b_soc, w_obj, b_obj, v, tmp, out):
+@_jit_small
+def _V_mul(P, W, v, tmp, out):
     """out = W^T W v through the scaling factors (iterative refinement)."""
+    m = P.m
     for i in range(m):
-        out[i] = s_over_z[i] * v[i]
+        out[i] = W.s_over_z[i] * v[i]
         c = m + 3 * i
-        _soc_apply(w_soc[i], b_soc[i], v[c:c + 3], tmp[c:c + 3], False)
-        _soc_apply(w_soc[i], b_soc[i], tmp[c:c + 3], out[c:c + 3], False)
+        _soc_apply(W.w, W.beta[i], v, tmp, c, 3, False)
+        _soc_apply(W.w, W.beta[i], tmp, out, c, 3, False)
     o = 4 * m
-    _soc_apply(w_obj, b_obj, v[o:], tmp[o:], False)
-    _soc_apply(w_obj, b_obj, tmp[o:], out[o:], False)
+    _soc_apply(W.w, W.beta[m], v, tmp, o, P.e + 2, False)
+    _soc_apply(W.w, W.beta[m], tmp, out, o, P.e + 2, False)
 
 
-@_jit
-def _cholesky(M, L):
-    """Lower Cholesky factor L of the SPD matrix M (lower triangle read)."""
-    n = M.shape[0]
+@_jit_small
+def _cholesky(M, L, n):
+    """Lower Cholesky factor L of the leading (n, n) SPD block of M (lower triangle read)."""
     for j in range(n):
         for i in range(j, n):
             acc = M[i, j]
@@ -257,10 +311,9 @@ def _cholesky(M, L):
                 L[i, j] = acc / L[j, j]
 
 
-@_jit
-def _cho_solve(L, b, x):
-    """x with L L^T x = b."""
-    n = L.shape[0]
+@_jit_small
+def _cho_solve(L, n, b, x):
+    """x with L L^T x = b (leading n entries)."""
     for i in range(n):
         acc = b[i]
         for k in range(i):
@@ -273,51 +326,164 @@ def _cho_solve(L, b, x):
         x[i] = acc / L[i, i]
 
 
-@_jit
-def _reduced(D, m, e, L, w_lin, H_soc, H_obj, bx, bz, dx, dz, wN, wn):
+@_jit_small
+def _reduced(P, W, bx, bz, dx, dz):
     """[0 G^T; G -W^T W] [dx; dz] = [bx; bz] by the normal equations."""
-    _H_mul(m, e, w_lin, H_soc, H_obj, bz, wN)
-    _GT_mul(D, m, e, wN, wn)
-    for j in range(e + 1):
+    wN, wn = W.wN, W.wn
+    _H_mul(P, W, bz, wN)
+    _GT_mul(P, wN, wn)
+    for j in range(P.e + 1):
         wn[j] += bx[j]
-    _cho_solve(L, wn, dx)
-    _G_mul(D, m, e, dx, wN)
-    for k in range(wN.size):
+    _cho_solve(W.L, P.e + 1, wn, dx)
+    _G_mul(P, dx, wN)
+    for k in range(4 * P.m + P.e + 2):
         wN[k] -= bz[k]
-    _H_mul(m, e, w_lin, H_soc, H_obj, wN, dz)
+    _H_mul(P, W, wN, dz)
 
 
-@_jit
-def _solve_kkt(D, m, e, L, w_lin, H_soc, H_obj, s_over_z, w_soc, b_soc, w_obj, b_obj, refine,
-               bx, bz, dx, dz, wN, wN2, wN3, wn, wn2):
-    _reduced(D, m, e, L, w_lin, H_soc, H_obj, bx, bz, dx, dz, wN, wn)
+@_jit_small
+def _solve_kkt(P, W, refine, bx, bz, dx, dz):
+    """The Newton system for (bx, bz), with `refine` steps of iterative refinement."""
+    _reduced(P, W, bx, bz, dx, dz)
+    n, N = P.e + 1, 4 * P.m + P.e + 2
+    wN2, wN3, wn2 = W.wN2, W.wN3, W.wn2
     for _ in range(refine):
         # residual of the full system, then a correction from the same factorisation
-        _G_mul(D, m, e, dx, wN2)
-        _V_mul(m, e, s_over_z, w_soc, b_soc, w_obj, b_obj, dz, wN, wN3)
-        for k in range(wN.size):
+        _G_mul(P, dx, wN2)
+        _V_mul(P, W, dz, W.wN, wN3)
+        for k in range(N):
             wN2[k] = bz[k] - wN2[k] + wN3[k]
-        _GT_mul(D, m, e, dz, wn2)
-        for j in range(e + 1):
+        _GT_mul(P, dz, wn2)
+        for j in range(n):
             wn2[j] = bx[j] - wn2[j]
-        ex = np.empty(e + 1)
-        ez = np.empty(wN.size)
-        _reduced(D, m, e, L, w_lin, H_soc, H_obj, wn2, wN2, ex, ez, wN, wn)
-        for j in range(e + 1):
-            dx[j] += ex[j]
-        for k in range(wN.size):
-            dz[k] += ez[k]
+        _reduced(P, W, wn2, wN2, W.ex, W.ez)
+        for j in range(n):
+            dx[j] += W.ex[j]
+        for k in range(N):
+            dz[k] += W.ez[k]
 
 
-@_jit
-def _max_step(m, s, z, ds, dz, tau, dtau, kappa, dkappa):
+# --------------------------------------------------------------------------- one problem
+
+
+@_jit_small
+def _scaling(P, W):
+    """NT scaling of the iterate (W.s, W.z), lambda = W z, and the Cholesky factor of the
+    normal matrix M = G^T (W^T W)^-1 G, (e+1, e+1)."""
+    m, e, D, s, z = P.m, P.e, P.D, W.s, W.z
+    H3, H_obj, T, M = W.H3, W.H_obj, W.T, W.M
+    o = 4 * m
+    for i in range(m):
+        W.w_lin[i] = z[i] / s[i]
+        W.s_over_z[i] = s[i] / z[i]
+        W.lam[i] = math.sqrt(s[i] * z[i])
+        c = m + 3 * i
+        W.beta[i] = _soc_nt(s, z, W.w, c, 3)
+        _soc_apply(W.w, W.beta[i], z, W.lam, c, 3, False)
+        _soc_hessian(W.w, W.beta[i], c, 3, H3, 3 * i)
+    W.beta[m] = _soc_nt(s, z, W.w, o, e + 2)
+    _soc_apply(W.w, W.beta[m], z, W.lam, o, e + 2, False)
+    _soc_hessian(W.w, W.beta[m], o, e + 2, H_obj, 0)
+    M[0, 0] = H_obj[0, 0]
+    for j in range(e):
+        M[1 + j, 0] = H_obj[2 + j, 0]
+        for k in range(j + 1):
+            M[1 + j, 1 + k] = H_obj[2 + j, 2 + k]
+    for i in range(m):
+        # a contact's linear row is the first row of its Coulomb rows
+        r = 3 * i
+        h00 = H3[r, 0] + W.w_lin[i]
+        for j in range(e):
+            d0, d1, d2 = D[i, 0, j], D[i, 1, j], D[i, 2, j]
+            T[i, 0, j] = h00 * d0 + H3[r, 1] * d1 + H3[r, 2] * d2
+            T[i, 1, j] = H3[r + 1, 0] * d0 + H3[r + 1, 1] * d1 + H3[r + 1, 2] * d2
+            T[i, 2, j] = H3[r + 2, 0] * d0 + H3[r + 2, 1] * d1 + H3[r + 2, 2] * d2
+    for j in range(e):
+        for k in range(j + 1):
+            acc = 0.0
+            for i in range(m):
+                acc += D[i, 0, j] * T[i, 0, k] + D[i, 1, j] * T[i, 1, k] + D[i, 2, j] * T[i, 2, k]
+            M[1 + j, 1 + k] += acc
+    _cholesky(M, W.L, e + 1)
+
+
+@_jit_small
+def _direction(P, W, refine, hom, sigma, dsv, d_kappa, dx, dz, ds):
+    """Newton direction for the complementarity right-hand side dsv (lambda \\ d_s form) and
+    d_kappa, at centring sigma; fills dx, dz, ds and returns (dtau, dkappa)."""
+    m, e, s, z, lam, q, wN = P.m, P.e, W.s, W.z, W.lam, W.q, W.wN
+    N = 4 * m + e + 2
+    o = 4 * m
+    f = 1.0 - sigma
+    # q = W^T (lambda \ d_s) per cone
+    for i in range(m):
+        q[i] = math.sqrt(s[i] / z[i]) * (dsv[i] / lam[i])
+        c = m + 3 * i
+        _soc_div(lam, dsv, wN, c, 3)
+        _soc_apply(W.w, W.beta[i], wN, q, c, 3, False)
+    _soc_div(lam, dsv, wN, o, e + 2)
+    _soc_apply(W.w, W.beta[m], wN, q, o, e + 2, False)
+    for k in range(N):
+        q[k] -= f * W.r_z[k]
+    for j in range(e + 1):
+        W.bx[j] = -f * W.r_x[j]
+    _solve_kkt(P, W, refine, W.bx, q, W.x2, W.z2)
+    cx2_hz2 = W.x2[0]
+    for k in range(N):
+        cx2_hz2 += W.h[k] * W.z2[k]
+    tau, kappa = hom.tau, hom.kappa
+    dtau = (d_kappa / tau - f * hom.r_tau - cx2_hz2) / (hom.cx1_hz1 - kappa / tau)
+    for j in range(e + 1):
+        dx[j] = W.x2[j] + dtau * W.x1[j]
+    for k in range(N):
+        dz[k] = W.z2[k] + dtau * W.z1[k]
+    dkappa = -(d_kappa + kappa * dtau) / tau
+    # ds from the primal row G dx + ds - h dtau = -(1 - sigma) r_z: it keeps the primal
+    # residual exact where W^T W is badly conditioned near the optimum.
+    _G_mul(P, dx, ds)
+    for k in range(N):
+        ds[k] = -f * W.r_z[k] - ds[k] + W.h[k] * dtau
+    return dtau, dkappa
+
+
+@_jit_small
+def _max_step(P, W, ds, dz, tau, dtau, kappa, dkappa):
+    """Largest step along (ds, dz, dtau, dkappa) that keeps (W.s, W.z, tau, kappa) in the cones."""
+    m, s, z = P.m, W.s, W.z
     st = min(_lin_max_step(tau, dtau), _lin_max_step(kappa, dkappa))
     for i in range(m):
         st = min(st, _lin_max_step(s[i], ds[i]), _lin_max_step(z[i], dz[i]))
         c = m + 3 * i
-        st = min(st, _soc_max_step(s[c:c + 3], ds[c:c + 3]), _soc_max_step(z[c:c + 3], dz[c:c + 3]))
+        st = min(st, _soc_max_step(s, ds, c, 3), _soc_max_step(z, dz, c, 3))
     o = 4 * m
-    return min(st, _soc_max_step(s[o:], ds[o:]), _soc_max_step(z[o:], dz[o:]))
+    return min(st, _soc_max_step(s, ds, o, P.e + 2), _soc_max_step(z, dz, o, P.e + 2))
+
+
+@_jit_small
+def _corrector_rhs(P, W, dtau_a, dkappa_a, tau, kappa, sm):
+    """W.dsv: Mehrotra's second-order term (W^-T ds_a) o (W dz_a) and centring sigma mu
+    (sm) added to lambda o lambda; returns the kappa row's counterpart."""
+    m, e, s, z, lam, dsv = P.m, P.e, W.s, W.z, W.lam, W.dsv
+    ds_a, dz_a, wN, wN2, wN3 = W.ds_a, W.dz_a, W.wN, W.wN2, W.wN3
+    for i in range(m):
+        dsv[i] = lam[i] * lam[i] + (math.sqrt(z[i] / s[i]) * ds_a[i]) * (math.sqrt(s[i] / z[i]) * dz_a[i]) - sm
+        c = m + 3 * i
+        _soc_apply(W.w, W.beta[i], ds_a, wN, c, 3, True)
+        _soc_apply(W.w, W.beta[i], dz_a, wN2, c, 3, False)
+        _soc_prod(wN, wN2, wN3, c, 3)
+        _soc_prod(lam, lam, dsv, c, 3)
+        for r in range(3):
+            dsv[c + r] += wN3[c + r]
+        dsv[c] -= sm
+    o, d = 4 * m, e + 2
+    _soc_apply(W.w, W.beta[m], ds_a, wN, o, d, True)
+    _soc_apply(W.w, W.beta[m], dz_a, wN2, o, d, False)
+    _soc_prod(wN, wN2, wN3, o, d)
+    _soc_prod(lam, lam, dsv, o, d)
+    for r in range(d):
+        dsv[o + r] += wN3[o + r]
+    dsv[o] -= sm
+    return tau * kappa + dtau_a * dkappa_a - sm
 
 
 @_jit
@@ -331,71 +497,62 @@ def _is_certificate(hz, gtz_norm, eps):
     return hz < 0.0 and gtz_norm <= eps * -hz
 
 
-@_jit
-def _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine, y):
-    """Solve one GFO problem (contact rows D (m, 3, e), h (m, 3), a (e,), N) by the homogeneous
-    self-dual embedding. Returns (code, iterations); fills y (N) when optimal."""
-    N = 4 * m + e + 2
-    n = e + 1
-    o = 4 * m
-    # Scale so that the forces are O(1): the iteration then starts well centred.
-    fp_norm = r0 * r0
+@_jit_small
+def _start(P, W):
+    """Scaled h (the data divided by rho = max(||f_p||, f_min), so that the forces are O(1)
+    and the iteration starts well centred) and the initial point; returns (rho, h_norm)."""
+    m, e, hv, a, h, s, z = P.m, P.e, P.hv, P.a, W.h, W.s, W.z
+    N, o = 4 * m + e + 2, 4 * m
+    fp_norm = P.r0 * P.r0
     for j in range(e):
         fp_norm += a[j] * a[j]
-    rho = max(math.sqrt(fp_norm), max(f_min, 1e-12))
-    h = np.zeros(N)
+    rho = max(math.sqrt(fp_norm), max(P.f_min, 1e-12))
     for i in range(m):
-        h[i] = (hv[i, 0] - f_min) / rho
+        h[i] = (hv[i, 0] - P.f_min) / rho
         for r in range(3):
             h[m + 3 * i + r] = hv[i, r] / rho
-    h[o + 1] = r0 / rho
+    h[o] = 0.0
+    h[o + 1] = P.r0 / rho
     for j in range(e):
         h[o + 2 + j] = a[j] / rho
     hh = 0.0
     for k in range(N):
         if k != o + 1:
             hh += h[k] * h[k]
-    h_norm = max(1.0, math.sqrt(hh))
-    n_deg = 2.0 * m + 1.0
-
-    x = np.zeros(n)
-    s = np.zeros(N)
+    for j in range(e + 1):
+        W.x[j] = 0.0
+    for k in range(N):
+        s[k] = 0.0
     for i in range(m):
         s[i] = 1.0
         s[m + 3 * i] = 1.0
     s[o] = 1.0
-    z = s.copy()
+    for k in range(N):
+        z[k] = s[k]
+    return rho, max(1.0, math.sqrt(hh))
+
+
+@_jit
+def _hsde(P, W, opt, refine, y):
+    """Solve one GFO problem by the homogeneous self-dual embedding with `refine` steps of
+    iterative refinement per linear solve. Returns (code, iterations); fills y (N) when optimal."""
+    m, e, h, x, s, z = P.m, P.e, W.h, W.x, W.s, W.z
+    N, n, o = 4 * m + e + 2, e + 1, 4 * m
+    rho, h_norm = _start(P, W)
+    n_deg = 2.0 * m + 1.0
     tau = 1.0
     kappa = 1.0
-
-    r_x, x1, x2, dx, dx_a = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    bx, wn, wn2 = np.empty(n), np.empty(n), np.empty(n)
-    r_z, z1, z2, dz, dz_a = np.empty(N), np.empty(N), np.empty(N), np.empty(N), np.empty(N)
-    ds, ds_a, dsv, q = np.empty(N), np.empty(N), np.empty(N), np.empty(N)
-    wN, wN2, wN3 = np.empty(N), np.empty(N), np.empty(N)
-    lam = np.empty(N)
-    w_lin = np.empty(m)
-    s_over_z = np.empty(m)
-    w_soc = np.empty((m, 3))
-    b_soc = np.empty(m)
-    w_obj = np.empty(e + 2)
-    H_soc = np.empty((m, 3, 3))
-    H_obj = np.empty((e + 2, e + 2))
-    T = np.empty((m, 3, e))
-    M = np.empty((n, n))
-    L = np.zeros((n, n))
-    tmp3 = np.empty(3)
-    tmp_o = np.empty(e + 2)
+    r_x, r_z, dsv = W.r_x, W.r_z, W.dsv
     stalled = False
 
-    for it in range(max_iter + 1):
-        _GT_mul(D, m, e, z, r_x)
+    for it in range(opt.max_iter + 1):
+        _GT_mul(P, z, r_x)
         gtz = 0.0
         for j in range(n):
             gtz += r_x[j] * r_x[j]
         gtz_norm = math.sqrt(gtz)
         r_x[0] += tau
-        _G_mul(D, m, e, x, r_z)
+        _G_mul(P, x, r_z)
         hz = 0.0
         sz = 0.0
         pr = 0.0
@@ -414,12 +571,12 @@ def _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, 
         dres = math.sqrt(dr) / tau
         pcost = x[0] / tau
         gap = sz / (tau * tau)
-        last = it == max_iter or stalled
-        optimal = _is_optimal(pres, dres, gap, pcost, tol)
-        infeasible = not optimal and _is_certificate(hz, gtz_norm, tol)
+        last = it == opt.max_iter or stalled
+        optimal = _is_optimal(pres, dres, gap, pcost, opt.tol)
+        infeasible = not optimal and _is_certificate(hz, gtz_norm, opt.tol)
         if last:
-            optimal = optimal or _is_optimal(pres, dres, gap, pcost, reduced_tol)
-            infeasible = infeasible or (not optimal and _is_certificate(hz, gtz_norm, reduced_tol))
+            optimal = optimal or _is_optimal(pres, dres, gap, pcost, opt.reduced_tol)
+            infeasible = infeasible or (not optimal and _is_certificate(hz, gtz_norm, opt.reduced_tol))
         if optimal:
             for j in range(e):
                 y[j] = x[1 + j] / tau * rho
@@ -429,155 +586,54 @@ def _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, 
         if last or not (math.isfinite(mu) and math.isfinite(tau) and tau > 0.0):
             return UNDECIDED, it
 
-        # Nesterov-Todd scaling and the normal matrix M = G^T (W^T W)^-1 G, (e+1, e+1).
-        for i in range(m):
-            w_lin[i] = z[i] / s[i]
-            s_over_z[i] = s[i] / z[i]
-            lam[i] = math.sqrt(s[i] * z[i])
-            c = m + 3 * i
-            b_soc[i] = _soc_nt(s[c:c + 3], z[c:c + 3], w_soc[i])
-            _soc_apply(w_soc[i], b_soc[i], z[c:c + 3], lam[c:c + 3], False)
-            _soc_hessian(w_soc[i], b_soc[i], H_soc[i])
-        b_obj = _soc_nt(s[o:], z[o:], w_obj)
-        _soc_apply(w_obj, b_obj, z[o:], lam[o:], False)
-        _soc_hessian(w_obj, b_obj, H_obj)
-        M[0, 0] = H_obj[0, 0]
-        for j in range(e):
-            M[1 + j, 0] = H_obj[2 + j, 0]
-            for k in range(j + 1):
-                M[1 + j, 1 + k] = H_obj[2 + j, 2 + k]
-        for i in range(m):
-            # a contact's linear row is the first row of its Coulomb rows
-            h00 = H_soc[i, 0, 0] + w_lin[i]
-            for j in range(e):
-                d0, d1, d2 = D[i, 0, j], D[i, 1, j], D[i, 2, j]
-                T[i, 0, j] = h00 * d0 + H_soc[i, 0, 1] * d1 + H_soc[i, 0, 2] * d2
-                T[i, 1, j] = H_soc[i, 1, 0] * d0 + H_soc[i, 1, 1] * d1 + H_soc[i, 1, 2] * d2
-                T[i, 2, j] = H_soc[i, 2, 0] * d0 + H_soc[i, 2, 1] * d1 + H_soc[i, 2, 2] * d2
-        for j in range(e):
-            for k in range(j + 1):
-                acc = 0.0
-                for i in range(m):
-                    acc += D[i, 0, j] * T[i, 0, k] + D[i, 1, j] * T[i, 1, k] + D[i, 2, j] * T[i, 2, k]
-                M[1 + j, 1 + k] += acc
-        _cholesky(M, L)
-
+        _scaling(P, W)
         # x1, z1: the solution for the tau column, -c and h.
         for j in range(n):
-            bx[j] = -1.0 if j == 0 else 0.0
-        _solve_kkt(D, m, e, L, w_lin, H_soc, H_obj, s_over_z, w_soc, b_soc, w_obj, b_obj, refine,
-                   bx, h, x1, z1, wN, wN2, wN3, wn, wn2)
-        cx1_hz1 = x1[0]
+            W.bx[j] = -1.0 if j == 0 else 0.0
+        _solve_kkt(P, W, refine, W.bx, h, W.x1, W.z1)
+        cx1_hz1 = W.x1[0]
         for k in range(N):
-            cx1_hz1 += h[k] * z1[k]
+            cx1_hz1 += h[k] * W.z1[k]
+        hom = _Homogeneous(tau, kappa, r_tau, cx1_hz1)
 
         # Predictor (affine scaling): d_s = lambda o lambda, d_kappa = tau kappa.
         for i in range(m):
-            dsv[i] = lam[i] * lam[i]
-            c = m + 3 * i
-            _soc_prod(lam[c:c + 3], lam[c:c + 3], dsv[c:c + 3])
-        _soc_prod(lam[o:], lam[o:], dsv[o:])
-        dtau_a, dkappa_a = _direction(D, m, e, 0.0, dsv, tau * kappa, s, z, lam, h, r_x, r_z, r_tau, tau, kappa,
-                                      cx1_hz1, x1, z1, L, w_lin, H_soc, H_obj, s_over_z, w_soc, b_soc, w_obj, b_obj,
-                                      refine, dx_a, dz_a, ds_a, q, x2, z2, wN, wN2, wN3, bx, wn, wn2)
-        alpha_a = min(1.0, _max_step(m, s, z, ds_a, dz_a, tau, dtau_a, kappa, dkappa_a))
+            dsv[i] = W.lam[i] * W.lam[i]
+            _soc_prod(W.lam, W.lam, dsv, m + 3 * i, 3)
+        _soc_prod(W.lam, W.lam, dsv, o, e + 2)
+        dtau_a, dkappa_a = _direction(P, W, refine, hom, 0.0, dsv, tau * kappa, W.dx_a, W.dz_a, W.ds_a)
+        alpha_a = min(1.0, _max_step(P, W, W.ds_a, W.dz_a, tau, dtau_a, kappa, dkappa_a))
         sigma = min(max((1.0 - alpha_a) ** 3, 0.0), 1.0)
-        sm = sigma * mu
 
-        # Corrector: Mehrotra's second-order term (W^-T ds_a) o (W dz_a) and centring sigma mu.
-        for i in range(m):
-            dsv[i] = lam[i] * lam[i] + (math.sqrt(z[i] / s[i]) * ds_a[i]) * (math.sqrt(s[i] / z[i]) * dz_a[i]) - sm
-            c = m + 3 * i
-            _soc_apply(w_soc[i], b_soc[i], ds_a[c:c + 3], wN[c:c + 3], True)
-            _soc_apply(w_soc[i], b_soc[i], dz_a[c:c + 3], wN2[c:c + 3], False)
-            _soc_prod(wN[c:c + 3], wN2[c:c + 3], tmp3)
-            _soc_prod(lam[c:c + 3], lam[c:c + 3], dsv[c:c + 3])
-            for r in range(3):
-                dsv[c + r] += tmp3[r]
-            dsv[c] -= sm
-        _soc_apply(w_obj, b_obj, ds_a[o:], wN[o:], True)
-        _soc_apply(w_obj, b_obj, dz_a[o:], wN2[o:], False)
-        _soc_prod(wN[o:], wN2[o:], tmp_o)
-        _soc_prod(lam[o:], lam[o:], dsv[o:])
-        for r in range(e + 2):
-            dsv[o + r] += tmp_o[r]
-        dsv[o] -= sm
-        d_kap = tau * kappa + dtau_a * dkappa_a - sm
-        dtau, dkappa = _direction(D, m, e, sigma, dsv, d_kap, s, z, lam, h, r_x, r_z, r_tau, tau, kappa,
-                                  cx1_hz1, x1, z1, L, w_lin, H_soc, H_obj, s_over_z, w_soc, b_soc, w_obj, b_obj,
-                                  refine, dx, dz, ds, q, x2, z2, wN, wN2, wN3, bx, wn, wn2)
-        alpha = min(1.0, step_fraction * _max_step(m, s, z, ds, dz, tau, dtau, kappa, dkappa))
+        # Corrector.
+        d_kap = _corrector_rhs(P, W, dtau_a, dkappa_a, tau, kappa, sigma * mu)
+        dtau, dkappa = _direction(P, W, refine, hom, sigma, dsv, d_kap, W.dx, W.dz, W.ds)
+        alpha = min(1.0, opt.step_fraction * _max_step(P, W, W.ds, W.dz, tau, dtau, kappa, dkappa))
 
         # A vanishing step near the optimum means the normal equations have run out of
         # accuracy: keep the current point and judge it with the reduced tolerance.
-        stalled = alpha < stall_step
+        stalled = alpha < opt.stall_step
         if stalled:
             alpha = 0.0
         for j in range(n):
-            x[j] += alpha * dx[j]
+            x[j] += alpha * W.dx[j]
         for k in range(N):
-            s[k] += alpha * ds[k]
-            z[k] += alpha * dz[k]
+            s[k] += alpha * W.ds[k]
+            z[k] += alpha * W.dz[k]
         tau += alpha * dtau
         kappa += alpha * dkappa
-    return UNDECIDED, max_iter
-
-
-@_jit
-def _direction(D, m, e, sigma, dsv, d_kappa, s, z, lam, h, r_x, r_z, r_tau, tau, kappa, cx1_hz1, x1, z1,
-               L, w_lin, H_soc, H_obj, s_over_z, w_soc, b_soc, w_obj, b_obj, refine,
-               dx, dz, ds, q, x2, z2, wN, wN2, wN3, bx, wn, wn2):
-    """Newton direction for the complementarity right-hand side dsv (lambda \\ d_s form);
-    fills dx, dz, ds and returns (dtau, dkappa)."""
-    N = 4 * m + e + 2
-    o = 4 * m
-    f = 1.0 - sigma
-    # q = W^T (lambda \ d_s) per cone
-    for i in range(m):
-        q[i] = math.sqrt(s[i] / z[i]) * (dsv[i] / lam[i])
-        c = m + 3 * i
-        _soc_div(lam[c:c + 3], dsv[c:c + 3], wN[c:c + 3])
-        _soc_apply(w_soc[i], b_soc[i], wN[c:c + 3], q[c:c + 3], False)
-    _soc_div(lam[o:], dsv[o:], wN[o:])
-    _soc_apply(w_obj, b_obj, wN[o:], q[o:], False)
-    for k in range(N):
-        q[k] -= f * r_z[k]
-    for j in range(e + 1):
-        bx[j] = -f * r_x[j]
-    _solve_kkt(D, m, e, L, w_lin, H_soc, H_obj, s_over_z, w_soc, b_soc, w_obj, b_obj, refine,
-               bx, q, x2, z2, wN, wN2, wN3, wn, wn2)
-    cx2_hz2 = x2[0]
-    for k in range(N):
-        cx2_hz2 += h[k] * z2[k]
-    dtau = (d_kappa / tau - f * r_tau - cx2_hz2) / (cx1_hz1 - kappa / tau)
-    for j in range(e + 1):
-        dx[j] = x2[j] + dtau * x1[j]
-    for k in range(N):
-        dz[k] = z2[k] + dtau * z1[k]
-    dkappa = -(d_kappa + kappa * dtau) / tau
-    # ds from the primal row G dx + ds - h dtau = -(1 - sigma) r_z: it keeps the primal
-    # residual exact where W^T W is badly conditioned near the optimum.
-    _G_mul(D, m, e, dx, ds)
-    for k in range(N):
-        ds[k] = -f * r_z[k] - ds[k] + h[k] * dtau
-    return dtau, dkappa
+    return UNDECIDED, opt.max_iter
 
 
 # --------------------------------------------------------------------------- one problem, built
 
 
-@_jit
-def _solve_one(rows, E, fp, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine,
-               retry_refine, violation_tol, y):
-    """Build the contact rows of one GFO problem from its cone rows (m, 3, 3) (`_cone_rows`),
-    basis E (3m, e) and f_p (3m,) (N) and solve it. Returns (code, ||f|| N, worst violation N, iterations); fills y.
-
-    An optimal point whose forces violate a constraint by more than violation_tol max(1 N, ||f||)
-    is 'not decided' (the rule of `solve_gfo` for reduced accuracy).
-    """
-    D = np.empty((m, 3, e))
-    hv = np.empty((m, 3))
-    a = np.zeros(e)
+@_jit_alloc
+def _build(rows, E, fp, e, mu, f_min, W):
+    """The problem of cone rows (m, 3, 3) (`_cone_rows`), basis E (3m, >= e; its first e
+    columns) and f_p (3m,) N, its data written into W."""
+    m = rows.shape[0]
+    D, hv, a = W.D, W.hv, W.a
     for i in range(m):
         for r in range(3):
             acc = 0.0
@@ -589,6 +645,8 @@ def _solve_one(rows, E, fp, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fr
                 for q in range(3):
                     acc += rows[i, r, q] * E[3 * i + q, k]
                 D[i, r, k] = acc
+    for k in range(e):
+        a[k] = 0.0
     for c in range(3 * m):
         for k in range(e):
             a[k] += E[c, k] * fp[c]
@@ -598,41 +656,48 @@ def _solve_one(rows, E, fp, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fr
         for k in range(e):
             acc -= E[c, k] * a[k]
         r0 += acc * acc
-    r0 = math.sqrt(r0)
-    code, norm, viol, it = _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction,
-                                    stall_step, refine, violation_tol, y)
-    if code == UNDECIDED and retry_refine > refine:
-        # Undecided problems are mostly stalls at a degenerate optimum, where the normal
-        # equations lose accuracy: a second attempt with iterative refinement decides most.
-        code, norm, viol, it2 = _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction,
-                                         stall_step, retry_refine, violation_tol, y)
-        it += it2
+    return _Problem(D, hv, a, math.sqrt(r0), mu, f_min, m, e)
+
+
+@_jit
+def _attempt(P, W, opt, refine, y):
+    """`_hsde`, then the force check of an optimal point: (code, ||f|| N, violation N, iterations).
+    An optimal point whose forces violate a constraint by more than violation_tol max(1 N, ||f||)
+    is 'not decided' (the rule of `solve_gfo` for reduced accuracy)."""
+    code, it = _hsde(P, W, opt, refine, y)
+    if code != OPTIMAL:
+        return code, math.nan, math.nan, it
+    # f = f_p + E y in the contact frames: [n.f, t1.f/mu, t2.f/mu]
+    D, hv, e = P.D, P.hv, P.e
+    norm = 0.0
+    viol = -math.inf
+    for i in range(P.m):
+        f0, f1, f2 = hv[i, 0], hv[i, 1], hv[i, 2]
+        for k in range(e):
+            f0 += D[i, 0, k] * y[k]
+        for k in range(e):
+            f1 += D[i, 1, k] * y[k]
+        for k in range(e):
+            f2 += D[i, 2, k] * y[k]
+        ft = P.mu * math.sqrt(f1 * f1 + f2 * f2)
+        norm += f0 * f0 + ft * ft
+        viol = max(viol, P.f_min - f0, ft - P.mu * f0)
+    norm = math.sqrt(norm)
+    if viol > opt.violation_tol * max(1.0, norm):
+        return UNDECIDED, math.nan, math.nan, it
     return code, norm, viol, it
 
 
 @_jit
-def _attempt(D, hv, a, r0, mu, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine,
-             violation_tol, y):
-    """`_hsde`, then the force check of an optimal point: (code, ||f|| N, violation N, iterations)."""
-    code, it = _hsde(D, hv, a, r0, f_min, m, e, tol, reduced_tol, max_iter, step_fraction, stall_step, refine, y)
-    if code != OPTIMAL:
-        return code, math.nan, math.nan, it
-    # f = f_p + E y in the contact frames: [n.f, t1.f/mu, t2.f/mu]
-    norm = 0.0
-    viol = -math.inf
-    fr = np.empty(3)
-    for i in range(m):
-        for r in range(3):
-            acc = hv[i, r]
-            for k in range(e):
-                acc += D[i, r, k] * y[k]
-            fr[r] = acc
-        ft = mu * math.sqrt(fr[1] * fr[1] + fr[2] * fr[2])
-        norm += fr[0] * fr[0] + ft * ft
-        viol = max(viol, f_min - fr[0], ft - mu * fr[0])
-    norm = math.sqrt(norm)
-    if viol > violation_tol * max(1.0, norm):
-        return UNDECIDED, math.nan, math.nan, it
+def _solve_one(P, W, opt, y):
+    """`_attempt`, and a second one with refinement if the first leaves the problem undecided.
+    Returns (code, ||f|| N, worst violation N, iterations of both); fills y."""
+    code, norm, viol, it = _attempt(P, W, opt, opt.refine, y)
+    if code == UNDECIDED and opt.retry_refine > opt.refine:
+        # Undecided problems are mostly stalls at a degenerate optimum, where the normal
+        # equations lose accuracy: a second attempt with iterative refinement decides most.
+        code, norm, viol, it2 = _attempt(P, W, opt, opt.retry_refine, y)
+        it += it2
     return code, norm, viol, it
 
 
@@ -648,14 +713,23 @@ def _cone_rows(frames, mu, rows):
             rows[i, 2, q] = frames[i, 2, q] / mu
 
 
-@_jit
-def _solve_sets(F_all, fp, frames, cols, n_cols, thresholds, mu, mu_strict, f_min, strict,
-                tol, reduced_tol, max_iter, step_fraction, stall_step, refine, retry_refine, violation_tol,
-                code, norm, viol, iters, e_s, strict_code, forces):
-    """Every synergy set of one grasp: E_s from the SVD of F_s = F_all[:, set] (columns with a
-    singular value above the set's threshold), then the GFO, its forces f_p + E_s y (N) and,
-    if `strict`, the strict internal-force test (f_p = 0, f_min = 1 N, mu_strict). Sets with
-    e_s = 0 get code NOT_SOLVED."""
+@_jit_alloc
+def _solve_single(frames, E, fp, mu, f_min, opt, y):
+    """One problem (`solve_problem`): (code, ||f|| N, iterations); fills y."""
+    m, e = frames.shape[0], E.shape[1]
+    rows = np.empty((m, 3, 3))
+    _cone_rows(frames, mu, rows)
+    W = _workspace(m, e)
+    code, norm, _, it = _solve_one(_build(rows, E, fp, e, mu, f_min, W), W, opt, y)
+    return code, norm, it
+
+
+@_jit_alloc
+def _solve_sets(F_all, fp, frames, cols, n_cols, thresholds, mu, mu_strict, f_min, strict, opt, out):
+    """Every synergy set of one grasp into `out` (`SetsResult`): E_s from the SVD of
+    F_s = F_all[:, set] (columns with a singular value above the set's threshold), then the
+    GFO, its forces f_p + E_s y (N) and, if `strict`, the strict internal-force test
+    (f_p = 0, f_min = 1 N, mu_strict). Sets with e_s = 0 get code NOT_SOLVED."""
     c = F_all.shape[0]
     m = c // 3
     rows = np.empty((m, 3, 3))
@@ -663,6 +737,7 @@ def _solve_sets(F_all, fp, frames, cols, n_cols, thresholds, mu, mu_strict, f_mi
     _cone_rows(frames, mu, rows)
     _cone_rows(frames, mu_strict, rows_strict)
     zero = np.zeros(c)
+    W = _workspace(m, cols.shape[1])
     y = np.empty(cols.shape[1])
     for j in range(cols.shape[0]):
         s = n_cols[j]
@@ -674,28 +749,28 @@ def _solve_sets(F_all, fp, frames, cols, n_cols, thresholds, mu, mu_strict, f_mi
         for q in range(sv.size):
             if sv[q] > thresholds[j]:
                 rank += 1
-        e_s[j] = rank
+        out.e_s[j] = rank
         if rank == 0:
-            code[j] = NOT_SOLVED
+            out.code[j] = NOT_SOLVED
             continue
-        E = np.ascontiguousarray(U[:, :rank])
-        code[j], norm[j], viol[j], iters[j] = _solve_one(
-            rows, E, fp, mu, f_min, m, rank, tol, reduced_tol, max_iter, step_fraction, stall_step, refine,
-            retry_refine, violation_tol, y)
-        if code[j] == OPTIMAL:
+        # E_s is the first `rank` columns of U
+        code, out.force_norm[j], out.max_violation[j], out.iterations[j] = _solve_one(
+            _build(rows, U, fp, rank, mu, f_min, W), W, opt, y)
+        out.code[j] = code
+        if code == OPTIMAL:
             for k in range(c):
                 acc = fp[k]
                 for q in range(rank):
-                    acc += E[k, q] * y[q]
-                forces[j, k] = acc
+                    acc += U[k, q] * y[q]
+                out.forces[j, k] = acc
         if strict:
-            strict_code[j] = _solve_one(rows_strict, E, zero, mu_strict, 1.0, m, rank, tol, reduced_tol, max_iter,
-                                        step_fraction, stall_step, refine, retry_refine, violation_tol, y)[0]
+            out.strict_code[j] = _solve_one(_build(rows_strict, U, zero, rank, mu_strict, 1.0, W), W, opt, y)[0]
 
 
-def _kernel_settings(settings: IPMSettings, violation_tol: float) -> tuple:
-    return (float(settings.tol), float(settings.reduced_tol), int(settings.max_iter), float(settings.step_fraction),
-            float(settings.stall_step), int(settings.refine), int(settings.retry_refine), float(violation_tol))
+def _kernel_settings(settings: IPMSettings, violation_tol: float) -> _Settings:
+    return _Settings(float(settings.tol), float(settings.reduced_tol), int(settings.max_iter),
+                     float(settings.step_fraction), float(settings.stall_step), int(settings.refine),
+                     int(settings.retry_refine), float(violation_tol))
 
 
 def solve_problem(frames: NDArray, E: NDArray, f_p: NDArray, mu: float, f_min: float, settings: IPMSettings,
@@ -704,19 +779,16 @@ def solve_problem(frames: NDArray, E: NDArray, f_p: NDArray, mu: float, f_min: f
     with e >= 1, f_p (3m,) N, mu, f_min N. An optimal point whose forces violate a
     constraint by more than violation_tol max(1 N, ||f||) is UNDECIDED.
     Returns (code, ||f|| N, y (e,) N (NaN unless OPTIMAL), iterations)."""
-    m, e = frames.shape[0], E.shape[1]
-    rows = np.empty((m, 3, 3))
-    _cone_rows(frames, float(mu), rows)
-    y = np.full(e, np.nan)
-    code, norm, _, iters = _solve_one(rows, np.ascontiguousarray(E, dtype=float), np.ascontiguousarray(f_p, dtype=float),
-                                      float(mu), float(f_min), m, e, *_kernel_settings(settings, violation_tol), y)
+    y = np.full(E.shape[1], np.nan)
+    code, norm, iters = _solve_single(frames, np.ascontiguousarray(E, dtype=float),
+                                      np.ascontiguousarray(f_p, dtype=float), float(mu), float(f_min),
+                                      _kernel_settings(settings, violation_tol), y)
     if code != OPTIMAL:
         y[:] = np.nan
     return int(code), float(norm), y, int(iters)
 
 
-@dataclass(frozen=True)
-class SetsResult:
+class SetsResult(NamedTuple):
     """Kernel output for the sets of one grasp (arrays over the sets): code, ||f|| N,
     worst constraint violation N, iterations, e_s, strict_code (INFEASIBLE where not
     tested), forces (n_sets, 3m) N (rows of OPTIMAL sets only)."""
@@ -744,6 +816,5 @@ def solve_sets(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, 
                      forces=np.full((n_sets, f_p.size), np.nan))
     _solve_sets(np.ascontiguousarray(F_all), np.ascontiguousarray(f_p, dtype=float), frames, columns, n_columns,
                 thresholds, float(mu), float(mu_strict), float(f_min), bool(strict),
-                *_kernel_settings(settings, violation_tol), out.code, out.force_norm, out.max_violation, out.iterations,
-                out.e_s, out.strict_code, out.forces)
+                _kernel_settings(settings, violation_tol), out)
     return out
