@@ -344,8 +344,11 @@ def _incomplete(workdir: Path) -> set[str]:
 @pytest.mark.parametrize("kill", [signal.SIGINT, signal.SIGKILL], ids=["SIGINT", "SIGKILL"])
 def test_a_killed_run_reruns_only_what_did_not_finish(run_j2, tmp_path, kill):
     with open(tmp_path / "killed.log", "w") as log:
+        # SIGINT handled as in a terminal even when the suite itself was started in the
+        # background (a shell then starts it, and so every child, with SIGINT ignored)
         run = subprocess.Popen(command(tmp_path, "-j2", "figures"), stdout=log, stderr=subprocess.STDOUT,
-                               start_new_session=True)
+                               start_new_session=True,
+                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
         deadline = time.monotonic() + 900
         while not list((tmp_path / "results" / "objects").glob("*/gfo_shards/*.parquet")):
             assert run.poll() is None, "the run ended before its first optimisation output"

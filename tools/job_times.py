@@ -1,0 +1,38 @@
+"""Where a run's time went: jobs, wall seconds and CPU seconds per rule, summed over every
+Snakemake benchmark file under a results folder (the default study's and every scenario's).
+
+    .venv/bin/python tools/job_times.py [results]
+
+A rule's benchmark files are `<root>/benchmarks/<rule>/<...>.tsv` or
+`<root>/benchmarks/<rule>.tsv` (workflow/rules/*.smk); `s` is the job's wall time and
+`cpu_time` its CPU time, in seconds. Prints one row per rule, largest CPU share first.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+
+def job_times(results: Path) -> pd.DataFrame:
+    """One row per rule: jobs, wall s, CPU s and the CPU share (percent)."""
+    rows = []
+    for path in sorted(results.rglob("benchmarks/**/*.tsv")):
+        parts = path.relative_to(results).parts
+        at = parts.index("benchmarks")
+        rule = parts[at + 1] if len(parts) > at + 2 else path.stem
+        bench = pd.read_csv(path, sep="\t")
+        rows.append({"rule": rule, "wall_s": float(bench["s"].iloc[-1]), "cpu_s": float(bench["cpu_time"].iloc[-1])})
+    table = pd.DataFrame(rows, columns=["rule", "wall_s", "cpu_s"])
+    out = table.groupby("rule").agg(jobs=("wall_s", "size"), wall_s=("wall_s", "sum"), cpu_s=("cpu_s", "sum"))
+    out["cpu_percent"] = 100.0 * out["cpu_s"] / out["cpu_s"].sum()
+    return out.sort_values("cpu_s", ascending=False)
+
+
+if __name__ == "__main__":
+    table = job_times(Path(sys.argv[1] if len(sys.argv) > 1 else "results"))
+    print(table.round(1).to_string())
+    print(f"total: {int(table['jobs'].sum())} jobs, {table['wall_s'].sum():.0f} job-seconds, "
+          f"{table['cpu_s'].sum():.0f} CPU seconds")
