@@ -4,11 +4,12 @@ In the style of `scipy.optimize.linprog`: the problems (`problem.GFOProblem` or,
 grasp and many synergy sets, `problem.GraspSets`) carry their friction-cone model; the
 method picks the back end; every back end returns one `problem.GFOSolution`.
 
-- "ipm": the compiled interior-point kernel (`ipm_kernel`); the problems it leaves undecided
-  are solved again by Clarabel and marked 'clarabel_fallback' (nothing is dropped).
+- "ipm": the compiled interior-point kernel (`ipm_kernel`), circular and pyramid cones; the
+  problems it leaves undecided are solved again by Clarabel and marked 'clarabel_fallback'
+  (nothing is dropped).
 - "clarabel": Clarabel per problem (`clarabel_solver`), the exact reference of the study.
 - "cvxpy": the cvxpy reference (`cvxpy_reference`), for tests and benchmarks.
-- "piqp": PIQP per problem (`piqp_solver`), for pyramid cones (a QP).
+- "piqp": PIQP per problem (`piqp_solver`), for pyramid cones (a QP); a check of "ipm".
 """
 
 from __future__ import annotations

@@ -98,13 +98,14 @@ _jit_small = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False,
 _Settings = namedtuple("_Settings", "tol reduced_tol max_iter step_fraction stall_step refine retry_refine violation_tol")
 
 #: One problem as the iteration sees it: contact rows D (m, 3, >= e) applied to E, hv (m, 3)
-#: the rows applied to f_p (N), a = E^T f_p (N), r0 = ||f_p - E a|| (N), mu, f_min (N),
-#: m contacts, e = e_s; q Coulomb cones (m or 0) and nl linear rows of their own, DL
+#: the rows applied to f_p (N), a = E^T f_p (N), r0 = ||f_p - E a|| (N), mu (1 for a pyramid,
+#: whose D serves only ||f||), f_min (N), m contacts, e = e_s; q Coulomb cones (m or 0) and nl linear rows of their own, DL
 #: (nl, >= e) applied to E and hl (nl,) N their constant terms (the slack is hl + DL y >= 0).
 #: L = q + nl is the size of the nonnegative block.
 _Problem = namedtuple("_Problem", "D hv a r0 mu f_min m e q nl L DL hl")
 
-#: Work arrays for problems of m contacts and e_s <= e_max (`_workspace`), allocated once
+#: Work arrays for problems of m contacts, q SOCs, nl own linear rows and e_s <= e_max
+#: (`_workspace`), allocated once
 #: and reused by every problem of a pose; a problem uses the leading N (cone layout) or
 #: n (x layout) entries of each vector.
 _Work = namedtuple("_Work", [
