@@ -20,6 +20,12 @@ def synergies(hand):
     return load_synergies(None, joint_names=hand.joint_names)
 
 
+#: Near-boundary band (docs/batched_solver.md): problems whose friction coefficient is within
+#: this relative distance of the critical one may get either verdict from solvers with 1e-8
+#: tolerances.
+BAND = 1e-4
+
+
 def study_gfo_params(**changes):
     """The study's GFO parameters (the configuration's defaults, obj1's weight) with
     ``changes`` replacing fields; the one path from configuration to parameters."""

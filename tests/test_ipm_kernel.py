@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import BAND
 
 from synergrasp.optimisation.cones import CircularCone
 from synergrasp.optimisation.gfo import solve_gfo
@@ -13,9 +14,6 @@ from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_ba
 from synergrasp.optimisation.problem import GFOProblem, GraspSets, SynergySets
 from synergrasp.optimisation.problems import random_gfo_problems, random_grasp, random_synergies, random_unit_vector
 
-#: Near-boundary band (docs/batched_solver.md): problems whose friction coefficient is within
-#: this relative distance of the critical one may get either verdict.
-BAND = 1e-4
 RTOL_NORM = 1e-4
 
 

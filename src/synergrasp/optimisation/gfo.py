@@ -4,11 +4,12 @@ In the style of `scipy.optimize.linprog`: the problems (`problem.GFOProblem` or,
 grasp and many synergy sets, `problem.GraspSets`) carry their friction-cone model; the
 method picks the back end; every back end returns one `problem.GFOSolution`.
 
-- "ipm": the compiled interior-point kernel (`ipm_kernel`); the problems it leaves undecided
-  are solved again by Clarabel and marked 'clarabel_fallback' (nothing is dropped).
+- "ipm": the compiled interior-point kernel (`ipm_kernel`), circular and pyramid cones; the
+  problems it leaves undecided are solved again by Clarabel and marked 'clarabel_fallback'
+  (nothing is dropped).
 - "clarabel": Clarabel per problem (`clarabel_solver`), the exact reference of the study.
 - "cvxpy": the cvxpy reference (`cvxpy_reference`), for tests and benchmarks.
-- "piqp": PIQP per problem (`piqp_solver`), for pyramid cones (a QP).
+- "piqp": PIQP per problem (`piqp_solver`), for pyramid cones (a QP); a check of "ipm".
 """
 
 from __future__ import annotations
@@ -36,14 +37,14 @@ __all__ = ["FASTEST_METHOD", "METHODS", "solve_gfo", "warm_up"]
 
 #: Methods of `solve_gfo` and the friction-cone kinds each accepts.
 METHODS: dict[str, tuple[str, ...]] = {
-    "ipm": ("circular",),
+    "ipm": ("circular", "pyramid"),
     "clarabel": ("circular", "pyramid"),
     "cvxpy": ("circular",),
     "piqp": ("pyramid",),
 }
 
 #: The fastest method for each cone kind (the study's choice).
-FASTEST_METHOD: dict[str, str] = {"circular": "ipm", "pyramid": "piqp"}
+FASTEST_METHOD: dict[str, str] = {"circular": "ipm", "pyramid": "ipm"}
 
 #: Verdict of each kernel code; '' marks the problems that go to the Clarabel fallback.
 _STATUS_OF_CODE = np.array(["", "force_closure", "infeasible", ""], dtype=object)
@@ -120,8 +121,7 @@ def _ipm_one(sol: GFOSolution, k: int, problem: GFOProblem, shrink: float | None
             sol.strict_internal[k] = _strict_fallback(problem, shrink, tol, max_iter)
         return
     frames = contact_frames(problem.normals)
-    mu = problem.cone.mu
-    code, norm, y, iters = ipm_kernel.solve_problem(frames, problem.E, problem.f_p, mu, problem.f_min, ipm,
+    code, norm, y, iters = ipm_kernel.solve_problem(frames, problem.E, problem.f_p, problem.cone, problem.f_min, ipm,
                                                     ALMOST_SOLVED_TOL)
     status = _STATUS_OF_CODE[code]
     if status == "force_closure":
@@ -134,7 +134,7 @@ def _ipm_one(sol: GFOSolution, k: int, problem: GFOProblem, shrink: float | None
         _fallback(sol, k, problem, tol, max_iter)
     if shrink is not None:
         strict = problem.strict_test(shrink)
-        code = ipm_kernel.solve_problem(frames, strict.E, strict.f_p, strict.cone.mu, strict.f_min, ipm,
+        code = ipm_kernel.solve_problem(frames, strict.E, strict.f_p, strict.cone, strict.f_min, ipm,
                                         ALMOST_SOLVED_TOL)[0]
         sol.strict_internal[k] = (code == ipm_kernel.OPTIMAL if code in (ipm_kernel.OPTIMAL, ipm_kernel.INFEASIBLE)
                                   else _strict_fallback(problem, shrink, tol, max_iter))
@@ -146,9 +146,8 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
     P, S = g.projector, g.synergies
     thresholds = g.basis_rtol * g.response_norm * S.norms
     strict = shrink is not None
-    mu_strict = g.cone.narrowed(shrink).mu if strict else g.cone.mu
     res = ipm_kernel.solve_sets(P @ S.matrix, g.f_p, contact_frames(g.normals), S.table, S.sizes, thresholds,
-                                g.cone.mu, mu_strict, g.f_min, strict, ipm, ALMOST_SOLVED_TOL)
+                                g.cone, g.cone.narrowed(shrink) if strict else None, g.f_min, ipm, ALMOST_SOLVED_TOL)
     n = len(g)
     status = _STATUS_OF_CODE[res.code]
     optimal = res.code == ipm_kernel.OPTIMAL

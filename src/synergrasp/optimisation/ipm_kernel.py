@@ -1,8 +1,9 @@
-"""Back end: the compiled interior-point kernel (numba) for GFO problems with circular cones
-(docs/batched_solver.md).
+"""Back end: the compiled interior-point kernel (numba) for GFO problems with circular or
+pyramid friction cones (docs/batched_solver.md).
 
 Per problem, forces in N: minimise ||f_p + E y||_2 subject to, per contact i,
-n_i.f_i >= f_min and ||f_i - (n_i.f_i) n_i|| <= mu n_i.f_i. With E orthonormal,
+n_i.f_i >= f_min and ||f_i - (n_i.f_i) n_i|| <= mu n_i.f_i (circular cone) or the pyramid's
+face rows a_k.f_i <= 0 (`cones.PyramidCone.face_rows`). With E orthonormal,
 ||f_p + E y||^2 = ||f_p - E a||^2 + ||y + a||^2 (a = E^T f_p), so the kernel minimises t
 subject to (t, y + a) in a second-order cone: a linear-objective SOCP in x = (t, y), solved
 through the homogeneous self-dual embedding (infeasibility ends in a certificate, not a
@@ -24,6 +25,8 @@ from typing import NamedTuple
 import numba
 import numpy as np
 from numpy.typing import NDArray
+
+from synergrasp.optimisation.cones import FrictionCone
 
 __all__ = ["INFEASIBLE", "IPMSettings", "NOT_SOLVED", "OPTIMAL", "SetsResult", "UNDECIDED", "solve_problem", "solve_sets"]
 
@@ -74,9 +77,12 @@ class IPMSettings:
 # Compiled with numba: one problem at a time, so a problem's numbers never depend on the
 # batch it arrives in, and the ~10 iterations of a tiny problem cost microseconds instead of
 # the hundreds of numpy calls a vectorised iteration needs. A cone vector v has v[0] >= ||v[1:]||.
-# Flat layout of a problem's cone vectors (length N = 4m + e + 2): m linear slacks
-# n.f - f_min, then m Coulomb cones SOC(3) [n.f, t1.f/mu, t2.f/mu] at m + 3i, then the
-# objective cone (t, r0, y + a) at o = 4m. x = (t, y) has length n = e + 1.
+# Flat layout of a problem's cone vectors (length N = L + 3q + e + 2): the nonnegative block
+# of L linear slacks, then q Coulomb cones SOC(3) [n.f, t1.f/mu, t2.f/mu] at L + 3i, then
+# the objective cone (t, r0, y + a) at o = L + 3q. x = (t, y) has length n = e + 1.
+# Circular cone: q = m and L = m, the linear slack n.f - f_min of contact i (slot i) sharing
+# the rows of its Coulomb cone. Pyramid: q = 0 and L = m (1 + sides), every friction
+# constraint a linear row of its own (`_Problem.DL`).
 # The cone functions address one cone as (array, offset k, dimension d), never as a slice.
 # Every array is allocated once per pose (`_workspace`); the functions that allocate or
 # return arrays are compiled with numba's reference counting (`_jit_alloc`), the iteration
@@ -92,15 +98,18 @@ _jit_small = numba.njit(cache=True, nogil=True, error_model="numpy", _nrt=False,
 _Settings = namedtuple("_Settings", "tol reduced_tol max_iter step_fraction stall_step refine retry_refine violation_tol")
 
 #: One problem as the iteration sees it: contact rows D (m, 3, >= e) applied to E, hv (m, 3)
-#: the rows applied to f_p (N), a = E^T f_p (N), r0 = ||f_p - E a|| (N), mu, f_min (N),
-#: m contacts, e = e_s.
-_Problem = namedtuple("_Problem", "D hv a r0 mu f_min m e")
+#: the rows applied to f_p (N), a = E^T f_p (N), r0 = ||f_p - E a|| (N), mu (1 for a pyramid,
+#: whose D serves only ||f||), f_min (N), m contacts, e = e_s; q Coulomb cones (m or 0) and nl linear rows of their own, DL
+#: (nl, >= e) applied to E and hl (nl,) N their constant terms (the slack is hl + DL y >= 0).
+#: L = q + nl is the size of the nonnegative block.
+_Problem = namedtuple("_Problem", "D hv a r0 mu f_min m e q nl L DL hl")
 
-#: Work arrays for problems of m contacts and e_s <= e_max (`_workspace`), allocated once
+#: Work arrays for problems of m contacts, q SOCs, nl own linear rows and e_s <= e_max
+#: (`_workspace`), allocated once
 #: and reused by every problem of a pose; a problem uses the leading N (cone layout) or
 #: n (x layout) entries of each vector.
 _Work = namedtuple("_Work", [
-    "D", "hv", "a",                          # the problem's data (`_Problem` refers to them)
+    "D", "hv", "a", "DL", "hl",              # the problem's data (`_Problem` refers to them)
     "h", "x", "s", "z",                      # scaled h (cone layout); the iterate
     "w", "beta", "w_lin", "s_over_z", "lam",  # NT scaling: points w (cone layout), beta per SOC (objective last)
     "H3", "H_obj", "T", "M", "L",            # (W^T W)^-1 blocks (3m, 3), (e+2, e+2); normal matrix, its factor
@@ -115,11 +124,12 @@ _Homogeneous = namedtuple("_Homogeneous", "tau kappa r_tau cx1_hz1")
 
 
 @_jit_alloc
-def _workspace(m, e_max):
-    N, n = 4 * m + e_max + 2, e_max + 1
-    return _Work(np.empty((m, 3, e_max)), np.empty((m, 3)), np.empty(e_max),
+def _workspace(m, q, nl, e_max):
+    L = q + nl
+    N, n = L + 3 * q + e_max + 2, e_max + 1
+    return _Work(np.empty((m, 3, e_max)), np.empty((m, 3)), np.empty(e_max), np.empty((nl, e_max)), np.empty(nl),
                  np.empty(N), np.empty(n), np.empty(N), np.empty(N),
-                 np.empty(N), np.empty(m + 1), np.empty(m), np.empty(m), np.empty(N),
+                 np.empty(N), np.empty(q + 1), np.empty(L), np.empty(L), np.empty(N),
                  np.empty((3 * m, 3)), np.empty((e_max + 2, e_max + 2)), np.empty((m, 3, e_max)),
                  np.empty((n, n)), np.empty((n, n)),
                  np.empty(n), np.empty(N), np.empty(n), np.empty(N), np.empty(n), np.empty(N), np.empty(n),
@@ -235,16 +245,21 @@ def _lin_max_step(v, d):
 
 @_jit_small
 def _G_mul(P, x, out):
-    """out = G x for x = (t, y): linear rows -D0 y, Coulomb rows -D y, objective -(t, 0, y)."""
-    D, m, e = P.D, P.m, P.e
-    for i in range(m):
+    """out = G x for x = (t, y): linear rows -D0 y and -DL y, Coulomb rows -D y, objective -(t, 0, y)."""
+    D, DL, L, e = P.D, P.DL, P.L, P.e
+    for i in range(P.q):
         for r in range(3):
             acc = 0.0
             for j in range(e):
                 acc += D[i, r, j] * x[1 + j]
-            out[m + 3 * i + r] = -acc
-        out[i] = out[m + 3 * i]
-    o = 4 * m
+            out[L + 3 * i + r] = -acc
+        out[i] = out[L + 3 * i]
+    for k in range(P.nl):
+        acc = 0.0
+        for j in range(e):
+            acc += DL[k, j] * x[1 + j]
+        out[P.q + k] = -acc
+    o = L + 3 * P.q
     out[o] = -x[0]
     out[o + 1] = 0.0
     for j in range(e):
@@ -254,14 +269,16 @@ def _G_mul(P, x, out):
 @_jit_small
 def _GT_mul(P, z, out):
     """out = G^T z."""
-    D, m, e = P.D, P.m, P.e
-    o = 4 * m
+    D, DL, q, L, e = P.D, P.DL, P.q, P.L, P.e
+    o = L + 3 * q
     out[0] = -z[o]
     for j in range(e):
         acc = 0.0
-        for i in range(m):
-            c = m + 3 * i
+        for i in range(q):
+            c = L + 3 * i
             acc += D[i, 0, j] * (z[c] + z[i]) + D[i, 1, j] * z[c + 1] + D[i, 2, j] * z[c + 2]
+        for k in range(P.nl):
+            acc += DL[k, j] * z[q + k]
         out[1 + j] = -z[o + 2 + j] - acc
 
 
@@ -269,13 +286,14 @@ def _GT_mul(P, z, out):
 def _H_mul(P, W, v, out):
     """out = (W^T W)^-1 v, with the same matrices as the normal matrix (a closed form
     rounds differently, and that mismatch costs accuracy near the optimum)."""
-    m, e, H3, H_obj = P.m, P.e, W.H3, W.H_obj
-    for i in range(m):
-        out[i] = W.w_lin[i] * v[i]
-        c = m + 3 * i
+    L, e, H3, H_obj = P.L, P.e, W.H3, W.H_obj
+    for k in range(L):
+        out[k] = W.w_lin[k] * v[k]
+    for i in range(P.q):
+        c = L + 3 * i
         for r in range(3):
             out[c + r] = H3[3 * i + r, 0] * v[c] + H3[3 * i + r, 1] * v[c + 1] + H3[3 * i + r, 2] * v[c + 2]
-    o = 4 * m
+    o = L + 3 * P.q
     for r in range(e + 2):
         acc = 0.0
         for k in range(e + 2):
@@ -286,15 +304,16 @@ def _H_mul(P, W, v, out):
 @_jit_small
 def _V_mul(P, W, v, tmp, out):
     """out = W^T W v through the scaling factors (iterative refinement)."""
-    m = P.m
-    for i in range(m):
-        out[i] = W.s_over_z[i] * v[i]
-        c = m + 3 * i
+    q, L = P.q, P.L
+    for k in range(L):
+        out[k] = W.s_over_z[k] * v[k]
+    for i in range(q):
+        c = L + 3 * i
         _soc_apply(W.w, W.beta[i], v, tmp, c, 3, False)
         _soc_apply(W.w, W.beta[i], tmp, out, c, 3, False)
-    o = 4 * m
-    _soc_apply(W.w, W.beta[m], v, tmp, o, P.e + 2, False)
-    _soc_apply(W.w, W.beta[m], tmp, out, o, P.e + 2, False)
+    o = L + 3 * q
+    _soc_apply(W.w, W.beta[q], v, tmp, o, P.e + 2, False)
+    _soc_apply(W.w, W.beta[q], tmp, out, o, P.e + 2, False)
 
 
 @_jit_small
@@ -336,7 +355,7 @@ def _reduced(P, W, bx, bz, dx, dz):
         wn[j] += bx[j]
     _cho_solve(W.L, P.e + 1, wn, dx)
     _G_mul(P, dx, wN)
-    for k in range(4 * P.m + P.e + 2):
+    for k in range(P.L + 3 * P.q + P.e + 2):
         wN[k] -= bz[k]
     _H_mul(P, W, wN, dz)
 
@@ -345,7 +364,7 @@ def _reduced(P, W, bx, bz, dx, dz):
 def _solve_kkt(P, W, refine, bx, bz, dx, dz):
     """The Newton system for (bx, bz), with `refine` steps of iterative refinement."""
     _reduced(P, W, bx, bz, dx, dz)
-    n, N = P.e + 1, 4 * P.m + P.e + 2
+    n, N = P.e + 1, P.L + 3 * P.q + P.e + 2
     wN2, wN3, wn2 = W.wN2, W.wN3, W.wn2
     for _ in range(refine):
         # residual of the full system, then a correction from the same factorisation
@@ -370,26 +389,27 @@ def _solve_kkt(P, W, refine, bx, bz, dx, dz):
 def _scaling(P, W):
     """NT scaling of the iterate (W.s, W.z), lambda = W z, and the Cholesky factor of the
     normal matrix M = G^T (W^T W)^-1 G, (e+1, e+1)."""
-    m, e, D, s, z = P.m, P.e, P.D, W.s, W.z
+    q, L, e, D, DL, s, z = P.q, P.L, P.e, P.D, P.DL, W.s, W.z
     H3, H_obj, T, M = W.H3, W.H_obj, W.T, W.M
-    o = 4 * m
-    for i in range(m):
-        W.w_lin[i] = z[i] / s[i]
-        W.s_over_z[i] = s[i] / z[i]
-        W.lam[i] = math.sqrt(s[i] * z[i])
-        c = m + 3 * i
+    o = L + 3 * q
+    for k in range(L):
+        W.w_lin[k] = z[k] / s[k]
+        W.s_over_z[k] = s[k] / z[k]
+        W.lam[k] = math.sqrt(s[k] * z[k])
+    for i in range(q):
+        c = L + 3 * i
         W.beta[i] = _soc_nt(s, z, W.w, c, 3)
         _soc_apply(W.w, W.beta[i], z, W.lam, c, 3, False)
         _soc_hessian(W.w, W.beta[i], c, 3, H3, 3 * i)
-    W.beta[m] = _soc_nt(s, z, W.w, o, e + 2)
-    _soc_apply(W.w, W.beta[m], z, W.lam, o, e + 2, False)
-    _soc_hessian(W.w, W.beta[m], o, e + 2, H_obj, 0)
+    W.beta[q] = _soc_nt(s, z, W.w, o, e + 2)
+    _soc_apply(W.w, W.beta[q], z, W.lam, o, e + 2, False)
+    _soc_hessian(W.w, W.beta[q], o, e + 2, H_obj, 0)
     M[0, 0] = H_obj[0, 0]
     for j in range(e):
         M[1 + j, 0] = H_obj[2 + j, 0]
         for k in range(j + 1):
             M[1 + j, 1 + k] = H_obj[2 + j, 2 + k]
-    for i in range(m):
+    for i in range(q):
         # a contact's linear row is the first row of its Coulomb rows
         r = 3 * i
         h00 = H3[r, 0] + W.w_lin[i]
@@ -401,8 +421,10 @@ def _scaling(P, W):
     for j in range(e):
         for k in range(j + 1):
             acc = 0.0
-            for i in range(m):
+            for i in range(q):
                 acc += D[i, 0, j] * T[i, 0, k] + D[i, 1, j] * T[i, 1, k] + D[i, 2, j] * T[i, 2, k]
+            for r in range(P.nl):
+                acc += DL[r, j] * (W.w_lin[q + r] * DL[r, k])
             M[1 + j, 1 + k] += acc
     _cholesky(M, W.L, e + 1)
 
@@ -411,18 +433,19 @@ def _scaling(P, W):
 def _direction(P, W, refine, hom, sigma, dsv, d_kappa, dx, dz, ds):
     """Newton direction for the complementarity right-hand side dsv (lambda \\ d_s form) and
     d_kappa, at centring sigma; fills dx, dz, ds and returns (dtau, dkappa)."""
-    m, e, s, z, lam, q, wN = P.m, P.e, W.s, W.z, W.lam, W.q, W.wN
-    N = 4 * m + e + 2
-    o = 4 * m
+    n_soc, L, e, s, z, lam, q, wN = P.q, P.L, P.e, W.s, W.z, W.lam, W.q, W.wN
+    o = L + 3 * n_soc
+    N = o + e + 2
     f = 1.0 - sigma
     # q = W^T (lambda \ d_s) per cone
-    for i in range(m):
-        q[i] = math.sqrt(s[i] / z[i]) * (dsv[i] / lam[i])
-        c = m + 3 * i
+    for k in range(L):
+        q[k] = math.sqrt(s[k] / z[k]) * (dsv[k] / lam[k])
+    for i in range(n_soc):
+        c = L + 3 * i
         _soc_div(lam, dsv, wN, c, 3)
         _soc_apply(W.w, W.beta[i], wN, q, c, 3, False)
     _soc_div(lam, dsv, wN, o, e + 2)
-    _soc_apply(W.w, W.beta[m], wN, q, o, e + 2, False)
+    _soc_apply(W.w, W.beta[n_soc], wN, q, o, e + 2, False)
     for k in range(N):
         q[k] -= f * W.r_z[k]
     for j in range(e + 1):
@@ -449,13 +472,15 @@ def _direction(P, W, refine, hom, sigma, dsv, d_kappa, dx, dz, ds):
 @_jit_small
 def _max_step(P, W, ds, dz, tau, dtau, kappa, dkappa):
     """Largest step along (ds, dz, dtau, dkappa) that keeps (W.s, W.z, tau, kappa) in the cones."""
-    m, s, z = P.m, W.s, W.z
+    q, L, s, z = P.q, P.L, W.s, W.z
     st = min(_lin_max_step(tau, dtau), _lin_max_step(kappa, dkappa))
-    for i in range(m):
+    for i in range(q):
         st = min(st, _lin_max_step(s[i], ds[i]), _lin_max_step(z[i], dz[i]))
-        c = m + 3 * i
+        c = L + 3 * i
         st = min(st, _soc_max_step(s, ds, c, 3), _soc_max_step(z, dz, c, 3))
-    o = 4 * m
+    for k in range(q, L):
+        st = min(st, _lin_max_step(s[k], ds[k]), _lin_max_step(z[k], dz[k]))
+    o = L + 3 * q
     return min(st, _soc_max_step(s, ds, o, P.e + 2), _soc_max_step(z, dz, o, P.e + 2))
 
 
@@ -463,11 +488,12 @@ def _max_step(P, W, ds, dz, tau, dtau, kappa, dkappa):
 def _corrector_rhs(P, W, dtau_a, dkappa_a, tau, kappa, sm):
     """W.dsv: Mehrotra's second-order term (W^-T ds_a) o (W dz_a) and centring sigma mu
     (sm) added to lambda o lambda; returns the kappa row's counterpart."""
-    m, e, s, z, lam, dsv = P.m, P.e, W.s, W.z, W.lam, W.dsv
+    q, L, e, s, z, lam, dsv = P.q, P.L, P.e, W.s, W.z, W.lam, W.dsv
     ds_a, dz_a, wN, wN2, wN3 = W.ds_a, W.dz_a, W.wN, W.wN2, W.wN3
-    for i in range(m):
-        dsv[i] = lam[i] * lam[i] + (math.sqrt(z[i] / s[i]) * ds_a[i]) * (math.sqrt(s[i] / z[i]) * dz_a[i]) - sm
-        c = m + 3 * i
+    for k in range(L):
+        dsv[k] = lam[k] * lam[k] + (math.sqrt(z[k] / s[k]) * ds_a[k]) * (math.sqrt(s[k] / z[k]) * dz_a[k]) - sm
+    for i in range(q):
+        c = L + 3 * i
         _soc_apply(W.w, W.beta[i], ds_a, wN, c, 3, True)
         _soc_apply(W.w, W.beta[i], dz_a, wN2, c, 3, False)
         _soc_prod(wN, wN2, wN3, c, 3)
@@ -475,9 +501,9 @@ def _corrector_rhs(P, W, dtau_a, dkappa_a, tau, kappa, sm):
         for r in range(3):
             dsv[c + r] += wN3[c + r]
         dsv[c] -= sm
-    o, d = 4 * m, e + 2
-    _soc_apply(W.w, W.beta[m], ds_a, wN, o, d, True)
-    _soc_apply(W.w, W.beta[m], dz_a, wN2, o, d, False)
+    o, d = L + 3 * q, e + 2
+    _soc_apply(W.w, W.beta[q], ds_a, wN, o, d, True)
+    _soc_apply(W.w, W.beta[q], dz_a, wN2, o, d, False)
     _soc_prod(wN, wN2, wN3, o, d)
     _soc_prod(lam, lam, dsv, o, d)
     for r in range(d):
@@ -501,16 +527,19 @@ def _is_certificate(hz, gtz_norm, eps):
 def _start(P, W):
     """Scaled h (the data divided by rho = max(||f_p||, f_min), so that the forces are O(1)
     and the iteration starts well centred) and the initial point; returns (rho, h_norm)."""
-    m, e, hv, a, h, s, z = P.m, P.e, P.hv, P.a, W.h, W.s, W.z
-    N, o = 4 * m + e + 2, 4 * m
+    q, L, e, hv, a, h, s, z = P.q, P.L, P.e, P.hv, P.a, W.h, W.s, W.z
+    o = L + 3 * q
+    N = o + e + 2
     fp_norm = P.r0 * P.r0
     for j in range(e):
         fp_norm += a[j] * a[j]
     rho = max(math.sqrt(fp_norm), max(P.f_min, 1e-12))
-    for i in range(m):
+    for i in range(q):
         h[i] = (hv[i, 0] - P.f_min) / rho
         for r in range(3):
-            h[m + 3 * i + r] = hv[i, r] / rho
+            h[L + 3 * i + r] = hv[i, r] / rho
+    for k in range(P.nl):
+        h[q + k] = P.hl[k] / rho
     h[o] = 0.0
     h[o + 1] = P.r0 / rho
     for j in range(e):
@@ -523,9 +552,10 @@ def _start(P, W):
         W.x[j] = 0.0
     for k in range(N):
         s[k] = 0.0
-    for i in range(m):
-        s[i] = 1.0
-        s[m + 3 * i] = 1.0
+    for k in range(L):
+        s[k] = 1.0
+    for i in range(q):
+        s[L + 3 * i] = 1.0
     s[o] = 1.0
     for k in range(N):
         z[k] = s[k]
@@ -536,10 +566,11 @@ def _start(P, W):
 def _hsde(P, W, opt, refine, y):
     """Solve one GFO problem by the homogeneous self-dual embedding with `refine` steps of
     iterative refinement per linear solve. Returns (code, iterations); fills y (N) when optimal."""
-    m, e, h, x, s, z = P.m, P.e, W.h, W.x, W.s, W.z
-    N, n, o = 4 * m + e + 2, e + 1, 4 * m
+    q, L, e, h, x, s, z = P.q, P.L, P.e, W.h, W.x, W.s, W.z
+    o = L + 3 * q
+    N, n = o + e + 2, e + 1
     rho, h_norm = _start(P, W)
-    n_deg = 2.0 * m + 1.0
+    n_deg = float(L + q) + 1.0  # degree: L linear, q + 1 second-order cones
     tau = 1.0
     kappa = 1.0
     r_x, r_z, dsv = W.r_x, W.r_z, W.dsv
@@ -597,9 +628,10 @@ def _hsde(P, W, opt, refine, y):
         hom = _Homogeneous(tau, kappa, r_tau, cx1_hz1)
 
         # Predictor (affine scaling): d_s = lambda o lambda, d_kappa = tau kappa.
-        for i in range(m):
-            dsv[i] = W.lam[i] * W.lam[i]
-            _soc_prod(W.lam, W.lam, dsv, m + 3 * i, 3)
+        for k in range(L):
+            dsv[k] = W.lam[k] * W.lam[k]
+        for i in range(q):
+            _soc_prod(W.lam, W.lam, dsv, L + 3 * i, 3)
         _soc_prod(W.lam, W.lam, dsv, o, e + 2)
         dtau_a, dkappa_a = _direction(P, W, refine, hom, 0.0, dsv, tau * kappa, W.dx_a, W.dz_a, W.ds_a)
         alpha_a = min(1.0, _max_step(P, W, W.ds_a, W.dz_a, tau, dtau_a, kappa, dkappa_a))
@@ -629,11 +661,25 @@ def _hsde(P, W, opt, refine, y):
 
 
 @_jit_alloc
-def _build(rows, E, fp, e, mu, f_min, W):
-    """The problem of cone rows (m, 3, 3) (`_cone_rows`), basis E (3m, >= e; its first e
-    columns) and f_p (3m,) N, its data written into W."""
-    m = rows.shape[0]
-    D, hv, a = W.D, W.hv, W.a
+def _build(rows, lin, E, fp, e, mu, f_min, W):
+    """The problem of cone rows (m, 3, 3) (`_cone_rows`), linear rows lin (m, p, 3)
+    (`_cone_data`: p = 0 for the circular cone, whose Coulomb cones are SOCs; a pyramid's
+    [n; -a_1; ...] with the normal bound first, the kernel's nonnegative block in this
+    order), basis E (3m, >= e; its first e columns) and f_p (3m,) N, its data written into W."""
+    m, p = rows.shape[0], lin.shape[1]
+    D, hv, a, DL, hl = W.D, W.hv, W.a, W.DL, W.hl
+    for i in range(m):
+        for r in range(p):
+            k = i * p + r
+            acc = 0.0
+            for q in range(3):
+                acc += lin[i, r, q] * fp[3 * i + q]
+            hl[k] = acc - f_min if r == 0 else acc
+            for j in range(e):
+                acc = 0.0
+                for q in range(3):
+                    acc += lin[i, r, q] * E[3 * i + q, j]
+                DL[k, j] = acc
     for i in range(m):
         for r in range(3):
             acc = 0.0
@@ -656,7 +702,8 @@ def _build(rows, E, fp, e, mu, f_min, W):
         for k in range(e):
             acc -= E[c, k] * a[k]
         r0 += acc * acc
-    return _Problem(D, hv, a, math.sqrt(r0), mu, f_min, m, e)
+    q = m if p == 0 else 0
+    return _Problem(D, hv, a, math.sqrt(r0), mu, f_min, m, e, q, m * p, q + m * p, DL, hl)
 
 
 @_jit
@@ -668,7 +715,7 @@ def _attempt(P, W, opt, refine, y):
     if code != OPTIMAL:
         return code, math.nan, math.nan, it
     # f = f_p + E y in the contact frames: [n.f, t1.f/mu, t2.f/mu]
-    D, hv, e = P.D, P.hv, P.e
+    D, hv, DL, hl, e = P.D, P.hv, P.DL, P.hl, P.e
     norm = 0.0
     viol = -math.inf
     for i in range(P.m):
@@ -681,7 +728,14 @@ def _attempt(P, W, opt, refine, y):
             f2 += D[i, 2, k] * y[k]
         ft = P.mu * math.sqrt(f1 * f1 + f2 * f2)
         norm += f0 * f0 + ft * ft
-        viol = max(viol, P.f_min - f0, ft - P.mu * f0)
+        if i < P.q:
+            viol = max(viol, P.f_min - f0, ft - P.mu * f0)
+    for k in range(P.nl):
+        # a linear row's slack hl + DL y (N) must be >= 0
+        acc = hl[k]
+        for j in range(e):
+            acc += DL[k, j] * y[j]
+        viol = max(viol, -acc)
     norm = math.sqrt(norm)
     if viol > opt.violation_tol * max(1.0, norm):
         return UNDECIDED, math.nan, math.nan, it
@@ -714,30 +768,31 @@ def _cone_rows(frames, mu, rows):
 
 
 @_jit_alloc
-def _solve_single(frames, E, fp, mu, f_min, opt, y):
-    """One problem (`solve_problem`): (code, ||f|| N, iterations); fills y."""
-    m, e = frames.shape[0], E.shape[1]
+def _solve_single(frames, cone, E, fp, f_min, opt, y):
+    """One problem (`solve_problem`; cone: `_ConeData`): (code, ||f|| N, iterations); fills y."""
+    m, p, e = frames.shape[0], cone.lin.shape[1], E.shape[1]
     rows = np.empty((m, 3, 3))
-    _cone_rows(frames, mu, rows)
-    W = _workspace(m, e)
-    code, norm, _, it = _solve_one(_build(rows, E, fp, e, mu, f_min, W), W, opt, y)
+    _cone_rows(frames, cone.mu, rows)
+    W = _workspace(m, m if p == 0 else 0, m * p, e)
+    code, norm, _, it = _solve_one(_build(rows, cone.lin, E, fp, e, cone.mu, f_min, W), W, opt, y)
     return code, norm, it
 
 
 @_jit_alloc
-def _solve_sets(F_all, fp, frames, cols, n_cols, thresholds, mu, mu_strict, f_min, strict, opt, out):
+def _solve_sets(F_all, fp, frames, cols, n_cols, thresholds, cone, cone_strict, f_min, strict, opt, out):
     """Every synergy set of one grasp into `out` (`SetsResult`): E_s from the SVD of
     F_s = F_all[:, set] (columns with a singular value above the set's threshold), then the
     GFO, its forces f_p + E_s y (N) and, if `strict`, the strict internal-force test
-    (f_p = 0, f_min = 1 N, mu_strict). Sets with e_s = 0 get code NOT_SOLVED."""
+    (f_p = 0, f_min = 1 N, cone_strict). cone, cone_strict: `_ConeData` of the same kind.
+    Sets with e_s = 0 get code NOT_SOLVED."""
     c = F_all.shape[0]
-    m = c // 3
+    m, p = c // 3, cone.lin.shape[1]
     rows = np.empty((m, 3, 3))
     rows_strict = np.empty((m, 3, 3))
-    _cone_rows(frames, mu, rows)
-    _cone_rows(frames, mu_strict, rows_strict)
+    _cone_rows(frames, cone.mu, rows)
+    _cone_rows(frames, cone_strict.mu, rows_strict)
     zero = np.zeros(c)
-    W = _workspace(m, cols.shape[1])
+    W = _workspace(m, m if p == 0 else 0, m * p, cols.shape[1])
     y = np.empty(cols.shape[1])
     for j in range(cols.shape[0]):
         s = n_cols[j]
@@ -755,7 +810,7 @@ def _solve_sets(F_all, fp, frames, cols, n_cols, thresholds, mu, mu_strict, f_mi
             continue
         # E_s is the first `rank` columns of U
         code, out.force_norm[j], out.max_violation[j], out.iterations[j] = _solve_one(
-            _build(rows, U, fp, rank, mu, f_min, W), W, opt, y)
+            _build(rows, cone.lin, U, fp, rank, cone.mu, f_min, W), W, opt, y)
         out.code[j] = code
         if code == OPTIMAL:
             for k in range(c):
@@ -764,7 +819,8 @@ def _solve_sets(F_all, fp, frames, cols, n_cols, thresholds, mu, mu_strict, f_mi
                     acc += U[k, q] * y[q]
                 out.forces[j, k] = acc
         if strict:
-            out.strict_code[j] = _solve_one(_build(rows_strict, U, zero, rank, mu_strict, 1.0, W), W, opt, y)[0]
+            out.strict_code[j] = _solve_one(_build(rows_strict, cone_strict.lin, U, zero, rank, cone_strict.mu, 1.0, W),
+                                            W, opt, y)[0]
 
 
 def _kernel_settings(settings: IPMSettings, violation_tol: float) -> _Settings:
@@ -773,15 +829,30 @@ def _kernel_settings(settings: IPMSettings, violation_tol: float) -> _Settings:
                      int(settings.retry_refine), float(violation_tol))
 
 
-def solve_problem(frames: NDArray, E: NDArray, f_p: NDArray, mu: float, f_min: float, settings: IPMSettings,
-                  violation_tol: float) -> tuple[int, float, NDArray, int]:
+#: A friction cone as the compiled code takes it: mu dividing the tangent rows of the contact
+#: frames (1 for a pyramid, whose D rows serve only ||f||) and the linear rows lin (m, p, 3)
+#: per contact, p = 0 for the circular cone (see `_build`).
+_ConeData = namedtuple("_ConeData", "mu lin")
+
+
+def _cone_data(cone: FrictionCone, frames: NDArray) -> _ConeData:
+    """The kernel's form of a cone model on the contact frames (m, 3, 3): the circular cone's
+    mu; a pyramid's rows n (the normal bound) and -a_k (`PyramidCone.face_rows`, a_k.f <= 0)."""
+    if cone.kind == "circular":
+        return _ConeData(float(cone.mu), np.empty((frames.shape[0], 0, 3)))
+    lin = np.concatenate([frames[:, None, 0], -cone.face_rows(frames)], axis=1)
+    return _ConeData(1.0, np.ascontiguousarray(lin))
+
+
+def solve_problem(frames: NDArray, E: NDArray, f_p: NDArray, cone: FrictionCone, f_min: float,
+                  settings: IPMSettings, violation_tol: float) -> tuple[int, float, NDArray, int]:
     """One problem: frames (m, 3, 3) from `mechanics.contact_frames`, E (3m, e) orthonormal
-    with e >= 1, f_p (3m,) N, mu, f_min N. An optimal point whose forces violate a
-    constraint by more than violation_tol max(1 N, ||f||) is UNDECIDED.
+    with e >= 1, f_p (3m,) N, the friction-cone model, f_min N. An optimal point whose forces
+    violate a constraint by more than violation_tol max(1 N, ||f||) is UNDECIDED.
     Returns (code, ||f|| N, y (e,) N (NaN unless OPTIMAL), iterations)."""
     y = np.full(E.shape[1], np.nan)
-    code, norm, iters = _solve_single(frames, np.ascontiguousarray(E, dtype=float),
-                                      np.ascontiguousarray(f_p, dtype=float), float(mu), float(f_min),
+    code, norm, iters = _solve_single(frames, _cone_data(cone, frames), np.ascontiguousarray(E, dtype=float),
+                                      np.ascontiguousarray(f_p, dtype=float), float(f_min),
                                       _kernel_settings(settings, violation_tol), y)
     if code != OPTIMAL:
         y[:] = np.nan
@@ -803,18 +874,21 @@ class SetsResult(NamedTuple):
 
 
 def solve_sets(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_columns: NDArray,
-               thresholds: NDArray, mu: float, mu_strict: float, f_min: float, strict: bool,
+               thresholds: NDArray, cone: FrictionCone, strict_cone: FrictionCone | None, f_min: float,
                settings: IPMSettings, violation_tol: float) -> SetsResult:
     """Every set of one grasp in one compiled call. F_all: (3m, k) projector @ S, N per
     unit activation; columns: (n_sets, max size) 0-based columns of F_all per set (the first
-    n_columns[j] of row j); thresholds: (n_sets,) rank thresholds of the singular values."""
+    n_columns[j] of row j); thresholds: (n_sets,) rank thresholds of the singular values;
+    cone: the friction-cone model; strict_cone: that of the strict internal-force test (the
+    cone narrowed), None for no strict test."""
     n_sets = columns.shape[0]
     out = SetsResult(code=np.zeros(n_sets, dtype=np.int8), force_norm=np.full(n_sets, np.nan),
                      max_violation=np.full(n_sets, np.nan),
                      iterations=np.zeros(n_sets, dtype=np.int32), e_s=np.zeros(n_sets, dtype=np.int64),
                      strict_code=np.full(n_sets, INFEASIBLE, dtype=np.int8),
                      forces=np.full((n_sets, f_p.size), np.nan))
+    data = _cone_data(cone, frames)
     _solve_sets(np.ascontiguousarray(F_all), np.ascontiguousarray(f_p, dtype=float), frames, columns, n_columns,
-                thresholds, float(mu), float(mu_strict), float(f_min), bool(strict),
-                _kernel_settings(settings, violation_tol), out)
+                thresholds, data, data if strict_cone is None else _cone_data(strict_cone, frames), float(f_min),
+                strict_cone is not None, _kernel_settings(settings, violation_tol), out)
     return out

@@ -12,12 +12,12 @@ long finger f). A contact's Jacobian rows are non-zero only on its chain's joint
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
-from synergrasp.optimisation.cones import CircularCone
+from synergrasp.optimisation.cones import CircularCone, FrictionCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.mechanics import Grasp, grasp_mechanics, internal_force_basis, object_wrench
 from synergrasp.optimisation.problem import GFOProblem
@@ -163,8 +163,12 @@ def critical_friction(
     mu_start: float = 1.5,
     mu_max: float = 1e3,
     mu_min: float = 1e-6,
+    cone: FrictionCone = CircularCone(1.0),
 ) -> float:
     """Least mu at which the GFO problem is feasible, by bisection on log(mu).
+
+    cone: the friction-cone model whose mu is varied (its own mu is ignored; a pyramid keeps
+    its sides and inscription).
 
     Feasibility is monotone in mu (the cones grow with it). Returns inf if the problem is
     infeasible at `mu_max`, 0.0 if feasible at `mu_min`; otherwise the upper end of a
@@ -172,7 +176,7 @@ def critical_friction(
     """
 
     def feasible(mu: float) -> bool:
-        problem = GFOProblem(f_p, E, normals, f_min, CircularCone(mu))
+        problem = GFOProblem(f_p, E, normals, f_min, replace(cone, mu=mu))
         return solve_gfo([problem], "clarabel").status[0] == "force_closure"
 
     if feasible(mu_start):

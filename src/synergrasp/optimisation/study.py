@@ -45,8 +45,7 @@ class GFOParams:
     gravity_direction: unit vector of gravity in the palm frame
     mu: Coulomb friction coefficient; f_min_N: least normal force at every contact, N
     friction_cone: the friction-cone model, one of cones.CONE_MODELS ('circular', the exact
-        Coulomb cone, solved by the compiled interior-point kernel; the pyramids, solved as
-        QPs by PIQP)
+        Coulomb cone; the pyramids), both solved by the compiled interior-point kernel
     k_stru_N_per_mm: structural contact stiffness, N/mm; k_ss_Nmm_per_rad: joint stiffness, N·mm/rad
     mass_kg, g_m_per_s2: the object's weight is mass_kg · g_m_per_s2, N
     basis_rtol: rank tolerance of E_s; grasp_rank_rtol: rank tolerance of G
@@ -107,8 +106,8 @@ def optimise_grasps(
     """GFO verdict, optimal force and strict internal-force test of every (grasp, set).
 
     grasps: poses (None or no contacts: 'no_grasp'). Solved with the fastest method for the
-    cone (`gfo.FASTEST_METHOD`: the compiled kernel with Clarabel for what it leaves
-    undecided for the circular cone, PIQP for pyramids). strict=False skips the strict
+    cone (`gfo.FASTEST_METHOD`: the compiled kernel, with Clarabel for what it leaves
+    undecided, for every cone kind). strict=False skips the strict
     test (column all False). Returns columns, one row per (grasp, set), grasp-major:
     set_id, n_synergies, status, force_closure, strict_internal, force_norm (N), e_s,
     rank_G, n_contacts, iterations, solver.
