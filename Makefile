@@ -45,6 +45,7 @@ cluster-test: $(BIN)/.installed
 # One core, as the targets are stated per core.
 bench: $(BIN)/.installed
 	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_gfo.py
+	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_pyramid.py
 	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_closure.py
 
 # Regenerate the pinned, hashed lock from pyproject.toml (Python 3.11, Linux x86_64).
