@@ -70,7 +70,7 @@ def figure_table2_curves(table2: pd.DataFrame, png: str | Path, pdf: str | Path,
     success_rate (analysis.sensitivity.table2_long)."""
     data = table2[table2["k"] <= k_max]
     objects = sorted(data["object"].unique())
-    fig, axes = plt.subplots(1, len(objects), figsize=(3.2 * len(objects), 3.4), sharey=True,
+    fig, axes = plt.subplots(1, len(objects), figsize=(3.2 * len(objects), 4.6), sharey=True,
                              squeeze=False)
     scenarios = list(dict.fromkeys(data["scenario"]))
     colours = plt.get_cmap("tab20")(np.linspace(0, 1, max(len(scenarios), 2)))
@@ -86,6 +86,9 @@ def figure_table2_curves(table2: pd.DataFrame, png: str | Path, pdf: str | Path,
         ax.set_xticks(range(1, k_max + 1))
         ax.set_ylim(0, 102)
     axes[0][0].set_ylabel("success rate (%)")
-    axes[0][-1].legend(fontsize=6, loc="lower right", ncol=1 + len(scenarios) // 12)
-    fig.tight_layout()
+    # the legend below the panels: inside one it hides that object's curves
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    n_cols = min(len(scenarios), 6)
+    fig.tight_layout(rect=(0, 0.06 * (1 + (len(scenarios) - 1) // n_cols), 1, 1))
+    fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=n_cols, frameon=False)
     save_figure(fig, png, pdf)
