@@ -319,7 +319,7 @@ def test_optimise_params_keep_the_mechanics_and_the_objects_weight():
     assert gfo.gravity_direction == (0.0, 0.0, -1.0)
     assert (gfo.mu, gfo.f_min_N, gfo.k_stru_N_per_mm, gfo.k_ss_Nmm_per_rad, gfo.g_m_per_s2) == (1.5, 0.1, 1.0, 200.0, 9.81)
     assert gfo.wrench()[2] == pytest.approx(0.5 * 9.81)  # the contacts hold the weight: +z
-    assert len(params.sets) == 75 and params.pose_shards == 4
+    assert len(params.sets) == 75 and params.pose_shards == 1
     assert gfo.friction_cone == "circular"
     pyramid = validate_config(_broken(("mechanics", "friction_cone"), "pyramid8_circumscribed", STUDY))
     assert step_params(pyramid, "optimise", "obj1").gfo.cone.kind == "pyramid"
@@ -417,6 +417,47 @@ def test_scenarios_differing_in_an_analysis_key_share_simulation_and_optimisatio
     assert code == 0, out[-3000:]
     assert all(p.startswith("results/objects/") for p in jobs["simulate_contacts"])
     assert all(p.startswith("results/scenarios/mu1/") for p in jobs["aggregate_gfo"] + jobs["optimise_shard"])
+
+
+def test_dropping_or_keeping_unloaded_contacts_shares_one_dynamic_closure(tmp_path):
+    """`unloaded_contacts` is read by the contacts step, not by the closure: the two dynamic
+    scenarios run one closure per object; only `drop` selects the load-carrying contacts, and
+    each scenario optimises its own contacts."""
+    scenarios = {"dyn": {"closure": {"model": "dynamic"}},
+                 "dyn_all": {"closure": {"model": "dynamic", "dynamic": {"unloaded_contacts": "keep"}}}}
+    code, out, jobs = _dry_run(tmp_path, "scenarios", scenarios)
+    assert code == 0, out[-3000:]
+    closures = sorted(p for p in jobs["simulate_contacts"] if "/scenarios/" in p)
+    assert closures == [f"results/scenarios/dyn/objects/{o}/contacts.parquet" for o in ("obj1", "obj4")]
+    assert sorted(jobs["select_contacts"]) == [f"results/scenarios/dyn/objects/{o}/load_carrying_contacts.parquet"
+                                              for o in ("obj1", "obj4")]
+    gfo_roots = sorted({p.split("/objects/")[0] for p in jobs["aggregate_gfo"]})
+    assert gfo_roots == ["results", "results/scenarios/dyn", "results/scenarios/dyn_all"]
+
+
+def test_the_closure_shares_across_synergy_tables_that_agree_in_the_mean_and_s1():
+    """The closure reads q_m and S1 only: two thumb readings that differ in S2…S15 share it (the
+    figure of S1…S7 and the optimisation do not); a table with another S1 does not."""
+    full = validate_config(STUDY)
+    higher = validate_config(_broken(("synergies",), "softhand_human_higher", STUDY))
+    legacy = validate_config(_broken(("synergies",), "legacy_thumb", STUDY))
+    assert step_hash(full, "simulate", "obj1") == step_hash(higher, "simulate", "obj1")
+    assert step_hash(full, "fig2") == step_hash(higher, "fig2")
+    for step, obj in (("fig1", None), ("optimise", "obj1")):
+        assert step_hash(full, step, obj) != step_hash(higher, step, obj), step
+    assert step_hash(full, "simulate", "obj1") != step_hash(legacy, "simulate", "obj1")
+
+
+def test_the_closure_reads_no_contact_selection_key():
+    full = validate_config(STUDY)
+    keep = validate_config(_broken(("closure", "dynamic", "unloaded_contacts"), "keep", STUDY))
+    dynamic, dynamic_keep = ({**c, "closure": {**c["closure"], "model": "dynamic"}} for c in (full, keep))
+    assert "unloaded_contacts" not in step_config(dynamic, "simulate", "obj1")["closure"]["dynamic"]
+    assert step_hash(dynamic, "simulate", "obj1") == step_hash(dynamic_keep, "simulate", "obj1")
+    assert step_hash(dynamic, "contacts", "obj1") != step_hash(dynamic_keep, "contacts", "obj1")
+    assert step_hash(dynamic, "optimise", "obj1") != step_hash(dynamic_keep, "optimise", "obj1")
+    assert step_params(dynamic, "contacts", "obj1").drop_unloaded and not step_params(full, "contacts", "obj1").drop_unloaded
+    assert step_hash(full, "contacts", "obj1") == step_hash(keep, "contacts", "obj1")  # kinematic: nothing to select
 
 
 def _target_inputs(out, rule):

@@ -73,7 +73,8 @@ def test_box_against_the_palm_ends_with_a_palm_contact(model, hand):
     result = model.grasp(CUBE60, placed)
     assert result.status == "grasp" and result.settled
     assert 0 in result.links.tolist()
-    assert np.all(result.normal_force_N >= PARAMS.dynamic.load_threshold_N)
+    # every touching link is listed with its load (which count is decided downstream); the palm carries load
+    assert np.all(result.normal_force_N >= 0.0) and result.normal_force_N[result.links.tolist().index(0)] > 0.01
     # contact points on the exact box surface at its settled pose, inward normals
     pose = result.settled_pose
     for point, normal in zip(result.points, result.normals):

@@ -45,9 +45,9 @@ def _gfo(obj: str = "a") -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _table(hand, contacts=None, gfo=None, **kw):
+def _table(hand, contacts=None, gfo=None, load_threshold_N=0.01):
     return grasp_realism(_contacts() if contacts is None else contacts, _gfo() if gfo is None else gfo,
-                         hand.link_names, hand.link_finger, "1-2", {"a": 10.0}, **kw)
+                         hand.link_names, hand.link_finger, "1-2", {"a": 10.0}, load_threshold_N)
 
 
 def test_counts_and_shares_by_hand(hand):
@@ -104,9 +104,9 @@ def test_link_categories_of_the_shipped_hand(hand):
 
 def test_missing_weight_or_full_set_is_one_clear_error(hand):
     with pytest.raises(ValueError, match=r"no weight for object\(s\) \['a'\]"):
-        grasp_realism(_contacts(), _gfo(), hand.link_names, hand.link_finger, "1-2", {"b": 1.0})
+        grasp_realism(_contacts(), _gfo(), hand.link_names, hand.link_finger, "1-2", {"b": 1.0}, 0.01)
     with pytest.raises(ValueError, match="full_set_id '1-2-3'"):
-        grasp_realism(_contacts(), _gfo(), hand.link_names, hand.link_finger, "1-2-3", {"a": 1.0})
+        grasp_realism(_contacts(), _gfo(), hand.link_names, hand.link_finger, "1-2-3", {"a": 1.0}, 0.01)
 
 
 def test_figure_is_written_and_the_same_on_rerun(hand, tmp_path):
@@ -150,3 +150,12 @@ def test_a_closure_without_contact_is_simulated_not_dropped(hand):
     assert row["pct_thumb"] == pytest.approx(75.0)
     assert row["median_force_per_weight"] == pytest.approx(2.0)
 
+
+
+def test_a_contact_carries_load_from_the_configured_threshold_on(hand):
+    """Loads 0.5 / 0 N, 1 / 2 / 0 / 3 N and 7 × 0 N: at 1 N the counts are 0, 3 and 0 (a load equal
+    to the threshold counts); without a threshold nothing is known."""
+    assert _table(hand, load_threshold_N=1.0)["loaded_contacts_median"].iloc[0] == 0.0
+    assert _table(hand, load_threshold_N=0.6)["loaded_contacts_median"].iloc[0] == 0.0
+    assert _table(hand, load_threshold_N=0.5)["loaded_contacts_median"].iloc[0] == 1.0
+    assert np.isnan(_table(hand, load_threshold_N=None)["loaded_contacts_median"].iloc[0])

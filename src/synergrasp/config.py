@@ -390,6 +390,7 @@ def scenario_configs(config: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
 STEP_KEYS: dict[str, tuple[str, ...]] = {
     "simulate": ("hand", "synergies", "grid", "placement", "closure",
                  "objects.{object}.size_mm", "objects.{object}.placement"),
+    "contacts": ("closure.model",),
     "optimise": ("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg"),
     "minima": ("analyses.minima_radius_deg", "analyses.success"),
     "tables": ("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max", "analyses.success",
@@ -401,19 +402,32 @@ STEP_KEYS: dict[str, tuple[str, ...]] = {
     "fig4": ("analyses.fig4", "analyses.success"),
     "fig5": ("synergy_sets.hierarchy_first", "analyses.success"),
 }
+#: The keys of the choice of which contacts count (the ``contacts`` step).
+_CONTACT_SELECTION = ("closure.dynamic.unloaded_contacts", "closure.dynamic.load_threshold_N")
 #: Keys a step reads only when another key has a given value: step -> ((key, value, reads), ...).
 STEP_KEYS_WHEN: dict[str, tuple[tuple[str, Any, tuple[str, ...]], ...]] = {
     # the dynamic closure: a free box of the object's mass, μ, k_ss and gravity of mechanics
     "simulate": (("closure.model", "dynamic", ("objects.{object}.mass_kg", "mechanics")),),
+    # which contacts count: only the dynamic model records the load each contact carries
+    "contacts": (("closure.model", "dynamic", _CONTACT_SELECTION),),
+    "realism": (("closure.model", "dynamic", ("closure.dynamic.load_threshold_N",)),),
 }
+#: Keys inside a block a step reads that the step itself does not read: step -> key paths.
+#: The closure lists every touching link with its load; which of them count is the
+#: ``contacts`` step's choice, so that ``drop`` and ``keep`` share one simulation.
+STEP_KEYS_EXCEPT: dict[str, tuple[str, ...]] = {"simulate": _CONTACT_SELECTION}
 #: The steps whose outputs a step reads (its hash includes theirs): for a step run per object
 #: (OBJECT_STEPS), that object's; for a step run once per scenario, every object's.
 UPSTREAM: dict[str, tuple[str, ...]] = {
-    "optimise": ("simulate",), "minima": ("optimise",), "tables": ("optimise", "minima"),
-    "realism": ("simulate", "optimise"), "fig2": ("simulate",), "fig4": ("optimise", "minima"),
+    "contacts": ("simulate",), "optimise": ("contacts",), "minima": ("optimise",), "tables": ("optimise", "minima"),
+    "realism": ("contacts", "optimise"), "fig2": ("contacts",), "fig4": ("optimise", "minima"),
     "fig5": ("tables",)}
 #: Steps run once per object (the others once per scenario).
-OBJECT_STEPS: frozenset[str] = frozenset({"simulate", "optimise", "minima", "fig4"})
+OBJECT_STEPS: frozenset[str] = frozenset({"simulate", "contacts", "optimise", "minima", "fig4"})
+#: Steps that read only some synergies of the synergy table: step -> the synergies (1-based)
+#: it reads besides the mean posture. Their hash holds those values, not the table's name,
+#: so tables that agree there (thumb readings that differ in S2…S15 only) share the step.
+SYNERGY_COLUMNS_READ: dict[str, tuple[int, ...]] = {"simulate": (1,)}
 #: Keys read by the workflow itself, not by a step.
 WORKFLOW_KEYS: tuple[str, ...] = ("scenarios",)
 
@@ -462,6 +476,11 @@ def step_config(config: Mapping[str, Any], step: str, obj: str | None = None) ->
         value = _get(config, path)
         if value is not _MISSING:
             _put(out, path, value)
+    for path in STEP_KEYS_EXCEPT.get(step, ()):
+        *parents, last = path.split(".")
+        node = _get(out, ".".join(parents))
+        if isinstance(node, dict):
+            node.pop(last, None)
     return out
 
 
@@ -469,7 +488,10 @@ def step_hash(config: Mapping[str, Any], step: str, obj: str | None = None) -> s
     """Hash of what a step's outputs depend on: the keys it reads and, through
     :data:`UPSTREAM`, those of the steps before it (12 hex digits). ``obj``: the object of
     a step of :data:`OBJECT_STEPS`; None for a step run once per scenario."""
-    parts: list[Any] = [step_config(config, step, obj)]
+    own = step_config(config, step, obj)
+    if step in SYNERGY_COLUMNS_READ:
+        own["synergies"] = _synergy_digest(own.get("hand"), own["synergies"], SYNERGY_COLUMNS_READ[step])
+    parts: list[Any] = [own]
     for upstream in UPSTREAM.get(step, ()):
         if upstream in OBJECT_STEPS and obj is None:
             parts.append([[name, step_hash(config, upstream, name)] for name in config["objects"]])
@@ -477,6 +499,17 @@ def step_hash(config: Mapping[str, Any], step: str, obj: str | None = None) -> s
             parts.append(step_hash(config, upstream, obj if upstream in OBJECT_STEPS else None))
     text = json.dumps(parts, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+@functools.cache
+def _synergy_digest(hand: str | None, synergies: str | None, columns: tuple[int, ...]) -> str:
+    """SHA-256 of the mean posture and the synergies ``columns`` (1-based) of a synergy table,
+    as loaded for ``hand`` (the exact float64 values, rad)."""
+    kinematics = importlib.import_module("synergrasp.hand.kinematics")
+    loader = importlib.import_module("synergrasp.hand.synergies")
+    table = loader.load_synergies(synergies, joint_names=kinematics.load_hand(hand).joint_names)
+    values = np.concatenate([table.mean, table.columns(list(columns)).ravel(order="F")])
+    return "sha256:" + hashlib.sha256(np.ascontiguousarray(values, dtype=np.float64).tobytes()).hexdigest()
 
 
 # --------------------------------------------------------------------------- typed parameters
@@ -519,11 +552,21 @@ class TablesParams:
 
 
 @dataclass(frozen=True)
+class ContactsParams:
+    """Which contacts of a closure count. ``drop_unloaded``: keep only the contacts carrying
+    at least ``load_threshold_N`` (N); only the dynamic model records loads (None otherwise)."""
+    drop_unloaded: bool
+    load_threshold_N: float | None
+
+
+@dataclass(frozen=True)
 class RealismParams:
-    """The grasp-realism table: hand file, the full set's id, each object's weight (N)."""
+    """The grasp-realism table: hand file, the full set's id, each object's weight (N), and
+    the least normal force (N) of a load-carrying contact (None: the model records no loads)."""
     hand: str | None
     full_set_id: str
     weights_N: dict[str, float]
+    load_threshold_N: float | None
 
 
 @dataclass(frozen=True)
@@ -635,7 +678,7 @@ def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) ->
     complete configuration or from the step's own part of it (:func:`step_config`).
 
     The one path from configuration to the parameters of every module: ``simulate`` →
-    :class:`SimulateParams`, ``optimise`` → :class:`OptimiseParams`, ``minima`` →
+    :class:`SimulateParams`, ``contacts`` → :class:`ContactsParams`, ``optimise`` → :class:`OptimiseParams`, ``minima`` →
     :class:`MinimaParams`, ``tables`` → :class:`TablesParams`, ``realism`` →
     :class:`RealismParams`, ``fig1``/``fig2``/``fig4``/
     ``fig5`` → :class:`FiguresParams`. A value a typed class rejects raises ConfigError
@@ -645,6 +688,9 @@ def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) ->
     config = step_config(config, step, obj)
     if step == "simulate":
         return _simulate(config, obj)
+    if step == "contacts":
+        dynamic = config["closure"].get("dynamic", {})
+        return ContactsParams(dynamic.get("unloaded_contacts") == "drop", dynamic.get("load_threshold_N"))
     if step == "optimise":
         return _optimise(config, obj)
     if step == "minima":
@@ -654,7 +700,8 @@ def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) ->
     if step == "realism":
         g = config["mechanics"]["g_m_per_s2"]
         return RealismParams(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),
-                             {name: spec["mass_kg"] * g for name, spec in config["objects"].items()})
+                             {name: spec["mass_kg"] * g for name, spec in config["objects"].items()},
+                             config.get("closure", {}).get("dynamic", {}).get("load_threshold_N"))
     if step in ("fig1", "fig2", "fig4", "fig5"):
         return _figures(config, step)
     raise ValueError(f"unknown step {step!r}; allowed values: {sorted(STEP_KEYS)}")

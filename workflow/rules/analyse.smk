@@ -56,7 +56,7 @@ rule study_tables:
 
 rule grasp_realism:
     input:
-        contacts=step_inputs("simulate"),
+        contacts=step_inputs("contacts"),
         gfo=step_inputs("optimise"),
         code=code("grasp_realism"),
         data=SHIPPED_DATA,

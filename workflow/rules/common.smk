@@ -13,6 +13,7 @@ from synergrasp.config import (
     scenario_configs,
     step_config,
     step_hash,
+    step_params,
     synergy_problems,
 )
 
@@ -56,8 +57,15 @@ SCENARIO_ROOT = {
     name: "results" if name == "default" else f"results/scenarios/{name}" for name in SCENARIOS
 }
 _ROOT_SCENARIO = {root: name for name, root in SCENARIO_ROOT.items()}
-#: The file each per-object step writes under its root's objects/<object>/.
-STEP_FILES = {"simulate": "contacts.parquet", "optimise": "gfo.parquet", "minima": "minima.parquet"}
+#: The file each per-object step writes under its root's objects/<object>/: the closure's
+#: contacts (every touching link), the contacts that count (only where unloaded ones are
+#: dropped: the `contacts` step), the optimisation and the minima.
+STEP_FILES = {
+    "simulate": "contacts.parquet",
+    "contacts": "load_carrying_contacts.parquet",
+    "optimise": "gfo.parquet",
+    "minima": "minima.parquet",
+}
 
 
 def scenario_config(wildcards):
@@ -78,8 +86,16 @@ def step_root(scenario, step, obj=None):
     return SCENARIO_ROOT[owner]
 
 
+def drops_unloaded(scenario, obj):
+    """Whether ``scenario`` keeps only the load-carrying contacts of ``obj``'s closure
+    (else the `contacts` step has nothing to select and is the closure's own table)."""
+    return step_params(SCENARIOS[scenario], "contacts", obj).drop_unloaded
+
+
 def step_file(scenario, step, obj):
     """Where ``scenario``'s output of per-object ``step`` (STEP_FILES) for ``obj`` lives."""
+    if step == "contacts" and not drops_unloaded(scenario, obj):
+        step = "simulate"
     return f"{step_root(scenario, step, obj)}/objects/{obj}/{STEP_FILES[step]}"
 
 
@@ -179,7 +195,8 @@ def fig4_files(scenario, name):
 
 def object_targets(name, scenario="default"):
     """One object's outputs in a scenario: its per-object tables and Fig. 4 (wherever shared)."""
-    return [step_file(scenario, step, name) for step in STEP_FILES] + fig4_files(scenario, name)
+    files = dict.fromkeys(step_file(scenario, step, name) for step in STEP_FILES)
+    return list(files) + fig4_files(scenario, name)
 
 
 TABLES = [

@@ -4,7 +4,7 @@
 
 rule optimise_shard:
     input:
-        contacts=step_input("simulate"),
+        contacts=step_input("contacts"),
         code=code("optimise_shard"),
         data=SHIPPED_DATA,
         user=user_files,

@@ -10,12 +10,18 @@ from synergrasp.config import grid_axis_deg, synergy_sets
 # (columns s, cpu_time and max_rss) of the default study and of tests/config/small.yaml on a
 # 2-core x86_64 machine running two jobs at a time; the slope is between the two sizes. The
 # closure's cost per pose is CPU time per pose of the closure to the end of S1 (docs/cluster.md).
-#   unit = pose (closure), pose x synergy set (optimisation, minima, Fig. 4, tables), none (figures)
+#   unit = pose (closure, contact selection), pose x synergy set (optimisation, minima, Fig. 4, tables), none (figures)
 JOB_COST = {
     "simulate_contacts": {
         "fixed_s": 1.5,
         "unit_s": 4.5e-2,
         "fixed_mb": 178,
+        "unit_mb": 7.6e-3,
+    },
+    "select_contacts": {
+        "fixed_s": 1.0,
+        "unit_s": 5.0e-4,
+        "fixed_mb": 150,
         "unit_mb": 7.6e-3,
     },
     "optimise_shard": {
@@ -100,6 +106,7 @@ def job_size(step):
     """Units of work of one job of rule ``step`` under the current config (see JOB_COST)."""
     return {
         "simulate_contacts": N_POSES * CLOSURE_FACTOR,
+        "select_contacts": N_POSES,
         "optimise_shard": SHARD_POSES * N_SETS,
         "aggregate_gfo": N_POSES * N_SETS,
         "local_minima": N_POSES * N_SETS,
@@ -130,6 +137,7 @@ def mem_mb(step):
 # Jobs of a few seconds and a few hundred MB for the default study run where Snakemake runs:
 # submitting them would cost more queue time than they take.
 localrules:
+    select_contacts,
     aggregate_gfo,
     sensitivity_summary,
     local_minima,

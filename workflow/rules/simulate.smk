@@ -23,6 +23,26 @@ rule simulate_contacts:
         "../scripts/simulate_contacts.py"
 
 
+rule select_contacts:
+    input:
+        contacts=step_input("simulate"),
+        code=code("select_contacts"),
+    output:
+        "{root}/objects/{object}/load_carrying_contacts.parquet",
+    log:
+        "{root}/logs/select_contacts/{object}.log",
+    benchmark:
+        "{root}/benchmarks/select_contacts/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("select_contacts"),
+        runtime=runtime_min("select_contacts"),
+    params:
+        cfg=step_cfg("contacts"),
+    script:
+        "../scripts/select_contacts.py"
+
+
 rule fig1_synergy_postures:
     input:
         code=code("fig1_synergy_postures"),
@@ -51,7 +71,7 @@ rule fig1_synergy_postures:
 
 rule fig2_example_grasps:
     input:
-        contacts=step_inputs("simulate"),
+        contacts=step_inputs("contacts"),
         code=code("fig2_example_grasps"),
         data=SHIPPED_DATA,
         user=user_files,

@@ -14,6 +14,7 @@ with job_log(snakemake.log[0]):
     hand = load_hand(params.hand)
     contacts = pd.concat([tables.read(tables.CONTACTS, p) for p in snakemake.input.contacts], ignore_index=True)
     gfo = pd.concat([tables.read(tables.GFO, p) for p in snakemake.input.gfo], ignore_index=True)
-    table = grasp_realism(contacts, gfo, hand.link_names, hand.link_finger, params.full_set_id, params.weights_N)
+    table = grasp_realism(contacts, gfo, hand.link_names, hand.link_finger, params.full_set_id, params.weights_N,
+                          params.load_threshold_N)
     tables.write_study_table(table, snakemake.output.csv, snakemake.output.md, title="Grasp realism")
     figure_grasp_realism(table, snakemake.output.png, snakemake.output.pdf)

@@ -47,15 +47,15 @@ def _touches(links: pd.Series, category: frozenset[int]) -> pd.Series:
     return links.map(lambda ls: bool(len(ls)) and any(int(i) in category for i in ls))
 
 
-def _loaded(contacts: pd.DataFrame, threshold_N: float) -> pd.Series:
-    """Contacts per row whose normal force exceeds ``threshold_N``; NaN where the forces are
-    unknown (NaN entries, as the kinematic model writes them)."""
+def _loaded(contacts: pd.DataFrame, threshold_N: float | None) -> pd.Series:
+    """Contacts per row whose normal force is at least ``threshold_N``; NaN where the forces
+    are unknown (NaN entries, as the kinematic model writes them, or no threshold)."""
 
     def count(forces) -> float:
-        if forces is None or (np.isscalar(forces) and pd.isna(forces)):
+        if threshold_N is None or forces is None or (np.isscalar(forces) and pd.isna(forces)):
             return np.nan
         values = np.asarray(forces, dtype=float)
-        return np.nan if np.isnan(values).any() else float(np.count_nonzero(values > threshold_N))
+        return np.nan if np.isnan(values).any() else float(np.count_nonzero(values >= threshold_N))
 
     return contacts[NORMAL_FORCE_COLUMN].map(count)
 
@@ -110,7 +110,7 @@ def _bin_column(b: int) -> str:
 
 
 def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequence[str], link_finger: Sequence[str],
-                  full_set_id: str, weights_N: Mapping[str, float], load_threshold_N: float = 1e-3) -> pd.DataFrame:
+                  full_set_id: str, weights_N: Mapping[str, float], load_threshold_N: float | None) -> pd.DataFrame:
     """The grasp-realism table (columns of :data:`synergrasp.tables.GRASP_REALISM`).
 
     ``contacts``: contacts tables of the objects (CONTACTS contract; rows are grouped by
@@ -119,7 +119,9 @@ def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequenc
     column); rank(G), force closure and ‖f‖₂ are taken from the full set ``full_set_id`` (e.g. ``"1-2-…-15"``). ``weights_N``: m·g per object, N.
     ``link_names`` / ``link_finger``: the hand's links (``Hand.link_names``, ``Hand.link_finger``).
     Shares are percent of the simulated poses (``SIMULATED_STATUSES``); a contact carries load if
-    its normal force exceeds ``load_threshold_N``. One row per (object, closure model).
+    its normal force is at least ``load_threshold_N`` (N; the configuration's
+    ``closure.dynamic.load_threshold_N``, None where no model records loads). One row per
+    (object, closure model).
     """
     for table, frame in ((CONTACTS, contacts), (GFO, gfo)):
         absent = [c for c in table.names if c not in frame.columns]

@@ -2,8 +2,9 @@
 
 Every closure model returns a :class:`ClosureResult`; :func:`contacts_row` turns it into a
 row of the table whose columns, types and units are ``synergrasp.tables.CONTACTS``;
-:func:`read_grasps` turns rows back into grasps for the optimisation. Pure numpy and
-pandas: pybullet is never imported here.
+:func:`read_grasps` turns rows back into grasps for the optimisation;
+:func:`load_carrying_contacts` keeps the contacts that carry load (where the closure model
+records loads). Pure numpy and pandas: pybullet is never imported here.
 """
 
 from __future__ import annotations
@@ -33,12 +34,14 @@ __all__ = [
     "contacts_table",
     "write_contacts",
     "read_grasps",
+    "load_carrying_contacts",
 ]
 
 STATUSES: tuple[str, ...] = ("grasp", "intersects_open_hand", "no_contact", "lost")
 """``grasp``: the closure ran and at least one link touches the box; ``intersects_open_hand``:
 the box overlaps the open hand (only the ``fixed`` placement can give it); ``no_contact``:
-the closure ran, nothing touches the box; ``lost`` (dynamic model only): the closing hand
+the closure ran, nothing touches the box (or, once the unloaded contacts are dropped, nothing
+that touches it carries load); ``lost`` (dynamic model only): the closing hand
 pushed the free box out of reach."""
 
 FINGER_STATES: tuple[str, ...] = ("contact", "limit", "self")
@@ -172,3 +175,30 @@ def read_grasps(table: pd.DataFrame) -> list[Grasp | None]:
             center=np.asarray(row.object_center, dtype=float),
         ))
     return grasps
+
+
+def load_carrying_contacts(table: pd.DataFrame, threshold_N: float) -> pd.DataFrame:
+    """The contacts table with only the contacts whose normal force is at least ``threshold_N``
+    (N) in each row: its links, points, normals, Jacobian rows and forces kept, ``n_contacts``
+    counted again, and a ``grasp`` left without any contact made ``no_contact``. Every other
+    column is the closure's own (``max_penetration_mm`` stays the deepest touching link's)."""
+    out = table.reset_index(drop=True)
+    for i, row in enumerate(table.itertuples(index=False)):
+        forces = np.asarray(row.contact_normal_force_N, dtype=float)
+        if np.isnan(forces).any():
+            raise ValueError(f"contacts table, pose {row.pose}: the closure model ({row.closure_model}) "
+                             "recorded no contact loads, so none can be selected by load")
+        if row.status != "grasp" or np.all(forces >= threshold_N):
+            continue
+        keep = np.flatnonzero(forces >= threshold_N)
+        jac = np.asarray(row.jacobian, dtype=float).reshape(3 * len(forces), -1)
+        jac_rows = (3 * keep[:, None] + np.arange(3)).ravel()
+        out.at[i, "n_contacts"] = len(keep)
+        out.at[i, "contact_link"] = [int(v) for v in np.asarray(row.contact_link)[keep]]
+        for col in ("contact_point", "contact_normal"):
+            out.at[i, col] = [float(v) for v in np.asarray(getattr(row, col), dtype=float).reshape(-1, 3)[keep].ravel()]
+        out.at[i, "jacobian"] = [float(v) for v in jac[jac_rows].ravel()]
+        out.at[i, "contact_normal_force_N"] = [float(v) for v in forces[keep]]
+        if len(keep) == 0:
+            out.at[i, "status"] = "no_contact"
+    return out

@@ -74,9 +74,10 @@ class DynamicParams:
                            mechanics.gravity_direction) if true.
     lost_distance_mm:      a box with no contact at the end that moved farther than this from
                            its initial pose was pushed out of the hand: status ``lost``.
-    load_threshold_N:      a contact carries load if its normal force is at least this, N.
-    unloaded_contacts:     ``drop`` (not listed) or ``keep`` (listed) the contacts below the
-                           threshold.
+
+    Every hand link touching the box is listed with the normal force it carries; which of
+    them count (``closure.dynamic.unloaded_contacts``) is decided downstream
+    (``synergrasp.simulation.contacts.load_carrying_contacts``), so both choices share one closure.
     """
 
     time_step_s: float
@@ -94,8 +95,6 @@ class DynamicParams:
     hand_hand_mu: float
     gravity: bool
     lost_distance_mm: float
-    load_threshold_N: float
-    unloaded_contacts: str
 
     @property
     def ramp_steps(self) -> int:
@@ -281,8 +280,6 @@ class DynamicClosure:
         for link in touching:
             rows = np.flatnonzero(forces.link_b == link)
             load = float(forces.normal_force[rows].sum()) if len(rows) else 0.0
-            if load < p.load_threshold_N and p.unloaded_contacts == "drop":
-                continue
             if load > 0.0:
                 on_link = (forces.normal_force[rows] / load) @ forces.point_b[rows]
             else:
