@@ -460,6 +460,26 @@ def test_the_closure_reads_no_contact_selection_key():
     assert step_hash(full, "contacts", "obj1") == step_hash(keep, "contacts", "obj1")  # kinematic: nothing to select
 
 
+def test_resources_follow_each_scenarios_own_size(tmp_path):
+    """A job's requests come from its scenario: on the study's 5° grid a closure asks for more
+    than on the small config's grid, a dynamic one for more than a kinematic one."""
+    fine = {"alpha_deg": {"start": -180, "stop": 175, "step": 5}, "beta_deg": {"start": -60, "stop": 60, "step": 5}}
+    scenarios = {"fine": {"grid": fine}, "fine_dyn": {"grid": fine, "closure": {"model": "dynamic"}}}
+    code, out, _ = _dry_run(tmp_path, "scenarios", scenarios)
+    assert code == 0, out[-3000:]
+    requests, output = {}, None
+    for line in out.splitlines():
+        if line.strip().startswith("output:"):
+            output = line.split(":", 1)[1].split(",")[0].strip()
+        elif line.strip().startswith("resources:") and output:
+            fields = dict(kv.split("=", 1) for kv in line.split(":", 1)[1].replace(" ", "").split(","))
+            if "runtime" in fields:
+                requests[output] = (int(fields["runtime"]), int(fields["mem_mb"]))
+    small, fine_kin, fine_dyn = (requests[f"{root}/objects/obj1/contacts.parquet"] for root in
+                                 ("results", "results/scenarios/fine", "results/scenarios/fine_dyn"))
+    assert small[0] < fine_kin[0] < fine_dyn[0] and small[1] <= fine_kin[1] <= fine_dyn[1]
+
+
 def _target_inputs(out, rule):
     """The input files of the target rule ``rule`` in a dry run's output."""
     lines = out.splitlines()

@@ -92,46 +92,54 @@ SOLVER_COMPILE_S, SOLVER_COMPILE_MB = 60.0, 150
 # rounded up to whole minutes and to 100 MB.
 RUNTIME_MARGIN, MEMORY_MARGIN = 3.0, 1.5
 
-# Sizes of the default scenario (the largest scenarios of a sweep should set their own
-# resources through a profile if they are much larger).
-N_POSES = len(grid_axis_deg(STUDY["grid"]["alpha_deg"])) * len(
-    grid_axis_deg(STUDY["grid"]["beta_deg"])
-)
-N_SETS = len(synergy_sets(STUDY["synergy_sets"]))
-SHARD_POSES = math.ceil(N_POSES / STUDY["solver"]["pose_shards"])
-CLOSURE_FACTOR = CLOSURE_COST_FACTOR.get(STUDY["closure"]["model"], CLOSURE_UNMEASURED_FACTOR)
-
-
-def job_size(step):
-    """Units of work of one job of rule ``step`` under the current config (see JOB_COST)."""
+def job_size(step, cfg):
+    """Units of work of one job of rule ``step`` under the scenario configuration ``cfg``
+    (see JOB_COST): the closure's cost follows the scenario's grid and closure model, the
+    optimisation's its grid, synergy sets and shards."""
+    n_poses = len(grid_axis_deg(cfg["grid"]["alpha_deg"])) * len(grid_axis_deg(cfg["grid"]["beta_deg"]))
+    n_sets = len(synergy_sets(cfg["synergy_sets"]))
+    factor = CLOSURE_COST_FACTOR.get(cfg["closure"]["model"], CLOSURE_UNMEASURED_FACTOR)
     return {
-        "simulate_contacts": N_POSES * CLOSURE_FACTOR,
-        "select_contacts": N_POSES,
-        "optimise_shard": SHARD_POSES * N_SETS,
-        "aggregate_gfo": N_POSES * N_SETS,
-        "local_minima": N_POSES * N_SETS,
-        "fig4_force_maps": N_POSES * N_SETS,
-        "study_tables": len(OBJECTS) * N_POSES * N_SETS,
-        "grasp_realism": len(OBJECTS) * N_POSES * N_SETS,
+        "simulate_contacts": n_poses * factor,
+        "select_contacts": n_poses,
+        "optimise_shard": math.ceil(n_poses / cfg["solver"]["pose_shards"]) * n_sets,
+        "aggregate_gfo": n_poses * n_sets,
+        "local_minima": n_poses * n_sets,
+        "fig4_force_maps": n_poses * n_sets,
+        "study_tables": len(cfg["objects"]) * n_poses * n_sets,
+        "grasp_realism": len(cfg["objects"]) * n_poses * n_sets,
     }.get(step, 0)
 
 
+def _job_config(wildcards):
+    """The configuration of the job's scenario (the default for the jobs outside any root)."""
+    return scenario_config(wildcards) if "root" in wildcards.keys() else STUDY
+
+
 def runtime_min(step):
-    """Wall-time request of one job of rule ``step``, in whole minutes (at least 1)."""
-    cost = JOB_COST[step]
-    seconds = cost["fixed_s"] + cost["unit_s"] * job_size(step)
-    if step == "optimise_shard":
-        seconds += SOLVER_COMPILE_S
-    return max(1, math.ceil(RUNTIME_MARGIN * seconds / 60.0))
+    """Wall-time request of one job of rule ``step`` in its scenario, in whole minutes (at least 1)."""
+
+    def request(wildcards):
+        cost = JOB_COST[step]
+        seconds = cost["fixed_s"] + cost["unit_s"] * job_size(step, _job_config(wildcards))
+        if step == "optimise_shard":
+            seconds += SOLVER_COMPILE_S
+        return max(1, math.ceil(RUNTIME_MARGIN * seconds / 60.0))
+
+    return request
 
 
 def mem_mb(step):
-    """Memory request of one job of rule ``step``, in MB rounded up to 100 MB."""
-    cost = JOB_COST[step]
-    mb = cost["fixed_mb"] + cost["unit_mb"] * job_size(step)
-    if step == "optimise_shard":
-        mb += SOLVER_COMPILE_MB
-    return 100 * math.ceil(MEMORY_MARGIN * mb / 100.0)
+    """Memory request of one job of rule ``step`` in its scenario, in MB rounded up to 100 MB."""
+
+    def request(wildcards):
+        cost = JOB_COST[step]
+        mb = cost["fixed_mb"] + cost["unit_mb"] * job_size(step, _job_config(wildcards))
+        if step == "optimise_shard":
+            mb += SOLVER_COMPILE_MB
+        return 100 * math.ceil(MEMORY_MARGIN * mb / 100.0)
+
+    return request
 
 
 # Jobs of a few seconds and a few hundred MB for the default study run where Snakemake runs:
