@@ -92,11 +92,14 @@ SOLVER_COMPILE_S, SOLVER_COMPILE_MB = 60.0, 150
 # rounded up to whole minutes and to 100 MB.
 RUNTIME_MARGIN, MEMORY_MARGIN = 3.0, 1.5
 
+
 def job_size(step, cfg):
     """Units of work of one job of rule ``step`` under the scenario configuration ``cfg``
     (see JOB_COST): the closure's cost follows the scenario's grid and closure model, the
     optimisation's its grid, synergy sets and shards."""
-    n_poses = len(grid_axis_deg(cfg["grid"]["alpha_deg"])) * len(grid_axis_deg(cfg["grid"]["beta_deg"]))
+    n_poses = len(grid_axis_deg(cfg["grid"]["alpha_deg"])) * len(
+        grid_axis_deg(cfg["grid"]["beta_deg"])
+    )
     n_sets = len(synergy_sets(cfg["synergy_sets"]))
     factor = CLOSURE_COST_FACTOR.get(cfg["closure"]["model"], CLOSURE_UNMEASURED_FACTOR)
     return {
