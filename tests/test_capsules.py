@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from synergrasp.hand.kinematics import forward_kinematics
+from synergrasp.hand.kinematics import forward_kinematics, load_hand
 from synergrasp.simulation.capsules import HandCapsules, segment_box_distance, segment_segment_distance
 
 RNG = np.random.default_rng(7)
@@ -58,3 +58,16 @@ def test_capsule_segments_follow_the_hands_forward_kinematics(hand):
             half = 0.5 * shape.length * pose[:3, 2]
             np.testing.assert_allclose(p0[row], pose[:3, 3] - half, atol=1e-9)
             np.testing.assert_allclose(p1[row], pose[:3, 3] + half, atol=1e-9)
+
+
+def test_the_hand_encloses_its_palm_not_points_far_in_front_or_beside_it():
+    """Open hand (every joint at its lower limit, fingers straight along palm z): the palm box's
+    centre is inside; a point 60 mm in front of the palm face, or 100 mm beside the little
+    finger, is outside."""
+    hand = load_hand()
+    caps = HandCapsules.of(hand)
+    open_q = np.asarray(hand.lower, dtype=float)
+    palm = caps.palm_centre[0]
+    assert caps.encloses(open_q, palm)
+    assert not caps.encloses(open_q, palm + [60.0 + caps.palm_half[0][0], 0.0, 0.0])
+    assert not caps.encloses(open_q, palm + [0.0, -100.0 - caps.palm_half[0][1], 0.0])

@@ -11,6 +11,7 @@ import pytest
 from conftest import study_closure_params, study_dynamic_params, study_placement
 from synergrasp.config import ConfigError, defaults, step_params, validate_config
 from synergrasp.hand.synergies import Synergies, SynergyPath
+from synergrasp.simulation.capsules import HandCapsules
 from synergrasp.simulation.closure import closure_model, simulate_object
 from synergrasp.simulation.dynamic_closure import DynamicParams
 from synergrasp.simulation.objects import Box
@@ -185,7 +186,21 @@ def test_a_box_pushed_out_of_the_hand_is_lost(hand, synergies):
     assert (row["alpha_deg"], row["beta_deg"]) == (-180.0, -40.0)
     assert row["status"] == "lost" and row["n_contacts"] == 0
     assert np.linalg.norm(row["object_translation_mm"]) > 10.0
+    assert not HandCapsules.of(hand).encloses(np.asarray(row["q"]), np.asarray(row["object_center"]))
     assert np.allclose(row["object_center"], np.asarray(placement.center_mm) + row["object_translation_mm"])
+
+
+def test_a_box_moved_but_left_inside_the_closed_hand_is_caged(hand, synergies):
+    """obj1 (30 mm cube, approach placement) at α = −180°, β = −60°: the closing fingers push it
+    toward the wrist and close past it; nothing touches it at the end, and its centre is inside
+    the closed hand's hull, so it is caged, not lost."""
+    config = {**defaults(), "closure": {**defaults()["closure"], "model": "dynamic"}}
+    sim = step_params(config, "simulate", "obj1")
+    row = simulate_object(hand, synergies, sim.box, sim.placement, sim.closure, poses=[0],
+                          mechanics=sim.mechanics).iloc[0]
+    assert row["status"] == "caged" and row["n_contacts"] == 0
+    assert np.linalg.norm(row["object_translation_mm"]) > sim.closure.dynamic.lost_distance_mm
+    assert HandCapsules.of(hand).encloses(np.asarray(row["q"]), np.asarray(row["object_center"]))
 
 
 def test_thumb_index_pinch_of_a_small_box_settles_with_a_near_zero_net_wrench(hand, synergies):

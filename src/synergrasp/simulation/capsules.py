@@ -346,3 +346,18 @@ class HandCapsules:
     def segments(self, q: NDArray) -> tuple[NDArray, NDArray]:
         """Axis end points (c, 3) and (c, 3) of every capsule in the palm frame at q (rad)."""
         return _segments(_frames(np.asarray(q, dtype=float), *self.tree), self.frame, self.ends)
+
+    def encloses(self, q: NDArray, point_mm: NDArray) -> bool:
+        """Whether ``point_mm`` (palm frame) lies inside the hand at q (rad): within the convex
+        hull of the hand's volume, the capsules (each axis end point widened by its radius in
+        14 directions, a polyhedron inside the sphere) and the palm boxes' corners."""
+        from scipy.spatial import Delaunay
+
+        p0, p1 = self.segments(q)
+        cube = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+        directions = np.vstack([np.eye(3), -np.eye(3), cube / np.sqrt(3.0)])
+        widened = (np.vstack([p0, p1])[:, None, :]
+                   + np.concatenate([self.radius, self.radius])[:, None, None] * directions[None]).reshape(-1, 3)
+        corners = [c + (cube * h) @ r.T for r, c, h in zip(self.palm_rotation, self.palm_centre, self.palm_half)]
+        hull = Delaunay(np.vstack([widened, *corners]))
+        return bool(hull.find_simplex(np.asarray(point_mm, dtype=float)) >= 0)

@@ -37,12 +37,14 @@ __all__ = [
     "load_carrying_contacts",
 ]
 
-STATUSES: tuple[str, ...] = ("grasp", "intersects_open_hand", "no_contact", "lost")
+STATUSES: tuple[str, ...] = ("grasp", "intersects_open_hand", "no_contact", "caged", "lost")
 """``grasp``: the closure ran and at least one link touches the box; ``intersects_open_hand``:
 the box overlaps the open hand (only the ``fixed`` placement can give it); ``no_contact``:
 the closure ran, nothing touches the box (or, once the unloaded contacts are dropped, nothing
-that touches it carries load); ``lost`` (dynamic model only): the closing hand
-pushed the free box out of reach."""
+that touches it carries load); ``caged`` and ``lost`` (dynamic model only): the closing hand
+moved the free box and nothing touches it at the end; ``caged``: its centre is inside the
+closed hand (the convex hull of the hand's links, ``HandCapsules.encloses``), loose in the
+fist; ``lost``: pushed out of the hand."""
 
 FINGER_STATES: tuple[str, ...] = ("contact", "limit", "self")
 """How a finger ended: ``contact`` (one of its links touches the box), ``self`` (stopped by

@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from synergrasp.hand.synergies import SynergyPath
+from synergrasp.simulation.capsules import HandCapsules
 from synergrasp.simulation.contacts import ClosureResult
 from synergrasp.simulation.placement import ObjectPose
 
@@ -73,7 +74,9 @@ class DynamicParams:
     gravity:               the box's weight acts during the closure (along
                            mechanics.gravity_direction) if true.
     lost_distance_mm:      a box with no contact at the end that moved farther than this from
-                           its initial pose was pushed out of the hand: status ``lost``.
+                           its initial pose was moved by the hand and is held by nothing:
+                           ``caged`` if its centre is inside the closed hand
+                           (``HandCapsules.encloses``), ``lost`` (pushed out) if not.
 
     Every hand link touching the box is listed with the normal force it carries; which of
     them count (``closure.dynamic.unloaded_contacts``) is decided downstream
@@ -171,6 +174,7 @@ class DynamicClosure:
         self.axis_sum[self.axis_joint, np.arange(len(self.axis_joint))] = 1.0
         self.q_open = self.path.reference(self.sigma_open)
         self.self_pairs = self._colliding_pairs()
+        self.capsules = HandCapsules.of(hand)
         self.box: int | None = None
         self.box_size: NDArray | None = None
 
@@ -294,5 +298,7 @@ class DynamicClosure:
         if links:
             return self._result("grasp", q, state, now, settled, links, points, normals, loads, max(depth, 0.0))
         moved = float(np.linalg.norm(center - placed.center_mm))
-        status = "lost" if not touching and moved > p.lost_distance_mm else "no_contact"
+        status = "no_contact"
+        if moved > p.lost_distance_mm:  # moved by the hand, held by nothing: still inside it, or out
+            status = "caged" if self.capsules.encloses(q, center) else "lost"
         return self._result(status, q, state, now, settled)
