@@ -5,7 +5,7 @@ Realistic study mix: random grasps with 4-12 contacts (some on the palm) x the 7
 sets of the study (15 incremental + subsets of 1-3 of S1..S7). The "ipm" figure is the
 study's loop (`study.optimise_grasps`, GFO only): mechanics, bases, rows and solves,
 measured after one warm-up call that loads the compiled kernel (its one-time cost per
-process is printed separately). Run on one core with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1. The last two
+process is printed separately), median of 5 runs (`--repeats`). Run on one core with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1. The last two
 lines are machine-read.
 """
 
@@ -38,6 +38,7 @@ def main() -> None:
     ap.add_argument("--exact", type=int, default=1500, help="problems for the per-problem exact solver")
     ap.add_argument("--cvxpy", type=int, default=60, help="problems for the cvxpy loop")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--repeats", type=int, default=5, help="runs of the study loop; the median is reported")
     args = ap.parse_args()
 
     rng = np.random.default_rng(args.seed)
@@ -52,9 +53,13 @@ def main() -> None:
     t0 = time.perf_counter()
     optimise_grasps(grasps[:1], SynergySets(synergies.matrix, tuple(sets[:1])), params, strict=False)  # loads the kernel
     t_load = time.perf_counter() - t0
-    t0, c0 = time.perf_counter(), time.process_time()
-    out = optimise_grasps(grasps, synergies, params, strict=False)
-    t_ipm, c_ipm = time.perf_counter() - t0, time.process_time() - c0
+    walls, cpus = [], []
+    for _ in range(args.repeats):
+        t0, c0 = time.perf_counter(), time.process_time()
+        out = optimise_grasps(grasps, synergies, params, strict=False)
+        walls.append(time.perf_counter() - t0)
+        cpus.append(time.process_time() - c0)
+    t_ipm, c_ipm = float(np.median(walls)), float(np.median(cpus))
     ipm_rate = n / t_ipm
     fallback = float(np.mean(out["solver"] == "clarabel_fallback"))
 
@@ -82,7 +87,8 @@ def main() -> None:
     print(f"problems: {n} ({n_poses} grasps x {len(sets)} sets), statuses {statuses}")
     print(f"mean interior-point iterations: {out['iterations'][out['solver'] == 'ipm'].mean():.2f}")
     print(f"compiled kernel load (once per process): {t_load:.2f} s")
-    print(f"ipm (incl. mechanics and building): {ipm_rate:.0f} solves/s ({t_ipm:.2f} s);"
+    print(f"ipm (incl. mechanics and building, median of {args.repeats} runs): {ipm_rate:.0f} solves/s ({t_ipm:.2f} s;"
+          f" runs {min(walls):.2f}-{max(walls):.2f} s);"
           f" with the load: {n / (t_ipm + t_load):.0f} solves/s")
     print(f"ipm per CPU second (time.process_time, steadier on a loaded machine): {n / c_ipm:.0f} solves/s")
     print(f"per-problem exact (Clarabel, {min(args.exact, n)} problems): {exact_rate:.0f} solves/s")

@@ -9,7 +9,7 @@ from conftest import BAND
 
 from synergrasp.optimisation.cones import CircularCone
 from synergrasp.optimisation.gfo import solve_gfo
-from synergrasp.optimisation.ipm_kernel import IPMSettings
+from synergrasp.optimisation.ipm_kernel import IPMSettings, _range_basis
 from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_basis, object_wrench
 from synergrasp.optimisation.problem import GFOProblem, GraspSets, SynergySets
 from synergrasp.optimisation.problems import random_gfo_problems, random_grasp, random_synergies, random_unit_vector
@@ -106,16 +106,23 @@ def test_hand_derivable_problem():
     # An internal force that loads only the first contact leaves n.f = 0 < f_min at the second.
     sol = solve_gfo([GFOProblem(np.zeros(6), np.eye(6)[:, :1], normals, 0.5, CircularCone(1.0))])
     assert sol.status[0] == "infeasible" and sol.forces[0] is None
+    # Its certificate is exact (the second contact's normal row: G^T z = 0, h^T z = -f_min):
+    # the dual start point moved onto G^T z = 0 proves it before any Newton step.
+    assert sol.iterations[0] == 0
 
 
 def test_fallback_path_when_the_iteration_cap_is_tiny():
     problems = _study_sized_problems(40, seed=5)
     sol = solve_gfo(problems, ipm=IPMSettings(max_iter=2), strict_shrink=1e-5)
     ref = solve_gfo(problems, "clarabel", strict_shrink=1e-5)
-    assert np.all(sol.solver == "clarabel_fallback")
+    # Two iterations decide no feasible problem (an optimum needs more); an infeasible one
+    # may already be proved by a certificate. What the kernel leaves open is Clarabel's.
+    fallback = sol.solver == "clarabel_fallback"
+    assert np.all(fallback[ref.force_closure]) and fallback.sum() >= 10
+    assert np.all(sol.status[~fallback] == "infeasible")
     np.testing.assert_array_equal(sol.status, ref.status)
     np.testing.assert_array_equal(sol.strict_internal, ref.strict_internal)
-    np.testing.assert_array_equal(sol.iterations, ref.iterations)
+    np.testing.assert_array_equal(sol.iterations[fallback], ref.iterations[fallback])
     fc = ref.force_closure
     np.testing.assert_allclose(sol.force_norm[fc], ref.force_norm[fc], rtol=1e-12)
 
@@ -162,3 +169,28 @@ def test_bad_settings_name_the_field():
         IPMSettings(retry_refine=-1)
     with pytest.raises(ValueError, match="strict_shrink"):
         solve_gfo([], strict_shrink=1.5)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_range_basis_against_lapack_svd(seed):
+    # F = Q1 diag(sv) Q2^T with singular values from 10 down to 1e-14 (some below the
+    # threshold 1e-9), columns picked out of a wider matrix as a synergy set does.
+    rng = np.random.default_rng(seed)
+    c, s = 3 * int(rng.integers(2, 13)), int(rng.integers(1, 16))
+    s = min(s, c)
+    sv = 10.0 ** rng.uniform(-14, 1, size=s)
+    Q1 = np.linalg.qr(rng.normal(size=(c, s)))[0]
+    Q2 = np.linalg.qr(rng.normal(size=(s, s)))[0]
+    F = (Q1 * sv) @ Q2.T
+    cols = rng.permutation(s + 3)[:s]
+    F_all = rng.normal(size=(c, s + 3))
+    F_all[:, cols] = F
+    U = np.full((c, 16), np.nan)
+    rank = _range_basis(F_all, cols, s, 1e-9, U)
+    lapack = np.linalg.svd(F, compute_uv=False)
+    assert rank == int(np.sum(lapack > 1e-9))
+    E = U[:, :rank]
+    np.testing.assert_allclose(E.T @ E, np.eye(rank), atol=1e-13)
+    # the kept directions span F up to the dropped singular values
+    dropped = lapack[lapack <= 1e-9].max(initial=0.0)
+    assert np.linalg.norm(F - E @ (E.T @ F), 2) <= dropped + 1e-13 * lapack[0]

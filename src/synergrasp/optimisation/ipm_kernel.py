@@ -116,6 +116,7 @@ _Work = namedtuple("_Work", [
     "r_x", "r_z", "x1", "z1", "x2", "z2", "bx", "q", "dsv",  # residuals and right-hand sides
     "dx", "dz", "ds", "dx_a", "dz_a", "ds_a",                # corrector and predictor directions
     "wn", "wn2", "ex", "wN", "wN2", "wN3", "ez",             # scratch of the linear solves
+    "R_rows",                                 # Cholesky factor of A^T A, A the constraint rows
 ])
 
 #: The homogenising pair (tau, kappa), the tau-row residual and c^T x1 + h^T z1 of the tau
@@ -135,7 +136,8 @@ def _workspace(m, q, nl, e_max):
                  np.empty(n), np.empty(N), np.empty(n), np.empty(N), np.empty(n), np.empty(N), np.empty(n),
                  np.empty(N), np.empty(N),
                  np.empty(n), np.empty(N), np.empty(N), np.empty(n), np.empty(N), np.empty(N),
-                 np.empty(n), np.empty(n), np.empty(n), np.empty(N), np.empty(N), np.empty(N), np.empty(N))
+                 np.empty(n), np.empty(n), np.empty(n), np.empty(N), np.empty(N), np.empty(N), np.empty(N),
+                 np.empty((n, n)))
 
 
 # --------------------------------------------------------------------------- cone algebra
@@ -267,19 +269,25 @@ def _G_mul(P, x, out):
 
 
 @_jit_small
+def _rows_T_col(P, z, j):
+    """Entry j of A^T z for the constraint rows A = D, DL of y (G is -A on them)."""
+    D, DL, q, L = P.D, P.DL, P.q, P.L
+    acc = 0.0
+    for i in range(q):
+        c = L + 3 * i
+        acc += D[i, 0, j] * (z[c] + z[i]) + D[i, 1, j] * z[c + 1] + D[i, 2, j] * z[c + 2]
+    for k in range(P.nl):
+        acc += DL[k, j] * z[q + k]
+    return acc
+
+
+@_jit_small
 def _GT_mul(P, z, out):
     """out = G^T z."""
-    D, DL, q, L, e = P.D, P.DL, P.q, P.L, P.e
-    o = L + 3 * q
+    o = P.L + 3 * P.q
     out[0] = -z[o]
-    for j in range(e):
-        acc = 0.0
-        for i in range(q):
-            c = L + 3 * i
-            acc += D[i, 0, j] * (z[c] + z[i]) + D[i, 1, j] * z[c + 1] + D[i, 2, j] * z[c + 2]
-        for k in range(P.nl):
-            acc += DL[k, j] * z[q + k]
-        out[1 + j] = -z[o + 2 + j] - acc
+    for j in range(P.e):
+        out[1 + j] = -z[o + 2 + j] - _rows_T_col(P, z, j)
 
 
 @_jit_small
@@ -524,6 +532,66 @@ def _is_certificate(hz, gtz_norm, eps):
 
 
 @_jit_small
+def _factor_rows(P, W):
+    """W.R_rows: Cholesky factor of A^T A (e, e) for the constraint rows A = D, DL of y (a
+    contact's linear row is its D row 0, hence the 2). Scratch: W.M (refilled by `_scaling`)."""
+    D, DL, A = P.D, P.DL, W.M
+    for j in range(P.e):
+        for l in range(j + 1):
+            acc = 0.0
+            for i in range(P.q):
+                acc += 2.0 * D[i, 0, j] * D[i, 0, l] + D[i, 1, j] * D[i, 1, l] + D[i, 2, j] * D[i, 2, l]
+            for k in range(P.nl):
+                acc += DL[k, j] * DL[k, l]
+            A[j, l] = acc
+    _cholesky(A, W.R_rows, P.e)
+
+
+@_jit_small
+def _polished_certificate(P, W, eps):
+    """Whether the dual iterate's constraint part, moved to the nearest point (Euclidean)
+    with G^T z = 0 and its objective part set to 0, is a Farkas certificate: inside the
+    cones, h^T z < 0 and ||G^T z|| <= eps |h^T z| recomputed on the moved point. Such a
+    point proves infeasibility on its own (z^T s = h^T z < 0 for every s = h - G x is
+    impossible with z and s in the self-dual cones), so the iteration can stop as soon as
+    the dual iterate is that close to one instead of when the homogeneous iterate has
+    converged. Needs `_factor_rows`; scratch: W.wn, W.ex, W.wN2."""
+    q, L, e, D, DL, z = P.q, P.L, P.e, P.D, P.DL, W.z
+    g, u, zc = W.wn, W.ex, W.wN2
+    for j in range(e):
+        g[j] = _rows_T_col(P, z, j)
+    _cho_solve(W.R_rows, e, g, u)
+    # z_c = z - A u on the constraint rows; the cone test as it goes
+    for i in range(q):
+        c = L + 3 * i
+        for r in range(3):
+            acc = 0.0
+            for j in range(e):
+                acc += D[i, r, j] * u[j]
+            zc[c + r] = z[c + r] - acc
+        zc[i] = z[i] - (z[c] - zc[c])  # the linear row is the Coulomb cone's first row
+        if zc[i] < 0.0 or zc[c] < math.sqrt(zc[c + 1] * zc[c + 1] + zc[c + 2] * zc[c + 2]):
+            return False
+    for k in range(P.nl):
+        acc = 0.0
+        for j in range(e):
+            acc += DL[k, j] * u[j]
+        zc[q + k] = z[q + k] - acc
+        if zc[q + k] < 0.0:
+            return False
+    hz = 0.0
+    for k in range(L + 3 * q):
+        hz += W.h[k] * zc[k]
+    if not hz < 0.0:
+        return False
+    gtz = 0.0
+    for j in range(e):
+        acc = _rows_T_col(P, zc, j)
+        gtz += acc * acc
+    return _is_certificate(hz, math.sqrt(gtz), eps)
+
+
+@_jit_small
 def _start(P, W):
     """Scaled h (the data divided by rho = max(||f_p||, f_min), so that the forces are O(1)
     and the iteration starts well centred) and the initial point; returns (rho, h_norm)."""
@@ -575,6 +643,7 @@ def _hsde(P, W, opt, refine, y):
     kappa = 1.0
     r_x, r_z, dsv = W.r_x, W.r_z, W.dsv
     stalled = False
+    rows_factored = False
 
     for it in range(opt.max_iter + 1):
         _GT_mul(P, z, r_x)
@@ -605,6 +674,11 @@ def _hsde(P, W, opt, refine, y):
         last = it == opt.max_iter or stalled
         optimal = _is_optimal(pres, dres, gap, pcost, opt.tol)
         infeasible = not optimal and _is_certificate(hz, gtz_norm, opt.tol)
+        if not (optimal or infeasible) and hz < 0.0:
+            if not rows_factored:
+                _factor_rows(P, W)
+                rows_factored = True
+            infeasible = _polished_certificate(P, W, opt.tol)
         if last:
             optimal = optimal or _is_optimal(pres, dres, gap, pcost, opt.reduced_tol)
             infeasible = infeasible or (not optimal and _is_certificate(hz, gtz_norm, opt.reduced_tol))
@@ -778,10 +852,61 @@ def _solve_single(frames, cone, E, fp, f_min, opt, y):
     return code, norm, it
 
 
+@_jit
+def _range_basis(F_all, cols, s, threshold, U):
+    """E_s of one set: an orthonormal basis of the range of F = F_all[:, cols[:s]] from its
+    singular vectors whose singular value exceeds `threshold` (the rule of
+    `mechanics.internal_force_basis`), written into the leading columns of U; returns their
+    number. One-sided Jacobi (Hestenes): plane rotations of pairs of F's columns until every
+    pair is orthogonal to ~1e-15 relative; the columns are then U Sigma, and their norms the
+    singular values, to high relative accuracy. Sets hold 1 to 15 synergies, so this is a
+    few sweeps of short loops, without LAPACK's copies, workspace query and allocations."""
+    c = F_all.shape[0]
+    for q in range(s):
+        for k in range(c):
+            U[k, q] = F_all[k, cols[q]]
+    tol = 1e-15 * c
+    for _ in range(60):
+        rotated = False
+        for a in range(s - 1):
+            for b in range(a + 1, s):
+                alpha = 0.0
+                beta = 0.0
+                gamma = 0.0
+                for k in range(c):
+                    alpha += U[k, a] * U[k, a]
+                    beta += U[k, b] * U[k, b]
+                    gamma += U[k, a] * U[k, b]
+                if abs(gamma) <= tol * math.sqrt(alpha * beta):
+                    continue
+                rotated = True
+                zeta = (beta - alpha) / (2.0 * gamma)
+                t = math.copysign(1.0, zeta) / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
+                cs = 1.0 / math.sqrt(1.0 + t * t)
+                sn = cs * t
+                for k in range(c):
+                    ua, ub = U[k, a], U[k, b]
+                    U[k, a] = cs * ua - sn * ub
+                    U[k, b] = sn * ua + cs * ub
+        if not rotated:
+            break
+    rank = 0
+    for q in range(s):
+        norm = 0.0
+        for k in range(c):
+            norm += U[k, q] * U[k, q]
+        norm = math.sqrt(norm)
+        if norm > threshold:
+            for k in range(c):
+                U[k, rank] = U[k, q] / norm
+            rank += 1
+    return rank
+
+
 @_jit_alloc
 def _solve_sets(F_all, fp, frames, cols, n_cols, thresholds, cone, cone_strict, f_min, strict, opt, out):
-    """Every synergy set of one grasp into `out` (`SetsResult`): E_s from the SVD of
-    F_s = F_all[:, set] (columns with a singular value above the set's threshold), then the
+    """Every synergy set of one grasp into `out` (`SetsResult`): E_s from the singular vectors
+    of F_s = F_all[:, set] whose singular value is above the set's threshold (`_range_basis`), then the
     GFO, its forces f_p + E_s y (N) and, if `strict`, the strict internal-force test
     (f_p = 0, f_min = 1 N, cone_strict). cone, cone_strict: `_ConeData` of the same kind.
     Sets with e_s = 0 get code NOT_SOLVED."""
@@ -794,16 +919,9 @@ def _solve_sets(F_all, fp, frames, cols, n_cols, thresholds, cone, cone_strict, 
     zero = np.zeros(c)
     W = _workspace(m, m if p == 0 else 0, m * p, cols.shape[1])
     y = np.empty(cols.shape[1])
+    U = np.empty((c, cols.shape[1]))
     for j in range(cols.shape[0]):
-        s = n_cols[j]
-        F = np.empty((c, s))
-        for q in range(s):
-            F[:, q] = F_all[:, cols[j, q]]
-        U, sv, _ = np.linalg.svd(F, full_matrices=False)
-        rank = 0
-        for q in range(sv.size):
-            if sv[q] > thresholds[j]:
-                rank += 1
+        rank = _range_basis(F_all, cols[j], n_cols[j], thresholds[j], U)
         out.e_s[j] = rank
         if rank == 0:
             out.code[j] = NOT_SOLVED
