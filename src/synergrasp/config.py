@@ -416,7 +416,8 @@ STEP_KEYS: dict[str, tuple[str, ...]] = {
     "minima": ("analyses.minima_radius_deg", "analyses.success"),
     "tables": ("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max", "analyses.success",
                "analyses.marginal_weight_multiple", "analyses.success_rate_tolerance_percent",
-               "analyses.null_model", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
+               "analyses.null_model", "analyses.headline_view", "analyses.tie_band", "analyses.min_distinct_poses",
+               "analyses.bootstrap", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
     "realism": ("hand", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2"),
     "fig1": ("hand", "synergies"),
     "fig2": ("hand", "objects.*.size_mm"),
@@ -429,6 +430,8 @@ STEP_KEYS: dict[str, tuple[str, ...]] = {
 }
 #: The keys of the choice of which contacts count (the ``contacts`` step).
 _CONTACT_SELECTION = ("closure.dynamic.unloaded_contacts", "closure.dynamic.load_threshold_N")
+#: The keys of the force bound of ``analyses.success: force_closure_bounded``.
+_FORCE_BOUND = ("analyses.marginal_weight_multiple", "objects.{object}.mass_kg", "mechanics.g_m_per_s2")
 #: Keys a step reads only when another key has a given value: step -> ((key, value, reads), ...).
 STEP_KEYS_WHEN: dict[str, tuple[tuple[str, Any, tuple[str, ...]], ...]] = {
     # the dynamic closure: a free box of the object's mass, μ, k_ss and gravity of mechanics
@@ -436,6 +439,9 @@ STEP_KEYS_WHEN: dict[str, tuple[tuple[str, Any, tuple[str, ...]], ...]] = {
     # which contacts count: only the dynamic model records the load each contact carries
     "contacts": (("closure.model", "dynamic", _CONTACT_SELECTION),),
     "realism": (("closure.model", "dynamic", ("closure.dynamic.load_threshold_N",)),),
+    # force closure within a multiple of the weight: the minima and Fig. 4 read the bound
+    "minima": (("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
+    "fig4": (("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
 }
 #: Keys inside a block a step reads that the step itself does not read: step -> key paths.
 #: The closure lists every touching link with its load; which of them count is the
@@ -604,9 +610,21 @@ class OptimiseParams:
 
 @dataclass(frozen=True)
 class MinimaParams:
-    """Local minima of one object: neighbourhood radius (deg) and the success verdict."""
+    """Local minima of one object: neighbourhood radius (deg), the success verdict and, for
+    ``force_closure_bounded``, the object's weight (N) and the bound's multiple of it."""
     radius_deg: float
     success: str
+    weight_N: float | None = None
+    bound_multiple: float = math.inf
+
+
+def _force_bound(config: Mapping[str, Any], obj: str | None) -> dict[str, Any]:
+    """weight_N and bound_multiple of ``obj`` where the verdict is force_closure_bounded."""
+    analyses = config["analyses"]
+    if analyses["success"] != "force_closure_bounded":
+        return {}
+    weight = float(config["objects"][obj]["mass_kg"]) * float(config["mechanics"]["g_m_per_s2"])
+    return {"weight_N": weight, "bound_multiple": float(analyses["marginal_weight_multiple"])}
 
 
 @dataclass(frozen=True)
@@ -646,6 +664,8 @@ class FiguresParams:
     fig4_alpha_slice_deg: float = math.nan
     fig4_beta_slice_deg: float = math.nan
     hierarchy_first: int = 0
+    weight_N: float | None = None
+    bound_multiple: float = math.inf
 
 
 #: Modules holding the typed parameter classes a step's parameters are built from (the
@@ -752,7 +772,7 @@ def _tables(config: Mapping[str, Any]) -> TablesParams:
     return TablesParams(dict(config["synergy_sets"]), int(analyses["table2_k_max"]), settings)
 
 
-def _figures(config: Mapping[str, Any], step: str) -> FiguresParams:
+def _figures(config: Mapping[str, Any], step: str, obj: str | None = None) -> FiguresParams:
     if step == "fig1":
         return FiguresParams(hand=config["hand"], synergies=config["synergies"])
     if step == "fig2":
@@ -761,7 +781,8 @@ def _figures(config: Mapping[str, Any], step: str) -> FiguresParams:
     if step == "fig4":
         fig4 = config["analyses"]["fig4"]
         return FiguresParams(success=success, fig4_panel_k=tuple(fig4["panel_k"]),
-                             fig4_alpha_slice_deg=fig4["alpha_slice_deg"], fig4_beta_slice_deg=fig4["beta_slice_deg"])
+                             fig4_alpha_slice_deg=fig4["alpha_slice_deg"], fig4_beta_slice_deg=fig4["beta_slice_deg"],
+                             **_force_bound(config, obj))
     return FiguresParams(success=success, hierarchy_first=config["synergy_sets"]["hierarchy_first"])
 
 
@@ -788,7 +809,8 @@ def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) ->
     if step == "optimise":
         return _optimise(config, obj)
     if step == "minima":
-        return MinimaParams(float(config["analyses"]["minima_radius_deg"]), config["analyses"]["success"])
+        return MinimaParams(float(config["analyses"]["minima_radius_deg"]), config["analyses"]["success"],
+                            **_force_bound(config, obj))
     if step == "tables":
         return _tables(config)
     if step == "realism":
@@ -797,7 +819,7 @@ def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) ->
                              {name: spec["mass_kg"] * g for name, spec in config["objects"].items()},
                              config.get("closure", {}).get("dynamic", {}).get("load_threshold_N"))
     if step in ("fig1", "fig2", "fig4", "fig5"):
-        return _figures(config, step)
+        return _figures(config, step, obj)
     raise ValueError(f"unknown step {step!r}; allowed values: {sorted(STEP_KEYS)}")
 
 
