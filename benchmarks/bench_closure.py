@@ -28,9 +28,11 @@ from synergrasp.simulation.scene import HandScene  # noqa: E402
 
 
 def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_median_ms") -> None:
-    """The study's boxes, placements and closure settings (the configuration's defaults),
+    """The study's boxes and closure settings (the configuration's defaults), each box placed
+    by the approach preset (the palm centre; a searched target needs the search's output),
     closed by ``model``."""
-    study = validate_config({**defaults(), "closure": {**defaults()["closure"], "model": model}})
+    study = validate_config({**defaults(), "closure": {**defaults()["closure"], "model": model},
+                             "placement": {**defaults()["placement"], "mode": "approach"}})
     hand = load_hand()
     synergies = load_synergies(None, joint_names=hand.joint_names)
     first = step_params(study, "simulate", next(iter(study["objects"])))

@@ -33,9 +33,10 @@ def study_gfo_params(**changes):
 
 
 def study_placement(obj="obj1", **changes):
-    """The study's placement of ``obj`` with its pose grid (the configuration's defaults),
+    """The study's placement of ``obj`` with its pose grid (the configuration's defaults) in
+    its ``approach`` preset (the palm centre: a searched target needs the search's output),
     with ``changes`` replacing fields."""
-    return replace(step_params(defaults(), "simulate", obj).placement, **changes)
+    return replace(step_params(defaults(), "simulate", obj).placement, **{"mode": "approach", **changes})
 
 
 def study_dynamic_params(**changes):

@@ -130,3 +130,23 @@ def test_figures_are_written_and_the_same_on_rerun(hand, synergies, tmp_path):
             first = (tmp_path / f"{name}a.{ext}").read_bytes()
             assert len(first) > 10_000, (name, ext)
             assert first == (tmp_path / f"{name}b.{ext}").read_bytes(), (name, ext)
+
+
+def test_placement_map_is_written_and_the_same_on_rerun(hand, synergies, tmp_path):
+    from synergrasp.figures.placement_map import figure_placement_map
+    from synergrasp.simulation.objects import Box
+
+    box = Box("cube", (30.0, 30.0, 30.0), 1.0)
+    targets = [(9.5, y, z) for y in (-10.0, 10.0) for z in (60.0, 80.0)] + [(19.5, -10.0, 60.0)]
+    placement = pd.DataFrame({"object": "cube", "rank": range(1, 6), "chosen": [True] + [False] * 4,
+                              "distinct_rank": range(1, 6), "x_mm": [t[0] for t in targets],
+                              "y_mm": [t[1] for t in targets], "z_mm": [t[2] for t in targets], "round": 0,
+                              "n_poses": 27, "force_closure_percent": [90.0, 80.0, 50.0, 0.0, 90.0],
+                              "median_force_per_weight": [1.0, 2.0, 3.0, float("inf"), 1.0],
+                              "median_contacts": 4.0, "distance_to_chosen_mm": 0.0})
+    for run in ("a", "b"):
+        figure_placement_map(hand, box, placement, _one_grasp_table(hand, synergies), 10.0,
+                             tmp_path / f"m{run}.png", tmp_path / f"m{run}.pdf")
+    for ext in ("png", "pdf"):
+        first = (tmp_path / f"ma.{ext}").read_bytes()
+        assert len(first) > 10_000 and first == (tmp_path / f"mb.{ext}").read_bytes(), ext

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "PLACEMENT", "write", "read", "empty",
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "PLACEMENT", "write", "read", "write_csv", "read_csv", "empty",
            "write_study_table"]
 
 
@@ -187,6 +187,19 @@ def write(table: Table, frame: pd.DataFrame, path: str | Path) -> None:
 def read(table: Table, path: str | Path) -> pd.DataFrame:
     """Read a Parquet table and check it holds the contract's columns."""
     frame = pd.read_parquet(path)
+    _check(table, frame, str(path))
+    return frame
+
+
+def write_csv(table: Table, frame: pd.DataFrame, path: str | Path) -> None:
+    """Write ``frame`` as CSV (full precision) with exactly the contract's columns and order."""
+    _check(table, frame, str(path))
+    frame[list(table.names)].to_csv(path, index=False)
+
+
+def read_csv(table: Table, path: str | Path) -> pd.DataFrame:
+    """Read a CSV table and check it holds the contract's columns."""
+    frame = pd.read_csv(path)
     _check(table, frame, str(path))
     return frame
 

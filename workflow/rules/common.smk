@@ -10,10 +10,12 @@ from snakemake.exceptions import WorkflowError
 from synergrasp.config import (
     ConfigError,
     check_relations,
+    overlay,
     scenario_configs,
     step_config,
     step_hash,
     step_params,
+    step_upstream_when,
     synergy_problems,
 )
 
@@ -61,6 +63,7 @@ _ROOT_SCENARIO = {root: name for name, root in SCENARIO_ROOT.items()}
 #: contacts (every touching link), the contacts that count (only where unloaded ones are
 #: dropped: the `contacts` step), the optimisation and the minima.
 STEP_FILES = {
+    "search": "placement.csv",
     "simulate": "contacts.parquet",
     "contacts": "load_carrying_contacts.parquet",
     "optimise": "gfo.parquet",
@@ -97,6 +100,22 @@ def step_file(scenario, step, obj):
     if step == "contacts" and not drops_unloaded(scenario, obj):
         step = "simulate"
     return f"{step_root(scenario, step, obj)}/objects/{obj}/{STEP_FILES[step]}"
+
+
+def searched(scenario, obj):
+    """Whether ``obj``'s placement in ``scenario`` is the searched one (its closure reads the
+    placement search's targets, docs/placement_search.md)."""
+    cfg = SCENARIOS[scenario]
+    return "search" in step_upstream_when(cfg, "simulate", obj)
+
+
+def searched_input(wildcards):
+    """Input function: the placement search's table of the job's object, where its placement
+    is searched (none otherwise)."""
+    scenario = _ROOT_SCENARIO[wildcards.root]
+    if not searched(scenario, wildcards.object):
+        return []
+    return step_file(scenario, "search", wildcards.object)
 
 
 def step_input(step):
@@ -195,8 +214,24 @@ def fig4_files(scenario, name):
 
 def object_targets(name, scenario="default"):
     """One object's outputs in a scenario: its per-object tables and Fig. 4 (wherever shared)."""
-    files = dict.fromkeys(step_file(scenario, step, name) for step in STEP_FILES)
-    return list(files) + fig4_files(scenario, name)
+    steps = [s for s in STEP_FILES if s != "search" or searched(scenario, name)]
+    files = dict.fromkeys(step_file(scenario, step, name) for step in steps)
+    return list(files) + fig4_files(scenario, name) + placement_map_files(scenario, name)
+
+
+def placement_map_files(scenario, name):
+    """The placement map of object ``name``, where ``scenario`` places it at the search's
+    chosen target (search_rank 1)."""
+    if not searched(scenario, name):
+        return []
+    cfg = SCENARIOS[scenario]
+    rank = overlay(cfg["placement"], cfg["objects"][name].get("placement"))["search_rank"]
+    root = SCENARIO_ROOT[scenario]
+    return (
+        [f"{root}/objects/{name}/placement_map.{ext}" for ext in ("png", "pdf")]
+        if rank == 1
+        else []
+    )
 
 
 TABLES = [

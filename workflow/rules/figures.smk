@@ -94,3 +94,32 @@ rule fig3_rulegraph:
         configfile=str(ROOT / "config" / "config.yaml"),
     script:
         "../scripts/fig3_rulegraph.py"
+
+
+rule placement_map:
+    input:
+        placement=step_input("search"),
+        contacts=step_input("contacts"),
+        code=code("placement_map"),
+        data=SHIPPED_DATA,
+        user=user_files,
+    output:
+        png=report(
+            "{root}/objects/{object}/placement_map.png",
+            caption="../report/placement_map.rst",
+            category="Placement search",
+            subcategory="{object}",
+        ),
+        pdf="{root}/objects/{object}/placement_map.pdf",
+    log:
+        "{root}/logs/placement_map/{object}.log",
+    benchmark:
+        "{root}/benchmarks/placement_map/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("placement_map"),
+        runtime=runtime_min("placement_map"),
+    params:
+        cfg=step_cfg("search"),
+    script:
+        "../scripts/placement_map.py"

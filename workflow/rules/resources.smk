@@ -12,6 +12,13 @@ from synergrasp.config import grid_axis_deg, synergy_sets
 # closure's cost per pose is CPU time per pose of the closure to the end of S1 (docs/cluster.md).
 #   unit = pose (closure, contact selection), pose x synergy set (optimisation, minima, Fig. 4, tables), none (figures)
 JOB_COST = {
+    # unit = target scored (27 poses each with the default steps; ~7 ms of one core per pose)
+    "search_placement": {
+        "fixed_s": 3.0,
+        "unit_s": 0.2,
+        "fixed_mb": 300,
+        "unit_mb": 0.0,
+    },
     "simulate_contacts": {
         "fixed_s": 1.5,
         "unit_s": 4.5e-2,
@@ -78,6 +85,7 @@ JOB_COST = {
         "fixed_mb": 311,
         "unit_mb": 0.0,
     },
+    "placement_map": {"fixed_s": 6.0, "unit_s": 0.0, "fixed_mb": 400, "unit_mb": 0.0},
     "fig3_rulegraph": {"fixed_s": 5.3, "unit_s": 0.0, "fixed_mb": 380, "unit_mb": 0.0},
     "fig5_hierarchy": {"fixed_s": 9.6, "unit_s": 0.0, "fixed_mb": 268, "unit_mb": 0.0},
 }
@@ -102,7 +110,13 @@ def job_size(step, cfg):
     )
     n_sets = len(synergy_sets(cfg["synergy_sets"]))
     factor = CLOSURE_COST_FACTOR.get(cfg["closure"]["model"], CLOSURE_UNMEASURED_FACTOR)
+    search = cfg["placement"]["search"]
+    n_targets = math.prod(
+        math.floor((hi - lo) / search["coarse_spacing_mm"]) + 1
+        for lo, hi in search["region_mm"].values()
+    )
     return {
+        "search_placement": n_targets + 26 * search["refine_top"] * search["max_rounds"],
         "simulate_contacts": n_poses * factor,
         "select_contacts": n_poses,
         "optimise_shard": math.ceil(n_poses / cfg["solver"]["pose_shards"]) * n_sets,
@@ -125,7 +139,7 @@ def runtime_min(step):
     def request(wildcards):
         cost = JOB_COST[step]
         seconds = cost["fixed_s"] + cost["unit_s"] * job_size(step, _job_config(wildcards))
-        if step == "optimise_shard":
+        if step in ("optimise_shard", "search_placement"):
             seconds += SOLVER_COMPILE_S
         return max(1, math.ceil(RUNTIME_MARGIN * seconds / 60.0))
 
@@ -138,7 +152,7 @@ def mem_mb(step):
     def request(wildcards):
         cost = JOB_COST[step]
         mb = cost["fixed_mb"] + cost["unit_mb"] * job_size(step, _job_config(wildcards))
-        if step == "optimise_shard":
+        if step in ("optimise_shard", "search_placement"):
             mb += SOLVER_COMPILE_MB
         return 100 * math.ceil(MEMORY_MARGIN * mb / 100.0)
 
@@ -159,3 +173,4 @@ localrules:
     fig3_rulegraph,
     fig4_force_maps,
     fig5_hierarchy,
+    placement_map,

@@ -2,11 +2,33 @@
 # the hand (Fig. 1) and of example grasps (Fig. 2).
 
 
+rule search_placement:
+    input:
+        code=code("search_placement"),
+        data=SHIPPED_DATA,
+        user=user_files,
+    output:
+        "{root}/objects/{object}/placement.csv",
+    log:
+        "{root}/logs/search_placement/{object}.log",
+    benchmark:
+        "{root}/benchmarks/search_placement/{object}.tsv"
+    threads: 2
+    resources:
+        mem_mb=mem_mb("search_placement"),
+        runtime=runtime_min("search_placement"),
+    params:
+        cfg=step_cfg("search"),
+    script:
+        "../scripts/search_placement.py"
+
+
 rule simulate_contacts:
     input:
         code=code("simulate_contacts"),
         data=SHIPPED_DATA,
         user=user_files,
+        search=searched_input,
     output:
         "{root}/objects/{object}/contacts.parquet",
     log:

@@ -19,7 +19,7 @@ from synergrasp.figures.hand_pictures import (BOX, PALM_CAMERA, SKIN, TOUCHING, 
 from synergrasp.figures.output import save_figure
 from synergrasp.hand.synergies import SynergyPath
 
-__all__ = ["figure_synergy_postures", "figure_example_grasps", "PANEL_PX"]
+__all__ = ["figure_synergy_postures", "figure_example_grasps", "draw_grasp_row", "PANEL_PX"]
 
 #: Rendered panel size, pixels (width, height).
 PANEL_PX = (330, 330)
@@ -182,6 +182,47 @@ def _legend(fig: Any) -> None:
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
 
 
+def draw_grasp_row(axes: Sequence[Any], hand: Any, box: Any, table: pd.DataFrame, camera: Camera = PALM_CAMERA) -> None:
+    """One row of Fig. 2 on ``axes``: the representative grasps of ``box`` in its contacts
+    ``table`` (``synergrasp.analysis.realism.representative_grasps``, one per axis), drawn
+    in one window with the touching links, the contact points and the touching links in words."""
+    n_grasps = len(axes)
+    chosen = representative_grasps(table, n_grasps)
+    simulated = int(table["status"].isin(SIMULATED_STATUSES).sum())
+    rows = [table[table["pose"] == pose].iloc[0] for pose in chosen["pose"]]
+    row_camera = _fit(camera, hand, [np.asarray(row["q"], dtype=float) for row in rows],
+                      [_box_of(row, box.size_mm) for row in rows]) if rows else camera
+    pictures, thumbs = [], []
+    axes[0].set_ylabel(f"{box.name}\n{' × '.join(f'{v:g}' for v in box.size_mm)} mm", fontsize=10)
+    for c in range(n_grasps):
+        ax = axes[c]
+        _bare(ax)
+        if c >= len(chosen):
+            ax.text(0.5, 0.5, "no other contact set" if c else f"no grasp with contacts\n({simulated} simulated)",
+                    ha="center", va="center", transform=ax.transAxes, fontsize=8, color="0.4")
+            continue
+        pick, row = chosen.iloc[c], rows[c]
+        points = np.asarray(row["contact_point"], dtype=float).reshape(-1, 3)
+        picture = render(hand, np.asarray(row["q"], dtype=float), row_camera, PANEL_PX,
+                         box=_box_of(row, box.size_mm), touching=pick["pattern"])
+        ax.imshow(picture.rgb, interpolation="antialiased")
+        pictures.append(picture)
+        thumbs.append((picture, np.asarray(row["q"], dtype=float)))
+        px, hidden = picture.pixels(points), picture.hidden(points)
+        ax.scatter(px[~hidden, 0], px[~hidden, 1], s=16, c=_CONTACT, edgecolors="white", linewidths=0.6, zorder=3)
+        ax.scatter(px[hidden, 0], px[hidden, 1], s=16, facecolors="none", edgecolors=_CONTACT, linewidths=0.9,
+                   zorder=3)
+        ax.set_title(f"{pick['reason']}: {pick['share_pct']:.0f} % of grasps\n"
+                     f"α = {pick['alpha_deg']:g}°, β = {pick['beta_deg']:g}°, {int(row['n_contacts'])} contacts",
+                     fontsize=8)
+        ax.set_xlabel(_touching_words(hand, pick["pattern"]), fontsize=7, labelpad=2)
+    if pictures:
+        _frame(axes[:len(pictures)], pictures)
+        for ax, (picture, q) in zip(axes, thumbs):
+            _label(ax, "thumb", picture.pixels(_thumb_point(hand, q)[None])[0],
+                   picture.pixels(_palm_point(hand)[None])[0])
+
+
 def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.DataFrame], png_path: str | Path,
                           pdf_path: str | Path, n_grasps: int = 3, camera: Camera = PALM_CAMERA) -> None:
     """Fig. 2: representative simulated grasps, one row per box, chosen by rule
@@ -203,40 +244,7 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.D
     fig, axes = plt.subplots(len(boxes), n_grasps, figsize=(panel * n_grasps + 0.5, panel * len(boxes) + 0.9),
                              squeeze=False)
     for r, (box, table) in enumerate(zip(boxes, tables)):
-        chosen = representative_grasps(table, n_grasps)
-        simulated = int(table["status"].isin(SIMULATED_STATUSES).sum())
-        rows = [table[table["pose"] == pose].iloc[0] for pose in chosen["pose"]]
-        row_camera = _fit(camera, hand, [np.asarray(row["q"], dtype=float) for row in rows],
-                          [_box_of(row, box.size_mm) for row in rows]) if rows else camera
-        pictures, thumbs = [], []
-        axes[r, 0].set_ylabel(f"{box.name}\n{' × '.join(f'{v:g}' for v in box.size_mm)} mm", fontsize=10)
-        for c in range(n_grasps):
-            ax = axes[r, c]
-            _bare(ax)
-            if c >= len(chosen):
-                ax.text(0.5, 0.5, "no other contact set" if c else f"no grasp with contacts\n({simulated} simulated)",
-                        ha="center", va="center", transform=ax.transAxes, fontsize=8, color="0.4")
-                continue
-            pick, row = chosen.iloc[c], rows[c]
-            points = np.asarray(row["contact_point"], dtype=float).reshape(-1, 3)
-            picture = render(hand, np.asarray(row["q"], dtype=float), row_camera, PANEL_PX,
-                             box=_box_of(row, box.size_mm), touching=pick["pattern"])
-            ax.imshow(picture.rgb, interpolation="antialiased")
-            pictures.append(picture)
-            thumbs.append((picture, np.asarray(row["q"], dtype=float)))
-            px, hidden = picture.pixels(points), picture.hidden(points)
-            ax.scatter(px[~hidden, 0], px[~hidden, 1], s=16, c=_CONTACT, edgecolors="white", linewidths=0.6, zorder=3)
-            ax.scatter(px[hidden, 0], px[hidden, 1], s=16, facecolors="none", edgecolors=_CONTACT, linewidths=0.9,
-                       zorder=3)
-            ax.set_title(f"{pick['reason']}: {pick['share_pct']:.0f} % of grasps\n"
-                         f"α = {pick['alpha_deg']:g}°, β = {pick['beta_deg']:g}°, {int(row['n_contacts'])} contacts",
-                         fontsize=8)
-            ax.set_xlabel(_touching_words(hand, pick["pattern"]), fontsize=7, labelpad=2)
-        if pictures:
-            _frame(axes[r, :len(pictures)], pictures)
-            for ax, (picture, q) in zip(axes[r], thumbs):
-                _label(ax, "thumb", picture.pixels(_thumb_point(hand, q)[None])[0],
-                       picture.pixels(_palm_point(hand)[None])[0])
+        draw_grasp_row(axes[r], hand, box, table, camera)
     _legend(fig)
     fig.tight_layout(rect=(0, 0.035, 1, 1), h_pad=0.6, w_pad=0.3)
     save_figure(fig, png_path, pdf_path)

@@ -6,10 +6,11 @@ Lengths in mm, angles in rad (degrees only in pose labels and grid ranges), palm
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -19,7 +20,7 @@ from synergrasp.hand.kinematics import axis_rotation
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
 
-__all__ = ["palm_centre", "approach_line", "placement_target", "FINGER_AXIS", "MODES", "Placement", "PoseGrid",
+__all__ = ["palm_centre", "approach_line", "placement_target", "searched_placement", "FINGER_AXIS", "MODES", "Placement", "PoseGrid",
            "ObjectPose", "pose_grid", "object_pose"]
 
 #: The placement modes: presets of one rule, which differ only in where the target comes from.
@@ -243,3 +244,15 @@ def approach_line(placement: Placement, hand: Hand) -> tuple[NDArray, NDArray]:
     """The target point (mm) and the unit direction from the palm outward (the palm
     normal): the box centre moves on target + t·direction, t ≥ 0, from far out toward t = 0."""
     return placement_target(placement, hand), _unit(hand.palm_normal)
+
+
+def searched_placement(placement: Placement, table: Any) -> Placement:
+    """``placement`` (mode ``searched``) with its target: the row of the search's placement
+    table (a DataFrame of ``tables.PLACEMENT``) whose ``distinct_rank`` is the placement's
+    ``search_rank``."""
+    rows = table[table["distinct_rank"] == placement.search_rank]
+    if len(rows) != 1:
+        raise ValueError(f"placement.search_rank {placement.search_rank}: the search has "
+                         f"{int((table['distinct_rank'] > 0).sum())} distinct targets")
+    row = rows.iloc[0]
+    return dataclasses.replace(placement, target_mm=(float(row["x_mm"]), float(row["y_mm"]), float(row["z_mm"])))

@@ -327,3 +327,4 @@ def search_object(hand: Hand, synergies: Synergies, box: Any, placement: Placeme
             scorer.close()
     ranked = rank_targets(list(scores.values()), reference, params.tie_band_points, params.force_tie_relative)
     return SearchResult(str(box.name), tuple(ranked), rounds)
+

@@ -1,0 +1,50 @@
+"""Benchmark of the placement search (docs/placement_search.md): the default study's search
+of each object (or of the objects named on the command line), with 2 processes; prints the
+wall time, the CPU time of the search's processes, the number of targets scored and the
+machine's load average (the targets: at most 30 s wall per object on 2 quiet cores).
+
+    .venv/bin/python benchmarks/bench_search.py [obj1 obj2 ...]
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import sys
+import time
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+from synergrasp.analysis.periods import alpha_period_deg  # noqa: E402
+from synergrasp.config import defaults, step_params  # noqa: E402
+from synergrasp.hand.kinematics import load_hand  # noqa: E402
+from synergrasp.hand.synergies import load_synergies  # noqa: E402
+from synergrasp.optimisation.gfo import warm_up  # noqa: E402
+from synergrasp.simulation.placement_search import full_synergy_set, search_object  # noqa: E402
+
+
+def _cpu_s() -> float:
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+def main(objects: list[str], processes: int = 2) -> None:
+    study = defaults()
+    warm_up()
+    for name in objects or list(study["objects"]):
+        sim = step_params(study, "search", name)
+        hand = load_hand(sim.hand)
+        synergies = load_synergies(sim.synergies, joint_names=hand.joint_names)
+        period = alpha_period_deg(sim.placement, sim.box.size_mm, hand.palm_normal)
+        wall, cpu = time.perf_counter(), _cpu_s()
+        result = search_object(hand, synergies, sim.box, sim.placement, sim.closure, sim.gfo,
+                               full_synergy_set(synergies.matrix, sim.full_set_size), sim.search, period, processes)
+        wall, cpu = time.perf_counter() - wall, _cpu_s() - cpu
+        n_poses = result.chosen.n_poses
+        print(f"{name}: {len(result.ranked)} targets x {n_poses} poses, {processes} processes: wall {wall:.1f} s, "
+              f"CPU {cpu:.1f} s ({1e3 * cpu / (len(result.ranked) * n_poses):.1f} ms per grasp), "
+              f"load average {os.getloadavg()[0]:.1f}; chosen {result.chosen.target_mm}", flush=True)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
