@@ -399,5 +399,12 @@ def test_small_sweep_summary_has_one_row_per_scenario(run_j2, tmp_path):
     assert {f"claim{c}_verdict" for c in claims["claim"]} <= set(summary.columns)
     for name in ("claims_grid", "table2_curves"):
         assert (workdir / "results" / "sensitivity" / f"{name}.png").stat().st_size > 0
-    # both scenarios share the default's simulation: no contacts of their own
-    assert not list((workdir / "results" / "scenarios").glob("*/objects/*/contacts.parquet"))
+    # the optimisation and analysis scenarios share the default's simulation: no contacts of
+    # their own; the searched one searches, closes at its targets and draws its placement maps
+    scenarios = workdir / "results" / "scenarios"
+    assert not list(scenarios.glob("mu_1_0/objects/*/contacts.parquet"))
+    assert not list(scenarios.glob("success_load_feasible/objects/*/contacts.parquet"))
+    for name in ("placement.csv", "contacts.parquet", "placement_map.png"):
+        assert len(list(scenarios.glob(f"placement_searched/objects/*/{name}"))) == 2, name
+    placement = dict(zip(summary["scenario"], summary["placement"]))
+    assert placement["default"] == "approach" and placement["placement_searched"] == "searched, rank 1 (own search)"

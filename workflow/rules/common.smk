@@ -219,6 +219,20 @@ def object_targets(name, scenario="default"):
     return list(files) + fig4_files(scenario, name) + placement_map_files(scenario, name)
 
 
+def placement_label(scenario):
+    """How ``scenario`` places the boxes, for the sweep's summary: the mode; for a searched
+    placement the rank and whether the scenario searched again or uses another scenario's
+    targets (docs/sensitivity.md)."""
+    cfg = SCENARIOS[scenario]
+    mode = cfg["placement"]["mode"]
+    if mode != "searched":
+        return mode
+    roots = {step_root(scenario, "search", o) for o in cfg["objects"] if searched(scenario, o)}
+    own = SCENARIO_ROOT[scenario] in roots
+    where = "own search" if own else "targets of " + ", ".join(sorted(_ROOT_SCENARIO[r] for r in roots))
+    return f"searched, rank {cfg['placement']['search_rank']} ({where})"
+
+
 def placement_map_files(scenario, name):
     """The placement map of object ``name``, where ``scenario`` places it at the search's
     chosen target (search_rank 1)."""

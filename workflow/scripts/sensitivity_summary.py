@@ -15,6 +15,7 @@ with job_log(snakemake.log[0]):
             read("preservation"))
     }
     summary = sensitivity_table(scenarios)
+    summary.insert(1, "placement", snakemake.params.placements)  # searched again or not (docs/sensitivity.md)
     write_study_table(summary, snakemake.output.csv, snakemake.output.md,
                       title="Findings across the scenarios of the sweep")
     figure_claims_grid(summary, snakemake.output.grid_png, snakemake.output.grid_pdf)

@@ -78,20 +78,20 @@ def figure_placement_map(hand: Any, box: Any, placement: pd.DataFrame, contacts:
     limits = (placement["y_mm"].min() - half - 2, placement["y_mm"].max() + half + 2,
               placement["z_mm"].min() - half - 2, placement["z_mm"].max() + half + 2)
     outline = _palm_outline(hand)
-    n_cols = max(len(levels), n_grasps)
-    fig = plt.figure(figsize=(2.2 * n_cols + 1.0, 8.4))
-    grid = fig.add_gridspec(2, n_cols, height_ratios=(1.25, 1.0))
+    fig = plt.figure(figsize=(max(2.2 * len(levels) + 1.0, 3.4 * n_grasps), 8.8))
+    grid = fig.add_gridspec(2, 1, height_ratios=(1.1, 1.0), hspace=0.25)
+    top, bottom = grid[0].subgridspec(1, len(levels)), grid[1].subgridspec(1, n_grasps)
     for i, x in enumerate(levels):
-        ax = fig.add_subplot(grid[0, i])
+        ax = fig.add_subplot(top[0, i])
         _level_panel(ax, placement[np.isclose(placement["x_mm"], x)], spacing_mm, outline, limits)
         ax.set_title(f"x = {x:g} mm", fontsize=8)
         ax.set_xlabel("y (mm, thumb side +)", fontsize=7)
         if i == 0:
             ax.set_ylabel("z (mm, along the fingers)", fontsize=7)
-    bar = fig.colorbar(ScalarMappable(Normalize(0, 100), "viridis"), ax=fig.axes, fraction=0.02, pad=0.01)
+    bar = fig.colorbar(ScalarMappable(Normalize(0, 100), "viridis"), ax=list(fig.axes), fraction=0.02, pad=0.01)
     bar.set_label("force closure with the full set, % of scored poses", fontsize=7)
     bar.ax.tick_params(labelsize=7)
-    grasp_axes = [fig.add_subplot(grid[1, c]) for c in range(n_grasps)]
+    grasp_axes = [fig.add_subplot(bottom[0, c]) for c in range(n_grasps)]
     draw_grasp_row(grasp_axes, hand, box, contacts)
     fig.suptitle(f"{box.name}: chosen target ({chosen['x_mm']:g}, {chosen['y_mm']:g}, {chosen['z_mm']:g}) mm, "
                  f"{chosen['force_closure_percent']:.0f} % force closure, median force "
