@@ -180,6 +180,7 @@ def with_intervals(rates: pd.DataFrame, counts: StudyCounts) -> pd.DataFrame:
                 ratio, n = counts.pooled_ratio_to_full(sid)
                 est, low, high = counts.estimate_interval(ratio)
                 row.update(force_ratio_median=est, force_ratio_low=low, force_ratio_high=high, n_force_poses=n,
+                           absolute_share=100.0 * row["n_success"] / row["n_poses"] if row["n_poses"] else np.nan,
                            marginal_percent=100.0 * row["n_marginal"] / row["n_success_grid"]
                            if row["n_success_grid"] else np.nan)
             views.append(row)
