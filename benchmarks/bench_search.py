@@ -35,9 +35,9 @@ def main(objects: list[str], processes: int = 2) -> None:
         sim = step_params(study, "search", name)
         hand = load_hand(sim.hand)
         synergies = load_synergies(sim.synergies, joint_names=hand.joint_names)
-        period = alpha_period_deg(sim.placement, sim.box.size_mm, hand.palm_normal)
+        period = alpha_period_deg(sim.placement, sim.object.shape, hand.palm_normal)
         wall, cpu = time.perf_counter(), _cpu_s()
-        result = search_object(hand, synergies, sim.box, sim.placement, sim.closure, sim.gfo,
+        result = search_object(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo,
                                full_synergy_set(synergies.matrix, sim.full_set_size), sim.search, period, processes)
         wall, cpu = time.perf_counter() - wall, _cpu_s() - cpu
         n_poses = result.chosen.n_poses

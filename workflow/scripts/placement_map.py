@@ -8,6 +8,6 @@ from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
     sim = step_params(snakemake.params.cfg, "search", snakemake.wildcards.object)
-    figure_placement_map(load_hand(sim.hand), sim.box, tables.read_csv(tables.PLACEMENT, snakemake.input.placement),
+    figure_placement_map(load_hand(sim.hand), sim.object, tables.read_csv(tables.PLACEMENT, snakemake.input.placement),
                          tables.read(tables.CONTACTS, snakemake.input.contacts), sim.search.spacing_mm,
                          snakemake.output.png, snakemake.output.pdf)

@@ -12,8 +12,8 @@ with job_log(snakemake.log[0]):
     sim = step_params(snakemake.params.cfg, "search", snakemake.wildcards.object)
     hand = load_hand(sim.hand)
     synergies = load_synergies(sim.synergies, joint_names=hand.joint_names)
-    period = alpha_period_deg(sim.placement, sim.box.size_mm, hand.palm_normal)
-    result = search_object(hand, synergies, sim.box, sim.placement, sim.closure, sim.gfo,
+    period = alpha_period_deg(sim.placement, sim.object.shape, hand.palm_normal)
+    result = search_object(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo,
                            full_synergy_set(synergies.matrix, sim.full_set_size), sim.search, period,
                            processes=snakemake.threads)
     tables.write_csv(tables.PLACEMENT, result.table(sim.distinct_mm), snakemake.output[0])

@@ -16,5 +16,5 @@ with job_log(snakemake.log[0]):
     placement = sim.placement
     if placement.mode == "searched":
         placement = searched_placement(placement, tables.read_csv(tables.PLACEMENT, snakemake.input.search))
-    table = simulate_object(hand, synergies, sim.box, placement, sim.closure, mechanics=sim.mechanics)
+    table = simulate_object(hand, synergies, sim.object, placement, sim.closure, mechanics=sim.mechanics)
     write_contacts(table, snakemake.output[0])

@@ -57,9 +57,9 @@ def image_colour(percent: float) -> Any:
     return matplotlib.colormaps["viridis"](float(percent) / 100.0)
 
 
-def figure_placement_map(hand: Any, box: Any, placement: pd.DataFrame, contacts: pd.DataFrame,
+def figure_placement_map(hand: Any, obj: Any, placement: pd.DataFrame, contacts: pd.DataFrame,
                          spacing_mm: float, png_path: str | Path, pdf_path: str | Path, n_grasps: int = 3) -> None:
-    """The placement map of ``box``: one panel per distance x of the targets from the palm
+    """The placement map of ``obj`` (a ``synergrasp.simulation.objects.GraspedObject``): one panel per distance x of the targets from the palm
     (palm frame, mm): every scored target as a square coloured by its share of scored poses
     in force closure with the full synergy set, the chosen target a red star, the second and
     third distinct targets circles; the palm's outline dashed. Below, ``n_grasps``
@@ -92,8 +92,8 @@ def figure_placement_map(hand: Any, box: Any, placement: pd.DataFrame, contacts:
     bar.set_label("force closure with the full set, % of scored poses", fontsize=7)
     bar.ax.tick_params(labelsize=7)
     grasp_axes = [fig.add_subplot(bottom[0, c]) for c in range(n_grasps)]
-    draw_grasp_row(grasp_axes, hand, box, contacts)
-    fig.suptitle(f"{box.name}: chosen target ({chosen['x_mm']:g}, {chosen['y_mm']:g}, {chosen['z_mm']:g}) mm, "
+    draw_grasp_row(grasp_axes, hand, obj, contacts)
+    fig.suptitle(f"{obj.name}: chosen target ({chosen['x_mm']:g}, {chosen['y_mm']:g}, {chosen['z_mm']:g}) mm, "
                  f"{chosen['force_closure_percent']:.0f} % force closure, median force "
                  f"{chosen['median_force_per_weight']:.2g} × weight, {len(placement)} targets scored on "
                  f"{int(chosen['n_poses'])} poses; grasps at it below", fontsize=9)
