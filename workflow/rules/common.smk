@@ -229,7 +229,9 @@ def placement_label(scenario):
         return mode
     roots = {step_root(scenario, "search", o) for o in cfg["objects"] if searched(scenario, o)}
     own = SCENARIO_ROOT[scenario] in roots
-    where = "own search" if own else "targets of " + ", ".join(sorted(_ROOT_SCENARIO[r] for r in roots))
+    where = (
+        "own search" if own else "targets of " + ", ".join(sorted(_ROOT_SCENARIO[r] for r in roots))
+    )
     return f"searched, rank {cfg['placement']['search_rank']} ({where})"
 
 
