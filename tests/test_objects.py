@@ -3,17 +3,19 @@ import math
 import numpy as np
 import pytest
 
-from synergrasp.config import defaults, step_params
+from synergrasp.config import defaults
+from synergrasp.figures.hand_figures import Fig2Params
+from synergrasp.optimisation.study import OptimiseParams
 from synergrasp.simulation.objects import Box, ObjectError
 
 
 def test_study_boxes_from_the_config_defaults():
-    boxes = step_params(defaults(), "fig2").boxes
+    boxes = Fig2Params.from_config(defaults()).boxes
     assert [b.name for b in boxes] == ["obj1", "obj2", "obj3", "obj4"]
     np.testing.assert_array_equal(boxes[3].size_mm, [100, 60, 100])
     np.testing.assert_array_equal(boxes[1].half_extents_mm, [15, 30, 30])
     assert all(b.mass_kg is None for b in boxes)  # Fig. 2 does not read the masses
-    assert all(step_params(defaults(), "optimise", b.name).gfo.mass_kg == 1.0 for b in boxes)
+    assert all(OptimiseParams.from_config(defaults(), b.name).gfo.mass_kg == 1.0 for b in boxes)
     assert Box("a", [1, 2, 3], 1).mass_kg == 1.0 and isinstance(Box("a", [1, 2, 3], 1).mass_kg, float)
 
 

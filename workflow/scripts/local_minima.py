@@ -2,12 +2,11 @@
 
 import pandas as pd
 
-from synergrasp.analysis.minima import minima_table
+from synergrasp.analysis.minima import MinimaParams, minima_table
 from synergrasp.analysis.verdicts import with_verdicts
-from synergrasp.config import step_params
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
-    params = step_params(snakemake.params.cfg, "minima")
+    params = MinimaParams.from_config(snakemake.params.cfg)
     gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), params.success)
     minima_table(gfo, radius_deg=params.radius_deg).to_parquet(snakemake.output[0], index=False)

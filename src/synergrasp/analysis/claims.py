@@ -17,7 +17,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from synergrasp.config import set_id
+from synergrasp.ids import set_id
 
 __all__ = ["HOLDS", "FAILS", "UNDEFINED", "compare", "combine", "claims_table", "TIE_PERCENT_POINTS",
            "TIE_FORCE_RELATIVE"]

@@ -16,11 +16,15 @@ A minimum of {S1..Sk} is *preserved* if {S1..Sk+1} has a minimum within ±radius
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["local_minima", "preserved", "minima_table", "MINIMA_COLUMNS", "FORCE_TIE_RTOL"]
+__all__ = ["MinimaParams", "local_minima", "preserved", "minima_table", "MINIMA_COLUMNS", "FORCE_TIE_RTOL"]
 
 # Grid angles are multiples of a step; the tolerance makes "within ±radius" inclusive
 # despite rounding in the stored degrees.
@@ -32,6 +36,20 @@ FORCE_TIE_RTOL = 1e-5
 
 MINIMA_COLUMNS = ("object", "set_id", "n_synergies", "pose", "alpha_deg", "beta_deg", "force_norm")
 
+
+
+@dataclass(frozen=True)
+class MinimaParams:
+    """Local minima of one object (the ``minima`` step): neighbourhood radius (deg) and the
+    success verdict."""
+
+    radius_deg: float
+    success: str
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> MinimaParams:
+        """From a configuration or the step's own part of it (``obj`` is not read)."""
+        return cls(float(config["analyses"]["minima_radius_deg"]), config["analyses"]["success"])
 
 def _as_1d(name: str, values: ArrayLike, n: int | None = None, dtype: type = float) -> NDArray:
     arr = np.asarray(values, dtype=dtype)

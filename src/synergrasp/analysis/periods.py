@@ -76,11 +76,11 @@ def object_periods(objects: Mapping[str, Mapping[str, Any]], grid: Mapping[str, 
     ``size_mm`` and effective ``placement`` (the global placement with its override),
     ``grid`` is the config's grid block, ``hand`` the hand file (None: the shipped hand,
     whose palm normal is the α axis)."""
-    from synergrasp.config import placement_params
     from synergrasp.hand.kinematics import load_hand
+    from synergrasp.simulation.placement import Placement
 
     normal = load_hand(hand).palm_normal
-    return {name: alpha_period_deg(placement_params(spec["placement"], grid), spec["size_mm"], normal)
+    return {name: alpha_period_deg(Placement.from_config(spec["placement"], grid), spec["size_mm"], normal)
             for name, spec in objects.items()}
 
 

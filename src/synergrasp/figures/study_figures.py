@@ -8,7 +8,9 @@ Forces are in N; angles in deg.
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
 from pathlib import Path
 
 import matplotlib
@@ -19,10 +21,12 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 import seaborn as sns  # noqa: E402
 
-from synergrasp.config import incremental_set_id  # noqa: E402
+from synergrasp.ids import incremental_set_id  # noqa: E402
 from synergrasp.figures.output import save_figure  # noqa: E402
 
 __all__ = [
+    "Fig4Params",
+    "Fig5Params",
     "force_grid",
     "figure_force_maps",
     "figure_exploded_views",
@@ -32,6 +36,35 @@ __all__ = [
     "canonical_rulegraph",
     "figure_rulegraph",
 ]
+
+
+@dataclass(frozen=True)
+class Fig4Params:
+    """Fig. 4 of one object (the ``fig4`` step): the success verdict, the k of the
+    incremental sets drawn, and the α and β (deg) of the exploded views' slices."""
+
+    success: str
+    panel_k: tuple[int, ...]
+    alpha_slice_deg: float
+    beta_slice_deg: float
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> Fig4Params:
+        fig4 = config["analyses"]["fig4"]
+        return cls(config["analyses"]["success"], tuple(fig4["panel_k"]), fig4["alpha_slice_deg"],
+                   fig4["beta_slice_deg"])
+
+
+@dataclass(frozen=True)
+class Fig5Params:
+    """Fig. 5 (the ``fig5`` step): the success verdict and S1..S_first of the hierarchy sets."""
+
+    success: str
+    hierarchy_first: int
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> Fig5Params:
+        return cls(config["analyses"]["success"], config["synergy_sets"]["hierarchy_first"])
 
 
 def force_grid(gfo: pd.DataFrame, set_id: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

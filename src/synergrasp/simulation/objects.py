@@ -5,10 +5,13 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from synergrasp.config import build
 
 __all__ = ["Box", "ObjectError"]
 
@@ -29,7 +32,7 @@ class Box:
     size_mm : (3,) edge lengths along the box's own x, y, z axes, mm.
     mass_kg : mass, kg; None where it is not given (a step that does not read it).
 
-    Built from the configuration by ``synergrasp.config.step_params``.
+    Built from the configuration by :meth:`from_config`.
     """
 
     name: str
@@ -42,6 +45,14 @@ class Box:
         mass = _check_mass(self.name, self.mass_kg)
         object.__setattr__(self, "size_mm", size)
         object.__setattr__(self, "mass_kg", mass)
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], name: str, with_mass: bool = True) -> Box:
+        """The object ``name`` of the configuration; without a mass (None) where the step
+        does not read it (``with_mass`` false)."""
+        spec = config["objects"][name]
+        return build(cls, f"objects.{name}", name=name, size_mm=spec["size_mm"],
+                     mass_kg=spec["mass_kg"] if with_mass else None)
 
     @property
     def half_extents_mm(self) -> NDArray[np.float64]:
