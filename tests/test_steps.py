@@ -177,6 +177,8 @@ def _rules():
 
 
 TARGET_RULES = ("all", "figures", "scenarios", "sensitivity")
+#: Steps declared (their keys are read) whose rule is still to be written (issue 22).
+NOT_YET_IN_THE_WORKFLOW = ("search",)
 
 
 def test_every_step_has_its_rules_outputs_and_costs_and_every_rule_its_step():
@@ -187,6 +189,9 @@ def test_every_step_has_its_rules_outputs_and_costs_and_every_rule_its_step():
     prefix = {"object": "{root}/objects/{object}/", "scenario": "{root}/", "workflow": "results/"}
     for name, step in STEPS.items():
         assert step.outputs, name
+        if name in NOT_YET_IN_THE_WORKFLOW:
+            assert not step.rules, name
+            continue
         written = rules[list(step.rules)[-1]]
         assert sorted(written) == sorted(prefix[step.scope] + rel for rel in step.outputs.values()), name
         assert all(c.unit in ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose_set")
@@ -194,7 +199,7 @@ def test_every_step_has_its_rules_outputs_and_costs_and_every_rule_its_step():
         assert set(step.upstream) <= set(STEPS), name
 
 
-@pytest.mark.parametrize("step", [s for s in STEPS if STEPS[s].params])
+@pytest.mark.parametrize("step", [s for s in STEPS if STEPS[s].params and STEPS[s].rules])
 def test_a_steps_script_imports_the_module_its_parameters_come_from(step):
     # so the rule's code inputs (derived from the script's imports) cover them
     script = ROOT / "workflow" / "scripts" / f"{list(STEPS[step].rules)[0]}.py"

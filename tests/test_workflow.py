@@ -91,7 +91,7 @@ def expected_targets() -> list[str]:
     assert config["closure"]["model"] == "kinematic"
     where = {"object": [f"results/objects/{o}/" for o in config["objects"]], "scenario": ["results/"],
              "workflow": ["results/"]}
-    return [root + rel for name, step in STEPS.items() if name not in ("sensitivity", "contacts")
+    return [root + rel for name, step in STEPS.items() if name not in ("sensitivity", "contacts") and step.rules
             for root in where[step.scope] for rel in step.outputs.values()]
 
 

@@ -303,6 +303,26 @@ def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -
                         f"synergy_sets.incremental_max ({k_max})")
     if not _grid_problems(config["grid"]):
         problems += _pose_problems(config)
+        problems += _search_problems(config)
+    return problems
+
+
+def _search_problems(config: Mapping[str, Any]) -> list[str]:
+    """The placement search's relations (docs/placement_search.md), globally and per object:
+    the refinement spacing divides the coarse one, every region interval is ordered."""
+    problems = []
+    for where, block in [("placement", config["placement"])] + [
+            (f"objects.{name}.placement", spec.get("placement") or {}) for name, spec in config["objects"].items()]:
+        search = overlay(config["placement"]["search"], block.get("search")) if where != "placement" else block["search"]
+        if where != "placement" and "search" not in block:
+            continue
+        ratio = search["coarse_spacing_mm"] / search["spacing_mm"]
+        if abs(ratio - round(ratio)) > 1e-9:
+            problems.append(f"config error at '{where}.search.coarse_spacing_mm': {search['coarse_spacing_mm']} must be "
+                            f"a whole multiple of search.spacing_mm ({search['spacing_mm']})")
+        for axis, (lo, hi) in search["region_mm"].items():
+            if hi < lo:
+                problems.append(f"config error at '{where}.search.region_mm.{axis}': stop {hi} is below start {lo}")
     return problems
 
 

@@ -27,10 +27,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from synergrasp.config import overlay
 from synergrasp.hand.synergies import synergy_values
 
 __all__ = ["Cost", "Step", "STEPS", "UNITS", "WORKFLOW_KEYS", "step_keys", "step_config", "step_hash",
-           "rule_costs"]
+           "upstream_when", "rule_costs"]
 
 #: Units of work a job's cost is counted in (resources.smk counts them for a scenario).
 UNITS = ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose_set")
@@ -65,6 +66,8 @@ class Step:
     not_reads: keys inside a block it reads that it does not read itself.
     upstream:  steps whose outputs it reads (its hash holds theirs): for a step run per
                object, that object's; for one run per scenario, every object's.
+    upstream_when: steps it reads only when a key of the object's effective placement
+               (the global one with the object's override) has a value: ((key, value, step), ...).
     synergy_columns: the synergies (1-based) it reads besides the mean posture; it is handed
                their values instead of the synergy table.
     params:    "module:Class" whose ``from_config`` builds its typed parameters.
@@ -77,6 +80,7 @@ class Step:
     reads_when: tuple[tuple[str, Any, tuple[str, ...]], ...] = ()
     not_reads: tuple[str, ...] = ()
     upstream: tuple[str, ...] = ()
+    upstream_when: tuple[tuple[str, Any, str], ...] = ()
     synergy_columns: tuple[int, ...] = ()
     params: str | None = None
 
@@ -91,6 +95,10 @@ TABLES = ("success_rates", "table2_success_rates", "hierarchy", "minimum_preserv
           "verdict_disagreements", "preservation_vs_chance", "invariant_checks", "claims")
 #: The keys of the choice of which contacts count (the ``contacts`` step).
 _CONTACT_SELECTION = ("closure.dynamic.unloaded_contacts", "closure.dynamic.load_threshold_N")
+#: The keys of the force bound of ``analyses.success: force_closure_bounded``.
+_FORCE_BOUND = ("analyses.marginal_weight_multiple", "objects.{object}.mass_kg", "mechanics.g_m_per_s2")
+#: The keys of a placement mode's target (the search reads none of them).
+_PLACEMENT_TARGETS = ("mode", "search_rank", "approach_point_mm", "center_mm")
 _PNG_PDF = ("png", "pdf")
 
 #: Every step of the workflow, in the order they run. Costs: from results/benchmarks/*.tsv
@@ -98,6 +106,17 @@ _PNG_PDF = ("png", "pdf")
 #: 2-core x86_64 machine running two jobs at a time; the slope is between the two sizes
 #: (docs/cluster.md).
 STEPS: dict[str, Step] = {
+    # the placement search (docs/placement_search.md): the kinematic closure and the
+    # optimisation with the full set {S1..S_incremental_max} only; its rule comes with the
+    # search's wiring into the workflow
+    "search": Step(
+        rules={}, outputs={"placement": "placement.csv"}, scope="object",
+        reads=("hand", "synergies", "grid", "placement", "closure", "mechanics", "synergy_sets.incremental_max",
+               "objects.{object}.size_mm", "objects.{object}.mass_kg", "objects.{object}.placement"),
+        not_reads=("closure.model", "closure.dynamic",
+                   *(f"{where}.{key}" for where in ("placement", "objects.{object}.placement")
+                     for key in _PLACEMENT_TARGETS)),
+        params="synergrasp.optimisation.placement_search:SearchStepParams"),
     "simulate": Step(
         rules={"simulate_contacts": Cost("closure_pose", 1.5, 178, 4.5e-2, 7.6e-3, local=False)},
         outputs={"contacts": "contacts.parquet"}, scope="object",
@@ -106,7 +125,9 @@ STEPS: dict[str, Step] = {
         # the dynamic closure: a free box of the object's mass, μ, k_ss and gravity of mechanics
         reads_when=(("closure.model", "dynamic", ("objects.{object}.mass_kg", "mechanics")),),
         # which contacts count is the `contacts` step's choice: `drop` and `keep` share one closure
-        not_reads=_CONTACT_SELECTION, synergy_columns=(1,),
+        # nor the search's settings (a searched placement reads the search's output)
+        not_reads=(*_CONTACT_SELECTION, "placement.search", "objects.{object}.placement.search"),
+        upstream_when=(("placement.mode", "searched", "search"),), synergy_columns=(1,),
         params="synergrasp.simulation.closure:SimulateParams"),
     "contacts": Step(
         rules={"select_contacts": Cost("pose", 1.0, 150, 5.0e-4, 7.6e-3)},
@@ -125,13 +146,16 @@ STEPS: dict[str, Step] = {
         rules={"local_minima": Cost("pose_set", 0.6, 136, 1.35e-5, 6.0e-4)},
         outputs={"minima": "minima.parquet"}, scope="object",
         reads=("analyses.minima_radius_deg", "analyses.success"),
+        # force closure within a multiple of the weight: the minima and Fig. 4 read the bound
+        reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
         upstream=("optimise",), params="synergrasp.analysis.minima:MinimaParams"),
     "tables": Step(
         rules={"study_tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
         outputs=_files(TABLES, "tables", ("csv", "md")),
         reads=("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max", "analyses.success",
                "analyses.marginal_weight_multiple", "analyses.success_rate_tolerance_percent",
-               "analyses.null_model", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
+               "analyses.null_model", "analyses.headline_view", "analyses.tie_band", "analyses.min_distinct_poses",
+               "analyses.bootstrap", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
         upstream=("optimise", "minima"), params="synergrasp.analysis.summaries:TablesParams"),
     "realism": Step(
         rules={"grasp_realism": Cost("object_pose_set", 4.0, 300, 4.0e-6, 3.0e-4)},
@@ -152,7 +176,8 @@ STEPS: dict[str, Step] = {
     "fig4": Step(
         rules={"fig4_force_maps": Cost("pose_set", 4.3, 257, 5.1e-6, 4.0e-4)},
         outputs=_files(("fig4_force_maps", "fig4_exploded"), "", _PNG_PDF), scope="object",
-        reads=("analyses.fig4", "analyses.success"), upstream=("optimise", "minima"),
+        reads=("analyses.fig4", "analyses.success"),
+        reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),), upstream=("optimise", "minima"),
         params="synergrasp.figures.study_figures:Fig4Params"),
     "fig5": Step(
         rules={"fig5_hierarchy": Cost("none", 9.6, 268)},
@@ -228,6 +253,10 @@ def step_config(config: Mapping[str, Any], step: str, obj: str | None = None) ->
         if value is not _MISSING:
             _put(out, path, value)
     for path in STEPS[step].not_reads:
+        if "{object}" in path:
+            if obj is None:
+                continue
+            path = path.format(object=obj)
         *parents, last = path.split(".")
         node = _get(out, ".".join(parents))
         if isinstance(node, dict):
@@ -247,7 +276,7 @@ def step_hash(config: Mapping[str, Any], step: str, obj: str | None = None,
     if (step, obj) in memo:
         return memo[step, obj]
     parts: list[Any] = [step_config(config, step, obj)]
-    for upstream in STEPS[step].upstream:
+    for upstream in (*STEPS[step].upstream, *upstream_when(config, step, obj)):
         if STEPS[upstream].scope == "object" and obj is None:
             parts.append([[name, step_hash(config, upstream, name, memo)] for name in config["objects"]])
         else:
@@ -255,3 +284,13 @@ def step_hash(config: Mapping[str, Any], step: str, obj: str | None = None,
     text = json.dumps(parts, sort_keys=True, default=str)
     memo[step, obj] = hashlib.sha256(text.encode()).hexdigest()[:12]
     return memo[step, obj]
+
+
+def upstream_when(config: Mapping[str, Any], step: str, obj: str | None = None) -> tuple[str, ...]:
+    """The steps ``step`` reads for ``obj`` besides its ``upstream``, from the object's
+    effective placement (``upstream_when``): ``search`` for a searched placement."""
+    if obj is None or not STEPS[step].upstream_when:
+        return ()
+    placement = overlay(config["placement"], config["objects"][obj].get("placement"))
+    return tuple(up for key, value, up in STEPS[step].upstream_when
+                 if placement.get(key.removeprefix("placement.")) == value)

@@ -193,7 +193,7 @@ def object_targets(name, scenario_name="default"):
     """One object's outputs in a scenario: the outputs of every per-object step (wherever shared)."""
     files = {}
     for step, spec in STEPS.items():
-        if spec.scope != "object":
+        if spec.scope != "object" or not spec.rules:  # a step whose rule is still to come
             continue
         if len(spec.outputs) == 1:
             files[step_file(scenario_name, step, name)] = None
@@ -226,7 +226,7 @@ def study_targets(name="default"):
     files = [
         study_file(name, step, rel)
         for step, spec in STEPS.items()
-        if spec.scope == "scenario"
+        if spec.scope == "scenario" and spec.rules
         for rel in spec.outputs.values()
     ]
     files += workflow_files("fig3")

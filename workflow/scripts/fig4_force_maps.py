@@ -7,8 +7,9 @@ from synergrasp.figures.study_figures import Fig4Params, figure_exploded_views, 
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
-    p = Fig4Params.from_config(snakemake.params.cfg)
-    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), p.success)
+    p = Fig4Params.from_config(snakemake.params.cfg, snakemake.wildcards.object)
+    weights = {snakemake.wildcards.object: p.weight_N} if p.weight_N is not None else None
+    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), p.success, weights, p.bound_multiple)
     minima = pd.read_parquet(snakemake.input.minima)
     name, out, panel_k = snakemake.wildcards.object, snakemake.output, list(p.panel_k)
     figure_force_maps(gfo, minima, panel_k, name, out.maps_png, out.maps_pdf, p.success)

@@ -7,6 +7,7 @@ Forces are in N; angles in deg.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -21,6 +22,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 import seaborn as sns  # noqa: E402
 
+from synergrasp.analysis.verdicts import force_bound  # noqa: E402
 from synergrasp.ids import incremental_set_id  # noqa: E402
 from synergrasp.figures.output import save_figure  # noqa: E402
 
@@ -41,18 +43,21 @@ __all__ = [
 @dataclass(frozen=True)
 class Fig4Params:
     """Fig. 4 of one object (the ``fig4`` step): the success verdict, the k of the
-    incremental sets drawn, and the α and β (deg) of the exploded views' slices."""
+    incremental sets drawn, the α and β (deg) of the exploded views' slices and, for
+    ``force_closure_bounded``, the object's weight (N) and the bound's multiple of it."""
 
     success: str
     panel_k: tuple[int, ...]
     alpha_slice_deg: float
     beta_slice_deg: float
+    weight_N: float | None = None
+    bound_multiple: float = math.inf
 
     @classmethod
-    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> Fig4Params:
+    def from_config(cls, config: Mapping[str, Any], obj: str) -> Fig4Params:
         fig4 = config["analyses"]["fig4"]
         return cls(config["analyses"]["success"], tuple(fig4["panel_k"]), fig4["alpha_slice_deg"],
-                   fig4["beta_slice_deg"])
+                   fig4["beta_slice_deg"], **force_bound(config, obj))
 
 
 @dataclass(frozen=True)
