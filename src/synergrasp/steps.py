@@ -181,7 +181,8 @@ STEPS: dict[str, Step] = {
         params="synergrasp.figures.study_figures:Fig4Params"),
     "fig5": Step(
         rules={"fig5_hierarchy": Cost("none", 9.6, 268)},
-        outputs=_files(("fig5a_hierarchy_success", "fig5b_hierarchy_force"), "figures", _PNG_PDF),
+        outputs=_files(("fig5a_hierarchy_success", "fig5a_hierarchy_success_pooled", "fig5b_hierarchy_force"),
+                       "figures", _PNG_PDF),
         reads=("synergy_sets.hierarchy_first", "analyses.success"), upstream=("tables",),
         params="synergrasp.figures.study_figures:Fig5Params"),
     # the workflow's own rule graph: drawn with the shipped configuration, so it reads no key
