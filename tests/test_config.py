@@ -39,7 +39,7 @@ def test_study_config_holds_the_papers_parameters():
     assert study["mechanics"]["f_min_N"] == 0.1
     assert study["mechanics"]["k_stru_N_per_mm"] == 1.0
     assert study["mechanics"]["k_ss_Nmm_per_rad"] == 200.0
-    sizes = {name: spec["size_mm"] for name, spec in study["objects"].items()}
+    sizes = {name: spec["shape"]["box"]["size_mm"] for name, spec in study["objects"].items()}
     assert sizes == {"obj1": [30, 30, 30], "obj2": [30, 60, 60], "obj3": [60, 60, 60], "obj4": [100, 60, 100]}
     alpha, beta = study["grid"]["alpha_deg"], study["grid"]["beta_deg"]
     n_alpha = (alpha["stop"] - alpha["start"]) / alpha["step"] + 1
@@ -76,7 +76,9 @@ def _broken(path, value, config=SMALL):
         (("mechanics", "muu"), 1.5, "'mechanics': unknown key(s) ['muu']"),
         (("mechanics", "mu"), "high", "'mechanics.mu': 'high' is not of type 'number'"),
         (("mechanics", "mu"), -1.0, "'mechanics.mu'"),
-        (("objects", "obj1", "size_mm"), [30, -1, 30], "'objects.obj1.size_mm[1]'"),
+        (("objects", "obj1", "shape", "box", "size_mm"), [30, -1, 30], "'objects.obj1.shape.box.size_mm[1]'"),
+        (("objects", "obj1", "shape"), {"cone": {"size_mm": [1, 2, 3]}}, "'objects.obj1.shape': unknown key(s) ['cone']"),
+        (("objects", "obj1", "size_mm"), [30, 30, 30], "'objects.obj1': unknown key(s) ['size_mm']"),
         (("objects", "obj1", "mass_kg"), 0, "'objects.obj1.mass_kg'"),
         (("objects", "obj1", "mass_kg"), _DELETE, "'objects.obj1': 'mass_kg' is a required property"),
         (("solver", "method"), "newton", "'solver': unknown key(s) ['method']"),

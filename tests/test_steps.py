@@ -112,7 +112,7 @@ def test_step_params_are_built_from_the_steps_own_keys_only(model):
     sim = step_params(step_config(full, "simulate", "obj4"), "simulate", "obj4")
     assert sim.placement.mode == "approach" and sim.placement.box_axes == (1, 0, 2)
     assert sim.placement.alpha_deg == (-180.0, 175.0, 5.0)
-    assert sim.closure.step_mm == 8.0 and (sim.box.mass_kg is None) == (model == "kinematic")
+    assert sim.closure.step_mm == 8.0 and (sim.object.mass_kg is None) == (model == "kinematic")
 
 
 def test_the_closure_is_handed_the_mean_posture_and_s1_only():

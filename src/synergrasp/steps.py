@@ -112,7 +112,7 @@ STEPS: dict[str, Step] = {
     "search": Step(
         rules={}, outputs={"placement": "placement.csv"}, scope="object",
         reads=("hand", "synergies", "grid", "placement", "closure", "mechanics", "synergy_sets.incremental_max",
-               "objects.{object}.size_mm", "objects.{object}.mass_kg", "objects.{object}.placement"),
+               "objects.{object}.shape", "objects.{object}.mass_kg", "objects.{object}.placement"),
         not_reads=("closure.model", "closure.dynamic",
                    *(f"{where}.{key}" for where in ("placement", "objects.{object}.placement")
                      for key in _PLACEMENT_TARGETS)),
@@ -120,7 +120,7 @@ STEPS: dict[str, Step] = {
     "simulate": Step(
         rules={"simulate_contacts": Cost("closure_pose", 1.5, 178, 4.5e-2, 7.6e-3, local=False)},
         outputs={"contacts": "contacts.parquet"}, scope="object",
-        reads=("hand", "synergies", "grid", "placement", "closure", "objects.{object}.size_mm",
+        reads=("hand", "synergies", "grid", "placement", "closure", "objects.{object}.shape",
                "objects.{object}.placement"),
         # the dynamic closure: a free box of the object's mass, μ, k_ss and gravity of mechanics
         reads_when=(("closure.model", "dynamic", ("objects.{object}.mass_kg", "mechanics")),),
@@ -171,7 +171,7 @@ STEPS: dict[str, Step] = {
     "fig2": Step(
         rules={"fig2_example_grasps": Cost("none", 2.3, 311)},
         outputs=_files(("fig2_example_grasps",), "figures", _PNG_PDF),
-        reads=("hand", "objects.*.size_mm"), upstream=("contacts",),
+        reads=("hand", "objects.*.shape"), upstream=("contacts",),
         params="synergrasp.figures.hand_figures:Fig2Params"),
     "fig4": Step(
         rules={"fig4_force_maps": Cost("pose_set", 4.3, 257, 5.1e-6, 4.0e-4)},

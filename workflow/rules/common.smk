@@ -22,12 +22,14 @@ def scenario(name):
     any job runs (config/README.md): `figures` reads the default only, `sensitivity` all."""
     from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import load_synergies
+    from synergrasp.simulation.objects import object_problems
 
     try:
         cfg = checked_scenario_config(config, name)
         synergies = load_synergies(cfg["synergies"], joint_names=load_hand(cfg["hand"]).joint_names)
         problems = check_relations(cfg, synergies.matrix.shape[1])
         problems += synergy_problems(cfg, synergies.mean, synergies.matrix)
+        problems += object_problems(cfg)
         if problems:
             where = "" if name == "default" else f"scenario '{name}': "
             raise ConfigError("\n".join(where + p for p in problems))

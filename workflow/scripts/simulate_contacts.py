@@ -8,6 +8,6 @@ from synergrasp.simulation.contacts import write_contacts
 with job_log(snakemake.log[0]):
     sim = SimulateParams.from_config(snakemake.params.cfg, snakemake.wildcards.object)
     hand = load_hand(sim.hand)
-    table = simulate_object(hand, sim.synergies(hand.joint_names), sim.box, sim.placement, sim.closure,
+    table = simulate_object(hand, sim.synergies(hand.joint_names), sim.object, sim.placement, sim.closure,
                             mechanics=sim.mechanics)
     write_contacts(table, snakemake.output[0])

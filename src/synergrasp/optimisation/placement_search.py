@@ -29,7 +29,7 @@ from synergrasp.optimisation.problem import SynergySets
 from synergrasp.optimisation.study import GFOParams, optimise_grasps, read_grasps
 from synergrasp.simulation.contacts import contacts_row, contacts_table
 from synergrasp.simulation.closure_params import ClosureParams
-from synergrasp.simulation.objects import Box
+from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.placement import Placement, palm_centre, pose_grid
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -89,13 +89,13 @@ class SearchParams:
 @dataclass(frozen=True)
 class SearchStepParams:
     """The placement search of one object (the ``search`` step; docs/placement_search.md):
-    hand and synergy files, the box with its mass, its effective placement, the closure
+    hand and synergy files, the object with its mass, its effective placement, the closure
     settings (the search closes with the kinematic model), the GFO parameters, the size of
     the full synergy set, the search's settings."""
 
     hand: str | None
     synergies: str | None
-    box: Box
+    object: GraspedObject
     placement: Placement
     closure: ClosureParams
     gfo: GFOParams
@@ -113,7 +113,7 @@ class SearchStepParams:
             SearchParams, {k: v for k, v in spec.items() if k != "region_mm"}))
         closure = {**config["closure"], "model": "kinematic"}
         return cls(
-            hand=config["hand"], synergies=config["synergies"], box=Box.from_config(config, obj),
+            hand=config["hand"], synergies=config["synergies"], object=GraspedObject.from_config(config, obj),
             # the search places the box toward each of its targets: the modes' own targets are not read
             placement=Placement.from_config({**placement, "mode": "searched", "approach_point_mm": None,
                                              "center_mm": (0.0, 0.0, 0.0)}, config["grid"]),
@@ -247,15 +247,14 @@ class TargetScorer:
 
     def contacts(self, target_mm: Sequence[float]) -> pd.DataFrame:
         """The contacts table of the scored poses with the box placed toward ``target_mm``."""
-        from synergrasp.simulation.closure import place_box
+        from synergrasp.simulation.closure import place_object
 
         placement = replace(self.placement, mode="searched", target_mm=tuple(float(v) for v in target_mm))
-        size = np.asarray(self.box.size_mm, dtype=float)
         rows = []
         for pose in self.poses:
             a, b = self.grid.angles_deg(pose)
-            placed = place_box(self.placer, self.model.q_open, placement, size, a, b)
-            rows.append(contacts_row(str(self.box.name), pose, a, b, self.model.grasp(size, placed), placed))
+            placed = place_object(self.placer, self.model.q_open, placement, self.box.shape, a, b)
+            rows.append(contacts_row(str(self.box.name), pose, a, b, self.model.grasp(placed), placed))
         return contacts_table(rows)
 
     def __call__(self, target_mm: Sequence[float]) -> TargetScore:
