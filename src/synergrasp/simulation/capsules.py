@@ -20,6 +20,8 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from synergrasp.simulation.shapes.kernels import segment_cylinder, segment_sphere
+
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
 
@@ -229,8 +231,13 @@ def _capsule_to_box(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray
 def _seg_object(p0: NDArray, d: NDArray, code: int, params: NDArray, work: NDArray) -> tuple[float, float]:
     """Signed distance (mm) from the segment p0 + t·d, t in [0, 1] (the object's own frame),
     to the object's shape (``code``, ``params``: ``synergrasp.simulation.shapes``) and the t
-    attaining it; ``work`` is scratch space of 8 values. 0: a box, params its half extents."""
-    return _seg_box_into(p0, d, params, work)
+    attaining it; ``work`` is scratch space of 8 values. 0: a box, params its half extents;
+    1: a sphere about the origin, (radius); 2: a cylinder about the z axis, (radius, half height)."""
+    if code == 0:
+        return _seg_box_into(p0, d, params, work)
+    if code == 1:
+        return segment_sphere(p0, d, params[0])
+    return segment_cylinder(p0, d, params[0], params[1], work)
 
 
 @numba.njit(cache=True)
