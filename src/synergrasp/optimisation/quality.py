@@ -126,6 +126,7 @@ def synergy_manipulability(grasp: Grasp, synergies: NDArray, length_mm: float,
     if null.shape[1] == 0:
         return np.zeros(6)
     axes = np.linalg.svd(Gt_pinv @ JS @ null, compute_uv=False)
+    axes = axes[axes > rtol * max(float(np.max(np.abs(JS))), 1.0)]  # round-off of an empty direction
     out = np.zeros(6)
     out[: min(6, axes.size)] = axes[:6]
     return out
