@@ -2,7 +2,8 @@
 #   make venv           - build .venv from environment.lock only
 #   make study          - build .venv from environment.lock, then run the full study
 #   make test           - build .venv from environment.lock, then run the test suite
-#   make lint           - snakefmt --check and snakemake --lint (conda/container advice aside)
+#   make lint           - snakefmt --check, snakemake --lint (conda/container advice aside) and
+#                         the package's layers and no import circle (import-linter, pyproject.toml)
 #   make cluster-test   - the small study on a single-node SLURM started here (root; installs SLURM)
 PYTHON ?= python3.11
 VENV   ?= .venv
@@ -19,7 +20,8 @@ $(BIN)/.installed: environment.lock pyproject.toml
 
 venv: $(BIN)/.installed
 
-# Compiled solver code is cached next to the source; build it once here, not in every job.
+# Compiled solver code is cached per user, named by the kernel sources' hash (any checkout path
+# loads it); build it once here, not in every job.
 WARM_UP = $(BIN)/python -c "from synergrasp.optimisation.gfo import warm_up; warm_up()"
 
 study: $(BIN)/.installed
@@ -37,16 +39,19 @@ test: $(BIN)/.installed
 lint: $(BIN)/.installed
 	$(BIN)/snakefmt --check Snakefile workflow
 	$(BIN)/python tools/check_lint.py
+	$(BIN)/lint-imports
 
 cluster-test: $(BIN)/.installed
 	$(WARM_UP)
 	tools/cluster_test.sh $(BIN)
 
-# One core, as the targets are stated per core.
+# One core, as the targets are stated per core. bench_study describes the last `make study`.
 bench: $(BIN)/.installed
+	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_compile.py
 	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_gfo.py
 	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_pyramid.py
 	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_closure.py
+	$(BIN)/python benchmarks/bench_study.py --root results
 
 # Regenerate the pinned, hashed lock from pyproject.toml (Python 3.11, Linux x86_64).
 lock:

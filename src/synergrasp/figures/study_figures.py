@@ -7,8 +7,11 @@ Forces are in N; angles in deg.
 
 from __future__ import annotations
 
+import math
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
 from pathlib import Path
 
 import matplotlib
@@ -17,12 +20,14 @@ matplotlib.use("Agg")  # headless: figures are files, never windows
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
-import seaborn as sns  # noqa: E402
 
-from synergrasp.config import incremental_set_id  # noqa: E402
+from synergrasp.analysis.verdicts import force_bound  # noqa: E402
+from synergrasp.ids import incremental_set_id  # noqa: E402
 from synergrasp.figures.output import save_figure  # noqa: E402
 
 __all__ = [
+    "Fig4Params",
+    "Fig5Params",
     "force_grid",
     "figure_force_maps",
     "figure_exploded_views",
@@ -32,6 +37,38 @@ __all__ = [
     "canonical_rulegraph",
     "figure_rulegraph",
 ]
+
+
+@dataclass(frozen=True)
+class Fig4Params:
+    """Fig. 4 of one object (the ``fig4`` step): the success verdict, the k of the
+    incremental sets drawn, the α and β (deg) of the exploded views' slices and, for
+    ``force_closure_bounded``, the object's weight (N) and the bound's multiple of it."""
+
+    success: str
+    panel_k: tuple[int, ...]
+    alpha_slice_deg: float
+    beta_slice_deg: float
+    weight_N: float | None = None
+    bound_multiple: float = math.inf
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str) -> Fig4Params:
+        fig4 = config["analyses"]["fig4"]
+        return cls(config["analyses"]["success"], tuple(fig4["panel_k"]), fig4["alpha_slice_deg"],
+                   fig4["beta_slice_deg"], **force_bound(config, obj))
+
+
+@dataclass(frozen=True)
+class Fig5Params:
+    """Fig. 5 (the ``fig5`` step): the success verdict and S1..S_first of the hierarchy sets."""
+
+    success: str
+    hierarchy_first: int
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> Fig5Params:
+        return cls(config["analyses"]["success"], config["synergy_sets"]["hierarchy_first"])
 
 
 def force_grid(gfo: pd.DataFrame, set_id: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -99,7 +136,9 @@ def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: 
     β = ``beta_deg`` (nearest grid values), one line per {S1..Sk}; gaps where the pose is
     not a success of ``verdict``."""
     fig, (ax_b, ax_a) = plt.subplots(1, 2, figsize=(11, 3.8))
-    palette = sns.color_palette("viridis", len(panel_k))
+    # viridis sampled as seaborn's color_palette("viridis", n) does (importing seaborn cost
+    # the job more CPU than drawing: it imports scipy.stats)
+    palette = matplotlib.colormaps["viridis"](np.linspace(0.0, 1.0, len(panel_k) + 2)[1:-1])[:, :3]
     for colour, k in zip(palette, panel_k):
         alphas, betas, force = force_grid(gfo, incremental_set_id(k))
         ia = int(np.argmin(np.abs(((alphas - alpha_deg) + 180.0) % 360.0 - 180.0)))

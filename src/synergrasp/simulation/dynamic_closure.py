@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 from collections import deque
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -40,76 +39,12 @@ from synergrasp.simulation.placement import ObjectPose
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
-    from synergrasp.simulation.closure import ClosureParams
+    from synergrasp.simulation.closure_params import ClosureParams
+    from synergrasp.simulation.shapes import Shape
 
-__all__ = ["DynamicParams", "DynamicClosure", "compliant_self_pairs"]
+__all__ = ["DynamicClosure", "compliant_self_pairs"]
 
 _LONG_FINGERS = ("index", "middle", "ring", "little")
-
-
-@dataclass(frozen=True)
-class DynamicParams:
-    """Settings of the dynamic closure (config ``closure.dynamic``; docs/dynamic_closure.md).
-
-    The values are checked once, by the config schema and ``config.check_relations``; this
-    class only carries them.
-
-    time_step_s:           physics time step, s.
-    solver_iterations:     constraint-solver iterations per step.
-    link_mass_kg:          mass of every elementary hand link during the closure, kg.
-    link_inertia_kg_mm2:   rotational inertia of every elementary hand link about its own
-                           frame, kg·mm² (sets the fastest joint mode: √(k_ss / I)).
-    joint_damping_Nmm_s_per_rad: viscous damping on every elementary axis, N·mm·s/rad.
-    object_mass_kg:        mass of the box during the closure, kg (its weight, if gravity is
-                           on, is still mass_kg · g: see ``gravity``).
-    object_damping_per_s:  linear and angular drag rate of the box, 1/s.
-    ramp_time_s:           time over which σ runs from the open to the closed end, s.
-    time_limit_s:          the closure stops here if it has not settled, s.
-    settle_window_s:       settled when, over the last window of this length (s) after the
-                           ramp, ...
-    settle_joint_change_rad: ... no joint angle q changed by more than this (rad) ...
-    settle_object_change_mm: ... and no point of the box moved by more than this (mm:
-                           displacement of the centre + rotation angle × half diagonal).
-    hand_hand_mu:          friction between two hand links (hand–box friction is mechanics.mu).
-    gravity:               the box's weight acts during the closure (along
-                           mechanics.gravity_direction) if true.
-    lost_distance_mm:      a box with no contact at the end that moved farther than this from
-                           its initial pose was moved by the hand and is held by nothing:
-                           ``caged`` if its centre is inside the closed hand
-                           (``HandCapsules.encloses``), ``lost`` (pushed out) if not.
-
-    Every hand link touching the box is listed with the normal force it carries; which of
-    them count (``closure.dynamic.unloaded_contacts``) is decided downstream
-    (``synergrasp.simulation.contacts.load_carrying_contacts``), so both choices share one closure.
-    """
-
-    time_step_s: float
-    solver_iterations: int
-    link_mass_kg: float
-    link_inertia_kg_mm2: float
-    joint_damping_Nmm_s_per_rad: float
-    object_mass_kg: float
-    object_damping_per_s: float
-    ramp_time_s: float
-    time_limit_s: float
-    settle_window_s: float
-    settle_joint_change_rad: float
-    settle_object_change_mm: float
-    hand_hand_mu: float
-    gravity: bool
-    lost_distance_mm: float
-
-    @property
-    def ramp_steps(self) -> int:
-        return max(1, int(round(self.ramp_time_s / self.time_step_s)))
-
-    @property
-    def max_steps(self) -> int:
-        return max(self.ramp_steps, int(round(self.time_limit_s / self.time_step_s)))
-
-    @property
-    def window_steps(self) -> int:
-        return max(1, int(round(self.settle_window_s / self.time_step_s)))
 
 
 def compliant_self_pairs(hand: Any) -> tuple[tuple[int, int], ...]:
@@ -175,8 +110,8 @@ class DynamicClosure:
         self.q_open = self.path.reference(self.sigma_open)
         self.self_pairs = self._colliding_pairs()
         self.capsules = HandCapsules.of(hand)
-        self.box: int | None = None
-        self.box_size: NDArray | None = None
+        self.box: int | None = None  # the object's body
+        self.shape: Shape | None = None
 
     def close(self) -> None:
         self.bullet.disconnect(self.client)
@@ -185,14 +120,13 @@ class DynamicClosure:
         """Joint angles (rad) from the elementary axes' angles: q_j = Σ θ_i over the axes of joint j."""
         return self.axis_sum @ axis_values
 
-    def _place(self, size_mm: NDArray, placed: Any) -> None:
-        size = np.asarray(size_mm, dtype=float)
-        if self.box is None or self.box_size is None or not np.array_equal(size, self.box_size):
+    def _place(self, placed: ObjectPose) -> None:
+        if self.box is None or self.shape != placed.shape:
             if self.box is not None:
                 self.bullet.remove_body(self.client, self.box)
-            self.box = self.bullet.load_free_box(self.client, size, self.params.object_mass_kg,
-                                                 self.mu / self.link_friction, self.params.object_damping_per_s)
-            self.box_size = size
+            self.box = self.bullet.load_free_object(self.client, placed.shape, self.params.object_mass_kg,
+                                                    self.mu / self.link_friction, self.params.object_damping_per_s)
+            self.shape = placed.shape
         self.bullet.reset_body(self.client, self.box, placed.center_mm, placed.rotation)
 
     def _colliding_pairs(self) -> tuple[tuple[int, int], ...]:
@@ -207,19 +141,20 @@ class DynamicClosure:
         b.set_self_collision(self.client, self.body, kept)
         return kept
 
-    def grasp(self, size_mm: NDArray, placed: ObjectPose) -> ClosureResult:
-        """Close the hand from q_r(σ_open) to q_r(σ_closed) (the fully open hand to the end of S1) on a free box of ``size_mm`` (mm)
-        placed at ``placed``; the contacts of its settled state."""
+    def grasp(self, placed: ObjectPose) -> ClosureResult:
+        """Close the hand from q_r(σ_open) to q_r(σ_closed) (the fully open hand to the end of
+        S1) on the free object ``placed`` (its shape at its starting pose); the contacts of its
+        settled state."""
         p, b, c = self.params, self.bullet, self.closure
         q_open = self.q_open
         sigma_open, sigma_closed = self.sigma_open, self.sigma_closed
-        self._place(size_mm, placed)
+        self._place(placed)
         b.reset_hand(self.client, self.body, q_open)
         gaps = b.closest_points(self.client, self.box, self.body, c.contact_distance_mm)
         if len(gaps) and float(gaps.distance.min()) < -c.penetration_tolerance_mm:
             return self._result("intersects_open_hand", q_open, (), None, True)
         weight = self.weight if p.gravity else None
-        radius = float(np.linalg.norm(placed.half_extents_mm))
+        radius = placed.shape.bounding_radius_mm
         settled, steps = False, p.max_steps
         scale, axis_joint = self.axis_scale, self.axis_joint
         target = scale * q_open[axis_joint]
@@ -275,7 +210,7 @@ class DynamicClosure:
         theta, _ = b.axis_states(self.client, self.body)
         q = self.joint_values(theta)
         center, rotation, _, _ = b.body_state(self.client, self.box)
-        now = ObjectPose(center, rotation, placed.half_extents_mm)
+        now = ObjectPose(center, rotation, placed.shape)
         forces = b.contact_forces(self.client, self.box, self.body)
         near = b.closest_points(self.client, self.box, self.body, self.closure.contact_distance_mm)
         touching = sorted({int(v) for v in near.link_b if v >= 0})
