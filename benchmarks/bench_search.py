@@ -16,11 +16,11 @@ import time
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 from synergrasp.analysis.periods import alpha_period_deg  # noqa: E402
-from synergrasp.config import defaults, step_params  # noqa: E402
+from synergrasp.config import defaults  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
 from synergrasp.optimisation.gfo import warm_up  # noqa: E402
-from synergrasp.simulation.placement_search import full_synergy_set, search_object  # noqa: E402
+from synergrasp.optimisation.placement_search import SearchStepParams, full_synergy_set, search_object  # noqa: E402
 
 
 def _cpu_s() -> float:
@@ -32,7 +32,7 @@ def main(objects: list[str], processes: int = 2) -> None:
     study = defaults()
     warm_up()
     for name in objects or list(study["objects"]):
-        sim = step_params(study, "search", name)
+        sim = SearchStepParams.from_config(study, name)
         hand = load_hand(sim.hand)
         synergies = load_synergies(sim.synergies, joint_names=hand.joint_names)
         period = alpha_period_deg(sim.placement, sim.object.shape, hand.palm_normal)

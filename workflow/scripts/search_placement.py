@@ -2,14 +2,13 @@
 
 from synergrasp import tables
 from synergrasp.analysis.periods import alpha_period_deg
-from synergrasp.config import step_params
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
-from synergrasp.simulation.placement_search import full_synergy_set, search_object
+from synergrasp.optimisation.placement_search import SearchStepParams, full_synergy_set, search_object
 
 with job_log(snakemake.log[0]):
-    sim = step_params(snakemake.params.cfg, "search", snakemake.wildcards.object)
+    sim = SearchStepParams.from_config(snakemake.params.cfg, snakemake.wildcards.object)
     hand = load_hand(sim.hand)
     synergies = load_synergies(sim.synergies, joint_names=hand.joint_names)
     period = alpha_period_deg(sim.placement, sim.object.shape, hand.palm_normal)
