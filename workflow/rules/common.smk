@@ -134,9 +134,7 @@ def placement_label(name):
     roots = {step_root(name, "search", o) for o in cfg["objects"] if searched(name, o)}
     own = SCENARIO_ROOT[name] in roots
     where = (
-        "own search"
-        if own
-        else "targets of " + ", ".join(sorted(_ROOT_SCENARIO[r] for r in roots))
+        "own search" if own else "targets of " + ", ".join(sorted(_ROOT_SCENARIO[r] for r in roots))
     )
     return f"searched, rank {cfg['placement']['search_rank']} ({where})"
 

@@ -37,6 +37,6 @@ rule sensitivity_summary:
         runtime=runtime_min("sensitivity_summary"),
     params:
         scenarios=list(SCENARIOS),
-        placements=[placement_label(s) for s in SCENARIOS],
+        placements=lambda wildcards: [placement_label(s) for s in SCENARIOS],
     script:
         "../scripts/sensitivity_summary.py"
