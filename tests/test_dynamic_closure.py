@@ -247,3 +247,33 @@ def test_thumb_index_pinch_of_a_small_box_settles_with_a_near_zero_net_wrench(ha
         assert np.linalg.norm(moment) <= 0.05 * scale * edge / 2
     finally:
         model.close()
+
+
+def test_a_held_box_stays_put_and_the_fingers_settle_on_it_in_equilibrium(hand, synergies):
+    """The pose of test_a_box_pushed_out_of_the_hand_is_lost with ``object: held``: the box
+    cannot move, so the same closing fingers end on it, at rest, carrying load; its pose is
+    unchanged to the last digit. The end state is an equilibrium of the soft-synergy hand: the
+    torque residual of the recorded contacts (synergrasp.optimisation.equilibrium, an
+    independent model of the balance) is below 10 % (measured: 2.3 %)."""
+    from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
+
+    box = Box("obj4", (100.0, 60.0, 100.0), 1.0)
+    placement = study_placement(mode="fixed", center_mm=(90.0, 5.0, 112.0), box_axes=(1, 0, 2))
+    params = study_closure_params(model="dynamic", dynamic=study_dynamic_params(object="held"))
+    rows = simulate_object(hand, synergies, box, placement, params, poses=[4], mechanics=MECHANICS)
+    row = rows.iloc[0]
+    assert row["status"] == "grasp" and row["settled"] and row["n_contacts"] >= 1
+    assert row["closure_model"] == "dynamic_held"
+    assert np.all(np.asarray(row["contact_normal_force_N"]) > 0.01)
+    assert np.array_equal(row["object_center"], placement.center_mm) and row["object_rotation_deg"] == 0.0
+    assert np.array_equal(row["object_translation_mm"], np.zeros(3))
+    checks = grasp_equilibrium(rows, EquilibriumParams.of(hand, synergies, MECHANICS["k_ss_Nmm_per_rad"],
+                                                          MECHANICS["mu"]), synergies.columns([1])[:, 0])
+    assert checks["torque_residual"].iloc[0] < 0.1
+
+
+def test_the_held_setting_is_a_checked_key():
+    with pytest.raises(ConfigError, match=r"'closure.dynamic.object': 'fixed' is not allowed; allowed values: \['free', 'held'\]"):
+        validate_config(_with_dynamic(object="fixed"))
+    assert step_params(validate_config(_with_dynamic(object="held")), "simulate", "obj1").closure.dynamic.held
+    assert not step_params(defaults(), "simulate", "obj1").closure.dynamic.held

@@ -396,7 +396,8 @@ STEP_KEYS: dict[str, tuple[str, ...]] = {
     "tables": ("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max", "analyses.success",
                "analyses.marginal_weight_multiple", "analyses.success_rate_tolerance_percent",
                "analyses.null_model", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
-    "realism": ("hand", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2"),
+    "realism": ("hand", "synergies", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2",
+                "mechanics.k_ss_Nmm_per_rad", "mechanics.mu"),
     "fig1": ("hand", "synergies"),
     "fig2": ("hand", "objects.*.size_mm"),
     "fig4": ("analyses.fig4", "analyses.success"),
@@ -427,7 +428,7 @@ OBJECT_STEPS: frozenset[str] = frozenset({"simulate", "contacts", "optimise", "m
 #: Steps that read only some synergies of the synergy table: step -> the synergies (1-based)
 #: it reads besides the mean posture. Their hash holds those values, not the table's name,
 #: so tables that agree there (thumb readings that differ in S2…S15 only) share the step.
-SYNERGY_COLUMNS_READ: dict[str, tuple[int, ...]] = {"simulate": (1,)}
+SYNERGY_COLUMNS_READ: dict[str, tuple[int, ...]] = {"simulate": (1,), "realism": (1,)}
 #: Keys read by the workflow itself, not by a step.
 WORKFLOW_KEYS: tuple[str, ...] = ("scenarios",)
 
@@ -561,12 +562,16 @@ class ContactsParams:
 
 @dataclass(frozen=True)
 class RealismParams:
-    """The grasp-realism table: hand file, the full set's id, each object's weight (N), and
-    the least normal force (N) of a load-carrying contact (None: the model records no loads)."""
+    """The grasp-realism table: hand and synergy files, the full set's id, each object's weight
+    (N), the least normal force (N) of a load-carrying contact (None: the model records no
+    loads), and for the equilibrium checks the joint stiffness k_ss (N·mm/rad) and μ."""
     hand: str | None
+    synergies: str | None
     full_set_id: str
     weights_N: dict[str, float]
     load_threshold_N: float | None
+    k_ss_Nmm_per_rad: float
+    mu: float
 
 
 @dataclass(frozen=True)
@@ -698,10 +703,12 @@ def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) ->
     if step == "tables":
         return _tables(config)
     if step == "realism":
-        g = config["mechanics"]["g_m_per_s2"]
-        return RealismParams(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),
-                             {name: spec["mass_kg"] * g for name, spec in config["objects"].items()},
-                             config.get("closure", {}).get("dynamic", {}).get("load_threshold_N"))
+        mechanics = config["mechanics"]
+        return RealismParams(config["hand"], config["synergies"],
+                             incremental_set_id(config["synergy_sets"]["incremental_max"]),
+                             {name: spec["mass_kg"] * mechanics["g_m_per_s2"] for name, spec in config["objects"].items()},
+                             config.get("closure", {}).get("dynamic", {}).get("load_threshold_N"),
+                             float(mechanics["k_ss_Nmm_per_rad"]), float(mechanics["mu"]))
     if step in ("fig1", "fig2", "fig4", "fig5"):
         return _figures(config, step)
     raise ValueError(f"unknown step {step!r}; allowed values: {sorted(STEP_KEYS)}")

@@ -78,7 +78,8 @@ CONTACTS = Table("contacts", "one row per pose", _pose_columns() + (
     Column("object_center", "list<float64>", "mm", "box centre, palm frame (3)"),
     Column("object_rotation", "list<float64>", "", "box orientation, row-major rotation matrix (9)"),
     Column("max_penetration_mm", "float64", "mm", "deepest contact penetration"),
-    Column("closure_model", "string", "", "closure model that made the row: kinematic or dynamic"),
+    Column("closure_model", "string", "", "closure model that made the row: kinematic, dynamic (a free box) "
+           "or dynamic_held (closure.dynamic.object: held)"),
     Column("contact_normal_force_N", "list<float64>", "N",
            "normal force each contact carries at the settled state (m; NaN for the kinematic model)"),
     Column("object_translation_mm", "list<float64>", "mm",
@@ -126,6 +127,10 @@ def _realism_columns() -> tuple[Column, ...]:
         Column("pct_thumb", "float64", "%", "grasps with a contact on a thumb link"),
         Column("pct_palm", "float64", "%", "grasps with a contact on the palm"),
         Column("pct_proximal_or_middle", "float64", "%", "grasps with a contact on a proximal or middle phalanx"),
+        Column("pct_index", "float64", "%", "grasps with a contact on an index-finger link"),
+        Column("pct_middle", "float64", "%", "grasps with a contact on a middle-finger link"),
+        Column("pct_ring", "float64", "%", "grasps with a contact on a ring-finger link"),
+        Column("pct_little", "float64", "%", "grasps with a contact on a little-finger link"),
         Column("pct_rank6", "float64", "%", "grasps whose grasp matrix G has rank 6"),
         Column("pct_force_closure", "float64", "%",
                "grasps in force closure (rank(G) = 6 and the strict internal-force test) with every synergy"),
@@ -135,6 +140,13 @@ def _realism_columns() -> tuple[Column, ...]:
                "median optimal contact-force norm with every synergy over the force-closure grasps, in multiples of the weight m*g"),
         Column("loaded_contacts_median", "float64", "",
                "median contacts per grasp carrying normal force (NaN without per-contact forces)"),
+        Column("median_torque_residual", "float64", "",
+               "median relative torque residual of the end state, min over f in the friction cones of "
+               "|tau_B - J_B^T f| / |tau_B|, tau = k_ss (q_r - q) on the joints moving a box contact "
+               "(synergrasp.optimisation.equilibrium)"),
+        Column("pct_s1_outside_cone", "float64", "%",
+               "grasps with a contact that S1's closing motion J S1 pushes outside its friction cone "
+               "(angle to the inward normal > atan mu)"),
     )
 
 

@@ -68,6 +68,8 @@ rule grasp_realism:
             category="Tables",
         ),
         md="{root}/tables/grasp_realism.md",
+        links_csv="{root}/tables/grasp_links.csv",
+        links_md="{root}/tables/grasp_links.md",
         png=report(
             "{root}/figures/grasp_realism.png",
             caption="../report/grasp_realism.rst",

@@ -1,20 +1,28 @@
-"""The grasp-realism table and figure: how the simulated grasps touch the boxes."""
+"""The grasp-realism table and figure: how the simulated grasps touch the boxes, and whether
+their end states are equilibria of the soft-synergy hand."""
 
 import pandas as pd
 
 from synergrasp import tables
-from synergrasp.analysis.realism import grasp_realism
+from synergrasp.analysis.realism import grasp_realism, link_shares
 from synergrasp.config import step_params
 from synergrasp.figures.grasp_realism import figure_grasp_realism
 from synergrasp.hand.kinematics import load_hand
+from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
+from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
 
 with job_log(snakemake.log[0]):
     params = step_params(snakemake.params.cfg, "realism")
     hand = load_hand(params.hand)
+    synergies = load_synergies(params.synergies, joint_names=hand.joint_names)
     contacts = pd.concat([tables.read(tables.CONTACTS, p) for p in snakemake.input.contacts], ignore_index=True)
     gfo = pd.concat([tables.read(tables.GFO, p) for p in snakemake.input.gfo], ignore_index=True)
-    table = grasp_realism(contacts, gfo, hand.link_names, hand.link_finger, params.full_set_id, params.weights_N,
-                          params.load_threshold_N)
+    checks = grasp_equilibrium(contacts, EquilibriumParams.of(hand, synergies, params.k_ss_Nmm_per_rad, params.mu),
+                               synergies.columns([1])[:, 0])
+    table = grasp_realism(contacts, gfo, checks, hand.link_names, hand.link_finger, params.full_set_id,
+                          params.weights_N, params.load_threshold_N)
     tables.write_study_table(table, snakemake.output.csv, snakemake.output.md, title="Grasp realism")
+    tables.write_study_table(link_shares(contacts, hand.link_names, hand.link_finger), snakemake.output.links_csv,
+                             snakemake.output.links_md, title="Which links touch the box (% of simulated grasps)")
     figure_grasp_realism(table, snakemake.output.png, snakemake.output.pdf)

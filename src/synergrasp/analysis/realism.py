@@ -19,8 +19,8 @@ import pandas as pd
 from synergrasp.analysis.verdicts import verdict_columns
 from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 
-__all__ = ["SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "link_categories", "grasp_realism",
-           "representative_grasps"]
+__all__ = ["SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "LONG_FINGERS", "link_categories",
+           "grasp_realism", "link_shares", "representative_grasps"]
 
 #: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.STATUSES): a
 #: ``no_contact`` closure is a simulated grasp with 0 contacts; any other status is a dropped pose.
@@ -29,18 +29,23 @@ SIMULATED_STATUSES: tuple[str, ...] = ("grasp", "no_contact")
 CONTACT_BINS: tuple[int, ...] = (0, 1, 2, 3, 4, 5, 6)
 #: Contacts column: normal force per contact, N (NaN entries where the model computes none).
 NORMAL_FORCE_COLUMN = "contact_normal_force_N"
+#: The long fingers, each a column of the table (grasps touching the box with that finger).
+LONG_FINGERS: tuple[str, ...] = ("index", "middle", "ring", "little")
 #: Segments (the part of a link name after the finger) counted as proximal or middle phalanges.
 _PROXIMAL_OR_MIDDLE = ("proximal", "middle")
 
 
 def link_categories(link_names: Sequence[str], link_finger: Sequence[str]) -> dict[str, frozenset[int]]:
     """Hand link indices per category: ``thumb`` (every thumb link), ``palm`` (links of the
-    palm), ``proximal_or_middle`` (links named ``<finger>_proximal`` or ``<finger>_middle``)."""
-    thumb = frozenset(i for i, f in enumerate(link_finger) if f == "thumb")
-    palm = frozenset(i for i, f in enumerate(link_finger) if f == "palm")
+    palm), ``proximal_or_middle`` (links named ``<finger>_proximal`` or ``<finger>_middle``),
+    and every long finger's links (``index``, ``middle``, ``ring``, ``little``)."""
+    def finger(name: str) -> frozenset[int]:
+        return frozenset(i for i, f in enumerate(link_finger) if f == name)
+
     phalanx = frozenset(i for i, (name, f) in enumerate(zip(link_names, link_finger))
                         if f != "palm" and name.rsplit("_", 1)[-1] in _PROXIMAL_OR_MIDDLE)
-    return {"thumb": thumb, "palm": palm, "proximal_or_middle": phalanx}
+    return {"thumb": finger("thumb"), "palm": finger("palm"), "proximal_or_middle": phalanx,
+            **{name: finger(name) for name in LONG_FINGERS}}
 
 
 def _touches(links: pd.Series, category: frozenset[int]) -> pd.Series:
@@ -99,6 +104,8 @@ def _one_group(rows: pd.DataFrame, categories: dict[str, frozenset[int]]) -> dic
     out["pct_force_closure"] = share(grasps["force_closure"].fillna(False).astype(bool))
     out["pct_load_feasible"] = share(grasps["load_feasible"].fillna(False).astype(bool))
     out["median_force_per_weight"] = float(grasps["force_per_weight"].median()) if n else np.nan
+    out["median_torque_residual"] = float(grasps["torque_residual"].median()) if n else np.nan
+    out["pct_s1_outside_cone"] = share(grasps["s1_outside_cone"].fillna(0) > 0)
     loaded = grasps["loaded_contacts"]
     known = loaded[grasps["n_contacts"] > 0].notna().any()  # forces recorded where there are contacts
     out["loaded_contacts_median"] = float(loaded.median()) if known else np.nan
@@ -109,14 +116,19 @@ def _bin_column(b: int) -> str:
     return f"pct_m{b}plus" if b == CONTACT_BINS[-1] else f"pct_m{b}"
 
 
-def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequence[str], link_finger: Sequence[str],
-                  full_set_id: str, weights_N: Mapping[str, float], load_threshold_N: float | None) -> pd.DataFrame:
+def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, equilibrium: pd.DataFrame, link_names: Sequence[str],
+                  link_finger: Sequence[str], full_set_id: str, weights_N: Mapping[str, float],
+                  load_threshold_N: float | None) -> pd.DataFrame:
     """The grasp-realism table (columns of :data:`synergrasp.tables.GRASP_REALISM`).
 
     ``contacts``: contacts tables of the objects (CONTACTS contract; rows are grouped by
     ``closure_model``, loads read from ``contact_normal_force_N``, N).
     ``gfo``: their optimisation results (joined on ``closure_model`` too when it has that
     column); rank(G), force closure and ‖f‖₂ are taken from the full set ``full_set_id`` (e.g. ``"1-2-…-15"``). ``weights_N``: m·g per object, N.
+    ``equilibrium``: the per-grasp equilibrium checks of the same contacts
+    (``synergrasp.optimisation.equilibrium.grasp_equilibrium``: object, closure_model, pose,
+    torque_residual, s1_outside_cone, …); grasps missing from it count as unknown residual and
+    no contact pushed outside its cone.
     ``link_names`` / ``link_finger``: the hand's links (``Hand.link_names``, ``Hand.link_finger``).
     Shares are percent of the simulated poses (``SIMULATED_STATUSES``); a contact carries load if
     its normal force is at least ``load_threshold_N`` (N; the configuration's
@@ -134,10 +146,28 @@ def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequenc
     full = _weight_multiples(gfo, full_set_id, weights_N)
     keys = ["object", "pose", "closure_model"] if "closure_model" in full.columns else ["object", "pose"]
     work = work.merge(full, on=keys, how="left", validate="many_to_one")
+    checks = equilibrium[["object", "closure_model", "pose", "torque_residual", "s1_outside_cone"]]
+    work = work.merge(checks.astype({"pose": int}), on=["object", "closure_model", "pose"], how="left",
+                      validate="one_to_one")
     categories = link_categories(link_names, link_finger)
     rows = [{"object": obj, "closure_model": cm, **_one_group(group, categories)}
             for (obj, cm), group in work.groupby(["object", "closure_model"], sort=True)]
     return pd.DataFrame(rows, columns=list(GRASP_REALISM.names))
+
+
+def link_shares(contacts: pd.DataFrame, link_names: Sequence[str], link_finger: Sequence[str]) -> pd.DataFrame:
+    """Which links touch the box: per (object, closure model) and hand link, the share of the
+    simulated grasps (``SIMULATED_STATUSES``) with a contact on that link (``pct_grasps``, %).
+    Columns: object, closure_model, finger, link, pct_grasps; links in the hand's order."""
+    rows = []
+    for (obj, model), group in contacts.groupby(["object", "closure_model"], sort=True):
+        grasps = group[group["status"].isin(SIMULATED_STATUSES)]
+        touched = grasps["contact_link"].map(lambda ls: {int(i) for i in ls})
+        for index, (name, finger) in enumerate(zip(link_names, link_finger)):
+            hits = int(touched.map(lambda s, i=index: i in s).sum())
+            rows.append({"object": obj, "closure_model": model, "finger": finger, "link": name,
+                         "pct_grasps": 100.0 * hits / len(grasps) if len(grasps) else np.nan})
+    return pd.DataFrame(rows, columns=["object", "closure_model", "finger", "link", "pct_grasps"])
 
 
 def _pattern(links) -> tuple[int, ...]:

@@ -151,6 +151,8 @@ def load_box(client: int, size_mm: NDArray, center_mm: NDArray, rotation: NDArra
     size = np.asarray(size_mm, dtype=float)
     if size.shape != (3,) or np.any(size <= 0):
         raise ValueError(f"size_mm must be 3 positive lengths (mm), got {size_mm!r}")
+    if not mass_kg >= 0:
+        raise ValueError(f"mass_kg must be >= 0 (0: a fixed box), got {mass_kg!r}")
     shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(0.5 * size * MM).tolist(), physicsClientId=client)
     visual = pb.createVisualShape(pb.GEOM_BOX, halfExtents=(0.5 * size * MM).tolist(),
                                   rgbaColor=[0.8, 0.8, 0.75, 1.0], physicsClientId=client)
@@ -338,11 +340,14 @@ def apply_force(client: int, body: int, force_N: NDArray) -> None:
 
 def load_free_box(client: int, size_mm: NDArray, mass_kg: float, friction: float, damping_per_s: float) -> int:
     """A free (dynamic) box of edge lengths ``size_mm`` and mass ``mass_kg``, uniform inertia,
-    lateral friction ``friction``, linear and angular drag at the rate ``damping_per_s`` (1/s).
-    Place it with ``move_body``; returns its body id."""
+    lateral friction ``friction``, linear and angular drag at the rate ``damping_per_s`` (1/s);
+    with ``mass_kg`` = 0 a fixed box (Bullet's static body: it never moves, what touches it
+    slides on it with the same friction). Place it with ``move_body``; returns its body id."""
     size = np.asarray(size_mm, dtype=float)
     if size.shape != (3,) or np.any(size <= 0):
         raise ValueError(f"size_mm must be 3 positive lengths (mm), got {size_mm!r}")
+    if not mass_kg >= 0:
+        raise ValueError(f"mass_kg must be >= 0 (0: a fixed box), got {mass_kg!r}")
     shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(0.5 * size * MM).tolist(), physicsClientId=client)
     body = pb.createMultiBody(baseMass=float(mass_kg), baseCollisionShapeIndex=shape, physicsClientId=client)
     pb.changeDynamics(body, -1, lateralFriction=float(friction), linearDamping=float(damping_per_s),

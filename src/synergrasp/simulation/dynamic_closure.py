@@ -77,6 +77,9 @@ class DynamicParams:
                            its initial pose was moved by the hand and is held by nothing:
                            ``caged`` if its centre is inside the closed hand
                            (``HandCapsules.encloses``), ``lost`` (pushed out) if not.
+    object:                ``free`` (the box is a free rigid body) or ``held`` (the box cannot
+                           move: a fixed body in the engine, as if the arm held it; the compliant
+                           fingers slide on it with friction μ and settle).
 
     Every hand link touching the box is listed with the normal force it carries; which of
     them count (``closure.dynamic.unloaded_contacts``) is decided downstream
@@ -98,6 +101,11 @@ class DynamicParams:
     hand_hand_mu: float
     gravity: bool
     lost_distance_mm: float
+    object: str
+
+    @property
+    def held(self) -> bool:
+        return self.object == "held"
 
     @property
     def ramp_steps(self) -> int:
@@ -178,6 +186,11 @@ class DynamicClosure:
         self.box: int | None = None
         self.box_size: NDArray | None = None
 
+    @property
+    def model_name(self) -> str:
+        """The contacts table's ``closure_model``: ``dynamic`` (free box) or ``dynamic_held``."""
+        return "dynamic_held" if self.params.held else "dynamic"
+
     def close(self) -> None:
         self.bullet.disconnect(self.client)
 
@@ -190,8 +203,9 @@ class DynamicClosure:
         if self.box is None or self.box_size is None or not np.array_equal(size, self.box_size):
             if self.box is not None:
                 self.bullet.remove_body(self.client, self.box)
-            self.box = self.bullet.load_free_box(self.client, size, self.params.object_mass_kg,
-                                                 self.mu / self.link_friction, self.params.object_damping_per_s)
+            mass = 0.0 if self.params.held else self.params.object_mass_kg  # mass 0: a fixed body
+            self.box = self.bullet.load_free_box(self.client, size, mass, self.mu / self.link_friction,
+                                                 self.params.object_damping_per_s)
             self.box_size = size
         self.bullet.reset_body(self.client, self.box, placed.center_mm, placed.rotation)
 
@@ -218,7 +232,7 @@ class DynamicClosure:
         gaps = b.closest_points(self.client, self.box, self.body, c.contact_distance_mm)
         if len(gaps) and float(gaps.distance.min()) < -c.penetration_tolerance_mm:
             return self._result("intersects_open_hand", q_open, (), None, True)
-        weight = self.weight if p.gravity else None
+        weight = self.weight if p.gravity and not p.held else None
         radius = float(np.linalg.norm(placed.half_extents_mm))
         settled, steps = False, p.max_steps
         scale, axis_joint = self.axis_scale, self.axis_joint
@@ -257,7 +271,7 @@ class DynamicClosure:
         points_a = np.asarray(points, dtype=float).reshape(-1, 3)
         jac = contact_jacobian(self.hand, q, links_a, points_a) if len(links_a) else np.zeros((0, self.hand.n_joints))
         return ClosureResult(status, q, state, links_a, points_a, np.asarray(normals, dtype=float).reshape(-1, 3),
-                             jac, float(depth), model="dynamic", normal_force_N=np.asarray(loads, dtype=float),
+                             jac, float(depth), model=self.model_name, normal_force_N=np.asarray(loads, dtype=float),
                              settled_pose=settled_pose, settled=settled)
 
     def _finger_states(self, touching: list[int]) -> tuple[str, ...]:
