@@ -217,7 +217,9 @@ STUDY_FILES = {
     "fig1": [f"figures/fig1_synergy_postures.{ext}" for ext in ("png", "pdf")],
     "fig2": [f"figures/fig2_example_grasps.{ext}" for ext in ("png", "pdf")],
     "tables": [f"tables/{t}.{ext}" for t in TABLES for ext in ("csv", "md")],
-    "realism": [f"tables/{t}.{ext}" for t in ("grasp_realism", "grasp_links") for ext in ("csv", "md")]
+    "realism": [
+        f"tables/{t}.{ext}" for t in ("grasp_realism", "grasp_links") for ext in ("csv", "md")
+    ]
     + [f"figures/grasp_realism.{ext}" for ext in ("png", "pdf")],
     "fig5": [
         f"figures/{name}.{ext}"
