@@ -3,14 +3,16 @@
     .venv/bin/python tools/closure_sample.py OUT_DIR [EVERY] [MODEL ...]
     .venv/bin/python tools/closure_sample.py --pictures OUT_DIR PNG POSE_obj1 POSE_obj2 …
 
+    .venv/bin/python tools/closure_sample.py --summary OUT_DIR
+
 For every object of the default configuration, closes the hand at the poses 0, EVERY,
 2·EVERY, … (default 6: 300 of the 1800 poses) with each MODEL (``kinematic``, ``dynamic``: a
 free box, ``dynamic_held``: ``closure.dynamic.object: held``; default all three), writes the
-contacts table to ``OUT_DIR/<model>/<object>.parquet`` and prints, per object and model, the
-closure's CPU seconds, the grasps, the median relative torque residual (and the same over all
-19 joints, those moving no box contact counted as unbalanced), the share of grasps
-with a contact S1 pushes outside its cone and the share touching with the index finger
-(docs/closure.md, "Is the end state an equilibrium?"), and the CPU seconds of the checks.
+contacts that count (the ``contacts`` step's choice) to ``OUT_DIR/<model>/<object>.parquet``
+and prints the closure's CPU seconds. ``--summary``: the grasp-realism table of each model's
+sample (force closure from the optimisation with the full set only), with the median residual
+over all 19 joints (those moving no box contact counted as unbalanced) and the CPU seconds of
+the equilibrium checks (docs/closure.md, "Is the end state an equilibrium?").
 With ``--pictures``: one row per object at the given pose (of the sample), one panel per model
 found under OUT_DIR, drawn as in Fig. 2, the checks in each panel's title.
 """
@@ -25,12 +27,15 @@ import numpy as np
 import pandas as pd
 
 from synergrasp import tables
-from synergrasp.analysis.realism import link_categories
+from synergrasp.analysis.realism import grasp_realism
 from synergrasp.config import defaults, step_params, validate_config
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
+from synergrasp.optimisation.problem import SynergySets
+from synergrasp.optimisation.study import gfo_table
 from synergrasp.simulation.closure import simulate_object
+from synergrasp.simulation.contacts import load_carrying_contacts
 from synergrasp.simulation.placement import pose_grid
 
 MODELS = {"kinematic": ("kinematic", "free"), "dynamic": ("dynamic", "free"), "dynamic_held": ("dynamic", "held")}
@@ -43,38 +48,60 @@ def _all_joints(checks: pd.DataFrame) -> pd.Series:
     return ((checks["torque_residual"] * box) ** 2 + other ** 2) ** 0.5 / (box ** 2 + other ** 2) ** 0.5
 
 
-def main(out: Path, every: int, models: list[str]) -> None:
+def simulate(out: Path, every: int, models: list[str]) -> None:
+    """Close the hand at every ``every``-th pose with each model; write the contacts that count
+    (the ``contacts`` step's choice) and print the closure's CPU seconds."""
+    config = defaults()
+    hand = load_hand(config["hand"])
+    synergies = load_synergies(config["synergies"], joint_names=hand.joint_names)
+    for name in config["objects"]:
+        for label in models:
+            model, held = MODELS[label]
+            closure = {**config["closure"], "model": model, "dynamic": {**config["closure"]["dynamic"], "object": held}}
+            scenario = validate_config({**config, "closure": closure})
+            sim = step_params(scenario, "simulate", name)
+            start = time.process_time()
+            contacts = simulate_object(hand, synergies, sim.box, sim.placement, sim.closure,
+                                       poses=range(0, pose_grid(sim.placement).n_poses, every), mechanics=sim.mechanics)
+            print(f"{name} {label}: closure {time.process_time() - start:.1f} CPU s", flush=True)
+            select = step_params(scenario, "contacts", name)
+            if select.drop_unloaded:
+                contacts = load_carrying_contacts(contacts, select.load_threshold_N)
+            (out / label).mkdir(parents=True, exist_ok=True)
+            tables.write(tables.CONTACTS, contacts, out / label / f"{name}.parquet")
+
+
+def summary(out: Path) -> None:
+    """The grasp-realism table of every model's sample (the optimisation with the full set
+    only), its equilibrium columns, the residual over all joints and the checks' CPU seconds."""
     config = defaults()
     hand = load_hand(config["hand"])
     synergies = load_synergies(config["synergies"], joint_names=hand.joint_names)
     mech = config["mechanics"]
     checks_params = EquilibriumParams.of(hand, synergies, mech["k_ss_Nmm_per_rad"], mech["mu"])
-    index = link_categories(hand.link_names, hand.link_finger)["index"]
-    rows = []
-    for name in config["objects"]:
-        for label in models:
-            model, held = MODELS[label]
-            closure = {**config["closure"], "model": model, "dynamic": {**config["closure"]["dynamic"], "object": held}}
-            sim = step_params(validate_config({**config, "closure": closure}), "simulate", name)
-            poses = range(0, pose_grid(sim.placement).n_poses, every)
-            start = time.process_time()
-            contacts = simulate_object(hand, synergies, sim.box, sim.placement, sim.closure, poses=poses,
-                                       mechanics=sim.mechanics)
-            closure_s = time.process_time() - start
-            (out / label).mkdir(parents=True, exist_ok=True)
-            tables.write(tables.CONTACTS, contacts, out / label / f"{name}.parquet")
-            start = time.process_time()
-            checks = grasp_equilibrium(contacts, checks_params, synergies.columns([1])[:, 0])
-            checks_s = time.process_time() - start
-            grasps = contacts[contacts["status"] == "grasp"]
-            rows.append({"object": name, "model": label, "poses": len(contacts), "grasps": len(grasps),
-                         "closure_cpu_s": round(closure_s, 1), "checks_cpu_s": round(checks_s, 2),
-                         "median_residual": checks["torque_residual"].median(),
-                         "median_residual_all_joints": _all_joints(checks).median(),
-                         "pct_s1_outside": 100.0 * (checks["s1_outside_cone"] > 0).mean(),
-                         "pct_index": 100.0 * grasps["contact_link"].map(lambda ls: any(int(i) in index for i in ls)).mean()})
-            print(pd.DataFrame(rows[-1:]).to_string(index=False, header=len(rows) == 1), flush=True)
-    print(pd.DataFrame(rows).to_markdown(index=False, floatfmt=".3g"))
+    realism = step_params(config, "realism")
+    full = tuple(range(1, config["synergy_sets"]["incremental_max"] + 1))
+    parts, extra = [], []
+    for label in (m for m in MODELS if (out / m).is_dir()):
+        contacts = pd.concat([tables.read(tables.CONTACTS, out / label / f"{name}.parquet") for name in config["objects"]],
+                             ignore_index=True)
+        gfo = pd.concat([gfo_table(part, SynergySets(synergies.matrix, (full,)),
+                                   step_params(config, "optimise", name).gfo)
+                         for name, part in contacts.groupby("object", sort=False)], ignore_index=True)
+        gfo["closure_model"] = label
+        start = time.process_time()
+        checks = grasp_equilibrium(contacts, checks_params, synergies.columns([1])[:, 0])
+        extra.append(checks.assign(cpu_s=time.process_time() - start, all_joints=_all_joints(checks)))
+        parts.append(grasp_realism(contacts, gfo, checks, hand.link_names, hand.link_finger, realism.full_set_id,
+                                   realism.weights_N, realism.load_threshold_N))
+    table = pd.concat(parts, ignore_index=True)
+    more = pd.concat(extra).groupby(["object", "closure_model"]).agg(
+        median_residual_all_joints=("all_joints", "median"), checks_cpu_s=("cpu_s", "first"))
+    columns = ["object", "closure_model", "simulated", "dropped_by", "contacts_median", "pct_thumb", "pct_palm",
+               "pct_index", "pct_force_closure", "median_force_per_weight", "median_torque_residual",
+               "pct_s1_outside_cone"]
+    print(table[columns].merge(more.reset_index(), on=["object", "closure_model"], how="left")
+          .sort_values(["object", "closure_model"]).to_markdown(index=False, floatfmt=".3g"))
 
 
 def pictures(out: Path, png: Path, poses: list[int]) -> None:
@@ -122,5 +149,7 @@ def pictures(out: Path, png: Path, poses: list[int]) -> None:
 if __name__ == "__main__":
     if sys.argv[1] == "--pictures":
         pictures(Path(sys.argv[2]), Path(sys.argv[3]), [int(v) for v in sys.argv[4:]])
-        sys.exit()
-    main(Path(sys.argv[1]), int(sys.argv[2]) if len(sys.argv) > 2 else 6, sys.argv[3:] or list(MODELS))
+    elif sys.argv[1] == "--summary":
+        summary(Path(sys.argv[2]))
+    else:
+        simulate(Path(sys.argv[1]), int(sys.argv[2]) if len(sys.argv) > 2 else 6, sys.argv[3:] or list(MODELS))
