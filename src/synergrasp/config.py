@@ -680,7 +680,8 @@ STEP_MODULES: dict[str, tuple[str, ...]] = {
     "search": ("synergrasp.simulation.closure", "synergrasp.simulation.placement_search",
                "synergrasp.optimisation.study"),
     "optimise": ("synergrasp.optimisation.study",),
-    "tables": ("synergrasp.analysis.summaries", "synergrasp.analysis.periods"),
+    "tables": ("synergrasp.analysis.summaries", "synergrasp.analysis.periods", "synergrasp.analysis.bootstrap",
+               "synergrasp.analysis.claims"),
 }
 
 def _build(cls: Any, where: str, **kwargs: Any) -> Any:
@@ -760,6 +761,8 @@ def _optimise(config: Mapping[str, Any], obj: str) -> OptimiseParams:
 def _tables(config: Mapping[str, Any]) -> TablesParams:
     summaries = importlib.import_module("synergrasp.analysis.summaries")
     periods = importlib.import_module("synergrasp.analysis.periods")
+    bootstrap = importlib.import_module("synergrasp.analysis.bootstrap")
+    claims = importlib.import_module("synergrasp.analysis.claims")
     analyses, g = config["analyses"], config["mechanics"]["g_m_per_s2"]
     objects = {name: {**spec, "placement": overlay(config["placement"], spec.get("placement"))}
                for name, spec in config["objects"].items()}
@@ -772,6 +775,10 @@ def _tables(config: Mapping[str, Any]) -> TablesParams:
         radius_deg=float(analyses["minima_radius_deg"]), null_draws=int(analyses["null_model"]["draws"]),
         null_seed=int(analyses["null_model"]["seed"]),
         success_rate_tolerance_percent=float(analyses["success_rate_tolerance_percent"]),
+        bootstrap=_build(bootstrap.BootstrapSettings, "analyses.bootstrap", **analyses["bootstrap"]),
+        rules=_build(claims.VerdictRules, "analyses", rate_points=float(analyses["tie_band"]["rate_points"]),
+                     force_relative=float(analyses["tie_band"]["force_relative"]),
+                     min_distinct_poses=int(analyses["min_distinct_poses"]), headline_view=analyses["headline_view"]),
         weights_N={name: float(spec["mass_kg"]) * float(g) for name, spec in objects.items()},
         periods_deg=periods_deg)
     return TablesParams(dict(config["synergy_sets"]), int(analyses["table2_k_max"]), settings)
