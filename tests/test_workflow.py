@@ -176,14 +176,14 @@ def test_broken_config_fails_before_work_and_keeps_results(run_j2, tmp_path):
     before = digest(files)
     broken = yaml.safe_load(SMALL.read_text())
     broken["mechanics"]["friction"] = 1.0
-    broken["objects"]["obj4"]["size_mm"] = [100, -60, 100]
+    broken["objects"]["obj4"]["shape"]["box"]["size_mm"] = [100, -60, 100]
     path = tmp_path / "broken.yaml"
     path.write_text(yaml.safe_dump(broken))
     out = snakemake(run_j2, "-j2", "figures", "--forceall", configfile=path)
     assert out.returncode != 0
     message = out.stdout + out.stderr
     assert "config error at 'mechanics': unknown key(s) ['friction']" in message
-    assert "objects.obj4.size_mm[1]" in message
+    assert "objects.obj4.shape.box.size_mm[1]" in message
     assert digest(files) == before
 
 

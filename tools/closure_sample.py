@@ -61,7 +61,7 @@ def simulate(out: Path, every: int, models: list[str]) -> None:
             scenario = validate_config({**config, "closure": closure})
             sim = step_params(scenario, "simulate", name)
             start = time.process_time()
-            contacts = simulate_object(hand, synergies, sim.box, sim.placement, sim.closure,
+            contacts = simulate_object(hand, synergies, sim.object, sim.placement, sim.closure,
                                        poses=range(0, pose_grid(sim.placement).n_poses, every), mechanics=sim.mechanics)
             print(f"{name} {label}: closure {time.process_time() - start:.1f} CPU s", flush=True)
             select = step_params(scenario, "contacts", name)
@@ -110,7 +110,7 @@ def pictures(out: Path, png: Path, poses: list[int]) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from synergrasp.figures.hand_figures import PANEL_PX, _bare, _box_of, _fit, _frame, _touching_words
+    from synergrasp.figures.hand_figures import PANEL_PX, _bare, _fit, _frame, _object_of, _touching_words
     from synergrasp.figures.hand_pictures import PALM_CAMERA, render
 
     config = defaults()
@@ -122,16 +122,16 @@ def pictures(out: Path, png: Path, poses: list[int]) -> None:
     names = list(config["objects"])
     fig, axes = plt.subplots(len(names), len(labels), figsize=(2.7 * len(labels), 2.9 * len(names)), squeeze=False)
     for r, (name, pose) in enumerate(zip(names, poses)):
-        size = config["objects"][name]["size_mm"]
+        shape = step_params(config, "simulate", name).object.shape
         rows = [tables.read(tables.CONTACTS, out / m / f"{name}.parquet").set_index("pose").loc[pose] for m in labels]
         camera = _fit(PALM_CAMERA, hand, [np.asarray(row["q"], dtype=float) for row in rows],
-                      [_box_of(row, size) for row in rows])
+                      [_object_of(row, shape) for row in rows])
         drawn = []
         for c, (label, row) in enumerate(zip(labels, rows)):
             ax = axes[r, c]
             _bare(ax)
             links = [int(i) for i in row["contact_link"]]
-            picture = render(hand, np.asarray(row["q"], dtype=float), camera, PANEL_PX, box=_box_of(row, size),
+            picture = render(hand, np.asarray(row["q"], dtype=float), camera, PANEL_PX, shape=_object_of(row, shape),
                              touching=links)
             ax.imshow(picture.rgb, interpolation="antialiased")
             drawn.append(picture)

@@ -17,7 +17,6 @@ matplotlib.use("Agg")  # headless: figures are files, never windows
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
-import seaborn as sns  # noqa: E402
 
 from synergrasp.config import incremental_set_id  # noqa: E402
 from synergrasp.figures.output import save_figure  # noqa: E402
@@ -99,7 +98,9 @@ def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: 
     β = ``beta_deg`` (nearest grid values), one line per {S1..Sk}; gaps where the pose is
     not a success of ``verdict``."""
     fig, (ax_b, ax_a) = plt.subplots(1, 2, figsize=(11, 3.8))
-    palette = sns.color_palette("viridis", len(panel_k))
+    # viridis sampled as seaborn's color_palette("viridis", n) does (importing seaborn cost
+    # the job more CPU than drawing: it imports scipy.stats)
+    palette = matplotlib.colormaps["viridis"](np.linspace(0.0, 1.0, len(panel_k) + 2)[1:-1])[:, :3]
     for colour, k in zip(palette, panel_k):
         alphas, betas, force = force_grid(gfo, incremental_set_id(k))
         ia = int(np.argmin(np.abs(((alphas - alpha_deg) + 180.0) % 360.0 - 180.0)))

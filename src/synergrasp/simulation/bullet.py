@@ -1,4 +1,4 @@
-"""All pybullet-specific code for the hand and the boxes.
+"""All pybullet-specific code for the hand and the objects.
 
 pybullet works in metres; every function here takes and returns mm (and the palm frame).
 The hand's base (its palm) is fixed at the world origin with identity orientation, so
@@ -10,6 +10,7 @@ from __future__ import annotations
 import tempfile
 from dataclasses import dataclass, fields
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pybullet as pb
@@ -145,18 +146,26 @@ def bullet_jacobian(client: int, body: HandBody, q: NDArray, link: int, point_mm
     return jac
 
 
-def load_box(client: int, size_mm: NDArray, center_mm: NDArray, rotation: NDArray | None = None) -> int:
-    """A static box body of full edge lengths ``size_mm`` centred at ``center_mm`` (palm frame),
-    oriented by the 3 × 3 rotation matrix ``rotation`` (identity if None). Returns its body id."""
-    size = np.asarray(size_mm, dtype=float)
-    if size.shape != (3,) or np.any(size <= 0):
-        raise ValueError(f"size_mm must be 3 positive lengths (mm), got {size_mm!r}")
-    if not mass_kg >= 0:
-        raise ValueError(f"mass_kg must be >= 0 (0: a fixed box), got {mass_kg!r}")
-    shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(0.5 * size * MM).tolist(), physicsClientId=client)
-    visual = pb.createVisualShape(pb.GEOM_BOX, halfExtents=(0.5 * size * MM).tolist(),
-                                  rgbaColor=[0.8, 0.8, 0.75, 1.0], physicsClientId=client)
-    body = pb.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=shape, baseVisualShapeIndex=visual,
+def collision_shape(client: int, shape: Any) -> int:
+    """The collision shape of an object's shape (``synergrasp.simulation.shapes``: its
+    ``collision_geometry()``, mm) in ``client``; returns its index."""
+    kind, geometry = shape.collision_geometry()
+    if kind == "box":
+        half = np.asarray(geometry["half_extents_mm"], dtype=float)
+        return pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(half * MM).tolist(), physicsClientId=client)
+    if kind == "sphere":
+        return pb.createCollisionShape(pb.GEOM_SPHERE, radius=float(geometry["radius_mm"]) * MM, physicsClientId=client)
+    if kind == "cylinder":  # along the shape's own z axis, as pybullet's
+        return pb.createCollisionShape(pb.GEOM_CYLINDER, radius=float(geometry["radius_mm"]) * MM,
+                                       height=float(geometry["height_mm"]) * MM, physicsClientId=client)
+    raise ValueError(f"no collision shape for a {kind!r}")
+
+
+def load_object(client: int, shape: Any, center_mm: NDArray, rotation: NDArray | None = None) -> int:
+    """A static body of ``shape`` (``synergrasp.simulation.shapes``) centred at ``center_mm``
+    (palm frame), oriented by the 3 × 3 rotation matrix ``rotation`` (identity if None).
+    Returns its body id."""
+    body = pb.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=collision_shape(client, shape),
                               physicsClientId=client)
     move_body(client, body, center_mm, rotation)
     return body
@@ -338,18 +347,16 @@ def apply_force(client: int, body: int, force_N: NDArray) -> None:
     pb.applyExternalForce(body, -1, [float(v) for v in force_N], pos, pb.WORLD_FRAME, physicsClientId=client)
 
 
-def load_free_box(client: int, size_mm: NDArray, mass_kg: float, friction: float, damping_per_s: float) -> int:
-    """A free (dynamic) box of edge lengths ``size_mm`` and mass ``mass_kg``, uniform inertia,
-    lateral friction ``friction``, linear and angular drag at the rate ``damping_per_s`` (1/s);
-    with ``mass_kg`` = 0 a fixed box (Bullet's static body: it never moves, what touches it
-    slides on it with the same friction). Place it with ``move_body``; returns its body id."""
-    size = np.asarray(size_mm, dtype=float)
-    if size.shape != (3,) or np.any(size <= 0):
-        raise ValueError(f"size_mm must be 3 positive lengths (mm), got {size_mm!r}")
+def load_free_object(client: int, shape: Any, mass_kg: float, friction: float, damping_per_s: float) -> int:
+    """A free (dynamic) body of ``shape`` (``synergrasp.simulation.shapes``) and mass
+    ``mass_kg``, uniform density (the engine's inertia of the shape), lateral friction
+    ``friction``, linear and angular drag at the rate ``damping_per_s`` (1/s); with ``mass_kg``
+    = 0 a fixed body (Bullet's static body: it never moves, what touches it slides on it with
+    the same friction). Place it with ``move_body``; returns its body id."""
     if not mass_kg >= 0:
-        raise ValueError(f"mass_kg must be >= 0 (0: a fixed box), got {mass_kg!r}")
-    shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(0.5 * size * MM).tolist(), physicsClientId=client)
-    body = pb.createMultiBody(baseMass=float(mass_kg), baseCollisionShapeIndex=shape, physicsClientId=client)
+        raise ValueError(f"mass_kg must be >= 0 (0: a fixed body), got {mass_kg!r}")
+    body = pb.createMultiBody(baseMass=float(mass_kg), baseCollisionShapeIndex=collision_shape(client, shape),
+                              physicsClientId=client)
     pb.changeDynamics(body, -1, lateralFriction=float(friction), linearDamping=float(damping_per_s),
                       angularDamping=float(damping_per_s), physicsClientId=client)
     return body
