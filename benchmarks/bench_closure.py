@@ -22,10 +22,10 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from synergrasp.config import defaults, step_params, validate_config  # noqa: E402
+from synergrasp.config import defaults, validate_config  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
-from synergrasp.simulation.closure import closure_model, place_object  # noqa: E402
+from synergrasp.simulation.closure import SimulateParams, closure_model, place_object  # noqa: E402
 from synergrasp.simulation.placement import pose_grid  # noqa: E402
 from synergrasp.simulation.scene import HandScene  # noqa: E402
 from synergrasp.simulation.shapes import Box, Cylinder, Sphere  # noqa: E402
@@ -43,7 +43,7 @@ def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_media
     study = validate_config({**defaults(), "closure": {**defaults()["closure"], "model": model}})
     hand = load_hand()
     synergies = load_synergies(None, joint_names=hand.joint_names)
-    first = step_params(study, "simulate", next(iter(study["objects"])))
+    first = SimulateParams.from_config(study, next(iter(study["objects"])))
     grid = pose_grid(first.placement)
     poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
     print(f"closure model: {model}")
@@ -52,7 +52,7 @@ def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_media
     all_times = []
     try:
         for name in study["objects"]:
-            sim = step_params(study, "simulate", name)
+            sim = SimulateParams.from_config(study, name)
             obj, placement = sim.object, sim.placement
             times, placing, statuses, counts, two_fingers = [], [], [], [], 0
             for pose in poses:

@@ -236,12 +236,12 @@ def _contacts_digest(table) -> str:
 
 
 def test_the_box_gives_the_contacts_of_8966525_bit_for_bit_on_the_small_config(hand, synergies):
-    from synergrasp.config import step_params, validate_config
-    from synergrasp.simulation.closure import simulate_object
+    from synergrasp.config import validate_config
+    from synergrasp.simulation.closure import SimulateParams, simulate_object
 
     config = validate_config(yaml.safe_load((Path(__file__).parent / "config" / "small.yaml").read_text()))
     for name, pinned in PINNED_SMALL_CONTACTS.items():
-        sim = step_params(config, "simulate", name)
+        sim = SimulateParams.from_config(config, name)
         table = simulate_object(hand, synergies, sim.object, sim.placement, sim.closure)
         assert _contacts_digest(table) == pinned, name
 

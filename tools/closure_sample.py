@@ -28,7 +28,11 @@ import pandas as pd
 
 from synergrasp import tables
 from synergrasp.analysis.realism import grasp_realism
-from synergrasp.config import defaults, step_params, validate_config
+from synergrasp.analysis.realism import RealismParams
+from synergrasp.config import defaults, validate_config
+from synergrasp.optimisation.study import OptimiseParams
+from synergrasp.simulation.closure import SimulateParams
+from synergrasp.simulation.contacts import ContactsParams
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
@@ -59,12 +63,12 @@ def simulate(out: Path, every: int, models: list[str]) -> None:
             model, held = MODELS[label]
             closure = {**config["closure"], "model": model, "dynamic": {**config["closure"]["dynamic"], "object": held}}
             scenario = validate_config({**config, "closure": closure})
-            sim = step_params(scenario, "simulate", name)
+            sim = SimulateParams.from_config(scenario, name)
             start = time.process_time()
             contacts = simulate_object(hand, synergies, sim.object, sim.placement, sim.closure,
                                        poses=range(0, pose_grid(sim.placement).n_poses, every), mechanics=sim.mechanics)
             print(f"{name} {label}: closure {time.process_time() - start:.1f} CPU s", flush=True)
-            select = step_params(scenario, "contacts", name)
+            select = ContactsParams.from_config(scenario, name)
             if select.drop_unloaded:
                 contacts = load_carrying_contacts(contacts, select.load_threshold_N)
             (out / label).mkdir(parents=True, exist_ok=True)
@@ -79,14 +83,14 @@ def summary(out: Path) -> None:
     synergies = load_synergies(config["synergies"], joint_names=hand.joint_names)
     mech = config["mechanics"]
     checks_params = EquilibriumParams.of(hand, synergies, mech["k_ss_Nmm_per_rad"], mech["mu"])
-    realism = step_params(config, "realism")
+    realism = RealismParams.from_config(config)
     full = tuple(range(1, config["synergy_sets"]["incremental_max"] + 1))
     parts, extra = [], []
     for label in (m for m in MODELS if (out / m).is_dir()):
         contacts = pd.concat([tables.read(tables.CONTACTS, out / label / f"{name}.parquet") for name in config["objects"]],
                              ignore_index=True)
         gfo = pd.concat([gfo_table(part, SynergySets(synergies.matrix, (full,)),
-                                   step_params(config, "optimise", name).gfo)
+                                   OptimiseParams.from_config(config, name).gfo)
                          for name, part in contacts.groupby("object", sort=False)], ignore_index=True)
         gfo["closure_model"] = label
         start = time.process_time()
@@ -122,7 +126,7 @@ def pictures(out: Path, png: Path, poses: list[int]) -> None:
     names = list(config["objects"])
     fig, axes = plt.subplots(len(names), len(labels), figsize=(2.7 * len(labels), 2.9 * len(names)), squeeze=False)
     for r, (name, pose) in enumerate(zip(names, poses)):
-        shape = step_params(config, "simulate", name).object.shape
+        shape = SimulateParams.from_config(config, name).object.shape
         rows = [tables.read(tables.CONTACTS, out / m / f"{name}.parquet").set_index("pose").loc[pose] for m in labels]
         camera = _fit(PALM_CAMERA, hand, [np.asarray(row["q"], dtype=float) for row in rows],
                       [_object_of(row, shape) for row in rows])

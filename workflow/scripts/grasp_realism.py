@@ -4,18 +4,16 @@ their end states are equilibria of the soft-synergy hand."""
 import pandas as pd
 
 from synergrasp import tables
-from synergrasp.analysis.realism import grasp_realism, link_shares
-from synergrasp.config import step_params
+from synergrasp.analysis.realism import RealismParams, grasp_realism, link_shares
 from synergrasp.figures.grasp_realism import figure_grasp_realism
 from synergrasp.hand.kinematics import load_hand
-from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
 from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
 
 with job_log(snakemake.log[0]):
-    params = step_params(snakemake.params.cfg, "realism")
+    params = RealismParams.from_config(snakemake.params.cfg)
     hand = load_hand(params.hand)
-    synergies = load_synergies(params.synergies, joint_names=hand.joint_names)
+    synergies = params.synergies(hand.joint_names)
     contacts = pd.concat([tables.read(tables.CONTACTS, p) for p in snakemake.input.contacts], ignore_index=True)
     gfo = pd.concat([tables.read(tables.GFO, p) for p in snakemake.input.gfo], ignore_index=True)
     checks = grasp_equilibrium(contacts, EquilibriumParams.of(hand, synergies, params.k_ss_Nmm_per_rad, params.mu),

@@ -73,12 +73,12 @@ def object_periods(objects: Mapping[str, Mapping[str, Any]], grid: Mapping[str, 
     ``shape`` and effective ``placement`` (the global placement with its override),
     ``grid`` is the config's grid block, ``hand`` the hand file (None: the shipped hand,
     whose palm normal is the α axis)."""
-    from synergrasp.config import placement_params
     from synergrasp.hand.kinematics import load_hand
+    from synergrasp.simulation.placement import Placement
     from synergrasp.simulation.shapes import shape_from_config
 
     normal = load_hand(hand).palm_normal
-    return {name: alpha_period_deg(placement_params(spec["placement"], grid),
+    return {name: alpha_period_deg(Placement.from_config(spec["placement"], grid),
                                    shape_from_config(spec["shape"], f"objects.{name}.shape"), normal)
             for name, spec in objects.items()}
 

@@ -12,15 +12,19 @@ in, a DataFrame out.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from synergrasp.analysis.verdicts import verdict_columns
+from synergrasp.hand.synergies import Synergies, synergy_values
+from synergrasp.ids import incremental_set_id
 from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 
-__all__ = ["SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "LONG_FINGERS", "link_categories",
-           "grasp_realism", "link_shares", "representative_grasps"]
+__all__ = ["RealismParams", "SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "LONG_FINGERS",
+           "link_categories", "grasp_realism", "link_shares", "representative_grasps"]
 
 #: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.STATUSES): a
 #: ``no_contact`` closure is a simulated grasp with 0 contacts; any other status is a dropped pose.
@@ -33,6 +37,44 @@ NORMAL_FORCE_COLUMN = "contact_normal_force_N"
 LONG_FINGERS: tuple[str, ...] = ("index", "middle", "ring", "little")
 #: Segments (the part of a link name after the finger) counted as proximal or middle phalanges.
 _PROXIMAL_OR_MIDDLE = ("proximal", "middle")
+
+
+
+@dataclass(frozen=True)
+class RealismParams:
+    """The grasp-realism table (the ``realism`` step): hand file, the full set's id, each
+    object's weight (N), the least normal force (N) of a load-carrying contact (None: the
+    closure model records no loads), and for the equilibrium checks the mean posture q_m and
+    S1 of the synergy table (rad, the hand's joint order), the joint stiffness k_ss (N·mm/rad)
+    and μ."""
+
+    hand: str | None
+    full_set_id: str
+    weights_N: dict[str, float]
+    load_threshold_N: float | None
+    mean_rad: tuple[float, ...]
+    s1: tuple[float, ...]
+    k_ss_Nmm_per_rad: float
+    mu: float
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> RealismParams:
+        """From a configuration, or from the step's own part of it (whose ``synergies`` holds
+        q_m and S1 themselves; ``obj`` is not read)."""
+        mechanics = config["mechanics"]
+        closure = config["closure"]
+        threshold = closure["dynamic"]["load_threshold_N"] if closure["model"] == "dynamic" else None
+        values = config["synergies"]
+        if not isinstance(values, Mapping):
+            values = synergy_values(config["hand"], values, (1,))
+        return cls(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),
+                   {name: spec["mass_kg"] * mechanics["g_m_per_s2"] for name, spec in config["objects"].items()},
+                   threshold, tuple(values["mean_rad"]), tuple(values["S1"]), float(mechanics["k_ss_Nmm_per_rad"]),
+                   float(mechanics["mu"]))
+
+    def synergies(self, joint_names: tuple[str, ...]) -> Synergies:
+        """q_m and S1 as a one-synergy :class:`Synergies` of the hand's joints."""
+        return Synergies(tuple(joint_names), np.array(self.mean_rad), np.array(self.s1)[:, None], ("S1",))
 
 
 def link_categories(link_names: Sequence[str], link_finger: Sequence[str]) -> dict[str, frozenset[int]]:

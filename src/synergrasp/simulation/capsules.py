@@ -20,7 +20,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from synergrasp.simulation.shapes.kernels import segment_cylinder, segment_sphere
+from synergrasp.simulation.shapes.kernels import segment_cylinder, segment_sphere, sort_knots
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
@@ -101,12 +101,7 @@ def _seg_box_into(p0: NDArray, d: NDArray, half: NDArray, knots: NDArray) -> tup
                 if 0.0 < tb < 1.0:
                     knots[n] = tb
                     n += 1
-    for k in range(1, n):  # insertion sort of at most 8 values
-        v, j = knots[k], k - 1
-        while j >= 0 and knots[j] > v:
-            knots[j + 1] = knots[j]
-            j -= 1
-        knots[j + 1] = v
+    sort_knots(knots, n)
     best_sq, best_t = np.inf, 0.0
     for k in range(n):
         sq = _sq_excess(p0, d, half, knots[k])

@@ -64,9 +64,15 @@ class Shape(ABC):
     kernel_code: ClassVar[int]
 
     @property
-    @abstractmethod
     def kernel_params(self) -> NDArray:
         """Its sizes as the float64 array the compiled kernel reads (read-only)."""
+        return self._params
+
+    def _set_kernel_params(self, *values: float) -> None:
+        """Keep ``values`` as the read-only ``kernel_params`` (from ``__post_init__``)."""
+        params = np.array(values, dtype=float)
+        params.setflags(write=False)
+        object.__setattr__(self, "_params", params)
 
     @property
     @abstractmethod

@@ -33,13 +33,7 @@ class Cylinder(Shape):
         r, h = positive_length("radius_mm", self.radius_mm), positive_length("height_mm", self.height_mm)
         object.__setattr__(self, "radius_mm", r)
         object.__setattr__(self, "height_mm", h)
-        params = np.array([r, h / 2.0])
-        params.setflags(write=False)
-        object.__setattr__(self, "_params", params)
-
-    @property
-    def kernel_params(self) -> NDArray:
-        return self._params
+        self._set_kernel_params(r, h / 2.0)
 
     @property
     def half_height_mm(self) -> float:

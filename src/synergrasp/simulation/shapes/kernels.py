@@ -15,12 +15,23 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["segment_sphere", "segment_cylinder", "cylinder_sdf"]
+__all__ = ["sort_knots", "segment_sphere", "segment_cylinder", "cylinder_sdf"]
 
 _EPS = 1e-12
 _FLAT_MM = 1e-9  # distances (mm) this close count as equal (a flat stretch of the segment)
 _GOLDEN = 0.6180339887498949
 _GOLDEN_STEPS = 60
+
+
+@numba.njit(cache=True)
+def sort_knots(knots: NDArray, n: int) -> None:
+    """Sort the first ``n`` values of ``knots`` in place (insertion sort: n is at most 8)."""
+    for k in range(1, n):
+        v, j = knots[k], k - 1
+        while j >= 0 and knots[j] > v:
+            knots[j + 1] = knots[j]
+            j -= 1
+        knots[j + 1] = v
 
 
 @numba.njit(cache=True)
@@ -101,12 +112,7 @@ def segment_cylinder(p0: NDArray, d: NDArray, radius: float, half_height: float,
                 if 0.0 < tb < 1.0:
                     knots[n] = tb
                     n += 1
-    for k in range(1, n):  # insertion sort of at most 7 values
-        v, j = knots[k], k - 1
-        while j >= 0 and knots[j] > v:
-            knots[j + 1] = knots[j]
-            j -= 1
-        knots[j + 1] = v
+    sort_knots(knots, n)
     best, best_k = np.inf, 0
     for k in range(n):
         f = _sdf_at(p0, d, knots[k], radius, half_height)

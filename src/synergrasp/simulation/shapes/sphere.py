@@ -25,13 +25,7 @@ class Sphere(Shape):
     def __post_init__(self) -> None:
         r = positive_length("radius_mm", self.radius_mm)
         object.__setattr__(self, "radius_mm", r)
-        params = np.array([r])
-        params.setflags(write=False)
-        object.__setattr__(self, "_params", params)
-
-    @property
-    def kernel_params(self) -> NDArray:
-        return self._params
+        self._set_kernel_params(r)
 
     @property
     def bounding_radius_mm(self) -> float:
