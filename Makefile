@@ -26,7 +26,9 @@ study: $(BIN)/.installed
 	$(WARM_UP)
 	$(BIN)/snakemake -j$(CORES) figures
 
+# The report gathers the study's outputs: say so in one line when the study has not run yet.
 report: $(BIN)/.installed
+	@test -e results/tables/claims.csv || { echo "make report: the study has not run yet (no results/tables/claims.csv): run 'make study' first"; exit 1; }
 	$(BIN)/snakemake --report results/report.html
 	$(BIN)/snakemake --report results/report.zip
 

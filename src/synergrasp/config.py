@@ -31,9 +31,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
-
 from synergrasp.simulation.objects import Box
+from synergrasp.yaml_io import read_yaml
 
 __all__ = [
     "ConfigError",
@@ -69,8 +68,7 @@ class ConfigError(ValueError):
 
 @functools.cache
 def load_schema() -> dict[str, Any]:
-    with open(SCHEMA_PATH, encoding="utf-8") as handle:
-        return yaml.safe_load(handle)
+    return read_yaml(SCHEMA_PATH, "schema")
 
 
 def _resolve(node: Mapping[str, Any]) -> dict[str, Any]:
@@ -210,8 +208,10 @@ def _describe(error: Any) -> str:
         return (f"config error at '{where}': {error.instance!r} is not allowed; "
                 f"allowed values: {schema['enum']}")
     if "propertyNames" in error.schema_path:
-        return (f"config error at '{where}': name {error.instance!r} is not allowed; "
-                "names may use letters, digits and '_' only (and not 'default' for a scenario)")
+        name = error.instance
+        shown = repr(name) if len(str(name)) <= 70 else f"'{str(name)[:40]}…' ({len(str(name))} characters)"
+        return (f"config error at '{where}': name {shown} is not allowed; names become file "
+                "names: letters, digits and '_' only, at most 64 characters (and not 'default' for a scenario)")
     return f"config error at '{where}': {error.message}"
 
 
@@ -291,6 +291,8 @@ def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -
     if dynamic["time_limit_s"] < dynamic["ramp_time_s"]:
         problems.append(f"config error at 'closure.dynamic.time_limit_s': {dynamic['time_limit_s']} must be "
                         f"at least closure.dynamic.ramp_time_s ({dynamic['ramp_time_s']})")
+    else:
+        problems += _settle_problems(dynamic)
     if all(abs(v) < 1e-12 for v in config["mechanics"]["gravity_direction"]):
         problems.append("config error at 'mechanics.gravity_direction': must be a non-zero vector")
     sets = config["synergy_sets"]
@@ -314,6 +316,20 @@ def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -
     if not _grid_problems(config["grid"]):
         problems += _pose_problems(config)
     return problems
+
+
+def _settle_problems(dynamic: Mapping[str, Any]) -> list[str]:
+    """The dynamic closure can settle: after the ramp, the time left to the limit holds one
+    settle window and one step more (in whole time steps, as the closure counts them)."""
+    dt = dynamic["time_step_s"]
+    ramp = max(1, round(dynamic["ramp_time_s"] / dt))
+    left = max(ramp, round(dynamic["time_limit_s"] / dt)) - ramp
+    window = max(1, round(dynamic["settle_window_s"] / dt))
+    if left >= window + 1:
+        return []
+    return [f"config error at 'closure.dynamic.settle_window_s': {dynamic['settle_window_s']} s leaves no pose "
+            f"able to settle: it must be shorter than closure.dynamic.time_limit_s - ramp_time_s "
+            f"({dynamic['time_limit_s']} - {dynamic['ramp_time_s']} s) by at least one time_step_s ({dt:.4g} s)"]
 
 
 def synergy_problems(config: Mapping[str, Any], mean_rad: Any, matrix: Any) -> list[str]:

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "write", "read", "empty",
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "write", "read", "empty",
            "write_study_table"]
 
 
@@ -141,7 +141,21 @@ def _realism_columns() -> tuple[Column, ...]:
 #: Percentages are of the simulated grasps. Written as CSV and Markdown (results/tables).
 GRASP_REALISM = Table("grasp_realism", "one row per (object, closure model)", _realism_columns())
 
-TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM)}
+#: Whether each object can be grasped at all, and why not (synergrasp.analysis.graspability).
+#: Written as CSV and Markdown (results/tables) by the grasp-realism step.
+GRASPABLE_OBJECTS = Table("graspable_objects", "one row per object", (
+    Column("object", "string", "", "object name"),
+    Column("poses", "int32", "", "poses of the grid"),
+    Column("simulated", "int32", "", "poses whose closure ran (status grasp or no_contact)"),
+    Column("grasps", "int32", "", "closures that end touching the box (status grasp)"),
+    Column("settled", "int32", "", "grasps that came to rest (all of them for the kinematic closure)"),
+    Column("force_closure_full_set", "int32", "", "poses in force closure with every synergy enrolled"),
+    Column("graspable", "bool", "", "some pose reaches force closure with the full set"),
+    Column("reason", "string", "", "why no pose does: every pose dropped, nothing touched, no pose settled, "
+           "no force closure with the full set (empty when graspable)"),
+))
+
+TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS)}
 
 
 def _check(table: Table, frame: pd.DataFrame, where: str) -> None:
@@ -167,8 +181,12 @@ def write(table: Table, frame: pd.DataFrame, path: str | Path) -> None:
 
 
 def read(table: Table, path: str | Path) -> pd.DataFrame:
-    """Read a Parquet table and check it holds the contract's columns."""
-    frame = pd.read_parquet(path)
+    """Read a Parquet table and check it holds the contract's columns; ValueError naming the
+    table and the file if it cannot be read or lacks a column."""
+    try:
+        frame = pd.read_parquet(path)
+    except (OSError, ValueError) as err:  # pyarrow's read errors are either
+        raise ValueError(f"{table.name} table '{path}': cannot be read as Parquet ({err})") from None
     _check(table, frame, str(path))
     return frame
 

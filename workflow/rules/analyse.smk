@@ -74,6 +74,12 @@ rule grasp_realism:
             category="Figures",
         ),
         pdf="{root}/figures/grasp_realism.pdf",
+        graspable_csv=report(
+            "{root}/tables/graspable_objects.csv",
+            caption="../report/graspable_objects.rst",
+            category="Tables",
+        ),
+        graspable_md="{root}/tables/graspable_objects.md",
     log:
         "{root}/logs/grasp_realism.log",
     benchmark:

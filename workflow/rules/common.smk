@@ -6,6 +6,7 @@ import re
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
+from snakemake.logging import logger
 
 from synergrasp.config import (
     ConfigError,
@@ -16,6 +17,7 @@ from synergrasp.config import (
     step_params,
     synergy_problems,
 )
+from synergrasp.preflight import accept_configured_wildcards, configfile_problems, slurm_problems
 
 ROOT = Path(workflow.basedir)
 SRC = ROOT / "src" / "synergrasp"
@@ -23,16 +25,26 @@ SRC = ROOT / "src" / "synergrasp"
 
 def _check_inputs(raw):
     """Every scenario's complete configuration (``default`` first), checked with its hand
-    and synergy files before any job runs (config/README.md)."""
-    from synergrasp.hand.kinematics import load_hand
+    and synergy files before any job runs (config/README.md); warnings on hands far from a
+    human hand's dimensions are printed."""
+    from synergrasp.hand.checks import check_hand
     from synergrasp.hand.synergies import load_synergies
 
+    # Snakemake read the configuration files itself and kept a repeated key's last value
+    problems = configfile_problems(workflow.configfiles)
+    if problems:
+        raise ConfigError("\n".join(problems))
     scenarios = scenario_configs(raw)
-    problems = []
+    hands = {}
     for name, cfg in scenarios.items():
-        hand = load_hand(cfg["hand"])
-        synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
         where = "" if name == "default" else f"scenario '{name}': "
+        if cfg["hand"] not in hands:
+            hands[cfg["hand"]] = check_hand(cfg["hand"])
+            problems += hands[cfg["hand"]][1]
+            for warning in hands[cfg["hand"]][2]:
+                logger.warning(f"Warning: {warning}")
+        hand = hands[cfg["hand"]][0]
+        synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
         problems += [where + p for p in check_relations(cfg, synergies.matrix.shape[1])]
         problems += [where + p for p in synergy_problems(cfg, synergies.mean, synergies.matrix)]
     if problems:
@@ -42,7 +54,7 @@ def _check_inputs(raw):
 
 try:
     SCENARIOS = _check_inputs(config)
-except ValueError as err:  # ConfigError, SynergyFileError, hand-file errors are ValueErrors
+except ValueError as err:  # ConfigError, SynergyFileError, hand/YAML file errors
     raise WorkflowError(f"Invalid input, nothing was run:\n{err}") from None
 
 #: The main configuration (scenario `default`), complete (defaults filled in) and checked.
@@ -118,10 +130,33 @@ def step_cfg(step):
     return lambda wildcards: step_config(scenario_config(wildcards), step, wildcards.get("object"))
 
 
+def _exactly(values):
+    """A wildcard constraint matching exactly one of ``values`` (longest first)."""
+    return "|".join(re.escape(v) for v in sorted(set(values), key=lambda v: (-len(v), v)))
+
+
+# Wildcards match the configured names exactly, so Snakemake's guard against endless
+# recursion may accept a configured name ending in a repeated character (obj_000...0).
+_OBJECT_NAMES = {o for cfg in SCENARIOS.values() for o in cfg["objects"]}
+accept_configured_wildcards([*_OBJECT_NAMES, *SCENARIO_ROOT.values()])
+
+
 wildcard_constraints:
-    root="|".join(re.escape(r) for r in SCENARIO_ROOT.values()),
-    object="|".join(sorted({o for cfg in SCENARIOS.values() for o in cfg["objects"]})),
+    root=_exactly(SCENARIO_ROOT.values()),
+    object=_exactly(_OBJECT_NAMES),
     shard=r"\d+",
+
+
+onstart:
+    # A cluster profile on a machine or shell that cannot submit: one line, before any job.
+    if workflow.executor_plugin.name == "slurm":
+        _raw = {k: r.raw for k, r in workflow.resource_settings.default_resources.items()}
+        _problems = slurm_problems(workflow.executor_settings, _raw)
+        if _problems:
+            raise WorkflowError(
+                "The SLURM profile cannot submit from this shell, nothing was run: "
+                + "; ".join(_problems)
+            )
 
 
 def _imported_modules(path):
@@ -217,7 +252,9 @@ STUDY_FILES = {
     "fig1": [f"figures/fig1_synergy_postures.{ext}" for ext in ("png", "pdf")],
     "fig2": [f"figures/fig2_example_grasps.{ext}" for ext in ("png", "pdf")],
     "tables": [f"tables/{t}.{ext}" for t in TABLES for ext in ("csv", "md")],
-    "realism": [f"tables/grasp_realism.{ext}" for ext in ("csv", "md")]
+    "realism": [
+        f"tables/{t}.{ext}" for t in ("grasp_realism", "graspable_objects") for ext in ("csv", "md")
+    ]
     + [f"figures/grasp_realism.{ext}" for ext in ("png", "pdf")],
     "fig5": [
         f"figures/{name}.{ext}"

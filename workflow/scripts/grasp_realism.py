@@ -1,15 +1,17 @@
-"""The grasp-realism table and figure: how the simulated grasps touch the boxes."""
+"""The grasp-realism table and figure: how the simulated grasps touch the boxes; the
+graspable-objects table, and one line per object that can never be grasped."""
 
 import pandas as pd
 
 from synergrasp import tables
+from synergrasp.analysis.graspability import graspable_objects, ungraspable_lines
 from synergrasp.analysis.realism import grasp_realism
 from synergrasp.config import step_params
 from synergrasp.figures.grasp_realism import figure_grasp_realism
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.job_log import job_log
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0]) as log:
     params = step_params(snakemake.params.cfg, "realism")
     hand = load_hand(params.hand)
     contacts = pd.concat([tables.read(tables.CONTACTS, p) for p in snakemake.input.contacts], ignore_index=True)
@@ -18,3 +20,9 @@ with job_log(snakemake.log[0]):
                           params.load_threshold_N)
     tables.write_study_table(table, snakemake.output.csv, snakemake.output.md, title="Grasp realism")
     figure_grasp_realism(table, snakemake.output.png, snakemake.output.pdf)
+    graspable = graspable_objects(contacts, gfo, params.full_set_id)
+    tables.write_study_table(graspable, snakemake.output.graspable_csv, snakemake.output.graspable_md,
+                             title="Graspable objects")
+    for line in ungraspable_lines(graspable):  # on the console and in the job's log
+        print(f"WARNING: {line}")
+        print(f"WARNING: {line}", file=log)
