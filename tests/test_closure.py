@@ -257,12 +257,74 @@ def test_open_path_pinches_thumb_with_index_and_middle(hand, table):
         assert np.all(path.reference(first)[index] < hand.upper[index] - 0.05), (other, first)
 
 
-def test_box_through_the_palm_is_flagged(hand, synergies):
-    inside = study_placement(mode="fixed", center_mm=(0.0, 0.0, 50.0))
-    table = simulate_object(hand, synergies, CUBE, inside, PARAMS, poses=[0])
-    assert table.status.iloc[0] == "intersects_open_hand"
-    assert table.n_contacts.iloc[0] == 0
-    assert read_grasps(table) == [None]
+def test_a_target_behind_the_palm_ends_touching_and_not_intersecting_the_open_hand(hand, synergies):
+    """The box turned by (α, β) stops at first touch of the open hand when its target lies
+    behind the palm face (the earlier fixed placement dropped such a pose)."""
+    from synergrasp.simulation.closure import closure_model, place_box
+
+    behind = study_placement(mode="fixed", center_mm=(0.0, 0.0, 50.0))
+    model = closure_model(hand, synergies, PARAMS)
+    try:
+        for alpha, beta in [(0.0, 0.0), (-30.0, 20.0), (45.0, -60.0)]:
+            placed = place_box(model.scene, model.q_open, behind, np.asarray(CUBE.size_mm), alpha, beta)
+            model.scene.set_posture(model.q_open)
+            gap = float(np.min(model.scene.object_distance()))
+            assert -1e-9 <= gap <= 0.011, (alpha, beta, gap)  # touching (to round-off), not intersecting
+            assert placed.center_mm[0] > 0.0  # stopped in front of the target, on the palm normal
+            np.testing.assert_allclose(placed.center_mm[1:], [0.0, 50.0], atol=1e-12)
+    finally:
+        model.close()
+    table = simulate_object(hand, synergies, CUBE, behind, PARAMS, poses=[0])
+    assert table.status.iloc[0] == "grasp" and table.n_contacts.iloc[0] > 0
+
+
+@pytest.mark.parametrize("mode", ["fixed", "approach"])
+def test_a_reachable_target_puts_the_box_centre_on_it(hand, synergies, mode):
+    """A target the box reaches without touching the open hand: the centre is the target."""
+    from synergrasp.simulation.closure import closure_model, place_box
+
+    target = (90.0, -9.0, 100.0)
+    placement = study_placement(mode=mode, center_mm=target, approach_point_mm=target)
+    model = closure_model(hand, synergies, PARAMS)
+    try:
+        for alpha, beta in [(0.0, 0.0), (35.0, -45.0)]:
+            placed = place_box(model.scene, model.q_open, placement, np.asarray(PLATE.size_mm), alpha, beta)
+            np.testing.assert_array_equal(placed.center_mm, target)
+            model.scene.set_posture(model.q_open)
+            assert float(np.min(model.scene.object_distance())) > 0.0
+    finally:
+        model.close()
+
+
+def test_the_approach_preset_is_the_earlier_approach_bit_for_bit(hand, synergies, grid):
+    """With its target on the palm face the box always touches before reaching it, so the
+    rule takes exactly the earlier approach's steps (bring_box without the stop at the point)."""
+    from synergrasp.simulation.closure import closure_model, place_box
+
+    model = closure_model(hand, synergies, PARAMS)
+    point, normal = approach_line(PLACEMENT, hand)
+    try:
+        for box in (CUBE, PLATE, Box("obj4", (100.0, 60.0, 100.0), 1.0)):
+            size = np.asarray(box.size_mm)
+            for pose in range(0, grid.n_poses, 97):
+                a, b = grid.angles_deg(pose)
+                placed = place_box(model.scene, model.q_open, PLACEMENT, size, a, b)
+                turned = object_pose(PLACEMENT, size, a, b, hand.palm_normal)
+                earlier = model.scene.bring_box(size, turned.rotation, point, normal, model.q_open,
+                                                PLACEMENT.clearance_mm)
+                np.testing.assert_array_equal(placed.center_mm, earlier.center_mm)
+                np.testing.assert_array_equal(placed.rotation, earlier.rotation)
+    finally:
+        model.close()
+
+
+@pytest.mark.parametrize("target", [(-20.0, -9.0, 52.0), (9.5, -50.0, 20.0), (29.5, 30.0, 180.0),
+                                    (49.5, -10.0, 100.0), (9.5, 10.0, 120.0), (38.0, 5.0, 112.0)])
+def test_no_pose_is_dropped_at_any_target(hand, synergies, target):
+    obj4 = Box("obj4", (100.0, 60.0, 100.0), 1.0)
+    placement = study_placement("obj4", mode="searched", target_mm=target)
+    table = simulate_object(hand, synergies, obj4, placement, PARAMS, poses=range(0, 1800, 131))
+    assert "intersects_open_hand" not in set(table.status)
 
 
 def test_table_round_trips_through_parquet_into_grasps(sample, tmp_path):

@@ -82,5 +82,17 @@ def test_with_verdicts_picks_the_success_column_and_flags_marginal_grasps():
     assert lf["success"].tolist() == [True, True, True, False]
     assert lf["marginal"].tolist() == [False, True, False, False]  # 200 N > 98.1 N
     assert np.isnan(fc.loc[1, "success_force"]) and lf.loc[1, "success_force"] == 200.0
-    with pytest.raises(ValueError, match=r"success must be one of \['force_closure', 'load_feasible'\]"):
+    with pytest.raises(ValueError, match=r"success must be one of \['force_closure', 'load_feasible', "):
         with_verdicts(gfo, "feasible")
+
+
+def test_force_closure_bounded_is_force_closure_within_the_bound():
+    gfo = pd.DataFrame({"object": ["a"] * 4, "set_id": ["1"] * 4, "status": ["force_closure"] * 4,
+                        "force_closure": [True] * 4, "strict_internal": [True, True, True, False],
+                        "rank_G": [6] * 4, "force_norm": [50.0, 98.1, 98.2, 3.0]})
+    bounded = with_verdicts(gfo, "force_closure_bounded", {"a": 9.81}, 10.0)
+    assert bounded["success"].tolist() == [True, True, False, False]  # 98.2 N > 10 x 9.81 N; no strict test
+    assert not bounded["marginal"].any()  # a bounded success is never marginal
+    assert bounded["success_force"].tolist()[:2] == [50.0, 98.1] and bounded["success_force"].isna().tolist()[2:] == [True, True]
+    with pytest.raises(ValueError, match="needs every object's weight"):
+        with_verdicts(gfo, "force_closure_bounded", {"b": 9.81}, 10.0)

@@ -46,6 +46,7 @@ __all__ = [
     "scenario_configs",
     "step_config",
     "step_hash",
+    "step_upstream_when",
     "step_params",
     "placement_params",
     "grid_axis_deg",
@@ -315,6 +316,26 @@ def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -
                         f"synergy_sets.incremental_max ({k_max})")
     if not _grid_problems(config["grid"]):
         problems += _pose_problems(config)
+        problems += _search_problems(config)
+    return problems
+
+
+def _search_problems(config: Mapping[str, Any]) -> list[str]:
+    """The placement search's relations (docs/placement_search.md), globally and per object:
+    the refinement spacing divides the coarse one, every region interval is ordered."""
+    problems = []
+    for where, block in [("placement", config["placement"])] + [
+            (f"objects.{name}.placement", spec.get("placement") or {}) for name, spec in config["objects"].items()]:
+        search = overlay(config["placement"]["search"], block.get("search")) if where != "placement" else block["search"]
+        if where != "placement" and "search" not in block:
+            continue
+        ratio = search["coarse_spacing_mm"] / search["spacing_mm"]
+        if abs(ratio - round(ratio)) > 1e-9:
+            problems.append(f"config error at '{where}.search.coarse_spacing_mm': {search['coarse_spacing_mm']} must be "
+                            f"a whole multiple of search.spacing_mm ({search['spacing_mm']})")
+        for axis, (lo, hi) in search["region_mm"].items():
+            if hi < lo:
+                problems.append(f"config error at '{where}.search.region_mm.{axis}': stop {hi} is below start {lo}")
     return problems
 
 
@@ -411,15 +432,22 @@ STEP_KEYS: dict[str, tuple[str, ...]] = {
     "minima": ("analyses.minima_radius_deg", "analyses.success"),
     "tables": ("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max", "analyses.success",
                "analyses.marginal_weight_multiple", "analyses.success_rate_tolerance_percent",
-               "analyses.null_model", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
+               "analyses.null_model", "analyses.headline_view", "analyses.tie_band", "analyses.min_distinct_poses",
+               "analyses.bootstrap", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
     "realism": ("hand", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2"),
     "fig1": ("hand", "synergies"),
     "fig2": ("hand", "objects.*.size_mm"),
     "fig4": ("analyses.fig4", "analyses.success"),
     "fig5": ("synergy_sets.hierarchy_first", "analyses.success"),
+    # the placement search (docs/placement_search.md): the kinematic closure and the
+    # optimisation with the full set {S1..S_incremental_max} only
+    "search": ("hand", "synergies", "grid", "placement", "closure", "mechanics", "synergy_sets.incremental_max",
+               "objects.{object}.size_mm", "objects.{object}.mass_kg", "objects.{object}.placement"),
 }
 #: The keys of the choice of which contacts count (the ``contacts`` step).
 _CONTACT_SELECTION = ("closure.dynamic.unloaded_contacts", "closure.dynamic.load_threshold_N")
+#: The keys of the force bound of ``analyses.success: force_closure_bounded``.
+_FORCE_BOUND = ("analyses.marginal_weight_multiple", "objects.{object}.mass_kg", "mechanics.g_m_per_s2")
 #: Keys a step reads only when another key has a given value: step -> ((key, value, reads), ...).
 STEP_KEYS_WHEN: dict[str, tuple[tuple[str, Any, tuple[str, ...]], ...]] = {
     # the dynamic closure: a free box of the object's mass, μ, k_ss and gravity of mechanics
@@ -427,19 +455,33 @@ STEP_KEYS_WHEN: dict[str, tuple[tuple[str, Any, tuple[str, ...]], ...]] = {
     # which contacts count: only the dynamic model records the load each contact carries
     "contacts": (("closure.model", "dynamic", _CONTACT_SELECTION),),
     "realism": (("closure.model", "dynamic", ("closure.dynamic.load_threshold_N",)),),
+    # force closure within a multiple of the weight: the minima and Fig. 4 read the bound
+    "minima": (("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
+    "fig4": (("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
 }
 #: Keys inside a block a step reads that the step itself does not read: step -> key paths.
 #: The closure lists every touching link with its load; which of them count is the
 #: ``contacts`` step's choice, so that ``drop`` and ``keep`` share one simulation.
-STEP_KEYS_EXCEPT: dict[str, tuple[str, ...]] = {"simulate": _CONTACT_SELECTION}
+#: The closure does not read the search's settings (a searched placement reads its output);
+#: the search does not read which target a mode uses, nor the closure model (it always
+#: closes with the kinematic model, docs/placement_search.md).
+_PLACEMENT_TARGETS = ("mode", "search_rank", "approach_point_mm", "center_mm")
+STEP_KEYS_EXCEPT: dict[str, tuple[str, ...]] = {
+    "simulate": (*_CONTACT_SELECTION, "placement.search", "objects.{object}.placement.search"),
+    "search": ("closure.model", "closure.dynamic",
+               *(f"{where}.{key}" for where in ("placement", "objects.{object}.placement") for key in _PLACEMENT_TARGETS)),
+}
 #: The steps whose outputs a step reads (its hash includes theirs): for a step run per object
 #: (OBJECT_STEPS), that object's; for a step run once per scenario, every object's.
 UPSTREAM: dict[str, tuple[str, ...]] = {
     "contacts": ("simulate",), "optimise": ("contacts",), "minima": ("optimise",), "tables": ("optimise", "minima"),
     "realism": ("contacts", "optimise"), "fig2": ("contacts",), "fig4": ("optimise", "minima"),
     "fig5": ("tables",)}
+#: Steps whose outputs a step reads only when a key of the object's effective placement
+#: has a value: the closure of a searched placement reads the search's targets.
+UPSTREAM_WHEN: dict[str, tuple[tuple[str, Any, str], ...]] = {"simulate": (("mode", "searched", "search"),)}
 #: Steps run once per object (the others once per scenario).
-OBJECT_STEPS: frozenset[str] = frozenset({"simulate", "contacts", "optimise", "minima", "fig4"})
+OBJECT_STEPS: frozenset[str] = frozenset({"simulate", "contacts", "optimise", "minima", "fig4", "search"})
 #: Steps that read only some synergies of the synergy table: step -> the synergies (1-based)
 #: it reads besides the mean posture. Their hash holds those values, not the table's name,
 #: so tables that agree there (thumb readings that differ in S2…S15 only) share the step.
@@ -493,6 +535,10 @@ def step_config(config: Mapping[str, Any], step: str, obj: str | None = None) ->
         if value is not _MISSING:
             _put(out, path, value)
     for path in STEP_KEYS_EXCEPT.get(step, ()):
+        if "{object}" in path:
+            if obj is None:
+                continue
+            path = path.format(object=obj)
         *parents, last = path.split(".")
         node = _get(out, ".".join(parents))
         if isinstance(node, dict):
@@ -508,13 +554,22 @@ def step_hash(config: Mapping[str, Any], step: str, obj: str | None = None) -> s
     if step in SYNERGY_COLUMNS_READ:
         own["synergies"] = _synergy_digest(own.get("hand"), own["synergies"], SYNERGY_COLUMNS_READ[step])
     parts: list[Any] = [own]
-    for upstream in UPSTREAM.get(step, ()):
+    for upstream in (*UPSTREAM.get(step, ()), *step_upstream_when(config, step, obj)):
         if upstream in OBJECT_STEPS and obj is None:
             parts.append([[name, step_hash(config, upstream, name)] for name in config["objects"]])
         else:
             parts.append(step_hash(config, upstream, obj if upstream in OBJECT_STEPS else None))
     text = json.dumps(parts, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def step_upstream_when(config: Mapping[str, Any], step: str, obj: str | None = None) -> tuple[str, ...]:
+    """The steps ``step`` reads for ``obj`` besides :data:`UPSTREAM`, from the object's
+    effective placement (:data:`UPSTREAM_WHEN`): ``search`` for a searched placement."""
+    if obj is None or step not in UPSTREAM_WHEN:
+        return ()
+    placement = overlay(config["placement"], config["objects"][obj].get("placement"))
+    return tuple(up for key, value, up in UPSTREAM_WHEN[step] if placement.get(key) == value)
 
 
 @functools.cache
@@ -543,6 +598,23 @@ class SimulateParams:
 
 
 @dataclass(frozen=True)
+class SearchStepParams:
+    """The placement search of one object (docs/placement_search.md): hand and synergy files,
+    the box with its mass, its effective placement, the closure settings (the search closes
+    with the kinematic model), the GFO parameters, the size of the full synergy set, the
+    search's settings."""
+    hand: str | None
+    synergies: str | None
+    box: Box
+    placement: Any  # synergrasp.simulation.placement.Placement
+    closure: Any    # synergrasp.simulation.closure.ClosureParams
+    gfo: Any        # synergrasp.optimisation.study.GFOParams
+    full_set_size: int
+    search: Any     # synergrasp.simulation.placement_search.SearchParams
+    distinct_mm: float
+
+
+@dataclass(frozen=True)
 class OptimiseParams:
     """The optimisation of one object: synergy file, the study's synergy sets by id, the
     GFO parameters (mechanics and the object's weight) and the number of pose shards."""
@@ -554,9 +626,21 @@ class OptimiseParams:
 
 @dataclass(frozen=True)
 class MinimaParams:
-    """Local minima of one object: neighbourhood radius (deg) and the success verdict."""
+    """Local minima of one object: neighbourhood radius (deg), the success verdict and, for
+    ``force_closure_bounded``, the object's weight (N) and the bound's multiple of it."""
     radius_deg: float
     success: str
+    weight_N: float | None = None
+    bound_multiple: float = math.inf
+
+
+def _force_bound(config: Mapping[str, Any], obj: str | None) -> dict[str, Any]:
+    """weight_N and bound_multiple of ``obj`` where the verdict is force_closure_bounded."""
+    analyses = config["analyses"]
+    if analyses["success"] != "force_closure_bounded":
+        return {}
+    weight = float(config["objects"][obj]["mass_kg"]) * float(config["mechanics"]["g_m_per_s2"])
+    return {"weight_N": weight, "bound_multiple": float(analyses["marginal_weight_multiple"])}
 
 
 @dataclass(frozen=True)
@@ -596,12 +680,16 @@ class FiguresParams:
     fig4_alpha_slice_deg: float = math.nan
     fig4_beta_slice_deg: float = math.nan
     hierarchy_first: int = 0
+    weight_N: float | None = None
+    bound_multiple: float = math.inf
 
 
 #: Modules holding the typed parameter classes a step's parameters are built from (the
 #: step's script imports them itself; tests/test_config.py checks it).
 STEP_MODULES: dict[str, tuple[str, ...]] = {
     "simulate": ("synergrasp.simulation.closure", "synergrasp.simulation.placement"),
+    "search": ("synergrasp.simulation.closure", "synergrasp.simulation.placement_search",
+               "synergrasp.optimisation.study"),
     "optimise": ("synergrasp.optimisation.study",),
     "tables": ("synergrasp.analysis.summaries", "synergrasp.analysis.periods"),
 }
@@ -642,6 +730,30 @@ def _simulate(config: Mapping[str, Any], obj: str) -> SimulateParams:
         mechanics=config.get("mechanics"))
 
 
+def _search(config: Mapping[str, Any], obj: str) -> SearchStepParams:
+    closure = importlib.import_module("synergrasp.simulation.closure")
+    searching = importlib.import_module("synergrasp.simulation.placement_search")
+    gfo = importlib.import_module("synergrasp.optimisation.study")
+    placement = overlay(config["placement"], config["objects"][obj].get("placement"))
+    spec = placement["search"]
+    region = tuple(tuple(spec["region_mm"][axis]) for axis in ("x", "y", "z"))
+    search = _build(searching.SearchParams, "placement.search", region_mm=region, **_fields(
+        searching.SearchParams, {k: v for k, v in spec.items() if k != "region_mm"}))
+    dynamic = config["closure"].get("dynamic")
+    return SearchStepParams(
+        hand=config["hand"], synergies=config["synergies"], box=_box(config, obj),
+        # the search places the box toward each of its targets: the modes' own targets are not read
+        placement=placement_params({**placement, "mode": "searched", "approach_point_mm": None,
+                                    "center_mm": (0.0, 0.0, 0.0)}, config["grid"]),
+        closure=_build(closure.ClosureParams, "closure", **{
+            **_fields(closure.ClosureParams, {**config["closure"], "model": "kinematic"}),
+            "dynamic": closure.DynamicParams(**dynamic) if dynamic else None}),
+        gfo=_build(gfo.GFOParams, "mechanics", **_fields(gfo.GFOParams, config["mechanics"]),
+                   mass_kg=float(config["objects"][obj]["mass_kg"])),
+        full_set_size=int(config["synergy_sets"]["incremental_max"]), search=search,
+        distinct_mm=float(spec["distinct_mm"]))
+
+
 def _fields(cls: Any, values: Mapping[str, Any]) -> dict[str, Any]:
     """The entries of ``values`` that are fields of the dataclass ``cls``, lists as tuples."""
     names = set(cls.__dataclass_fields__)
@@ -676,7 +788,7 @@ def _tables(config: Mapping[str, Any]) -> TablesParams:
     return TablesParams(dict(config["synergy_sets"]), int(analyses["table2_k_max"]), settings)
 
 
-def _figures(config: Mapping[str, Any], step: str) -> FiguresParams:
+def _figures(config: Mapping[str, Any], step: str, obj: str | None = None) -> FiguresParams:
     if step == "fig1":
         return FiguresParams(hand=config["hand"], synergies=config["synergies"])
     if step == "fig2":
@@ -685,7 +797,8 @@ def _figures(config: Mapping[str, Any], step: str) -> FiguresParams:
     if step == "fig4":
         fig4 = config["analyses"]["fig4"]
         return FiguresParams(success=success, fig4_panel_k=tuple(fig4["panel_k"]),
-                             fig4_alpha_slice_deg=fig4["alpha_slice_deg"], fig4_beta_slice_deg=fig4["beta_slice_deg"])
+                             fig4_alpha_slice_deg=fig4["alpha_slice_deg"], fig4_beta_slice_deg=fig4["beta_slice_deg"],
+                             **_force_bound(config, obj))
     return FiguresParams(success=success, hierarchy_first=config["synergy_sets"]["hierarchy_first"])
 
 
@@ -704,13 +817,16 @@ def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) ->
     config = step_config(config, step, obj)
     if step == "simulate":
         return _simulate(config, obj)
+    if step == "search":
+        return _search(config, obj)
     if step == "contacts":
         dynamic = config["closure"].get("dynamic", {})
         return ContactsParams(dynamic.get("unloaded_contacts") == "drop", dynamic.get("load_threshold_N"))
     if step == "optimise":
         return _optimise(config, obj)
     if step == "minima":
-        return MinimaParams(float(config["analyses"]["minima_radius_deg"]), config["analyses"]["success"])
+        return MinimaParams(float(config["analyses"]["minima_radius_deg"]), config["analyses"]["success"],
+                            **_force_bound(config, obj))
     if step == "tables":
         return _tables(config)
     if step == "realism":
@@ -719,7 +835,7 @@ def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) ->
                              {name: spec["mass_kg"] * g for name, spec in config["objects"].items()},
                              config.get("closure", {}).get("dynamic", {}).get("load_threshold_N"))
     if step in ("fig1", "fig2", "fig4", "fig5"):
-        return _figures(config, step)
+        return _figures(config, step, obj)
     raise ValueError(f"unknown step {step!r}; allowed values: {sorted(STEP_KEYS)}")
 
 

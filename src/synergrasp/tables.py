@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "write", "read", "empty",
-           "write_study_table"]
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT",
+           "write", "read", "empty", "write_study_table"]
 
 
 @dataclass(frozen=True)
@@ -155,7 +155,25 @@ GRASPABLE_OBJECTS = Table("graspable_objects", "one row per object", (
            "no force closure with the full set (empty when graspable)"),
 ))
 
-TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS)}
+#: The placement search of one object (docs/placement_search.md), written as CSV
+#: (results/objects/<object>/placement.csv).
+PLACEMENT = Table("placement", "one row per scored target of one object, best first", (
+    Column("object", "string", "", "object name"),
+    Column("rank", "int32", "", "rank by the tie rules, 1 = the chosen target"),
+    Column("chosen", "bool", "", "rank 1"),
+    Column("distinct_rank", "int32", "", "rank among the targets at least search.distinct_mm from every better one (0: closer)"),
+    Column("x_mm", "float64", "mm", "target point, palm frame"),
+    Column("y_mm", "float64", "mm", "target point, palm frame"),
+    Column("z_mm", "float64", "mm", "target point, palm frame"),
+    Column("round", "int32", "", "search round that scored it (0 = the coarse lattice)"),
+    Column("n_poses", "int32", "", "scored poses"),
+    Column("force_closure_percent", "float64", "%", "share of the scored poses in force closure with the full set"),
+    Column("median_force_per_weight", "float64", "", "median optimal force over those poses / weight (inf: none)"),
+    Column("median_contacts", "float64", "", "median contacts per scored pose"),
+    Column("distance_to_chosen_mm", "float64", "mm", "distance to the chosen target"),
+))
+
+TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT)}
 
 
 def _check(table: Table, frame: pd.DataFrame, where: str) -> None:

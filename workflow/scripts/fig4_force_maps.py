@@ -8,8 +8,9 @@ from synergrasp.figures.study_figures import figure_exploded_views, figure_force
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
-    p = step_params(snakemake.params.cfg, "fig4")
-    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), p.success)
+    p = step_params(snakemake.params.cfg, "fig4", snakemake.wildcards.object)
+    weights = {snakemake.wildcards.object: p.weight_N} if p.weight_N is not None else None
+    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), p.success, weights, p.bound_multiple)
     minima = pd.read_parquet(snakemake.input.minima)
     name, out, panel_k = snakemake.wildcards.object, snakemake.output, list(p.fig4_panel_k)
     figure_force_maps(gfo, minima, panel_k, name, out.maps_png, out.maps_pdf, p.success)

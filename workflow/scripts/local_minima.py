@@ -8,6 +8,7 @@ from synergrasp.config import step_params
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
-    params = step_params(snakemake.params.cfg, "minima")
-    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), params.success)
+    params = step_params(snakemake.params.cfg, "minima", snakemake.wildcards.object)
+    weights = {snakemake.wildcards.object: params.weight_N} if params.weight_N is not None else None
+    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), params.success, weights, params.bound_multiple)
     minima_table(gfo, radius_deg=params.radius_deg).to_parquet(snakemake.output[0], index=False)

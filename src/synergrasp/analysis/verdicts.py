@@ -11,6 +11,8 @@ Two verdicts are derived from the columns the optimisation writes (docs/analyses
 - ``load_feasible`` — the optimisation under the object's weight is feasible (gfo column
   ``force_closure``, i.e. status ``force_closure``): the weight may help through f_p, so a
   box resting in curled fingers passes.
+- ``force_closure_bounded`` — force closure whose optimal force under the weight is at most
+  ``marginal_multiple`` times the weight: non-marginal force closure.
 
 In exact arithmetic force closure implies load feasibility (a strictly interior internal
 force scaled up absorbs any load), so the optimal force under the weight exists at every
@@ -31,7 +33,7 @@ import pandas as pd
 __all__ = ["VERDICTS", "verdict_columns", "with_verdicts"]
 
 #: The success verdicts the tables can use (config ``analyses.success``).
-VERDICTS: tuple[str, ...] = ("force_closure", "load_feasible")
+VERDICTS: tuple[str, ...] = ("force_closure", "load_feasible", "force_closure_bounded")
 _NEEDED = ("object", "set_id", "status", "force_closure", "strict_internal", "rank_G", "force_norm")
 
 
@@ -59,7 +61,8 @@ def with_verdicts(gfo: pd.DataFrame, success: str,
 
     Parameters
     ----------
-    success : one of :data:`VERDICTS` (config ``analyses.success``).
+    success : one of :data:`VERDICTS` (config ``analyses.success``); ``force_closure_bounded``
+        needs ``weights_N`` for every object and a finite ``marginal_multiple``.
     weights_N : object name → weight m·g of the object, N.
     marginal_multiple : a success is marginal above this multiple of the weight
         (config ``analyses.marginal_weight_multiple``; none is marginal by default).
@@ -70,8 +73,15 @@ def with_verdicts(gfo: pd.DataFrame, success: str,
     out = gfo.copy()
     out["verdict_force_closure"] = verdicts["force_closure"]
     out["verdict_load_feasible"] = verdicts["load_feasible"]
-    out["success"] = verdicts[success]
-    out["success_force"] = out["force_norm"].where(out["success"])
     weight = out["object"].map(dict(weights_N or {})).astype(float)
-    out["marginal"] = (out["success_force"] > marginal_multiple * weight).fillna(False).astype(bool)
+    above = (out["force_norm"] > marginal_multiple * weight).fillna(False).astype(bool)
+    if success == "force_closure_bounded":
+        if weights_N is None or weight.isna().any() or not math.isfinite(marginal_multiple):
+            raise ValueError("success 'force_closure_bounded' needs every object's weight and a finite "
+                             "marginal_multiple (config analyses.marginal_weight_multiple)")
+        out["success"] = verdicts["force_closure"] & ~above
+    else:
+        out["success"] = verdicts[success]
+    out["success_force"] = out["force_norm"].where(out["success"])
+    out["marginal"] = out["success"] & above
     return out

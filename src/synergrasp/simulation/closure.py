@@ -1,7 +1,7 @@
 """Closing the hand on an object at every pose: the closure settings and the study loop.
 
-``simulate_object`` places the box at each pose of the grid (:func:`place_box`: fixed, or
-brought to the open hand), runs a closure model on it and collects one contacts-table row
+``simulate_object`` places the box at each pose of the grid (:func:`place_box`: brought
+toward the placement's target, stopped there or at first touch of the open hand), runs a closure model on it and collects one contacts-table row
 per pose (``contacts``). A closure model (``kinematic_closure``, ``dynamic_closure``) takes
 the hand, the synergies and :class:`ClosureParams`; it has the open posture ``q_open``
 (rad) its closure starts from, ``grasp(size_mm, placed) -> ClosureResult`` and ``close()``.
@@ -80,15 +80,15 @@ def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams,
 
 def place_box(scene: HandScene, q_open: NDArray, placement: Placement, size_mm: NDArray, alpha_deg: float,
               beta_deg: float) -> ObjectPose:
-    """The box of ``size_mm`` at pose (α, β) deg: at the fixed centre (``fixed``), or turned
-    by (α, β) and brought along the palm normal to the open hand (posture ``q_open``, rad)
-    of ``scene`` (``approach``)."""
+    """The box of ``size_mm`` at pose (α, β) deg by the placement rule: turned by (α, β),
+    brought along the palm normal toward the placement's target, stopped at the target or at
+    first touch of the open hand (posture ``q_open``, rad) of ``scene``, whichever comes
+    first (:class:`synergrasp.simulation.placement.Placement`)."""
     hand = scene.hand
     turned = object_pose(placement, size_mm, alpha_deg, beta_deg, hand.palm_normal)
-    if placement.mode == "fixed":
-        return turned
     point, direction = approach_line(placement, hand)
-    return scene.bring_box(size_mm, turned.rotation, point, direction, q_open, placement.clearance_mm)
+    return scene.bring_box(size_mm, turned.rotation, point, direction, q_open, placement.clearance_mm,
+                           stop_at_point=True)
 
 
 def simulate_object(hand: Hand, synergies: Synergies, box: Any, placement: Placement,

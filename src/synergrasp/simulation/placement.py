@@ -19,7 +19,11 @@ from synergrasp.hand.kinematics import axis_rotation
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
 
-__all__ = ["palm_centre", "approach_line", "FINGER_AXIS", "Placement", "PoseGrid", "ObjectPose", "pose_grid", "object_pose"]
+__all__ = ["palm_centre", "approach_line", "placement_target", "FINGER_AXIS", "MODES", "Placement", "PoseGrid",
+           "ObjectPose", "pose_grid", "object_pose"]
+
+#: The placement modes: presets of one rule, which differ only in where the target comes from.
+MODES: tuple[str, ...] = ("approach", "fixed", "searched")
 
 
 #: Long-finger axis of the palm frame (β rotates about it).
@@ -49,15 +53,22 @@ class Placement:
     Built by :func:`synergrasp.config.step_params` (``"simulate"``) from the configuration,
     whose schema holds the defaults and checks the values.
 
-    mode:           ``approach``: the box, turned by (α, β), comes along the palm
-                    normal toward ``approach_point_mm`` until it is ``clearance_mm`` from the
-                    open hand (``HandScene.bring_box``), so it never intersects the open hand.
-                    ``fixed``: the box centre is ``center_mm`` at every pose.
-    approach_point_mm: the point of the palm the box comes toward (palm frame, mm); None =
-                    the centre of the palm's face (:func:`palm_centre`).
-    clearance_mm:   gap (mm, ≥ 0) left between the box and the open hand in ``approach`` mode.
-    center_mm:      ``fixed`` mode: box centre o in the palm frame (mm); α and β rotate
-                    about it, so it is the same for every pose.
+    One rule for every mode: the box, turned by (α, β) about its centre, travels along the
+    palm normal from outside toward a target point (palm frame, mm) and stops at the target
+    or when it first comes within ``clearance_mm`` of the open hand, whichever comes first
+    (``HandScene.bring_box``). It never intersects the open hand, so no pose is dropped.
+    The modes say where the target comes from (:func:`placement_target`):
+
+    mode:           ``approach``: ``approach_point_mm`` (None = the palm centre, which lies
+                    on the palm face, so the box always stops at first touch);
+                    ``fixed``: ``center_mm`` (a box that reaches it without touching the
+                    open hand sits there at every pose; one that would intersect the open
+                    hand stops at first touch); ``searched``: ``target_mm``, the object's
+                    target chosen by the placement search (docs/placement_search.md).
+    approach_point_mm: ``approach`` target (palm frame, mm); None = :func:`palm_centre`.
+    clearance_mm:   gap (mm, ≥ 0) left between the box and the open hand when it stops at
+                    first touch.
+    center_mm:      ``fixed`` target (palm frame, mm); α and β rotate the box about its centre.
     box_axes:       ``box_axes[k]`` is the index (into ``size_mm``) of the box edge that
                     lies along palm axis k (x = palm normal, y, z = long fingers) at
                     α = β = 0; a permutation of (0, 1, 2).
@@ -66,6 +77,9 @@ class Placement:
                     ``beta_then_alpha``: R = R_n(α)·R_z(β)·R_0. Only ``alpha_then_beta``
                     keeps the α ↔ α + 180° symmetry of a box exact.
     alpha_deg, beta_deg: (start, stop, step) of the inclusive grids, deg; α is periodic.
+    target_mm:      ``searched`` target (palm frame, mm), read from the search's output by
+                    the closure step; None in the other modes.
+    search_rank:    ``searched``: which of the search's distinct targets (1 = the chosen one).
     """
 
     mode: str
@@ -76,12 +90,15 @@ class Placement:
     rotation_order: str
     alpha_deg: tuple[float, float, float]
     beta_deg: tuple[float, float, float]
+    target_mm: tuple[float, float, float] | None = None
+    search_rank: int = 1
 
     def __post_init__(self) -> None:
         # Values are checked once, by the schema and config.check_relations; built by
         # config.step_params, which holds the defaults. Here only the types are settled.
-        if self.approach_point_mm is not None:
-            object.__setattr__(self, "approach_point_mm", tuple(float(v) for v in self.approach_point_mm))
+        for name in ("approach_point_mm", "target_mm"):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, tuple(float(v) for v in getattr(self, name)))
         object.__setattr__(self, "clearance_mm", float(self.clearance_mm))
         object.__setattr__(self, "center_mm", tuple(float(v) for v in self.center_mm))
         object.__setattr__(self, "box_axes", tuple(int(a) for a in self.box_axes))
@@ -209,8 +226,21 @@ def palm_centre(hand: Hand) -> NDArray:
     return centre + (float(np.max(pts @ n)) - float(centre @ n)) * n
 
 
+def placement_target(placement: Placement, hand: Hand) -> NDArray:
+    """The target point (palm frame, mm) the box travels toward in the placement's mode."""
+    if placement.mode == "fixed":
+        return np.asarray(placement.center_mm, dtype=float)
+    if placement.mode == "searched":
+        if placement.target_mm is None:
+            raise ValueError("placement.mode 'searched' needs the object's searched target (target_mm): "
+                             "the closure reads it from the search's placement.csv")
+        return np.asarray(placement.target_mm, dtype=float)
+    if placement.approach_point_mm is None:
+        return palm_centre(hand)
+    return np.asarray(placement.approach_point_mm, dtype=float)
+
+
 def approach_line(placement: Placement, hand: Hand) -> tuple[NDArray, NDArray]:
-    """The approach point (mm) and the unit direction from the palm outward (the palm
-    normal): the box centre moves on point + t·direction toward the palm."""
-    point = palm_centre(hand) if placement.approach_point_mm is None else np.asarray(placement.approach_point_mm)
-    return np.asarray(point, dtype=float), _unit(hand.palm_normal)
+    """The target point (mm) and the unit direction from the palm outward (the palm
+    normal): the box centre moves on target + t·direction, t ≥ 0, from far out toward t = 0."""
+    return placement_target(placement, hand), _unit(hand.palm_normal)

@@ -151,14 +151,17 @@ class HandScene:
         return d
 
     def bring_box(self, size_mm: NDArray, rotation: NDArray, point_mm: NDArray, direction: NDArray,
-                  q: NDArray, clearance_mm: float = 0.0, tolerance_mm: float = 0.01) -> ObjectPose:
+                  q: NDArray, clearance_mm: float = 0.0, tolerance_mm: float = 0.01,
+                  stop_at_point: bool = False) -> ObjectPose:
         """Bring a box (edge lengths ``size_mm``, orientation ``rotation``) from far along the
         line point + t·direction (mm; ``direction`` a unit vector pointing away from the hand)
         toward the hand at posture q, until its gap to the hand is ``clearance_mm`` (to
-        within ``tolerance_mm``). The box is left there; returns its pose.
+        within ``tolerance_mm``), or, with ``stop_at_point``, until its centre reaches the
+        point (t = 0) if that comes first. The box is left there; returns its pose.
 
         Conservative advancement: a translation by δ changes every distance by at most δ, so
-        stepping by the current excess gap never passes the first touch.
+        stepping by the current excess gap never passes the first touch; a last step to
+        t = 0 shorter than the excess gap cannot pass it either.
         """
         size = np.asarray(size_mm, dtype=float)
         point, direction = np.asarray(point_mm, dtype=float), np.asarray(direction, dtype=float)
@@ -177,6 +180,8 @@ class HandScene:
         for _ in range(_MAX_APPROACH_STEPS):
             if gap <= tolerance_mm:
                 break
+            if stop_at_point and t - gap <= 0.0:
+                return excess(0.0)[0]  # the centre reaches the point before the box touches
             t -= gap
             placed, gap = excess(t)
         return placed

@@ -1,0 +1,329 @@
+"""The placement search: where each box sits best in the hand (docs/placement_search.md).
+
+The objective is pre-registered in docs/placement_search.md, with this module, before any
+search result existed. A target point t (palm frame, mm) is scored on a fixed subset of the
+object's distinct poses (the α-period folded): the box is placed by the placement rule
+(travels along the palm normal toward t, stops at t or at first touch of the open hand), the
+hand closes on it, and the grasp-force optimisation runs with the **full synergy set only**.
+:func:`score_target` turns the per-pose results into a :class:`TargetScore` (a pure
+function), :func:`rank_targets` orders targets by the tie rules; :func:`search_object` runs
+the coarse-to-fine search over the region. Nothing here reads a synergy subset, a claim or
+a hierarchy figure. mm, N, deg; palm frame.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from synergrasp import tables
+from synergrasp.optimisation.problem import SynergySets
+from synergrasp.optimisation.study import GFOParams, optimise_grasps
+from synergrasp.simulation.contacts import contacts_row, contacts_table, read_grasps
+from synergrasp.simulation.placement import Placement, palm_centre, pose_grid
+
+if TYPE_CHECKING:  # pragma: no cover
+    from synergrasp.hand.kinematics import Hand
+    from synergrasp.hand.synergies import Synergies
+    from synergrasp.simulation.closure import ClosureParams
+
+__all__ = ["SearchParams", "TargetScore", "SearchResult", "score_target", "rank_targets", "pose_subset",
+           "full_synergy_set", "TargetScorer", "search_object", "region_lattice", "distinct_ranks"]
+
+_TOL = 1e-6
+
+
+@dataclass(frozen=True)
+class SearchParams:
+    """The search's settings (config ``placement.search``; defaults in the schema).
+
+    region_mm:          ((x0, x1), (y0, y1), (z0, z1)): the box of target points, palm frame, mm
+    coarse_spacing_mm:  spacing of the first lattice, anchored at (x0, y0, z0)
+    spacing_mm:         spacing of the refinement (the final resolution, ≤ 10 mm); divides
+                        coarse_spacing_mm
+    refine_top:         each round adds the unscored lattice neighbours (±spacing_mm on each
+                        axis, 26 of them) of the best ``refine_top`` targets
+    max_rounds:         refinement rounds at most (the search stops earlier when the best
+                        targets' neighbours are all scored)
+    pose_alpha_step_deg, pose_beta_step_deg: the scored poses: the grid's poses in the first
+                        α-period whose α and β lie on these steps from the grid's start
+    tie_band_points:    force-closure shares within this many percentage points of the best
+                        count as tied
+    force_tie_relative: median forces within this relative margin of the lowest count as tied
+    """
+
+    region_mm: tuple[tuple[float, float], tuple[float, float], tuple[float, float]]
+    coarse_spacing_mm: float
+    spacing_mm: float
+    refine_top: int
+    max_rounds: int
+    pose_alpha_step_deg: float
+    pose_beta_step_deg: float
+    tie_band_points: float
+    force_tie_relative: float
+
+    def __post_init__(self) -> None:
+        region = tuple((float(a), float(b)) for a, b in self.region_mm)
+        if len(region) != 3 or any(b < a for a, b in region):
+            raise ValueError(f"region_mm must be three (start, stop) pairs with stop >= start, got {self.region_mm!r}")
+        object.__setattr__(self, "region_mm", region)
+        for name in ("coarse_spacing_mm", "spacing_mm", "pose_alpha_step_deg", "pose_beta_step_deg",
+                     "tie_band_points", "force_tie_relative"):
+            object.__setattr__(self, name, float(getattr(self, name)))
+        ratio = self.coarse_spacing_mm / self.spacing_mm
+        if not (self.spacing_mm > 0 and abs(ratio - round(ratio)) < 1e-9 and round(ratio) >= 1):
+            raise ValueError(f"coarse_spacing_mm ({self.coarse_spacing_mm}) must be a whole multiple of "
+                             f"spacing_mm ({self.spacing_mm})")
+
+
+@dataclass(frozen=True)
+class TargetScore:
+    """The objective at one target: what the whole hand does on the scored poses.
+
+    force_closure_percent:   share of the scored poses in force closure (the study's
+                             Definition 1: rank(G) = 6 and a strictly internal force) with
+                             the full synergy set, %
+    median_force_per_weight: median optimal contact force ‖f‖₂ under the weight over those
+                             force-closure poses, divided by the weight (inf when none)
+    median_contacts:         median number of contacts per scored pose
+    """
+
+    target_mm: tuple[float, float, float]
+    n_poses: int
+    force_closure_percent: float
+    median_force_per_weight: float
+    median_contacts: float
+
+
+def score_target(target_mm: Sequence[float], force_closure: NDArray, force_N: NDArray, n_contacts: NDArray,
+                 weight_N: float) -> TargetScore:
+    """The objective of one target from its per-pose results with the full synergy set
+    (one entry per scored pose): force closure (bool), optimal force under the weight (N,
+    NaN where none) and the number of contacts. Pure: reads nothing else."""
+    fc = np.asarray(force_closure, dtype=bool)
+    force = np.asarray(force_N, dtype=float)
+    contacts = np.asarray(n_contacts, dtype=float)
+    if not (fc.shape == force.shape == contacts.shape and fc.ndim == 1 and fc.size > 0):
+        raise ValueError("force_closure, force_N and n_contacts must be equal-length 1-d arrays of the scored poses")
+    if not weight_N > 0:
+        raise ValueError(f"weight_N must be > 0, got {weight_N}")
+    held = fc & np.isfinite(force)
+    median_force = float(np.median(force[held])) / float(weight_N) if held.any() else math.inf
+    return TargetScore(tuple(float(v) for v in target_mm), int(fc.size), 100.0 * float(fc.mean()),
+                       median_force, float(np.median(contacts)))
+
+
+def _best(scores: Sequence[TargetScore], reference_mm: NDArray, tie_band_points: float,
+          force_tie_relative: float) -> TargetScore:
+    """The tie rules: the highest force-closure share, shares within ``tie_band_points`` tied;
+    among them the lowest median force over the weight, forces within ``force_tie_relative``
+    of it tied; then the most median contacts; then the target nearest the reference (the
+    palm centre); then the smallest (x, y, z)."""
+    top = max(s.force_closure_percent for s in scores)
+    tied = [s for s in scores if s.force_closure_percent >= top - tie_band_points - _TOL]
+    low = min(s.median_force_per_weight for s in tied)
+    if math.isfinite(low):
+        tied = [s for s in tied if s.median_force_per_weight <= low * (1.0 + force_tie_relative) + _TOL]
+    most = max(s.median_contacts for s in tied)
+    tied = [s for s in tied if s.median_contacts >= most]
+    return min(tied, key=lambda s: (round(float(np.linalg.norm(np.subtract(s.target_mm, reference_mm))), 9),
+                                    s.target_mm))
+
+
+def rank_targets(scores: Sequence[TargetScore], reference_mm: Sequence[float], tie_band_points: float,
+                 force_tie_relative: float) -> list[TargetScore]:
+    """Every target, best first: the first is the one the tie rules pick among all, the next
+    the one they pick among the rest, and so on (a total order, independent of input order)."""
+    left = sorted(scores, key=lambda s: s.target_mm)
+    ref = np.asarray(reference_mm, dtype=float)
+    out = []
+    while left:
+        best = _best(left, ref, tie_band_points, force_tie_relative)
+        out.append(best)
+        left.remove(best)
+    return out
+
+
+def region_lattice(params: SearchParams, spacing_mm: float) -> NDArray:
+    """(n, 3) the lattice points of the region at ``spacing_mm``, anchored at its lower corner."""
+    axes = [start + spacing_mm * np.arange(int(math.floor((stop - start) / spacing_mm + 1e-9)) + 1)
+            for start, stop in params.region_mm]
+    return np.array(list(itertools.product(*axes)), dtype=float)
+
+
+def _in_region(point: NDArray, params: SearchParams) -> bool:
+    return all(a - _TOL <= v <= b + _TOL for v, (a, b) in zip(point, params.region_mm))
+
+
+def pose_subset(placement: Placement, period_deg: float, params: SearchParams) -> list[int]:
+    """The scored poses: those of the placement's grid with α in the first α-period
+    [α0, α0 + period) and α − α0, β − β0 whole multiples of the search's pose steps."""
+    grid = pose_grid(placement)
+    a0, b0 = float(grid.alpha_deg[0]), float(grid.beta_deg[0])
+
+    def on_step(values: NDArray, start: float, step: float) -> NDArray:
+        k = (values - start) / step
+        return np.abs(k - np.round(k)) < 1e-9
+
+    alphas = np.flatnonzero(on_step(grid.alpha_deg, a0, params.pose_alpha_step_deg)
+                            & (grid.alpha_deg < a0 + period_deg - 1e-9))
+    betas = np.flatnonzero(on_step(grid.beta_deg, b0, params.pose_beta_step_deg))
+    if alphas.size == 0 or betas.size == 0:
+        raise ValueError("placement.search: no pose of the grid lies on the search's pose steps")
+    return [int(ia) * grid.n_beta + int(ib) for ia in alphas for ib in betas]
+
+
+def full_synergy_set(matrix: NDArray, n_full: int) -> SynergySets:
+    """The one synergy set the search reads: the full set {S1..S_n_full}."""
+    return SynergySets(np.asarray(matrix, dtype=float), (tuple(range(1, int(n_full) + 1)),))
+
+
+class TargetScorer:
+    """Scores targets of one object: placement rule, closure, GFO with the full set only."""
+
+    def __init__(self, hand: Hand, synergies: Synergies, box: Any, placement: Placement,
+                 closure: ClosureParams, gfo: GFOParams, full_set: SynergySets, poses: Sequence[int]) -> None:
+        from synergrasp.simulation.closure import closure_model
+        from synergrasp.simulation.scene import HandScene
+
+        if len(full_set) != 1:
+            raise ValueError("the search reads the full synergy set only: give exactly one set")
+        self.box, self.placement, self.gfo, self.full_set = box, placement, gfo, full_set
+        self.poses = [int(p) for p in poses]
+        self.grid = pose_grid(placement)
+        self.model = closure_model(hand, synergies, replace(closure, model="kinematic"))
+        self.placer = HandScene(hand)
+
+    def close(self) -> None:
+        self.model.close()
+        self.placer.close()
+
+    def contacts(self, target_mm: Sequence[float]) -> pd.DataFrame:
+        """The contacts table of the scored poses with the box placed toward ``target_mm``."""
+        from synergrasp.simulation.closure import place_box
+
+        placement = replace(self.placement, mode="searched", target_mm=tuple(float(v) for v in target_mm))
+        size = np.asarray(self.box.size_mm, dtype=float)
+        rows = []
+        for pose in self.poses:
+            a, b = self.grid.angles_deg(pose)
+            placed = place_box(self.placer, self.model.q_open, placement, size, a, b)
+            rows.append(contacts_row(str(self.box.name), pose, a, b, self.model.grasp(size, placed), placed))
+        return contacts_table(rows)
+
+    def __call__(self, target_mm: Sequence[float]) -> TargetScore:
+        table = self.contacts(target_mm)
+        out = optimise_grasps(read_grasps(table), self.full_set, self.gfo)
+        fc = np.asarray(out["strict_internal"], dtype=bool) & (np.asarray(out["rank_G"]) == 6)
+        weight = self.gfo.mass_kg * self.gfo.g_m_per_s2
+        return score_target(target_mm, fc, out["force_norm"], table["n_contacts"].to_numpy(), weight)
+
+
+def distinct_ranks(ranked: Sequence[TargetScore], distinct_mm: float) -> list[int]:
+    """Per target of a ranking, its rank among the targets at least ``distinct_mm`` from every
+    better distinct one (1, 2, …), 0 for a target closer than that to one of them."""
+    kept: list[NDArray] = []
+    out = []
+    for s in ranked:
+        p = np.asarray(s.target_mm)
+        if all(np.linalg.norm(p - q) >= distinct_mm - _TOL for q in kept):
+            kept.append(p)
+            out.append(len(kept))
+        else:
+            out.append(0)
+    return out
+
+
+@dataclass(frozen=True)
+class SearchResult:
+    """Every scored target of one object, best first (``ranked[0]`` is the chosen one), and
+    the refinement round in which each target was first scored (0 = the coarse lattice)."""
+
+    object: str
+    ranked: tuple[TargetScore, ...]
+    rounds: dict[tuple[float, float, float], int]
+
+    @property
+    def chosen(self) -> TargetScore:
+        return self.ranked[0]
+
+    def table(self, distinct_mm: float) -> pd.DataFrame:
+        """The placement table (``tables.PLACEMENT``), best first."""
+        chosen = np.asarray(self.chosen.target_mm)
+        distinct = distinct_ranks(self.ranked, distinct_mm)
+        rows = [{"object": self.object, "rank": k + 1, "chosen": k == 0, "distinct_rank": distinct[k],
+                 "x_mm": s.target_mm[0],
+                 "y_mm": s.target_mm[1], "z_mm": s.target_mm[2], "round": self.rounds[s.target_mm],
+                 "n_poses": s.n_poses, "force_closure_percent": s.force_closure_percent,
+                 "median_force_per_weight": s.median_force_per_weight, "median_contacts": s.median_contacts,
+                 "distance_to_chosen_mm": float(np.linalg.norm(np.asarray(s.target_mm) - chosen))}
+                for k, s in enumerate(self.ranked)]
+        return pd.DataFrame(rows, columns=list(tables.PLACEMENT.names))
+
+
+_WORKER: TargetScorer | None = None
+
+
+def _init_worker(args: tuple) -> None:
+    global _WORKER
+    _WORKER = TargetScorer(*args)
+
+
+def _score_in_worker(target: tuple[float, float, float]) -> TargetScore:
+    assert _WORKER is not None
+    return _WORKER(target)
+
+
+def _key(point: NDArray) -> tuple[float, float, float]:
+    return tuple(float(round(v, 6)) for v in point)
+
+
+def search_object(hand: Hand, synergies: Synergies, box: Any, placement: Placement, closure: ClosureParams,
+                  gfo: GFOParams, full_set: SynergySets, params: SearchParams, period_deg: float,
+                  processes: int = 1) -> SearchResult:
+    """The coarse-to-fine search of one object (docs/placement_search.md): score the coarse
+    lattice, then, round by round, the unscored neighbours at ``spacing_mm`` of the best
+    ``refine_top`` targets, until they are all scored or ``max_rounds`` is reached.
+    Deterministic: the same result for any ``processes``."""
+    args = (hand, synergies, box, placement, closure, gfo, full_set, pose_subset(placement, period_deg, params))
+    reference = palm_centre(hand)
+    scores: dict[tuple[float, float, float], TargetScore] = {}
+    rounds: dict[tuple[float, float, float], int] = {}
+    pool = None
+    if processes > 1:
+        import multiprocessing
+
+        pool = multiprocessing.get_context("fork").Pool(processes, initializer=_init_worker, initargs=(args,))
+        score_many = lambda targets: pool.map(_score_in_worker, targets, chunksize=1)  # noqa: E731
+    else:
+        scorer = TargetScorer(*args)
+        score_many = lambda targets: [scorer(t) for t in targets]  # noqa: E731
+    steps = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if any(d)], dtype=float)
+    try:
+        todo = [_key(p) for p in region_lattice(params, params.coarse_spacing_mm)]
+        for k in range(params.max_rounds + 1):
+            for target, score in zip(todo, score_many(todo)):
+                scores[target], rounds[target] = score, k
+            if k == params.max_rounds:
+                break
+            ranked = rank_targets(list(scores.values()), reference, params.tie_band_points, params.force_tie_relative)
+            near = {_key(np.asarray(s.target_mm) + params.spacing_mm * d)
+                    for s in ranked[:params.refine_top] for d in steps}
+            todo = sorted(t for t in near if t not in scores and _in_region(np.asarray(t), params))
+            if not todo:
+                break
+    finally:
+        if pool is not None:
+            pool.close()
+            pool.join()
+        else:
+            scorer.close()
+    ranked = rank_targets(list(scores.values()), reference, params.tie_band_points, params.force_tie_relative)
+    return SearchResult(str(box.name), tuple(ranked), rounds)
