@@ -102,21 +102,22 @@ def test_a_hand_far_from_a_human_hand_is_warned_naming_the_field(run, tmp_path):
 
 
 def test_an_object_that_can_never_be_grasped_is_said_with_its_reason(run, tmp_path):
-    """obj1 at a fixed centre inside the palm: every pose is dropped. The run says so, the
-    graspable-objects table gives the reason, and obj4's results are untouched."""
+    """obj1 brought toward a point 1 m in front of the palm: no closure touches it. The run
+    says so, the graspable-objects table gives the reason, and obj4's results are untouched."""
     config = yaml.safe_load(SMALL.read_text())
-    config["objects"]["obj1"]["placement"] = {"mode": "fixed", "center_mm": [0.0, -9.0, 52.0]}
+    config["objects"]["obj1"]["placement"] = {"approach_point_mm": [1000.0, 0.0, 0.0]}
     path = tmp_path / "my.yaml"
     path.write_text(yaml.safe_dump(config))
     obj4 = {p: d for p, d in _results(run).items() if "/objects/obj4/" in p}
     out = snakemake(run, "-j2", "figures", configfile=path)
     text = out.stdout + out.stderr
     assert out.returncode == 0, text[-3000:]
-    _one_line(text, "WARNING: obj1 can never be grasped: every pose dropped (intersects_open_hand: 84)")
+    reason = "nothing touched: no closure ends touching the box (no_contact: 84)"
+    _one_line(text, f"WARNING: obj1 can never be grasped: {reason}")
     table = pd.read_csv(run / "results" / "tables" / "graspable_objects.csv").set_index("object")
-    assert table.loc["obj1", "reason"] == "every pose dropped (intersects_open_hand: 84)"
+    assert table.loc["obj1", "reason"] == reason
     assert not table.loc["obj1", "graspable"] and table.loc["obj4", "graspable"]
-    assert "can never be grasped: every pose dropped" in (run / "results" / "logs" / "grasp_realism.log").read_text()
+    assert reason in (run / "results" / "logs" / "grasp_realism.log").read_text()
     assert {p: d for p, d in _results(run).items() if "/objects/obj4/" in p} == obj4
 
 
