@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from synergrasp.hand.hand_file import FINGERS, check_hand_doc, default_hand_path, read_hand_file
+from synergrasp.hand.hand_file import FINGERS, hand_spec
 from synergrasp.hand.kinematics import Hand, build_hand
 
 __all__ = ["link_field", "closure_shape_problems", "check_hand"]
@@ -45,12 +45,7 @@ def check_hand(path: str | Path | None) -> tuple[Hand, list[str], list[str]]:
     """The hand of a ``hand:`` value (None: the shipped one), the problems that make it
     unusable by the study and the warnings on its dimensions, each line naming the file and
     the field. A malformed file raises ValueError naming the file and the field."""
-    source = default_hand_path() if path is None else Path(path)
-    where = "the shipped hand" if path is None else f"hand file '{source}'"
-    try:
-        spec = check_hand_doc(read_hand_file(source))
-    except ValueError as exc:
-        raise ValueError(str(exc).replace("hand file:", f"{where}:", 1)) from None
+    spec, where = hand_spec(path)
     hand = build_hand(spec, where)
     return (hand, [f"{where}: {p}" for p in closure_shape_problems(hand)],
             [f"{where}: {w}" for w in spec.warnings])

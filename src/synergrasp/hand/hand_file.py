@@ -23,7 +23,7 @@ from synergrasp.hand.geometry import SHAPE_KINDS, Shape, pose_matrix, z_to
 from synergrasp.yaml_io import read_yaml
 
 __all__ = ["FINGERS", "JOINT_NAMES", "PALM_NORMAL", "HandSpec", "FingerSpec", "JointSpec",
-           "default_hand_path", "read_hand_file", "check_hand_doc"]
+           "default_hand_path", "read_hand_file", "check_hand_doc", "hand_spec"]
 
 FINGERS: tuple[str, ...] = ("thumb", "index", "middle", "ring", "little")
 
@@ -260,3 +260,16 @@ def check_hand_doc(doc: Any) -> HandSpec:
         check.warnings.append(f"<top level>: no length of the hand exceeds {max(check.lengths):.3g} mm, far "
                               "from a human hand's dimensions (about 190 mm long); lengths are in mm, not m")
     return HandSpec(str(doc.get("name", "hand")), palm_normal, palm_shapes, tuple(specs), tuple(check.warnings))
+
+
+def hand_spec(path: str | Path | None) -> tuple[HandSpec, str]:
+    """The checked content of the hand file ``path`` (None: the shipped hand) and how
+    messages name it (``hand file '<path>'`` or ``the shipped hand``); ValueError naming
+    the file and the field."""
+    source = default_hand_path() if path is None else Path(path)
+    where = "the shipped hand" if path is None else f"hand file '{source}'"
+    doc = read_hand_file(source)
+    try:
+        return check_hand_doc(doc), where
+    except ValueError as exc:
+        raise ValueError(str(exc).replace("hand file:", f"{where}:", 1)) from None

@@ -37,6 +37,7 @@ from synergrasp.hand.hand_file import (  # noqa: F401  (the file format, re-expo
     HandSpec,
     check_hand_doc,
     default_hand_path,
+    hand_spec,
     read_hand_file,
 )
 
@@ -103,19 +104,13 @@ class Hand:
 
 
 def load_hand(path: str | Path | None = None) -> Hand:
-    """Load a hand model from a YAML file (None: the shipped SoftHand-like model): read it
-    (``hand_file.read_hand_file``), check it (``hand_file.check_hand_doc``), build it.
+    """Load a hand model from a YAML file (None: the shipped SoftHand-like model): read and
+    check it (``hand_file.hand_spec``), then build it (:func:`build_hand`).
 
     The file format is documented in docs/hand.md and in the header of data/hand.yaml.
     Raises ValueError naming the file and the offending field.
     """
-    source = default_hand_path() if path is None else Path(path)
-    doc = read_hand_file(source)
-    try:
-        spec = check_hand_doc(doc)
-    except ValueError as exc:
-        raise ValueError(str(exc).replace("hand file:", f"hand file '{source}':", 1)) from None
-    return build_hand(spec, "the shipped hand" if path is None else f"hand file '{source}'")
+    return build_hand(*hand_spec(path))
 
 
 def hand_from_dict(doc: Any) -> Hand:
