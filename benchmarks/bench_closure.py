@@ -22,7 +22,7 @@ import numpy as np  # noqa: E402
 from synergrasp.config import defaults, step_params, validate_config  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
-from synergrasp.simulation.closure import closure_model, place_box  # noqa: E402
+from synergrasp.simulation.closure import closure_model, place_object  # noqa: E402
 from synergrasp.simulation.placement import pose_grid  # noqa: E402
 from synergrasp.simulation.scene import HandScene  # noqa: E402
 
@@ -37,20 +37,19 @@ def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_media
     grid = pose_grid(first.placement)
     poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
     print(f"closure model: {model}")
-    closer = closure_model(hand, synergies, first.closure, first.mechanics, first.box.mass_kg)
+    closer = closure_model(hand, synergies, first.closure, first.mechanics, first.object.mass_kg)
     placer = HandScene(hand)
     all_times = []
     try:
         for name in study["objects"]:
             sim = step_params(study, "simulate", name)
-            box, placement = sim.box, sim.placement
-            size = np.asarray(box.size_mm, dtype=float)
+            obj, placement = sim.object, sim.placement
             times, placing, statuses, counts, two_fingers = [], [], [], [], 0
             for pose in poses:
                 t0 = time.process_time()
-                placed = place_box(placer, closer.q_open, placement, size, *grid.angles_deg(int(pose)))
+                placed = place_object(placer, closer.q_open, placement, obj.shape, *grid.angles_deg(int(pose)))
                 t1 = time.process_time()
-                result = closer.grasp(size, placed)
+                result = closer.grasp(placed)
                 times.append(time.process_time() - t0)
                 placing.append(t1 - t0)
                 statuses.append(result.status)
@@ -60,7 +59,8 @@ def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_media
             all_times.extend(t)
             status, n_status = np.unique(statuses, return_counts=True)
             m, n_m = np.unique(counts, return_counts=True)
-            print(f"{box.name} {tuple(size.tolist())} {placement.mode} axes {placement.box_axes}: {len(poses)} poses, median {np.median(t):.2f} ms, "
+            print(f"{obj.name} {obj.shape.kind} {obj.shape.label} {placement.mode} axes {placement.box_axes}: "
+                  f"{len(poses)} poses, median {np.median(t):.2f} ms, "
                   f"p90 {np.percentile(t, 90):.2f} ms per grasp "
                   f"(placement median {1e3 * np.median(placing):.2f} ms)")
             print(f"  status: {dict(zip(status.tolist(), n_status.tolist()))}")

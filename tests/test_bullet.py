@@ -9,6 +9,7 @@ import pybullet as pb
 import pytest
 
 from synergrasp.simulation import bullet
+from synergrasp.simulation.shapes import Box
 from synergrasp.hand.kinematics import JOINT_NAMES, fingertip_positions, forward_kinematics, load_hand, point_jacobian
 
 
@@ -102,7 +103,7 @@ def test_box_closest_point_and_normal_sign(sim, hand):
     # a 10 mm cube in front of the middle distal phalanx; the capsule's front at x = -3.3 + 8
     tip_link = hand.link_index("middle_distal")
     z = forward_kinematics(hand, np.zeros(19))[tip_link, 2, 3] + 8.0
-    box = bullet.load_box(client, [10.0, 10.0, 10.0], [20.0, 0.0, z])
+    box = bullet.load_object(client, Box((10.0, 10.0, 10.0)), [20.0, 0.0, z])
     try:
         cp = bullet.closest_points(client, box, body, 20.0, link_b=tip_link)
         assert len(cp) == 1 and cp.link_b[0] == tip_link
@@ -147,8 +148,6 @@ def test_fully_flexed_finger_reaches_palm(sim, hand):
 
 def test_bad_inputs_raise(sim):
     client, body = sim
-    with pytest.raises(ValueError, match="size_mm"):
-        bullet.load_box(client, [10.0, -1.0, 10.0], [0.0, 0.0, 0.0])
     with pytest.raises(ValueError, match="q must have shape"):
         bullet.set_posture(client, body, np.zeros(5))
     with pytest.raises(ValueError, match="link must be"):

@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.analysis.chance import allowed_offsets, identical_force_maps, preservation_vs_chance
+from synergrasp.analysis.chance import allowed_offsets, identical_force_maps, preservation_vs_chance, reflected
 
 ALPHAS = np.arange(-180.0, 180.0, 5.0)  # 72
 BETAS = np.arange(-60.0, 61.0, 5.0)     # 25
@@ -30,12 +30,20 @@ def random_minima(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndar
 
 def test_allowed_offsets_exclude_the_identity_up_to_period_and_radius():
     offsets = {tuple(o) for o in allowed_offsets(ALPHAS, BETAS, 10.0, 90.0)}
-    for excluded in [(0, 0), (2, 2), (18, 0), (36, 1), (70, 24), (16, 23)]:  # 90 deg = 18 steps; wraps
+    for excluded in [(0, 0), (2, 2), (18, 0), (36, 1), (70, -2), (16, -1)]:  # 90 deg = 18 steps; alpha wraps
         assert excluded not in offsets, excluded
-    for kept in [(3, 0), (18, 3), (9, 12), (0, 3)]:
+    for kept in [(3, 0), (18, 3), (9, 12), (0, 3), (0, -24), (0, 24), (70, 23)]:  # beta does not wrap: 23 steps is far
         assert kept in offsets, kept
-    # excluded: 5 alpha offsets per period (0, +-5, +-10 deg) x 4 periods, times 5 beta offsets
-    assert len(offsets) == ALPHAS.size * BETAS.size - 20 * 5
+    # beta offsets -24..24; excluded: 5 alpha offsets per period (0, +-5, +-10 deg) x 4 periods, times 5 beta offsets
+    assert len(offsets) == ALPHAS.size * (2 * BETAS.size - 1) - 20 * 5
+
+
+def test_beta_shift_reflects_at_the_ends_and_keeps_every_point():
+    index = np.arange(25)
+    assert reflected(index + 3, 25).tolist()[-4:] == [24, 23, 22, 21]  # 24..27: the end, then back
+    assert reflected(np.array([-1, -2, 24, 25, 26, 48, 49]), 25).tolist() == [1, 2, 24, 23, 22, 0, 1]
+    shifted = reflected(index + 10, 25)
+    assert shifted.min() >= 0 and shifted.max() <= 24 and len(shifted) == 25
 
 
 def test_identical_maps_are_fully_preserved_and_above_the_null():

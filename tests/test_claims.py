@@ -1,71 +1,128 @@
-"""Every claim's verdict on hand-made tables where it holds, where it does not, and on a tie."""
+"""The claims' verdicts from intervals on hand-made study tables: where a claim holds, does
+not hold, is a tie, rests on too few poses or on nothing; both views of "averaged over
+objects"; forces compared like with like."""
 import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.analysis.claims import FAILS, HOLDS, UNDEFINED, claims_table, combine, compare, compare_lower_force
+from synergrasp.analysis.bootstrap import BootstrapSettings, PoseResampler
+from synergrasp.analysis.claims import FAILS, HOLDS, UNDEFINED, Difference, VerdictRules, claims_table, interval_verdict
+from synergrasp.analysis.intervals import StudyCounts
 
-SINGLES = {1: 50.0, 2: 10.0, 3: 12.0, 4: 20.0, 5: 25.0, 6: 5.0, 7: 5.0}
-PAIRS = {(1, 5): 80.0, (1, 4): 70.0, (1, 2): 60.0, (1, 3): 60.0}
-RATIOS = {1: 1.2, 2: 2.0, 3: 2.0, 4: 1.3, 5: 1.1, 6: 2.5, 7: 3.0}
-
-
-def inputs(singles=None, pairs=None, ratios=None, k7=(100.0, 99.6), lost=0, kept=95.0, null_high=40.0):
-    """Tables on which every claim holds (with the defaults)."""
-    singles, pairs, ratios = {**SINGLES, **(singles or {})}, {**PAIRS, **(pairs or {})}, {**RATIOS, **(ratios or {})}
-    rates = [(str(i), r) for i, r in singles.items()]
-    for i in range(1, 8):
-        for j in range(i + 1, 8):
-            rates.append((f"{i}-{j}", pairs.get((i, j), 30.0)))
-    mean_rates = pd.DataFrame(rates, columns=["set_id", "success_rate"])
-    table2 = pd.DataFrame({"object": ["a", "b"], 7: list(k7)})
-    preservation = pd.DataFrame([{"object": "all", "pairs": "all", "preserved_percent": kept,
-                                  "null_mean_percent": 30.0, "null_low_percent": 20.0, "null_high_percent": null_high}])
-    per_object = pd.DataFrame([(o, str(i), r * f) for o, f in (("a", 1.0), ("b", 1.1)) for i, r in ratios.items()],
-                              columns=["object", "set_id", "force_ratio_median"])
-    return table2, lost, preservation, mean_rates, per_object
+FULL = "1-2-3-4-5-6-7"
+ALPHAS = np.arange(0.0, 90.0, 5.0)  # 18
+BETAS = np.arange(0.0, 50.0, 5.0)   # 10: 180 poses, 6 x 4 blocks of 15 deg
+N = ALPHAS.size * BETAS.size
+RULES = VerdictRules(rate_points=1.0, force_relative=0.05, min_distinct_poses=30, headline_view="per_object")
+SETTINGS = BootstrapSettings(resamples=300, seed=1, block_deg=15.0, level=0.95)
+SETS = [str(i) for i in range(1, 8)] + [f"{i}-{j}" for i in range(1, 8) for j in range(i + 1, 8)] + [FULL]
 
 
-def verdicts(**changes) -> list[str]:
-    return claims_table(*inputs(**changes)).set_index("claim")["verdict"].tolist()
+def study(objects: dict[str, dict[str, np.ndarray]], forces: dict[str, dict[str, np.ndarray]] | None = None
+          ) -> StudyCounts:
+    """A study of objects on an 18 x 10 grid (period 360: every pose distinct); per object
+    the poses (bool, length N) where each set succeeds (absent sets: nowhere; the full set:
+    wherever any set does unless given) and optional forces (N) per set."""
+    a, b = np.meshgrid(ALPHAS, BETAS, indexing="ij")
+    parts = []
+    for obj, succeeds in objects.items():
+        full = succeeds.get(FULL, np.any([v for v in succeeds.values()], axis=0) if succeeds else np.zeros(N, bool))
+        for sid in SETS:
+            ok = full if sid == FULL else succeeds.get(sid, np.zeros(N, bool))
+            force = (forces or {}).get(obj, {}).get(sid, np.ones(N))
+            parts.append(pd.DataFrame({"object": obj, "pose": np.arange(N), "alpha_deg": a.ravel(),
+                                       "beta_deg": b.ravel(), "set_id": sid, "success": ok,
+                                       "success_force": np.where(ok, force, np.nan)}))
+    table = pd.concat(parts, ignore_index=True)
+    return StudyCounts(table, FULL, PoseResampler(table[table["set_id"] == FULL], {}, SETTINGS))
 
 
-def test_every_claim_holds_on_the_reference_tables():
-    table = claims_table(*inputs())
-    assert table["verdict"].tolist() == [HOLDS] * 7
-    assert list(table.columns) == ["claim", "statement", "tested_by", "measured", "verdict"]
-    assert table["tested_by"].str.len().min() > 0
+def claims(counts: StudyCounts) -> pd.DataFrame:
+    minima = pd.DataFrame({"object": counts.objects, "n_minima": [np.zeros(counts.rows)] * len(counts.objects),
+                           "n_preserved": [np.zeros(counts.rows)] * len(counts.objects)})
+    chance = pd.DataFrame({"object": ["all"], "pairs": ["all"], "null_high_percent": [30.0]})
+    return claims_table(counts, minima, chance, RULES).set_index(["claim", "view"])
 
 
-@pytest.mark.parametrize("changes, claim, verdict", [
-    (dict(k7=(100.0, 99.0)), 1, FAILS),
-    (dict(k7=(100.0, np.nan)), 1, UNDEFINED),
-    (dict(lost=3), 2, FAILS),
-    (dict(lost=None), 2, UNDEFINED),
-    (dict(kept=85.0), 3, FAILS),            # below 90 %
-    (dict(kept=95.0, null_high=96.5), 3, FAILS),   # not above chance
-    (dict(kept=90.5), 3, UNDEFINED),        # a tie with 90 %
-    (dict(singles={5: 60.0}), 4, FAILS),
-    (dict(singles={4: 50.5}), 4, UNDEFINED),
-    (dict(singles={3: 30.0}), 5, FAILS),    # S3 above S4
-    (dict(pairs={(1, 2): 75.0}), 5, FAILS),  # {S1,S2} above {S1,S4}
-    (dict(singles={3: 19.5}), 5, UNDEFINED),
-    (dict(pairs={(2, 3): 90.0}), 6, FAILS),
-    (dict(pairs={(1, 4): 79.5}), 6, UNDEFINED),
-    (dict(ratios={3: 1.0}), 7, FAILS),
-    (dict(ratios={3: 1.33}), 7, UNDEFINED),  # within 5 % of S4's 1.3
-    (dict(ratios={4: np.nan}), 7, UNDEFINED),  # S4 never succeeds alone
-])
-def test_each_claim_fails_or_is_undefined(changes, claim, verdict):
-    got = verdicts(**changes)
-    assert got[claim - 1] == verdict
-    assert all(v == HOLDS for i, v in enumerate(got, 1) if i != claim)  # the others are untouched
+def every(step: int, offset: int = 0) -> np.ndarray:
+    """Every ``step``-th pose from ``offset``: spread over the grid, so each block holds a share."""
+    out = np.zeros(N, bool)
+    out[offset::step] = True
+    return out
 
 
-def test_comparison_rules():
-    assert compare(52.0, 50.0) == HOLDS and compare(50.5, 50.0) == UNDEFINED and compare(48.0, 50.0) == FAILS
-    assert compare(np.nan, 1.0) == UNDEFINED
-    assert compare_lower_force(1.0, 1.1) == HOLDS and compare_lower_force(1.0, 1.04) == UNDEFINED
-    assert compare_lower_force(1.2, 1.0) == FAILS
-    assert combine([HOLDS, HOLDS]) == HOLDS and combine([HOLDS, UNDEFINED]) == UNDEFINED
-    assert combine([UNDEFINED, FAILS]) == FAILS
+def test_interval_rules():
+    d = dict(band=1.0, n=100)
+    assert interval_verdict(Difference(5.0, 2.0, 8.0, **d), 30)[0] == HOLDS
+    assert interval_verdict(Difference(-5.0, -8.0, -2.0, **d), 30)[0] == FAILS
+    assert interval_verdict(Difference(1.5, 0.5, 2.5, **d), 30) == (UNDEFINED, "interval overlaps the tie band (±1)")
+    assert interval_verdict(Difference(0.0, -0.5, 0.5, **d), 30)[1].startswith("interval inside the tie band")
+    assert interval_verdict(Difference(5.0, 2.0, 8.0, band=1.0, n=29), 30) == (
+        UNDEFINED, "fewer than 30 distinct poses: 29")
+    assert interval_verdict(Difference(5.0, 2.0, 8.0, band=1.0, n=0), 30)[1].startswith("nothing to compare")
+    # a claim of equality: "reaches 100 %" (d <= 0) holds within the band, fails beyond it
+    assert interval_verdict(Difference(-0.5, -0.9, 0.0, band=1.0, n=50, kind="within_below"), 30)[0] == HOLDS
+    assert interval_verdict(Difference(-5.0, -7.0, -2.0, band=1.0, n=50, kind="within_below"), 30)[0] == FAILS
+    assert interval_verdict(Difference(0.5, 0.0, 3.0, band=1.0, n=50, kind="within_above"), 30)[0] == UNDEFINED
+
+
+def test_a_claim_with_nothing_to_compare_is_undefined():
+    """No pose reaches force closure: nothing holds (claim 2 said "holds: 0 poses" before)."""
+    table = claims(study({"a": {}, "b": {}}))
+    assert (table["verdict"] == UNDEFINED).all()
+    assert "nothing to compare" in table.loc[(2, "per_object"), "reason"]
+    assert "nothing to compare" in table.loc[(1, "each_object"), "reason"]
+
+
+def test_too_few_poses_and_a_tie_are_undefined():
+    s1 = np.zeros(N, bool)
+    s1[:10] = True  # S1 alone on 10 poses, every other single nowhere
+    few = claims(study({"a": {"1": s1, FULL: every(2)}}))
+    assert few.loc[(4, "per_object"), "verdict"] == UNDEFINED
+    assert few.loc[(4, "per_object"), "reason"] == "fewer than 30 distinct poses: 10"
+    # S1 and S7 succeed on the same 60 poses: a difference of 0 in every resample
+    tie = claims(study({"a": {"1": every(3), "7": every(3), FULL: every(2)}}))
+    row = tie.loc[(4, "per_object")]
+    assert row["verdict"] == UNDEFINED and row["reason"].startswith("interval inside the tie band")
+    assert row["low"] == row["high"] == 0.0 and row["n_distinct_poses"] == 60
+
+
+def test_pooled_and_per_object_views_on_two_objects():
+    """a: the full set at all 180 poses, S1 at 90, S7 nowhere; b: the full set at 45 poses,
+    S7 at all of them. Per object: S1 (50 + 0) / 2 = 25 %, S7 (0 + 100) / 2 = 50 %: claim 4
+    does not hold. Pooled: S1 90 / 225 = 40 %, S7 45 / 225 = 20 %: it holds."""
+    b_full = every(4)
+    counts = study({"a": {"1": every(2), FULL: np.ones(N, bool)}, "b": {"7": b_full, FULL: b_full}})
+    assert counts.rate("1", "per_object")[0] == pytest.approx(25.0)
+    assert counts.rate("7", "per_object")[0] == pytest.approx(50.0)
+    assert counts.rate("1", "pooled")[0] == pytest.approx(40.0)
+    assert counts.rate("7", "pooled")[0] == pytest.approx(20.0)
+    table = claims(counts)
+    assert table.loc[(4, "per_object"), "difference"] == pytest.approx(-25.0)
+    assert table.loc[(4, "pooled"), "difference"] == pytest.approx(20.0)
+    assert table.loc[(4, "per_object"), "verdict"] == FAILS and table.loc[(4, "per_object"), "headline"]
+    assert table.loc[(4, "pooled"), "verdict"] == HOLDS and not table.loc[(4, "pooled"), "headline"]
+    assert list(table.loc[4].index) == ["per_object", "pooled"]  # the study's view first
+
+
+def forces_case(shared_with_s7: int) -> pd.DataFrame:
+    """Every single succeeds on the same 60 poses, where S1, S4, S5 need 1 N and the others
+    2 N; S1 also succeeds alone on 90 more poses at 100 N (a plain mean over each set's own
+    successes would rank S1 last). S7 shares ``shared_with_s7`` of the 60 poses."""
+    common = every(3)
+    extra = every(3, 1) | every(6, 2)
+    s7 = common.copy()
+    s7[np.flatnonzero(common)[shared_with_s7:]] = False
+    succeeds = {str(i): common for i in range(2, 7)} | {"1": common | extra, "7": s7, FULL: np.ones(N, bool)}
+    force = {str(i): np.full(N, 2.0) for i in (2, 3, 6, 7)} | {s: np.ones(N) for s in ("4", "5")}
+    force["1"] = np.where(extra, 100.0, 1.0)
+    return claims(study({"a": succeeds}, {"a": force}))
+
+
+def test_claim7_compares_like_with_like_on_unequal_success_sets():
+    row = forces_case(60).loc[(7, "pooled")]
+    assert row["verdict"] == HOLDS and row["n_distinct_poses"] == 60
+    assert np.exp(row["difference"]) == pytest.approx(2.0)  # F(other) / F(named) on the common poses
+    short = forces_case(10).loc[(7, "pooled")]
+    assert short["verdict"] == UNDEFINED
+    assert "S1-S7 (10)" in short["reason"] and "S4-S7 (10)" in short["reason"]

@@ -15,12 +15,13 @@ from synergrasp.simulation.contacts import read_grasps, write_contacts
 from synergrasp.simulation.placement import approach_line, object_pose, palm_centre, pose_grid
 from synergrasp.hand.kinematics import forward_kinematics
 from synergrasp.hand.synergies import SynergyPath, load_synergies
-from synergrasp.simulation.objects import Box
+from synergrasp.simulation.objects import GraspedObject
+from synergrasp.simulation.shapes import Box
 
 PARAMS = study_closure_params()
 PLACEMENT = study_placement()
-CUBE = Box("obj1", (30.0, 30.0, 30.0), 1.0)
-PLATE = Box("obj2", (30.0, 60.0, 60.0), 1.0)
+CUBE = GraspedObject("obj1", Box((30.0, 30.0, 30.0)), 1.0)
+PLATE = GraspedObject("obj2", Box((30.0, 60.0, 60.0)), 1.0)
 
 
 @pytest.fixture(scope="module")
@@ -77,28 +78,28 @@ def test_bad_placement_and_closure_values_name_the_key(block, key, value, messag
 
 
 def test_zero_pose_maps_box_edges_to_palm_axes():
-    placed = object_pose(study_placement(box_axes=(2, 0, 1)), (10.0, 20.0, 30.0), 0.0, 0.0)
-    extent = np.abs(placed.rotation) @ placed.half_extents_mm  # half extent along palm x, y, z
+    placed = object_pose(study_placement(box_axes=(2, 0, 1)), Box((10.0, 20.0, 30.0)), 0.0, 0.0)
+    extent = np.abs(placed.rotation) @ placed.shape.half_extents_mm  # half extent along palm x, y, z
     np.testing.assert_allclose(extent, [15.0, 5.0, 10.0])
 
 
 def test_alpha_turns_about_palm_normal_then_beta_about_fingers():
-    placed = object_pose(PLACEMENT, (10.0, 20.0, 30.0), 90.0, 90.0)
+    placed = object_pose(PLACEMENT, Box((10.0, 20.0, 30.0)), 90.0, 90.0)
     # α = 90° about x takes box y (20) onto palm z; β = 90° about z takes box x (10) onto palm y
-    extent = np.abs(placed.rotation) @ placed.half_extents_mm
+    extent = np.abs(placed.rotation) @ placed.shape.half_extents_mm
     np.testing.assert_allclose(extent, [15.0, 5.0, 10.0], atol=1e-12)
 
 
 def _corners(placed):
     signs = np.array(list(itertools.product((-1, 1), repeat=3)), dtype=float)
-    pts = (signs * placed.half_extents_mm) @ placed.rotation.T + placed.center_mm
+    pts = (signs * placed.shape.half_extents_mm) @ placed.rotation.T + placed.center_mm
     return pts[np.lexsort(np.round(pts, 9).T)]
 
 
 @pytest.mark.parametrize("alpha, beta", [(-30.0, 0.0), (45.0, 20.0), (-165.0, -60.0)])
 def test_alpha_and_alpha_plus_180_place_the_same_box(alpha, beta):
-    a = object_pose(PLACEMENT, (100.0, 60.0, 30.0), alpha, beta)
-    b = object_pose(PLACEMENT, (100.0, 60.0, 30.0), alpha + 180.0, beta)
+    a = object_pose(PLACEMENT, Box((100.0, 60.0, 30.0)), alpha, beta)
+    b = object_pose(PLACEMENT, Box((100.0, 60.0, 30.0)), alpha + 180.0, beta)
     np.testing.assert_allclose(_corners(a), _corners(b), atol=1e-9)
 
 
@@ -117,7 +118,7 @@ def test_contacts_lie_on_the_box_and_do_not_penetrate(sample):
         m = int(row.n_contacts)
         R = np.asarray(row.object_rotation).reshape(3, 3)
         c = np.asarray(row.object_center)
-        half = 0.5 * np.asarray(CUBE.size_mm if row.object == "obj1" else PLATE.size_mm)
+        half = (CUBE if row.object == "obj1" else PLATE).shape.half_extents_mm
         local = (np.asarray(row.contact_point).reshape(m, 3) - c) @ R
         np.testing.assert_allclose(np.max(np.abs(local) / half, axis=1), 1.0, atol=1e-9)
         assert row.max_penetration_mm <= PARAMS.penetration_tolerance_mm
@@ -260,13 +261,13 @@ def test_open_path_pinches_thumb_with_index_and_middle(hand, table):
 def test_a_target_behind_the_palm_ends_touching_and_not_intersecting_the_open_hand(hand, synergies):
     """The box turned by (α, β) stops at first touch of the open hand when its target lies
     behind the palm face (the earlier fixed placement dropped such a pose)."""
-    from synergrasp.simulation.closure import closure_model, place_box
+    from synergrasp.simulation.closure import closure_model, place_object
 
     behind = study_placement(mode="fixed", center_mm=(0.0, 0.0, 50.0))
     model = closure_model(hand, synergies, PARAMS)
     try:
         for alpha, beta in [(0.0, 0.0), (-30.0, 20.0), (45.0, -60.0)]:
-            placed = place_box(model.scene, model.q_open, behind, np.asarray(CUBE.size_mm), alpha, beta)
+            placed = place_object(model.scene, model.q_open, behind, CUBE.shape, alpha, beta)
             model.scene.set_posture(model.q_open)
             gap = float(np.min(model.scene.object_distance()))
             assert -1e-9 <= gap <= 0.011, (alpha, beta, gap)  # touching (to round-off), not intersecting
@@ -281,14 +282,14 @@ def test_a_target_behind_the_palm_ends_touching_and_not_intersecting_the_open_ha
 @pytest.mark.parametrize("mode", ["fixed", "approach"])
 def test_a_reachable_target_puts_the_box_centre_on_it(hand, synergies, mode):
     """A target the box reaches without touching the open hand: the centre is the target."""
-    from synergrasp.simulation.closure import closure_model, place_box
+    from synergrasp.simulation.closure import closure_model, place_object
 
     target = (90.0, -9.0, 100.0)
     placement = study_placement(mode=mode, center_mm=target, approach_point_mm=target)
     model = closure_model(hand, synergies, PARAMS)
     try:
         for alpha, beta in [(0.0, 0.0), (35.0, -45.0)]:
-            placed = place_box(model.scene, model.q_open, placement, np.asarray(PLATE.size_mm), alpha, beta)
+            placed = place_object(model.scene, model.q_open, placement, PLATE.shape, alpha, beta)
             np.testing.assert_array_equal(placed.center_mm, target)
             model.scene.set_posture(model.q_open)
             assert float(np.min(model.scene.object_distance())) > 0.0
@@ -298,20 +299,19 @@ def test_a_reachable_target_puts_the_box_centre_on_it(hand, synergies, mode):
 
 def test_the_approach_preset_is_the_earlier_approach_bit_for_bit(hand, synergies, grid):
     """With its target on the palm face the box always touches before reaching it, so the
-    rule takes exactly the earlier approach's steps (bring_box without the stop at the point)."""
-    from synergrasp.simulation.closure import closure_model, place_box
+    rule takes exactly the earlier approach's steps (bring_object without the stop at the point)."""
+    from synergrasp.simulation.closure import closure_model, place_object
 
     model = closure_model(hand, synergies, PARAMS)
     point, normal = approach_line(PLACEMENT, hand)
     try:
-        for box in (CUBE, PLATE, Box("obj4", (100.0, 60.0, 100.0), 1.0)):
-            size = np.asarray(box.size_mm)
+        for shape in (CUBE.shape, PLATE.shape, Box((100.0, 60.0, 100.0))):
             for pose in range(0, grid.n_poses, 97):
                 a, b = grid.angles_deg(pose)
-                placed = place_box(model.scene, model.q_open, PLACEMENT, size, a, b)
-                turned = object_pose(PLACEMENT, size, a, b, hand.palm_normal)
-                earlier = model.scene.bring_box(size, turned.rotation, point, normal, model.q_open,
-                                                PLACEMENT.clearance_mm)
+                placed = place_object(model.scene, model.q_open, PLACEMENT, shape, a, b)
+                turned = object_pose(PLACEMENT, shape, a, b, hand.palm_normal)
+                earlier = model.scene.bring_object(shape, turned.rotation, point, normal, model.q_open,
+                                                   PLACEMENT.clearance_mm)
                 np.testing.assert_array_equal(placed.center_mm, earlier.center_mm)
                 np.testing.assert_array_equal(placed.rotation, earlier.rotation)
     finally:
@@ -321,7 +321,7 @@ def test_the_approach_preset_is_the_earlier_approach_bit_for_bit(hand, synergies
 @pytest.mark.parametrize("target", [(-20.0, -9.0, 52.0), (9.5, -50.0, 20.0), (29.5, 30.0, 180.0),
                                     (49.5, -10.0, 100.0), (9.5, 10.0, 120.0), (38.0, 5.0, 112.0)])
 def test_no_pose_is_dropped_at_any_target(hand, synergies, target):
-    obj4 = Box("obj4", (100.0, 60.0, 100.0), 1.0)
+    obj4 = GraspedObject("obj4", Box((100.0, 60.0, 100.0)), 1.0)
     placement = study_placement("obj4", mode="searched", target_mm=target)
     table = simulate_object(hand, synergies, obj4, placement, PARAMS, poses=range(0, 1800, 131))
     assert "intersects_open_hand" not in set(table.status)
@@ -411,14 +411,14 @@ def test_palm_centre_is_the_middle_of_the_palm_face(hand):
 def test_approach_brings_the_box_to_the_open_hand(hand, synergies, clearance):
     """At every pose the box ends on the approach line, ``clearance`` from the open hand
     (independent check: pybullet distance at the open posture), never intersecting it."""
-    from synergrasp.simulation.closure import closure_model, place_box
+    from synergrasp.simulation.closure import closure_model, place_object
 
     placement = study_placement(clearance_mm=clearance)
     point, normal = approach_line(placement, hand)
     model = closure_model(hand, synergies, PARAMS)
     try:
         for alpha, beta in [(0.0, 0.0), (-30.0, 0.0), (45.0, 20.0), (90.0, -60.0)]:
-            placed = place_box(model.scene, model.q_open, placement, np.asarray(PLATE.size_mm), alpha, beta)
+            placed = place_object(model.scene, model.q_open, placement, PLATE.shape, alpha, beta)
             offset = placed.center_mm - point
             np.testing.assert_allclose(offset - (offset @ normal) * normal, 0.0, atol=1e-9)
             model.scene.set_posture(model.q_open)
@@ -429,7 +429,7 @@ def test_approach_brings_the_box_to_the_open_hand(hand, synergies, clearance):
 
 
 def test_large_box_brought_to_the_palm_ends_with_a_palm_contact(hand, synergies):
-    cube = Box("obj3", (60.0, 60.0, 60.0), 1.0)
+    cube = GraspedObject("obj3", Box((60.0, 60.0, 60.0)), 1.0)
     table = simulate_object(hand, synergies, cube, PLACEMENT, PARAMS, poses=[pose_grid(PLACEMENT).index(0.0, 0.0)])
     row = table.iloc[0]
     assert row.status == "grasp"

@@ -14,12 +14,13 @@ from synergrasp.hand.synergies import Synergies, SynergyPath
 from synergrasp.simulation.capsules import HandCapsules
 from synergrasp.simulation.closure import closure_model, simulate_object
 from synergrasp.simulation.dynamic_closure import DynamicParams
-from synergrasp.simulation.objects import Box
+from synergrasp.simulation.objects import GraspedObject
+from synergrasp.simulation.shapes import Box
 from synergrasp.simulation.placement import ObjectPose, object_pose
 
 MECHANICS = {"mu": 1.5, "k_ss_Nmm_per_rad": 200.0, "gravity_direction": [1.0, 0.0, 0.0], "g_m_per_s2": 9.81}
 PARAMS = study_closure_params(model="dynamic", dynamic=study_dynamic_params(time_limit_s=3.0))
-CUBE60 = np.array([60.0, 60.0, 60.0])
+CUBE60 = Box((60.0, 60.0, 60.0))
 #: A 60 mm cube against the palm: the palm's surface is at x = 9.5 mm (hand.yaml), the
 #: cube's palm-side face 0.3 mm in front of it, centred on the palm's width.
 AGAINST_PALM = study_placement(center_mm=(9.5 + 30.0 + 0.3, -9.0, 75.0))
@@ -58,7 +59,7 @@ def test_settings_name_the_key_and_allowed_values():
 
 def test_no_object_every_finger_closes_to_its_limits_or_to_the_hand(model, hand):
     far = object_pose(study_placement(center_mm=(600.0, 0.0, 100.0)), CUBE60, 0.0, 0.0, hand.palm_normal)
-    result = model.grasp(CUBE60, far)
+    result = model.grasp(far)
     assert result.status == "no_contact" and result.settled
     assert np.allclose(result.settled_pose.center_mm, far.center_mm)
     reference = model.path.reference(model.sigma_closed)
@@ -71,7 +72,7 @@ def test_no_object_every_finger_closes_to_its_limits_or_to_the_hand(model, hand)
 
 def test_box_against_the_palm_ends_with_a_palm_contact(model, hand):
     placed = object_pose(AGAINST_PALM, CUBE60, 0.0, 0.0, hand.palm_normal)
-    result = model.grasp(CUBE60, placed)
+    result = model.grasp(placed)
     assert result.status == "grasp" and result.settled
     assert 0 in result.links.tolist()
     # every touching link is listed with its load (which count is decided downstream); the palm carries load
@@ -127,7 +128,7 @@ def test_at_rest_the_springs_balance_the_contact_forces(hand, synergies):
     model = closure_model(hand, synergies, params, MECHANICS, 1.0)
     placed = object_pose(AGAINST_PALM, CUBE60, 0.0, 0.0, hand.palm_normal)
     try:
-        _check_balance(model, hand, params, model.grasp(CUBE60, placed))
+        _check_balance(model, hand, params, model.grasp(placed))
     finally:
         model.close()
 
@@ -153,7 +154,7 @@ def _check_balance(model, hand, params, result):
 
 def test_deterministic_on_rerun_and_whatever_ran_before(hand, synergies):
     params = study_closure_params(model="dynamic", dynamic=study_dynamic_params(time_limit_s=0.4))
-    box, placement = Box("obj1", (30.0, 30.0, 30.0), 1.0), study_placement()
+    box, placement = GraspedObject("obj1", Box((30.0, 30.0, 30.0)), 1.0), study_placement()
     alone = simulate_object(hand, synergies, box, placement, params, poses=[300], mechanics=MECHANICS)
     after = simulate_object(hand, synergies, box, placement, params, poses=[0, 150, 300], mechanics=MECHANICS)
     for column in ("status", "q", "contact_link", "contact_point", "contact_normal_force_N", "object_center"):
@@ -166,7 +167,7 @@ def test_settled_box_carries_a_near_zero_net_contact_wrench(model, hand):
     its contacts (force within 5 % of the summed contact-force magnitudes; moment about its
     centre within 5 % of that sum times the half edge)."""
     placed = object_pose(AGAINST_PALM, CUBE60, 0.0, 0.0, hand.palm_normal)
-    result = model.grasp(CUBE60, placed)
+    result = model.grasp(placed)
     assert result.settled and {0, 3, 7}.issubset(result.links.tolist())  # palm, thumb and index tips
     _, points, forces = model.bullet.contact_force_vectors(model.client, model.box, model.body)
     scale = np.linalg.norm(forces, axis=1).sum()
@@ -179,7 +180,7 @@ def test_settled_box_carries_a_near_zero_net_contact_wrench(model, hand):
 def test_a_box_pushed_out_of_the_hand_is_lost(hand, synergies):
     """obj4 placed 50 mm in front of the palm (fixed placement, centre (90, 5, 112) mm): at α = −180°,
     β = −40° the closing fingers push it away and nothing holds it (no gravity)."""
-    box = Box("obj4", (100.0, 60.0, 100.0), 1.0)
+    box = GraspedObject("obj4", Box((100.0, 60.0, 100.0)), 1.0)
     placement = study_placement(mode="fixed", center_mm=(90.0, 5.0, 112.0), box_axes=(1, 0, 2))
     row = simulate_object(hand, synergies, box, placement, study_closure_params(model="dynamic"), poses=[4],
                           mechanics=MECHANICS).iloc[0]
@@ -196,7 +197,7 @@ def test_a_box_moved_but_left_inside_the_closed_hand_is_caged(hand, synergies):
     the closed hand's hull, so it is caged, not lost."""
     config = {**defaults(), "closure": {**defaults()["closure"], "model": "dynamic"}}
     sim = step_params(config, "simulate", "obj1")
-    row = simulate_object(hand, synergies, sim.box, sim.placement, sim.closure, poses=[0],
+    row = simulate_object(hand, synergies, sim.object, sim.placement, sim.closure, poses=[0],
                           mechanics=sim.mechanics).iloc[0]
     assert row["status"] == "caged" and row["n_contacts"] == 0
     assert np.linalg.norm(row["object_translation_mm"]) > sim.closure.dynamic.lost_distance_mm
@@ -233,8 +234,8 @@ def test_thumb_index_pinch_of_a_small_box_settles_with_a_near_zero_net_wrench(ha
         y = np.cross(x, [0.0, 0.0, 1.0])
         y /= np.linalg.norm(y)
         placed = ObjectPose(near.point_a[k] + (edge / 2 + 0.3) * x, np.stack([x, y, np.cross(x, y)], axis=1),
-                            np.full(3, edge / 2))
-        result = model.grasp(np.full(3, edge), placed)
+                            Box((edge, edge, edge)))
+        result = model.grasp(placed)
         assert result.status == "grasp" and result.settled
         fingertips = set(hand.finger_links[0]) | set(hand.finger_links[1])
         links, points, forces = b.contact_force_vectors(model.client, model.box, model.body)

@@ -9,7 +9,8 @@ import pandas as pd
 import pytest
 
 from synergrasp.figures import hand_pictures as hp
-from synergrasp.figures.hand_pictures import PALM_CAMERA, SKIN, TOUCHING, BoxInPicture, Camera, hand_shapes, render
+from synergrasp.figures.hand_pictures import PALM_CAMERA, SKIN, TOUCHING, Camera, ShapeInPicture, hand_shapes, render
+from synergrasp.simulation.shapes import Box
 
 # Looking along -x (from the palm side), 100 mm wide image of 200 px: 0.5 mm per pixel.
 _CAMERA = Camera(direction=(-1.0, 0.0, 0.0), up=(0.0, 0.0, 1.0), center_mm=(0.0, 0.0, 0.0), width_mm=100.0)
@@ -38,7 +39,7 @@ def test_rotated_box_covers_its_projected_area():
     angle = np.radians(30.0)
     rotation = np.array([[1.0, 0.0, 0.0], [0.0, np.cos(angle), -np.sin(angle)], [0.0, np.sin(angle), np.cos(angle)]])
     rays = hp._Rays(_CAMERA, 200, 200)
-    face = hp._cast_box(rays, BoxInPicture(np.array([10.0, 30.0, 40.0]), np.zeros(3), rotation), label=0)
+    face = hp._cast_shape(rays, ShapeInPicture(Box((10.0, 30.0, 40.0)), np.zeros(3), rotation), label=0)
     # Seen along x the box is its 30 x 40 mm face turned in the image plane: 1200 mm^2.
     assert abs((face >= 0).sum() - 1200.0 / 0.25) / 4800.0 < 0.01
     assert set(np.unique(face)) == {-1, 1}  # only the +x face is seen (axis 0, side +)
@@ -115,15 +116,15 @@ def test_touching_links_in_words(hand):
 
 def test_figures_are_written_and_the_same_on_rerun(hand, synergies, tmp_path):
     from synergrasp.figures.hand_figures import figure_example_grasps, figure_synergy_postures
-    from synergrasp.simulation.objects import Box
+    from synergrasp.simulation.objects import GraspedObject
 
-    box = Box("cube", (30.0, 30.0, 30.0), 1.0)
+    box = GraspedObject("cube", Box((30.0, 30.0, 30.0)), 1.0)
     table = _one_grasp_table(hand, synergies)
     dropped = table.assign(object="big", status="intersects_open_hand", n_contacts=0, contact_link=[[]])
     for run in ("a", "b"):
         figure_synergy_postures(hand, synergies, tmp_path / f"f1{run}.png", tmp_path / f"f1{run}.pdf",
                                 n_synergies=1, sigmas=(-1.0, 0.0))
-        figure_example_grasps(hand, [box, Box("big", (90.0, 60.0, 90.0), 1.0)], [table, dropped],
+        figure_example_grasps(hand, [box, GraspedObject("big", Box((90.0, 60.0, 90.0)), 1.0)], [table, dropped],
                               tmp_path / f"f2{run}.png", tmp_path / f"f2{run}.pdf", n_grasps=2)
     for name in ("f1", "f2"):
         for ext in ("png", "pdf"):

@@ -1,4 +1,4 @@
-"""α-period from the box, the placement and the rotation order; distinct poses; the check
+"""α-period from the shape, the placement and the rotation order; distinct poses; the check
 that results repeat with the period."""
 import numpy as np
 import pandas as pd
@@ -7,6 +7,7 @@ import pytest
 from conftest import study_placement
 from synergrasp.config import defaults
 from synergrasp.analysis.periods import alpha_period_deg, distinct_pose_mask, object_periods, period_violations
+from synergrasp.simulation.shapes import Box
 
 GRID = dict(alpha_deg=(-180.0, 175.0, 5.0), beta_deg=(-60.0, 60.0, 5.0))
 
@@ -24,13 +25,13 @@ GRID = dict(alpha_deg=(-180.0, 175.0, 5.0), beta_deg=(-60.0, 60.0, 5.0))
 def test_period_of_boxes(size, axes, order, beta, period):
     placement = study_placement(center_mm=(40.0, 5.0, 110.0), box_axes=axes, rotation_order=order,
                                 alpha_deg=GRID["alpha_deg"], beta_deg=beta)
-    assert alpha_period_deg(placement, size) == period
+    assert alpha_period_deg(placement, Box(size)) == period
 
 
 def test_object_periods_from_the_config():
     placement = {**defaults()["placement"], "mode": "fixed", "center_mm": [38, 5, 112]}  # the effective placement
-    objects = {"cube": {"size_mm": [30, 30, 30], "placement": placement},
-               "slab": {"size_mm": [30, 60, 100], "placement": {**placement, "box_axes": [0, 1, 2]}}}
+    objects = {"cube": {"shape": {"box": {"size_mm": [30, 30, 30]}}, "placement": placement},
+               "slab": {"shape": {"box": {"size_mm": [30, 60, 100]}}, "placement": {**placement, "box_axes": [0, 1, 2]}}}
     grid = {"alpha_deg": {"start": -180, "stop": 175, "step": 5}, "beta_deg": {"start": -60, "stop": 60, "step": 5}}
     assert object_periods(objects, grid) == {"cube": 90.0, "slab": 180.0}
 

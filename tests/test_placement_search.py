@@ -142,7 +142,7 @@ def _tiny(obj="obj1", **search):
 
 def _run(sim, hand, synergies, processes=1):
     full = placement_search.full_synergy_set(synergies.matrix, sim.full_set_size)
-    return search_object(hand, synergies, sim.box, sim.placement, sim.closure, sim.gfo, full, sim.search,
+    return search_object(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo, full, sim.search,
                          period_deg=90.0, processes=processes)
 
 

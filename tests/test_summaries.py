@@ -82,8 +82,9 @@ def test_distinct_poses_count_one_period():
     table = pd.DataFrame(gfo_rows("a", "1", [1.0, None] * 4, step_deg=45.0)
                          + gfo_rows("a", "1-2", [1.0, 1.0] * 4, step_deg=45.0))
     r = success_rates(with_verdicts(table, "force_closure"), "1-2", {"a": 90.0}).set_index("set_id")
-    assert r.loc["1", "n_success"] == 4 and r.loc["1", "n_success_distinct"] == 1
-    assert r.loc["1", "success_rate_distinct"] == pytest.approx(50.0) == r.loc["1", "success_rate"]
+    assert r.loc["1", "n_success"] == 1 and r.loc["1", "n_success_grid"] == 4  # the headline: distinct poses
+    assert r.loc["1", "n_poses"] == 2
+    assert r.loc["1", "success_rate_grid"] == pytest.approx(50.0) == r.loc["1", "success_rate"]
 
 
 def test_marginal_grasps_flagged_and_excluded():
@@ -190,7 +191,7 @@ def test_verdict_disagreements():
 
 
 def test_study_tables_names_and_csv_round_trip(gfo, tmp_path):
-    minima = pd.DataFrame([dict(object="a", set_id="1", alpha_deg=0.0, beta_deg=0.0)])
+    minima = pd.DataFrame([dict(object="a", set_id="1", pose=0, alpha_deg=0.0, beta_deg=0.0)])
     settings = study_analysis_settings(null_draws=20)
     with pytest.warns(UserWarning):  # b's set 1-2 succeeds where its full set does not
         tables = study_tables(gfo, minima, {"incremental_max": 3, "hierarchy_first": 2, "hierarchy_max_size": 2}, 3,
@@ -199,6 +200,12 @@ def test_study_tables_names_and_csv_round_trip(gfo, tmp_path):
                            "preservation_vs_chance", "full_not_first7", "verdict_disagreements", "invariant_checks",
                            "claims"}
     assert tables["full_not_first7"][1]["pose"].tolist() == [2, 3]
+    rates = tables["success_rates"][1]
+    views = rates[rates["object"] == "all"].set_index(["set_id", "view"])
+    assert views.loc[("1-2", "per_object"), "success_rate"] == pytest.approx(50.0)  # b's full set never succeeds
+    assert views.loc[("1-2", "pooled"), "success_rate"] == pytest.approx(50.0)
+    assert views.loc[("1-2", "pooled"), "n_force_poses"] == 2  # a's poses 0, 1 (b's pose 0 has no full-set force)
+    assert views.loc[("1-2", "pooled"), "force_ratio_median"] == pytest.approx(2.0)
     checks = tables["invariant_checks"][1].set_index(["check", "object"])
     assert checks.loc[("nested_sets", "b"), "count"] == 1 and checks.loc[("nested_sets", "a"), "count"] == 0
     path = tmp_path / "rates.csv"  # a CSV round trip reads set "1" back as an integer
@@ -211,6 +218,6 @@ def test_study_tables_stop_on_a_rate_far_above_100(gfo):
     """A subset succeeding on twice the full set's poses (e.g. a synergy entry of 1e300)."""
     broken = pd.DataFrame(gfo_rows("a", "1", [1.0, 1.0, 1.0, 1.0]) + gfo_rows("a", "1-2", [1.0, 1.0, None, None]))
     with pytest.raises(InvariantError, match=r"success_rate_tolerance_percent \(1.0\).*a \{1\}: 200 %"):
-        study_tables(broken, broken.iloc[:0].assign(alpha_deg=[], beta_deg=[]),
+        study_tables(broken, broken.iloc[:0].assign(pose=[], alpha_deg=[], beta_deg=[]),
                      {"incremental_max": 2, "hierarchy_first": 2, "hierarchy_max_size": 1}, 2,
                      study_analysis_settings(null_draws=5))

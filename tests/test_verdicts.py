@@ -96,3 +96,20 @@ def test_force_closure_bounded_is_force_closure_within_the_bound():
     assert bounded["success_force"].tolist()[:2] == [50.0, 98.1] and bounded["success_force"].isna().tolist()[2:] == [True, True]
     with pytest.raises(ValueError, match="needs every object's weight"):
         with_verdicts(gfo, "force_closure_bounded", {"b": 9.81}, 10.0)
+
+
+def test_force_closure_without_a_force_beyond_the_bound_is_reclassified():
+    """Set 1 passes the strict test at pose 0 but the optimisation under the weight found no
+    force (the solver's failure at forces of ~1e5 N); its superset 1-2 needs 500 N there,
+    above 10 x 9.81 N, so set 1 is load-feasible in exact arithmetic and never bounded. At
+    pose 1 the superset needs only 50 N: left as it is (an unexplained invariant breach)."""
+    gfo = pd.DataFrame({"object": ["a"] * 4, "pose": [0, 0, 1, 1], "set_id": ["1", "1-2", "1", "1-2"],
+                        "status": ["infeasible", "force_closure", "infeasible", "force_closure"],
+                        "force_closure": [False, True, False, True], "strict_internal": [True] * 4,
+                        "rank_G": [6] * 4, "force_norm": [np.nan, 500.0, np.nan, 50.0]})
+    out = with_verdicts(gfo, "force_closure", {"a": 9.81}, 10.0)
+    assert out["force_lower_bound_N"].tolist()[0] == 500.0 and out["force_lower_bound_N"].tolist()[2] == 50.0
+    assert out["force_beyond_solver"].tolist() == [True, False, False, False]
+    assert out["verdict_load_feasible"].tolist() == [True, True, False, True]
+    assert out["verdict_force_closure_bounded"].tolist() == [False, False, False, True]
+    assert out["marginal"].tolist() == [True, True, True, False]  # no force, or above the bound

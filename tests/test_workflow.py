@@ -121,8 +121,11 @@ def test_tables_have_documented_columns_and_sane_values(run_j2):
     share = preservation["preserved_percent"].dropna()
     assert ((share >= 0) & (share <= 100)).all()
     claims = pd.read_csv(tables / "claims.csv")
-    assert claims["claim"].tolist() == list(range(1, 8))
+    assert claims.loc[claims["headline"], "claim"].tolist() == list(range(1, 8))  # one headline row per claim
     assert set(claims["verdict"]) <= {"holds", "does not hold", "undefined"}
+    assert claims.loc[claims["verdict"] != "undefined", "reason"].str.startswith("interval").all()
+    decided = claims[claims["verdict"] != "undefined"]
+    assert (decided["n_distinct_poses"] >= 30).all() and (decided["low"] <= decided["difference"]).all()
     checks = pd.read_csv(tables / "invariant_checks.csv")
     assert (checks.loc[checks["check"] == "alpha_period", "count"] == 0).all()  # results repeat every 90 deg
     gfo = pd.read_parquet(run_j2 / "results" / "objects" / "obj4" / "gfo.parquet")
@@ -173,14 +176,14 @@ def test_broken_config_fails_before_work_and_keeps_results(run_j2, tmp_path):
     before = digest(files)
     broken = yaml.safe_load(SMALL.read_text())
     broken["mechanics"]["friction"] = 1.0
-    broken["objects"]["obj4"]["size_mm"] = [100, -60, 100]
+    broken["objects"]["obj4"]["shape"]["box"]["size_mm"] = [100, -60, 100]
     path = tmp_path / "broken.yaml"
     path.write_text(yaml.safe_dump(broken))
     out = snakemake(run_j2, "-j2", "figures", "--forceall", configfile=path)
     assert out.returncode != 0
     message = out.stdout + out.stderr
     assert "config error at 'mechanics': unknown key(s) ['friction']" in message
-    assert "objects.obj4.size_mm[1]" in message
+    assert "objects.obj4.shape.box.size_mm[1]" in message
     assert digest(files) == before
 
 

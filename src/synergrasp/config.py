@@ -31,7 +31,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from synergrasp.simulation.objects import Box
+
+from synergrasp.simulation.objects import GraspedObject
+from synergrasp.simulation.shapes import ShapeError, shape_from_config
 from synergrasp.yaml_io import read_yaml
 
 __all__ = [
@@ -314,6 +316,11 @@ def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -
     if bad_k:
         problems.append(f"config error at 'analyses.fig4.panel_k': {bad_k} exceed "
                         f"synergy_sets.incremental_max ({k_max})")
+    for name, spec in config["objects"].items():
+        try:
+            shape_from_config(spec["shape"], f"objects.{name}.shape")
+        except ShapeError as err:
+            problems.append(f"config error at {err}")
     if not _grid_problems(config["grid"]):
         problems += _pose_problems(config)
         problems += _search_problems(config)
@@ -426,7 +433,7 @@ def scenario_configs(config: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
 #: them. A new key: one schema entry, plus its path here if a step reads it.
 STEP_KEYS: dict[str, tuple[str, ...]] = {
     "simulate": ("hand", "synergies", "grid", "placement", "closure",
-                 "objects.{object}.size_mm", "objects.{object}.placement"),
+                 "objects.{object}.shape", "objects.{object}.placement"),
     "contacts": ("closure.model",),
     "optimise": ("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg"),
     "minima": ("analyses.minima_radius_deg", "analyses.success"),
@@ -436,13 +443,13 @@ STEP_KEYS: dict[str, tuple[str, ...]] = {
                "analyses.bootstrap", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
     "realism": ("hand", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2"),
     "fig1": ("hand", "synergies"),
-    "fig2": ("hand", "objects.*.size_mm"),
+    "fig2": ("hand", "objects.*.shape"),
     "fig4": ("analyses.fig4", "analyses.success"),
     "fig5": ("synergy_sets.hierarchy_first", "analyses.success"),
     # the placement search (docs/placement_search.md): the kinematic closure and the
     # optimisation with the full set {S1..S_incremental_max} only
     "search": ("hand", "synergies", "grid", "placement", "closure", "mechanics", "synergy_sets.incremental_max",
-               "objects.{object}.size_mm", "objects.{object}.mass_kg", "objects.{object}.placement"),
+               "objects.{object}.shape", "objects.{object}.mass_kg", "objects.{object}.placement"),
 }
 #: The keys of the choice of which contacts count (the ``contacts`` step).
 _CONTACT_SELECTION = ("closure.dynamic.unloaded_contacts", "closure.dynamic.load_threshold_N")
@@ -587,11 +594,11 @@ def _synergy_digest(hand: str | None, synergies: str | None, columns: tuple[int,
 
 @dataclass(frozen=True)
 class SimulateParams:
-    """The closure of one object: hand and synergy files (None = shipped), the box, its
+    """The closure of one object: hand and synergy files (None = shipped), the object, its
     effective placement (with the pose grid) and the closure settings."""
     hand: str | None
     synergies: str | None
-    box: Box
+    object: GraspedObject
     placement: Any  # synergrasp.simulation.placement.Placement
     closure: Any    # synergrasp.simulation.closure.ClosureParams
     mechanics: dict[str, Any] | None = None  # the mechanics block, where the closure model reads it
@@ -600,12 +607,12 @@ class SimulateParams:
 @dataclass(frozen=True)
 class SearchStepParams:
     """The placement search of one object (docs/placement_search.md): hand and synergy files,
-    the box with its mass, its effective placement, the closure settings (the search closes
+    the object with its mass, its effective placement, the closure settings (the search closes
     with the kinematic model), the GFO parameters, the size of the full synergy set, the
     search's settings."""
     hand: str | None
     synergies: str | None
-    box: Box
+    object: GraspedObject
     placement: Any  # synergrasp.simulation.placement.Placement
     closure: Any    # synergrasp.simulation.closure.ClosureParams
     gfo: Any        # synergrasp.optimisation.study.GFOParams
@@ -674,7 +681,7 @@ class FiguresParams:
     """Parameters of the figures (each figure's rule is given its own keys only)."""
     hand: str | None = None
     synergies: str | None = None
-    boxes: tuple = ()
+    objects: tuple = ()  # GraspedObject
     success: str = ""
     fig4_panel_k: tuple[int, ...] = ()
     fig4_alpha_slice_deg: float = math.nan
@@ -691,7 +698,8 @@ STEP_MODULES: dict[str, tuple[str, ...]] = {
     "search": ("synergrasp.simulation.closure", "synergrasp.simulation.placement_search",
                "synergrasp.optimisation.study"),
     "optimise": ("synergrasp.optimisation.study",),
-    "tables": ("synergrasp.analysis.summaries", "synergrasp.analysis.periods"),
+    "tables": ("synergrasp.analysis.summaries", "synergrasp.analysis.periods", "synergrasp.analysis.bootstrap",
+               "synergrasp.analysis.claims"),
 }
 
 def _build(cls: Any, where: str, **kwargs: Any) -> Any:
@@ -703,11 +711,14 @@ def _build(cls: Any, where: str, **kwargs: Any) -> Any:
         raise ConfigError(f"config error at '{where}': {message}") from None
 
 
-def _box(config: Mapping[str, Any], name: str) -> Any:
-    """The object ``name`` as a Box; its mass is None where the step does not read it."""
+def _object(config: Mapping[str, Any], name: str) -> GraspedObject:
+    """The object ``name``; its mass is None where the step does not read it."""
     spec = config["objects"][name]
-    return _build(Box, f"objects.{name}", name=name, size_mm=spec["size_mm"],
-                  mass_kg=spec.get("mass_kg"))
+    try:
+        shape = shape_from_config(spec["shape"], f"objects.{name}.shape")
+    except ShapeError as err:
+        raise ConfigError(f"config error at {err}") from None
+    return _build(GraspedObject, f"objects.{name}", name=name, shape=shape, mass_kg=spec.get("mass_kg"))
 
 
 def placement_params(placement: Mapping[str, Any], grid: Mapping[str, Any]) -> Any:
@@ -722,7 +733,7 @@ def _simulate(config: Mapping[str, Any], obj: str) -> SimulateParams:
     closure = importlib.import_module("synergrasp.simulation.closure")
     placement = overlay(config["placement"], config["objects"][obj].get("placement"))
     return SimulateParams(
-        hand=config["hand"], synergies=config["synergies"], box=_box(config, obj),
+        hand=config["hand"], synergies=config["synergies"], object=_object(config, obj),
         placement=placement_params(placement, config["grid"]),
         closure=_build(closure.ClosureParams, "closure", **{
             **_fields(closure.ClosureParams, config["closure"]),
@@ -741,7 +752,7 @@ def _search(config: Mapping[str, Any], obj: str) -> SearchStepParams:
         searching.SearchParams, {k: v for k, v in spec.items() if k != "region_mm"}))
     dynamic = config["closure"].get("dynamic")
     return SearchStepParams(
-        hand=config["hand"], synergies=config["synergies"], box=_box(config, obj),
+        hand=config["hand"], synergies=config["synergies"], object=_object(config, obj),
         # the search places the box toward each of its targets: the modes' own targets are not read
         placement=placement_params({**placement, "mode": "searched", "approach_point_mm": None,
                                     "center_mm": (0.0, 0.0, 0.0)}, config["grid"]),
@@ -771,6 +782,8 @@ def _optimise(config: Mapping[str, Any], obj: str) -> OptimiseParams:
 def _tables(config: Mapping[str, Any]) -> TablesParams:
     summaries = importlib.import_module("synergrasp.analysis.summaries")
     periods = importlib.import_module("synergrasp.analysis.periods")
+    bootstrap = importlib.import_module("synergrasp.analysis.bootstrap")
+    claims = importlib.import_module("synergrasp.analysis.claims")
     analyses, g = config["analyses"], config["mechanics"]["g_m_per_s2"]
     objects = {name: {**spec, "placement": overlay(config["placement"], spec.get("placement"))}
                for name, spec in config["objects"].items()}
@@ -783,6 +796,10 @@ def _tables(config: Mapping[str, Any]) -> TablesParams:
         radius_deg=float(analyses["minima_radius_deg"]), null_draws=int(analyses["null_model"]["draws"]),
         null_seed=int(analyses["null_model"]["seed"]),
         success_rate_tolerance_percent=float(analyses["success_rate_tolerance_percent"]),
+        bootstrap=_build(bootstrap.BootstrapSettings, "analyses.bootstrap", **analyses["bootstrap"]),
+        rules=_build(claims.VerdictRules, "analyses", rate_points=float(analyses["tie_band"]["rate_points"]),
+                     force_relative=float(analyses["tie_band"]["force_relative"]),
+                     min_distinct_poses=int(analyses["min_distinct_poses"]), headline_view=analyses["headline_view"]),
         weights_N={name: float(spec["mass_kg"]) * float(g) for name, spec in objects.items()},
         periods_deg=periods_deg)
     return TablesParams(dict(config["synergy_sets"]), int(analyses["table2_k_max"]), settings)
@@ -792,7 +809,7 @@ def _figures(config: Mapping[str, Any], step: str, obj: str | None = None) -> Fi
     if step == "fig1":
         return FiguresParams(hand=config["hand"], synergies=config["synergies"])
     if step == "fig2":
-        return FiguresParams(hand=config["hand"], boxes=tuple(_box(config, n) for n in config["objects"]))
+        return FiguresParams(hand=config["hand"], objects=tuple(_object(config, n) for n in config["objects"]))
     success = config["analyses"]["success"]
     if step == "fig4":
         fig4 = config["analyses"]["fig4"]

@@ -258,7 +258,11 @@ STUDY_FILES = {
     + [f"figures/grasp_realism.{ext}" for ext in ("png", "pdf")],
     "fig5": [
         f"figures/{name}.{ext}"
-        for name in ("fig5a_hierarchy_success", "fig5b_hierarchy_force")
+        for name in (
+            "fig5a_hierarchy_success",
+            "fig5a_hierarchy_success_pooled",
+            "fig5b_hierarchy_force",
+        )
         for ext in ("png", "pdf")
     ],
 }

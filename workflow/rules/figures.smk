@@ -47,6 +47,12 @@ rule fig5_hierarchy:
             category="Figures",
         ),
         success_pdf="{root}/figures/fig5a_hierarchy_success.pdf",
+        pooled_png=report(
+            "{root}/figures/fig5a_hierarchy_success_pooled.png",
+            caption="../report/fig5a_pooled.rst",
+            category="Figures",
+        ),
+        pooled_pdf="{root}/figures/fig5a_hierarchy_success_pooled.pdf",
         force_png=report(
             "{root}/figures/fig5b_hierarchy_force.png",
             caption="../report/fig5b.rst",

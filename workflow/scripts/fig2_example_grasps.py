@@ -9,5 +9,5 @@ from synergrasp.job_log import job_log
 with job_log(snakemake.log[0]):
     params = step_params(snakemake.params.cfg, "fig2")
     contacts = [tables.read(tables.CONTACTS, path) for path in snakemake.input.contacts]
-    figure_example_grasps(load_hand(params.hand), params.boxes, contacts, snakemake.output.png,
+    figure_example_grasps(load_hand(params.hand), params.objects, contacts, snakemake.output.png,
                           snakemake.output.pdf)

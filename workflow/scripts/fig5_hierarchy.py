@@ -1,4 +1,5 @@
-"""Fig. 5A/5B: success rate and paired force ratio of every set {S_k, S_i, S_j}, mean over objects."""
+"""Fig. 5A/5B: success rate of every set {S_k, S_i, S_j} in both views of "averaged over
+objects", and its paired force ratio to the full set pooled over its successes, with counts."""
 
 import pandas as pd
 
@@ -10,9 +11,13 @@ with job_log(snakemake.log[0]):
     p, out = step_params(snakemake.params.cfg, "fig5"), snakemake.output
     first, success = p.hierarchy_first, p.success
     matrices = pd.read_csv(snakemake.input.hierarchy)
-    figure_hierarchy(matrices, "success_rate", first, f"Fig. 5A: success rate (%, {success}), mean over objects",
-                     ".0f", (0.0, 100.0), "success rate (%)", out.success_png, out.success_pdf)
+    for column, view, png, pdf in (("success_rate", "per-object view (the study's)", out.success_png,
+                                    out.success_pdf),
+                                   ("success_rate_pooled", "pooled view", out.pooled_png, out.pooled_pdf)):
+        figure_hierarchy(matrices, column, first, f"Fig. 5A: success rate (%, {success}), {view}", ".0f",
+                         (0.0, 100.0), "success rate (%)", png, pdf)
     figure_hierarchy(matrices, "force_ratio_median", first,
                      "Fig. 5B: optimal force / full set's optimal force on the same pose "
-                     "(median per object, mean over objects)", ".2f", FIG5B_RATIO_RANGE,
-                     "paired force ratio (log scale)", out.force_png, out.force_pdf, log_scale=True)
+                     "(median over every object's successes; below: distinct poses)", ".2f", FIG5B_RATIO_RANGE,
+                     "paired force ratio (log scale)", out.force_png, out.force_pdf, log_scale=True,
+                     counts="n_force_poses")

@@ -11,5 +11,5 @@ with job_log(snakemake.log[0]):
     sim = step_params(snakemake.params.cfg, "simulate", snakemake.wildcards.object)
     hand = load_hand(sim.hand)
     synergies = load_synergies(sim.synergies, joint_names=hand.joint_names)
-    table = simulate_object(hand, synergies, sim.box, sim.placement, sim.closure, mechanics=sim.mechanics)
+    table = simulate_object(hand, synergies, sim.object, sim.placement, sim.closure, mechanics=sim.mechanics)
     write_contacts(table, snakemake.output[0])

@@ -1,13 +1,12 @@
 """Minimum preservation against chance: a null model that keeps the spacing of the minima.
 
 For a pair ({S1..Sk}, {S1..Sk+1}) of one object, the null model shifts every minimum of
-{S1..Sk+1} by one common random offset on the (α, β) grid, toroidally (grid indices wrap
-in α and in β), and counts the minima of {S1..Sk} that have a shifted minimum within the
+{S1..Sk+1} by one common random offset on the (α, β) grid, wrapping in α (periodic) and
+reflected at the ends of the β range (β is not periodic), and counts the minima of {S1..Sk} that have a shifted minimum within the
 neighbourhood (the same test as the observed statistic, :func:`synergrasp.analysis.minima.
 preserved`). The shift keeps how many minima there are and how they are spread, and
 destroys where they are. Offsets that leave the map where it was are excluded: α offset
-within the radius of a multiple of the object's α-period *and* β offset within the radius
-(wrapped). Each draw gives every pair its own offset; the share is pooled over pairs as the
+within the radius of a multiple of the object's α-period *and* β offset within the radius. Each draw gives every pair its own offset; the share is pooled over pairs as the
 observed share is. ``draws`` draws from a generator seeded with ``seed``: deterministic.
 
 Pairs whose two force maps are identical (same success at every pose, forces equal to
@@ -20,10 +19,12 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from synergrasp.analysis.bootstrap import PoseResampler
 from synergrasp.analysis.minima import preserved
 from synergrasp.config import incremental_set_id
 
-__all__ = ["identical_force_maps", "allowed_offsets", "null_preserved", "preservation_vs_chance"]
+__all__ = ["identical_force_maps", "allowed_offsets", "null_preserved", "preservation_vs_chance",
+           "resampled_preservation"]
 
 ALL_OBJECTS = "all"
 _TOL_DEG = 1e-6
@@ -52,17 +53,28 @@ def _wrapped(offset: NDArray, length: float) -> NDArray:
 
 
 def allowed_offsets(alphas: NDArray, betas: NDArray, radius_deg: float, period_deg: float) -> NDArray:
-    """(n, 2) grid-index offsets (dα, dβ) of the null model: all toroidal offsets except those
-    within ``radius_deg`` of a multiple of the α-period in α and within ``radius_deg`` in β
-    (both wrapped). ``alphas``, ``betas``: the grid's sorted values, deg (uniform steps)."""
+    """(n, 2) grid-index offsets (dα, dβ) of the null model: dα = 0..n_α − 1 (wrapping, α is
+    periodic), dβ = −(n_β − 1)..n_β − 1 (reflected at the grid's ends, β is not periodic),
+    except those within ``radius_deg`` of a multiple of the α-period in α and within
+    ``radius_deg`` in β. ``alphas``, ``betas``: the grid's sorted values, deg (uniform steps)."""
     n_a, n_b = len(alphas), len(betas)
     step_a = float(alphas[1] - alphas[0]) if n_a > 1 else 360.0
     step_b = float(betas[1] - betas[0]) if n_b > 1 else 1.0
-    da, db = np.meshgrid(np.arange(n_a), np.arange(n_b), indexing="ij")
+    da, db = np.meshgrid(np.arange(n_a), np.arange(-(n_b - 1), n_b), indexing="ij")
     near_a = _wrapped(da * step_a, period_deg) <= radius_deg + _TOL_DEG
-    near_b = _wrapped(db, n_b) * step_b <= radius_deg + _TOL_DEG
+    near_b = np.abs(db) * step_b <= radius_deg + _TOL_DEG
     keep = ~(near_a & near_b)
     return np.column_stack([da[keep], db[keep]])
+
+
+def reflected(index: NDArray, n: int) -> NDArray:
+    """Grid indices shifted beyond 0..n − 1 mapped back by reflection at the ends (no wrap):
+    −1 → 1, n → n − 2; the number of points is kept."""
+    if n == 1:
+        return np.zeros_like(index)
+    period = 2 * (n - 1)
+    folded = np.mod(index, period)
+    return np.where(folded > n - 1, period - folded, folded)
 
 
 def _indices(values: NDArray, grid: NDArray) -> NDArray:
@@ -84,7 +96,7 @@ def null_preserved(this: pd.DataFrame, nxt: pd.DataFrame, alphas: NDArray, betas
     a, b = this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float)
     for d, (da, db) in enumerate(offsets[rng.integers(len(offsets), size=draws)]):
         shifted_a = alphas[(ia + da) % alphas.size]
-        shifted_b = betas[(ib + db) % betas.size]
+        shifted_b = betas[reflected(ib + db, betas.size)]
         counts[d] = int(preserved(a, b, shifted_a, shifted_b, radius_deg).sum())
     return counts
 
@@ -147,3 +159,31 @@ def preservation_vs_chance(table: pd.DataFrame, minima: pd.DataFrame, k_max: int
     pairs = pd.DataFrame([{"object": r["object"], "k": r["k"], "identical_maps": r["identical"]} for r in rows],
                          columns=["object", "k", "identical_maps"])
     return pd.DataFrame(summary), pairs
+
+
+def resampled_preservation(minima: pd.DataFrame, k_max: int, radius_deg: float,
+                           resampler: PoseResampler) -> pd.DataFrame:
+    """Per object: the minima of {S1..Sk} (k = 1..k_max − 1) at distinct poses and those
+    preserved in {S1..Sk+1}, counted under every bootstrap resample.
+
+    One row per object of the resampler: ``n_minima``, ``n_preserved`` — (1 + resamples,)
+    arrays of weighted counts, element 0 the counts on the data (minima per distinct pose).
+    """
+    rows = []
+    for obj in resampler.objects:
+        poses = resampler.poses(obj)
+        where = {int(p): i for i, p in enumerate(poses)}
+        n_min, n_kept = np.zeros(len(poses)), np.zeros(len(poses))
+        mins = minima[minima["object"] == obj]
+        for k in range(1, k_max):
+            this = mins[mins["set_id"] == incremental_set_id(k)]
+            nxt = mins[mins["set_id"] == incremental_set_id(k + 1)]
+            kept = preserved(this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float),
+                             nxt["alpha_deg"].to_numpy(float), nxt["beta_deg"].to_numpy(float), radius_deg)
+            index = np.array([where.get(int(p), -1) for p in this["pose"]], dtype=np.int64)
+            here = index >= 0
+            np.add.at(n_min, index[here], 1.0)
+            np.add.at(n_kept, index[here], kept[here].astype(float))
+        rows.append({"object": obj, "n_minima": resampler.sums(obj, n_min),
+                     "n_preserved": resampler.sums(obj, n_kept)})
+    return pd.DataFrame(rows, columns=["object", "n_minima", "n_preserved"])

@@ -1,157 +1,286 @@
-"""The study's claims as a table, each with the figure that tests it and a verdict.
+"""The study's claims as a table: each with what tests it, the compared difference with its
+bootstrap interval, the distinct poses it rests on, and a verdict with its reason.
 
-The claims are hypotheses of the study (Averta et al. 2018), tested on this run; nothing
-in the model is chosen toward them. Verdicts: ``holds``, ``does not hold``, ``undefined``
-(a tie, or a quantity this run cannot give). Success rates are the chosen verdict's,
-averaged over objects (objects whose full set never succeeds are skipped). A comparison
-of two measured quantities, or of a quantity with a round threshold (claims 3–7), is a
-tie when they differ by at most ``TIE_PERCENT_POINTS`` percentage points or, for forces,
-by at most ``TIE_FORCE_RELATIVE`` relative; a tie is ``undefined``. Claims 1 and 2 carry
-their own tolerance (99.5 %, a count of 0). docs/analyses.md gives every rule.
+The claims are hypotheses of the study (Averta et al. 2018), tested on this run; nothing in
+the model is chosen toward them. The rules (docs/analyses.md, "Verdicts from intervals"):
+a claim ``holds`` or ``does not hold`` only when the interval of its compared difference
+lies wholly beyond the tie band; otherwise, or with fewer than ``min_distinct_poses``
+distinct poses behind it, or with nothing to compare, it is ``undefined`` with the reason.
+Claims about averaged rates get one row per view (the headline view first).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
-from synergrasp.config import set_id
+from synergrasp.analysis.intervals import VIEWS, StudyCounts, mean_defined
+from synergrasp.config import incremental_set_id, set_id
 
-__all__ = ["HOLDS", "FAILS", "UNDEFINED", "compare", "combine", "claims_table", "TIE_PERCENT_POINTS",
-           "TIE_FORCE_RELATIVE"]
+__all__ = ["HOLDS", "FAILS", "UNDEFINED", "VerdictRules", "Difference", "interval_verdict", "claims_table",
+           "CLAIM_COLUMNS"]
 
 HOLDS, FAILS, UNDEFINED = "holds", "does not hold", "undefined"
-TIE_PERCENT_POINTS = 1.0
-TIE_FORCE_RELATIVE = 0.05
-CLAIM_COLUMNS = ["claim", "statement", "tested_by", "measured", "verdict"]
+CLAIM_COLUMNS = ["claim", "view", "headline", "statement", "tested_by", "measured", "difference", "low", "high",
+                 "unit", "tie_band", "n_distinct_poses", "verdict", "reason"]
+#: How a difference d decides a claim: "greater" (holds if d > band), "within_below" (a claim
+#: of equality, d ≤ 0: holds if d ≥ −band), "within_above" (d ≥ 0: holds if d ≤ band).
+KINDS = ("greater", "within_below", "within_above")
 
 
-def compare(higher: float, lower: float, tie: float = TIE_PERCENT_POINTS) -> str:
-    """``holds`` if higher − lower > tie, ``does not hold`` if < −tie, else (or NaN) ``undefined``."""
-    if not (np.isfinite(higher) and np.isfinite(lower)):
-        return UNDEFINED
-    diff = higher - lower
-    return HOLDS if diff > tie else FAILS if diff < -tie else UNDEFINED
+@dataclass(frozen=True)
+class VerdictRules:
+    """Config ``analyses``: tie band (percentage points; relative for forces), the least
+    number of distinct poses behind a comparison, the headline view."""
+
+    rate_points: float
+    force_relative: float
+    min_distinct_poses: int
+    headline_view: str
+
+    def __post_init__(self) -> None:
+        if self.headline_view not in VIEWS:
+            raise ValueError(f"VerdictRules.headline_view must be one of {list(VIEWS)}; got {self.headline_view!r}")
 
 
-def compare_lower_force(lower: float, higher: float, tie: float = TIE_FORCE_RELATIVE) -> str:
-    """``holds`` if ``lower`` is below ``higher`` by more than the relative tie (lower·(1+tie) <
-    higher), ``does not hold`` if above by more, else ``undefined``."""
-    if not (np.isfinite(lower) and np.isfinite(higher) and lower > 0 and higher > 0):
-        return UNDEFINED
-    return HOLDS if lower * (1 + tie) < higher else FAILS if higher * (1 + tie) < lower else UNDEFINED
+@dataclass(frozen=True)
+class Difference:
+    """A compared difference: its estimate and interval, its unit and band, the distinct poses
+    it rests on, how it decides, and a reason that overrides the interval (e.g. a set not
+    computed)."""
+
+    estimate: float
+    low: float
+    high: float
+    band: float
+    n: int
+    kind: str = "greater"
+    unit: str = "percentage points"
+    reason: str = ""
+    note: str = ""
 
 
-def combine(verdicts: Sequence[str]) -> str:
-    """All hold → holds; any does not hold → does not hold; else undefined."""
-    if verdicts and all(v == HOLDS for v in verdicts):
-        return HOLDS
-    return FAILS if FAILS in verdicts else UNDEFINED
+def interval_verdict(d: Difference, min_poses: int) -> tuple[str, str]:
+    """(verdict, reason) of a compared difference by the rules of docs/analyses.md."""
+    verdict, reason = _decide(d, min_poses)
+    return verdict, f"{reason}; {d.note}" if d.note else reason
+
+
+def _decide(d: Difference, min_poses: int) -> tuple[str, str]:
+    if d.reason:
+        return UNDEFINED, d.reason
+    if d.n == 0:
+        return UNDEFINED, "nothing to compare: 0 distinct poses"
+    if d.n < min_poses:
+        return UNDEFINED, f"fewer than {min_poses} distinct poses: {d.n}"
+    low, high, band = d.low, d.high, d.band
+    if not (np.isfinite(low) and np.isfinite(high)):
+        return UNDEFINED, "no interval (a statistic undefined in every resample)"
+    if d.kind == "greater":
+        holds, fails = low > band, high < -band
+    elif d.kind == "within_below":
+        holds, fails = low >= -band, high < -band
+    elif d.kind == "within_above":
+        holds, fails = high <= band, low > band
+    else:
+        raise ValueError(f"kind must be one of {list(KINDS)}; got {d.kind!r}")
+    if holds:
+        return HOLDS, f"interval wholly beyond the tie band (±{band:g})" if d.kind == "greater" else \
+            f"interval within the tie band (±{band:g})"
+    if fails:
+        return FAILS, f"interval wholly beyond the tie band (±{band:g}) on the other side"
+    if d.kind == "greater" and low >= -band and high <= band:
+        return UNDEFINED, f"interval inside the tie band (±{band:g}): a tie"
+    return UNDEFINED, f"interval overlaps the tie band (±{band:g})"
 
 
 def _label(sid: str) -> str:
     return "{" + ",".join(f"S{i}" for i in sid.split("-")) + "}"
 
 
-def _rate(mean_rates: pd.Series, *synergies: int) -> float:
-    return float(mean_rates.get(set_id(synergies), np.nan))
+def _fmt(values: NDArray, counts: StudyCounts, unit: str = "%") -> str:
+    est, low, high = counts.estimate_interval(values)
+    return f"{est:.1f} {unit} [{low:.1f}, {high:.1f}]"
 
 
-def _claim1(table2: pd.DataFrame, first: int) -> tuple[str, str]:
-    if first not in table2.columns or table2[first].isna().all():
-        return f"Table II has no k = {first}", UNDEFINED
-    column = table2.set_index("object")[first]
-    worst = column.idxmin() if column.notna().any() else None
-    if column.isna().any():
-        return f"Table II k = {first} undefined for {sorted(column[column.isna()].index)}", UNDEFINED
-    verdict = HOLDS if (column >= 99.5).all() else FAILS
-    return f"lowest Table II at k = {first}: {column[worst]:.2f} % ({worst})", verdict
+def _difference(values: NDArray, counts: StudyCounts, band: float, n: int, kind: str = "greater",
+                unit: str = "percentage points", reason: str = "") -> Difference:
+    est, low, high = counts.estimate_interval(values)
+    return Difference(est, low, high, band, n, kind, unit, reason)
 
 
-def _claim3(preservation: pd.DataFrame) -> tuple[str, str]:
-    row = preservation[(preservation["object"] == "all") & (preservation["pairs"] == "all")]
-    if row.empty or not np.isfinite(row["preserved_percent"].iloc[0]):
-        return "no local minima", UNDEFINED
-    r = row.iloc[0]
-    text = (f"{r.preserved_percent:.1f} % preserved; null model {r.null_mean_percent:.1f} % "
-            f"[{r.null_low_percent:.1f}, {r.null_high_percent:.1f}]")
-    return text, combine([compare(r.preserved_percent, 90.0), compare(r.preserved_percent, r.null_high_percent)])
+def _missing(counts: StudyCounts, set_ids: Sequence[str]) -> str:
+    absent = [_label(s) for s in set_ids if not counts.has(s)]
+    return f"sets not computed: {', '.join(absent)}" if absent else ""
 
 
-def _claim5(rates: pd.Series) -> tuple[str, str]:
-    singles = (min(_rate(rates, 4), _rate(rates, 5)), max(_rate(rates, 2), _rate(rates, 3)))
-    pairs = (min(_rate(rates, 1, 4), _rate(rates, 1, 5)), max(_rate(rates, 1, 2), _rate(rates, 1, 3)))
-    text = (f"singles: min(S4,S5) {singles[0]:.1f} % vs max(S2,S3) {singles[1]:.1f} %; with S1: "
-            f"min {pairs[0]:.1f} % vs max {pairs[1]:.1f} %")
-    return text, combine([compare(*singles), compare(*pairs)])
+def _best_of(counts: StudyCounts, view: str, target: str, others: Sequence[str], rules: VerdictRules,
+             what: str) -> tuple[str, Difference]:
+    """rate(target) − the best of ``others``, the best taken inside each resample."""
+    others = [s for s in others if counts.has(s)]
+    reason = _missing(counts, [target]) or ("" if others else f"no other {what} computed")
+    if reason:
+        return reason, Difference(np.nan, np.nan, np.nan, rules.rate_points, 0, reason=reason)
+    rates = np.vstack([counts.rate(s, view) for s in others])
+    best_rows = np.nanmax(np.where(np.isfinite(rates), rates, -np.inf), axis=0)
+    target_rate = counts.rate(target, view)
+    best = others[int(np.nanargmax(np.where(np.isfinite(rates[:, 0]), rates[:, 0], -np.inf)))]
+    text = (f"{_label(target)} {_fmt(target_rate, counts)}; best other {what} {_label(best)} "
+            f"{_fmt(counts.rate(best, view), counts)}")
+    return text, _difference(target_rate - best_rows, counts, rules.rate_points, counts.n_any([target, best]))
 
 
-def _claim6(rates: pd.Series, first: int) -> tuple[str, str]:
-    pairs = {set_id((i, j)): _rate(rates, i, j) for i in range(1, first + 1) for j in range(i + 1, first + 1)}
-    target = pairs.pop(set_id((1, 5)), np.nan)
-    others = {s: v for s, v in pairs.items() if np.isfinite(v)}
-    if not others:
-        return "no other pair computed", UNDEFINED
-    best = max(others, key=others.get)
-    return (f"{{S1,S5}} {target:.1f} %; best other pair {_label(best)} {others[best]:.1f} %",
-            compare(target, others[best]))
+def _claim1(counts: StudyCounts, first: int, rules: VerdictRules) -> tuple[str, Difference]:
+    sid = incremental_set_id(first)
+    objects = counts.counted_objects()
+    if not counts.has(sid) or not objects:
+        reason = _missing(counts, [sid]) or "nothing to compare: the full set succeeds nowhere"
+        return reason, Difference(np.nan, np.nan, np.nan, rules.rate_points, 0, "within_below", reason=reason)
+    rates = np.vstack([counts.object_rate(o, sid) for o in objects])
+    n = min(int(counts.count(o, counts.full)[0]) for o in objects)
+    text = "; ".join(f"{o} {_fmt(r, counts)}" for o, r in zip(objects, rates))
+    return (f"Table II at k = {first}: {text}",
+            _difference(np.nanmin(rates, axis=0) - 100.0, counts, rules.rate_points, n, "within_below"))
 
 
-def _claim7(per_object: pd.DataFrame, first: int) -> tuple[str, str]:
-    singles = [str(i) for i in range(1, first + 1)]
-    ratios = per_object[per_object["set_id"].astype(str).isin(singles)].assign(set_id=lambda t: t["set_id"].astype(str))
-    grouped = ratios.groupby("set_id")["force_ratio_median"]
-    mean, count = grouped.mean(), grouped.count()
-    named = ["1", "4", "5"]
-    if first < 5 or mean.reindex(named).isna().any():
-        return "S1, S4 or S5 never succeeds alone (no paired force)", UNDEFINED
-    rest = mean.drop(named).dropna()
-    if rest.empty:
-        return "no other single synergy succeeds", UNDEFINED
-    shown = ", ".join(f"S{s} {mean[s]:.2f} ({count[s]})" for s in sorted(mean.dropna().index, key=int))
-    never = [f"S{s}" for s in singles if s not in mean.dropna().index]
-    text = (f"paired force ratio, mean over objects (objects): {shown}"
-            + (f"; never succeed alone: {', '.join(never)}" if never else ""))
-    return text, compare_lower_force(float(mean[named].max()), float(rest.min()))
+def _claim2(counts: StudyCounts, first: int, view: str, rules: VerdictRules) -> tuple[str, Difference]:
+    sid = incremental_set_id(first)
+    if not counts.has(sid):
+        reason = _missing(counts, [sid])
+        return reason, Difference(np.nan, np.nan, np.nan, rules.rate_points, 0, "within_above", reason=reason)
+    if view == "pooled":
+        full, lost = counts.n_lost(sid)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            share = np.where(full > 0, 100.0 * lost / np.where(full > 0, full, 1.0), np.nan)
+    else:
+        share = 100.0 - counts.rate(sid, "per_object")
+    full, lost = counts.n_lost(sid)
+    text = (f"{int(lost[0])} of the full set's {int(full[0])} distinct force-closure poses missed by "
+            f"{_label(sid)}: {_fmt(share, counts)}")
+    return text, _difference(share, counts, rules.rate_points, int(full[0]), "within_above")
 
 
-def claims_table(table2: pd.DataFrame, n_full_not_first: int | None, preservation: pd.DataFrame,
-                 mean_rates: pd.DataFrame, per_object: pd.DataFrame, first: int = 7) -> pd.DataFrame:
-    """The seven claims (docs/analyses.md).
+def _claim3(minima: pd.DataFrame, chance: pd.DataFrame, view: str, rules: VerdictRules,
+            counts: StudyCounts) -> tuple[str, Difference]:
+    """``minima``: one row per object with (rows,) arrays n_minima, n_preserved (distinct poses)."""
+    rows = minima[minima["n_minima"].map(lambda a: a[0] > 0)]
+    if rows.empty:
+        return "no local minima", Difference(np.nan, np.nan, np.nan, rules.rate_points, 0,
+                                             reason="nothing to compare: no local minima")
+    high = chance.set_index(["object", "pairs"])["null_high_percent"]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        if view == "pooled":
+            share = 100.0 * np.sum(np.vstack(rows["n_preserved"]), axis=0) / np.sum(np.vstack(rows["n_minima"]), axis=0)
+            null_high = float(high.get(("all", "all"), np.nan))
+        else:
+            share = mean_defined(np.vstack([100.0 * p / np.where(m > 0, m, np.nan)
+                                            for p, m in zip(rows["n_preserved"], rows["n_minima"])]))
+            null_high = float(np.mean([high.get((o, "all"), np.nan) for o in rows["object"]]))
+    n = int(sum(m[0] for m in rows["n_minima"]))
+    text = (f"{_fmt(share, counts)} of {n} distinct minima preserved; null model's 97.5 percentile "
+            f"{null_high:.1f} %")
+    return text, _difference(np.minimum(share - 90.0, share - null_high), counts, rules.rate_points, n)
 
-    Parameters
-    ----------
-    table2 : Table II (object, then columns k = 1..).
-    n_full_not_first : poses where {S1..S_full} succeeds and {S1..S_first} does not (None:
-        that set was not computed).
-    preservation : the summary of :func:`synergrasp.analysis.chance.preservation_vs_chance`.
-    mean_rates : per set, success_rate averaged over objects (``mean_over_objects``).
-    per_object : per object and set, force_ratio_median (paired force measure).
-    first : the number of leading synergies of the hierarchy (the study's 7).
+
+def _worst_of(parts: Sequence[tuple[str, NDArray, int]], counts: StudyCounts, band: float, min_poses: int,
+              unit: str = "percentage points") -> Difference:
+    """The least favourable of several compared differences (name, (rows,) values, distinct
+    poses), taken inside each resample, over those resting on at least ``min_poses`` poses.
+    Left-out comparisons are named in the reason unless a tested one lies wholly below the band
+    (which decides "does not hold" alone)."""
+    tested = [p for p in parts if p[2] >= min_poses]
+    short = ", ".join(f"{name} ({n})" for name, _, n in parts if n < min_poses)
+    if not tested:
+        n = max((p[2] for p in parts), default=0)
+        return Difference(np.nan, np.nan, np.nan, band, n, unit=unit,
+                          reason=f"fewer than {min_poses} distinct poses: {short}" if n else "")
+    d = _difference(np.min(np.vstack([p[1] for p in tested]), axis=0), counts, band, min(p[2] for p in tested),
+                    unit=unit)
+    if short:
+        left_out = f"comparisons with fewer than {min_poses} distinct poses: {short}"
+        return Difference(d.estimate, d.low, d.high, band, d.n, unit=unit,
+                          **({"note": f"left out: {left_out}"} if d.high < -band else {"reason": left_out}))
+    return d
+
+
+def _claim5(counts: StudyCounts, view: str, rules: VerdictRules) -> tuple[str, Difference]:
+    parts = [(("4", "5"), ("2", "3"), "singles"), (("1-4", "1-5"), ("1-2", "1-3"), "with S1")]
+    reason = _missing(counts, [s for better, worse, _ in parts for s in (*better, *worse)])
+    if reason:
+        return reason, Difference(np.nan, np.nan, np.nan, rules.rate_points, 0, reason=reason)
+    compared, texts = [], []
+    for better, worse, what in parts:
+        low_better = np.minimum(*(counts.rate(s, view) for s in better))
+        high_worse = np.maximum(*(counts.rate(s, view) for s in worse))
+        compared.append((what, low_better - high_worse, counts.n_any([*better, *worse])))
+        texts.append(f"{what}: min({', '.join(map(_label, better))}) {_fmt(low_better, counts)} vs "
+                     f"max({', '.join(map(_label, worse))}) {_fmt(high_worse, counts)} ({compared[-1][2]} poses)")
+    return "; ".join(texts), _worst_of(compared, counts, rules.rate_points, rules.min_distinct_poses)
+
+
+def _claim7(counts: StudyCounts, first: int, rules: VerdictRules) -> tuple[str, Difference]:
+    band = float(np.log1p(rules.force_relative))
+    unit = "log force ratio"
+    named = [s for s in ("1", "4", "5") if int(s) <= first]
+    others = [str(i) for i in range(1, first + 1) if str(i) not in ("1", "4", "5")]
+    reason = _missing(counts, named + others) or ("" if len(named) == 3 and others else "S1, S4, S5 and another "
+                                                  "single synergy are needed")
+    if reason:
+        return reason, Difference(np.nan, np.nan, np.nan, band, 0, unit=unit, reason=reason)
+    compared = [(f"S{a}-S{b}", *counts.paired_log_ratio(a, b)) for a in named for b in others]
+    shown = [f"F(S{name.split('-')[1][1:]})/F(S{name.split('-')[0][1:]}) {_fmt(np.exp(v), counts, '')} ({n})"
+             for name, v, n in compared if n >= rules.min_distinct_poses]
+    short = [f"{name} ({n})" for name, _, n in compared if n < rules.min_distinct_poses]
+    text = ("median ratio of optimal forces on the distinct poses where both succeed (poses): "
+            + ("; ".join(shown) if shown else "no pair tested")
+            + (f"; fewer than {rules.min_distinct_poses} common distinct poses: {', '.join(short)}" if short else ""))
+    return text, _worst_of(compared, counts, band, rules.min_distinct_poses, unit)
+
+
+STATEMENTS = {
+    1: ("every object reaches 100 % of the full set's force-closure poses by k = {first}", "Table II"),
+    2: ("the first {first} synergies reach force closure wherever the full set does", "full_not_first7 table"),
+    3: ("local minima are preserved as synergies are added, well above chance (share >= 90 % and above the null "
+        "model's 97.5 percentile)", "Fig. 4, minimum_preservation and preservation_vs_chance tables"),
+    4: ("S1 is the best single synergy for force closure", "Fig. 5A"),
+    5: ("S4 and S5 are more useful for force closure than S2 and S3, as single synergies and as the second "
+        "synergy with S1", "Fig. 5A"),
+    6: ("the best pair (by success rate) contains S1 and S5", "Fig. 5A"),
+    7: ("among single synergies, S4, S5 and S1 need the lowest forces (like with like: two sets on the poses "
+        "where both succeed)", "Fig. 5B"),
+}
+
+
+def claims_table(counts: StudyCounts, minima: pd.DataFrame, chance: pd.DataFrame, rules: VerdictRules,
+                 first: int = 7) -> pd.DataFrame:
+    """The seven claims (docs/analyses.md), one row per (claim, view), the headline view first.
+
+    ``counts``: the study's resampled success counts; ``minima``: per object, the (rows,)
+    resampled counts of distinct minima and of preserved ones (columns object, n_minima,
+    n_preserved); ``chance``: the preservation_vs_chance summary; ``first``: the hierarchy's
+    leading synergies (the study's 7).
     """
-    rates = mean_rates.assign(set_id=mean_rates["set_id"].astype(str)).set_index("set_id")["success_rate"]
-    singles = {i: _rate(rates, i) for i in range(2, first + 1)}
-    best_other = max(singles, key=lambda i: singles[i] if np.isfinite(singles[i]) else -np.inf) if singles else None
-    c2 = (("set not computed", UNDEFINED) if n_full_not_first is None
-          else (f"{n_full_not_first} poses", HOLDS if n_full_not_first == 0 else FAILS))
-    c4 = ((f"S1 {_rate(rates, 1):.1f} %; best other single S{best_other} {singles[best_other]:.1f} %",
-           compare(_rate(rates, 1), singles[best_other])) if best_other else ("no other single", UNDEFINED))
-    found = [
-        (1, f"every object reaches 100 % of the full set's force-closure poses by k = {first} "
-            f"(Table II at k = {first} >= 99.5 % for every object)", "Table II", *_claim1(table2, first)),
-        (2, f"the first {first} synergies reach force closure wherever the full set does "
-            f"(poses where the full set succeeds and {{S1..S{first}}} does not = 0)",
-         "full_not_first7 table", *c2),
-        (3, "local minima are preserved as synergies are added, well above chance (share >= 90 % and above "
-            "the null model's 95 % interval)", "Fig. 4, minimum_preservation and preservation_vs_chance tables",
-         *_claim3(preservation)),
-        (4, "S1 is the best single synergy for force closure", "Fig. 5A", *c4),
-        (5, "S4 and S5 are more useful for force closure than S2 and S3, as single synergies and as the second "
-            "synergy with S1", "Fig. 5A", *_claim5(rates)),
-        (6, "the best pair (by success rate) contains S1 and S5", "Fig. 5A", *_claim6(rates, first)),
-        (7, "among single synergies, S4, S5 and S1 need the lowest forces (paired force measure)", "Fig. 5B",
-         *_claim7(per_object, first)),
-    ]
-    return pd.DataFrame(found, columns=CLAIM_COLUMNS)
+    views = [rules.headline_view] + [v for v in VIEWS if v != rules.headline_view]
+    singles = [str(i) for i in range(2, first + 1)]
+    pairs = [set_id((i, j)) for i in range(1, first + 1) for j in range(i + 1, first + 1) if (i, j) != (1, 5)]
+    found: list[tuple[int, str, str, Difference]] = [(1, "each_object", *_claim1(counts, first, rules))]
+    for view in views:
+        found.append((2, view, *_claim2(counts, first, view, rules)))
+        found.append((3, view, *_claim3(minima, chance, view, rules, counts)))
+        found.append((4, view, *_best_of(counts, view, "1", singles, rules, "single")))
+        found.append((5, view, *_claim5(counts, view, rules)))
+        found.append((6, view, *_best_of(counts, view, "1-5", pairs, rules, "pair")))
+    found.append((7, "pooled", *_claim7(counts, first, rules)))  # like with like: both sets' common poses
+    rows = []
+    order = [*views, "each_object"]
+    for claim, view, text, d in sorted(found, key=lambda f: (f[0], order.index(f[1]))):
+        verdict, reason = interval_verdict(d, rules.min_distinct_poses)
+        statement, tested_by = STATEMENTS[claim]
+        headline = view == rules.headline_view or claim in (1, 7)
+        rows.append((claim, view, headline, statement.format(first=first), tested_by, text, d.estimate, d.low,
+                     d.high, d.unit, d.band, d.n, verdict, reason))
+    return pd.DataFrame(rows, columns=CLAIM_COLUMNS)

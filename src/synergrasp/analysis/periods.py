@@ -1,8 +1,8 @@
 """The α-period of an object's pose grid, distinct poses, and the check on the results.
 
-A box occupies the same region of space at (α, β) and (α + P, β) when the rotation by P
-about the palm normal, applied after the placement at (0, β), maps the placed box onto
-itself (it is one of the box's symmetries). With ``rotation_order: alpha_then_beta``
+An object occupies the same region of space at (α, β) and (α + P, β) when the rotation by P
+about the palm normal, applied after the placement at (0, β), maps the placed object onto
+itself (it is one of its shape's symmetries, ``Shape.same_region``). For a box: With ``rotation_order: alpha_then_beta``
 (R = R_z(β)·R_n(α)·R_0) the condition does not depend on β: the α-rotation acts on the box
 before β, so P must be a symmetry of R_0·box about the palm normal — 180° for any box
 whose edge lies along the palm normal, 90° if the face toward the palm is square. With
@@ -32,37 +32,23 @@ _CANDIDATES_DEG = (90.0, 120.0, 180.0)
 _DEG_TOL = 1e-6
 
 
-def _corners(center: NDArray, rotation: NDArray, half: NDArray) -> NDArray:
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
-    return center + (signs * half) @ rotation.T
-
-
-def _same_region(a: NDArray, b: NDArray, tol: float) -> bool:
-    """Two boxes' corner sets (8 × 3, mm) are the same set within tol (mm)."""
-    d = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2)
-    return bool((d.min(axis=1) <= tol).all() and (d.min(axis=0) <= tol).all())
-
-
-def alpha_period_deg(placement, size_mm: Sequence[float], palm_normal: Sequence[float] = (1.0, 0.0, 0.0)) -> float:
-    """Smallest P in {90, 120, 180} deg such that the box at (α + P, β) fills the same
+def alpha_period_deg(placement, shape, palm_normal: Sequence[float] = (1.0, 0.0, 0.0)) -> float:
+    """Smallest P in {90, 120, 180} deg such that the object at (α + P, β) fills the same
     region as at (α, β) for every β of the placement's grid; 360 if none.
 
-    ``placement`` is a :class:`synergrasp.simulation.placement.Placement` (centre, box axes,
-    rotation order, grid); ``size_mm`` the box's edges (mm); ``palm_normal`` the hand's palm
-    normal (the α axis).
+    ``placement`` is a :class:`synergrasp.simulation.placement.Placement` (centre, starting
+    axes, rotation order, grid); ``shape`` a :class:`synergrasp.simulation.shapes.Shape`;
+    ``palm_normal`` the hand's palm normal (the α axis).
     """
     from synergrasp.simulation.placement import object_pose, pose_grid
 
-    size = np.asarray(size_mm, dtype=float)
-    tol = 1e-9 * float(size.max()) + 1e-12
     betas = pose_grid(placement).beta_deg
     for period in _CANDIDATES_DEG:
         ok = True
         for beta in betas:
-            here = object_pose(placement, size, 0.0, float(beta), palm_normal)
-            there = object_pose(placement, size, period, float(beta), palm_normal)
-            if not _same_region(_corners(here.center_mm, here.rotation, here.half_extents_mm),
-                                _corners(there.center_mm, there.rotation, there.half_extents_mm), tol):
+            here = object_pose(placement, shape, 0.0, float(beta), palm_normal)
+            there = object_pose(placement, shape, period, float(beta), palm_normal)
+            if not shape.same_region(here.rotation, here.center_mm, there.rotation, there.center_mm):
                 ok = False
                 break
         if ok:
@@ -73,14 +59,16 @@ def alpha_period_deg(placement, size_mm: Sequence[float], palm_normal: Sequence[
 def object_periods(objects: Mapping[str, Mapping[str, Any]], grid: Mapping[str, Any],
                    hand: str | None = None) -> dict[str, float]:
     """α-period (deg) of every object from the config: ``objects`` maps a name to its
-    ``size_mm`` and effective ``placement`` (the global placement with its override),
+    ``shape`` and effective ``placement`` (the global placement with its override),
     ``grid`` is the config's grid block, ``hand`` the hand file (None: the shipped hand,
     whose palm normal is the α axis)."""
     from synergrasp.config import placement_params
     from synergrasp.hand.kinematics import load_hand
+    from synergrasp.simulation.shapes import shape_from_config
 
     normal = load_hand(hand).palm_normal
-    return {name: alpha_period_deg(placement_params(spec["placement"], grid), spec["size_mm"], normal)
+    return {name: alpha_period_deg(placement_params(spec["placement"], grid),
+                                   shape_from_config(spec["shape"], f"objects.{name}.shape"), normal)
             for name, spec in objects.items()}
 
 

@@ -42,10 +42,25 @@ def _k_column(table2: pd.DataFrame, k: int) -> pd.Series:
     return pd.Series(dtype=float)
 
 
-def _single_rate(success_rates: pd.DataFrame, synergy: int) -> float:
-    """Success rate (%) of the set {S<synergy>} alone, averaged over objects; NaN if absent."""
+def _single_rate(success_rates: pd.DataFrame, synergy: int, view: str = "per_object") -> float:
+    """Success rate (%) of the set {S<synergy>} alone, averaged over objects in ``view`` (its
+    row of the table; a table without view rows: the mean over objects); NaN if absent."""
     rows = success_rates[success_rates["set_id"].astype(str) == str(synergy)]
+    if "view" in rows.columns:
+        chosen = rows[rows["view"] == view]
+        if len(chosen):
+            return float(chosen["success_rate"].iloc[0])
+        rows = rows[rows["view"] == "object"]
     return float(rows["success_rate"].mean()) if len(rows) else np.nan
+
+
+def _interval(claim: pd.Series) -> str:
+    """A claim row's compared difference with its interval, in the row's unit."""
+    if "difference" not in claim.index or not np.isfinite(claim["difference"]):
+        return "—"
+    scale = np.exp if claim.get("unit") == "log force ratio" else (lambda v: v)
+    name = "force ratio" if claim.get("unit") == "log force ratio" else "pp"
+    return f"{scale(claim['difference']):.3g} [{scale(claim['low']):.3g}, {scale(claim['high']):.3g}] {name}"
 
 
 def _preservation_share(preservation: pd.DataFrame) -> float:
@@ -59,12 +74,22 @@ def _preservation_share(preservation: pd.DataFrame) -> float:
 
 
 def scenario_row(name: str, tables: ScenarioTables) -> dict[str, object]:
-    """One scenario's summary: per claim its verdict and the figure behind it; Table II at
-    k = 1, 2, 3 per object; S1..S7 alone (mean over objects); minima preserved (%)."""
+    """One scenario's summary: per claim its headline verdict, the compared difference with its
+    interval, the reason, the other view's verdict and the figures behind it; Table II at
+    k = 1, 2, 3 per object; S1..S7 alone (the study's view); minima preserved (%)."""
     row: dict[str, object] = {"scenario": name}
-    for claim in tables.claims.itertuples(index=False):
-        row[f"claim{claim.claim}_verdict"] = claim.verdict
-        row[f"claim{claim.claim}_measured"] = claim.measured
+    claims = tables.claims
+    headline = claims[claims["headline"].astype(bool)] if "headline" in claims.columns else claims
+    for _, claim in headline.iterrows():
+        n = claim["claim"]
+        row[f"claim{n}_verdict"] = claim["verdict"]
+        if "difference" in claim.index:
+            row[f"claim{n}_interval"] = _interval(claim)
+            row[f"claim{n}_reason"] = claim["reason"]
+            other = claims[(claims["claim"] == n) & (claims["view"] != claim["view"])]
+            if len(other):
+                row[f"claim{n}_{other['view'].iloc[0]}_verdict"] = other["verdict"].iloc[0]
+        row[f"claim{n}_measured"] = claim["measured"]
     for k in TABLE2_ROWS:
         column = _k_column(tables.table2, k)
         for obj, rate in column.items():

@@ -13,9 +13,11 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from synergrasp.analysis.chance import preservation_vs_chance
-from synergrasp.analysis.claims import claims_table
+from synergrasp.analysis.bootstrap import BootstrapSettings, PoseResampler
+from synergrasp.analysis.chance import preservation_vs_chance, resampled_preservation
+from synergrasp.analysis.claims import VerdictRules, claims_table
 from synergrasp.analysis.forces import force_summary
+from synergrasp.analysis.intervals import VIEWS, StudyCounts
 from synergrasp.analysis.invariants import invariant_checks
 from synergrasp.analysis.minima import preserved
 from synergrasp.analysis.periods import distinct_pose_mask
@@ -26,6 +28,9 @@ __all__ = [
     "AnalysisSettings",
     "success_rates",
     "mean_over_objects",
+    "with_intervals",
+    "object_rows",
+    "hierarchy_input",
     "incrementality_table",
     "hierarchy_matrices",
     "minimum_preservation",
@@ -60,6 +65,7 @@ class AnalysisSettings:
     radius_deg: neighbourhood half-width of the local minima, deg.
     null_draws, null_seed: draws and seed of the preservation null model.
     success_rate_tolerance_percent: a success rate above 100 % by more than this stops the run.
+    bootstrap: the block bootstrap's settings. rules: tie band, least distinct poses, headline view.
     weights_N: object → weight m·g, N. periods_deg: object → α-period, deg.
     """
 
@@ -69,6 +75,8 @@ class AnalysisSettings:
     null_draws: int
     null_seed: int
     success_rate_tolerance_percent: float
+    bootstrap: BootstrapSettings
+    rules: VerdictRules
     weights_N: Mapping[str, float] = field(default_factory=dict)
     periods_deg: Mapping[str, float] = field(default_factory=dict)
 
@@ -83,11 +91,15 @@ def _rate_columns(table: pd.DataFrame, column: str, full_set_id: str) -> pd.Data
 
 
 #: Columns of the success-rates table, in order (docs/analyses.md).
-RATE_COLUMNS = ("object", "set_id", "n_synergies", "n_poses", "n_success", "success_rate", "full_set_empty",
-                "absolute_share", "success_rate_force_closure", "success_rate_load_feasible", "n_success_distinct",
-                "success_rate_distinct", "n_marginal", "marginal_percent", "force_ratio_median",
+RATE_COLUMNS = ("object", "view", "set_id", "n_synergies", "n_poses", "n_success", "success_rate",
+                "success_rate_low", "success_rate_high", "full_set_empty", "n_success_grid", "success_rate_grid",
+                "absolute_share", "success_rate_force_closure", "success_rate_load_feasible",
+                "success_rate_force_closure_bounded", "above_bound_percent", "n_marginal", "marginal_percent",
+                "force_ratio_median", "force_ratio_low", "force_ratio_high", "n_force_poses",
                 "force_ratio_median_non_marginal", "n_ratio_undefined", "plain_mean_force_N", "plain_median_force_N",
-                "plain_mean_force_non_marginal_N", "plain_median_force_non_marginal_N")
+                "plain_mean_force_non_marginal_N", "plain_median_force_non_marginal_N", "n_objects")
+#: The ``view`` of a row of one object.
+OBJECT_VIEW = "object"
 
 
 def _distinct_poses(table: pd.DataFrame, periods_deg: Mapping[str, float]) -> NDArray[np.bool_]:
@@ -100,38 +112,91 @@ def _distinct_poses(table: pd.DataFrame, periods_deg: Mapping[str, float]) -> ND
 
 
 def success_rates(table: pd.DataFrame, full_set_id: str, periods_deg: Mapping[str, float] | None = None) -> pd.DataFrame:
-    """Success rates under both verdicts, per distinct pose, and force statistics, per object and set.
+    """Success rates per distinct pose under every verdict, and force statistics, per object and set.
 
     ``table``: a gfo table with the columns of :func:`synergrasp.analysis.verdicts.with_verdicts`;
     ``periods_deg``: α-period per object (360 if absent). Returns one row per (object,
-    set_id) with the columns ``RATE_COLUMNS`` (docs/analyses.md): the normalised rate
-    (percent of the full set's successes; NaN where the full set has none) under the
-    verdict in use, under each verdict and per distinct pose, and the columns of
-    :func:`synergrasp.analysis.forces.force_summary`.
+    set_id) with the columns ``RATE_COLUMNS`` (docs/analyses.md; view ``object``): counts and
+    the normalised rate (percent of the full set's successes; NaN where the full set has
+    none) per distinct pose (α in one period) under the verdict in use, under each verdict,
+    the same per grid pose, and the columns of :func:`synergrasp.analysis.forces.force_summary`.
+    The interval columns are NaN here (:func:`with_intervals` fills them).
     """
     _require(table, "gfo table", ("object", "set_id", "n_synergies", "pose", "alpha_deg", "success",
                                   "verdict_force_closure", "verdict_load_feasible", "success_force"))
     present = sorted(table["set_id"].unique(), key=lambda s: (len(s.split("-")), s))
     if full_set_id not in present:
         raise ValueError(f"full_set_id {full_set_id!r} is not in the gfo table; allowed values: {present}")
-    work = table.assign(success_distinct=table["success"].astype(bool) & _distinct_poses(table, periods_deg or {}))
+    distinct = _distinct_poses(table, periods_deg or {})
+    bounded = table.get("verdict_force_closure_bounded", table["verdict_force_closure"]).astype(bool)
+    work = table.assign(**{f"{c}_d": table[c].astype(bool) & distinct for c in
+                           ("success", "verdict_force_closure", "verdict_load_feasible")},
+                        bounded_d=bounded & distinct, one_d=distinct,
+                        fc_above=table["verdict_force_closure"].astype(bool) & ~bounded)
     keys = ["object", "set_id"]
-    out = work.groupby(keys, sort=False).agg(n_synergies=("n_synergies", "first"),
-                                             n_poses=("success", "size")).reset_index()
-    for name, column in (("", "success"), ("_force_closure", "verdict_force_closure"),
-                         ("_load_feasible", "verdict_load_feasible"), ("_distinct", "success_distinct")):
+    out = work.groupby(keys, sort=False).agg(n_synergies=("n_synergies", "first"), n_poses=("one_d", "sum"),
+                                             n_grid=("success", "size"), n_fc=("verdict_force_closure", "sum"),
+                                             n_above=("fc_above", "sum")).reset_index()
+    for name, column in (("", "success_d"), ("_grid", "success"), ("_force_closure", "verdict_force_closure_d"),
+                         ("_load_feasible", "verdict_load_feasible_d"), ("_force_closure_bounded", "bounded_d")):
         rates = _rate_columns(work, column, full_set_id)
         out = out.merge(rates.rename(columns={"n": f"n_success{name}", "rate": f"success_rate{name}"}), on=keys)
     out["full_set_empty"] = out["success_rate"].isna()
     out["absolute_share"] = 100.0 * out["n_success"] / out["n_poses"]
+    out["above_bound_percent"] = 100.0 * out["n_above"] / out["n_fc"].where(out["n_fc"] > 0)
     out = out.merge(force_summary(table, full_set_id).drop(columns="n_success"), on=keys)
+    out = out.assign(view=OBJECT_VIEW, success_rate_low=np.nan, success_rate_high=np.nan, force_ratio_low=np.nan,
+                     force_ratio_high=np.nan, n_force_poses=pd.NA, n_objects=1)
     out = out.sort_values(keys, key=lambda c: set_sort_key(c) if c.name == "set_id" else c, ignore_index=True)
-    return out[list(RATE_COLUMNS)].astype({c: "int64" for c in ("n_poses", "n_success", "n_success_distinct")})
+    return out[list(RATE_COLUMNS)].astype({c: "int64" for c in ("n_poses", "n_success", "n_success_grid")})
+
+
+def with_intervals(rates: pd.DataFrame, counts: StudyCounts) -> pd.DataFrame:
+    """The success-rates table with each object's rate interval filled and, per set, one
+    row per view of "averaged over objects" (object ``all``, view ``per_object`` or
+    ``pooled``): the view's rate with its interval, the successes summed over objects, and
+    the force ratio to the full set (per_object: mean over objects of the per-object
+    medians, the study's; pooled: the median over every object's successes, like with like,
+    with its interval and the number of those distinct poses)."""
+    out = rates.copy()
+    for i, r in enumerate(out.itertuples()):
+        if r.object in counts.objects and counts.has(r.set_id):
+            _, low, high = counts.estimate_interval(counts.object_rate(r.object, r.set_id))
+            out.iat[i, out.columns.get_loc("success_rate_low")] = low
+            out.iat[i, out.columns.get_loc("success_rate_high")] = high
+    means = mean_over_objects(rates).set_index("set_id")
+    summed = rates.groupby("set_id", sort=False)[["n_poses", "n_success", "n_success_grid", "n_marginal"]].sum()
+    views = []
+    for sid in means.index:
+        for view in VIEWS:
+            rate, low, high = counts.estimate_interval(counts.rate(sid, view))
+            row = {"object": ALL_OBJECTS, "view": view, "set_id": sid, "n_synergies": means.at[sid, "n_synergies"],
+                   **summed.loc[sid].to_dict(), "success_rate": rate, "success_rate_low": low,
+                   "success_rate_high": high, "n_objects": means.at[sid, "n_objects"],
+                   "full_set_empty": not np.isfinite(rate)}
+            if view == "per_object":
+                row.update({c: means.at[sid, c] for c in AVERAGED if c in means.columns and c != "success_rate"})
+            else:
+                ratio, n = counts.pooled_ratio_to_full(sid)
+                est, low, high = counts.estimate_interval(ratio)
+                row.update(force_ratio_median=est, force_ratio_low=low, force_ratio_high=high, n_force_poses=n,
+                           absolute_share=100.0 * row["n_success"] / row["n_poses"] if row["n_poses"] else np.nan,
+                           marginal_percent=100.0 * row["n_marginal"] / row["n_success_grid"]
+                           if row["n_success_grid"] else np.nan)
+            views.append(row)
+    out = pd.concat([out, pd.DataFrame(views)], ignore_index=True)
+    return out[list(RATE_COLUMNS)].astype({"n_force_poses": "Int64"})
+
+
+def object_rows(rates: pd.DataFrame) -> pd.DataFrame:
+    """The rows of one object each (``view`` ``object``) of a success-rates table."""
+    return rates[rates["view"] == OBJECT_VIEW] if "view" in rates.columns else rates
 
 
 #: Columns of the success-rates table averaged over objects (mean_over_objects, Fig. 5).
-AVERAGED = ("success_rate", "success_rate_force_closure", "success_rate_load_feasible", "absolute_share",
-            "marginal_percent", "force_ratio_median", "force_ratio_median_non_marginal", "plain_mean_force_N")
+AVERAGED = ("success_rate", "success_rate_grid", "success_rate_force_closure", "success_rate_load_feasible",
+            "success_rate_force_closure_bounded", "above_bound_percent", "absolute_share", "marginal_percent",
+            "force_ratio_median", "force_ratio_median_non_marginal", "plain_mean_force_N")
 
 
 def mean_over_objects(rates: pd.DataFrame) -> pd.DataFrame:
@@ -139,6 +204,7 @@ def mean_over_objects(rates: pd.DataFrame) -> pd.DataFrame:
     where each is defined (NaN entries skipped), and n_objects (objects in the average of
     success_rate)."""
     _require(rates, "rates table", ("set_id", "n_synergies", "success_rate"))
+    rates = object_rows(rates)
     rates = rates.assign(set_id=rates["set_id"].astype(str))  # a CSV round trip may read "1" as 1
     present = [c for c in AVERAGED if c in rates.columns]
     grouped = rates.groupby("set_id", sort=False)
@@ -157,10 +223,32 @@ def incrementality_table(rates: pd.DataFrame, k_max: int) -> pd.DataFrame:
     _require(rates, "rates table", ("object", "set_id", "success_rate"))
     if not (isinstance(k_max, (int, np.integer)) and k_max >= 1):
         raise ValueError(f"k_max must be an integer >= 1; got {k_max!r}")
+    rates = object_rows(rates)
     wide = rates.pivot(index="object", columns="set_id", values="success_rate")
     table = pd.DataFrame({k: wide.get(incremental_set_id(k), pd.Series(np.nan, index=wide.index))
                           for k in range(1, k_max + 1)}, index=wide.index)
     return table.reset_index().rename_axis(columns=None)
+
+
+#: The hierarchy table's values per set (docs/analyses.md).
+HIERARCHY_VALUES = ("success_rate", "success_rate_low", "success_rate_high", "success_rate_pooled",
+                    "success_rate_pooled_low", "success_rate_pooled_high", "force_ratio_median", "force_ratio_low",
+                    "force_ratio_high", "n_force_poses", "plain_mean_force_N")
+
+
+def hierarchy_input(rates: pd.DataFrame) -> pd.DataFrame:
+    """One row per set from the view rows of a success-rates table (:func:`with_intervals`):
+    the per-object view's rate and interval, the pooled view's (``success_rate_pooled``...),
+    the pooled like-with-like force ratio to the full set with its interval and count, and the
+    per-object mean of the plain mean force."""
+    per = rates[rates["view"] == "per_object"].set_index("set_id")
+    pooled = rates[rates["view"] == "pooled"].set_index("set_id")
+    out = per[["n_synergies", "success_rate", "success_rate_low", "success_rate_high", "plain_mean_force_N"]].copy()
+    for c in ("success_rate", "success_rate_low", "success_rate_high"):
+        out[c.replace("success_rate", "success_rate_pooled")] = pooled[c]
+    for c in ("force_ratio_median", "force_ratio_low", "force_ratio_high", "n_force_poses"):
+        out[c] = pooled[c].astype(float)
+    return out.reset_index()
 
 
 def hierarchy_matrices(rates_mean_over_objects: pd.DataFrame, first: int = 7,
@@ -306,6 +394,8 @@ def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
     first_n = incremental_set_id(first)
     table = with_verdicts(gfo, settings.success, settings.weights_N, settings.marginal_weight_multiple)
     periods = dict(settings.periods_deg)
+    resampler = PoseResampler(table[table["set_id"] == full], periods, settings.bootstrap)
+    counts = StudyCounts(table, full, resampler)
     rates = success_rates(table, full, periods)
     checks = invariant_checks(table, rates, periods, settings.success_rate_tolerance_percent)
     lost = (full_but_not_first7(table, full, first_n) if first_n in set(table["set_id"]) else None)
@@ -313,17 +403,20 @@ def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
                                            settings.null_draws, settings.null_seed)
     preservation = minimum_preservation(table, minima, k_max, settings.radius_deg, periods)
     preservation = preservation.merge(pairs.astype({"k": "Int64"}), on=["object", "k"], how="left")
-    means = mean_over_objects(rates)
     table2 = incrementality_table(rates, table2_k_max)
-    claims = claims_table(incrementality_table(rates, first), None if lost is None else len(lost), chance, means,
-                          rates, first)
+    rates = with_intervals(rates, counts)
+    kept = resampled_preservation(minima, k_max, settings.radius_deg, resampler)
+    claims = claims_table(counts, kept, chance, settings.rules, first)
     verdict = f"success = {settings.success}"
+    level = f"{100 * settings.bootstrap.level:g} % intervals: block bootstrap over distinct poses"
     return {
-        "success_rates": (f"Success rates (both verdicts) and forces per object and synergy set; {verdict}", rates),
-        "table2_success_rates": (f"Table II: success rate (%) with {{S1..Sk}}, k = 1..{table2_k_max}; {verdict}",
-                                 table2),
-        "hierarchy": (f"Hierarchy: sets {{S_k, S_i, S_j}} of the first {first} synergies, mean over objects; {verdict}",
-                      hierarchy_matrices(means, first)),
+        "success_rates": (f"Success rates per distinct pose (every verdict) and forces per object and synergy set, "
+                          f"and averaged over objects in both views; {level}; {verdict}", rates),
+        "table2_success_rates": (f"Table II: success rate (%, per distinct pose) with {{S1..Sk}}, "
+                                 f"k = 1..{table2_k_max}; {verdict}", table2),
+        "hierarchy": (f"Hierarchy: sets {{S_k, S_i, S_j}} of the first {first} synergies, averaged over objects "
+                      f"(per-object and pooled views); {level}; {verdict}",
+                      hierarchy_matrices(hierarchy_input(rates), first, HIERARCHY_VALUES)),
         "minimum_preservation": (f"Local minima of {{S1..Sk}} preserved in {{S1..Sk+1}}; {verdict}", preservation),
         "preservation_vs_chance": (f"Minimum preservation against the null model ({settings.null_draws} draws, "
                                    f"seed {settings.null_seed}); {verdict}", chance),
@@ -334,5 +427,6 @@ def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
         "verdict_disagreements": ("Force closure (Definition 1) vs feasibility under the weight",
                                   verdict_disagreements(table)),
         "invariant_checks": ("The pipeline's invariant checks on this run", checks),
-        "claims": (f"The study's claims tested on this run; {verdict}", claims),
+        "claims": (f"The study's claims tested on this run, one row per view (headline first); {level}; "
+                   f"{verdict}", claims),
     }

@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 
+import numpy as np
 import pandas as pd
 
 __all__ = ["VERDICTS", "verdict_columns", "with_verdicts"]
@@ -49,15 +50,44 @@ def verdict_columns(gfo: pd.DataFrame) -> pd.DataFrame:
                         index=gfo.index)
 
 
+def force_lower_bound(table: pd.DataFrame, rows: np.ndarray) -> np.ndarray:
+    """For the ``rows`` (bool mask) of a gfo table, a lower bound of the optimal force (N):
+    the largest optimal force of any computed superset of the row's set at the same object
+    and pose (a superset reaches every internal force the set reaches, so its minimum is no
+    larger); NaN elsewhere or without such a superset."""
+    bound = np.full(len(table), np.nan)
+    if not rows.any():
+        return bound
+    groups = table.groupby(["object", "pose"], sort=False).indices
+    set_ids, forces = table["set_id"].astype(str).to_numpy(), table["force_norm"].to_numpy(float)
+    for i in np.flatnonzero(rows):
+        here = groups[(table["object"].iat[i], table["pose"].iat[i])]
+        members = frozenset(set_ids[i].split("-"))
+        bigger = np.array([members < frozenset(set_ids[j].split("-")) for j in here], dtype=bool)
+        found = forces[here[bigger]]
+        bound[i] = np.nanmax(found) if np.isfinite(found).any() else np.nan
+    return bound
+
+
 def with_verdicts(gfo: pd.DataFrame, success: str,
                   weights_N: Mapping[str, float] | None = None, marginal_multiple: float = math.inf) -> pd.DataFrame:
     """A copy of the gfo table with the analysis columns added.
 
-    Columns added: ``verdict_force_closure``, ``verdict_load_feasible`` (bool, see the
-    module docstring); ``success`` (the one picked by ``success``); ``success_force``
+    Force closure without an optimal force under the weight cannot happen in exact
+    arithmetic; where the optimal force of a computed superset at the same pose
+    (``force_lower_bound_N``) already exceeds ``marginal_multiple`` × the weight, the
+    optimisation left a force beyond the solver's accuracy undecided (the cvxpy reference
+    finds 0.2–1.3 MN at the default study's nine such rows): the row is reclassified
+    load-feasible, never bounded, and flagged ``force_beyond_solver``. Other such rows stay
+    as they are (the invariant checks count them).
+
+    Columns added: ``verdict_force_closure``, ``verdict_load_feasible``,
+    ``verdict_force_closure_bounded`` (bool, see the module docstring; without weights the
+    bound is not applied); ``success`` (the one picked by ``success``); ``success_force``
     (optimal ‖f‖₂ in N under the weight where ``success``, NaN elsewhere); ``marginal``
-    (success and success_force > marginal_multiple × weight; False when ``weights_N`` is
-    None or lacks the object).
+    (success and success_force > marginal_multiple × weight, or no optimal force; False
+    when ``weights_N`` is None or lacks the object); ``force_lower_bound_N``,
+    ``force_beyond_solver`` (above).
 
     Parameters
     ----------
@@ -72,16 +102,20 @@ def with_verdicts(gfo: pd.DataFrame, success: str,
     verdicts = verdict_columns(gfo)
     out = gfo.copy()
     out["verdict_force_closure"] = verdicts["force_closure"]
-    out["verdict_load_feasible"] = verdicts["load_feasible"]
     weight = out["object"].map(dict(weights_N or {})).astype(float)
-    above = (out["force_norm"] > marginal_multiple * weight).fillna(False).astype(bool)
+    unresolved = verdicts["force_closure"] & ~np.isfinite(out["force_norm"].to_numpy(float))
+    out["force_lower_bound_N"] = force_lower_bound(out, unresolved.to_numpy(bool))
+    out["force_beyond_solver"] = unresolved & (out["force_lower_bound_N"] > marginal_multiple * weight).fillna(False)
+    out["verdict_load_feasible"] = verdicts["load_feasible"] | out["force_beyond_solver"]
+    above = (out["force_norm"] > marginal_multiple * weight).fillna(False).astype(bool) | (unresolved & weight.notna())
     if success == "force_closure_bounded":
         if weights_N is None or weight.isna().any() or not math.isfinite(marginal_multiple):
             raise ValueError("success 'force_closure_bounded' needs every object's weight and a finite "
                              "marginal_multiple (config analyses.marginal_weight_multiple)")
         out["success"] = verdicts["force_closure"] & ~above
     else:
-        out["success"] = verdicts[success]
+        out["success"] = out[f"verdict_{success}"]
+    out["verdict_force_closure_bounded"] = verdicts["force_closure"] & ~above
     out["success_force"] = out["force_norm"].where(out["success"])
     out["marginal"] = out["success"] & above
     return out

@@ -14,8 +14,8 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from synergrasp.analysis.realism import SIMULATED_STATUSES, representative_grasps
-from synergrasp.figures.hand_pictures import (BOX, PALM_CAMERA, SKIN, TOUCHING, BoxInPicture, Camera, box_corners,
-                                              hand_shapes, render)
+from synergrasp.figures.hand_pictures import (BOX, PALM_CAMERA, SKIN, TOUCHING, Camera, ShapeInPicture, hand_shapes,
+                                              render)
 from synergrasp.figures.output import save_figure
 from synergrasp.hand.synergies import SynergyPath
 
@@ -55,21 +55,22 @@ def _palm_point(hand: Any) -> NDArray:
     if not boxes:
         return np.zeros(3)
     normal = np.asarray(hand.palm_normal, dtype=float)
-    front = [np.asarray(b.center_mm) + (np.abs(np.asarray(b.rotation).T @ normal) @ (np.asarray(b.size_mm) / 2.0)) * normal
+    front = [np.asarray(b.center_mm) + (np.abs(np.asarray(b.rotation).T @ normal) @ b.shape.half_extents_mm) * normal
              for b in boxes]
     return max(front, key=lambda p: float(p @ normal))
 
 
-def _fit(camera: Camera, hand: Any, postures: Sequence[NDArray], boxes: Sequence[BoxInPicture] = ()) -> Camera:
-    """``camera`` centred on and sized to the hand at every posture and the boxes."""
+def _fit(camera: Camera, hand: Any, postures: Sequence[NDArray], objects: Sequence[ShapeInPicture] = ()) -> Camera:
+    """``camera`` centred on and sized to the hand at every posture and the objects."""
     points, radii = [], []
     for q in postures:
         p, r = hand_shapes(hand, q).extent()
         points.append(p)
         radii.append(r)
-    for box in boxes:
-        points.append(box_corners(box))
-        radii.append(np.zeros(8))
+    for obj in objects:
+        p, r = obj.extent()
+        points.append(p)
+        radii.append(r)
     return camera.fitted(np.vstack(points), np.concatenate(radii))
 
 
@@ -164,9 +165,9 @@ def _touching_words(hand: Any, links: Sequence[int]) -> str:
     return "\n".join(textwrap.wrap("touching: " + ", ".join(parts), 48))
 
 
-def _box_of(row: pd.Series, size_mm: ArrayLike) -> BoxInPicture:
-    return BoxInPicture(np.asarray(size_mm, dtype=float), np.asarray(row["object_center"], dtype=float),
-                        np.asarray(row["object_rotation"], dtype=float).reshape(3, 3))
+def _object_of(row: pd.Series, shape: Any) -> ShapeInPicture:
+    return ShapeInPicture(shape, np.asarray(row["object_center"], dtype=float),
+                          np.asarray(row["object_rotation"], dtype=float).reshape(3, 3))
 
 
 def _legend(fig: Any) -> None:
@@ -174,42 +175,43 @@ def _legend(fig: Any) -> None:
     from matplotlib.patches import Patch
 
     handles = [Patch(facecolor=SKIN, edgecolor="0.2", label="hand"),
-               Patch(facecolor=TOUCHING, edgecolor="0.2", label="link touching the box"),
-               Patch(facecolor=BOX, edgecolor="#1f3f7a", alpha=0.5, label="box (see-through)"),
+               Patch(facecolor=TOUCHING, edgecolor="0.2", label="link touching the object"),
+               Patch(facecolor=BOX, edgecolor="#1f3f7a", alpha=0.5, label="object (see-through)"),
                Line2D([], [], ls="", marker="o", color=_CONTACT, markeredgecolor="white", label="contact point"),
                Line2D([], [], ls="", marker="o", markerfacecolor="none", color=_CONTACT,
                       label="contact point behind the hand")]
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
 
 
-def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.DataFrame], png_path: str | Path,
+def figure_example_grasps(hand: Any, objects: Sequence[Any], tables: Sequence[pd.DataFrame], png_path: str | Path,
                           pdf_path: str | Path, n_grasps: int = 3, camera: Camera = PALM_CAMERA) -> None:
-    """Fig. 2: representative simulated grasps, one row per box, chosen by rule
+    """Fig. 2: representative simulated grasps, one row per object, chosen by rule
     (``synergrasp.analysis.realism.representative_grasps``: the most common set of touching
     links, the most common one at the typical contact count, the next most common), each at
-    its pose nearest (α, β) = (0, 0), all in the view of Fig. 1. ``tables[i]`` is the contacts
-    table of ``boxes[i]``.
-    Links touching the box are highlighted, contact points are dots (hollow where the hand
-    hides them); the box is see-through.
+    its pose nearest (α, β) = (0, 0), all in the view of Fig. 1. ``objects`` are
+    ``synergrasp.simulation.objects.GraspedObject``; ``tables[i]`` is the contacts table of
+    ``objects[i]``.
+    Links touching the object are highlighted, contact points are dots (hollow where the
+    hand hides them); the object is see-through.
     """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    if len(boxes) != len(tables):
-        raise ValueError(f"boxes and tables must have the same length, got {len(boxes)} and {len(tables)}")
+    if len(objects) != len(tables):
+        raise ValueError(f"objects and tables must have the same length, got {len(objects)} and {len(tables)}")
     panel = 2.6  # inches
-    fig, axes = plt.subplots(len(boxes), n_grasps, figsize=(panel * n_grasps + 0.5, panel * len(boxes) + 0.9),
+    fig, axes = plt.subplots(len(objects), n_grasps, figsize=(panel * n_grasps + 0.5, panel * len(objects) + 0.9),
                              squeeze=False)
-    for r, (box, table) in enumerate(zip(boxes, tables)):
+    for r, (obj, table) in enumerate(zip(objects, tables)):
         chosen = representative_grasps(table, n_grasps)
         simulated = int(table["status"].isin(SIMULATED_STATUSES).sum())
         rows = [table[table["pose"] == pose].iloc[0] for pose in chosen["pose"]]
         row_camera = _fit(camera, hand, [np.asarray(row["q"], dtype=float) for row in rows],
-                          [_box_of(row, box.size_mm) for row in rows]) if rows else camera
+                          [_object_of(row, obj.shape) for row in rows]) if rows else camera
         pictures, thumbs = [], []
-        axes[r, 0].set_ylabel(f"{box.name}\n{' × '.join(f'{v:g}' for v in box.size_mm)} mm", fontsize=10)
+        axes[r, 0].set_ylabel(f"{obj.name}\n{obj.shape.label}", fontsize=10)
         for c in range(n_grasps):
             ax = axes[r, c]
             _bare(ax)
@@ -220,7 +222,7 @@ def figure_example_grasps(hand: Any, boxes: Sequence[Any], tables: Sequence[pd.D
             pick, row = chosen.iloc[c], rows[c]
             points = np.asarray(row["contact_point"], dtype=float).reshape(-1, 3)
             picture = render(hand, np.asarray(row["q"], dtype=float), row_camera, PANEL_PX,
-                             box=_box_of(row, box.size_mm), touching=pick["pattern"])
+                             shape=_object_of(row, obj.shape), touching=pick["pattern"])
             ax.imshow(picture.rgb, interpolation="antialiased")
             pictures.append(picture)
             thumbs.append((picture, np.asarray(row["q"], dtype=float)))

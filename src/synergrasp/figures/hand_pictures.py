@@ -1,12 +1,13 @@
-"""Shaded pictures of the hand and of a box, ray-cast from the bodies the simulation uses.
+"""Shaded pictures of the hand and of an object, ray-cast from the bodies the simulation uses.
 
 The hand is what the closure collides (``synergrasp.simulation.capsules``): a capsule per
-phalanx (axis end points and radius at the posture) and the palm box; the object is its box. Every
-pixel of an orthographic camera casts a ray and the nearest exact intersection with a
-capsule or box gives its depth, surface normal and link (a z-buffer). The picture is then
-shaded (ambient + diffuse + a little specular light from the upper left of the viewer),
-outlined (dark lines wherever the link seen changes, so every phalanx stays distinct),
-the box is see-through (hand parts behind it show through, parts in front cover it), an
+phalanx (axis end points and radius at the posture) and the palm box; the object is its
+exact shape (``Shape.ray_hits``). Every pixel of an orthographic camera casts a ray and the
+nearest exact intersection with a capsule or shape gives its depth, surface normal and link
+(a z-buffer). The picture is then shaded (ambient + diffuse + a little specular light from
+the upper left of the viewer), outlined (dark lines wherever the link seen changes, so every
+phalanx stays distinct), the object is see-through (hand parts behind it show through, parts
+in front cover it; its outline where the face seen changes), an
 optional reference posture is a pale silhouette behind the hand, and everything is
 computed at ``supersample`` times the size and averaged down (smooth edges). Pure numpy:
 deterministic, no renderer, no display. Positions in the palm frame, mm.
@@ -21,17 +22,17 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Camera", "BoxInPicture", "HandShapes", "Picture", "hand_shapes", "box_corners", "render", "SKIN", "TOUCHING",
+__all__ = ["Camera", "ShapeInPicture", "HandShapes", "Picture", "hand_shapes", "render", "SKIN", "TOUCHING",
            "BOX", "PALM_CAMERA"]
 
-#: Colours (r, g, b in [0, 1]): the hand, a link touching the box, the box.
+#: Colours (r, g, b in [0, 1]): the hand, a link touching the object, the object.
 SKIN = (0.96, 0.80, 0.67)
 TOUCHING = (0.93, 0.40, 0.06)
 BOX = (0.33, 0.52, 0.85)
 _BACKGROUND = 1.0
 _GHOST = 0.87        # grey of the reference silhouette
 _OUTLINE = 0.15      # grey of the outlines
-_BOX_OPACITY = 0.42  # share of the box's own colour where it covers something
+_BOX_OPACITY = 0.42  # share of the object's own colour where it covers something
 _NO_LINK = -1
 _FAR = 1e9
 
@@ -74,12 +75,17 @@ class Camera:
 PALM_CAMERA = Camera(direction=(-1.0, 0.32, 0.22), center_mm=(10.0, -2.0, 92.0), width_mm=205.0)
 
 @dataclass(frozen=True)
-class BoxInPicture:
-    """A box: full edge lengths (mm), centre (mm, palm frame), 3 × 3 rotation (box to palm frame)."""
+class ShapeInPicture:
+    """A shape (``synergrasp.simulation.shapes``) at its centre (mm, palm frame) and 3 × 3
+    rotation (own frame to palm frame)."""
 
-    size_mm: NDArray
+    shape: Any
     center_mm: NDArray
     rotation: NDArray
+
+    def extent(self) -> tuple[NDArray, NDArray]:
+        """Points (k, 3) and radii (k,) whose spheres cover it (``Shape.extent``)."""
+        return self.shape.extent(np.asarray(self.rotation, dtype=float), np.asarray(self.center_mm, dtype=float))
 
 
 @dataclass(frozen=True)
@@ -91,13 +97,13 @@ class HandShapes:
     ends: NDArray
     radius: NDArray
     link: NDArray
-    boxes: tuple[BoxInPicture, ...]
+    boxes: tuple[ShapeInPicture, ...]
 
     def extent(self) -> tuple[NDArray, NDArray]:
         """Points (k, 3) and radii (k,) whose spheres cover every shape (for ``Camera.fitted``)."""
-        corners = [box_corners(b) for b in self.boxes]
-        points = np.vstack([self.ends.reshape(-1, 3), *corners]) if corners else self.ends.reshape(-1, 3)
-        radii = np.concatenate([np.repeat(self.radius, 2), np.zeros(8 * len(corners))])
+        parts = [b.extent() for b in self.boxes]
+        points = np.vstack([self.ends.reshape(-1, 3), *[p for p, _ in parts]])
+        radii = np.concatenate([np.repeat(self.radius, 2), *[r for _, r in parts]])
         return points, radii
 
 
@@ -105,10 +111,11 @@ def hand_shapes(hand: Any, q: NDArray) -> HandShapes:
     """The shapes the closure collides (``synergrasp.simulation.capsules.HandCapsules``) at
     joint angles q (rad)."""
     from synergrasp.simulation.capsules import HandCapsules
+    from synergrasp.simulation.shapes import Box
 
     capsules = HandCapsules.of(hand)
     start, end = capsules.segments(np.asarray(q, dtype=float))
-    boxes = tuple(BoxInPicture(2.0 * half, centre, rotation) for rotation, centre, half
+    boxes = tuple(ShapeInPicture(Box(tuple(2.0 * half)), centre, rotation) for rotation, centre, half
                   in zip(capsules.palm_rotation, capsules.palm_centre, capsules.palm_half))
     return HandShapes(np.stack([start, end], axis=1), np.asarray(capsules.radius, dtype=float),
                       np.asarray(capsules.links, dtype=np.int64), boxes)
@@ -193,35 +200,18 @@ def _cast_capsule(rays: _Rays, a: NDArray, b: NDArray, r: float, label: int) -> 
     rays.keep(rows, cols, t, normal, label)
 
 
-def box_corners(box: BoxInPicture) -> NDArray:
-    """(8, 3) corners of a box, mm, palm frame."""
-    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
-    return (signs * np.asarray(box.size_mm, float) / 2.0) @ np.asarray(box.rotation, float).T + box.center_mm
-
-
-def _cast_box(rays: _Rays, box: BoxInPicture, label: int) -> NDArray | None:
-    """Nearest hit of every ray with the box (slabs); returns the face index (axis·2 + side)
-    hit at each pixel of the window (-1: missed), or None when the box is out of the image."""
-    corners = rays.to_image(box_corners(box))
-    win = rays.window(corners.min(axis=0) - 1.0, corners.max(axis=0) + 1.0)
+def _cast_shape(rays: _Rays, obj: ShapeInPicture, label: int) -> NDArray | None:
+    """Nearest hit of every ray with a shape (``Shape.ray_hits``); returns the face index hit
+    at each pixel of the window (-1: missed), or None when the shape is out of the image."""
+    points, radii = obj.extent()
+    px, reach = rays.to_image(points), radii[:, None] / rays.scale + 1.0
+    win = rays.window((px - reach).min(axis=0), (px + reach).max(axis=0))
     if win is None:
         return None
     rows, cols, o = win
-    rot = np.asarray(box.rotation, dtype=float)
-    half = np.asarray(box.size_mm, dtype=float) / 2.0
-    lo_ = (o - box.center_mm) @ rot  # origins in the box frame
-    d = rays.basis[2] @ rot
-    d = np.where(np.abs(d) < 1e-12, 1e-12, d)  # a ray parallel to a slab: far-away crossings
-    t1 = (-half - lo_) / d
-    t2 = (half - lo_) / d
-    t_in, t_out = np.minimum(t1, t2), np.maximum(t1, t2)
-    near, far = t_in.max(axis=-1), t_out.min(axis=-1)
-    axis = t_in.argmax(axis=-1)
-    hit = (near <= far) & (far > 0.0)
-    sign = -np.sign(d[axis])  # the entry face faces against the ray
-    normal = np.einsum("ijk,lk->ijl", np.eye(3)[axis] * sign[..., None], rot)
-    face = np.where(hit, 2 * axis + (sign > 0), -1)
-    rays.keep(rows, cols, np.where(hit, near, _FAR), normal, label)
+    rot = np.asarray(obj.rotation, dtype=float)
+    t, normal, face = obj.shape.ray_hits((o - obj.center_mm) @ rot, rays.basis[2] @ rot)  # in its own frame
+    rays.keep(rows, cols, np.where(face >= 0, t, _FAR), normal @ rot.T, label)
     full = np.full((rays.height, rays.width), -1, dtype=np.int64)
     full[rows, cols] = face
     return full
@@ -229,7 +219,7 @@ def _cast_box(rays: _Rays, box: BoxInPicture, label: int) -> NDArray | None:
 
 def _cast_hand(rays: _Rays, caps: HandShapes) -> None:
     for box in caps.boxes:
-        _cast_box(rays, box, 0)
+        _cast_shape(rays, box, 0)
     for (a, b), r, link in zip(caps.ends, caps.radius, caps.link):
         _cast_capsule(rays, a, b, float(r), int(link))
 
@@ -268,7 +258,7 @@ def _downsample(image: NDArray, k: int) -> NDArray:
 @dataclass(frozen=True)
 class Picture:
     """A rendered picture: ``rgb`` (h, w, 3) in [0, 1]; ``link`` (h, w) the hand link seen at
-    each pixel's centre in front of everything but the see-through box (-1: none)."""
+    each pixel's centre in front of everything but the see-through object (-1: none)."""
 
     rgb: NDArray
     link: NDArray
@@ -290,11 +280,11 @@ class Picture:
 
 
 def render(hand: Any, q: NDArray, camera: Camera, size_px: tuple[int, int] = (360, 360),
-           box: BoxInPicture | None = None, touching: Sequence[int] = (), ghost_q: NDArray | None = None,
+           shape: ShapeInPicture | None = None, touching: Sequence[int] = (), ghost_q: NDArray | None = None,
            supersample: int = 2) -> Picture:
     """The hand at joint angles q (rad) seen by ``camera``; ``size_px`` = (width, height).
 
-    ``box`` is drawn see-through; hand links in ``touching`` (hand link indices) get the
+    ``shape`` (the object) is drawn see-through; hand links in ``touching`` (hand link indices) get the
     highlight colour ``TOUCHING``; ``ghost_q`` (rad) is a pale silhouette behind the hand.
     """
     w, h, k = int(size_px[0]) * supersample, int(size_px[1]) * supersample, int(supersample)
@@ -314,9 +304,9 @@ def render(hand: Any, q: NDArray, camera: Camera, size_px: tuple[int, int] = (36
         rgb[pale] = _GHOST
         rgb[_edges(ghost.label >= 0) & ~on_hand] = 0.72
     rgb[_edges(rays.label)] = _OUTLINE
-    if box is not None:
+    if shape is not None:
         cover = _Rays(camera, w, h)
-        face = _cast_box(cover, box, 0)
+        face = _cast_shape(cover, shape, 0)
         if face is not None:
             front = (face >= 0) & (cover.depth < rays.depth)
             own = _shade(np.asarray(BOX), cover.normal[front], basis)

@@ -24,22 +24,25 @@ _MISSING = "#dddddd"
 
 def _claim_ids(summary: pd.DataFrame) -> list[str]:
     return [c[len("claim"):-len("_verdict")] for c in summary.columns
-            if c.startswith("claim") and c.endswith("_verdict")]
+            if c.startswith("claim") and c.endswith("_verdict") and c[len("claim"):-len("_verdict")].isdigit()]
 
 
 def figure_claims_grid(summary: pd.DataFrame, png: str | Path, pdf: str | Path) -> None:
-    """Claims (columns) × scenarios (rows), each cell coloured by the verdict and holding the
-    figure behind it (the claims table's ``measured``, wrapped)."""
+    """Claims (columns) × scenarios (rows), each cell coloured by the headline verdict and
+    holding the compared difference with its interval (the reason when undefined), or the
+    claims table's ``measured`` for a summary without intervals."""
     claims = _claim_ids(summary)
     n_rows, n_cols = len(summary), max(len(claims), 1)
     fig, ax = plt.subplots(figsize=(2.6 * n_cols + 1.8, 0.75 * n_rows + 1.2))
     for i in range(n_rows):
         for j, claim in enumerate(claims):
             verdict = summary.iloc[i][f"claim{claim}_verdict"]
-            measured = summary.iloc[i][f"claim{claim}_measured"]
+            shown = summary.iloc[i].get(f"claim{claim}_interval", summary.iloc[i][f"claim{claim}_measured"])
+            reason = summary.iloc[i].get(f"claim{claim}_reason")
             colour = VERDICT_COLOURS.get(verdict, _MISSING) if isinstance(verdict, str) else _MISSING
             ax.add_patch(plt.Rectangle((j, i), 1, 1, facecolor=colour, edgecolor="white"))
-            text = str(measured) if isinstance(measured, str) else "—"
+            text = str(shown) if isinstance(shown, str) else "—"
+            text += f"; {reason[:60]}" if isinstance(reason, str) and verdict == UNDEFINED else ""
             ax.text(j + 0.5, i + 0.5, _wrap(text, 34), ha="center", va="center", fontsize=5)
     ax.set_xlim(0, n_cols)
     ax.set_ylim(n_rows, 0)

@@ -17,7 +17,6 @@ matplotlib.use("Agg")  # headless: figures are files, never windows
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
-import seaborn as sns  # noqa: E402
 
 from synergrasp.config import incremental_set_id  # noqa: E402
 from synergrasp.figures.output import save_figure  # noqa: E402
@@ -99,7 +98,9 @@ def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: 
     β = ``beta_deg`` (nearest grid values), one line per {S1..Sk}; gaps where the pose is
     not a success of ``verdict``."""
     fig, (ax_b, ax_a) = plt.subplots(1, 2, figsize=(11, 3.8))
-    palette = sns.color_palette("viridis", len(panel_k))
+    # viridis sampled as seaborn's color_palette("viridis", n) does (importing seaborn cost
+    # the job more CPU than drawing: it imports scipy.stats)
+    palette = matplotlib.colormaps["viridis"](np.linspace(0.0, 1.0, len(panel_k) + 2)[1:-1])[:, :3]
     for colour, k in zip(palette, panel_k):
         alphas, betas, force = force_grid(gfo, incremental_set_id(k))
         ia = int(np.argmin(np.abs(((alphas - alpha_deg) + 180.0) % 360.0 - 180.0)))
@@ -133,16 +134,17 @@ NO_VALUE_COLOUR = "#b9cde5"
 
 
 def _hierarchy_panel(ax: plt.Axes, grid: np.ndarray, norm: matplotlib.colors.Normalize, fmt: str,
-                     labels: list[str]) -> matplotlib.image.AxesImage:
+                     labels: list[str], counts: np.ndarray | None = None) -> matplotlib.image.AxesImage:
     """One 7 × 7 matrix in grey (black = low, white = high), its value printed in every cell
-    ("–" where it has none)."""
+    ("–" where it has none) and, if given, the count below it."""
     cmap = matplotlib.colormaps["Greys_r"].with_extremes(bad=NO_VALUE_COLOUR)
     image = ax.imshow(np.ma.masked_invalid(grid), cmap=cmap, norm=norm)
     for (i, j), value in np.ndenumerate(grid):
         if np.isfinite(value):
             shade = float(norm(np.clip(value, norm.vmin, norm.vmax)))
-            ax.text(j, i, format(value, fmt), ha="center", va="center", fontsize=6,
-                    color="black" if shade > 0.5 else "white")
+            text = format(value, fmt) + (f"\n{int(counts[i, j])}" if counts is not None else "")
+            ax.text(j, i, text, ha="center", va="center", fontsize=6 if counts is None else 5,
+                    color="black" if shade > 0.5 else "white", linespacing=0.9)
         else:
             ax.text(j, i, "–", ha="center", va="center", fontsize=6, color="0.25")
     ax.set_xticks(range(len(labels)), labels, fontsize=7)
@@ -156,11 +158,11 @@ def _hierarchy_panel(ax: plt.Axes, grid: np.ndarray, norm: matplotlib.colors.Nor
 
 def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str, fmt: str,
                      value_range: tuple[float, float], colorbar_label: str, png: str | Path, pdf: str | Path,
-                     log_scale: bool = False) -> None:
+                     log_scale: bool = False, counts: str | None = None) -> None:
     """Fig. 5: ``first`` matrices ``first`` × ``first``, one per first synergy S_k; cell
     (i, j) of matrix k is the set {S_k, S_i, S_j}. Grey scale on the fixed ``value_range``
     (black = its low end, white = its high end; values beyond it take the end's grey), the
-    value printed in every cell.
+    value printed in every cell and, with ``counts`` (a column), that count below it.
 
     ``matrices`` has one row per (k, i, j) with 1-based columns ``k``, ``i``, ``j`` and the
     column ``value``. ``log_scale`` spaces the grey levels logarithmically.
@@ -180,8 +182,13 @@ def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str,
         k = index + 1
         sub = matrices[matrices["k"] == k]
         grid = np.full((first, first), np.nan)
-        grid[sub["i"].to_numpy() - 1, sub["j"].to_numpy() - 1] = sub[value].to_numpy(dtype=float)
-        image = _hierarchy_panel(ax, grid, norm, fmt, labels)
+        cells = (sub["i"].to_numpy() - 1, sub["j"].to_numpy() - 1)
+        grid[cells] = sub[value].to_numpy(dtype=float)
+        count_grid = None
+        if counts is not None:
+            count_grid = np.zeros((first, first))
+            count_grid[cells] = sub[counts].fillna(0).to_numpy(dtype=float)
+        image = _hierarchy_panel(ax, grid, norm, fmt, labels, count_grid)
         ax.set_title(f"first synergy S{k}", fontsize=9)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout(rect=(0, 0, 0.93, 1))

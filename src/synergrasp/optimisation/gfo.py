@@ -120,22 +120,20 @@ def _ipm_one(sol: GFOSolution, k: int, problem: GFOProblem, shrink: float | None
         if shrink is not None:
             sol.strict_internal[k] = _strict_fallback(problem, shrink, tol, max_iter)
         return
-    frames = contact_frames(problem.normals)
-    code, norm, y, iters = ipm_kernel.solve_problem(frames, problem.E, problem.f_p, problem.cone, problem.f_min, ipm,
-                                                    ALMOST_SOLVED_TOL)
-    status = _STATUS_OF_CODE[code]
+    res = ipm_kernel.solve_problem(contact_frames(problem.normals), problem.E, problem.f_p, problem.cone,
+                                   problem.cone.narrowed(shrink) if shrink is not None else None, problem.f_min, ipm,
+                                   ALMOST_SOLVED_TOL)
+    status, iters = _STATUS_OF_CODE[res.code[0]], int(res.iterations[0])
     if status == "force_closure":
-        forces = problem.f_p + problem.E @ y
-        sol.record(k, Outcome(status, norm, forces, iters, "ipm", "",
+        forces = res.forces[0]
+        sol.record(k, Outcome(status, float(res.force_norm[0]), forces, iters, "ipm", "",
                               problem.cone.violation(forces, problem.normals, problem.f_min)))
     elif status == "infeasible":
         sol.record(k, Outcome(status, float("nan"), None, iters, "ipm"))
     else:
         _fallback(sol, k, problem, tol, max_iter)
     if shrink is not None:
-        strict = problem.strict_test(shrink)
-        code = ipm_kernel.solve_problem(frames, strict.E, strict.f_p, strict.cone, strict.f_min, ipm,
-                                        ALMOST_SOLVED_TOL)[0]
+        code = res.strict_code[0]
         sol.strict_internal[k] = (code == ipm_kernel.OPTIMAL if code in (ipm_kernel.OPTIMAL, ipm_kernel.INFEASIBLE)
                                   else _strict_fallback(problem, shrink, tol, max_iter))
 
@@ -168,13 +166,15 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
 
 
 def warm_up() -> None:
-    """Compile the interior-point kernel's machine code, or load it from the cache next to
-    its source. Called once after installation (Makefile) so that no workflow job pays the
-    compilation (about two minutes of CPU time) and parallel jobs do not compile side by side.
+    """Compile the interior-point kernel's machine code, or load it from its cache
+    (`ipm.compiled.cache_dir()`: per user, named by the hash of the kernel's sources, so any
+    checkout of the same kernel loads it). Called once after installation (Makefile) so that
+    no workflow job pays the compilation (docs/measurements) and parallel jobs do not compile
+    side by side. Both entry points (`ipm_kernel.solve_problem`, `ipm_kernel.solve_sets`)
+    are one compiled function; one pose with the strict test compiles all of it.
     """
     normals = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])
     squeeze = np.array([[1.0], [0.0], [0.0], [-1.0], [0.0], [0.0]]) / np.sqrt(2.0)
-    cone = CircularCone(1.0)
-    solve_gfo([GFOProblem(np.zeros(6), squeeze, normals, 0.5, cone)], strict_shrink=1e-5)
     sets = SynergySets(np.eye(1), ((1,),))
-    solve_gfo(GraspSets(np.zeros(6), normals, squeeze, 1.0, sets, 0.5, cone, basis_rtol=1e-9), strict_shrink=1e-5)
+    solve_gfo(GraspSets(np.zeros(6), normals, squeeze, 1.0, sets, 0.5, CircularCone(1.0), basis_rtol=1e-9),
+              strict_shrink=1e-5)

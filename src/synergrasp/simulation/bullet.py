@@ -1,4 +1,4 @@
-"""All pybullet-specific code for the hand and the boxes.
+"""All pybullet-specific code for the hand and the objects.
 
 pybullet works in metres; every function here takes and returns mm (and the palm frame).
 The hand's base (its palm) is fixed at the world origin with identity orientation, so
@@ -10,6 +10,7 @@ from __future__ import annotations
 import tempfile
 from dataclasses import dataclass, fields
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pybullet as pb
@@ -145,16 +146,21 @@ def bullet_jacobian(client: int, body: HandBody, q: NDArray, link: int, point_mm
     return jac
 
 
-def load_box(client: int, size_mm: NDArray, center_mm: NDArray, rotation: NDArray | None = None) -> int:
-    """A static box body of full edge lengths ``size_mm`` centred at ``center_mm`` (palm frame),
-    oriented by the 3 × 3 rotation matrix ``rotation`` (identity if None). Returns its body id."""
-    size = np.asarray(size_mm, dtype=float)
-    if size.shape != (3,) or np.any(size <= 0):
-        raise ValueError(f"size_mm must be 3 positive lengths (mm), got {size_mm!r}")
-    shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(0.5 * size * MM).tolist(), physicsClientId=client)
-    visual = pb.createVisualShape(pb.GEOM_BOX, halfExtents=(0.5 * size * MM).tolist(),
-                                  rgbaColor=[0.8, 0.8, 0.75, 1.0], physicsClientId=client)
-    body = pb.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=shape, baseVisualShapeIndex=visual,
+def collision_shape(client: int, shape: Any) -> int:
+    """The collision shape of an object's shape (``synergrasp.simulation.shapes``: its
+    ``collision_geometry()``, mm) in ``client``; returns its index."""
+    kind, geometry = shape.collision_geometry()
+    if kind == "box":
+        half = np.asarray(geometry["half_extents_mm"], dtype=float)
+        return pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(half * MM).tolist(), physicsClientId=client)
+    raise ValueError(f"no collision shape for a {kind!r}")
+
+
+def load_object(client: int, shape: Any, center_mm: NDArray, rotation: NDArray | None = None) -> int:
+    """A static body of ``shape`` (``synergrasp.simulation.shapes``) centred at ``center_mm``
+    (palm frame), oriented by the 3 × 3 rotation matrix ``rotation`` (identity if None).
+    Returns its body id."""
+    body = pb.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=collision_shape(client, shape),
                               physicsClientId=client)
     move_body(client, body, center_mm, rotation)
     return body
@@ -336,15 +342,13 @@ def apply_force(client: int, body: int, force_N: NDArray) -> None:
     pb.applyExternalForce(body, -1, [float(v) for v in force_N], pos, pb.WORLD_FRAME, physicsClientId=client)
 
 
-def load_free_box(client: int, size_mm: NDArray, mass_kg: float, friction: float, damping_per_s: float) -> int:
-    """A free (dynamic) box of edge lengths ``size_mm`` and mass ``mass_kg``, uniform inertia,
-    lateral friction ``friction``, linear and angular drag at the rate ``damping_per_s`` (1/s).
-    Place it with ``move_body``; returns its body id."""
-    size = np.asarray(size_mm, dtype=float)
-    if size.shape != (3,) or np.any(size <= 0):
-        raise ValueError(f"size_mm must be 3 positive lengths (mm), got {size_mm!r}")
-    shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(0.5 * size * MM).tolist(), physicsClientId=client)
-    body = pb.createMultiBody(baseMass=float(mass_kg), baseCollisionShapeIndex=shape, physicsClientId=client)
+def load_free_object(client: int, shape: Any, mass_kg: float, friction: float, damping_per_s: float) -> int:
+    """A free (dynamic) body of ``shape`` (``synergrasp.simulation.shapes``) and mass
+    ``mass_kg``, uniform density (the engine's inertia of the shape), lateral friction
+    ``friction``, linear and angular drag at the rate ``damping_per_s`` (1/s). Place it with
+    ``move_body``; returns its body id."""
+    body = pb.createMultiBody(baseMass=float(mass_kg), baseCollisionShapeIndex=collision_shape(client, shape),
+                              physicsClientId=client)
     pb.changeDynamics(body, -1, lateralFriction=float(friction), linearDamping=float(damping_per_s),
                       angularDamping=float(damping_per_s), physicsClientId=client)
     return body

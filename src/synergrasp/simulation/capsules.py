@@ -25,8 +25,8 @@ from synergrasp.hand.checks import closure_shape_problems
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
 
-__all__ = ["HandCapsules", "segment_segment_distance", "segment_box_distance", "capsule_box", "pair_gaps",
-           "nearest_per_link", "posture_gaps"]
+__all__ = ["HandCapsules", "segment_segment_distance", "segment_box_distance", "segment_object_distance",
+           "capsule_object", "pair_gaps", "nearest_per_link", "posture_gaps"]
 
 _EPS = 1e-12
 _FLAT_MM2 = 1e-9  # squared distances (mm²) this close count as equal (flat stretch of a segment)
@@ -228,15 +228,47 @@ def _capsule_to_box(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray
 
 
 @numba.njit(cache=True)
-def capsule_box(p0: NDArray, p1: NDArray, radius: NDArray, rotation: NDArray, centre: NDArray,
-                half: NDArray) -> tuple[NDArray, NDArray]:
-    """Signed distance (c,) of every capsule to a box (palm frame pose) and the parameter of
-    the closest point of its axis."""
+def _seg_object(p0: NDArray, d: NDArray, code: int, params: NDArray, work: NDArray) -> tuple[float, float]:
+    """Signed distance (mm) from the segment p0 + t·d, t in [0, 1] (the object's own frame),
+    to the object's shape (``code``, ``params``: ``synergrasp.simulation.shapes``) and the t
+    attaining it; ``work`` is scratch space of 8 values. 0: a box, params its half extents."""
+    return _seg_box_into(p0, d, params, work)
+
+
+@numba.njit(cache=True)
+def segment_object_distance(p0: NDArray, p1: NDArray, code: int, params: NDArray) -> tuple[NDArray, NDArray]:
+    """Signed distances (k,) from segments p0–p1 ((k, 3), the object's own frame) to one
+    object shape (``code``, ``params``) and the segment parameters (k,) attaining them."""
+    k = p0.shape[0]
+    dist, t = np.empty(k), np.empty(k)
+    work = np.empty(8)
+    for i in range(k):
+        dist[i], t[i] = _seg_object(p0[i], p1[i] - p0[i], code, params, work)
+    return dist, t
+
+
+@numba.njit(cache=True)
+def _capsule_to_object(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray, code: int, params: NDArray,
+                       work: NDArray) -> tuple[float, float]:
+    """Signed distance of the axis p0–p1 (palm frame) to an object at (rotation, centre) and
+    its parameter; ``work`` (3, 8) is scratch space."""
+    _to_box(p0, rotation, centre, work[0])
+    _to_box(p1, rotation, centre, work[1])
+    for i in range(3):
+        work[1, i] -= work[0, i]
+    return _seg_object(work[0, :3], work[1, :3], code, params, work[2])
+
+
+@numba.njit(cache=True)
+def capsule_object(p0: NDArray, p1: NDArray, radius: NDArray, rotation: NDArray, centre: NDArray, code: int,
+                   params: NDArray) -> tuple[NDArray, NDArray]:
+    """Signed distance (c,) of every capsule to the object (shape ``code``, ``params``; palm
+    frame pose) and the parameter of the closest point of its axis."""
     c = p0.shape[0]
     dist, t = np.empty(c), np.empty(c)
     work = np.empty((3, 8))
     for i in range(c):
-        d, ti = _capsule_to_box(p0[i], p1[i], rotation, centre, half, work)
+        d, ti = _capsule_to_object(p0[i], p1[i], rotation, centre, code, params, work)
         dist[i], t[i] = d - radius[i], ti
     return dist, t
 
@@ -278,16 +310,17 @@ def nearest_per_link(gaps: NDArray, ends: NDArray, n_links: int) -> tuple[NDArra
 @numba.njit(cache=True)
 def posture_gaps(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: NDArray, scale: NDArray,
                  cap_frame: NDArray, ends: NDArray, radius: NDArray, cap_link: NDArray, palm_gap: float,
-                 box_rotation: NDArray, box_centre: NDArray, box_half: NDArray, first: NDArray, second: NDArray,
+                 object_rotation: NDArray, object_centre: NDArray, code: int, params: NDArray, first: NDArray,
+                 second: NDArray,
                  pair_ends: NDArray, palm_rotation: NDArray, palm_centre: NDArray, palm_half: NDArray,
                  n_links: int) -> tuple[NDArray, NDArray, NDArray]:
     """Everything the closure asks at one posture q (rad), in one call: per link the signed
-    distance to the box (the palm's, ``palm_gap``, does not change with q), the distance to
+    distance to the object (the palm's, ``palm_gap``, does not change with q), the distance to
     the nearest link it is paired with and that link (mm; see ``pair_gaps``)."""
     p0, p1 = _segments(_frames(q, parent, offset, axis, joint, scale), cap_frame, ends)
     d_obj = np.full(n_links, np.inf)
     d_obj[0] = palm_gap
-    dist, _ = capsule_box(p0, p1, radius, box_rotation, box_centre, box_half)
+    dist, _ = capsule_object(p0, p1, radius, object_rotation, object_centre, code, params)
     for i in range(cap_link.shape[0]):
         d_obj[cap_link[i]] = dist[i]
     gaps = pair_gaps(p0, p1, radius, first, second, palm_rotation, palm_centre, palm_half)

@@ -1,10 +1,12 @@
 """Closing the hand on an object at every pose: the closure settings and the study loop.
 
-``simulate_object`` places the box at each pose of the grid (:func:`place_box`: brought
-toward the placement's target, stopped there or at first touch of the open hand), runs a closure model on it and collects one contacts-table row
+``simulate_object`` places the object at each pose of the grid (:func:`place_object`: brought
+toward the placement's target, stopped there or at first touch of the open hand), runs a
+closure model on it and collects one contacts-table row
 per pose (``contacts``). A closure model (``kinematic_closure``, ``dynamic_closure``) takes
 the hand, the synergies and :class:`ClosureParams`; it has the open posture ``q_open``
-(rad) its closure starts from, ``grasp(size_mm, placed) -> ClosureResult`` and ``close()``.
+(rad) its closure starts from, ``grasp(placed) -> ClosureResult`` (``placed``: an
+``ObjectPose``, the shape at its pose) and ``close()``.
 mm, rad, palm frame (docs/closure.md).
 """
 
@@ -26,8 +28,10 @@ from synergrasp.simulation.scene import HandScene
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
+    from synergrasp.simulation.objects import GraspedObject
+    from synergrasp.simulation.shapes import Shape
 
-__all__ = ["ClosureParams", "simulate_object", "closure_model", "place_box"]
+__all__ = ["ClosureParams", "simulate_object", "closure_model", "place_object"]
 
 @dataclass(frozen=True)
 class ClosureParams:
@@ -65,7 +69,7 @@ class ClosureParams:
 def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams,
                   mechanics: Mapping[str, Any] | None = None, mass_kg: float | None = None):
     """The closure model of ``params`` on a new pybullet scene of ``hand``; the dynamic model
-    also needs the config's ``mechanics`` block (k_ss, μ, gravity) and the box's mass (kg)."""
+    also needs the config's ``mechanics`` block (k_ss, μ, gravity) and the object's mass (kg)."""
     if params.model == "dynamic":
         from synergrasp.simulation.dynamic_closure import DynamicClosure
 
@@ -78,41 +82,42 @@ def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams,
     return KinematicClosure(hand, synergies, params)
 
 
-def place_box(scene: HandScene, q_open: NDArray, placement: Placement, size_mm: NDArray, alpha_deg: float,
-              beta_deg: float) -> ObjectPose:
-    """The box of ``size_mm`` at pose (α, β) deg by the placement rule: turned by (α, β),
-    brought along the palm normal toward the placement's target, stopped at the target or at
-    first touch of the open hand (posture ``q_open``, rad) of ``scene``, whichever comes
-    first (:class:`synergrasp.simulation.placement.Placement`)."""
+def place_object(scene: HandScene, q_open: NDArray, placement: Placement, shape: Shape, alpha_deg: float,
+                 beta_deg: float) -> ObjectPose:
+    """``shape`` at pose (α, β) deg by the placement rule: turned by (α, β), brought along
+    the palm normal toward the placement's target, stopped at the target or at first touch
+    of the open hand (posture ``q_open``, rad) of ``scene``, whichever comes first
+    (:class:`synergrasp.simulation.placement.Placement`)."""
     hand = scene.hand
-    turned = object_pose(placement, size_mm, alpha_deg, beta_deg, hand.palm_normal)
+    turned = object_pose(placement, shape, alpha_deg, beta_deg, hand.palm_normal)
     point, direction = approach_line(placement, hand)
-    return scene.bring_box(size_mm, turned.rotation, point, direction, q_open, placement.clearance_mm,
-                           stop_at_point=True)
+    return scene.bring_object(shape, turned.rotation, point, direction, q_open, placement.clearance_mm,
+                              stop_at_point=True)
 
 
-def simulate_object(hand: Hand, synergies: Synergies, box: Any, placement: Placement,
+def simulate_object(hand: Hand, synergies: Synergies, grasped: GraspedObject, placement: Placement,
                     closure_params: ClosureParams, poses: Iterable[int] | None = None,
                     mechanics: Mapping[str, Any] | None = None) -> pd.DataFrame:
-    """Close the hand on ``box`` at every pose of the placement's grid (or at ``poses``).
+    """Close the hand on the object ``grasped`` (name, shape, mass) at every pose of the
+    placement's grid (or at ``poses``).
 
     Returns the contacts table (``synergrasp.tables.CONTACTS``, one row per pose, in the
-    order of ``poses``). ``box`` has ``name`` and ``size_mm``. Deterministic.
+    order of ``poses``). Deterministic.
     """
     grid = pose_grid(placement)
     pose_list = list(range(grid.n_poses)) if poses is None else [int(v) for v in poses]
     for v in pose_list:
         if not 0 <= v < grid.n_poses:
             raise ValueError(f"poses must be in 0 … {grid.n_poses - 1}, got {v}")
-    size = np.asarray(box.size_mm, dtype=float)
-    model = closure_model(hand, synergies, closure_params, mechanics, getattr(box, "mass_kg", None))
+    shape = grasped.shape
+    model = closure_model(hand, synergies, closure_params, mechanics, grasped.mass_kg)
     placer = HandScene(hand)  # the open hand the box is brought to (placement)
     try:
         rows = []
         for pose in pose_list:
             a, b = grid.angles_deg(pose)
-            placed = place_box(placer, model.q_open, placement, size, a, b)
-            rows.append(contacts_row(str(box.name), pose, a, b, model.grasp(size, placed), placed))
+            placed = place_object(placer, model.q_open, placement, shape, a, b)
+            rows.append(contacts_row(str(grasped.name), pose, a, b, model.grasp(placed), placed))
     finally:
         model.close()
         placer.close()

@@ -41,6 +41,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
     from synergrasp.simulation.closure import ClosureParams
+    from synergrasp.simulation.shapes import Shape
 
 __all__ = ["DynamicParams", "DynamicClosure", "compliant_self_pairs"]
 
@@ -175,8 +176,8 @@ class DynamicClosure:
         self.q_open = self.path.reference(self.sigma_open)
         self.self_pairs = self._colliding_pairs()
         self.capsules = HandCapsules.of(hand)
-        self.box: int | None = None
-        self.box_size: NDArray | None = None
+        self.box: int | None = None  # the object's body
+        self.shape: Shape | None = None
 
     def close(self) -> None:
         self.bullet.disconnect(self.client)
@@ -185,14 +186,13 @@ class DynamicClosure:
         """Joint angles (rad) from the elementary axes' angles: q_j = Σ θ_i over the axes of joint j."""
         return self.axis_sum @ axis_values
 
-    def _place(self, size_mm: NDArray, placed: Any) -> None:
-        size = np.asarray(size_mm, dtype=float)
-        if self.box is None or self.box_size is None or not np.array_equal(size, self.box_size):
+    def _place(self, placed: ObjectPose) -> None:
+        if self.box is None or self.shape != placed.shape:
             if self.box is not None:
                 self.bullet.remove_body(self.client, self.box)
-            self.box = self.bullet.load_free_box(self.client, size, self.params.object_mass_kg,
-                                                 self.mu / self.link_friction, self.params.object_damping_per_s)
-            self.box_size = size
+            self.box = self.bullet.load_free_object(self.client, placed.shape, self.params.object_mass_kg,
+                                                    self.mu / self.link_friction, self.params.object_damping_per_s)
+            self.shape = placed.shape
         self.bullet.reset_body(self.client, self.box, placed.center_mm, placed.rotation)
 
     def _colliding_pairs(self) -> tuple[tuple[int, int], ...]:
@@ -207,19 +207,20 @@ class DynamicClosure:
         b.set_self_collision(self.client, self.body, kept)
         return kept
 
-    def grasp(self, size_mm: NDArray, placed: ObjectPose) -> ClosureResult:
-        """Close the hand from q_r(σ_open) to q_r(σ_closed) (the fully open hand to the end of S1) on a free box of ``size_mm`` (mm)
-        placed at ``placed``; the contacts of its settled state."""
+    def grasp(self, placed: ObjectPose) -> ClosureResult:
+        """Close the hand from q_r(σ_open) to q_r(σ_closed) (the fully open hand to the end of
+        S1) on the free object ``placed`` (its shape at its starting pose); the contacts of its
+        settled state."""
         p, b, c = self.params, self.bullet, self.closure
         q_open = self.q_open
         sigma_open, sigma_closed = self.sigma_open, self.sigma_closed
-        self._place(size_mm, placed)
+        self._place(placed)
         b.reset_hand(self.client, self.body, q_open)
         gaps = b.closest_points(self.client, self.box, self.body, c.contact_distance_mm)
         if len(gaps) and float(gaps.distance.min()) < -c.penetration_tolerance_mm:
             return self._result("intersects_open_hand", q_open, (), None, True)
         weight = self.weight if p.gravity else None
-        radius = float(np.linalg.norm(placed.half_extents_mm))
+        radius = placed.shape.bounding_radius_mm
         settled, steps = False, p.max_steps
         scale, axis_joint = self.axis_scale, self.axis_joint
         target = scale * q_open[axis_joint]
@@ -275,7 +276,7 @@ class DynamicClosure:
         theta, _ = b.axis_states(self.client, self.body)
         q = self.joint_values(theta)
         center, rotation, _, _ = b.body_state(self.client, self.box)
-        now = ObjectPose(center, rotation, placed.half_extents_mm)
+        now = ObjectPose(center, rotation, placed.shape)
         forces = b.contact_forces(self.client, self.box, self.body)
         near = b.closest_points(self.client, self.box, self.body, self.closure.contact_distance_mm)
         touching = sorted({int(v) for v in near.link_b if v >= 0})

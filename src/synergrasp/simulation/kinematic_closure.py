@@ -72,9 +72,9 @@ class KinematicClosure:
         """Release the pybullet scene."""
         self.scene.close()
 
-    def grasp(self, size_mm: NDArray, placed: ObjectPose) -> ClosureResult:
-        """Close the hand on a box of edge lengths ``size_mm`` (mm) placed at ``placed``."""
-        self.scene.place_box(size_mm, placed)
+    def grasp(self, placed: ObjectPose) -> ClosureResult:
+        """Close the hand on the object ``placed`` (its shape at its pose)."""
+        self.scene.place_object(placed)
         q, state, intersects = self.run()
         if intersects:
             return closure_result(self.hand, q, state, np.zeros(0, dtype=np.int64), np.zeros((0, 3)),

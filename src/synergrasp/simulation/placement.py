@@ -18,6 +18,7 @@ from synergrasp.hand.kinematics import axis_rotation
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
+    from synergrasp.simulation.shapes import Shape
 
 __all__ = ["palm_centre", "approach_line", "placement_target", "FINGER_AXIS", "MODES", "Placement", "PoseGrid",
            "ObjectPose", "pose_grid", "object_pose"]
@@ -56,7 +57,7 @@ class Placement:
     One rule for every mode: the box, turned by (α, β) about its centre, travels along the
     palm normal from outside toward a target point (palm frame, mm) and stops at the target
     or when it first comes within ``clearance_mm`` of the open hand, whichever comes first
-    (``HandScene.bring_box``). It never intersects the open hand, so no pose is dropped.
+    (``HandScene.bring_object``). It never intersects the open hand, so no pose is dropped.
     The modes say where the target comes from (:func:`placement_target`):
 
     mode:           ``approach``: ``approach_point_mm`` (None = the palm centre, which lies
@@ -69,9 +70,10 @@ class Placement:
     clearance_mm:   gap (mm, ≥ 0) left between the box and the open hand when it stops at
                     first touch.
     center_mm:      ``fixed`` target (palm frame, mm); α and β rotate the box about its centre.
-    box_axes:       ``box_axes[k]`` is the index (into ``size_mm``) of the box edge that
-                    lies along palm axis k (x = palm normal, y, z = long fingers) at
-                    α = β = 0; a permutation of (0, 1, 2).
+    box_axes:       ``box_axes[k]`` is the object's own axis (for a box: the index into
+                    ``size_mm`` of its edge) that lies along palm axis k (x = palm normal,
+                    y, z = long fingers) at α = β = 0; a permutation of (0, 1, 2)
+                    (``synergrasp.simulation.shapes.start_rotation``).
     rotation_order: ``alpha_then_beta``: R = R_z(β)·R_n(α)·R_0 (α about the palm normal
                     n first, then β about the long-finger axis z, both palm-fixed axes);
                     ``beta_then_alpha``: R = R_n(α)·R_z(β)·R_0. Only ``alpha_then_beta``
@@ -150,56 +152,33 @@ def pose_grid(placement: Placement) -> PoseGrid:
 
 @dataclass(frozen=True)
 class ObjectPose:
-    """A box placed in the palm frame: centre (mm) and rotation (box frame → palm frame)."""
+    """An object placed in the palm frame: centre (mm), rotation (own frame → palm frame) and
+    its shape (``synergrasp.simulation.shapes``)."""
 
     center_mm: NDArray
     rotation: NDArray
-    half_extents_mm: NDArray  # along the box's own axes (size_mm / 2)
+    shape: Shape
 
     def surface_point(self, point_mm: NDArray) -> tuple[NDArray, NDArray]:
-        """The point of the exact box surface nearest to ``point_mm`` (palm frame, mm) and the
-        box's inward unit normal there.
-
-        Outside the box: the nearest box point, normal from ``point_mm`` toward it. Inside
-        (penetration): the nearest face point, that face's inward normal. (pybullet rounds
-        box edges by its collision margin; contacts are projected onto the exact box.)
-        """
-        R, c, h = self.rotation, self.center_mm, self.half_extents_mm
-        local = R.T @ (np.asarray(point_mm, dtype=float) - c)
-        clamped = np.clip(local, -h, h)
-        gap = local - clamped
-        if np.linalg.norm(gap) > 1e-6:
-            n_local = -gap / np.linalg.norm(gap)
-        else:  # inside: leave through the nearest face
-            k = int(np.argmin(h - np.abs(local)))
-            clamped = local.copy()
-            sign = 1.0 if local[k] >= 0 else -1.0
-            clamped[k] = sign * h[k]
-            n_local = np.zeros(3)
-            n_local[k] = -sign
-        n = R @ n_local
-        return R @ clamped + c, n / np.linalg.norm(n)
+        """The point of the exact surface nearest to ``point_mm`` (palm frame, mm) and the
+        object's inward unit normal there (``Shape.surface_point``; pybullet rounds box edges
+        by its collision margin, contacts are projected onto the exact shape)."""
+        return self.shape.surface_point(point_mm, self.rotation, self.center_mm)
 
 
-def object_pose(placement: Placement, size_mm: Sequence[float], alpha_deg: float, beta_deg: float,
+def object_pose(placement: Placement, shape: Shape, alpha_deg: float, beta_deg: float,
                 palm_normal: Sequence[float] = (1.0, 0.0, 0.0)) -> ObjectPose:
-    """Centre and orientation of a box of ``size_mm`` at (α, β) deg.
+    """Centre and orientation of ``shape`` at (α, β) deg, at the placement's fixed centre.
 
-    α turns about ``palm_normal`` (``synergrasp.hand.kinematics.PALM_NORMAL``), β about the palm z
-    axis, both about the box centre; see :class:`Placement` for the order.
+    It starts at ``shape.start_rotation(placement.box_axes)``; α turns about ``palm_normal``
+    (``synergrasp.hand.kinematics.PALM_NORMAL``), β about the palm z axis, both about its
+    centre; see :class:`Placement` for the order.
     """
-    size = np.asarray(size_mm, dtype=float)
-    if size.shape != (3,) or not np.all(size > 0):
-        raise ValueError(f"size_mm must be 3 positive lengths (mm), got {size_mm!r}")
-    R0 = np.zeros((3, 3))
-    for k, edge in enumerate(placement.box_axes):
-        R0[k, edge] = 1.0  # box edge `edge` lies along palm axis k
-    if np.linalg.det(R0) < 0:  # an odd permutation: flip the box's z edge (a box is mirror-symmetric)
-        R0[:, placement.box_axes[2]] *= -1.0
+    R0 = shape.start_rotation(placement.box_axes)
     Ra = axis_rotation(_unit(palm_normal), math.radians(alpha_deg))
     Rb = axis_rotation(FINGER_AXIS, math.radians(beta_deg))
     R = Rb @ Ra @ R0 if placement.rotation_order == "alpha_then_beta" else Ra @ Rb @ R0
-    return ObjectPose(np.array(placement.center_mm, dtype=float), R, size / 2.0)
+    return ObjectPose(np.array(placement.center_mm, dtype=float), R, shape)
 
 
 def palm_centre(hand: Hand) -> NDArray:

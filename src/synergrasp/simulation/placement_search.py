@@ -207,15 +207,14 @@ class TargetScorer:
 
     def contacts(self, target_mm: Sequence[float]) -> pd.DataFrame:
         """The contacts table of the scored poses with the box placed toward ``target_mm``."""
-        from synergrasp.simulation.closure import place_box
+        from synergrasp.simulation.closure import place_object
 
         placement = replace(self.placement, mode="searched", target_mm=tuple(float(v) for v in target_mm))
-        size = np.asarray(self.box.size_mm, dtype=float)
         rows = []
         for pose in self.poses:
             a, b = self.grid.angles_deg(pose)
-            placed = place_box(self.placer, self.model.q_open, placement, size, a, b)
-            rows.append(contacts_row(str(self.box.name), pose, a, b, self.model.grasp(size, placed), placed))
+            placed = place_object(self.placer, self.model.q_open, placement, self.box.shape, a, b)
+            rows.append(contacts_row(str(self.box.name), pose, a, b, self.model.grasp(placed), placed))
         return contacts_table(rows)
 
     def __call__(self, target_mm: Sequence[float]) -> TargetScore:

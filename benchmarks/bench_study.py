@@ -1,0 +1,42 @@
+"""The real study's optimisation rate and fallback share, from a finished run's files.
+
+Reads the optimisation jobs' benchmark files (`<root>/benchmarks/optimise/*.tsv`, column
+cpu_time: CPU seconds of each job, imports and I/O included) and the gfo tables
+(`<root>/objects/*/gfo.parquet`), and prints (pose, set) rows per CPU second, over all rows
+and over the rows that reached the solver (solver not 'none'), and the share of rows the
+Clarabel fallback decided. Nothing is run: it describes the last `make study` (or any root
+given), so run that first. The last two lines are machine-read.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import pandas as pd
+
+from synergrasp import tables
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--root", type=Path, default=Path("results"), help="results directory of a finished study")
+    args = ap.parse_args()
+    bench = sorted((args.root / "benchmarks" / "optimise").glob("*.tsv"))
+    gfo_files = sorted((args.root / "objects").glob("*/gfo.parquet"))
+    if not bench or not gfo_files:
+        raise SystemExit(f"no optimisation benchmark files or gfo tables under {args.root}: run `make study` first")
+    cpu = sum(float(pd.read_csv(f, sep="\t")["cpu_time"].iloc[-1]) for f in bench)
+    solver = pd.concat([tables.read(tables.GFO, f)["solver"] for f in gfo_files], ignore_index=True)
+    n, solved = len(solver), int((solver != "none").sum())
+    fallback = int((solver == "clarabel_fallback").sum())
+    print(f"{args.root}: {len(gfo_files)} objects, {len(bench)} optimisation jobs, {cpu:.2f} CPU s of jobs")
+    print(f"(pose, set) rows: {n} ({solved} solved, {n - solved} without a solve); "
+          f"{n / cpu:.0f} rows per CPU s, {solved / cpu:.0f} solved per CPU s")
+    print(f"fallback: {fallback} rows, {fallback / n:.4f} of all rows, {fallback / max(solved, 1):.4f} of the solved")
+    print(f"study_problems_per_cpu_s: {n / cpu:.0f}")
+    print(f"study_fallback_share: {fallback / n:.4f}")
+
+
+if __name__ == "__main__":
+    main()

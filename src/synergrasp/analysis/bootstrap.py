@@ -1,0 +1,142 @@
+"""Block bootstrap over distinct poses: the intervals behind every verdict (docs/analyses.md).
+
+Each object's pose grid is folded to its first α-period (the copies at α + P are the same
+grasp) and cut into square blocks of ``block_deg`` × ``block_deg`` in (α, β); a resample
+draws, within each object, as many blocks as it has, with replacement. It is carried out as
+a weight per block (a multinomial draw), so every statistic is a function of weighted sums
+over poses: a few matrix products for 1000 resamples. Row 0 of every weight matrix is the
+data itself (every block once), rows 1.. are the resamples, so a statistic computed on all
+rows gives its estimate and its resampled values together, from the same poses, and a
+difference of two statistics is taken inside each resample. Seeded and deterministic: one
+generator, the objects drawn in a fixed (sorted) order.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from synergrasp.analysis.periods import distinct_pose_mask
+
+__all__ = ["BootstrapSettings", "PoseResampler", "block_index", "interval", "weighted_median"]
+
+_TOL_DEG = 1e-6
+
+
+@dataclass(frozen=True)
+class BootstrapSettings:
+    """Config ``analyses.bootstrap``: resamples, seed, block edge (deg), interval level."""
+
+    resamples: int
+    seed: int
+    block_deg: float
+    level: float
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.resamples, (int, np.integer)) and self.resamples >= 1):
+            raise ValueError(f"BootstrapSettings.resamples must be an integer >= 1; got {self.resamples!r}")
+        if not self.block_deg > 0:
+            raise ValueError(f"BootstrapSettings.block_deg must be > 0; got {self.block_deg!r}")
+        if not 0.5 < self.level < 1:
+            raise ValueError(f"BootstrapSettings.level must lie in (0.5, 1); got {self.level!r}")
+
+
+def block_index(alpha_deg: NDArray, beta_deg: NDArray, block_deg: float, alpha_start_deg: float,
+                beta_start_deg: float) -> NDArray:
+    """Block number of each pose: square blocks of ``block_deg`` counted from the grid's start
+    in α and in β (deg). Poses must lie in one α-period; numbers are 0..n_blocks − 1 (only
+    blocks holding a pose are numbered)."""
+    ia = np.floor((np.asarray(alpha_deg, float) - alpha_start_deg + _TOL_DEG) / block_deg).astype(np.int64)
+    ib = np.floor((np.asarray(beta_deg, float) - beta_start_deg + _TOL_DEG) / block_deg).astype(np.int64)
+    key = ia * (int(ib.max(initial=0)) + 1) + ib
+    return np.unique(key, return_inverse=True)[1].astype(np.int64)
+
+
+class PoseResampler:
+    """The distinct poses of every object, their blocks and the bootstrap weights.
+
+    ``poses``: one row per pose of the grid (columns object, pose, alpha_deg, beta_deg; a
+    gfo table's rows of one set will do); ``periods_deg``: α-period per object (360 if
+    absent). ``weights(obj)`` is a (1 + resamples, n_distinct) matrix of pose weights, row 0
+    all ones (the data); ``poses(obj)`` the pose ids of the distinct poses, in that order.
+    """
+
+    def __init__(self, poses: pd.DataFrame, periods_deg: Mapping[str, float], settings: BootstrapSettings):
+        self.settings = settings
+        rng = np.random.default_rng(settings.seed)
+        self._poses: dict[str, NDArray] = {}
+        self._block_weights: dict[str, NDArray] = {}
+        self._blocks: dict[str, NDArray] = {}
+        unique = poses[["object", "pose", "alpha_deg", "beta_deg"]].drop_duplicates(["object", "pose"])
+        for obj in sorted(unique["object"].unique()):
+            own = unique[unique["object"] == obj].sort_values("pose")
+            alpha, beta = own["alpha_deg"].to_numpy(float), own["beta_deg"].to_numpy(float)
+            keep = distinct_pose_mask(alpha, float(periods_deg.get(obj, 360.0)))
+            blocks = block_index(alpha[keep], beta[keep], settings.block_deg, float(alpha.min()), float(beta.min()))
+            n_blocks = int(blocks.max()) + 1 if blocks.size else 0
+            draws = (rng.multinomial(n_blocks, np.full(n_blocks, 1.0 / n_blocks), size=settings.resamples)
+                     if n_blocks else np.zeros((settings.resamples, 0), dtype=np.int64))
+            self._poses[obj] = own["pose"].to_numpy()[keep]
+            self._blocks[obj] = blocks
+            self._block_weights[obj] = np.vstack([np.ones((1, n_blocks)), draws]).astype(float)
+
+    @property
+    def objects(self) -> list[str]:
+        return list(self._poses)
+
+    def poses(self, obj: str) -> NDArray:
+        """Pose ids of ``obj``'s distinct poses (sorted)."""
+        return self._poses[obj]
+
+    def n_blocks(self, obj: str) -> int:
+        return self._block_weights[obj].shape[1]
+
+    def weights(self, obj: str) -> NDArray:
+        """(1 + resamples, n_distinct) pose weights of ``obj``: row 0 ones, then the resamples."""
+        return self._block_weights[obj][:, self._blocks[obj]]
+
+    def sums(self, obj: str, values: NDArray) -> NDArray:
+        """Weighted sums over ``obj``'s distinct poses of ``values`` (n_distinct,) or
+        (n_distinct, m): (1 + resamples,) or (1 + resamples, m)."""
+        values = np.asarray(values, dtype=float)
+        n_blocks = self.n_blocks(obj)
+        flat = values.reshape(len(values), -1)
+        per_block = np.zeros((n_blocks, flat.shape[1]))
+        np.add.at(per_block, self._blocks[obj], flat)
+        out = self._block_weights[obj] @ per_block
+        return out[:, 0] if values.ndim == 1 else out
+
+    def on_distinct(self, obj: str, frame: pd.DataFrame, column: str, fill: float = 0.0) -> NDArray:
+        """``frame``'s ``column`` (indexed by pose) at ``obj``'s distinct poses, ``fill`` where absent."""
+        return frame[column].reindex(self._poses[obj]).fillna(fill).to_numpy(float)
+
+
+def weighted_median(values: NDArray, weights: NDArray) -> NDArray:
+    """Median of ``values`` (n,) under each row of ``weights`` (r, n) (≥ 0): the mean of the
+    lower and upper weighted medians, so that unit weights give numpy's median. NaN for a row
+    of zero weight or no values."""
+    values = np.asarray(values, dtype=float)
+    weights = np.atleast_2d(np.asarray(weights, dtype=float))
+    if values.size == 0:
+        return np.full(weights.shape[0], np.nan)
+    order = np.argsort(values, kind="stable")
+    v, cum = values[order], np.cumsum(weights[:, order], axis=1)
+    total = cum[:, -1:]
+    lower = np.minimum((cum < total / 2.0 - 1e-9).sum(axis=1), v.size - 1)
+    upper = np.minimum((cum <= total / 2.0 + 1e-9).sum(axis=1), v.size - 1)
+    out = 0.5 * (v[lower] + v[upper])
+    return np.where(total[:, 0] > 0, out, np.nan)
+
+
+def interval(resampled: NDArray, level: float) -> tuple[float, float]:
+    """Percentile interval of the resampled values (NaN resamples left out; NaN if all are)."""
+    finite = np.asarray(resampled, dtype=float)
+    finite = finite[np.isfinite(finite)]
+    if finite.size == 0:
+        return np.nan, np.nan
+    low, high = np.percentile(finite, [50.0 * (1.0 - level), 50.0 * (1.0 + level)])
+    return float(low), float(high)

@@ -1,0 +1,151 @@
+"""Success counts per distinct pose, resampled, and the two views of "averaged over objects".
+
+:class:`StudyCounts` holds, for every object, its successes per distinct pose and synergy set
+(the verdict in use), their weighted sums under every bootstrap resample
+(:class:`synergrasp.analysis.bootstrap.PoseResampler`; row 0 the data) and the optimal
+forces of the successes. From them:
+
+- the **per-object** view (the study's): each object's rate is 100 · successes / the full
+  set's successes on that object; the view averages it over the objects whose full set
+  succeeds anywhere (in the data);
+- the **pooled** view: 100 · Σ successes / Σ the full set's successes over those objects.
+
+Rates in percent; forces in N.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from synergrasp.analysis.bootstrap import PoseResampler, interval, weighted_median
+
+__all__ = ["VIEWS", "StudyCounts", "mean_defined"]
+
+#: The views of "averaged over objects", the study's first.
+VIEWS: tuple[str, ...] = ("per_object", "pooled")
+
+
+def mean_defined(values: NDArray) -> NDArray:
+    """Column means of (objects, rows) values over the finite entries; NaN where none is."""
+    finite = np.isfinite(values)
+    count = finite.sum(axis=0)
+    total = np.where(finite, values, 0.0).sum(axis=0)
+    return np.where(count > 0, total / np.maximum(count, 1), np.nan)
+
+
+class StudyCounts:
+    """Successes per distinct pose of every object and set, and their resampled sums.
+
+    ``table``: gfo table with the columns of ``with_verdicts`` (success, success_force);
+    ``full_set_id``: the full set; ``resampler``: the distinct poses and bootstrap weights.
+    """
+
+    def __init__(self, table: pd.DataFrame, full_set_id: str, resampler: PoseResampler):
+        self.resampler = resampler
+        self.full = full_set_id
+        self.sets: list[str] = sorted(table["set_id"].astype(str).unique(),
+                                      key=lambda s: (len(s.split("-")), tuple(int(x) for x in s.split("-"))))
+        self.objects = resampler.objects
+        self._success: dict[str, NDArray] = {}
+        self._force: dict[str, NDArray] = {}
+        self._sums: dict[str, NDArray] = {}
+        for obj in self.objects:
+            own = table[table["object"] == obj]
+            poses = resampler.poses(obj)
+            success = own.pivot(index="pose", columns="set_id", values="success")
+            force = own.pivot(index="pose", columns="set_id", values="success_force")
+            success = success.reindex(index=poses, columns=self.sets).fillna(False).to_numpy(bool)
+            self._success[obj] = success
+            self._force[obj] = force.reindex(index=poses, columns=self.sets).to_numpy(float)
+            self._sums[obj] = resampler.sums(obj, success)
+        self._col = {s: i for i, s in enumerate(self.sets)}
+
+    @property
+    def rows(self) -> int:
+        """1 + resamples."""
+        return self.resampler.settings.resamples + 1
+
+    def has(self, sid: str) -> bool:
+        return sid in self._col
+
+    def success(self, obj: str, sid: str) -> NDArray:
+        """(n_distinct,) success of set ``sid`` at ``obj``'s distinct poses."""
+        return self._success[obj][:, self._col[sid]]
+
+    def force(self, obj: str, sid: str) -> NDArray:
+        """(n_distinct,) optimal force (N) of ``sid`` where it succeeds, NaN elsewhere."""
+        return self._force[obj][:, self._col[sid]]
+
+    def count(self, obj: str, sid: str) -> NDArray:
+        """(rows,) weighted success count of ``sid`` on ``obj``: row 0 the distinct-pose count."""
+        return self._sums[obj][:, self._col[sid]]
+
+    def counted_objects(self) -> list[str]:
+        """Objects whose full set succeeds at some distinct pose (in the data)."""
+        return [o for o in self.objects if self.count(o, self.full)[0] > 0]
+
+    def object_rate(self, obj: str, sid: str) -> NDArray:
+        """(rows,) 100 · count(sid) / count(full) on ``obj``; NaN where the full set has none."""
+        full = self.count(obj, self.full)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(full > 0, 100.0 * self.count(obj, sid) / np.where(full > 0, full, 1.0), np.nan)
+
+    def rate(self, sid: str, view: str) -> NDArray:
+        """(rows,) the rate of ``sid`` averaged over the counted objects in ``view``; NaN for a
+        set not computed or no counted object."""
+        objects = self.counted_objects()
+        if not self.has(sid) or not objects:
+            return np.full(self.rows, np.nan)
+        if view == "per_object":
+            return mean_defined(np.vstack([self.object_rate(o, sid) for o in objects]))
+        if view == "pooled":
+            num = sum(self.count(o, sid) for o in objects)
+            den = sum(self.count(o, self.full) for o in objects)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                return np.where(den > 0, 100.0 * num / np.where(den > 0, den, 1.0), np.nan)
+        raise ValueError(f"view must be one of {list(VIEWS)}; got {view!r}")
+
+    def n_any(self, set_ids: Sequence[str]) -> int:
+        """Distinct poses, over the counted objects, where at least one of ``set_ids`` succeeds."""
+        present = [s for s in set_ids if self.has(s)]
+        return int(sum(np.column_stack([self.success(o, s) for s in present]).any(axis=1).sum()
+                       for o in self.counted_objects())) if present else 0
+
+    def n_lost(self, small: str) -> tuple[NDArray, NDArray]:
+        """(rows,) weighted counts, over the counted objects, of the full set's distinct
+        successes and of those where ``small`` does not succeed."""
+        objects = self.counted_objects()
+        full = sum((self.count(o, self.full) for o in objects), np.zeros(self.rows))
+        lost = sum((self.resampler.sums(o, (self.success(o, self.full) & ~self.success(o, small)).astype(float))
+                    for o in objects), np.zeros(self.rows))
+        return full, lost
+
+    def paired_log_ratio(self, a: str, b: str) -> tuple[NDArray, int]:
+        """(rows,) weighted median over the distinct poses, of every object, where both ``a``
+        and ``b`` succeed, of log(F_b / F_a); and the number of such poses. F_b / F_a > 1:
+        ``a`` needs the lower force."""
+        values, weights = [], []
+        for obj in self.objects:
+            fa, fb = self.force(obj, a), self.force(obj, b)
+            both = np.isfinite(fa) & np.isfinite(fb) & (fa > 0) & (fb > 0)
+            values.append(np.log(fb[both] / fa[both]))
+            weights.append(self.resampler.weights(obj)[:, both])
+        v = np.concatenate(values) if values else np.zeros(0)
+        w = np.hstack(weights) if weights else np.zeros((self.rows, 0))
+        return weighted_median(v, w), int(v.size)
+
+    def pooled_ratio_to_full(self, sid: str) -> tuple[NDArray, int]:
+        """(rows,) weighted median over every object's distinct successes of ``sid`` of its
+        optimal force / the full set's at the same pose (Fig. 5B, like with like); and their
+        number."""
+        log_ratio, n = self.paired_log_ratio(self.full, sid) if self.has(sid) else (np.full(self.rows, np.nan), 0)
+        return np.exp(log_ratio), n
+
+    def estimate_interval(self, values: NDArray) -> tuple[float, float, float]:
+        """(estimate, low, high) of a statistic computed on every row."""
+        low, high = interval(values[1:], self.resampler.settings.level)
+        return float(values[0]), low, high

@@ -1,0 +1,219 @@
+"""The compiled call per pose: every synergy set of one grasp (`solve_sets`): the set's
+basis by one-sided Jacobi rotations (`range_basis`), its problem built into the pose's work
+arrays (`build`), solved (`solve_one`: `hsde` and a refined second attempt) and its forces
+checked, then the strict internal-force test on the same basis."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from synergrasp.optimisation.ipm.compiled import jit_alloc, jit_call, jit_inline
+from synergrasp.optimisation.ipm.iteration import hsde
+from synergrasp.optimisation.ipm.layout import NOT_SOLVED, OPTIMAL, UNDECIDED, Problem, workspace
+
+__all__ = ["range_basis", "solve_sets"]
+
+
+@jit_alloc
+def build(rows, lin, E, fp, e, mu, f_min, W):
+    """The problem of cone rows (m, 3, 3) (`cone_rows`), linear rows lin (m, p, 3)
+    (`ipm_kernel.cone_data`: p = 0 for the circular cone, whose Coulomb cones are SOCs; a pyramid's
+    [n; -a_1; ...] with the normal bound first, the kernel's nonnegative block in this
+    order), basis E (3m, >= e; its first e columns) and f_p (3m,) N, its data written into W."""
+    m, p = rows.shape[0], lin.shape[1]
+    D, hv, a, DL, hl = W.D, W.hv, W.a, W.DL, W.hl
+    for i in range(m):
+        for r in range(p):
+            k = i * p + r
+            acc = 0.0
+            for q in range(3):
+                acc += lin[i, r, q] * fp[3 * i + q]
+            hl[k] = acc - f_min if r == 0 else acc
+            for j in range(e):
+                acc = 0.0
+                for q in range(3):
+                    acc += lin[i, r, q] * E[3 * i + q, j]
+                DL[k, j] = acc
+    for i in range(m):
+        for r in range(3):
+            acc = 0.0
+            for q in range(3):
+                acc += rows[i, r, q] * fp[3 * i + q]
+            hv[i, r] = acc
+            for k in range(e):
+                acc = 0.0
+                for q in range(3):
+                    acc += rows[i, r, q] * E[3 * i + q, k]
+                D[i, r, k] = acc
+    for k in range(e):
+        a[k] = 0.0
+    for c in range(3 * m):
+        for k in range(e):
+            a[k] += E[c, k] * fp[c]
+    r0 = 0.0
+    for c in range(3 * m):
+        acc = fp[c]
+        for k in range(e):
+            acc -= E[c, k] * a[k]
+        r0 += acc * acc
+    q = m if p == 0 else 0
+    return Problem(D, hv, a, math.sqrt(r0), mu, f_min, m, e, q, m * p, q + m * p, DL, hl)
+
+
+@jit_inline
+def attempt(P, W, opt, refine, y):
+    """`hsde`, then the force check of an optimal point: (code, ||f|| N, violation N, iterations).
+    An optimal point whose forces violate a constraint by more than violation_tol max(1 N, ||f||)
+    is 'not decided' (the rule of `solve_gfo` for reduced accuracy)."""
+    code, it = hsde(P, W, opt, refine, y)
+    if code != OPTIMAL:
+        return code, math.nan, math.nan, it
+    # f = f_p + E y in the contact frames: [n.f, t1.f/mu, t2.f/mu]
+    D, hv, DL, hl, e = P.D, P.hv, P.DL, P.hl, P.e
+    norm = 0.0
+    viol = -math.inf
+    for i in range(P.m):
+        f0, f1, f2 = hv[i, 0], hv[i, 1], hv[i, 2]
+        for k in range(e):
+            f0 += D[i, 0, k] * y[k]
+        for k in range(e):
+            f1 += D[i, 1, k] * y[k]
+        for k in range(e):
+            f2 += D[i, 2, k] * y[k]
+        ft = P.mu * math.sqrt(f1 * f1 + f2 * f2)
+        norm += f0 * f0 + ft * ft
+        if i < P.q:
+            viol = max(viol, P.f_min - f0, ft - P.mu * f0)
+    for k in range(P.nl):
+        # a linear row's slack hl + DL y (N) must be >= 0
+        acc = hl[k]
+        for j in range(e):
+            acc += DL[k, j] * y[j]
+        viol = max(viol, -acc)
+    norm = math.sqrt(norm)
+    if viol > opt.violation_tol * max(1.0, norm):
+        return UNDECIDED, math.nan, math.nan, it
+    return code, norm, viol, it
+
+
+@jit_call
+def solve_one(P, W, opt, y):
+    """`attempt`, and a second one with refinement if the first leaves the problem undecided.
+    Returns (code, ||f|| N, worst violation N, iterations of both); fills y."""
+    code, norm, viol, it = attempt(P, W, opt, opt.refine, y)
+    if code == UNDECIDED and opt.retry_refine > opt.refine:
+        # Undecided problems are mostly stalls at a degenerate optimum, where the normal
+        # equations lose accuracy: a second attempt with iterative refinement decides most.
+        code, norm, viol, it2 = attempt(P, W, opt, opt.retry_refine, y)
+        it += it2
+    return code, norm, viol, it
+
+
+@jit_call
+def cone_rows(frames, mu, rows):
+    """Kernel form of the circular cone from the contact frames (m, 3, 3) [n; t1; t2]:
+    rows [n; t1/mu; t2/mu], so that the cone is rows @ f_i in SOC(3) and the linear row
+    n.f - f_min >= 0 is its first row."""
+    for i in range(frames.shape[0]):
+        for q in range(3):
+            rows[i, 0, q] = frames[i, 0, q]
+            rows[i, 1, q] = frames[i, 1, q] / mu
+            rows[i, 2, q] = frames[i, 2, q] / mu
+
+
+
+@jit_call
+def range_basis(F_all, cols, s, threshold, U):
+    """E_s of one set: an orthonormal basis of the range of F = F_all[:, cols[:s]] from its
+    singular vectors whose singular value exceeds `threshold` (the rule of
+    `mechanics.internal_force_basis`), written into the leading columns of U; returns their
+    number. One-sided Jacobi (Hestenes): plane rotations of pairs of F's columns until every
+    pair is orthogonal to ~1e-15 relative; the columns are then U Sigma, and their norms the
+    singular values, to high relative accuracy. Sets hold 1 to 15 synergies, so this is a
+    few sweeps of short loops, without LAPACK's copies, workspace query and allocations."""
+    c = F_all.shape[0]
+    for q in range(s):
+        for k in range(c):
+            U[k, q] = F_all[k, cols[q]]
+    tol = 1e-15 * c
+    for _ in range(60):
+        rotated = False
+        for a in range(s - 1):
+            for b in range(a + 1, s):
+                alpha = 0.0
+                beta = 0.0
+                gamma = 0.0
+                for k in range(c):
+                    alpha += U[k, a] * U[k, a]
+                    beta += U[k, b] * U[k, b]
+                    gamma += U[k, a] * U[k, b]
+                if abs(gamma) <= tol * math.sqrt(alpha * beta):
+                    continue
+                rotated = True
+                zeta = (beta - alpha) / (2.0 * gamma)
+                t = math.copysign(1.0, zeta) / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
+                cs = 1.0 / math.sqrt(1.0 + t * t)
+                sn = cs * t
+                for k in range(c):
+                    ua, ub = U[k, a], U[k, b]
+                    U[k, a] = cs * ua - sn * ub
+                    U[k, b] = sn * ua + cs * ub
+        if not rotated:
+            break
+    rank = 0
+    for q in range(s):
+        norm = 0.0
+        for k in range(c):
+            norm += U[k, q] * U[k, q]
+        norm = math.sqrt(norm)
+        if norm > threshold:
+            for k in range(c):
+                U[k, rank] = U[k, q] / norm
+            rank += 1
+    return rank
+
+
+@jit_alloc
+def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, cone, cone_strict, f_min, strict, opt, out):
+    """Every synergy set of one grasp into `out` (`SetsResult`): E_s from the singular vectors
+    of F_s = F_all[:, set] whose singular value is above the set's threshold (`range_basis`),
+    or, if `given`, F_s itself (orthonormal columns), then the GFO, its forces f_p + E_s y (N)
+    and, if `strict`, the strict internal-force test (f_p = 0, f_min = 1 N, cone_strict).
+    cone, cone_strict: `ConeData` of the same kind. Sets with e_s = 0 get code NOT_SOLVED."""
+    c = F_all.shape[0]
+    m, p = c // 3, cone.lin.shape[1]
+    rows = np.empty((m, 3, 3))
+    rows_strict = np.empty((m, 3, 3))
+    cone_rows(frames, cone.mu, rows)
+    cone_rows(frames, cone_strict.mu, rows_strict)
+    zero = np.zeros(c)
+    W = workspace(m, m if p == 0 else 0, m * p, cols.shape[1])
+    y = np.empty(cols.shape[1])
+    U = np.empty((c, cols.shape[1]))
+    for j in range(cols.shape[0]):
+        if given:
+            rank = n_cols[j]
+            for q in range(rank):
+                for k in range(c):
+                    U[k, q] = F_all[k, cols[j, q]]
+        else:
+            rank = range_basis(F_all, cols[j], n_cols[j], thresholds[j], U)
+        out.e_s[j] = rank
+        if rank == 0:
+            out.code[j] = NOT_SOLVED
+            continue
+        # E_s is the first `rank` columns of U
+        code, out.force_norm[j], out.max_violation[j], out.iterations[j] = solve_one(
+            build(rows, cone.lin, U, fp, rank, cone.mu, f_min, W), W, opt, y)
+        out.code[j] = code
+        if code == OPTIMAL:
+            for k in range(c):
+                acc = fp[k]
+                for q in range(rank):
+                    acc += U[k, q] * y[q]
+                out.forces[j, k] = acc
+        if strict:
+            out.strict_code[j] = solve_one(build(rows_strict, cone_strict.lin, U, zero, rank, cone_strict.mu, 1.0, W),
+                                            W, opt, y)[0]
