@@ -2,7 +2,8 @@
 #   make venv           - build .venv from environment.lock only
 #   make study          - build .venv from environment.lock, then run the full study
 #   make test           - build .venv from environment.lock, then run the test suite
-#   make lint           - snakefmt --check and snakemake --lint (conda/container advice aside)
+#   make lint           - snakefmt --check, snakemake --lint (conda/container advice aside) and
+#                         the package's layers and no import circle (import-linter, pyproject.toml)
 #   make cluster-test   - the small study on a single-node SLURM started here (root; installs SLURM)
 PYTHON ?= python3.11
 VENV   ?= .venv
@@ -40,6 +41,7 @@ test: $(BIN)/.installed
 lint: $(BIN)/.installed
 	$(BIN)/snakefmt --check Snakefile workflow
 	$(BIN)/python tools/check_lint.py
+	$(BIN)/lint-imports
 
 cluster-test: $(BIN)/.installed
 	$(WARM_UP)

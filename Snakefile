@@ -50,23 +50,24 @@ for _name in OBJECTS:
 
 
 # One target per scenario (config/README.md): `snakemake -j2 scenario_<name>`; `scenarios`
-# builds them all. scenario_default is the same study as `figures`.
+# builds them all. scenario_default is the same study as `figures`. A scenario's configuration
+# is read and checked only when one of these targets asks for it.
 for _scenario in SCENARIOS:
 
     rule:
         name:
             f"scenario_{_scenario}"
         input:
-            study_targets(_scenario),
+            scenario_targets(_scenario),
 
 
 rule scenarios:
     input:
-        [f for _scenario in SCENARIOS for f in study_targets(_scenario)],
+        every_scenario_targets,
 
 
 # Every scenario and the summary across them (docs/sensitivity.md).
 rule sensitivity:
     input:
-        [f for _scenario in SCENARIOS for f in study_targets(_scenario)],
+        every_scenario_targets,
         SENSITIVITY_FILES,

@@ -3,8 +3,11 @@
 Prints per object the median (CPU time, `time.process_time`) and 90th-percentile time per grasp over a spread of poses,
 the status counts, the contact-count distribution and how many poses have at least two
 fingers in contact; for the dynamic closure model (``closure.model: dynamic``, on fewer
-poses: it costs more) the same, then ``closure_dynamic_median_ms: N``. Last line:
-``closure_median_ms: N`` (kinematic model) over all objects.
+poses: it costs more) the same, then ``closure_dynamic_median_ms: N``; then
+``closure_median_ms: N`` (kinematic model) over all objects. Last, the kinematic closure on
+each kind of shape (docs/shapes.md) beside a box of the same size, with the study's placement
+and closure settings on the same poses: the median per grasp and its ratio to the box's
+(``closure_shape_ratio_<kind>: N``; issue 25 asks ≤ 1.5 for the sphere and the cylinder).
 
 Usage: bench_closure.py [poses per object, kinematic (300)] [poses per object, dynamic (60)]
 """
@@ -19,12 +22,19 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from synergrasp.config import defaults, step_params, validate_config  # noqa: E402
+from synergrasp.config import defaults, validate_config  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
-from synergrasp.simulation.closure import closure_model, place_object  # noqa: E402
+from synergrasp.simulation.closure import SimulateParams, closure_model, place_object  # noqa: E402
 from synergrasp.simulation.placement import pose_grid  # noqa: E402
 from synergrasp.simulation.scene import HandScene  # noqa: E402
+from synergrasp.simulation.shapes import Box, Cylinder, Sphere  # noqa: E402
+
+#: The shapes timed against the box: (name, shape, placement.box_axes).
+SHAPES = (("box 60 mm", Box((60.0, 60.0, 60.0)), (0, 1, 2)),
+          ("sphere r 30 mm", Sphere(30.0), (0, 1, 2)),
+          ("cylinder r 30 x 120 mm, axis along the fingers", Cylinder(30.0, 120.0), (0, 1, 2)),
+          ("cylinder r 30 x 120 mm, axis along the palm normal", Cylinder(30.0, 120.0), (2, 0, 1)))
 
 
 def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_median_ms") -> None:
@@ -33,7 +43,7 @@ def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_media
     study = validate_config({**defaults(), "closure": {**defaults()["closure"], "model": model}})
     hand = load_hand()
     synergies = load_synergies(None, joint_names=hand.joint_names)
-    first = step_params(study, "simulate", next(iter(study["objects"])))
+    first = SimulateParams.from_config(study, next(iter(study["objects"])))
     grid = pose_grid(first.placement)
     poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
     print(f"closure model: {model}")
@@ -42,7 +52,7 @@ def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_media
     all_times = []
     try:
         for name in study["objects"]:
-            sim = step_params(study, "simulate", name)
+            sim = SimulateParams.from_config(study, name)
             obj, placement = sim.object, sim.placement
             times, placing, statuses, counts, two_fingers = [], [], [], [], 0
             for pose in poses:
@@ -72,6 +82,41 @@ def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_media
     print(f"{key}: {np.median(all_times):.2f}")
 
 
+def shapes(n_poses: int = 300) -> None:
+    """The kinematic closure per kind of shape, against the box, on the same poses (one core)."""
+    from dataclasses import replace
+
+    study = defaults()
+    hand = load_hand()
+    synergies = load_synergies(None, joint_names=hand.joint_names)
+    sim = step_params(study, "simulate", next(iter(study["objects"])))
+    grid = pose_grid(sim.placement)
+    poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
+    closer = closure_model(hand, synergies, sim.closure)
+    placer = HandScene(hand)
+    medians = {}
+    try:
+        for name, shape, axes in SHAPES:
+            placement = replace(sim.placement, box_axes=axes)
+            times, contacts = [], []
+            for pose in poses:
+                t0 = time.process_time()
+                placed = place_object(placer, closer.q_open, placement, shape, *grid.angles_deg(int(pose)))
+                result = closer.grasp(placed)
+                times.append(time.process_time() - t0)
+                contacts.append(len(result.links))
+            medians[name] = float(np.median(times)) * 1e3
+            print(f"{name}: {len(poses)} poses, median {medians[name]:.2f} ms, p90 {1e3 * np.percentile(times, 90):.2f} ms "
+                  f"per grasp, median {np.median(contacts):g} contacts")
+    finally:
+        closer.close()
+        placer.close()
+    box = medians[SHAPES[0][0]]
+    for name, shape, _ in SHAPES[1:]:
+        print(f"closure_shape_ratio_{shape.kind}: {medians[name] / box:.2f}  ({name})")
+
+
 if __name__ == "__main__":
     main(int(sys.argv[2]) if len(sys.argv) > 2 else 60, "dynamic", "closure_dynamic_median_ms")
     main(int(sys.argv[1]) if len(sys.argv) > 1 else 300)
+    shapes(int(sys.argv[1]) if len(sys.argv) > 1 else 300)

@@ -18,7 +18,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from synergrasp.config import defaults, step_params
+from synergrasp.config import defaults
+from synergrasp.optimisation.study import OptimiseParams
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.problem import GraspSets, SynergySets
 from synergrasp.optimisation.problems import random_grasp, random_synergies
@@ -46,7 +47,7 @@ def main() -> None:
     n_poses = max(1, args.problems // len(sets))
     grasps = [random_grasp(rng, int(rng.integers(4, 13)), palm_contacts=int(rng.integers(0, 2))) for _ in range(n_poses)]
     # the study's mechanics (configuration defaults), gravity along the benchmark grasps' -z
-    params = replace(step_params(defaults(), "optimise", "obj1").gfo, gravity_direction=(0.0, 0.0, -1.0))
+    params = replace(OptimiseParams.from_config(defaults(), "obj1").gfo, gravity_direction=(0.0, 0.0, -1.0))
     synergies = SynergySets(random_synergies(rng), tuple(sets))
     n = n_poses * len(sets)
 

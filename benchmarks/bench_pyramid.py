@@ -18,7 +18,8 @@ from dataclasses import replace
 import numpy as np
 from bench_gfo import study_sets
 
-from synergrasp.config import defaults, step_params
+from synergrasp.config import defaults
+from synergrasp.optimisation.study import OptimiseParams
 from synergrasp.optimisation import gfo
 from synergrasp.optimisation.problem import SynergySets
 from synergrasp.optimisation.problems import random_grasp, random_synergies
@@ -37,7 +38,7 @@ def main() -> None:
     grasps = [random_grasp(rng, int(rng.integers(4, 13)), palm_contacts=int(rng.integers(0, 2))) for _ in range(200)]
     grasps = grasps[:args.grasps]
     synergies = SynergySets(random_synergies(rng), tuple(sets))
-    base = replace(step_params(defaults(), "optimise", "obj1").gfo, gravity_direction=(0.0, 0.0, -1.0))
+    base = replace(OptimiseParams.from_config(defaults(), "obj1").gfo, gravity_direction=(0.0, 0.0, -1.0))
     n = len(grasps) * len(sets)
     print(f"{n} (pose, set) pairs, mu = {base.mu}, strict test on; pairs per CPU second, median of {args.repeats}")
     study_method = gfo.FASTEST_METHOD["pyramid"]

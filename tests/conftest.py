@@ -4,10 +4,12 @@ from dataclasses import replace
 
 import pytest
 
-from synergrasp.config import defaults, step_params
-
+from synergrasp.analysis.summaries import TablesParams
+from synergrasp.config import _resolve, defaults, load_schema
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
+from synergrasp.optimisation.study import OptimiseParams
+from synergrasp.simulation.closure import SimulateParams
 
 
 @pytest.fixture(scope="session")
@@ -29,26 +31,38 @@ BAND = 1e-4
 def study_gfo_params(**changes):
     """The study's GFO parameters (the configuration's defaults, obj1's weight) with
     ``changes`` replacing fields; the one path from configuration to parameters."""
-    return replace(step_params(defaults(), "optimise", "obj1").gfo, **changes)
+    return replace(OptimiseParams.from_config(defaults(), "obj1").gfo, **changes)
 
 
 def study_placement(obj="obj1", **changes):
     """The study's placement of ``obj`` with its pose grid (the configuration's defaults),
     with ``changes`` replacing fields."""
-    return replace(step_params(defaults(), "simulate", obj).placement, **changes)
+    return replace(SimulateParams.from_config(defaults(), obj).placement, **changes)
 
 
 def study_dynamic_params(**changes):
     """The dynamic closure's settings of the configuration's defaults, ``changes`` replaced."""
-    return replace(step_params(defaults(), "simulate", "obj1").closure.dynamic, **changes)
+    return replace(SimulateParams.from_config(defaults(), "obj1").closure.dynamic, **changes)
 
 
 def study_closure_params(**changes):
     """The study's closure settings (the configuration's defaults), ``changes`` replaced."""
-    return replace(step_params(defaults(), "simulate", "obj1").closure, **changes)
+    return replace(SimulateParams.from_config(defaults(), "obj1").closure, **changes)
 
 
 def study_analysis_settings(**changes):
     """The study's analysis settings (the configuration's defaults) for tables of made-up
     objects (no weights, no α-periods), with ``changes`` replacing fields."""
-    return replace(step_params(defaults(), "tables").settings, weights_N={}, periods_deg={}, **changes)
+    return replace(TablesParams.from_config(defaults()).settings, weights_N={}, periods_deg={}, **changes)
+
+
+def schema_leaf_paths(node=None, prefix=""):
+    """Every key path of the configuration schema, objects' own keys as objects.*.<key>."""
+    schema = _resolve(load_schema() if node is None else node)
+    props = schema.get("properties", {})
+    extra = schema.get("additionalProperties")
+    if not props and isinstance(extra, dict) and _resolve(extra).get("properties"):
+        return schema_leaf_paths(extra, f"{prefix}*.")
+    if not props:
+        return [prefix.rstrip(".")]
+    return [p for name, sub in props.items() for p in schema_leaf_paths(sub, f"{prefix}{name}.")]

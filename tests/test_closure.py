@@ -11,7 +11,8 @@ import pytest
 from conftest import study_closure_params, study_placement
 from synergrasp.config import ConfigError, defaults, validate_config
 from synergrasp.simulation.closure import simulate_object
-from synergrasp.simulation.contacts import read_grasps, write_contacts
+from synergrasp.optimisation.study import read_grasps
+from synergrasp.simulation.contacts import write_contacts
 from synergrasp.simulation.placement import approach_line, object_pose, palm_centre, pose_grid
 from synergrasp.hand.kinematics import forward_kinematics
 from synergrasp.hand.synergies import SynergyPath, load_synergies

@@ -5,7 +5,8 @@ import pandas as pd
 import pytest
 
 from synergrasp import tables
-from synergrasp.simulation.contacts import load_carrying_contacts, read_grasps
+from synergrasp.optimisation.study import read_grasps
+from synergrasp.simulation.contacts import load_carrying_contacts
 
 
 def _row(pose: int, links: list[int], loads: list[float], status: str = "grasp") -> dict:

@@ -9,11 +9,12 @@ import pybullet as pb
 import pytest
 
 from conftest import study_closure_params, study_dynamic_params, study_placement
-from synergrasp.config import ConfigError, defaults, step_params, validate_config
+from synergrasp.config import ConfigError, defaults, validate_config
 from synergrasp.hand.synergies import Synergies, SynergyPath
 from synergrasp.simulation.capsules import HandCapsules
 from synergrasp.simulation.closure import closure_model, simulate_object
-from synergrasp.simulation.dynamic_closure import DynamicParams
+from synergrasp.simulation.closure import SimulateParams
+from synergrasp.simulation.closure_params import DynamicParams
 from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.shapes import Box
 from synergrasp.simulation.placement import ObjectPose, object_pose
@@ -51,7 +52,7 @@ def test_settings_name_the_key_and_allowed_values():
         validate_config(_with_dynamic(time_limit_s=0.2))
     # the workflow's one path from the config to the parameters
     config = validate_config(_with_dynamic(settle_window_s=0.1))
-    params = step_params(config, "simulate", "obj1").closure.dynamic
+    params = SimulateParams.from_config(config, "obj1").closure.dynamic
     assert isinstance(params, DynamicParams) and params.settle_window_s == 0.1 and params.window_steps == 24
     with pytest.raises(ValueError, match="needs the mechanics block"):
         closure_model(None, None, PARAMS)  # type: ignore[arg-type]
@@ -196,7 +197,7 @@ def test_a_box_moved_but_left_inside_the_closed_hand_is_caged(hand, synergies):
     toward the wrist and close past it; nothing touches it at the end, and its centre is inside
     the closed hand's hull, so it is caged, not lost."""
     config = {**defaults(), "closure": {**defaults()["closure"], "model": "dynamic"}}
-    sim = step_params(config, "simulate", "obj1")
+    sim = SimulateParams.from_config(config, "obj1")
     row = simulate_object(hand, synergies, sim.object, sim.placement, sim.closure, poses=[0],
                           mechanics=sim.mechanics).iloc[0]
     assert row["status"] == "caged" and row["n_contacts"] == 0

@@ -3,19 +3,21 @@ import math
 import numpy as np
 import pytest
 
-from synergrasp.config import defaults, step_params
+from synergrasp.config import defaults
+from synergrasp.figures.hand_figures import Fig2Params
+from synergrasp.optimisation.study import OptimiseParams
 from synergrasp.simulation.objects import GraspedObject, ObjectError
 from synergrasp.simulation.shapes import Box, ShapeError, shape_from_config
 
 
 def test_study_objects_from_the_config_defaults():
-    objects = step_params(defaults(), "fig2").objects
+    objects = Fig2Params.from_config(defaults()).objects
     assert [o.name for o in objects] == ["obj1", "obj2", "obj3", "obj4"]
     assert all(o.shape.kind == "box" for o in objects)
     assert objects[3].shape.size_mm == (100.0, 60.0, 100.0)
     np.testing.assert_array_equal(objects[1].shape.half_extents_mm, [15, 30, 30])
     assert all(o.mass_kg is None for o in objects)  # Fig. 2 does not read the masses
-    assert all(step_params(defaults(), "optimise", o.name).gfo.mass_kg == 1.0 for o in objects)
+    assert all(OptimiseParams.from_config(defaults(), o.name).gfo.mass_kg == 1.0 for o in objects)
     heavy = GraspedObject("a", Box((1, 2, 3)), 1)
     assert heavy.mass_kg == 1.0 and isinstance(heavy.mass_kg, float)
 

@@ -10,9 +10,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from synergrasp.config import defaults, overlay, step_params
-from synergrasp.simulation import placement_search
-from synergrasp.simulation.placement_search import (
+from synergrasp.config import defaults, overlay
+from synergrasp.optimisation import placement_search
+from synergrasp.optimisation.placement_search import (
+    SearchStepParams,
     SearchParams,
     TargetScore,
     distinct_ranks,
@@ -104,7 +105,7 @@ def test_distinct_ranks_skip_targets_too_close_to_a_better_one():
 
 
 def _params(**changes):
-    return replace(step_params(defaults(), "search", "obj1").search, **changes)
+    return replace(SearchStepParams.from_config(defaults(), "obj1").search, **changes)
 
 
 def test_the_default_region_is_a_20_mm_lattice_of_135_targets_refined_at_10_mm():
@@ -120,7 +121,7 @@ def test_the_default_region_is_a_20_mm_lattice_of_135_targets_refined_at_10_mm()
 
 
 def test_scored_poses_are_the_first_alpha_period_on_the_search_steps():
-    sim = step_params(defaults(), "search", "obj1")
+    sim = SearchStepParams.from_config(defaults(), "obj1")
     poses = pose_subset(sim.placement, 90.0, sim.search)
     from synergrasp.simulation.placement import pose_grid
 
@@ -137,7 +138,7 @@ def _tiny(obj="obj1", **search):
     cfg = overlay(defaults(), {"placement": {"search": {
         "region_mm": {"x": [9.5, 9.5], "y": [-10.0, -10.0], "z": [60.0, 80.0]}, "pose_alpha_step_deg": 60.0,
         "pose_beta_step_deg": 60.0, "refine_top": 1, "max_rounds": 1, **search}}})
-    return step_params(cfg, "search", obj)
+    return SearchStepParams.from_config(cfg, obj)
 
 
 def _run(sim, hand, synergies, processes=1):

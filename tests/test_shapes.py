@@ -13,13 +13,13 @@ import yaml
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from synergrasp.simulation.shapes import Box, start_rotation
+from synergrasp.simulation.shapes import Box, Cylinder, Sphere, start_rotation
 
 RNG = np.random.default_rng(25)
 #: Spacing (mm) of the dense surface samples; a sampled distance exceeds the exact one by less.
 SPACING_MM = 0.25
 
-SHAPES = [Box((30.0, 60.0, 100.0)), Box((30.0, 30.0, 30.0))]
+SHAPES = [Box((30.0, 60.0, 100.0)), Box((30.0, 30.0, 30.0)), Sphere(25.0), Cylinder(30.0, 120.0), Cylinder(40.0, 15.0)]
 
 
 def dense_surface(shape, spacing=SPACING_MM) -> np.ndarray:
@@ -37,6 +37,24 @@ def dense_surface(shape, spacing=SPACING_MM) -> np.ndarray:
                 face[:, i], face[:, j], face[:, k] = uu.ravel(), vv.ravel(), side * h[k]
                 faces.append(face)
         return np.concatenate(faces)
+    if shape.kind == "sphere":  # a Fibonacci lattice, ~spacing apart
+        n = int(np.ceil(4 * np.pi * shape.radius_mm ** 2 / spacing ** 2))
+        k = np.arange(n) + 0.5
+        z = 1 - 2 * k / n
+        phi = np.pi * (1 + 5 ** 0.5) * k
+        s = np.sqrt(1 - z * z)
+        return shape.radius_mm * np.c_[s * np.cos(phi), s * np.sin(phi), z]
+    if shape.kind == "cylinder":
+        r, hh = shape.radius_mm, shape.half_height_mm
+        phi = np.linspace(0, 2 * np.pi, int(np.ceil(2 * np.pi * r / spacing)), endpoint=False)
+        z = np.linspace(-hh, hh, int(np.ceil(2 * hh / spacing)) + 1)
+        pp, zz = np.meshgrid(phi, z, indexing="ij")
+        wall = np.c_[r * np.cos(pp.ravel()), r * np.sin(pp.ravel()), zz.ravel()]
+        u = np.arange(-r, r + spacing / 2, spacing / 1.5)
+        xx, yy = np.meshgrid(u, u, indexing="ij")
+        disc = np.c_[xx.ravel(), yy.ravel()][xx.ravel() ** 2 + yy.ravel() ** 2 <= r * r]
+        caps = [np.c_[disc, np.full(len(disc), side * hh)] for side in (-1.0, 1.0)]
+        return np.concatenate([wall, *caps])
     raise AssertionError(f"no sampler for {shape.kind}")
 
 
@@ -44,6 +62,10 @@ def inside(shape, points: np.ndarray) -> np.ndarray:
     """Brute-force membership (own frame), independent of the shape's methods."""
     if shape.kind == "box":
         return np.all(np.abs(points) <= shape.half_extents_mm, axis=-1)
+    if shape.kind == "sphere":
+        return np.linalg.norm(points, axis=-1) <= shape.radius_mm
+    if shape.kind == "cylinder":
+        return (np.hypot(points[..., 0], points[..., 1]) <= shape.radius_mm) & (np.abs(points[..., 2]) <= shape.half_height_mm)
     raise AssertionError(shape.kind)
 
 
@@ -214,11 +236,93 @@ def _contacts_digest(table) -> str:
 
 
 def test_the_box_gives_the_contacts_of_8966525_bit_for_bit_on_the_small_config(hand, synergies):
-    from synergrasp.config import step_params, validate_config
-    from synergrasp.simulation.closure import simulate_object
+    from synergrasp.config import validate_config
+    from synergrasp.simulation.closure import SimulateParams, simulate_object
 
     config = validate_config(yaml.safe_load((Path(__file__).parent / "config" / "small.yaml").read_text()))
     for name, pinned in PINNED_SMALL_CONTACTS.items():
-        sim = step_params(config, "simulate", name)
+        sim = SimulateParams.from_config(config, name)
         table = simulate_object(hand, synergies, sim.object, sim.placement, sim.closure)
         assert _contacts_digest(table) == pinned, name
+
+
+# ------------------------------------------------------------------ symmetry through the closure
+
+_COMPARED = ("status", "q", "contact_link", "contact_point", "contact_normal", "object_center")
+
+
+def _same_grasps(table, rows, atol=1e-6):
+    first = table.iloc[rows[0]]
+    for i in rows[1:]:
+        other = table.iloc[i]
+        for column in _COMPARED:
+            a, b = first[column], other[column]
+            if isinstance(a, str):
+                assert a == b, (column, i)
+            else:
+                np.testing.assert_allclose(np.asarray(b, dtype=float), np.asarray(a, dtype=float), atol=atol,
+                                           err_msg=f"{column} at row {i}")
+
+
+def test_a_sphere_on_the_approach_gives_the_same_grasp_at_every_pose(hand, synergies):
+    """A sphere turned about its centre fills the same region: brought toward the palm centre
+    it stops at the same place and the hand closes on it the same way at every (α, β)."""
+    from conftest import study_closure_params, study_placement
+    from synergrasp.simulation.closure import simulate_object
+    from synergrasp.simulation.objects import GraspedObject
+
+    ball = GraspedObject("ball", Sphere(30.0), 0.2)
+    poses = [0, 137, 512, 901, 1250, 1799]
+    table = simulate_object(hand, synergies, ball, study_placement(), study_closure_params(), poses=poses)
+    assert (table.status == "grasp").all() and (table.n_contacts >= 2).all()
+    _same_grasps(table, list(range(len(poses))))
+
+
+@pytest.mark.parametrize("axes, period", [((2, 0, 1), 5.0), ((0, 1, 2), 180.0)])
+def test_the_cylinders_period_and_its_grasps_repeat_with_it(hand, synergies, axes, period):
+    """Axis along the palm normal (the α axis): every α step is a symmetry; axis along the
+    fingers: the half turn. The α-period says so, and the closure repeats with it."""
+    from conftest import study_closure_params, study_placement
+    from synergrasp.analysis.periods import alpha_period_deg
+    from synergrasp.simulation.closure import simulate_object
+    from synergrasp.simulation.objects import GraspedObject
+    from synergrasp.simulation.placement import pose_grid
+
+    can = GraspedObject("can", Cylinder(30.0, 120.0), 0.5)
+    placement = study_placement(box_axes=axes)
+    assert alpha_period_deg(placement, can.shape) == period
+    grid = pose_grid(placement)
+    for alpha, beta in [(-30.0, 0.0), (40.0, 25.0)]:
+        shifted = (alpha + period + 180.0) % 360.0 - 180.0
+        poses = [grid.index(alpha, beta), grid.index(shifted, beta)]
+        table = simulate_object(hand, synergies, can, placement, study_closure_params(), poses=poses)
+        assert (table.status == "grasp").all()
+        _same_grasps(table, [0, 1])
+    if period < 90.0:  # not the half turn: the grasp is the same at every α
+        poses = [grid.index(a, 10.0) for a in (-180.0, -95.0, 0.0, 135.0)]
+        _same_grasps(simulate_object(hand, synergies, can, placement, study_closure_params(), poses=poses), [0, 1, 2, 3])
+
+
+@pytest.mark.parametrize("shape", [Box((30.0, 60.0, 100.0)), Sphere(25.0), Cylinder(30.0, 120.0)],
+                         ids=lambda s: s.kind)
+def test_the_engines_collision_shape_is_the_same_shape(shape):
+    """pybullet's body of the shape (``collision_geometry``), turned and moved, against small
+    probe spheres off the middle of its faces (where the engine does not round its edges):
+    the engine's distances are the shape's ``gap`` (float32 and its solver: 0.05 mm); so its sizes and axes
+    are the shape's."""
+    from synergrasp.simulation import bullet
+
+    R, c = Rotation.from_rotvec([0.3, -0.5, 0.2]).as_matrix(), np.array([10.0, -4.0, 30.0])
+    client = bullet.connect()
+    try:
+        obj = bullet.load_object(client, shape, c, R)
+        for u in np.vstack([np.eye(3), -np.eye(3)]) @ R.T:  # its own axes, palm frame
+            on, _ = shape.surface_point(c + u * (shape.bounding_radius_mm + 5.0), R, c)
+            for offset in (3.0, 7.5):
+                point = on + offset * u
+                probe = bullet.load_object(client, Sphere(1.0), point)
+                near = bullet.closest_points(client, obj, probe, 50.0)
+                assert abs(float(near.distance.min()) + 1.0 - shape.gap(point[None], R, c)[0]) < 0.05
+                bullet.remove_body(client, probe)
+    finally:
+        bullet.disconnect(client)

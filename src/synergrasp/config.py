@@ -9,52 +9,41 @@
 - **Checks** run once, before any job: the schema (keys, types, ranges; no NaN or inf; whole
   numbers for integers; text names), then :func:`check_relations` (every relation between
   values). Each problem is one line naming the config key and what is allowed.
-- **Steps**: :data:`STEP_KEYS` says which keys each step of the workflow reads;
-  :func:`step_config` cuts a configuration down to them (the workflow passes only that to a
-  rule, so a step reruns only when a key it reads changes, and scenarios share a step's
-  outputs when its keys agree, :func:`step_hash`), and :func:`step_params` turns it into
-  the step's typed parameters (units kept in the names).
+- **Parameters**: each stage builds its typed parameters from the configuration itself (a
+  ``from_config`` beside the parameter class), with :func:`build` turning a value the class
+  rejects into a ConfigError naming the config key. Which keys each step of the workflow
+  reads is stated once, in :mod:`synergrasp.steps`.
+
+This module is the lowest layer of the package: it imports no stage.
 """
 
 from __future__ import annotations
 
 import copy
 import functools
-import hashlib
-import importlib
-import itertools
-import json
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from synergrasp.simulation.objects import GraspedObject
-from synergrasp.simulation.shapes import ShapeError, shape_from_config
 from synergrasp.yaml_io import read_yaml
 
 __all__ = [
     "ConfigError",
     "SCHEMA_PATH",
-    "STEP_KEYS",
     "defaults",
     "overlay",
     "validate_config",
     "check_relations",
     "synergy_problems",
+    "scenario_names",
+    "scenario_config",
     "scenario_configs",
-    "step_config",
-    "step_hash",
-    "step_upstream_when",
-    "step_params",
-    "placement_params",
     "grid_axis_deg",
-    "synergy_sets",
-    "incremental_set_id",
-    "set_id",
+    "build",
+    "dataclass_fields",
 ]
 
 #: The schema: keys, types, ranges, descriptions and every default.
@@ -316,11 +305,6 @@ def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -
     if bad_k:
         problems.append(f"config error at 'analyses.fig4.panel_k': {bad_k} exceed "
                         f"synergy_sets.incremental_max ({k_max})")
-    for name, spec in config["objects"].items():
-        try:
-            shape_from_config(spec["shape"], f"objects.{name}.shape")
-        except ShapeError as err:
-            problems.append(f"config error at {err}")
     if not _grid_problems(config["grid"]):
         problems += _pose_problems(config)
         problems += _search_problems(config)
@@ -395,13 +379,17 @@ def _pose_problems(config: Mapping[str, Any]) -> list[str]:
 
 # --------------------------------------------------------------------------- scenarios
 
-def scenario_configs(config: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
-    """Every scenario's complete configuration by name, ``default`` (the configuration
-    itself) first, then the ``scenarios:`` in their given order.
+def scenario_names(config: Mapping[str, Any]) -> list[str]:
+    """The scenarios' names, ``default`` (the configuration itself) first, then the
+    ``scenarios:`` in their given order; nothing of them is checked here."""
+    return [DEFAULT_SCENARIO, *(config.get("scenarios") or {})]
 
-    Each scenario is the configuration (without ``scenarios``) overlaid with the scenario's
-    mapping (:func:`overlay`), validated like the configuration itself. Synergy-count
-    bounds are checked by the caller (they need the synergy file).
+
+def scenario_config(config: Mapping[str, Any], name: str) -> dict[str, Any]:
+    """One scenario's complete, checked configuration: the configuration (without
+    ``scenarios``) overlaid with the scenario's mapping (:func:`overlay`), validated like the
+    configuration itself; ``default`` is the configuration. Synergy-count bounds are checked
+    by the caller (they need the synergy file).
 
     Raises
     ------
@@ -409,301 +397,39 @@ def scenario_configs(config: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
         Naming the scenario and the key.
     """
     main = validate_config(config)
-    base = {k: v for k, v in config.items() if k != "scenarios"}
-    out = {DEFAULT_SCENARIO: {**main, "scenarios": {}}}
-    problems = []
-    for name, changes in main["scenarios"].items():
-        if "scenarios" in changes:
-            problems.append(f"scenario '{name}': config error at 'scenarios': a scenario cannot define scenarios")
-            continue
+    if name == DEFAULT_SCENARIO:
+        return {**main, "scenarios": {}}
+    if name not in main["scenarios"]:
+        raise ConfigError(f"config error at 'scenarios': no scenario {name!r}; allowed values: "
+                          f"{scenario_names(main)}")
+    changes = main["scenarios"][name]
+    if "scenarios" in changes:
+        raise ConfigError(f"scenario '{name}': config error at 'scenarios': a scenario cannot define scenarios")
+    try:
+        return validate_config(overlay({k: v for k, v in config.items() if k != "scenarios"}, changes))
+    except ConfigError as err:
+        raise ConfigError("\n".join(f"scenario '{name}': {line}" for line in str(err).splitlines())) from None
+
+
+def scenario_configs(config: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
+    """Every scenario's complete configuration by name (:func:`scenario_config`), ``default``
+    first; every problem of every scenario in one ConfigError."""
+    out, problems = {}, []
+    for name in scenario_names(validate_config(config)):
         try:
-            out[name] = validate_config(overlay(base, changes))
+            out[name] = scenario_config(config, name)
         except ConfigError as err:
-            problems += [f"scenario '{name}': {line}" for line in str(err).splitlines()]
+            problems += str(err).splitlines()
     if problems:
         raise ConfigError("\n".join(problems))
     return out
 
 
-# --------------------------------------------------------------------------- steps
-
-#: The configuration keys each step reads ("objects.{object}" is the step's object,
-#: "objects.*" every object). A step's rule is given only these (step_config), so it reruns
-#: only when one of them changes, and two scenarios share its outputs when they agree on
-#: them. A new key: one schema entry, plus its path here if a step reads it.
-STEP_KEYS: dict[str, tuple[str, ...]] = {
-    "simulate": ("hand", "synergies", "grid", "placement", "closure",
-                 "objects.{object}.shape", "objects.{object}.placement"),
-    "contacts": ("closure.model",),
-    "optimise": ("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg"),
-    "minima": ("analyses.minima_radius_deg", "analyses.success"),
-    "tables": ("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max", "analyses.success",
-               "analyses.marginal_weight_multiple", "analyses.success_rate_tolerance_percent",
-               "analyses.null_model", "analyses.headline_view", "analyses.tie_band", "analyses.min_distinct_poses",
-               "analyses.bootstrap", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
-    "realism": ("hand", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2"),
-    "fig1": ("hand", "synergies"),
-    "fig2": ("hand", "objects.*.shape"),
-    "fig4": ("analyses.fig4", "analyses.success"),
-    "fig5": ("synergy_sets.hierarchy_first", "analyses.success"),
-    # the placement search (docs/placement_search.md): the kinematic closure and the
-    # optimisation with the full set {S1..S_incremental_max} only
-    "search": ("hand", "synergies", "grid", "placement", "closure", "mechanics", "synergy_sets.incremental_max",
-               "objects.{object}.shape", "objects.{object}.mass_kg", "objects.{object}.placement"),
-}
-#: The keys of the choice of which contacts count (the ``contacts`` step).
-_CONTACT_SELECTION = ("closure.dynamic.unloaded_contacts", "closure.dynamic.load_threshold_N")
-#: The keys of the force bound of ``analyses.success: force_closure_bounded``.
-_FORCE_BOUND = ("analyses.marginal_weight_multiple", "objects.{object}.mass_kg", "mechanics.g_m_per_s2")
-#: Keys a step reads only when another key has a given value: step -> ((key, value, reads), ...).
-STEP_KEYS_WHEN: dict[str, tuple[tuple[str, Any, tuple[str, ...]], ...]] = {
-    # the dynamic closure: a free box of the object's mass, μ, k_ss and gravity of mechanics
-    "simulate": (("closure.model", "dynamic", ("objects.{object}.mass_kg", "mechanics")),),
-    # which contacts count: only the dynamic model records the load each contact carries
-    "contacts": (("closure.model", "dynamic", _CONTACT_SELECTION),),
-    "realism": (("closure.model", "dynamic", ("closure.dynamic.load_threshold_N",)),),
-    # force closure within a multiple of the weight: the minima and Fig. 4 read the bound
-    "minima": (("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
-    "fig4": (("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
-}
-#: Keys inside a block a step reads that the step itself does not read: step -> key paths.
-#: The closure lists every touching link with its load; which of them count is the
-#: ``contacts`` step's choice, so that ``drop`` and ``keep`` share one simulation.
-#: The closure does not read the search's settings (a searched placement reads its output);
-#: the search does not read which target a mode uses, nor the closure model (it always
-#: closes with the kinematic model, docs/placement_search.md).
-_PLACEMENT_TARGETS = ("mode", "search_rank", "approach_point_mm", "center_mm")
-STEP_KEYS_EXCEPT: dict[str, tuple[str, ...]] = {
-    "simulate": (*_CONTACT_SELECTION, "placement.search", "objects.{object}.placement.search"),
-    "search": ("closure.model", "closure.dynamic",
-               *(f"{where}.{key}" for where in ("placement", "objects.{object}.placement") for key in _PLACEMENT_TARGETS)),
-}
-#: The steps whose outputs a step reads (its hash includes theirs): for a step run per object
-#: (OBJECT_STEPS), that object's; for a step run once per scenario, every object's.
-UPSTREAM: dict[str, tuple[str, ...]] = {
-    "contacts": ("simulate",), "optimise": ("contacts",), "minima": ("optimise",), "tables": ("optimise", "minima"),
-    "realism": ("contacts", "optimise"), "fig2": ("contacts",), "fig4": ("optimise", "minima"),
-    "fig5": ("tables",)}
-#: Steps whose outputs a step reads only when a key of the object's effective placement
-#: has a value: the closure of a searched placement reads the search's targets.
-UPSTREAM_WHEN: dict[str, tuple[tuple[str, Any, str], ...]] = {"simulate": (("mode", "searched", "search"),)}
-#: Steps run once per object (the others once per scenario).
-OBJECT_STEPS: frozenset[str] = frozenset({"simulate", "contacts", "optimise", "minima", "fig4", "search"})
-#: Steps that read only some synergies of the synergy table: step -> the synergies (1-based)
-#: it reads besides the mean posture. Their hash holds those values, not the table's name,
-#: so tables that agree there (thumb readings that differ in S2…S15 only) share the step.
-SYNERGY_COLUMNS_READ: dict[str, tuple[int, ...]] = {"simulate": (1,)}
-#: Keys read by the workflow itself, not by a step.
-WORKFLOW_KEYS: tuple[str, ...] = ("scenarios",)
-
-
-def _get(config: Mapping[str, Any], path: str) -> Any:
-    node: Any = config
-    for part in path.split("."):
-        if not isinstance(node, Mapping) or part not in node:
-            return _MISSING
-        node = node[part]
-    return node
-
-
-def _put(out: dict[str, Any], path: str, value: Any) -> None:
-    *parents, last = path.split(".")
-    for part in parents:
-        out = out.setdefault(part, {})
-    out[last] = copy.deepcopy(value)
-
-
-def step_keys(config: Mapping[str, Any], step: str, obj: str | None = None) -> list[str]:
-    """The key paths ``step`` reads in ``config`` (for object ``obj`` where it matters)."""
-    if step not in STEP_KEYS:
-        raise ValueError(f"unknown step {step!r}; allowed values: {sorted(STEP_KEYS)}")
-    paths = list(STEP_KEYS[step])
-    for key, value, reads in STEP_KEYS_WHEN.get(step, ()):
-        if _get(config, key) == value:
-            paths += reads
-    out = []
-    for path in paths:
-        if path.startswith("objects.*"):
-            out += [path.replace("*", name, 1) for name in config["objects"]]
-        elif "{object}" in path:
-            if obj is None:
-                raise ValueError(f"step {step!r} reads {path}: an object is required")
-            out.append(path.format(object=obj))
-        else:
-            out.append(path)
-    return out
-
-
-def step_config(config: Mapping[str, Any], step: str, obj: str | None = None) -> dict[str, Any]:
-    """The part of ``config`` that ``step`` reads, in the configuration's own shape."""
-    out: dict[str, Any] = {}
-    for path in step_keys(config, step, obj):
-        value = _get(config, path)
-        if value is not _MISSING:
-            _put(out, path, value)
-    for path in STEP_KEYS_EXCEPT.get(step, ()):
-        if "{object}" in path:
-            if obj is None:
-                continue
-            path = path.format(object=obj)
-        *parents, last = path.split(".")
-        node = _get(out, ".".join(parents))
-        if isinstance(node, dict):
-            node.pop(last, None)
-    return out
-
-
-def step_hash(config: Mapping[str, Any], step: str, obj: str | None = None) -> str:
-    """Hash of what a step's outputs depend on: the keys it reads and, through
-    :data:`UPSTREAM`, those of the steps before it (12 hex digits). ``obj``: the object of
-    a step of :data:`OBJECT_STEPS`; None for a step run once per scenario."""
-    own = step_config(config, step, obj)
-    if step in SYNERGY_COLUMNS_READ:
-        own["synergies"] = _synergy_digest(own.get("hand"), own["synergies"], SYNERGY_COLUMNS_READ[step])
-    parts: list[Any] = [own]
-    for upstream in (*UPSTREAM.get(step, ()), *step_upstream_when(config, step, obj)):
-        if upstream in OBJECT_STEPS and obj is None:
-            parts.append([[name, step_hash(config, upstream, name)] for name in config["objects"]])
-        else:
-            parts.append(step_hash(config, upstream, obj if upstream in OBJECT_STEPS else None))
-    text = json.dumps(parts, sort_keys=True, default=str)
-    return hashlib.sha256(text.encode()).hexdigest()[:12]
-
-
-def step_upstream_when(config: Mapping[str, Any], step: str, obj: str | None = None) -> tuple[str, ...]:
-    """The steps ``step`` reads for ``obj`` besides :data:`UPSTREAM`, from the object's
-    effective placement (:data:`UPSTREAM_WHEN`): ``search`` for a searched placement."""
-    if obj is None or step not in UPSTREAM_WHEN:
-        return ()
-    placement = overlay(config["placement"], config["objects"][obj].get("placement"))
-    return tuple(up for key, value, up in UPSTREAM_WHEN[step] if placement.get(key) == value)
-
-
-@functools.cache
-def _synergy_digest(hand: str | None, synergies: str | None, columns: tuple[int, ...]) -> str:
-    """SHA-256 of the mean posture and the synergies ``columns`` (1-based) of a synergy table,
-    as loaded for ``hand`` (the exact float64 values, rad)."""
-    kinematics = importlib.import_module("synergrasp.hand.kinematics")
-    loader = importlib.import_module("synergrasp.hand.synergies")
-    table = loader.load_synergies(synergies, joint_names=kinematics.load_hand(hand).joint_names)
-    values = np.concatenate([table.mean, table.columns(list(columns)).ravel(order="F")])
-    return "sha256:" + hashlib.sha256(np.ascontiguousarray(values, dtype=np.float64).tobytes()).hexdigest()
-
-
 # --------------------------------------------------------------------------- typed parameters
 
-@dataclass(frozen=True)
-class SimulateParams:
-    """The closure of one object: hand and synergy files (None = shipped), the object, its
-    effective placement (with the pose grid) and the closure settings."""
-    hand: str | None
-    synergies: str | None
-    object: GraspedObject
-    placement: Any  # synergrasp.simulation.placement.Placement
-    closure: Any    # synergrasp.simulation.closure.ClosureParams
-    mechanics: dict[str, Any] | None = None  # the mechanics block, where the closure model reads it
-
-
-@dataclass(frozen=True)
-class SearchStepParams:
-    """The placement search of one object (docs/placement_search.md): hand and synergy files,
-    the object with its mass, its effective placement, the closure settings (the search closes
-    with the kinematic model), the GFO parameters, the size of the full synergy set, the
-    search's settings."""
-    hand: str | None
-    synergies: str | None
-    object: GraspedObject
-    placement: Any  # synergrasp.simulation.placement.Placement
-    closure: Any    # synergrasp.simulation.closure.ClosureParams
-    gfo: Any        # synergrasp.optimisation.study.GFOParams
-    full_set_size: int
-    search: Any     # synergrasp.simulation.placement_search.SearchParams
-    distinct_mm: float
-
-
-@dataclass(frozen=True)
-class OptimiseParams:
-    """The optimisation of one object: synergy file, the study's synergy sets by id, the
-    GFO parameters (mechanics and the object's weight) and the number of pose shards."""
-    synergies: str | None
-    sets: dict[str, tuple[int, ...]]
-    gfo: Any  # synergrasp.optimisation.study.GFOParams
-    pose_shards: int
-
-
-@dataclass(frozen=True)
-class MinimaParams:
-    """Local minima of one object: neighbourhood radius (deg), the success verdict and, for
-    ``force_closure_bounded``, the object's weight (N) and the bound's multiple of it."""
-    radius_deg: float
-    success: str
-    weight_N: float | None = None
-    bound_multiple: float = math.inf
-
-
-def _force_bound(config: Mapping[str, Any], obj: str | None) -> dict[str, Any]:
-    """weight_N and bound_multiple of ``obj`` where the verdict is force_closure_bounded."""
-    analyses = config["analyses"]
-    if analyses["success"] != "force_closure_bounded":
-        return {}
-    weight = float(config["objects"][obj]["mass_kg"]) * float(config["mechanics"]["g_m_per_s2"])
-    return {"weight_N": weight, "bound_multiple": float(analyses["marginal_weight_multiple"])}
-
-
-@dataclass(frozen=True)
-class TablesParams:
-    """The study's tables: the synergy-set bounds, Table II's k_max and the analysis settings."""
-    synergy_sets: dict[str, int]
-    table2_k_max: int
-    settings: Any  # synergrasp.analysis.summaries.AnalysisSettings
-
-
-@dataclass(frozen=True)
-class ContactsParams:
-    """Which contacts of a closure count. ``drop_unloaded``: keep only the contacts carrying
-    at least ``load_threshold_N`` (N); only the dynamic model records loads (None otherwise)."""
-    drop_unloaded: bool
-    load_threshold_N: float | None
-
-
-@dataclass(frozen=True)
-class RealismParams:
-    """The grasp-realism table: hand file, the full set's id, each object's weight (N), and
-    the least normal force (N) of a load-carrying contact (None: the model records no loads)."""
-    hand: str | None
-    full_set_id: str
-    weights_N: dict[str, float]
-    load_threshold_N: float | None
-
-
-@dataclass(frozen=True)
-class FiguresParams:
-    """Parameters of the figures (each figure's rule is given its own keys only)."""
-    hand: str | None = None
-    synergies: str | None = None
-    objects: tuple = ()  # GraspedObject
-    success: str = ""
-    fig4_panel_k: tuple[int, ...] = ()
-    fig4_alpha_slice_deg: float = math.nan
-    fig4_beta_slice_deg: float = math.nan
-    hierarchy_first: int = 0
-    weight_N: float | None = None
-    bound_multiple: float = math.inf
-
-
-#: Modules holding the typed parameter classes a step's parameters are built from (the
-#: step's script imports them itself; tests/test_config.py checks it).
-STEP_MODULES: dict[str, tuple[str, ...]] = {
-    "simulate": ("synergrasp.simulation.closure", "synergrasp.simulation.placement"),
-    "search": ("synergrasp.simulation.closure", "synergrasp.simulation.placement_search",
-               "synergrasp.optimisation.study"),
-    "optimise": ("synergrasp.optimisation.study",),
-    "tables": ("synergrasp.analysis.summaries", "synergrasp.analysis.periods", "synergrasp.analysis.bootstrap",
-               "synergrasp.analysis.claims"),
-}
-
-def _build(cls: Any, where: str, **kwargs: Any) -> Any:
-    """``cls(**kwargs)``; a rejected value becomes a ConfigError naming the config key."""
+def build(cls: Any, where: str, **kwargs: Any) -> Any:
+    """``cls(**kwargs)``; a value the class rejects becomes a ConfigError naming the config
+    key ``where`` (not the class's field)."""
     try:
         return cls(**kwargs)
     except (TypeError, ValueError) as err:
@@ -711,175 +437,7 @@ def _build(cls: Any, where: str, **kwargs: Any) -> Any:
         raise ConfigError(f"config error at '{where}': {message}") from None
 
 
-def _object(config: Mapping[str, Any], name: str) -> GraspedObject:
-    """The object ``name``; its mass is None where the step does not read it."""
-    spec = config["objects"][name]
-    try:
-        shape = shape_from_config(spec["shape"], f"objects.{name}.shape")
-    except ShapeError as err:
-        raise ConfigError(f"config error at {err}") from None
-    return _build(GraspedObject, f"objects.{name}", name=name, shape=shape, mass_kg=spec.get("mass_kg"))
-
-
-def placement_params(placement: Mapping[str, Any], grid: Mapping[str, Any]) -> Any:
-    """The :class:`synergrasp.simulation.placement.Placement` of an effective ``placement``
-    block (the global one with an object's override laid over it) and the ``grid`` block."""
-    placing = importlib.import_module("synergrasp.simulation.placement")
-    ranges = {k: (v["start"], v["stop"], v["step"]) for k, v in grid.items()}
-    return _build(placing.Placement, "placement", **_fields(placing.Placement, {**placement, **ranges}))
-
-
-def _simulate(config: Mapping[str, Any], obj: str) -> SimulateParams:
-    closure = importlib.import_module("synergrasp.simulation.closure")
-    placement = overlay(config["placement"], config["objects"][obj].get("placement"))
-    return SimulateParams(
-        hand=config["hand"], synergies=config["synergies"], object=_object(config, obj),
-        placement=placement_params(placement, config["grid"]),
-        closure=_build(closure.ClosureParams, "closure", **{
-            **_fields(closure.ClosureParams, config["closure"]),
-            "dynamic": closure.DynamicParams(**config["closure"]["dynamic"])}),
-        mechanics=config.get("mechanics"))
-
-
-def _search(config: Mapping[str, Any], obj: str) -> SearchStepParams:
-    closure = importlib.import_module("synergrasp.simulation.closure")
-    searching = importlib.import_module("synergrasp.simulation.placement_search")
-    gfo = importlib.import_module("synergrasp.optimisation.study")
-    placement = overlay(config["placement"], config["objects"][obj].get("placement"))
-    spec = placement["search"]
-    region = tuple(tuple(spec["region_mm"][axis]) for axis in ("x", "y", "z"))
-    search = _build(searching.SearchParams, "placement.search", region_mm=region, **_fields(
-        searching.SearchParams, {k: v for k, v in spec.items() if k != "region_mm"}))
-    dynamic = config["closure"].get("dynamic")
-    return SearchStepParams(
-        hand=config["hand"], synergies=config["synergies"], object=_object(config, obj),
-        # the search places the box toward each of its targets: the modes' own targets are not read
-        placement=placement_params({**placement, "mode": "searched", "approach_point_mm": None,
-                                    "center_mm": (0.0, 0.0, 0.0)}, config["grid"]),
-        closure=_build(closure.ClosureParams, "closure", **{
-            **_fields(closure.ClosureParams, {**config["closure"], "model": "kinematic"}),
-            "dynamic": closure.DynamicParams(**dynamic) if dynamic else None}),
-        gfo=_build(gfo.GFOParams, "mechanics", **_fields(gfo.GFOParams, config["mechanics"]),
-                   mass_kg=float(config["objects"][obj]["mass_kg"])),
-        full_set_size=int(config["synergy_sets"]["incremental_max"]), search=search,
-        distinct_mm=float(spec["distinct_mm"]))
-
-
-def _fields(cls: Any, values: Mapping[str, Any]) -> dict[str, Any]:
+def dataclass_fields(cls: Any, values: Mapping[str, Any]) -> dict[str, Any]:
     """The entries of ``values`` that are fields of the dataclass ``cls``, lists as tuples."""
     names = set(cls.__dataclass_fields__)
     return {k: tuple(v) if isinstance(v, list) else v for k, v in values.items() if k in names}
-
-
-def _optimise(config: Mapping[str, Any], obj: str) -> OptimiseParams:
-    gfo = importlib.import_module("synergrasp.optimisation.study")
-    params = _build(gfo.GFOParams, "mechanics", **_fields(gfo.GFOParams, config["mechanics"]),
-                    mass_kg=float(config["objects"][obj]["mass_kg"]))
-    return OptimiseParams(config["synergies"], synergy_sets(config["synergy_sets"]), params,
-                          int(config["solver"]["pose_shards"]))
-
-
-def _tables(config: Mapping[str, Any]) -> TablesParams:
-    summaries = importlib.import_module("synergrasp.analysis.summaries")
-    periods = importlib.import_module("synergrasp.analysis.periods")
-    bootstrap = importlib.import_module("synergrasp.analysis.bootstrap")
-    claims = importlib.import_module("synergrasp.analysis.claims")
-    analyses, g = config["analyses"], config["mechanics"]["g_m_per_s2"]
-    objects = {name: {**spec, "placement": overlay(config["placement"], spec.get("placement"))}
-               for name, spec in config["objects"].items()}
-    try:
-        periods_deg = periods.object_periods(objects, config["grid"], config["hand"])
-    except (TypeError, ValueError) as err:
-        raise ConfigError(f"config error at 'objects' / 'placement': {err}") from None
-    settings = summaries.AnalysisSettings(
-        success=analyses["success"], marginal_weight_multiple=float(analyses["marginal_weight_multiple"]),
-        radius_deg=float(analyses["minima_radius_deg"]), null_draws=int(analyses["null_model"]["draws"]),
-        null_seed=int(analyses["null_model"]["seed"]),
-        success_rate_tolerance_percent=float(analyses["success_rate_tolerance_percent"]),
-        bootstrap=_build(bootstrap.BootstrapSettings, "analyses.bootstrap", **analyses["bootstrap"]),
-        rules=_build(claims.VerdictRules, "analyses", rate_points=float(analyses["tie_band"]["rate_points"]),
-                     force_relative=float(analyses["tie_band"]["force_relative"]),
-                     min_distinct_poses=int(analyses["min_distinct_poses"]), headline_view=analyses["headline_view"]),
-        weights_N={name: float(spec["mass_kg"]) * float(g) for name, spec in objects.items()},
-        periods_deg=periods_deg)
-    return TablesParams(dict(config["synergy_sets"]), int(analyses["table2_k_max"]), settings)
-
-
-def _figures(config: Mapping[str, Any], step: str, obj: str | None = None) -> FiguresParams:
-    if step == "fig1":
-        return FiguresParams(hand=config["hand"], synergies=config["synergies"])
-    if step == "fig2":
-        return FiguresParams(hand=config["hand"], objects=tuple(_object(config, n) for n in config["objects"]))
-    success = config["analyses"]["success"]
-    if step == "fig4":
-        fig4 = config["analyses"]["fig4"]
-        return FiguresParams(success=success, fig4_panel_k=tuple(fig4["panel_k"]),
-                             fig4_alpha_slice_deg=fig4["alpha_slice_deg"], fig4_beta_slice_deg=fig4["beta_slice_deg"],
-                             **_force_bound(config, obj))
-    return FiguresParams(success=success, hierarchy_first=config["synergy_sets"]["hierarchy_first"])
-
-
-def step_params(config: Mapping[str, Any], step: str, obj: str | None = None) -> Any:
-    """The typed parameters of ``step`` (for object ``obj`` where it has one), from a
-    complete configuration or from the step's own part of it (:func:`step_config`).
-
-    The one path from configuration to the parameters of every module: ``simulate`` →
-    :class:`SimulateParams`, ``contacts`` → :class:`ContactsParams`, ``optimise`` → :class:`OptimiseParams`, ``minima`` →
-    :class:`MinimaParams`, ``tables`` → :class:`TablesParams`, ``realism`` →
-    :class:`RealismParams`, ``fig1``/``fig2``/``fig4``/
-    ``fig5`` → :class:`FiguresParams`. A value a typed class rejects raises ConfigError
-    naming the config key (not the class's field). Only the keys the step reads
-    (:data:`STEP_KEYS`) are used, so its parameters cannot depend on any other.
-    """
-    config = step_config(config, step, obj)
-    if step == "simulate":
-        return _simulate(config, obj)
-    if step == "search":
-        return _search(config, obj)
-    if step == "contacts":
-        dynamic = config["closure"].get("dynamic", {})
-        return ContactsParams(dynamic.get("unloaded_contacts") == "drop", dynamic.get("load_threshold_N"))
-    if step == "optimise":
-        return _optimise(config, obj)
-    if step == "minima":
-        return MinimaParams(float(config["analyses"]["minima_radius_deg"]), config["analyses"]["success"],
-                            **_force_bound(config, obj))
-    if step == "tables":
-        return _tables(config)
-    if step == "realism":
-        g = config["mechanics"]["g_m_per_s2"]
-        return RealismParams(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),
-                             {name: spec["mass_kg"] * g for name, spec in config["objects"].items()},
-                             config.get("closure", {}).get("dynamic", {}).get("load_threshold_N"))
-    if step in ("fig1", "fig2", "fig4", "fig5"):
-        return _figures(config, step, obj)
-    raise ValueError(f"unknown step {step!r}; allowed values: {sorted(STEP_KEYS)}")
-
-
-# --------------------------------------------------------------------------- synergy sets
-
-def set_id(synergies: Sequence[int]) -> str:
-    """Canonical id of a synergy set: 1-based indices, sorted, joined by '-' ("1-2-3")."""
-    return "-".join(str(i) for i in sorted(set(synergies)))
-
-
-def incremental_set_id(k: int) -> str:
-    """Id of the incremental set {S1..Sk}."""
-    return set_id(range(1, k + 1))
-
-
-def synergy_sets(sets_config: Mapping[str, int]) -> dict[str, tuple[int, ...]]:
-    """All distinct synergy sets of the study, by id, in a fixed order.
-
-    The incremental sets {S1..Sk}, k = 1..incremental_max, then every subset of
-    S1..S_hierarchy_first with 1..hierarchy_max_size elements; sets that coincide (e.g.
-    {S1, S2}) appear once.
-    """
-    out: dict[str, tuple[int, ...]] = {}
-    for k in range(1, sets_config["incremental_max"] + 1):
-        out[incremental_set_id(k)] = tuple(range(1, k + 1))
-    first = sets_config["hierarchy_first"]
-    for size in range(1, sets_config["hierarchy_max_size"] + 1):
-        for combo in itertools.combinations(range(1, first + 1), size):
-            out.setdefault(set_id(combo), combo)
-    return out

@@ -1,5 +1,5 @@
-# Shared definitions: configuration checks (before any job runs), object and synergy-set
-# lists, code dependencies that trigger reruns, and the target lists.
+# Shared definitions: configuration checks (before any job runs), where each step's outputs
+# live (synergrasp.steps.STEPS), code dependencies that trigger reruns, and the target lists.
 import functools
 import math
 import re
@@ -8,107 +8,114 @@ from pathlib import Path
 from snakemake.exceptions import WorkflowError
 from snakemake.logging import logger
 
-from synergrasp.config import (
-    ConfigError,
-    check_relations,
-    scenario_configs,
-    step_config,
-    step_hash,
-    step_params,
-    synergy_problems,
-)
+from synergrasp.config import ConfigError, check_relations, scenario_names, synergy_problems
+from synergrasp.config import scenario_config as checked_scenario_config
 from synergrasp.preflight import accept_configured_wildcards, configfile_problems, slurm_problems
+from synergrasp.steps import STEPS, TABLES, step_config, step_hash
 
 ROOT = Path(workflow.basedir)
 SRC = ROOT / "src" / "synergrasp"
 
 
-def _check_inputs(raw):
-    """Every scenario's complete configuration (``default`` first), checked with its hand
-    and synergy files before any job runs (config/README.md); warnings on hands far from a
-    human hand's dimensions are printed."""
+@functools.cache
+def _hand(path):
+    """The hand of a ``hand:`` value, checked for what the study asks of it (one line per
+    problem naming the file and the field); its warnings printed once."""
     from synergrasp.hand.checks import check_hand
+
+    hand, problems, warnings = check_hand(path)
+    for warning in warnings:
+        logger.warning(f"Warning: {warning}")
+    return hand, problems
+
+
+@functools.cache
+def scenario(name):
+    """The complete configuration of scenario ``name`` (``default``: the configuration
+    itself), checked with its hand and synergy files when a target first needs it, before
+    any job runs (config/README.md): `figures` reads the default only, `sensitivity` all."""
     from synergrasp.hand.synergies import load_synergies
+    from synergrasp.simulation.objects import object_problems
 
-    # Snakemake read the configuration files itself and kept a repeated key's last value
-    problems = configfile_problems(workflow.configfiles)
-    if problems:
-        raise ConfigError("\n".join(problems))
-    scenarios = scenario_configs(raw)
-    hands = {}
-    for name, cfg in scenarios.items():
-        where = "" if name == "default" else f"scenario '{name}': "
-        if cfg["hand"] not in hands:
-            hands[cfg["hand"]] = check_hand(cfg["hand"])
-            problems += hands[cfg["hand"]][1]
-            for warning in hands[cfg["hand"]][2]:
-                logger.warning(f"Warning: {warning}")
-        hand = hands[cfg["hand"]][0]
+    try:
+        cfg = checked_scenario_config(config, name)
+        hand, hand_problems = _hand(cfg["hand"])
+        problems = list(hand_problems)
         synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
-        problems += [where + p for p in check_relations(cfg, synergies.matrix.shape[1])]
-        problems += [where + p for p in synergy_problems(cfg, synergies.mean, synergies.matrix)]
-    if problems:
-        raise ConfigError("\n".join(problems))
-    return scenarios
+        problems += check_relations(cfg, synergies.matrix.shape[1])
+        problems += synergy_problems(cfg, synergies.mean, synergies.matrix)
+        problems += object_problems(cfg)
+        if problems:
+            where = "" if name == "default" else f"scenario '{name}': "
+            raise ConfigError("\n".join(where + p for p in problems))
+    except ValueError as err:  # ConfigError, SynergyFileError, hand/YAML file errors
+        raise WorkflowError(f"Invalid input, nothing was run:\n{err}") from None
+    return cfg
 
 
-try:
-    SCENARIOS = _check_inputs(config)
-except ValueError as err:  # ConfigError, SynergyFileError, hand/YAML file errors
-    raise WorkflowError(f"Invalid input, nothing was run:\n{err}") from None
+# Snakemake read the configuration files itself and kept a repeated key's last value.
+_PROBLEMS = configfile_problems(workflow.configfiles)
+if _PROBLEMS:
+    raise WorkflowError("Invalid input, nothing was run:\n" + "\n".join(_PROBLEMS))
 
 #: The main configuration (scenario `default`), complete (defaults filled in) and checked.
-STUDY = SCENARIOS["default"]
+STUDY = scenario("default")
 OBJECTS = list(STUDY["objects"])
+#: The scenarios' names, default first (config/README.md).
+SCENARIOS = scenario_names(config)
 
 # Scenarios (config/README.md): each one's outputs live under its root; the default keeps
 # results/. A step's output (per object or per scenario) is made once, under the root of the
 # first scenario (default first) whose step reads the same keys and the same upstream
-# outputs (synergrasp.config.step_hash), and shared.
+# outputs (synergrasp.steps.step_hash), and shared.
 SCENARIO_ROOT = {
     name: "results" if name == "default" else f"results/scenarios/{name}" for name in SCENARIOS
 }
 _ROOT_SCENARIO = {root: name for name, root in SCENARIO_ROOT.items()}
-#: The file each per-object step writes under its root's objects/<object>/: the closure's
-#: contacts (every touching link), the contacts that count (only where unloaded ones are
-#: dropped: the `contacts` step), the optimisation and the minima.
-STEP_FILES = {
-    "simulate": "contacts.parquet",
-    "contacts": "load_carrying_contacts.parquet",
-    "optimise": "gfo.parquet",
-    "minima": "minima.parquet",
-}
 
 
 def scenario_config(wildcards):
     """The complete configuration of the scenario whose root a job's {root} names."""
-    return SCENARIOS[_ROOT_SCENARIO[wildcards.root]]
+    return scenario(_ROOT_SCENARIO[wildcards.root])
 
 
 @functools.cache
-def step_root(scenario, step, obj=None):
-    """The root under which ``scenario``'s output of ``step`` (for ``obj``, a per-object
+def _hashes(name):
+    """Memo of scenario ``name``'s step hashes, filled as they are asked for."""
+    return {}
+
+
+def _step_hash(name, step, obj=None):
+    return step_hash(scenario(name), step, obj, _hashes(name))
+
+
+@functools.cache
+def step_root(name, step, obj=None):
+    """The root under which scenario ``name``'s output of ``step`` (for ``obj``, a per-object
     step's object) lives: that of the first scenario whose step has the same hash."""
-    key = step_hash(SCENARIOS[scenario], step, obj)
+    key = _step_hash(name, step, obj)
     owner = next(
-        name
-        for name, cfg in SCENARIOS.items()
-        if (obj is None or obj in cfg["objects"]) and step_hash(cfg, step, obj) == key
+        other
+        for other in SCENARIOS
+        if (obj is None or obj in scenario(other)["objects"])
+        and _step_hash(other, step, obj) == key
     )
     return SCENARIO_ROOT[owner]
 
 
-def drops_unloaded(scenario, obj):
-    """Whether ``scenario`` keeps only the load-carrying contacts of ``obj``'s closure
+def drops_unloaded(name, obj):
+    """Whether scenario ``name`` keeps only the load-carrying contacts of ``obj``'s closure
     (else the `contacts` step has nothing to select and is the closure's own table)."""
-    return step_params(SCENARIOS[scenario], "contacts", obj).drop_unloaded
+    cfg = scenario(name)["closure"]
+    return cfg["model"] == "dynamic" and cfg["dynamic"]["unloaded_contacts"] == "drop"
 
 
-def step_file(scenario, step, obj):
-    """Where ``scenario``'s output of per-object ``step`` (STEP_FILES) for ``obj`` lives."""
-    if step == "contacts" and not drops_unloaded(scenario, obj):
+def step_file(name, step, obj):
+    """Where scenario ``name``'s output of the per-object ``step`` for ``obj`` lives."""
+    if step == "contacts" and not drops_unloaded(name, obj):
         step = "simulate"
-    return f"{step_root(scenario, step, obj)}/objects/{obj}/{STEP_FILES[step]}"
+    (rel,) = STEPS[step].outputs.values()
+    return f"{step_root(name, step, obj)}/objects/{obj}/{rel}"
 
 
 def step_input(step):
@@ -125,8 +132,8 @@ def step_inputs(step):
 
 def step_cfg(step):
     """A rule's ``params``: the part of the job's scenario configuration its step reads (for
-    the job's object; synergrasp.config.STEP_KEYS), so that a job reruns only when a key it
-    reads changes. Its script turns it into typed parameters with synergrasp.config.step_params."""
+    the job's object; synergrasp.steps.STEPS), so that a job reruns only when a key it reads
+    changes. Its script builds typed parameters from it (the step's ``params`` class)."""
     return lambda wildcards: step_config(scenario_config(wildcards), step, wildcards.get("object"))
 
 
@@ -135,9 +142,16 @@ def _exactly(values):
     return "|".join(re.escape(v) for v in sorted(set(values), key=lambda v: (-len(v), v)))
 
 
+#: Every object name the configuration or a scenario's overlay gives (read without checking
+#: the scenarios: a superset of the objects any checked scenario has).
+_OBJECT_NAMES = set(OBJECTS) | {
+    o
+    for over in (config.get("scenarios") or {}).values()
+    if isinstance(over, dict)
+    for o in map(str, over.get("objects") or {})
+}
 # Wildcards match the configured names exactly, so Snakemake's guard against endless
 # recursion may accept a configured name ending in a repeated character (obj_000...0).
-_OBJECT_NAMES = {o for cfg in SCENARIOS.values() for o in cfg["objects"]}
 accept_configured_wildcards([*_OBJECT_NAMES, *SCENARIO_ROOT.values()])
 
 
@@ -159,21 +173,29 @@ onstart:
             )
 
 
-def _imported_modules(path):
-    """Names of the synergrasp modules a Python file imports, at any depth of the file."""
-    import ast
+#: `import synergrasp.x[, ...]` and `from synergrasp.x import a, b` (or a parenthesised list),
+#: at any indentation (lazy imports inside functions included).
+_IMPORT = re.compile(
+    r"^[ \t]*(?:import[ \t]+(synergrasp[\w.]*(?:[ \t]*,[ \t]*[\w.]+)*)"
+    r"|from[ \t]+(synergrasp[\w.]*)[ \t]+import[ \t]+(\([^)]*\)|[^\n]*))",
+    re.MULTILINE,
+)
 
+
+@functools.cache
+def _imported_modules(path):
+    """Names of the synergrasp modules a Python file imports, at any depth of the file (read
+    as text: parsing every module would cost a second at each start of Snakemake)."""
     found = set()
-    for node in ast.walk(ast.parse(Path(path).read_text())):
-        if isinstance(node, ast.Import):
-            found |= {a.name for a in node.names if a.name.startswith("synergrasp")}
-        elif (
-            isinstance(node, ast.ImportFrom)
-            and node.module
-            and node.module.startswith("synergrasp")
-        ):
-            found.add(node.module)
-            found |= {f"{node.module}.{a.name}" for a in node.names}  # `from pkg import module`
+    for plain, module, names in _IMPORT.findall(Path(path).read_text()):
+        if plain:
+            found |= {n.strip() for n in plain.split(",") if n.strip().startswith("synergrasp")}
+        else:
+            found.add(module)
+            names = names.split("#")[0] if not names.startswith("(") else names
+            for name in re.split(r"[\s,()]+", re.sub(r"#[^\n]*", "", names)):
+                if name and name != "as":
+                    found.add(f"{module}.{name}")  # `from pkg import module`
     return found
 
 
@@ -219,58 +241,25 @@ def user_files(wildcards):
 SHIPPED_DATA = sorted(str(p) for p in (SRC / "data").glob("*") if p.is_file())
 
 
-def fig4_files(scenario, name):
-    """Fig. 4 of object ``name`` in ``scenario`` (wherever shared)."""
-    return [
-        f"{step_root(scenario, 'fig4', name)}/objects/{name}/fig4_{kind}.{ext}"
-        for kind in ("force_maps", "exploded")
-        for ext in ("png", "pdf")
-    ]
+def object_targets(name, scenario_name="default"):
+    """One object's outputs in a scenario: the outputs of every per-object step (wherever shared)."""
+    files = {}
+    for step, spec in STEPS.items():
+        if spec.scope != "object" or not spec.rules:  # a step whose rule is still to come
+            continue
+        if len(spec.outputs) == 1:
+            files[step_file(scenario_name, step, name)] = None
+        else:
+            root = step_root(scenario_name, step, name)
+            files.update(
+                dict.fromkeys(f"{root}/objects/{name}/{rel}" for rel in spec.outputs.values())
+            )
+    return list(files)
 
 
-def object_targets(name, scenario="default"):
-    """One object's outputs in a scenario: its per-object tables and Fig. 4 (wherever shared)."""
-    files = dict.fromkeys(step_file(scenario, step, name) for step in STEP_FILES)
-    return list(files) + fig4_files(scenario, name)
-
-
-TABLES = [
-    "success_rates",
-    "table2_success_rates",
-    "hierarchy",
-    "minimum_preservation",
-    "full_not_first7",
-    "verdict_disagreements",
-    "preservation_vs_chance",
-    "invariant_checks",
-    "claims",
-]
-
-
-#: The files each step run once per scenario writes under its root.
-STUDY_FILES = {
-    "fig1": [f"figures/fig1_synergy_postures.{ext}" for ext in ("png", "pdf")],
-    "fig2": [f"figures/fig2_example_grasps.{ext}" for ext in ("png", "pdf")],
-    "tables": [f"tables/{t}.{ext}" for t in TABLES for ext in ("csv", "md")],
-    "realism": [
-        f"tables/{t}.{ext}" for t in ("grasp_realism", "graspable_objects") for ext in ("csv", "md")
-    ]
-    + [f"figures/grasp_realism.{ext}" for ext in ("png", "pdf")],
-    "fig5": [
-        f"figures/{name}.{ext}"
-        for name in (
-            "fig5a_hierarchy_success",
-            "fig5a_hierarchy_success_pooled",
-            "fig5b_hierarchy_force",
-        )
-        for ext in ("png", "pdf")
-    ],
-}
-
-
-def study_file(scenario, step, rel):
-    """Where ``scenario``'s file ``rel`` (one of STUDY_FILES[step]) lives (wherever shared)."""
-    return f"{step_root(scenario, step)}/{rel}"
+def study_file(name, step, rel):
+    """Where scenario ``name``'s file ``rel`` (one of the step's outputs) lives (wherever shared)."""
+    return f"{step_root(name, step)}/{rel}"
 
 
 def study_input(step, rel):
@@ -278,29 +267,38 @@ def study_input(step, rel):
     return lambda w: study_file(_ROOT_SCENARIO[w.root], step, rel)
 
 
-def study_targets(scenario="default"):
+def workflow_files(step):
+    """The files of a step run once for the whole workflow (under results/)."""
+    return [f"results/{rel}" for rel in STEPS[step].outputs.values()]
+
+
+def study_targets(name="default"):
     """Every output of one scenario's study, each where it is made (a shared file counts;
-    Fig. 3, the rule graph, is the same for all)."""
-    files = [study_file(scenario, step, rel) for step, rels in STUDY_FILES.items() for rel in rels]
-    files += [f"results/figures/fig3_rulegraph.{ext}" for ext in ("png", "pdf")]
-    per_object = [
-        f for name in SCENARIOS[scenario]["objects"] for f in object_targets(name, scenario)
+    Fig. 3, the rule graph, is the same for all; the sweep's summary is `sensitivity`'s)."""
+    files = [
+        study_file(name, step, rel)
+        for step, spec in STEPS.items()
+        if spec.scope == "scenario" and spec.rules
+        for rel in spec.outputs.values()
     ]
-    return files + per_object
+    files += workflow_files("fig3")
+    return files + [f for obj in scenario(name)["objects"] for f in object_targets(obj, name)]
+
+
+def scenario_targets(name):
+    """Input function: scenario ``name``'s study (its configuration is read only when asked)."""
+    return lambda wildcards: study_targets(name)
+
+
+def every_scenario_targets(wildcards):
+    """Input function: every scenario's study."""
+    return [f for name in SCENARIOS for f in study_targets(name)]
 
 
 # The sensitivity sweep's summary across every scenario (docs/sensitivity.md).
 def scenario_tables(table):
-    """Every scenario's (default first) study table ``table``.csv."""
-    return [study_file(s, "tables", f"tables/{table}.csv") for s in SCENARIOS]
+    """Input function: every scenario's (default first) study table ``table``.csv."""
+    return lambda wildcards: [study_file(s, "tables", f"tables/{table}.csv") for s in SCENARIOS]
 
 
-SENSITIVITY_FILES = [
-    f"results/sensitivity/{name}.{ext}"
-    for name, exts in (
-        ("claims", ("csv", "md")),
-        ("claims_grid", ("png", "pdf")),
-        ("table2_curves", ("png", "pdf")),
-    )
-    for ext in exts
-]
+SENSITIVITY_FILES = workflow_files("sensitivity")

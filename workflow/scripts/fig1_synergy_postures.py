@@ -1,13 +1,12 @@
 """Fig. 1: the hand along each of the first seven synergies, sigma = -1, 0, +1."""
 
-from synergrasp.config import step_params
-from synergrasp.figures.hand_figures import figure_synergy_postures
+from synergrasp.figures.hand_figures import Fig1Params, figure_synergy_postures
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
-    params = step_params(snakemake.params.cfg, "fig1")
+    params = Fig1Params.from_config(snakemake.params.cfg)
     hand = load_hand(params.hand)
     synergies = load_synergies(params.synergies, joint_names=hand.joint_names)
     figure_synergy_postures(hand, synergies, snakemake.output.png, snakemake.output.pdf,

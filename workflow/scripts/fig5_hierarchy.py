@@ -3,12 +3,11 @@ objects", and its paired force ratio to the full set pooled over its successes, 
 
 import pandas as pd
 
-from synergrasp.config import step_params
-from synergrasp.figures.study_figures import FIG5B_RATIO_RANGE, figure_hierarchy
+from synergrasp.figures.study_figures import FIG5B_RATIO_RANGE, Fig5Params, figure_hierarchy
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
-    p, out = step_params(snakemake.params.cfg, "fig5"), snakemake.output
+    p, out = Fig5Params.from_config(snakemake.params.cfg), snakemake.output
     first, success = p.hierarchy_first, p.success
     matrices = pd.read_csv(snakemake.input.hierarchy)
     for column, view, png, pdf in (("success_rate", "per-object view (the study's)", out.success_png,

@@ -5,14 +5,13 @@ import pandas as pd
 
 from synergrasp import tables
 from synergrasp.analysis.graspability import graspable_objects, ungraspable_lines
-from synergrasp.analysis.realism import grasp_realism
-from synergrasp.config import step_params
+from synergrasp.analysis.realism import RealismParams, grasp_realism
 from synergrasp.figures.grasp_realism import figure_grasp_realism
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]) as log:
-    params = step_params(snakemake.params.cfg, "realism")
+    params = RealismParams.from_config(snakemake.params.cfg)
     hand = load_hand(params.hand)
     contacts = pd.concat([tables.read(tables.CONTACTS, p) for p in snakemake.input.contacts], ignore_index=True)
     gfo = pd.concat([tables.read(tables.GFO, p) for p in snakemake.input.gfo], ignore_index=True)

@@ -2,13 +2,12 @@
 
 import pandas as pd
 
-from synergrasp.analysis.minima import minima_table
+from synergrasp.analysis.minima import MinimaParams, minima_table
 from synergrasp.analysis.verdicts import with_verdicts
-from synergrasp.config import step_params
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
-    params = step_params(snakemake.params.cfg, "minima", snakemake.wildcards.object)
+    params = MinimaParams.from_config(snakemake.params.cfg, snakemake.wildcards.object)
     weights = {snakemake.wildcards.object: params.weight_N} if params.weight_N is not None else None
     gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), params.success, weights, params.bound_multiple)
     minima_table(gfo, radius_deg=params.radius_deg).to_parquet(snakemake.output[0], index=False)

@@ -4,14 +4,13 @@ import warnings
 import pandas as pd
 
 from synergrasp.analysis.invariants import InvariantWarning
-from synergrasp.analysis.summaries import study_tables
-from synergrasp.config import step_params
+from synergrasp.analysis.summaries import TablesParams, study_tables
 from synergrasp.job_log import job_log
 from synergrasp.tables import write_study_table
 
 with job_log(snakemake.log[0]) as log, warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always", InvariantWarning)
-    p = step_params(snakemake.params.cfg, "tables")
+    p = TablesParams.from_config(snakemake.params.cfg)
     gfo = pd.concat([pd.read_parquet(path) for path in snakemake.input.gfo], ignore_index=True)
     minima = pd.concat([pd.read_parquet(path) for path in snakemake.input.minima], ignore_index=True)
     tables = study_tables(gfo, minima, p.synergy_sets, p.table2_k_max, p.settings)

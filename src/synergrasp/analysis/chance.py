@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 from synergrasp.analysis.bootstrap import PoseResampler
 from synergrasp.analysis.minima import preserved
-from synergrasp.config import incremental_set_id
+from synergrasp.ids import incremental_set_id
 
 __all__ = ["identical_force_maps", "allowed_offsets", "null_preserved", "preservation_vs_chance",
            "resampled_preservation"]

@@ -19,7 +19,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp.analysis.intervals import VIEWS, StudyCounts, mean_defined
-from synergrasp.config import incremental_set_id, set_id
+from synergrasp.ids import incremental_set_id, set_id
 
 __all__ = ["HOLDS", "FAILS", "UNDEFINED", "VerdictRules", "Difference", "interval_verdict", "claims_table",
            "CLAIM_COLUMNS"]

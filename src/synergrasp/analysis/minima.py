@@ -16,11 +16,18 @@ A minimum of {S1..Sk} is *preserved* if {S1..Sk+1} has a minimum within ±radius
 
 from __future__ import annotations
 
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["local_minima", "preserved", "minima_table", "MINIMA_COLUMNS", "FORCE_TIE_RTOL"]
+from synergrasp.analysis.verdicts import force_bound
+
+__all__ = ["MinimaParams", "local_minima", "preserved", "minima_table", "MINIMA_COLUMNS", "FORCE_TIE_RTOL"]
 
 # Grid angles are multiples of a step; the tolerance makes "within ±radius" inclusive
 # despite rounding in the stored degrees.
@@ -32,6 +39,24 @@ FORCE_TIE_RTOL = 1e-5
 
 MINIMA_COLUMNS = ("object", "set_id", "n_synergies", "pose", "alpha_deg", "beta_deg", "force_norm")
 
+
+
+@dataclass(frozen=True)
+class MinimaParams:
+    """Local minima of one object (the ``minima`` step): neighbourhood radius (deg), the
+    success verdict and, for ``force_closure_bounded``, the object's weight (N) and the
+    bound's multiple of it."""
+
+    radius_deg: float
+    success: str
+    weight_N: float | None = None
+    bound_multiple: float = math.inf
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str) -> MinimaParams:
+        """From a configuration or the step's own part of it, for the object ``obj``."""
+        return cls(float(config["analyses"]["minima_radius_deg"]), config["analyses"]["success"],
+                   **force_bound(config, obj))
 
 def _as_1d(name: str, values: ArrayLike, n: int | None = None, dtype: type = float) -> NDArray:
     arr = np.asarray(values, dtype=dtype)

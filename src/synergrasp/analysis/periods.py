@@ -27,14 +27,25 @@ from numpy.typing import NDArray
 
 __all__ = ["alpha_period_deg", "object_periods", "distinct_pose_mask", "period_violations"]
 
-#: Candidate periods, deg: the rotations of a box about one axis that can be symmetries.
+#: Candidate periods, deg: the rotations of a box about one axis that can be symmetries
+#: (a shape turning freely about the α axis, a cylinder or a sphere, adds every divisor of
+#: 360° on the α grid: :func:`_candidates_deg`).
 _CANDIDATES_DEG = (90.0, 120.0, 180.0)
+
+
+def _candidates_deg(step_deg: float) -> list[float]:
+    """The candidate periods, deg: the box's, and every divisor of 360° below it that is a
+    whole number of α grid steps, ascending."""
+    on_grid = [k * step_deg for k in range(1, int(180.0 // step_deg) + 1)
+               if abs(360.0 / (k * step_deg) - round(360.0 / (k * step_deg))) < 1e-9]
+    return sorted(set(_CANDIDATES_DEG) | set(on_grid))
 _DEG_TOL = 1e-6
 
 
 def alpha_period_deg(placement, shape, palm_normal: Sequence[float] = (1.0, 0.0, 0.0)) -> float:
-    """Smallest P in {90, 120, 180} deg such that the object at (α + P, β) fills the same
-    region as at (α, β) for every β of the placement's grid; 360 if none.
+    """Smallest P among the candidates (90, 120, 180 deg and the divisors of 360° on the α
+    grid) such that the object at (α + P, β) fills the same region as at (α, β) for every β
+    of the placement's grid; 360 if none.
 
     ``placement`` is a :class:`synergrasp.simulation.placement.Placement` (centre, starting
     axes, rotation order, grid); ``shape`` a :class:`synergrasp.simulation.shapes.Shape`;
@@ -43,7 +54,7 @@ def alpha_period_deg(placement, shape, palm_normal: Sequence[float] = (1.0, 0.0,
     from synergrasp.simulation.placement import object_pose, pose_grid
 
     betas = pose_grid(placement).beta_deg
-    for period in _CANDIDATES_DEG:
+    for period in _candidates_deg(float(placement.alpha_deg[2])):
         ok = True
         for beta in betas:
             here = object_pose(placement, shape, 0.0, float(beta), palm_normal)
@@ -62,12 +73,12 @@ def object_periods(objects: Mapping[str, Mapping[str, Any]], grid: Mapping[str, 
     ``shape`` and effective ``placement`` (the global placement with its override),
     ``grid`` is the config's grid block, ``hand`` the hand file (None: the shipped hand,
     whose palm normal is the α axis)."""
-    from synergrasp.config import placement_params
     from synergrasp.hand.kinematics import load_hand
+    from synergrasp.simulation.placement import Placement
     from synergrasp.simulation.shapes import shape_from_config
 
     normal = load_hand(hand).palm_normal
-    return {name: alpha_period_deg(placement_params(spec["placement"], grid),
+    return {name: alpha_period_deg(Placement.from_config(spec["placement"], grid),
                                    shape_from_config(spec["shape"], f"objects.{name}.shape"), normal)
             for name, spec in objects.items()}
 

@@ -12,14 +12,17 @@ in, a DataFrame out.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from synergrasp.analysis.verdicts import verdict_columns
+from synergrasp.ids import incremental_set_id
 from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 
-__all__ = ["SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "link_categories", "grasp_realism",
+__all__ = ["RealismParams", "SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "link_categories", "grasp_realism",
            "representative_grasps"]
 
 #: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.STATUSES): a
@@ -32,6 +35,27 @@ NORMAL_FORCE_COLUMN = "contact_normal_force_N"
 #: Segments (the part of a link name after the finger) counted as proximal or middle phalanges.
 _PROXIMAL_OR_MIDDLE = ("proximal", "middle")
 
+
+
+@dataclass(frozen=True)
+class RealismParams:
+    """The grasp-realism table (the ``realism`` step): hand file, the full set's id, each
+    object's weight (N), and the least normal force (N) of a load-carrying contact (None:
+    the closure model records no loads)."""
+
+    hand: str | None
+    full_set_id: str
+    weights_N: dict[str, float]
+    load_threshold_N: float | None
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> RealismParams:
+        """From a configuration or the step's own part of it (``obj`` is not read)."""
+        g = config["mechanics"]["g_m_per_s2"]
+        closure = config["closure"]
+        threshold = closure["dynamic"]["load_threshold_N"] if closure["model"] == "dynamic" else None
+        return cls(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),
+                   {name: spec["mass_kg"] * g for name, spec in config["objects"].items()}, threshold)
 
 def link_categories(link_names: Sequence[str], link_finger: Sequence[str]) -> dict[str, frozenset[int]]:
     """Hand link indices per category: ``thumb`` (every thumb link), ``palm`` (links of the

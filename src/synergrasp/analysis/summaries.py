@@ -20,12 +20,14 @@ from synergrasp.analysis.forces import force_summary
 from synergrasp.analysis.intervals import VIEWS, StudyCounts
 from synergrasp.analysis.invariants import invariant_checks
 from synergrasp.analysis.minima import preserved
-from synergrasp.analysis.periods import distinct_pose_mask
+from synergrasp.analysis.periods import distinct_pose_mask, object_periods
 from synergrasp.analysis.verdicts import with_verdicts
-from synergrasp.config import incremental_set_id, set_id
+from synergrasp.config import ConfigError, build, overlay
+from synergrasp.ids import incremental_set_id, set_id
 
 __all__ = [
     "AnalysisSettings",
+    "TablesParams",
     "success_rates",
     "mean_over_objects",
     "with_intervals",
@@ -57,8 +59,8 @@ def _require(table: pd.DataFrame, name: str, columns: Iterable[str]) -> None:
 @dataclass(frozen=True)
 class AnalysisSettings:
     """What the study's tables need beyond the gfo and minima tables (config ``analyses``;
-    docs/analyses.md), built by :func:`synergrasp.config.step_params` (``"tables"``), which
-    holds the defaults (the schema) and checks the values.
+    docs/analyses.md), built by :meth:`TablesParams.from_config`; the schema holds the
+    defaults and checks the values.
 
     success: the verdict the tables use (``force_closure`` | ``load_feasible``).
     marginal_weight_multiple: a success is marginal above this multiple of the weight.
@@ -80,6 +82,40 @@ class AnalysisSettings:
     weights_N: Mapping[str, float] = field(default_factory=dict)
     periods_deg: Mapping[str, float] = field(default_factory=dict)
 
+
+
+@dataclass(frozen=True)
+class TablesParams:
+    """The study's tables (the ``tables`` step): the synergy-set bounds (the configuration's
+    ``synergy_sets``), Table II's k_max and the analysis settings."""
+
+    synergy_sets: dict[str, int]
+    table2_k_max: int
+    settings: AnalysisSettings
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> TablesParams:
+        """From a configuration or the step's own part of it (``obj`` is not read): the
+        objects' weights m·g and α-periods (from their boxes, placements and the grid)."""
+        analyses, g = config["analyses"], config["mechanics"]["g_m_per_s2"]
+        objects = {name: {**spec, "placement": overlay(config["placement"], spec.get("placement"))}
+                   for name, spec in config["objects"].items()}
+        try:
+            periods_deg = object_periods(objects, config["grid"], config["hand"])
+        except (TypeError, ValueError) as err:
+            raise ConfigError(f"config error at 'objects' / 'placement': {err}") from None
+        settings = AnalysisSettings(
+            success=analyses["success"], marginal_weight_multiple=float(analyses["marginal_weight_multiple"]),
+            radius_deg=float(analyses["minima_radius_deg"]), null_draws=int(analyses["null_model"]["draws"]),
+            null_seed=int(analyses["null_model"]["seed"]),
+            success_rate_tolerance_percent=float(analyses["success_rate_tolerance_percent"]),
+            bootstrap=build(BootstrapSettings, "analyses.bootstrap", **analyses["bootstrap"]),
+            rules=build(VerdictRules, "analyses", rate_points=float(analyses["tie_band"]["rate_points"]),
+                        force_relative=float(analyses["tie_band"]["force_relative"]),
+                        min_distinct_poses=int(analyses["min_distinct_poses"]), headline_view=analyses["headline_view"]),
+            weights_N={name: float(spec["mass_kg"]) * float(g) for name, spec in objects.items()},
+            periods_deg=periods_deg)
+        return cls(dict(config["synergy_sets"]), int(analyses["table2_k_max"]), settings)
 
 def _rate_columns(table: pd.DataFrame, column: str, full_set_id: str) -> pd.DataFrame:
     """Per (object, set): count of ``column`` and its rate relative to the full set (percent)."""

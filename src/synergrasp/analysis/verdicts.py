@@ -27,11 +27,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
-__all__ = ["VERDICTS", "verdict_columns", "with_verdicts"]
+__all__ = ["VERDICTS", "verdict_columns", "with_verdicts", "force_bound"]
 
 #: The success verdicts the tables can use (config ``analyses.success``).
 VERDICTS: tuple[str, ...] = ("force_closure", "load_feasible", "force_closure_bounded")
@@ -119,3 +120,13 @@ def with_verdicts(gfo: pd.DataFrame, success: str,
     out["success_force"] = out["force_norm"].where(out["success"])
     out["marginal"] = out["success"] & above
     return out
+
+
+def force_bound(config: Mapping[str, Any], obj: str) -> dict[str, Any]:
+    """``weight_N`` and ``bound_multiple`` of ``obj`` where the configuration's verdict is
+    ``force_closure_bounded`` (else none: the verdict reads no bound)."""
+    analyses = config["analyses"]
+    if analyses["success"] != "force_closure_bounded":
+        return {}
+    weight = float(config["objects"][obj]["mass_kg"]) * float(config["mechanics"]["g_m_per_s2"])
+    return {"weight_N": weight, "bound_multiple": float(analyses["marginal_weight_multiple"])}

@@ -5,7 +5,8 @@ deg (pose labels), lengths in mm.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -18,12 +19,37 @@ from synergrasp.figures.hand_pictures import (BOX, PALM_CAMERA, SKIN, TOUCHING, 
                                               render)
 from synergrasp.figures.output import save_figure
 from synergrasp.hand.synergies import SynergyPath
+from synergrasp.simulation.objects import GraspedObject
 
 __all__ = ["figure_synergy_postures", "figure_example_grasps", "PANEL_PX"]
 
 #: Rendered panel size, pixels (width, height).
 PANEL_PX = (330, 330)
 _CONTACT = "#c2000b"
+
+
+@dataclass(frozen=True)
+class Fig1Params:
+    """Fig. 1 (the ``fig1`` step): the hand and synergy files (None: the shipped ones)."""
+
+    hand: str | None
+    synergies: str | None
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> Fig1Params:
+        return cls(config["hand"], config["synergies"])
+
+
+@dataclass(frozen=True)
+class Fig2Params:
+    """Fig. 2 (the ``fig2`` step): the hand file and every object (no mass)."""
+
+    hand: str | None
+    objects: tuple[GraspedObject, ...]
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> Fig2Params:
+        return cls(config["hand"], tuple(GraspedObject.from_config(config, n, with_mass=False) for n in config["objects"]))
 
 
 def _bare(ax: Any) -> None:

@@ -7,8 +7,11 @@ Forces are in N; angles in deg.
 
 from __future__ import annotations
 
+import math
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
 from pathlib import Path
 
 import matplotlib
@@ -18,10 +21,13 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from synergrasp.config import incremental_set_id  # noqa: E402
+from synergrasp.analysis.verdicts import force_bound  # noqa: E402
+from synergrasp.ids import incremental_set_id  # noqa: E402
 from synergrasp.figures.output import save_figure  # noqa: E402
 
 __all__ = [
+    "Fig4Params",
+    "Fig5Params",
     "force_grid",
     "figure_force_maps",
     "figure_exploded_views",
@@ -31,6 +37,38 @@ __all__ = [
     "canonical_rulegraph",
     "figure_rulegraph",
 ]
+
+
+@dataclass(frozen=True)
+class Fig4Params:
+    """Fig. 4 of one object (the ``fig4`` step): the success verdict, the k of the
+    incremental sets drawn, the α and β (deg) of the exploded views' slices and, for
+    ``force_closure_bounded``, the object's weight (N) and the bound's multiple of it."""
+
+    success: str
+    panel_k: tuple[int, ...]
+    alpha_slice_deg: float
+    beta_slice_deg: float
+    weight_N: float | None = None
+    bound_multiple: float = math.inf
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str) -> Fig4Params:
+        fig4 = config["analyses"]["fig4"]
+        return cls(config["analyses"]["success"], tuple(fig4["panel_k"]), fig4["alpha_slice_deg"],
+                   fig4["beta_slice_deg"], **force_bound(config, obj))
+
+
+@dataclass(frozen=True)
+class Fig5Params:
+    """Fig. 5 (the ``fig5`` step): the success verdict and S1..S_first of the hierarchy sets."""
+
+    success: str
+    hierarchy_first: int
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> Fig5Params:
+        return cls(config["analyses"]["success"], config["synergy_sets"]["hierarchy_first"])
 
 
 def force_grid(gfo: pd.DataFrame, set_id: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -10,6 +10,8 @@ by :func:`map_human_synergies`; regenerate them with ``python -m synergrasp.hand
 
 from __future__ import annotations
 
+import functools
+import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -21,7 +23,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
-from synergrasp.hand.kinematics import JOINT_NAMES
+from synergrasp.hand.kinematics import JOINT_NAMES, load_hand
 from synergrasp.yaml_io import read_yaml
 
 __all__ = [
@@ -29,6 +31,7 @@ __all__ = [
     "SynergyFileError",
     "HUMAN_JOINT_NAMES",
     "load_synergies",
+    "synergy_values",
     "load_human_synergies",
     "load_synergy_mapping",
     "map_human_synergies",
@@ -223,6 +226,23 @@ def load_synergies(path: str | Path | None = None,
     syn_cols, mean, matrix = _read_table(path, joint_names)
     return Synergies(tuple(joint_names), mean, matrix, tuple(f"S{i}" for i in range(1, len(syn_cols) + 1)))
 
+
+
+def synergy_values(hand: str | Path | None, synergies: str | Path | None,
+                   columns: Sequence[int]) -> dict[str, list[float]]:
+    """The mean posture (``mean_rad``) and the synergies ``columns`` (1-based: ``S1``, ...) of
+    the synergy table ``synergies`` loaded for the hand file ``hand`` (None: the shipped
+    ones): rad, in the hand's joint order, the exact float64 values. What a step that reads
+    only these is handed instead of the table (``synergrasp.steps``)."""
+    return json.loads(_synergy_values(hand, synergies, tuple(int(i) for i in columns)))
+
+
+@functools.cache
+def _synergy_values(hand: str | Path | None, synergies: str | Path | None, columns: tuple[int, ...]) -> str:
+    table = load_synergies(synergies, joint_names=load_hand(hand).joint_names)
+    values = {"mean_rad": table.mean.tolist()}
+    values.update({f"S{i}": table.columns([i])[:, 0].tolist() for i in columns})
+    return json.dumps(values)
 
 def load_human_synergies(path: str | Path | None = None) -> Synergies:
     """The 20-joint human synergies (Santello et al. 1998 via SynGrasp); None = the shipped copy."""

@@ -9,13 +9,16 @@ grasps with rank(G) < 6 'rank_deficient', both without any solve (solver 'none')
 from __future__ import annotations
 
 from collections.abc import Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from synergrasp.config import set_id
+from synergrasp.config import build, dataclass_fields
+from synergrasp.ids import set_id, synergy_sets
 from synergrasp.optimisation.cones import FrictionCone, cone_model
 from synergrasp.optimisation.gfo import FASTEST_METHOD, solve_gfo
 from synergrasp.optimisation.ipm_kernel import IPMSettings
@@ -28,10 +31,9 @@ from synergrasp.optimisation.mechanics import (
     object_wrench,
 )
 from synergrasp.optimisation.problem import DEFAULT_TOL, STRICT_SHRINK, GraspSets, SynergySets
-from synergrasp.simulation.contacts import read_grasps
 
-__all__ = ["GFOParams", "gfo_table", "mechanics_for", "merge_shards", "optimise_grasps", "optimise_shard",
-           "shard_rows"]
+__all__ = ["GFOParams", "OptimiseParams", "gfo_table", "mechanics_for", "merge_shards", "optimise_grasps",
+           "optimise_shard", "read_grasps", "shard_rows"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -39,8 +41,8 @@ class GFOParams:
     """Parameters of the grasp-force optimisation of one object.
 
     The study's values come from the configuration's ``mechanics`` block and the object's
-    ``mass_kg`` through :func:`synergrasp.config.step_params` (``"optimise"``), which holds
-    their defaults (the schema) and checks them; the field names are the config keys.
+    ``mass_kg`` through :meth:`OptimiseParams.from_config`; the schema holds their defaults
+    and checks them; the field names are the config keys.
 
     gravity_direction: unit vector of gravity in the palm frame
     mu: Coulomb friction coefficient; f_min_N: least normal force at every contact, N
@@ -87,6 +89,53 @@ class GFOParams:
     def cone(self) -> FrictionCone:
         """The friction-cone model of every contact."""
         return cone_model(self.friction_cone, self.mu)
+
+
+@dataclass(frozen=True)
+class OptimiseParams:
+    """The optimisation of one object (the ``optimise`` step): the synergy file (None: the
+    shipped table), the study's synergy sets by id, the GFO parameters (mechanics and the
+    object's weight) and the number of pose shards."""
+
+    synergies: str | None
+    sets: dict[str, tuple[int, ...]]
+    gfo: GFOParams
+    pose_shards: int
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str) -> OptimiseParams:
+        """From a configuration or the step's own part of it, for the object ``obj``."""
+        gfo = build(GFOParams, "mechanics", **dataclass_fields(GFOParams, config["mechanics"]),
+                    mass_kg=float(config["objects"][obj]["mass_kg"]))
+        return cls(config["synergies"], synergy_sets(config["synergy_sets"]), gfo,
+                   int(config["solver"]["pose_shards"]))
+
+
+def read_grasps(table: pd.DataFrame) -> list[Grasp | None]:
+    """One :class:`synergrasp.optimisation.mechanics.Grasp` per row of a contacts table, in row order.
+
+    Rows whose status is not ``grasp`` or that have no contact give ``None``. Reads only
+    numbers: pybullet is not imported.
+    """
+    missing = [c for c in ("status", "n_contacts", "contact_link", "contact_point", "contact_normal",
+                           "jacobian", "object_center") if c not in table.columns]
+    if missing:
+        raise ValueError(f"contacts table: missing column(s) {missing}")
+    grasps: list[Grasp | None] = []
+    for row in table.itertuples(index=False):
+        m = int(row.n_contacts)
+        if row.status != "grasp" or m == 0:
+            grasps.append(None)
+            continue
+        jac = np.asarray(row.jacobian, dtype=float)
+        grasps.append(Grasp(
+            points=np.asarray(row.contact_point, dtype=float).reshape(m, 3),
+            normals=np.asarray(row.contact_normal, dtype=float).reshape(m, 3),
+            links=np.asarray(row.contact_link, dtype=np.int64),
+            jacobian=jac.reshape(3 * m, jac.size // (3 * m)),
+            center=np.asarray(row.object_center, dtype=float),
+        ))
+    return grasps
 
 
 def mechanics_for(grasp: Grasp, params: GFOParams) -> GraspMechanics:

@@ -153,6 +153,11 @@ def collision_shape(client: int, shape: Any) -> int:
     if kind == "box":
         half = np.asarray(geometry["half_extents_mm"], dtype=float)
         return pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(half * MM).tolist(), physicsClientId=client)
+    if kind == "sphere":
+        return pb.createCollisionShape(pb.GEOM_SPHERE, radius=float(geometry["radius_mm"]) * MM, physicsClientId=client)
+    if kind == "cylinder":  # along the shape's own z axis, as pybullet's
+        return pb.createCollisionShape(pb.GEOM_CYLINDER, radius=float(geometry["radius_mm"]) * MM,
+                                       height=float(geometry["height_mm"]) * MM, physicsClientId=client)
     raise ValueError(f"no collision shape for a {kind!r}")
 
 

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from synergrasp.hand.checks import closure_shape_problems
+from synergrasp.simulation.shapes.kernels import segment_cylinder, segment_sphere, sort_knots
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
@@ -101,12 +102,7 @@ def _seg_box_into(p0: NDArray, d: NDArray, half: NDArray, knots: NDArray) -> tup
                 if 0.0 < tb < 1.0:
                     knots[n] = tb
                     n += 1
-    for k in range(1, n):  # insertion sort of at most 8 values
-        v, j = knots[k], k - 1
-        while j >= 0 and knots[j] > v:
-            knots[j + 1] = knots[j]
-            j -= 1
-        knots[j + 1] = v
+    sort_knots(knots, n)
     best_sq, best_t = np.inf, 0.0
     for k in range(n):
         sq = _sq_excess(p0, d, half, knots[k])
@@ -231,8 +227,13 @@ def _capsule_to_box(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray
 def _seg_object(p0: NDArray, d: NDArray, code: int, params: NDArray, work: NDArray) -> tuple[float, float]:
     """Signed distance (mm) from the segment p0 + t·d, t in [0, 1] (the object's own frame),
     to the object's shape (``code``, ``params``: ``synergrasp.simulation.shapes``) and the t
-    attaining it; ``work`` is scratch space of 8 values. 0: a box, params its half extents."""
-    return _seg_box_into(p0, d, params, work)
+    attaining it; ``work`` is scratch space of 8 values. 0: a box, params its half extents;
+    1: a sphere about the origin, (radius); 2: a cylinder about the z axis, (radius, half height)."""
+    if code == 0:
+        return _seg_box_into(p0, d, params, work)
+    if code == 1:
+        return segment_sphere(p0, d, params[0])
+    return segment_cylinder(p0, d, params[0], params[1], work)
 
 
 @numba.njit(cache=True)

@@ -20,51 +20,57 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from synergrasp.config import build, dataclass_fields, overlay
+from synergrasp.hand.synergies import Synergies, synergy_values
+from synergrasp.simulation.closure_params import ClosureParams, DynamicParams
 from synergrasp.simulation.contacts import contacts_row, contacts_table
-from synergrasp.simulation.dynamic_closure import DynamicParams
+from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.placement import ObjectPose, Placement, approach_line, object_pose, pose_grid
 from synergrasp.simulation.scene import HandScene
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
-    from synergrasp.hand.synergies import Synergies
-    from synergrasp.simulation.objects import GraspedObject
     from synergrasp.simulation.shapes import Shape
 
-__all__ = ["ClosureParams", "simulate_object", "closure_model", "place_object"]
+__all__ = ["SimulateParams", "simulate_object", "closure_model", "place_object"]
 
 @dataclass(frozen=True)
-class ClosureParams:
-    """Closure settings (docs/closure.md), built by :func:`synergrasp.config.step_params`
-    (``"simulate"``) from the configuration, whose schema holds the defaults and checks them.
+class SimulateParams:
+    """The closure of one object (the ``simulate`` step): the hand file (None: the shipped
+    hand), the mean posture q_m and the first synergy S1 of the synergy table (rad, in the
+    hand's joint order: all the closure reads of the table), the object, its effective placement
+    (with the pose grid), the closure settings, and the ``mechanics`` block where the dynamic
+    model reads it (else None)."""
 
-    The path itself is not a setting: it runs from the fully open hand to the σ at which
-    every joint moved by S1 is at a limit (``SynergyPath.closure_range``).
-    tolerance_mm:             a stopping link ends within this gap of what it touches
-                              (the refinement stops once the gap is in [0, tolerance_mm]).
-    contact_distance_mm:      a link at most this far from the object counts as touching.
-    penetration_tolerance_mm: the box intersects the open hand if it penetrates a link of
-                              the open hand deeper than this; also the largest accepted
-                              penetration of a recorded contact.
-    step_mm:                  largest travel of any link point per coarse σ step, mm.
-    model:                    ``kinematic`` (the quasi-static closure: links stop at first
-                              touch, the box fixed) or ``dynamic`` (the compliant hand
-                              closing on a free box, ``dynamic_closure``).
-    dynamic:                  settings of the dynamic model (``DynamicParams``).
-    """
+    hand: str | None
+    mean_rad: tuple[float, ...]
+    s1: tuple[float, ...]
+    object: GraspedObject
+    placement: Placement
+    closure: ClosureParams
+    mechanics: dict[str, Any] | None = None
 
-    tolerance_mm: float
-    contact_distance_mm: float
-    penetration_tolerance_mm: float
-    step_mm: float
-    model: str
-    dynamic: DynamicParams
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str) -> SimulateParams:
+        """From a configuration, or from the step's own part of it
+        (``synergrasp.steps.step_config``), whose ``synergies`` holds q_m and S1 themselves."""
+        values = config["synergies"]
+        if not isinstance(values, Mapping):
+            values = synergy_values(config["hand"], values, (1,))
+        closure = config["closure"]
+        dynamic_model = closure["model"] == "dynamic"  # reads the box's mass and the mechanics
+        dynamic = build(DynamicParams, "closure.dynamic", **dataclass_fields(DynamicParams, closure["dynamic"]))
+        return cls(
+            hand=config["hand"], mean_rad=tuple(values["mean_rad"]), s1=tuple(values["S1"]),
+            object=GraspedObject.from_config(config, obj, with_mass=dynamic_model),
+            placement=Placement.from_config(overlay(config["placement"], config["objects"][obj].get("placement")),
+                                            config["grid"]),
+            closure=build(ClosureParams, "closure", **{**dataclass_fields(ClosureParams, closure), "dynamic": dynamic}),
+            mechanics=config["mechanics"] if dynamic_model else None)
 
-    def __post_init__(self) -> None:
-        # Checked once, by the schema and config.check_relations (built by config.step_params).
-        for name in ("tolerance_mm", "contact_distance_mm", "penetration_tolerance_mm", "step_mm"):
-            object.__setattr__(self, name, float(getattr(self, name)))
-
+    def synergies(self, joint_names: tuple[str, ...]) -> Synergies:
+        """q_m and S1 as a one-synergy :class:`Synergies` of the hand's joints."""
+        return Synergies(tuple(joint_names), np.array(self.mean_rad), np.array(self.s1)[:, None], ("S1",))
 
 def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams,
                   mechanics: Mapping[str, Any] | None = None, mass_kg: float | None = None):

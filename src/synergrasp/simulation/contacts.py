@@ -2,14 +2,13 @@
 
 Every closure model returns a :class:`ClosureResult`; :func:`contacts_row` turns it into a
 row of the table whose columns, types and units are ``synergrasp.tables.CONTACTS``;
-:func:`read_grasps` turns rows back into grasps for the optimisation;
 :func:`load_carrying_contacts` keeps the contacts that carry load (where the closure model
 records loads). Pure numpy and pandas: pybullet is never imported here.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -23,7 +22,6 @@ from synergrasp.simulation.placement import ObjectPose
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
-    from synergrasp.optimisation.mechanics import Grasp
 
 __all__ = [
     "STATUSES",
@@ -33,7 +31,7 @@ __all__ = [
     "contacts_row",
     "contacts_table",
     "write_contacts",
-    "read_grasps",
+    "ContactsParams",
     "load_carrying_contacts",
 ]
 
@@ -150,33 +148,23 @@ def write_contacts(table: pd.DataFrame, path: str | Path) -> None:
     tables.write(tables.CONTACTS, table, path)
 
 
-def read_grasps(table: pd.DataFrame) -> list[Grasp | None]:
-    """One :class:`synergrasp.optimisation.mechanics.Grasp` per row of a contacts table, in row order.
+@dataclass(frozen=True)
+class ContactsParams:
+    """Which contacts of a closure count (the ``contacts`` step). ``drop_unloaded``: keep only
+    the contacts carrying at least ``load_threshold_N`` (N); only the dynamic model records
+    loads (None otherwise)."""
 
-    Rows whose status is not ``grasp`` or that have no contact give ``None``. Reads only
-    numbers: pybullet is not imported.
-    """
-    from synergrasp.optimisation.mechanics import Grasp
+    drop_unloaded: bool
+    load_threshold_N: float | None
 
-    missing = [c for c in ("status", "n_contacts", "contact_link", "contact_point", "contact_normal",
-                           "jacobian", "object_center") if c not in table.columns]
-    if missing:
-        raise ValueError(f"contacts table: missing column(s) {missing}")
-    grasps: list[Grasp | None] = []
-    for row in table.itertuples(index=False):
-        m = int(row.n_contacts)
-        if row.status != "grasp" or m == 0:
-            grasps.append(None)
-            continue
-        jac = np.asarray(row.jacobian, dtype=float)
-        grasps.append(Grasp(
-            points=np.asarray(row.contact_point, dtype=float).reshape(m, 3),
-            normals=np.asarray(row.contact_normal, dtype=float).reshape(m, 3),
-            links=np.asarray(row.contact_link, dtype=np.int64),
-            jacobian=jac.reshape(3 * m, jac.size // (3 * m)),
-            center=np.asarray(row.object_center, dtype=float),
-        ))
-    return grasps
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> ContactsParams:
+        """From a configuration or the step's own part of it; ``obj`` is not read (every
+        object's closure is selected alike)."""
+        closure = config["closure"]
+        if closure["model"] != "dynamic":
+            return cls(False, None)
+        return cls(closure["dynamic"]["unloaded_contacts"] == "drop", closure["dynamic"]["load_threshold_N"])
 
 
 def load_carrying_contacts(table: pd.DataFrame, threshold_N: float) -> pd.DataFrame:

@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 from collections import deque
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -40,77 +39,12 @@ from synergrasp.simulation.placement import ObjectPose
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
-    from synergrasp.simulation.closure import ClosureParams
+    from synergrasp.simulation.closure_params import ClosureParams
     from synergrasp.simulation.shapes import Shape
 
-__all__ = ["DynamicParams", "DynamicClosure", "compliant_self_pairs"]
+__all__ = ["DynamicClosure", "compliant_self_pairs"]
 
 _LONG_FINGERS = ("index", "middle", "ring", "little")
-
-
-@dataclass(frozen=True)
-class DynamicParams:
-    """Settings of the dynamic closure (config ``closure.dynamic``; docs/dynamic_closure.md).
-
-    The values are checked once, by the config schema and ``config.check_relations``; this
-    class only carries them.
-
-    time_step_s:           physics time step, s.
-    solver_iterations:     constraint-solver iterations per step.
-    link_mass_kg:          mass of every elementary hand link during the closure, kg.
-    link_inertia_kg_mm2:   rotational inertia of every elementary hand link about its own
-                           frame, kg·mm² (sets the fastest joint mode: √(k_ss / I)).
-    joint_damping_Nmm_s_per_rad: viscous damping on every elementary axis, N·mm·s/rad.
-    object_mass_kg:        mass of the box during the closure, kg (its weight, if gravity is
-                           on, is still mass_kg · g: see ``gravity``).
-    object_damping_per_s:  linear and angular drag rate of the box, 1/s.
-    ramp_time_s:           time over which σ runs from the open to the closed end, s.
-    time_limit_s:          the closure stops here if it has not settled, s.
-    settle_window_s:       settled when, over the last window of this length (s) after the
-                           ramp, ...
-    settle_joint_change_rad: ... no joint angle q changed by more than this (rad) ...
-    settle_object_change_mm: ... and no point of the box moved by more than this (mm:
-                           displacement of the centre + rotation angle × half diagonal).
-    hand_hand_mu:          friction between two hand links (hand–box friction is mechanics.mu).
-    gravity:               the box's weight acts during the closure (along
-                           mechanics.gravity_direction) if true.
-    lost_distance_mm:      a box with no contact at the end that moved farther than this from
-                           its initial pose was moved by the hand and is held by nothing:
-                           ``caged`` if its centre is inside the closed hand
-                           (``HandCapsules.encloses``), ``lost`` (pushed out) if not.
-
-    Every hand link touching the box is listed with the normal force it carries; which of
-    them count (``closure.dynamic.unloaded_contacts``) is decided downstream
-    (``synergrasp.simulation.contacts.load_carrying_contacts``), so both choices share one closure.
-    """
-
-    time_step_s: float
-    solver_iterations: int
-    link_mass_kg: float
-    link_inertia_kg_mm2: float
-    joint_damping_Nmm_s_per_rad: float
-    object_mass_kg: float
-    object_damping_per_s: float
-    ramp_time_s: float
-    time_limit_s: float
-    settle_window_s: float
-    settle_joint_change_rad: float
-    settle_object_change_mm: float
-    hand_hand_mu: float
-    gravity: bool
-    lost_distance_mm: float
-
-    @property
-    def ramp_steps(self) -> int:
-        return max(1, int(round(self.ramp_time_s / self.time_step_s)))
-
-    @property
-    def max_steps(self) -> int:
-        return max(self.ramp_steps, int(round(self.time_limit_s / self.time_step_s)))
-
-    @property
-    def window_steps(self) -> int:
-        return max(1, int(round(self.settle_window_s / self.time_step_s)))
 
 
 def compliant_self_pairs(hand: Any) -> tuple[tuple[int, int], ...]:

@@ -26,7 +26,7 @@ from synergrasp.simulation.scene import HandScene
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
-    from synergrasp.simulation.closure import ClosureParams
+    from synergrasp.simulation.closure_params import ClosureParams
 
 __all__ = ["KinematicClosure"]
 

@@ -5,11 +5,13 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
+from collections.abc import Mapping
 from typing import Any
 
-from synergrasp.simulation.shapes import Shape
+from synergrasp.config import ConfigError, build
+from synergrasp.simulation.shapes import Shape, ShapeError, shape_from_config
 
-__all__ = ["GraspedObject", "ObjectError"]
+__all__ = ["GraspedObject", "ObjectError", "object_problems"]
 
 _NAME = re.compile(r"[A-Za-z0-9_]+")
 
@@ -28,7 +30,7 @@ class GraspedObject:
     shape : its geometry (a box, ...), in its own frame, mm.
     mass_kg : mass, kg; None where it is not given (a step that does not read it).
 
-    Built from the configuration by ``synergrasp.config.step_params``.
+    Built from the configuration by :meth:`from_config`.
     """
 
     name: str
@@ -41,6 +43,17 @@ class GraspedObject:
             raise ObjectError(f"object '{self.name}': field 'shape' must be a shape "
                               f"(synergrasp.simulation.shapes), got {self.shape!r}")
         object.__setattr__(self, "mass_kg", _check_mass(self.name, self.mass_kg))
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], name: str, with_mass: bool = True) -> GraspedObject:
+        """The object ``name`` of the configuration; without a mass (None) where the step
+        does not read it (``with_mass`` false)."""
+        spec = config["objects"][name]
+        try:
+            shape = shape_from_config(spec["shape"], f"objects.{name}.shape")
+        except ShapeError as err:
+            raise ConfigError(f"config error at {err}") from None
+        return build(cls, f"objects.{name}", name=name, shape=shape, mass_kg=spec["mass_kg"] if with_mass else None)
 
 
 def _check_name(name: Any) -> None:
@@ -60,3 +73,15 @@ def _check_mass(name: str, mass: Any) -> float | None:
         raise ObjectError(f"object '{name}': field 'mass_kg' is {mass!r}; a finite positive mass in kg "
                           "is required")
     return value
+
+
+def object_problems(config: Mapping[str, Any]) -> list[str]:
+    """What the schema cannot check of a complete configuration's objects: each shape's own
+    relations (one line per problem, naming the key), checked before any job runs."""
+    problems = []
+    for name, spec in config["objects"].items():
+        try:
+            shape_from_config(spec["shape"], f"objects.{name}.shape")
+        except ShapeError as err:
+            problems.append(f"config error at {err}")
+    return problems

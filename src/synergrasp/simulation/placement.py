@@ -7,13 +7,14 @@ Lengths in mm, angles in rad (degrees only in pose labels and grid ranges), palm
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from synergrasp.config import build, dataclass_fields
 from synergrasp.hand.kinematics import axis_rotation
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -51,8 +52,8 @@ def _range_deg(start: float, stop: float, step: float, name: str) -> NDArray:
 class Placement:
     """Where the box sits relative to the palm (docs/closure.md).
 
-    Built by :func:`synergrasp.config.step_params` (``"simulate"``) from the configuration,
-    whose schema holds the defaults and checks the values.
+    Built by :meth:`from_config` from the configuration, whose schema holds the defaults
+    and checks the values.
 
     One rule for every mode: the box, turned by (α, β) about its centre, travels along the
     palm normal from outside toward a target point (palm frame, mm) and stops at the target
@@ -95,9 +96,16 @@ class Placement:
     target_mm: tuple[float, float, float] | None = None
     search_rank: int = 1
 
+    @classmethod
+    def from_config(cls, placement: Mapping[str, Any], grid: Mapping[str, Any]) -> Placement:
+        """The placement of an effective ``placement`` block (the global one with an object's
+        override laid over it) and the configuration's ``grid`` block."""
+        ranges = {k: (v["start"], v["stop"], v["step"]) for k, v in grid.items()}
+        return build(cls, "placement", **dataclass_fields(cls, {**placement, **ranges}))
+
     def __post_init__(self) -> None:
         # Values are checked once, by the schema and config.check_relations; built by
-        # config.step_params, which holds the defaults. Here only the types are settled.
+        # Placement.from_config; the schema holds the defaults. Here only the types are settled.
         for name in ("approach_point_mm", "target_mm"):
             if getattr(self, name) is not None:
                 object.__setattr__(self, name, tuple(float(v) for v in getattr(self, name)))

@@ -16,6 +16,7 @@ The configuration names a shape by one key, ``objects.<name>.shape: {box: {size_
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
@@ -23,11 +24,23 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Shape", "ShapeError", "SHAPES", "shape_from_config", "start_rotation", "Box"]
+__all__ = ["Shape", "ShapeError", "SHAPES", "shape_from_config", "start_rotation", "positive_length", "Box", "Sphere",
+           "Cylinder"]
 
 
 class ShapeError(ValueError):
     """A shape description is invalid; the message names the field."""
+
+
+def positive_length(field: str, value: Any) -> float:
+    """``value`` as a finite positive length in mm; ShapeError("<field>: ...") otherwise."""
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        out = math.nan
+    if isinstance(value, (bool, str)) or not (math.isfinite(out) and out > 0):
+        raise ShapeError(f"{field}: {value!r} is not allowed; a finite positive length in mm is required")
+    return out
 
 
 def start_rotation(axes: Sequence[int]) -> NDArray:
@@ -51,9 +64,15 @@ class Shape(ABC):
     kernel_code: ClassVar[int]
 
     @property
-    @abstractmethod
     def kernel_params(self) -> NDArray:
         """Its sizes as the float64 array the compiled kernel reads (read-only)."""
+        return self._params
+
+    def _set_kernel_params(self, *values: float) -> None:
+        """Keep ``values`` as the read-only ``kernel_params`` (from ``__post_init__``)."""
+        params = np.array(values, dtype=float)
+        params.setflags(write=False)
+        object.__setattr__(self, "_params", params)
 
     @property
     @abstractmethod
@@ -145,6 +164,8 @@ def shape_from_config(spec: Mapping[str, Any], where: str = "shape") -> Shape:
 
 
 from synergrasp.simulation.shapes.box import Box  # noqa: E402
+from synergrasp.simulation.shapes.cylinder import Cylinder  # noqa: E402
+from synergrasp.simulation.shapes.sphere import Sphere  # noqa: E402
 
 #: The shapes by the key that names them in the configuration.
-SHAPES: dict[str, type[Shape]] = {cls.kind: cls for cls in (Box,)}
+SHAPES: dict[str, type[Shape]] = {cls.kind: cls for cls in (Box, Sphere, Cylinder)}

@@ -74,17 +74,12 @@ class Box(Shape):
             raise ShapeError(f"size_mm: {size!r} is not allowed; three finite positive edge lengths in mm "
                              "are required")
         object.__setattr__(self, "size_mm", values)
-        half = np.array(values) / 2.0
-        half.setflags(write=False)
-        object.__setattr__(self, "_half", half)
+        self._set_kernel_params(*(np.array(values) / 2.0))  # the half extents
+        object.__setattr__(self, "_half", self._params)
 
     @property
     def half_extents_mm(self) -> NDArray:
         """(3,) half edge lengths, mm (read-only)."""
-        return self._half
-
-    @property
-    def kernel_params(self) -> NDArray:
         return self._half
 
     @property

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
@@ -24,17 +24,19 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp import tables
+from synergrasp.config import build, dataclass_fields, overlay
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.study import GFOParams, optimise_grasps
-from synergrasp.simulation.contacts import contacts_row, contacts_table, read_grasps
+from synergrasp.optimisation.study import GFOParams, optimise_grasps, read_grasps
+from synergrasp.simulation.contacts import contacts_row, contacts_table
+from synergrasp.simulation.closure_params import ClosureParams
+from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.placement import Placement, palm_centre, pose_grid
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
-    from synergrasp.simulation.closure import ClosureParams
 
-__all__ = ["SearchParams", "TargetScore", "SearchResult", "score_target", "rank_targets", "pose_subset",
+__all__ = ["SearchStepParams", "SearchParams", "TargetScore", "SearchResult", "score_target", "rank_targets", "pose_subset",
            "full_synergy_set", "TargetScorer", "search_object", "region_lattice", "distinct_ranks"]
 
 _TOL = 1e-6
@@ -82,6 +84,44 @@ class SearchParams:
             raise ValueError(f"coarse_spacing_mm ({self.coarse_spacing_mm}) must be a whole multiple of "
                              f"spacing_mm ({self.spacing_mm})")
 
+
+
+@dataclass(frozen=True)
+class SearchStepParams:
+    """The placement search of one object (the ``search`` step; docs/placement_search.md):
+    hand and synergy files, the object with its mass, its effective placement, the closure
+    settings (the search closes with the kinematic model), the GFO parameters, the size of
+    the full synergy set, the search's settings."""
+
+    hand: str | None
+    synergies: str | None
+    object: GraspedObject
+    placement: Placement
+    closure: ClosureParams
+    gfo: GFOParams
+    full_set_size: int
+    search: SearchParams
+    distinct_mm: float
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str) -> SearchStepParams:
+        """From a configuration or the step's own part of it, for the object ``obj``."""
+        placement = overlay(config["placement"], config["objects"][obj].get("placement"))
+        spec = placement["search"]
+        region = tuple(tuple(spec["region_mm"][axis]) for axis in ("x", "y", "z"))
+        search = build(SearchParams, "placement.search", region_mm=region, **dataclass_fields(
+            SearchParams, {k: v for k, v in spec.items() if k != "region_mm"}))
+        closure = {**config["closure"], "model": "kinematic"}
+        return cls(
+            hand=config["hand"], synergies=config["synergies"], object=GraspedObject.from_config(config, obj),
+            # the search places the box toward each of its targets: the modes' own targets are not read
+            placement=Placement.from_config({**placement, "mode": "searched", "approach_point_mm": None,
+                                             "center_mm": (0.0, 0.0, 0.0)}, config["grid"]),
+            closure=build(ClosureParams, "closure", **{**dataclass_fields(ClosureParams, closure), "dynamic": None}),
+            gfo=build(GFOParams, "mechanics", **dataclass_fields(GFOParams, config["mechanics"]),
+                      mass_kg=float(config["objects"][obj]["mass_kg"])),
+            full_set_size=int(config["synergy_sets"]["incremental_max"]), search=search,
+            distinct_mm=float(spec["distinct_mm"]))
 
 @dataclass(frozen=True)
 class TargetScore:

@@ -1,0 +1,145 @@
+"""Compiled segment queries of the round shapes (numba, cached next to the source; mm).
+
+The closure asks, at every posture, for the signed distance from each capsule's axis to the
+object (``synergrasp.simulation.capsules._seg_object`` dispatches on the shape's code; the
+box's query lives there, as the palm is made of boxes too). Both answers here are in the
+shape's own frame and follow the box's conventions: the segment is p0 + t·d, t in [0, 1];
+outside, the exact distance and the t attaining it (on a stretch of equal distance, the
+middle of the stretch, so that t does not depend on how the segment is oriented along it);
+crossing the shape, minus the deepest penetration of a point of the segment.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["sort_knots", "segment_sphere", "segment_cylinder", "cylinder_sdf"]
+
+_EPS = 1e-12
+_FLAT_MM = 1e-9  # distances (mm) this close count as equal (a flat stretch of the segment)
+_GOLDEN = 0.6180339887498949
+_GOLDEN_STEPS = 60
+
+
+@numba.njit(cache=True)
+def sort_knots(knots: NDArray, n: int) -> None:
+    """Sort the first ``n`` values of ``knots`` in place (insertion sort: n is at most 8)."""
+    for k in range(1, n):
+        v, j = knots[k], k - 1
+        while j >= 0 and knots[j] > v:
+            knots[j + 1] = knots[j]
+            j -= 1
+        knots[j + 1] = v
+
+
+@numba.njit(cache=True)
+def segment_sphere(p0: NDArray, d: NDArray, radius: float) -> tuple[float, float]:
+    """Signed distance from the segment p0 + t·d to the sphere of ``radius`` about the origin
+    and the t attaining it: the axis point nearest the centre (exact, also when crossing)."""
+    dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+    t = 0.0
+    if dd > _EPS:
+        t = min(max(-(p0[0] * d[0] + p0[1] * d[1] + p0[2] * d[2]) / dd, 0.0), 1.0)
+    x, y, z = p0[0] + t * d[0], p0[1] + t * d[1], p0[2] + t * d[2]
+    return np.sqrt(x * x + y * y + z * z) - radius, t
+
+
+@numba.njit(cache=True)
+def cylinder_sdf(x: float, y: float, z: float, radius: float, half_height: float) -> float:
+    """Signed distance (mm) of the point (x, y, z) to the solid cylinder about the z axis
+    (radius, |z| ≤ half_height): negative inside (minus the depth)."""
+    dr = np.sqrt(x * x + y * y) - radius
+    dz = abs(z) - half_height
+    if dr > 0.0 and dz > 0.0:
+        return np.sqrt(dr * dr + dz * dz)
+    return max(dr, dz)
+
+
+@numba.njit(cache=True)
+def _sdf_at(p0: NDArray, d: NDArray, t: float, radius: float, half_height: float) -> float:
+    return cylinder_sdf(p0[0] + t * d[0], p0[1] + t * d[1], p0[2] + t * d[2], radius, half_height)
+
+
+@numba.njit(cache=True)
+def _golden(p0: NDArray, d: NDArray, lo: float, hi: float, radius: float, half_height: float) -> float:
+    """The t of least signed distance on [lo, hi] (a convex function of t): golden section."""
+    a, b = lo, hi
+    x1, x2 = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
+    f1, f2 = _sdf_at(p0, d, x1, radius, half_height), _sdf_at(p0, d, x2, radius, half_height)
+    for _ in range(_GOLDEN_STEPS):
+        if f1 <= f2:
+            b, x2, f2 = x2, x1, f1
+            x1 = b - _GOLDEN * (b - a)
+            f1 = _sdf_at(p0, d, x1, radius, half_height)
+        else:
+            a, x1, f1 = x1, x2, f2
+            x2 = a + _GOLDEN * (b - a)
+            f2 = _sdf_at(p0, d, x2, radius, half_height)
+    return 0.5 * (a + b)
+
+
+@numba.njit(cache=True)
+def segment_cylinder(p0: NDArray, d: NDArray, radius: float, half_height: float,
+                     knots: NDArray) -> tuple[float, float]:
+    """Signed distance from the segment p0 + t·d to the solid cylinder about the z axis and
+    the t attaining it (``knots``: work space of 8 values).
+
+    The signed distance of a convex body is convex along a line, and on the pieces between
+    the knots (where z crosses ±half_height or 0, where the radial distance crosses the
+    radius) it has one form: beside the wall, the radial distance less the radius, least at
+    the vertex of a quadratic; beyond a cap inside the radius, linear; beyond a rim or inside
+    the body, minimised by golden section (to ~1e-12 of the piece). Only the two pieces about
+    the best knot can hold the minimum.
+    """
+    knots[0], knots[1] = 0.0, 1.0
+    n = 2
+    if abs(d[2]) > _EPS:
+        for level in (half_height, -half_height, 0.0):
+            tb = (level - p0[2]) / d[2]
+            if 0.0 < tb < 1.0:
+                knots[n] = tb
+                n += 1
+    a = d[0] * d[0] + d[1] * d[1]
+    b = 2.0 * (p0[0] * d[0] + p0[1] * d[1])
+    c = p0[0] * p0[0] + p0[1] * p0[1] - radius * radius
+    if a > _EPS:
+        disc = b * b - 4.0 * a * c
+        if disc > 0.0:
+            root = np.sqrt(disc)
+            for tb in ((-b - root) / (2.0 * a), (-b + root) / (2.0 * a)):
+                if 0.0 < tb < 1.0:
+                    knots[n] = tb
+                    n += 1
+    sort_knots(knots, n)
+    best, best_k = np.inf, 0
+    for k in range(n):
+        f = _sdf_at(p0, d, knots[k], radius, half_height)
+        if f < best:
+            best, best_k = f, k
+    best_t = knots[best_k]
+    for piece in range(max(best_k - 1, 0), min(best_k + 1, n - 1)):
+        lo, hi = knots[piece], knots[piece + 1]
+        mid = 0.5 * (lo + hi)
+        x, y, z = p0[0] + mid * d[0], p0[1] + mid * d[1], p0[2] + mid * d[2]
+        beside = np.sqrt(x * x + y * y) > radius and abs(z) <= half_height
+        beyond_cap = np.sqrt(x * x + y * y) <= radius and abs(z) > half_height
+        if beyond_cap:
+            continue  # linear: least at a knot
+        if beside:
+            tv = min(max(-b / (2.0 * a), lo), hi) if a > _EPS else mid
+        else:
+            tv = _golden(p0, d, lo, hi, radius, half_height)
+        f = _sdf_at(p0, d, tv, radius, half_height)
+        if f < best:
+            best, best_t = f, tv
+    if best > 0.0:  # a stretch of equal distance (bounded by knots): its middle
+        t_lo, t_hi = best_t, best_t
+        for k in range(n):
+            if _sdf_at(p0, d, knots[k], radius, half_height) <= best + _FLAT_MM:
+                t_lo, t_hi = min(t_lo, knots[k]), max(t_hi, knots[k])
+        if t_hi > t_lo:
+            best_t = 0.5 * (t_lo + t_hi)
+            best = min(best, _sdf_at(p0, d, best_t, radius, half_height))
+    return best, best_t

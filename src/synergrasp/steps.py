@@ -1,0 +1,298 @@
+"""The steps of the workflow, each declared once (docs/design.md, "Adding a step").
+
+:data:`STEPS` is data only: for every step, its rules and the measured cost of one job of
+each, the files it writes, the configuration keys it reads (and those it reads only when
+another key has a given value), the steps whose outputs it reads, and the class whose
+``from_config`` builds its typed parameters. The step hash, ``workflow/rules/common.smk``
+(targets, where a shared output lives), ``workflow/rules/resources.smk`` (threads, memory,
+run time, local rules) and the tests all read it.
+
+A rule is handed only the part of its scenario's configuration that its step reads
+(:func:`step_config`); so a job reruns only when a key it reads changes, and two scenarios
+share a step's outputs when their steps read the same values and the same upstream outputs
+(:func:`step_hash`). A step that reads only some synergies of the synergy table is handed
+their values (``synergrasp.hand.synergies.synergy_values``), not the table, so that what its hash says is what
+it reads.
+
+Layer: above the stages (it reads the hand and synergy files); imported only by the
+workflow and the tests.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from synergrasp.config import overlay
+from synergrasp.hand.synergies import synergy_values
+
+__all__ = ["Cost", "Step", "STEPS", "UNITS", "WORKFLOW_KEYS", "step_keys", "step_config", "step_hash",
+           "upstream_when", "rule_costs"]
+
+#: Units of work a job's cost is counted in (resources.smk counts them for a scenario).
+UNITS = ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose_set")
+
+
+@dataclass(frozen=True)
+class Cost:
+    """Measured cost of one job of a rule: fixed wall time (s) and memory (MB) of the job
+    itself (imports, reading inputs), plus wall time and memory per unit of work (UNITS).
+    ``local``: a job of seconds, run where Snakemake runs rather than submitted."""
+
+    unit: str
+    fixed_s: float
+    fixed_mb: float
+    unit_s: float = 0.0
+    unit_mb: float = 0.0
+    local: bool = True
+
+
+@dataclass(frozen=True)
+class Step:
+    """One step of the workflow.
+
+    rules:     its rules, each with the cost of one job; the last one writes ``outputs``.
+    outputs:   the files it writes, by output name: under ``{root}/objects/{object}/`` for a
+               step run per object, under ``{root}/`` for one run per scenario, under
+               ``results/`` for one run once for the whole workflow (``scope``).
+    scope:     ``object`` | ``scenario`` | ``workflow``.
+    reads:     configuration keys it reads ("objects.{object}" is the step's object,
+               "objects.*" every object).
+    reads_when: keys it reads only when another key has a value: ((key, value, keys), ...).
+    not_reads: keys inside a block it reads that it does not read itself.
+    upstream:  steps whose outputs it reads (its hash holds theirs): for a step run per
+               object, that object's; for one run per scenario, every object's.
+    upstream_when: steps it reads only when a key of the object's effective placement
+               (the global one with the object's override) has a value: ((key, value, step), ...).
+    synergy_columns: the synergies (1-based) it reads besides the mean posture; it is handed
+               their values instead of the synergy table.
+    params:    "module:Class" whose ``from_config`` builds its typed parameters.
+    """
+
+    rules: Mapping[str, Cost]
+    outputs: Mapping[str, str]
+    scope: str = "scenario"
+    reads: tuple[str, ...] = ()
+    reads_when: tuple[tuple[str, Any, tuple[str, ...]], ...] = ()
+    not_reads: tuple[str, ...] = ()
+    upstream: tuple[str, ...] = ()
+    upstream_when: tuple[tuple[str, Any, str], ...] = ()
+    synergy_columns: tuple[int, ...] = ()
+    params: str | None = None
+
+
+def _files(names: tuple[str, ...], folder: str, exts: tuple[str, ...]) -> dict[str, str]:
+    """Output name ``<name>_<ext>`` -> ``<folder>/<name>.<ext>`` for every name and extension."""
+    return {f"{n}_{e}": f"{folder}/{n}.{e}".lstrip("/") for n in names for e in exts}
+
+
+#: The study's tables (the ``tables`` step).
+TABLES = ("success_rates", "table2_success_rates", "hierarchy", "minimum_preservation", "full_not_first7",
+          "verdict_disagreements", "preservation_vs_chance", "invariant_checks", "claims")
+#: The keys of the choice of which contacts count (the ``contacts`` step).
+_CONTACT_SELECTION = ("closure.dynamic.unloaded_contacts", "closure.dynamic.load_threshold_N")
+#: The keys of the force bound of ``analyses.success: force_closure_bounded``.
+_FORCE_BOUND = ("analyses.marginal_weight_multiple", "objects.{object}.mass_kg", "mechanics.g_m_per_s2")
+#: The keys of a placement mode's target (the search reads none of them).
+_PLACEMENT_TARGETS = ("mode", "search_rank", "approach_point_mm", "center_mm")
+_PNG_PDF = ("png", "pdf")
+
+#: Every step of the workflow, in the order they run. Costs: from results/benchmarks/*.tsv
+#: (columns s, cpu_time and max_rss) of the default study and of tests/config/small.yaml on a
+#: 2-core x86_64 machine running two jobs at a time; the slope is between the two sizes
+#: (docs/cluster.md).
+STEPS: dict[str, Step] = {
+    # the placement search (docs/placement_search.md): the kinematic closure and the
+    # optimisation with the full set {S1..S_incremental_max} only; its rule comes with the
+    # search's wiring into the workflow
+    "search": Step(
+        rules={}, outputs={"placement": "placement.csv"}, scope="object",
+        reads=("hand", "synergies", "grid", "placement", "closure", "mechanics", "synergy_sets.incremental_max",
+               "objects.{object}.shape", "objects.{object}.mass_kg", "objects.{object}.placement"),
+        not_reads=("closure.model", "closure.dynamic",
+                   *(f"{where}.{key}" for where in ("placement", "objects.{object}.placement")
+                     for key in _PLACEMENT_TARGETS)),
+        params="synergrasp.optimisation.placement_search:SearchStepParams"),
+    "simulate": Step(
+        rules={"simulate_contacts": Cost("closure_pose", 1.5, 178, 4.5e-2, 7.6e-3, local=False)},
+        outputs={"contacts": "contacts.parquet"}, scope="object",
+        reads=("hand", "synergies", "grid", "placement", "closure", "objects.{object}.shape",
+               "objects.{object}.placement"),
+        # the dynamic closure: a free box of the object's mass, μ, k_ss and gravity of mechanics
+        reads_when=(("closure.model", "dynamic", ("objects.{object}.mass_kg", "mechanics")),),
+        # which contacts count is the `contacts` step's choice: `drop` and `keep` share one closure
+        # nor the search's settings (a searched placement reads the search's output)
+        not_reads=(*_CONTACT_SELECTION, "placement.search", "objects.{object}.placement.search"),
+        upstream_when=(("placement.mode", "searched", "search"),), synergy_columns=(1,),
+        params="synergrasp.simulation.closure:SimulateParams"),
+    "contacts": Step(
+        rules={"select_contacts": Cost("pose", 1.0, 150, 5.0e-4, 7.6e-3)},
+        outputs={"contacts": "load_carrying_contacts.parquet"}, scope="object",
+        reads=("closure.model",),
+        # only the dynamic model records the load each contact carries
+        reads_when=(("closure.model", "dynamic", _CONTACT_SELECTION),),
+        upstream=("simulate",), params="synergrasp.simulation.contacts:ContactsParams"),
+    "optimise": Step(
+        rules={"optimise_shard": Cost("shard_pose_set", 2.2, 271, 6.1e-5, 1.1e-3, local=False),
+               "aggregate_gfo": Cost("pose_set", 0.6, 134, 2.0e-6, 6.0e-4)},
+        outputs={"gfo": "gfo.parquet"}, scope="object",
+        reads=("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg"),
+        upstream=("contacts",), params="synergrasp.optimisation.study:OptimiseParams"),
+    "minima": Step(
+        rules={"local_minima": Cost("pose_set", 0.6, 136, 1.35e-5, 6.0e-4)},
+        outputs={"minima": "minima.parquet"}, scope="object",
+        reads=("analyses.minima_radius_deg", "analyses.success"),
+        # force closure within a multiple of the weight: the minima and Fig. 4 read the bound
+        reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
+        upstream=("optimise",), params="synergrasp.analysis.minima:MinimaParams"),
+    "tables": Step(
+        rules={"study_tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
+        outputs=_files(TABLES, "tables", ("csv", "md")),
+        reads=("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max", "analyses.success",
+               "analyses.marginal_weight_multiple", "analyses.success_rate_tolerance_percent",
+               "analyses.null_model", "analyses.headline_view", "analyses.tie_band", "analyses.min_distinct_poses",
+               "analyses.bootstrap", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
+        upstream=("optimise", "minima"), params="synergrasp.analysis.summaries:TablesParams"),
+    "realism": Step(
+        rules={"grasp_realism": Cost("object_pose_set", 4.0, 300, 4.0e-6, 3.0e-4)},
+        outputs={"csv": "tables/grasp_realism.csv", "md": "tables/grasp_realism.md",
+                 "png": "figures/grasp_realism.png", "pdf": "figures/grasp_realism.pdf",
+                 "graspable_csv": "tables/graspable_objects.csv", "graspable_md": "tables/graspable_objects.md"},
+        reads=("hand", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2", "closure.model"),
+        reads_when=(("closure.model", "dynamic", ("closure.dynamic.load_threshold_N",)),),
+        upstream=("contacts", "optimise"), params="synergrasp.analysis.realism:RealismParams"),
+    "fig1": Step(
+        rules={"fig1_synergy_postures": Cost("none", 3.0, 565)},
+        outputs=_files(("fig1_synergy_postures",), "figures", _PNG_PDF),
+        reads=("hand", "synergies"), params="synergrasp.figures.hand_figures:Fig1Params"),
+    "fig2": Step(
+        rules={"fig2_example_grasps": Cost("none", 2.3, 311)},
+        outputs=_files(("fig2_example_grasps",), "figures", _PNG_PDF),
+        reads=("hand", "objects.*.shape"), upstream=("contacts",),
+        params="synergrasp.figures.hand_figures:Fig2Params"),
+    "fig4": Step(
+        rules={"fig4_force_maps": Cost("pose_set", 4.3, 257, 5.1e-6, 4.0e-4)},
+        outputs=_files(("fig4_force_maps", "fig4_exploded"), "", _PNG_PDF), scope="object",
+        reads=("analyses.fig4", "analyses.success"),
+        reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),), upstream=("optimise", "minima"),
+        params="synergrasp.figures.study_figures:Fig4Params"),
+    "fig5": Step(
+        rules={"fig5_hierarchy": Cost("none", 9.6, 268)},
+        outputs=_files(("fig5a_hierarchy_success", "fig5a_hierarchy_success_pooled", "fig5b_hierarchy_force"),
+                       "figures", _PNG_PDF),
+        reads=("synergy_sets.hierarchy_first", "analyses.success"), upstream=("tables",),
+        params="synergrasp.figures.study_figures:Fig5Params"),
+    # the workflow's own rule graph: drawn with the shipped configuration, so it reads no key
+    "fig3": Step(
+        rules={"fig3_rulegraph": Cost("none", 5.3, 380)},
+        outputs={**_files(("fig3_rulegraph",), "figures", _PNG_PDF), "dot": "figures/fig3_rulegraph.dot"},
+        scope="workflow"),
+    # the sweep's summary across every scenario (docs/sensitivity.md): built by `sensitivity`
+    "sensitivity": Step(
+        rules={"sensitivity_summary": Cost("none", 5.0, 300)},
+        outputs={"csv": "sensitivity/claims.csv", "md": "sensitivity/claims.md",
+                 **_files(("claims_grid", "table2_curves"), "sensitivity", _PNG_PDF)},
+        scope="workflow", upstream=("tables",)),
+}
+#: Keys read by the workflow itself, not by a step.
+WORKFLOW_KEYS: tuple[str, ...] = ("scenarios",)
+
+_MISSING = object()
+
+
+def rule_costs() -> dict[str, Cost]:
+    """Every rule of every step, with the cost of one of its jobs."""
+    return {rule: cost for step in STEPS.values() for rule, cost in step.rules.items()}
+
+
+def _get(config: Mapping[str, Any], path: str) -> Any:
+    node: Any = config
+    for part in path.split("."):
+        if not isinstance(node, Mapping) or part not in node:
+            return _MISSING
+        node = node[part]
+    return node
+
+
+def _put(out: dict[str, Any], path: str, value: Any) -> None:
+    *parents, last = path.split(".")
+    for part in parents:
+        out = out.setdefault(part, {})
+    out[last] = copy.deepcopy(value)
+
+
+def step_keys(config: Mapping[str, Any], step: str, obj: str | None = None) -> list[str]:
+    """The key paths ``step`` reads in ``config`` (for object ``obj`` where it matters)."""
+    if step not in STEPS:
+        raise ValueError(f"unknown step {step!r}; allowed values: {sorted(STEPS)}")
+    paths = list(STEPS[step].reads)
+    for key, value, reads in STEPS[step].reads_when:
+        if _get(config, key) == value:
+            paths += reads
+    out = []
+    for path in paths:
+        if path.startswith("objects.*"):
+            out += [path.replace("*", name, 1) for name in config["objects"]]
+        elif "{object}" in path:
+            if obj is None:
+                raise ValueError(f"step {step!r} reads {path}: an object is required")
+            out.append(path.format(object=obj))
+        else:
+            out.append(path)
+    return out
+
+
+def step_config(config: Mapping[str, Any], step: str, obj: str | None = None) -> dict[str, Any]:
+    """The part of ``config`` that ``step`` reads, in the configuration's own shape; for a
+    step with ``synergy_columns``, ``synergies`` holds their values (``synergrasp.hand.synergies.synergy_values``)."""
+    out: dict[str, Any] = {}
+    for path in step_keys(config, step, obj):
+        value = _get(config, path)
+        if value is not _MISSING:
+            _put(out, path, value)
+    for path in STEPS[step].not_reads:
+        if "{object}" in path:
+            if obj is None:
+                continue
+            path = path.format(object=obj)
+        *parents, last = path.split(".")
+        node = _get(out, ".".join(parents))
+        if isinstance(node, dict):
+            node.pop(last, None)
+    columns = STEPS[step].synergy_columns
+    if columns and not isinstance(out.get("synergies"), Mapping):
+        out["synergies"] = synergy_values(out.get("hand"), out.get("synergies"), columns)
+    return out
+
+
+def step_hash(config: Mapping[str, Any], step: str, obj: str | None = None,
+              _memo: dict | None = None) -> str:
+    """Hash of what a step's outputs depend on: the keys it reads and, through its
+    ``upstream`` steps, those of the steps before it (12 hex digits). ``obj``: the object of
+    a step run per object; None for a step run once per scenario."""
+    memo = {} if _memo is None else _memo
+    if (step, obj) in memo:
+        return memo[step, obj]
+    parts: list[Any] = [step_config(config, step, obj)]
+    for upstream in (*STEPS[step].upstream, *upstream_when(config, step, obj)):
+        if STEPS[upstream].scope == "object" and obj is None:
+            parts.append([[name, step_hash(config, upstream, name, memo)] for name in config["objects"]])
+        else:
+            parts.append(step_hash(config, upstream, obj if STEPS[upstream].scope == "object" else None, memo))
+    text = json.dumps(parts, sort_keys=True, default=str)
+    memo[step, obj] = hashlib.sha256(text.encode()).hexdigest()[:12]
+    return memo[step, obj]
+
+
+def upstream_when(config: Mapping[str, Any], step: str, obj: str | None = None) -> tuple[str, ...]:
+    """The steps ``step`` reads for ``obj`` besides its ``upstream``, from the object's
+    effective placement (``upstream_when``): ``search`` for a searched placement."""
+    if obj is None or not STEPS[step].upstream_when:
+        return ()
+    placement = overlay(config["placement"], config["objects"][obj].get("placement"))
+    return tuple(up for key, value, up in STEPS[step].upstream_when
+                 if placement.get(key.removeprefix("placement.")) == value)
