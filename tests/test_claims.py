@@ -126,3 +126,14 @@ def test_claim7_compares_like_with_like_on_unequal_success_sets():
     short = forces_case(10).loc[(7, "pooled")]
     assert short["verdict"] == UNDEFINED
     assert "S1-S7 (10)" in short["reason"] and "S4-S7 (10)" in short["reason"]
+
+
+def test_an_object_with_too_few_poses_is_left_out_of_claim1():
+    """Here {S1..S7} is the full set, so it reaches 100 % on a (180 poses); b has 10 poses
+    only: it is left out and named, and the claim cannot hold."""
+    b_full = np.zeros(N, bool)
+    b_full[:10] = True
+    row = claims(study({"a": {FULL: np.ones(N, bool)}, "b": {FULL: b_full}})).loc[(1, "each_object")]
+    assert row["difference"] == 0.0 and row["n_distinct_poses"] == 180
+    assert row["verdict"] == UNDEFINED
+    assert row["reason"] == "comparisons with fewer than 30 distinct poses: b (10)"

@@ -149,6 +149,13 @@ STEPS: dict[str, Step] = {
         # force closure within a multiple of the weight: the minima and Fig. 4 read the bound
         reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
         upstream=("optimise",), params="synergrasp.analysis.minima:MinimaParams"),
+    # quality indices of every pose and their maps (docs/quality.md)
+    "quality": Step(
+        rules={"grasp_quality": Cost("pose", 3.0, 300, 6.0e-3, 0.05)},
+        outputs={"table": "quality.parquet", **_files(("quality_maps",), "", _PNG_PDF)}, scope="object",
+        reads=("hand", "synergies", "mechanics.mu", "mechanics.g_m_per_s2", "synergy_sets.incremental_max",
+               "objects.{object}.shape", "objects.{object}.mass_kg"),
+        upstream=("contacts", "optimise"), params="synergrasp.optimisation.quality:QualityParams"),
     "tables": Step(
         rules={"study_tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
         outputs=_files(TABLES, "tables", ("csv", "md")),

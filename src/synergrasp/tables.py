@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "PLACEMENT", "write", "read", "empty",
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "PLACEMENT", "QUALITY", "write", "read", "empty",
            "write_study_table"]
 
 
@@ -153,7 +153,21 @@ PLACEMENT = Table("placement", "one row per scored target of one object, best fi
     Column("distance_to_chosen_mm", "float64", "mm", "distance to the chosen target"),
 ))
 
-TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, PLACEMENT)}
+#: Quality indices of every pose of one object (docs/quality.md), Parquet
+#: (results/objects/<object>/quality.parquet).
+QUALITY = Table("quality", "one row per pose", _pose_columns() + (
+    Column("n_contacts", "int32", "", "contacts of the grasp"),
+    Column("rank_G", "int32", "", "rank of the grasp matrix (0: no grasp)"),
+    Column("sigma_min", "float64", "", "smallest singular value of G with torques / torque_length_mm (0: rank < 6; NaN: no grasp)"),
+    Column("isotropy", "float64", "", "sigma_min / sigma_max of that matrix"),
+    Column("epsilon", "float64", "", "Ferrari-Canny epsilon (L1, 8-edge cones) of the fully actuated hand, in units of the total normal force"),
+    Column("manipulability", "list<float64>", "mm", "semi-axes of the all-synergy manipulability ellipsoid, largest first (rotations x torque_length_mm)"),
+    Column("force_closure", "bool", "", "force closure (Definition 1) with the full synergy set"),
+    Column("force_per_weight", "float64", "", "optimal contact-force norm with the full set over the weight (NaN: not load-feasible)"),
+    Column("torque_length_mm", "float64", "mm", "the length torques are divided by: the object's bounding radius"),
+))
+
+TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, PLACEMENT, QUALITY)}
 
 
 def _check(table: Table, frame: pd.DataFrame, where: str) -> None:

@@ -140,11 +140,11 @@ def _claim1(counts: StudyCounts, first: int, rules: VerdictRules) -> tuple[str, 
     if not counts.has(sid) or not objects:
         reason = _missing(counts, [sid]) or "nothing to compare: the full set succeeds nowhere"
         return reason, Difference(np.nan, np.nan, np.nan, rules.rate_points, 0, "within_below", reason=reason)
-    rates = np.vstack([counts.object_rate(o, sid) for o in objects])
-    n = min(int(counts.count(o, counts.full)[0]) for o in objects)
+    rates = [counts.object_rate(o, sid) for o in objects]
     text = "; ".join(f"{o} {_fmt(r, counts)}" for o, r in zip(objects, rates))
+    parts = [(o, r - 100.0, int(counts.count(o, counts.full)[0])) for o, r in zip(objects, rates)]
     return (f"Table II at k = {first}: {text}",
-            _difference(np.nanmin(rates, axis=0) - 100.0, counts, rules.rate_points, n, "within_below"))
+            _worst_of(parts, counts, rules.rate_points, rules.min_distinct_poses, kind="within_below"))
 
 
 def _claim2(counts: StudyCounts, first: int, view: str, rules: VerdictRules) -> tuple[str, Difference]:
@@ -187,7 +187,7 @@ def _claim3(minima: pd.DataFrame, chance: pd.DataFrame, view: str, rules: Verdic
 
 
 def _worst_of(parts: Sequence[tuple[str, NDArray, int]], counts: StudyCounts, band: float, min_poses: int,
-              unit: str = "percentage points") -> Difference:
+              unit: str = "percentage points", kind: str = "greater") -> Difference:
     """The least favourable of several compared differences (name, (rows,) values, distinct
     poses), taken inside each resample, over those resting on at least ``min_poses`` poses.
     Left-out comparisons are named in the reason unless a tested one lies wholly below the band
@@ -196,13 +196,14 @@ def _worst_of(parts: Sequence[tuple[str, NDArray, int]], counts: StudyCounts, ba
     short = ", ".join(f"{name} ({n})" for name, _, n in parts if n < min_poses)
     if not tested:
         n = max((p[2] for p in parts), default=0)
-        return Difference(np.nan, np.nan, np.nan, band, n, unit=unit,
-                          reason=f"fewer than {min_poses} distinct poses: {short}" if n else "")
+        return Difference(np.nan, np.nan, np.nan, band, n, kind, unit=unit,
+                          reason=(f"fewer than {min_poses} distinct poses: {short}" if n
+                                  else f"nothing to compare: 0 distinct poses ({short})" if short else ""))
     d = _difference(np.min(np.vstack([p[1] for p in tested]), axis=0), counts, band, min(p[2] for p in tested),
-                    unit=unit)
+                    kind, unit=unit)
     if short:
         left_out = f"comparisons with fewer than {min_poses} distinct poses: {short}"
-        return Difference(d.estimate, d.low, d.high, band, d.n, unit=unit,
+        return Difference(d.estimate, d.low, d.high, band, d.n, kind, unit=unit,
                           **({"note": f"left out: {left_out}"} if d.high < -band else {"reason": left_out}))
     return d
 
