@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from synergrasp.tables import CONTACTS, GFO, MINIMA, Table
+from synergrasp.tables import CONTACTS, GFO, MINIMA, QUALITY, Table
 
 DESIGN = Path(__file__).resolve().parents[1] / "docs" / "design.md"
 BEGIN = "<!-- schemas: written by tools/design_schemas.py from src/synergrasp/tables.py; do not edit -->"
@@ -22,6 +22,7 @@ FILES: tuple[tuple[Table, str], ...] = (
     (CONTACTS, "objects/<object>/contacts.parquet"),
     (GFO, "objects/<object>/gfo.parquet"),
     (MINIMA, "objects/<object>/minima.parquet"),
+    (QUALITY, "objects/<object>/quality.parquet"),
 )
 
 
