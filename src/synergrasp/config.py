@@ -1,7 +1,7 @@
 """The one configuration model of the study.
 
 - **Defaults** live in one place: the ``default:`` values of the schema
-  (``workflow/schemas/config.schema.yaml``); :func:`defaults` builds the full default
+  (``config.schema.yaml``, package data beside the shipped hand and synergies); :func:`defaults` builds the full default
   configuration from them and :func:`validate_config` fills every key a config leaves out.
 - **Overlays** (a user's config file, a scenario) follow one rule, :func:`overlay`: a mapping
   merges key by key, any other value replaces, ``null`` removes the key (which then takes
@@ -23,6 +23,7 @@ import copy
 import functools
 import math
 from collections.abc import Mapping, Sequence
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -47,7 +48,7 @@ __all__ = [
 ]
 
 #: The schema: keys, types, ranges, descriptions and every default.
-SCHEMA_PATH = Path(__file__).resolve().parents[2] / "workflow" / "schemas" / "config.schema.yaml"
+SCHEMA_PATH = Path(str(resources.files("synergrasp") / "data" / "config.schema.yaml"))
 #: Name of the main configuration among the scenarios.
 DEFAULT_SCENARIO = "default"
 

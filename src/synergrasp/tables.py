@@ -50,12 +50,6 @@ class Table:
 
         return pa.schema([(c.name, arrow(c.dtype)) for c in self.columns])
 
-    def markdown(self) -> str:
-        """The contract as a Markdown table (for the docs)."""
-        lines = ["| column | type | unit | meaning |", "|---|---|---|---|"]
-        lines += [f"| `{c.name}` | {c.dtype} | {c.unit or '–'} | {c.meaning} |" for c in self.columns]
-        return "\n".join(lines)
-
 
 def _pose_columns() -> tuple[Column, ...]:
     return (
@@ -67,7 +61,7 @@ def _pose_columns() -> tuple[Column, ...]:
 
 
 CONTACTS = Table("contacts", "one row per pose", _pose_columns() + (
-    Column("status", "string", "", "closure outcome (see synergrasp.simulation)"),
+    Column("status", "string", "", "grasp (closure ran), intersects_open_hand, no_contact, caged (dynamic model: the hand moved the object, nothing touches it, its centre is inside the closed hand), lost (likewise, pushed out of the hand)"),
     Column("q", "list<float64>", "rad", "final joint angles (19)"),
     Column("finger_state", "list<string>", "", "per finger thumb..little: contact (box), self (blocked by the hand), limit (end of the closure path)"),
     Column("n_contacts", "int32", "", "number of contacts m"),
@@ -98,7 +92,7 @@ GFO = Table("gfo", "one row per (pose, synergy set)", _pose_columns() + (
     Column("rank_G", "int32", "", "rank of the grasp matrix"),
     Column("n_contacts", "int32", "", "number of contacts"),
     Column("iterations", "int32", "", "interior-point iterations"),
-    Column("solver", "string", "", "back end that decided the problem: ipm, clarabel_fallback, direct, none"),
+    Column("solver", "string", "", "back end that decided the problem: ipm (compiled interior-point kernel), clarabel_fallback (the kernel left it undecided), direct (e_s = 0: f = f_p judged without a solver), none (no_grasp, rank_deficient: nothing solved)"),
 ))
 
 MINIMA = Table("minima", "one row per local minimum of (object, synergy set)", (

@@ -287,11 +287,6 @@ def contact_jacobian(hand: Hand, q: NDArray, links: NDArray, points_mm: NDArray)
     return jac
 
 
-def clip_to_limits(hand: Hand, q: NDArray) -> NDArray[np.float64]:
-    """q clipped into the joint limits (rad)."""
-    return np.clip(_check_q(hand, q), hand.lower, hand.upper)
-
-
 # --------------------------------------------------------------------------- URDF
 
 
