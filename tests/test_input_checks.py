@@ -16,7 +16,7 @@ import pytest
 import yaml
 
 from synergrasp.analysis.graspability import graspable_objects, ungraspable_lines
-from synergrasp.config import ConfigError, defaults, validate_config
+from synergrasp.config import SCHEMA_PATH, ConfigError, defaults, validate_config
 from synergrasp.hand.checks import check_hand, closure_shape_problems
 from synergrasp.hand.kinematics import default_hand_path, load_hand
 from synergrasp.preflight import configfile_problems, slurm_problems
@@ -50,7 +50,7 @@ def test_keys_that_differ_only_in_type_or_nesting_are_not_repeats(tmp_path):
 
 @pytest.mark.parametrize("path", [
     ROOT / "config" / "config.yaml", ROOT / "config" / "sensitivity.yaml", ROOT / "tests" / "config" / "small.yaml",
-    ROOT / "workflow" / "schemas" / "config.schema.yaml", default_hand_path(),
+    SCHEMA_PATH, default_hand_path(),
     *sorted((ROOT / "src" / "synergrasp" / "data").glob("synergy_mapping_*.yaml"))], ids=lambda p: p.name)
 def test_every_shipped_yaml_reads_as_plain_yaml_does(path):
     assert read_yaml(path) == yaml.safe_load(path.read_text(encoding="utf-8"))
