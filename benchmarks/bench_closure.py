@@ -89,7 +89,7 @@ def shapes(n_poses: int = 300) -> None:
     study = defaults()
     hand = load_hand()
     synergies = load_synergies(None, joint_names=hand.joint_names)
-    sim = step_params(study, "simulate", next(iter(study["objects"])))
+    sim = SimulateParams.from_config(study, next(iter(study["objects"])))
     grid = pose_grid(sim.placement)
     poses = np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int)
     closer = closure_model(hand, synergies, sim.closure)

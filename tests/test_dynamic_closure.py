@@ -14,12 +14,12 @@ from synergrasp.hand.synergies import Synergies, SynergyPath
 from synergrasp.simulation.capsules import HandCapsules
 from synergrasp.simulation.closure import closure_model, simulate_object
 from synergrasp.simulation.closure import SimulateParams
-from synergrasp.simulation.closure_params import DynamicParams
+from synergrasp.simulation.closure_params import ClosureMechanics, DynamicParams
 from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.shapes import Box
 from synergrasp.simulation.placement import ObjectPose, object_pose
 
-MECHANICS = {"mu": 1.5, "k_ss_Nmm_per_rad": 200.0, "gravity_direction": [1.0, 0.0, 0.0], "g_m_per_s2": 9.81}
+MECHANICS = ClosureMechanics(k_ss_Nmm_per_rad=200.0, mu=1.5, gravity_direction=(1.0, 0.0, 0.0), g_m_per_s2=9.81)
 PARAMS = study_closure_params(model="dynamic", dynamic=study_dynamic_params(time_limit_s=3.0))
 CUBE60 = Box((60.0, 60.0, 60.0))
 #: A 60 mm cube against the palm: the palm's surface is at x = 9.5 mm (hand.yaml), the

@@ -150,6 +150,7 @@ def optimise_grasps(
     params: GFOParams,
     *,
     strict: bool = True,
+    forces: bool = False,
     ipm: IPMSettings = IPMSettings(),
 ) -> dict[str, NDArray]:
     """GFO verdict, optimal force and strict internal-force test of every (grasp, set).
@@ -159,7 +160,8 @@ def optimise_grasps(
     undecided, for every cone kind). strict=False skips the strict
     test (column all False). Returns columns, one row per (grasp, set), grasp-major:
     set_id, n_synergies, status, force_closure, strict_internal, force_norm (N), e_s,
-    rank_G, n_contacts, iterations, solver.
+    rank_G, n_contacts, iterations, solver; with forces=True also ``forces``, each row's optimal
+    contact forces (3m,) N (None unless load-feasible; the one-grasp inspector reads them).
     """
     n_sets, n_poses = len(synergies), len(grasps)
     total = n_sets * n_poses
@@ -176,6 +178,8 @@ def optimise_grasps(
         "iterations": np.zeros(total, dtype=np.int32),
         "solver": np.full(total, "none", dtype=object),
     }
+    if forces:
+        out["forces"] = np.full(total, None, dtype=object)
     cone = params.cone
     method = FASTEST_METHOD[cone.kind]
     for p, grasp in enumerate(grasps):
@@ -195,6 +199,8 @@ def optimise_grasps(
         out["iterations"][rows], out["solver"][rows] = sol.iterations, sol.solver
         if strict:
             out["strict_internal"][rows] = sol.strict_internal
+        if forces:
+            out["forces"][rows] = sol.forces
     out["force_closure"] = out["status"] == "force_closure"
     return out
 

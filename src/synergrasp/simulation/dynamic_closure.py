@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -39,7 +38,7 @@ from synergrasp.simulation.placement import ObjectPose
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
-    from synergrasp.simulation.closure_params import ClosureParams
+    from synergrasp.simulation.closure_params import ClosureMechanics, ClosureParams
     from synergrasp.simulation.shapes import Shape
 
 __all__ = ["DynamicClosure", "compliant_self_pairs"]
@@ -70,29 +69,26 @@ class DynamicClosure:
 
     ``params`` is the closure's :class:`synergrasp.simulation.closure.ClosureParams` (contact
     distance, penetration tolerance, ``params.dynamic``); the σ path is the kinematic
-    model's (``SynergyPath.closure_range``); ``mechanics`` the config's mechanics block (k_ss,
+    model's (``SynergyPath.closure_range``); ``mechanics`` the :class:`ClosureMechanics` (k_ss,
     μ, gravity direction and g); ``mass_kg`` the box's mass (its weight, if gravity is on).
     """
 
-    def __init__(self, hand: Hand, synergies: Synergies, params: ClosureParams, mechanics: Mapping[str, Any],
+    def __init__(self, hand: Hand, synergies: Synergies, params: ClosureParams, mechanics: ClosureMechanics,
                  mass_kg: float = 1.0) -> None:
         from synergrasp.simulation import bullet
 
         names = tuple(synergies.joint_names)
         if names != tuple(hand.joint_names):
             raise ValueError(f"synergies.joint_names must equal hand.joint_names {hand.joint_names}, got {names}")
-        missing = [k for k in ("mu", "k_ss_Nmm_per_rad", "gravity_direction", "g_m_per_s2") if k not in mechanics]
-        if missing:
-            raise ValueError(f"mechanics: the dynamic closure needs key(s) {missing}")
         self.bullet = bullet
         self.hand = hand
         self.closure = params
         self.params = p = params.dynamic
-        self.k_ss = float(mechanics["k_ss_Nmm_per_rad"])
-        self.mu = float(mechanics["mu"])
-        down = np.asarray(mechanics["gravity_direction"], dtype=float)
+        self.k_ss = mechanics.k_ss_Nmm_per_rad
+        self.mu = mechanics.mu
+        down = np.asarray(mechanics.gravity_direction, dtype=float)
         # weight of the box, N (palm frame), applied only when params.dynamic.gravity is true
-        self.weight = float(mass_kg) * float(mechanics["g_m_per_s2"]) * down / np.linalg.norm(down)
+        self.weight = float(mass_kg) * mechanics.g_m_per_s2 * down / np.linalg.norm(down)
         self.path = SynergyPath.along(synergies, hand.lower, hand.upper)
         # the same path as the kinematic model: fully open hand to every S1 joint at a limit
         self.sigma_open, self.sigma_closed = self.path.closure_range(hand.flexion_joints)

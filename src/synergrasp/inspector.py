@@ -1,0 +1,189 @@
+"""One grasp in full: the closure at one pose, the optimisation for chosen synergy sets, the
+quality indices (docs/inspector.md). The front door is :func:`inspect_grasp`; the console
+command ``synergrasp grasp`` (``synergrasp.cli``) prints its result.
+
+Units: mm, N, N·mm, deg for the pose; palm frame. Top layer: it runs the simulation and the
+optimisation stages as the workflow's steps do, from the same configuration.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from synergrasp.ids import set_id
+from synergrasp.optimisation.quality import GraspQuality, grasp_quality
+
+__all__ = ["InspectionError", "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp"]
+
+
+class InspectionError(ValueError):
+    """A bad argument of the inspector (the message names it)."""
+
+
+@dataclass(frozen=True)
+class SetResult:
+    """The optimisation of one synergy set at the inspected pose.
+
+    status: the optimisation under the weight: 'force_closure' (feasible) | 'infeasible' |
+        'numerical_failure' | 'rank_deficient' | 'no_grasp'
+    force_closure: the study's verdict, Definition 1: rank(G) = 6 and a synergy-reachable
+        internal force strictly inside every cone (independent of the weight)
+    load_feasible: the optimisation under the weight is feasible (status 'force_closure')
+    force_N: optimal ‖f‖₂ under the object's weight (NaN unless load-feasible)
+    e_s: dimension of the synergy-reachable internal forces
+    cone_use: largest ‖f_t‖ / (μ f_n) over the contacts of the optimal forces (≤ 1: inside
+        every circular cone; NaN unless feasible)
+    """
+
+    set_id: str
+    synergies: tuple[int, ...]
+    status: str
+    force_closure: bool
+    load_feasible: bool
+    force_N: float
+    e_s: int
+    cone_use: float
+
+
+@dataclass(frozen=True)
+class GraspInspection:
+    """Everything about one grasp: the pose, the closure's contacts, each set's optimisation
+    and the quality indices (``quality`` None where the closure made no grasp)."""
+
+    object: str
+    pose: int
+    alpha_deg: float
+    beta_deg: float
+    closure_status: str
+    weight_N: float
+    contacts: pd.DataFrame = field(repr=False)  # link, link_name, point_mm, normal, finger
+    sets: tuple[SetResult, ...] = ()
+    quality: GraspQuality | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The inspection as plain data (lists and numbers), for ``--json``."""
+        q = None if self.quality is None else {**asdict(self.quality),
+                                                "manipulability": self.quality.manipulability.tolist()}
+        return {"object": self.object, "pose": self.pose, "alpha_deg": self.alpha_deg, "beta_deg": self.beta_deg,
+                "closure_status": self.closure_status, "weight_N": self.weight_N,
+                "contacts": [{"link": int(r.link), "link_name": r.link_name, "point_mm": list(r.point_mm),
+                              "normal": list(r.normal)} for r in self.contacts.itertuples()],
+                "sets": [asdict(s) for s in self.sets], "quality": q}
+
+
+_TOKEN = re.compile(r"^(\d+)(?:-(\d+))?$|^(\d+(?:,\d+)+)$")
+
+
+def parse_sets(tokens: Sequence[str], n_synergies: int) -> list[tuple[int, ...]]:
+    """Synergy sets from command-line tokens: ``3`` = {S3}, ``1-5`` = {S1..S5} (a range),
+    ``2,5`` = {S2, S5}; 1-based, within 1 … ``n_synergies``."""
+    out = []
+    for token in tokens:
+        match = _TOKEN.match(str(token).strip())
+        if not match:
+            raise InspectionError(f"--sets: {token!r} is not a set; give k, a-b (S_a..S_b) or a,b,c")
+        if match.group(3):
+            members = tuple(sorted({int(v) for v in match.group(3).split(",")}))
+        else:
+            lo = int(match.group(1))
+            hi = int(match.group(2)) if match.group(2) else lo
+            if hi < lo:
+                raise InspectionError(f"--sets: {token!r} is an empty range")
+            members = tuple(range(lo, hi + 1))
+        bad = [v for v in members if not 1 <= v <= n_synergies]
+        if bad:
+            raise InspectionError(f"--sets: {token!r} names synergies {bad}; the table has S1..S{n_synergies}")
+        out.append(members)
+    return out
+
+
+def default_sets(n_synergies: int) -> list[tuple[int, ...]]:
+    """Each single synergy, then {S1..Sk} for k = 2 … n."""
+    return [(k,) for k in range(1, n_synergies + 1)] + [tuple(range(1, k + 1)) for k in range(2, n_synergies + 1)]
+
+
+def cone_use(forces: np.ndarray, normals: np.ndarray, mu: float) -> float:
+    """Largest ‖f_t‖ / (μ f_n) over the contacts (forces (3m,) N, inward normals (m, 3))."""
+    F = np.asarray(forces, dtype=float).reshape(-1, 3)
+    n = np.asarray(normals, dtype=float)
+    fn = np.einsum("ij,ij->i", F, n)
+    ft = np.linalg.norm(F - fn[:, None] * n, axis=1)
+    return float(np.max(ft / (mu * fn))) if len(fn) else float("nan")
+
+
+def _pose_index(placement: Any, alpha_deg: float, beta_deg: float) -> tuple[int, Any]:
+    from synergrasp.simulation.placement import pose_grid
+
+    grid = pose_grid(placement)
+    try:
+        return grid.index(alpha_deg, beta_deg), grid
+    except ValueError:
+        a, b = placement.alpha_deg, placement.beta_deg
+        raise InspectionError(
+            f"--alpha/--beta: ({alpha_deg:g}, {beta_deg:g}) deg is not a pose of the grid (alpha {a[0]:g}..{a[1]:g} "
+            f"step {a[2]:g}, beta {b[0]:g}..{b[1]:g} step {b[2]:g})") from None
+
+
+def _contacts_frame(hand: Any, row: pd.Series) -> pd.DataFrame:
+    m = int(row["n_contacts"])
+    links = np.asarray(row["contact_link"], dtype=np.int64)
+    points = np.asarray(row["contact_point"], dtype=float).reshape(m, 3)
+    normals = np.asarray(row["contact_normal"], dtype=float).reshape(m, 3)
+    return pd.DataFrame({"link": links, "link_name": [hand.link_names[k] for k in links],
+                         "point_mm": [tuple(p) for p in points], "normal": [tuple(n) for n in normals]})
+
+
+def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_deg: float,
+                  sets: Sequence[Sequence[int]] | None = None) -> GraspInspection:
+    """Close the hand on object ``obj`` at pose (α, β) deg with the configuration's hand,
+    synergies, placement and closure, then optimise the grasp for each synergy set in ``sets``
+    (1-based synergies; None: :func:`default_sets`), as the study's steps do.
+
+    ``config`` is a configuration as read from YAML (an overlay on the defaults); it is
+    checked like the workflow's. Raises InspectionError (naming the argument) or
+    ``synergrasp.config.ConfigError``; a closure or solver failure is a status in the result.
+    """
+    from synergrasp.config import validate_config
+    from synergrasp.hand.kinematics import load_hand
+    from synergrasp.hand.synergies import load_synergies
+    from synergrasp.optimisation.problem import SynergySets
+    from synergrasp.optimisation.study import OptimiseParams, optimise_grasps, read_grasps
+    from synergrasp.simulation.closure import SimulateParams, simulate_object
+    from synergrasp.simulation.contacts import ContactsParams, load_carrying_contacts
+
+    cfg = validate_config(config)
+    if obj not in cfg["objects"]:
+        raise InspectionError(f"object: {obj!r} is not an object of the configuration; objects: {list(cfg['objects'])}")
+    sim = SimulateParams.from_config(cfg, obj)
+    pose, _ = _pose_index(sim.placement, alpha_deg, beta_deg)
+    hand = load_hand(sim.hand)
+    full = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
+    chosen = default_sets(full.matrix.shape[1]) if sets is None else [tuple(sorted(set(s))) for s in sets]
+    table = simulate_object(hand, sim.synergies(hand.joint_names), sim.object, sim.placement, sim.closure,
+                            poses=[pose], mechanics=sim.mechanics)
+    selection = ContactsParams.from_config(cfg, obj)
+    if selection.drop_unloaded:
+        table = load_carrying_contacts(table, selection.load_threshold_N)
+    row = table.iloc[0]
+    opt = OptimiseParams.from_config(cfg, obj)
+    grasp = read_grasps(table)[0]
+    weight = float(opt.gfo.mass_kg * opt.gfo.g_m_per_s2)
+    if grasp is None:
+        return GraspInspection(obj, pose, float(row["alpha_deg"]), float(row["beta_deg"]), str(row["status"]),
+                               weight, _contacts_frame(hand, row) if int(row["n_contacts"]) else pd.DataFrame())
+    out = optimise_grasps([grasp], SynergySets(full.matrix, tuple(chosen)), opt.gfo, forces=True)
+    mu = float(opt.gfo.mu)
+    results = tuple(
+        SetResult(set_id(s), s, str(out["status"][k]), bool(out["strict_internal"][k] and out["rank_G"][k] == 6),
+                  bool(out["force_closure"][k]), float(out["force_norm"][k]), int(out["e_s"][k]),
+                  cone_use(out["forces"][k], grasp.normals, mu) if out["forces"][k] is not None else float("nan"))
+        for k, s in enumerate(chosen))
+    quality = grasp_quality(grasp, mu, sim.object.shape.bounding_radius_mm, synergies=full.matrix)
+    return GraspInspection(obj, pose, float(row["alpha_deg"]), float(row["beta_deg"]), str(row["status"]), weight,
+                           _contacts_frame(hand, row), results, quality)

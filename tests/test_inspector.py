@@ -1,0 +1,94 @@
+"""The one-grasp inspector against the study's own steps on the small configuration."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from synergrasp.cli import main
+from synergrasp.config import validate_config
+from synergrasp.hand.kinematics import load_hand
+from synergrasp.hand.synergies import load_synergies
+from synergrasp.ids import set_id
+from synergrasp.inspector import default_sets, inspect_grasp, parse_sets
+from synergrasp.optimisation.problem import SynergySets
+from synergrasp.optimisation.study import OptimiseParams, gfo_table
+from synergrasp.simulation.closure import SimulateParams, simulate_object
+from synergrasp.steps import step_config
+
+SMALL = Path(__file__).parent / "config" / "small.yaml"
+POSES = [("obj1", -30.0, 0.0), ("obj1", 90.0, 40.0), ("obj4", -150.0, -20.0)]
+SETS = [(1,), (1, 2), (2, 5), tuple(range(1, 16))]
+
+
+@pytest.fixture(scope="module")
+def small():
+    return yaml.safe_load(SMALL.read_text())
+
+
+@pytest.fixture(scope="module")
+def study_rows(small):
+    """The rows of the study's contacts and gfo tables at POSES, made as the workflow's
+    simulate and optimise steps make them (every pose of the object's grid, then the pose)."""
+    cfg = validate_config(small)
+    rows = {}
+    for obj in sorted({p[0] for p in POSES}):
+        sim = SimulateParams.from_config(step_config(cfg, "simulate", obj), obj)
+        hand = load_hand(sim.hand)
+        contacts = simulate_object(hand, sim.synergies(hand.joint_names), sim.object, sim.placement, sim.closure)
+        opt = OptimiseParams.from_config(step_config(cfg, "optimise", obj), obj)
+        full = load_synergies(opt.synergies, joint_names=hand.joint_names)
+        gfo = gfo_table(contacts, SynergySets(full.matrix, tuple(SETS)), opt.gfo)
+        rows[obj] = (contacts, gfo)
+    return rows
+
+
+@pytest.mark.parametrize("obj, alpha, beta", POSES)
+def test_the_inspector_agrees_with_the_study_tables(small, study_rows, obj, alpha, beta):
+    result = inspect_grasp(small, obj, alpha, beta, SETS)
+    contacts, gfo = study_rows[obj]
+    row = contacts[(contacts["alpha_deg"] == alpha) & (contacts["beta_deg"] == beta)].iloc[0]
+    assert result.pose == int(row["pose"]) and result.closure_status == row["status"]
+    assert list(result.contacts["link"]) == list(row["contact_link"])
+    assert np.array_equal(np.ravel(list(result.contacts["point_mm"])), np.asarray(row["contact_point"]))
+    rows = gfo[gfo["pose"] == row["pose"]].set_index("set_id")
+    assert [s.set_id for s in result.sets] == [set_id(s) for s in SETS]
+    for s in result.sets:
+        expected = rows.loc[s.set_id]
+        assert s.status == expected["status"]
+        assert s.force_closure == bool(expected["strict_internal"] and expected["rank_G"] == 6)
+        assert s.e_s == expected["e_s"]
+        assert s.force_N == pytest.approx(expected["force_norm"], rel=1e-12, nan_ok=True)
+        if s.load_feasible:  # the optimal forces lie in the cones (the solver's own tolerance)
+            assert s.cone_use <= 1.0 + 1e-6
+
+
+def test_sets_are_parsed_as_singles_ranges_and_lists():
+    assert parse_sets(["3", "1-5", "2,5"], 15) == [(3,), (1, 2, 3, 4, 5), (2, 5)]
+    assert default_sets(3) == [(1,), (2,), (3,), (1, 2), (1, 2, 3)]
+
+
+@pytest.mark.parametrize("argv, names", [
+    (["grasp", "obj9", "--alpha", "0", "--beta", "0"], "object"),
+    (["grasp", "obj1", "--alpha", "7", "--beta", "0"], "--alpha/--beta"),
+    (["grasp", "obj1", "--alpha", "0", "--beta", "0", "--sets", "16"], "--sets"),
+    (["grasp", "obj1", "--alpha", "0", "--beta", "0", "--sets", "1-x"], "--sets"),
+])
+def test_bad_arguments_give_one_line_naming_the_argument(capsys, argv, names):
+    assert main(argv + ["--configfile", str(SMALL)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and names in err[0]
+
+
+def test_json_output_holds_the_same_numbers(capsys, small):
+    assert main(["grasp", "obj4", "--alpha", "-150", "--beta", "-20", "--sets", "1-15", "--json",
+                 "--configfile", str(SMALL)]) == 0
+    data = json.loads(capsys.readouterr().out)
+    direct = inspect_grasp(small, "obj4", -150.0, -20.0, [tuple(range(1, 16))])
+    assert data["pose"] == direct.pose
+    assert data["sets"][0]["force_N"] == pytest.approx(direct.sets[0].force_N, nan_ok=True)
+    assert data["quality"]["epsilon"] == pytest.approx(direct.quality.epsilon)
