@@ -269,8 +269,8 @@ def test_a_held_box_stays_put_and_the_fingers_settle_on_it_in_equilibrium(hand, 
     assert np.all(np.asarray(row["contact_normal_force_N"]) > 0.01)
     assert np.array_equal(row["object_center"], placement.center_mm) and row["object_rotation_deg"] == 0.0
     assert np.array_equal(row["object_translation_mm"], np.zeros(3))
-    checks = grasp_equilibrium(rows, EquilibriumParams.of(hand, synergies, MECHANICS["k_ss_Nmm_per_rad"],
-                                                          MECHANICS["mu"]), synergies.columns([1])[:, 0])
+    checks = grasp_equilibrium(rows, EquilibriumParams.of(hand, synergies, MECHANICS.k_ss_Nmm_per_rad, MECHANICS.mu),
+                               synergies.columns([1])[:, 0])
     assert checks["torque_residual"].iloc[0] < 0.1
 
 
