@@ -1,7 +1,9 @@
 # Entry points for a fresh machine with Python 3.11 (see README):
 #   make venv           - build .venv from environment.lock only
 #   make study          - build .venv from environment.lock, then run the full study
-#   make test           - build .venv from environment.lock, then run the test suite
+#   make test           - build .venv from environment.lock, then run the fast tier of the tests
+#                         (all but the end-to-end workflow runs, marker `workflow`)
+#   make test-all       - every test, the end-to-end workflow runs included (CI)
 #   make lint           - snakefmt --check, snakemake --lint (conda/container advice aside) and
 #                         the package's layers and no import circle (import-linter, pyproject.toml)
 #   make cluster-test   - the small study on a single-node SLURM started here (root; installs SLURM)
@@ -10,7 +12,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 CORES  ?= 2
 
-.PHONY: venv study test lint cluster-test bench lock report clean-venv
+.PHONY: venv study test test-all lint cluster-test bench lock report clean-venv
 
 $(BIN)/.installed: environment.lock pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -28,13 +30,22 @@ study: $(BIN)/.installed
 	$(WARM_UP)
 	$(BIN)/snakemake -j$(CORES) figures
 
+# The report gathers the study's outputs: say so in one line when the study has not run yet.
 report: $(BIN)/.installed
+	@test -e results/tables/claims.csv || { echo "make report: the study has not run yet (no results/tables/claims.csv): run 'make study' first"; exit 1; }
 	$(BIN)/snakemake --report results/report.html
 	$(BIN)/snakemake --report results/report.zip
 
+# pytest's exit code 5 (no test collected, e.g. a tier left empty by a selection) is no failure.
+PYTEST = rc=0; $(BIN)/python -m pytest $(1) || rc=$$?; if [ $$rc -eq 5 ]; then echo "no tests collected"; exit 0; fi; exit $$rc
+
 test: $(BIN)/.installed
 	$(WARM_UP)
-	$(BIN)/python -m pytest; rc=$$?; if [ $$rc -eq 5 ]; then echo "no tests collected"; exit 0; fi; exit $$rc
+	$(call PYTEST,-m "not workflow")
+
+test-all: $(BIN)/.installed
+	$(WARM_UP)
+	$(call PYTEST,)
 
 lint: $(BIN)/.installed
 	$(BIN)/snakefmt --check Snakefile workflow

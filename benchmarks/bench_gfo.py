@@ -13,17 +13,20 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import sys
 import time
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
-from synergrasp.config import defaults
-from synergrasp.optimisation.study import OptimiseParams
-from synergrasp.optimisation.gfo import solve_gfo
-from synergrasp.optimisation.problem import GraspSets, SynergySets
-from synergrasp.optimisation.problems import random_grasp, random_synergies
-from synergrasp.optimisation.study import mechanics_for, optimise_grasps
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))  # the generators the tests use
+from grasp_problems import random_grasp, random_synergies  # noqa: E402
+
+from synergrasp.config import defaults  # noqa: E402
+from synergrasp.optimisation.gfo import solve_gfo  # noqa: E402
+from synergrasp.optimisation.problem import GraspSets, SynergySets  # noqa: E402
+from synergrasp.optimisation.study import OptimiseParams, mechanics_for, optimise_grasps  # noqa: E402
 
 
 def study_sets() -> list[tuple[int, ...]]:

@@ -16,14 +16,13 @@ import time
 from dataclasses import replace
 
 import numpy as np
-from bench_gfo import study_sets
+from bench_gfo import study_sets  # also puts tests/ (the generators) on the path
+from grasp_problems import random_grasp, random_synergies
 
 from synergrasp.config import defaults
-from synergrasp.optimisation.study import OptimiseParams
 from synergrasp.optimisation import gfo
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.problems import random_grasp, random_synergies
-from synergrasp.optimisation.study import optimise_grasps
+from synergrasp.optimisation.study import OptimiseParams, optimise_grasps
 
 
 def main() -> None:

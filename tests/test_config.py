@@ -237,3 +237,24 @@ def test_a_synergy_table_that_cannot_close_the_hand_or_is_not_in_rad_is_named():
     degrees = synergy_problems({**config, "synergies": "mine.csv"}, [10.0, 45.0], matrix)
     assert len(degrees) == 1 and "'synergies' (mine.csv): values up to 45 exceed 2π" in degrees[0]
     assert "exceed 2π" in synergy_problems(config, mean, [[1e300, 0.1], [0.2, 0.0]])[0]
+
+
+def test_config_readme_defaults_are_the_schemas():
+    """Every `| `key` | `value` | ...` row of config/README.md gives the schema's default."""
+    import re
+
+    full = defaults()
+    text = (ROOT / "config" / "README.md").read_text()
+    rows = re.findall(r"^\| `([a-z_.0-9]+)` \| `([^`|]*)` \|", text, flags=re.MULTILINE)
+    checked = []
+    for key, shown in rows:
+        node = full
+        for part in key.split("."):
+            if not isinstance(node, dict) or part not in node:
+                break
+            node = node[part]
+        else:
+            value = yaml.safe_load(shown)
+            assert value == node or (isinstance(node, (list, tuple)) and list(node) == value), (key, shown, node)
+            checked.append(key)
+    assert len(checked) > 20

@@ -14,12 +14,12 @@ from synergrasp.hand.synergies import Synergies, SynergyPath
 from synergrasp.simulation.capsules import HandCapsules
 from synergrasp.simulation.closure import closure_model, simulate_object
 from synergrasp.simulation.closure import SimulateParams
-from synergrasp.simulation.closure_params import DynamicParams
+from synergrasp.simulation.closure_params import ClosureMechanics, DynamicParams
 from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.shapes import Box
 from synergrasp.simulation.placement import ObjectPose, object_pose
 
-MECHANICS = {"mu": 1.5, "k_ss_Nmm_per_rad": 200.0, "gravity_direction": [1.0, 0.0, 0.0], "g_m_per_s2": 9.81}
+MECHANICS = ClosureMechanics(k_ss_Nmm_per_rad=200.0, mu=1.5, gravity_direction=(1.0, 0.0, 0.0), g_m_per_s2=9.81)
 PARAMS = study_closure_params(model="dynamic", dynamic=study_dynamic_params(time_limit_s=3.0))
 CUBE60 = Box((60.0, 60.0, 60.0))
 #: A 60 mm cube against the palm: the palm's surface is at x = 9.5 mm (hand.yaml), the
@@ -249,3 +249,33 @@ def test_thumb_index_pinch_of_a_small_box_settles_with_a_near_zero_net_wrench(ha
         assert np.linalg.norm(moment) <= 0.05 * scale * edge / 2
     finally:
         model.close()
+
+
+def test_a_held_box_stays_put_and_the_fingers_settle_on_it_in_equilibrium(hand, synergies):
+    """The pose of test_a_box_pushed_out_of_the_hand_is_lost with ``object: held``: the box
+    cannot move, so the same closing fingers end on it, at rest, carrying load; its pose is
+    unchanged to the last digit. The end state is an equilibrium of the soft-synergy hand: the
+    torque residual of the recorded contacts (synergrasp.optimisation.equilibrium, an
+    independent model of the balance) is below 10 % (measured: 2.3 %)."""
+    from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
+
+    box = GraspedObject("obj4", Box((100.0, 60.0, 100.0)), 1.0)
+    placement = study_placement(mode="fixed", center_mm=(90.0, 5.0, 112.0), box_axes=(1, 0, 2))
+    params = study_closure_params(model="dynamic", dynamic=study_dynamic_params(object="held"))
+    rows = simulate_object(hand, synergies, box, placement, params, poses=[4], mechanics=MECHANICS)
+    row = rows.iloc[0]
+    assert row["status"] == "grasp" and row["settled"] and row["n_contacts"] >= 1
+    assert row["closure_model"] == "dynamic_held"
+    assert np.all(np.asarray(row["contact_normal_force_N"]) > 0.01)
+    assert np.array_equal(row["object_center"], placement.center_mm) and row["object_rotation_deg"] == 0.0
+    assert np.array_equal(row["object_translation_mm"], np.zeros(3))
+    checks = grasp_equilibrium(rows, EquilibriumParams.of(hand, synergies, MECHANICS.k_ss_Nmm_per_rad, MECHANICS.mu),
+                               synergies.columns([1])[:, 0])
+    assert checks["torque_residual"].iloc[0] < 0.1
+
+
+def test_the_held_setting_is_a_checked_key():
+    with pytest.raises(ConfigError, match=r"'closure.dynamic.object': 'fixed' is not allowed; allowed values: \['free', 'held'\]"):
+        validate_config(_with_dynamic(object="fixed"))
+    assert SimulateParams.from_config(validate_config(_with_dynamic(object="held")), "obj1").closure.dynamic.held
+    assert not SimulateParams.from_config(defaults(), "obj1").closure.dynamic.held

@@ -13,7 +13,7 @@ from synergrasp.optimisation.ipm.sets import range_basis
 from synergrasp.optimisation.ipm_kernel import IPMSettings
 from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_basis, object_wrench
 from synergrasp.optimisation.problem import GFOProblem, GraspSets, SynergySets
-from synergrasp.optimisation.problems import random_gfo_problems, random_grasp, random_synergies, random_unit_vector
+from grasp_problems import random_gfo_problems, random_grasp, random_synergies, random_unit_vector
 
 RTOL_NORM = 1e-4
 

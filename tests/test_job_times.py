@@ -27,3 +27,19 @@ def test_rules_are_summed_over_the_default_study_and_every_scenario(tmp_path):
     assert table["cpu_percent"].sum() == pytest.approx(100.0)
     assert table.loc["optimise", "cpu_percent"] == pytest.approx(100.0 * 4 / 11)  # 4 of 11 CPU seconds
     assert list(table.index) == ["simulate_contacts", "optimise", "fig1_synergy_postures"]  # largest CPU first
+
+
+def test_measurements_page_gives_cpu_per_pose_from_the_benchmarks_and_the_tables(tmp_path):
+    """tools/measurements.py: 3 CPU s of closure over 2 objects x 500 poses = 3 ms per pose."""
+    import pandas as pd
+
+    spec = importlib.util.spec_from_file_location("measurements", Path(__file__).parents[1] / "tools" / "measurements.py")
+    measurements = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(measurements)
+    for obj, cpu in (("a", 1.0), ("b", 2.0)):
+        _bench(tmp_path / "benchmarks" / "simulate_contacts" / f"{obj}.tsv", 4.0, cpu)
+        (tmp_path / "objects" / obj).mkdir(parents=True)
+        pd.DataFrame({"pose": range(500)}).to_parquet(tmp_path / "objects" / obj / "contacts.parquet")
+    text = measurements.page(tmp_path, "quiet")
+    assert "| `simulate_contacts` | 2 | 8.0 | 3.0 | 100 | 1 | 3 ms per pose (1,000 poses) |" in text
+    assert "(quiet)." in text

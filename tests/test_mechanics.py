@@ -13,7 +13,7 @@ from synergrasp.optimisation.mechanics import (
     internal_force_basis,
     object_wrench,
 )
-from synergrasp.optimisation.problems import LINK_CHAINS, random_grasp, random_synergies
+from grasp_problems import LINK_CHAINS, random_grasp, random_synergies
 
 W = 9.81  # N, weight of the 1 kg object
 

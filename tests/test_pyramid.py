@@ -13,7 +13,7 @@ from synergrasp.optimisation.cones import CircularCone, PyramidCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.mechanics import contact_frames
 from synergrasp.optimisation.problem import STRICT_SHRINK, GFOProblem
-from synergrasp.optimisation.problems import critical_friction, random_gfo_problems
+from grasp_problems import critical_friction, random_gfo_problems
 
 W = 9.81
 MU = 1.5

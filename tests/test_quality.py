@@ -148,3 +148,27 @@ def test_manipulability_of_a_rigid_translation_and_of_a_squeeze():
     assert np.allclose(both[1:], 0.0, atol=1e-12)
     squeeze = synergy_manipulability(g, np.eye(2)[:, 1:], length_mm=10.0)
     assert np.allclose(squeeze, 0.0)
+
+
+def test_quality_table_rows_for_a_grasp_and_a_pose_without_one(tmp_path):
+    import pandas as pd
+
+    from synergrasp import tables
+    from synergrasp.optimisation.quality import QualityParams, quality_table
+
+    g = _cube_face_grasp(15.0)
+    contacts = pd.DataFrame({"object": ["cube", "cube"], "pose": [0, 1], "alpha_deg": [0.0, 5.0],
+                             "beta_deg": [0.0, 0.0], "n_contacts": [6, 0]})
+    gfo = pd.DataFrame({"object": "cube", "pose": [0, 1], "set_id": "1-2", "strict_internal": [True, False],
+                        "rank_G": [6, 0], "force_norm": [19.62, np.nan]})
+    params = QualityParams(hand=None, synergies=None, mu=0.8, full_set_id="1-2", weight_N=9.81,
+                           torque_length_mm=15.0 * math.sqrt(3.0))
+    table = quality_table(contacts, gfo, [g, None], np.zeros((2, 2)), params)
+    tables.write(tables.QUALITY, table, tmp_path / "quality.parquet")  # the contract's columns and types
+    table = tables.read(tables.QUALITY, tmp_path / "quality.parquet")
+    expected = grasp_quality(g, 0.8, params.torque_length_mm)
+    first, second = table.iloc[0], table.iloc[1]
+    assert first["epsilon"] == pytest.approx(expected.epsilon) and first["rank_G"] == 6
+    assert bool(first["force_closure"]) and first["force_per_weight"] == pytest.approx(2.0)
+    assert second["rank_G"] == 0 and np.isnan(second["epsilon"]) and not second["force_closure"]
+    assert np.isnan(second["force_per_weight"])

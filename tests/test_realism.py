@@ -45,9 +45,18 @@ def _gfo(obj: str = "a") -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def _checks(contacts: pd.DataFrame) -> pd.DataFrame:
+    """Per-grasp equilibrium checks, made up: residual 0.1 × pose, pose p has p contacts pushed
+    outside their cone (the real ones are tested in tests/test_equilibrium.py)."""
+    grasps = contacts[contacts["status"] == "grasp"]
+    return pd.DataFrame({"object": grasps["object"], "closure_model": grasps["closure_model"], "pose": grasps["pose"],
+                         "torque_residual": 0.1 * grasps["pose"], "s1_outside_cone": grasps["pose"]})
+
+
 def _table(hand, contacts=None, gfo=None, load_threshold_N=0.01):
-    return grasp_realism(_contacts() if contacts is None else contacts, _gfo() if gfo is None else gfo,
-                         hand.link_names, hand.link_finger, "1-2", {"a": 10.0}, load_threshold_N)
+    contacts = _contacts() if contacts is None else contacts
+    return grasp_realism(contacts, _gfo() if gfo is None else gfo, _checks(contacts), hand.link_names,
+                         hand.link_finger, "1-2", {"a": 10.0}, load_threshold_N)
 
 
 def test_counts_and_shares_by_hand(hand):
@@ -70,6 +79,29 @@ def test_counts_and_shares_by_hand(hand):
     assert row["pct_force_closure"] == pytest.approx(2 * third)
     assert row["median_force_per_weight"] == pytest.approx(2.0)  # 10/10 and 30/10
     assert row["loaded_contacts_median"] == 1.0  # 1, 3, 0 contacts with a normal force > 0
+    # index links 5, 6, 7 in poses 0, 1, 3; middle (11) in 1, 3; ring (15) and little (19) in 3
+    assert (row["pct_index"], row["pct_middle"]) == (pytest.approx(100.0), pytest.approx(2 * third))
+    assert (row["pct_ring"], row["pct_little"]) == (pytest.approx(third), pytest.approx(third))
+    assert row["median_torque_residual"] == pytest.approx(0.1)  # 0, 0.1, 0.3
+    assert row["pct_s1_outside_cone"] == pytest.approx(2 * third)  # poses 1 and 3
+
+
+def test_the_index_column_and_the_link_shares_on_a_hand_made_table(hand):
+    """Index touching in 1 of 3 grasps (its distal link only), a no_contact grasp counts as a
+    grasp without it, a dropped pose not at all."""
+    from synergrasp.analysis.realism import link_shares
+
+    poses = [("grasp", [0, 3], []), ("grasp", [3, 7], []), ("no_contact", [], []), ("intersects_open_hand", [], [])]
+    contacts = _contacts(poses=poses)
+    gfo = _gfo()
+    row = _table(hand, contacts, gfo).iloc[0]
+    assert row["pct_index"] == pytest.approx(100.0 / 3.0)
+    shares = link_shares(contacts, hand.link_names, hand.link_finger).set_index("link")["pct_grasps"]
+    assert shares["index_distal"] == pytest.approx(100.0 / 3.0)
+    assert shares["thumb_distal"] == pytest.approx(200.0 / 3.0)
+    assert shares["palm"] == pytest.approx(100.0 / 3.0)
+    assert shares["index_proximal"] == 0.0
+    assert len(shares) == len(hand.link_names)
 
 
 def test_force_closure_is_the_studys_definition_not_load_feasibility(hand):
@@ -98,15 +130,18 @@ def test_link_categories_of_the_shipped_hand(hand):
     cats = link_categories(hand.link_names, hand.link_finger)
     assert cats["palm"] == {0}
     assert cats["thumb"] == {1, 2, 3}
+    assert {hand.link_names[i] for i in cats["index"]} == {f"index_{s}" for s in ("knuckle", "proximal", "middle", "distal")}
     assert {hand.link_names[i] for i in cats["proximal_or_middle"]} == {
         "thumb_proximal", *(f"{f}_{s}" for f in ("index", "middle", "ring", "little") for s in ("proximal", "middle"))}
 
 
 def test_missing_weight_or_full_set_is_one_clear_error(hand):
     with pytest.raises(ValueError, match=r"no weight for object\(s\) \['a'\]"):
-        grasp_realism(_contacts(), _gfo(), hand.link_names, hand.link_finger, "1-2", {"b": 1.0}, 0.01)
+        grasp_realism(_contacts(), _gfo(), _checks(_contacts()), hand.link_names, hand.link_finger, "1-2",
+                      {"b": 1.0}, 0.01)
     with pytest.raises(ValueError, match="full_set_id '1-2-3'"):
-        grasp_realism(_contacts(), _gfo(), hand.link_names, hand.link_finger, "1-2-3", {"a": 1.0}, 0.01)
+        grasp_realism(_contacts(), _gfo(), _checks(_contacts()), hand.link_names, hand.link_finger, "1-2-3",
+                      {"a": 1.0}, 0.01)
 
 
 def test_figure_is_written_and_the_same_on_rerun(hand, tmp_path):

@@ -14,7 +14,7 @@ from synergrasp import tables
 from synergrasp.optimisation.cones import PyramidCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.problem import GraspSets, SynergySets
-from synergrasp.optimisation.problems import random_grasp, random_synergies
+from grasp_problems import random_grasp, random_synergies
 from synergrasp.optimisation.study import mechanics_for, merge_shards, optimise_grasps, shard_rows
 
 RTOL_NORM = 1e-4

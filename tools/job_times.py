@@ -17,16 +17,19 @@ import pandas as pd
 
 
 def job_times(results: Path) -> pd.DataFrame:
-    """One row per rule: jobs, wall s, CPU s and the CPU share (percent)."""
+    """One row per rule: jobs, wall s, CPU s, the CPU share (percent) and the largest peak
+    resident memory of any of its jobs (MB)."""
     rows = []
     for path in sorted(results.rglob("benchmarks/**/*.tsv")):
         parts = path.relative_to(results).parts
         at = parts.index("benchmarks")
         rule = parts[at + 1] if len(parts) > at + 2 else path.stem
         bench = pd.read_csv(path, sep="\t")
-        rows.append({"rule": rule, "wall_s": float(bench["s"].iloc[-1]), "cpu_s": float(bench["cpu_time"].iloc[-1])})
-    table = pd.DataFrame(rows, columns=["rule", "wall_s", "cpu_s"])
-    out = table.groupby("rule").agg(jobs=("wall_s", "size"), wall_s=("wall_s", "sum"), cpu_s=("cpu_s", "sum"))
+        rows.append({"rule": rule, "wall_s": float(bench["s"].iloc[-1]), "cpu_s": float(bench["cpu_time"].iloc[-1]),
+                     "mb": float(bench["max_rss"].iloc[-1])})
+    table = pd.DataFrame(rows, columns=["rule", "wall_s", "cpu_s", "mb"])
+    out = table.groupby("rule").agg(jobs=("wall_s", "size"), wall_s=("wall_s", "sum"), cpu_s=("cpu_s", "sum"),
+                                    peak_mb=("mb", "max"))
     out["cpu_percent"] = 100.0 * out["cpu_s"] / out["cpu_s"].sum()
     return out.sort_values("cpu_s", ascending=False)
 

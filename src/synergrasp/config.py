@@ -1,7 +1,7 @@
 """The one configuration model of the study.
 
 - **Defaults** live in one place: the ``default:`` values of the schema
-  (``workflow/schemas/config.schema.yaml``); :func:`defaults` builds the full default
+  (``config.schema.yaml``, package data beside the shipped hand and synergies); :func:`defaults` builds the full default
   configuration from them and :func:`validate_config` fills every key a config leaves out.
 - **Overlays** (a user's config file, a scenario) follow one rule, :func:`overlay`: a mapping
   merges key by key, any other value replaces, ``null`` removes the key (which then takes
@@ -23,11 +23,13 @@ import copy
 import functools
 import math
 from collections.abc import Mapping, Sequence
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
+
+from synergrasp.yaml_io import read_yaml
 
 __all__ = [
     "ConfigError",
@@ -46,7 +48,7 @@ __all__ = [
 ]
 
 #: The schema: keys, types, ranges, descriptions and every default.
-SCHEMA_PATH = Path(__file__).resolve().parents[2] / "workflow" / "schemas" / "config.schema.yaml"
+SCHEMA_PATH = Path(str(resources.files("synergrasp") / "data" / "config.schema.yaml"))
 #: Name of the main configuration among the scenarios.
 DEFAULT_SCENARIO = "default"
 
@@ -59,8 +61,7 @@ class ConfigError(ValueError):
 
 @functools.cache
 def load_schema() -> dict[str, Any]:
-    with open(SCHEMA_PATH, encoding="utf-8") as handle:
-        return yaml.load(handle, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # libyaml: 10x faster
+    return read_yaml(SCHEMA_PATH, "schema")
 
 
 def _resolve(node: Mapping[str, Any]) -> dict[str, Any]:
@@ -200,8 +201,10 @@ def _describe(error: Any) -> str:
         return (f"config error at '{where}': {error.instance!r} is not allowed; "
                 f"allowed values: {schema['enum']}")
     if "propertyNames" in error.schema_path:
-        return (f"config error at '{where}': name {error.instance!r} is not allowed; "
-                "names may use letters, digits and '_' only (and not 'default' for a scenario)")
+        name = error.instance
+        shown = repr(name) if len(str(name)) <= 70 else f"'{str(name)[:40]}…' ({len(str(name))} characters)"
+        return (f"config error at '{where}': name {shown} is not allowed; names become file "
+                "names: letters, digits and '_' only, at most 64 characters (and not 'default' for a scenario)")
     return f"config error at '{where}': {error.message}"
 
 
@@ -281,6 +284,8 @@ def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -
     if dynamic["time_limit_s"] < dynamic["ramp_time_s"]:
         problems.append(f"config error at 'closure.dynamic.time_limit_s': {dynamic['time_limit_s']} must be "
                         f"at least closure.dynamic.ramp_time_s ({dynamic['ramp_time_s']})")
+    else:
+        problems += _settle_problems(dynamic)
     if all(abs(v) < 1e-12 for v in config["mechanics"]["gravity_direction"]):
         problems.append("config error at 'mechanics.gravity_direction': must be a non-zero vector")
     sets = config["synergy_sets"]
@@ -324,6 +329,20 @@ def _search_problems(config: Mapping[str, Any]) -> list[str]:
             if hi < lo:
                 problems.append(f"config error at '{where}.search.region_mm.{axis}': stop {hi} is below start {lo}")
     return problems
+
+
+def _settle_problems(dynamic: Mapping[str, Any]) -> list[str]:
+    """The dynamic closure can settle: after the ramp, the time left to the limit holds one
+    settle window and one step more (in whole time steps, as the closure counts them)."""
+    dt = dynamic["time_step_s"]
+    ramp = max(1, round(dynamic["ramp_time_s"] / dt))
+    left = max(ramp, round(dynamic["time_limit_s"] / dt)) - ramp
+    window = max(1, round(dynamic["settle_window_s"] / dt))
+    if left >= window + 1:
+        return []
+    return [f"config error at 'closure.dynamic.settle_window_s': {dynamic['settle_window_s']} s leaves no pose "
+            f"able to settle: it must be shorter than closure.dynamic.time_limit_s - ramp_time_s "
+            f"({dynamic['time_limit_s']} - {dynamic['ramp_time_s']} s) by at least one time_step_s ({dt:.4g} s)"]
 
 
 def synergy_problems(config: Mapping[str, Any], mean_rad: Any, matrix: Any) -> list[str]:

@@ -152,6 +152,13 @@ STEPS: dict[str, Step] = {
         # force closure within a multiple of the weight: the minima and Fig. 4 read the bound
         reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
         upstream=("optimise",), params="synergrasp.analysis.minima:MinimaParams"),
+    # quality indices of every pose and their maps (docs/quality.md)
+    "quality": Step(
+        rules={"grasp_quality": Cost("pose", 3.0, 300, 6.0e-3, 0.05)},
+        outputs={"table": "quality.parquet", **_files(("quality_maps",), "", _PNG_PDF)}, scope="object",
+        reads=("hand", "synergies", "mechanics.mu", "mechanics.g_m_per_s2", "synergy_sets.incremental_max",
+               "objects.{object}.shape", "objects.{object}.mass_kg"),
+        upstream=("contacts", "optimise"), params="synergrasp.optimisation.quality:QualityParams"),
     "tables": Step(
         rules={"study_tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
         outputs=_files(TABLES, "tables", ("csv", "md")),
@@ -161,12 +168,16 @@ STEPS: dict[str, Step] = {
                "analyses.bootstrap", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
         upstream=("optimise", "minima"), params="synergrasp.analysis.summaries:TablesParams"),
     "realism": Step(
-        rules={"grasp_realism": Cost("object_pose_set", 4.0, 300, 4.0e-6, 3.0e-4)},
+        # with the equilibrium checks of every grasp: ~0.5 ms of CPU per grasp over 75 sets
+        rules={"grasp_realism": Cost("object_pose_set", 4.0, 300, 1.1e-5, 3.0e-4)},
         outputs={"csv": "tables/grasp_realism.csv", "md": "tables/grasp_realism.md",
-                 "png": "figures/grasp_realism.png", "pdf": "figures/grasp_realism.pdf"},
-        reads=("hand", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2", "closure.model"),
+                 "links_csv": "tables/grasp_links.csv", "links_md": "tables/grasp_links.md",
+                 "png": "figures/grasp_realism.png", "pdf": "figures/grasp_realism.pdf",
+                 "graspable_csv": "tables/graspable_objects.csv", "graspable_md": "tables/graspable_objects.md"},
+        reads=("hand", "synergies", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2",
+               "mechanics.k_ss_Nmm_per_rad", "mechanics.mu", "closure.model"),
         reads_when=(("closure.model", "dynamic", ("closure.dynamic.load_threshold_N",)),),
-        upstream=("contacts", "optimise"), params="synergrasp.analysis.realism:RealismParams"),
+        upstream=("contacts", "optimise"), synergy_columns=(1,), params="synergrasp.analysis.realism:RealismParams"),
     "fig1": Step(
         rules={"fig1_synergy_postures": Cost("none", 3.0, 565)},
         outputs=_files(("fig1_synergy_postures",), "figures", _PNG_PDF),

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "PLACEMENT", "write", "read", "write_csv", "read_csv", "empty",
-           "write_study_table"]
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT",
+           "QUALITY", "write", "read", "write_csv", "read_csv", "empty", "write_study_table"]
 
 
 @dataclass(frozen=True)
@@ -50,12 +50,6 @@ class Table:
 
         return pa.schema([(c.name, arrow(c.dtype)) for c in self.columns])
 
-    def markdown(self) -> str:
-        """The contract as a Markdown table (for the docs)."""
-        lines = ["| column | type | unit | meaning |", "|---|---|---|---|"]
-        lines += [f"| `{c.name}` | {c.dtype} | {c.unit or '–'} | {c.meaning} |" for c in self.columns]
-        return "\n".join(lines)
-
 
 def _pose_columns() -> tuple[Column, ...]:
     return (
@@ -67,7 +61,7 @@ def _pose_columns() -> tuple[Column, ...]:
 
 
 CONTACTS = Table("contacts", "one row per pose", _pose_columns() + (
-    Column("status", "string", "", "closure outcome (see synergrasp.simulation)"),
+    Column("status", "string", "", "grasp (closure ran), intersects_open_hand, no_contact, caged (dynamic model: the hand moved the object, nothing touches it, its centre is inside the closed hand), lost (likewise, pushed out of the hand)"),
     Column("q", "list<float64>", "rad", "final joint angles (19)"),
     Column("finger_state", "list<string>", "", "per finger thumb..little: contact (box), self (blocked by the hand), limit (end of the closure path)"),
     Column("n_contacts", "int32", "", "number of contacts m"),
@@ -78,7 +72,8 @@ CONTACTS = Table("contacts", "one row per pose", _pose_columns() + (
     Column("object_center", "list<float64>", "mm", "box centre, palm frame (3)"),
     Column("object_rotation", "list<float64>", "", "box orientation, row-major rotation matrix (9)"),
     Column("max_penetration_mm", "float64", "mm", "deepest contact penetration"),
-    Column("closure_model", "string", "", "closure model that made the row: kinematic or dynamic"),
+    Column("closure_model", "string", "", "closure model that made the row: kinematic, dynamic (a free box) "
+           "or dynamic_held (closure.dynamic.object: held)"),
     Column("contact_normal_force_N", "list<float64>", "N",
            "normal force each contact carries at the settled state (m; NaN for the kinematic model)"),
     Column("object_translation_mm", "list<float64>", "mm",
@@ -98,7 +93,7 @@ GFO = Table("gfo", "one row per (pose, synergy set)", _pose_columns() + (
     Column("rank_G", "int32", "", "rank of the grasp matrix"),
     Column("n_contacts", "int32", "", "number of contacts"),
     Column("iterations", "int32", "", "interior-point iterations"),
-    Column("solver", "string", "", "back end that decided the problem: ipm, clarabel_fallback, direct, none"),
+    Column("solver", "string", "", "back end that decided the problem: ipm (compiled interior-point kernel), clarabel_fallback (the kernel left it undecided), direct (e_s = 0: f = f_p judged without a solver), none (no_grasp, rank_deficient: nothing solved)"),
 ))
 
 MINIMA = Table("minima", "one row per local minimum of (object, synergy set)", (
@@ -126,6 +121,10 @@ def _realism_columns() -> tuple[Column, ...]:
         Column("pct_thumb", "float64", "%", "grasps with a contact on a thumb link"),
         Column("pct_palm", "float64", "%", "grasps with a contact on the palm"),
         Column("pct_proximal_or_middle", "float64", "%", "grasps with a contact on a proximal or middle phalanx"),
+        Column("pct_index", "float64", "%", "grasps with a contact on an index-finger link"),
+        Column("pct_middle", "float64", "%", "grasps with a contact on a middle-finger link"),
+        Column("pct_ring", "float64", "%", "grasps with a contact on a ring-finger link"),
+        Column("pct_little", "float64", "%", "grasps with a contact on a little-finger link"),
         Column("pct_rank6", "float64", "%", "grasps whose grasp matrix G has rank 6"),
         Column("pct_force_closure", "float64", "%",
                "grasps in force closure (rank(G) = 6 and the strict internal-force test) with every synergy"),
@@ -135,11 +134,32 @@ def _realism_columns() -> tuple[Column, ...]:
                "median optimal contact-force norm with every synergy over the force-closure grasps, in multiples of the weight m*g"),
         Column("loaded_contacts_median", "float64", "",
                "median contacts per grasp carrying normal force (NaN without per-contact forces)"),
+        Column("median_torque_residual", "float64", "",
+               "median relative torque residual of the end state, min over f in the friction cones of "
+               "|tau_B - J_B^T f| / |tau_B|, tau = k_ss (q_r - q) on the joints moving a box contact "
+               "(synergrasp.optimisation.equilibrium)"),
+        Column("pct_s1_outside_cone", "float64", "%",
+               "grasps with a contact that S1's closing motion J S1 pushes outside its friction cone "
+               "(angle to the inward normal > atan mu)"),
     )
 
 
 #: Percentages are of the simulated grasps. Written as CSV and Markdown (results/tables).
 GRASP_REALISM = Table("grasp_realism", "one row per (object, closure model)", _realism_columns())
+
+#: Whether each object can be grasped at all, and why not (synergrasp.analysis.graspability).
+#: Written as CSV and Markdown (results/tables) by the grasp-realism step.
+GRASPABLE_OBJECTS = Table("graspable_objects", "one row per object", (
+    Column("object", "string", "", "object name"),
+    Column("poses", "int32", "", "poses of the grid"),
+    Column("simulated", "int32", "", "poses whose closure ran (status grasp or no_contact)"),
+    Column("grasps", "int32", "", "closures that end touching the box (status grasp)"),
+    Column("settled", "int32", "", "grasps that came to rest (all of them for the kinematic closure)"),
+    Column("force_closure_full_set", "int32", "", "poses in force closure with every synergy enrolled"),
+    Column("graspable", "bool", "", "some pose reaches force closure with the full set"),
+    Column("reason", "string", "", "why no pose does: every pose dropped, nothing touched, no pose settled, "
+           "no force closure with the full set (empty when graspable)"),
+))
 
 #: The placement search of one object (docs/placement_search.md), written as CSV
 #: (results/objects/<object>/placement.csv).
@@ -159,7 +179,21 @@ PLACEMENT = Table("placement", "one row per scored target of one object, best fi
     Column("distance_to_chosen_mm", "float64", "mm", "distance to the chosen target"),
 ))
 
-TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, PLACEMENT)}
+#: Quality indices of every pose of one object (docs/quality.md), Parquet
+#: (results/objects/<object>/quality.parquet).
+QUALITY = Table("quality", "one row per pose", _pose_columns() + (
+    Column("n_contacts", "int32", "", "contacts of the grasp"),
+    Column("rank_G", "int32", "", "rank of the grasp matrix (0: no grasp)"),
+    Column("sigma_min", "float64", "", "smallest singular value of G with torques / torque_length_mm (0: rank < 6; NaN: no grasp)"),
+    Column("isotropy", "float64", "", "sigma_min / sigma_max of that matrix"),
+    Column("epsilon", "float64", "", "Ferrari-Canny epsilon (L1, 8-edge cones) of the fully actuated hand, in units of the total normal force"),
+    Column("manipulability", "list<float64>", "mm", "semi-axes of the all-synergy manipulability ellipsoid, largest first (rotations x torque_length_mm)"),
+    Column("force_closure", "bool", "", "force closure (Definition 1) with the full synergy set"),
+    Column("force_per_weight", "float64", "", "optimal contact-force norm with the full set over the weight (NaN: not load-feasible)"),
+    Column("torque_length_mm", "float64", "mm", "the length torques are divided by: the object's bounding radius"),
+))
+
+TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, QUALITY)}
 
 
 def _check(table: Table, frame: pd.DataFrame, where: str) -> None:
@@ -185,8 +219,12 @@ def write(table: Table, frame: pd.DataFrame, path: str | Path) -> None:
 
 
 def read(table: Table, path: str | Path) -> pd.DataFrame:
-    """Read a Parquet table and check it holds the contract's columns."""
-    frame = pd.read_parquet(path)
+    """Read a Parquet table and check it holds the contract's columns; ValueError naming the
+    table and the file if it cannot be read or lacks a column."""
+    try:
+        frame = pd.read_parquet(path)
+    except (OSError, ValueError) as err:  # pyarrow's read errors are either
+        raise ValueError(f"{table.name} table '{path}': cannot be read as Parquet ({err})") from None
     _check(table, frame, str(path))
     return frame
 

@@ -68,12 +68,20 @@ rule grasp_realism:
             category="Tables",
         ),
         md="{root}/tables/grasp_realism.md",
+        links_csv="{root}/tables/grasp_links.csv",
+        links_md="{root}/tables/grasp_links.md",
         png=report(
             "{root}/figures/grasp_realism.png",
             caption="../report/grasp_realism.rst",
             category="Figures",
         ),
         pdf="{root}/figures/grasp_realism.pdf",
+        graspable_csv=report(
+            "{root}/tables/graspable_objects.csv",
+            caption="../report/graspable_objects.rst",
+            category="Tables",
+        ),
+        graspable_md="{root}/tables/graspable_objects.md",
     log:
         "{root}/logs/grasp_realism.log",
     benchmark:
@@ -86,3 +94,33 @@ rule grasp_realism:
         cfg=step_cfg("realism"),
     script:
         "../scripts/grasp_realism.py"
+
+
+rule grasp_quality:
+    input:
+        contacts=step_input("contacts"),
+        gfo=step_input("optimise"),
+        code=code("grasp_quality"),
+        data=SHIPPED_DATA,
+        user=user_files,
+    output:
+        table="{root}/objects/{object}/quality.parquet",
+        png=report(
+            "{root}/objects/{object}/quality_maps.png",
+            caption="../report/quality_maps.rst",
+            category="Quality",
+            subcategory="{object}",
+        ),
+        pdf="{root}/objects/{object}/quality_maps.pdf",
+    log:
+        "{root}/logs/grasp_quality/{object}.log",
+    benchmark:
+        "{root}/benchmarks/grasp_quality/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("grasp_quality"),
+        runtime=runtime_min("grasp_quality"),
+    params:
+        cfg=step_cfg("quality"),
+    script:
+        "../scripts/grasp_quality.py"

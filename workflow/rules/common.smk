@@ -6,10 +6,12 @@ import re
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
+from snakemake.logging import logger
 
 from synergrasp.config import ConfigError, check_relations, scenario_names, synergy_problems
 from synergrasp.config import scenario_config as checked_scenario_config
 from synergrasp.config import overlay
+from synergrasp.preflight import accept_configured_wildcards, configfile_problems, slurm_problems
 from synergrasp.steps import STEPS, TABLES, step_config, step_hash, upstream_when
 
 ROOT = Path(workflow.basedir)
@@ -17,27 +19,45 @@ SRC = ROOT / "src" / "synergrasp"
 
 
 @functools.cache
+def _hand(path):
+    """The hand of a ``hand:`` value, checked for what the study asks of it (one line per
+    problem naming the file and the field); its warnings printed once."""
+    from synergrasp.hand.checks import check_hand
+
+    hand, problems, warnings = check_hand(path)
+    for warning in warnings:
+        logger.warning(f"Warning: {warning}")
+    return hand, problems
+
+
+@functools.cache
 def scenario(name):
     """The complete configuration of scenario ``name`` (``default``: the configuration
     itself), checked with its hand and synergy files when a target first needs it, before
     any job runs (config/README.md): `figures` reads the default only, `sensitivity` all."""
-    from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import load_synergies
     from synergrasp.simulation.objects import object_problems
 
     try:
         cfg = checked_scenario_config(config, name)
-        synergies = load_synergies(cfg["synergies"], joint_names=load_hand(cfg["hand"]).joint_names)
-        problems = check_relations(cfg, synergies.matrix.shape[1])
+        hand, hand_problems = _hand(cfg["hand"])
+        problems = list(hand_problems)
+        synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
+        problems += check_relations(cfg, synergies.matrix.shape[1])
         problems += synergy_problems(cfg, synergies.mean, synergies.matrix)
         problems += object_problems(cfg)
         if problems:
             where = "" if name == "default" else f"scenario '{name}': "
             raise ConfigError("\n".join(where + p for p in problems))
-    except ValueError as err:  # ConfigError, SynergyFileError, hand-file errors are ValueErrors
+    except ValueError as err:  # ConfigError, SynergyFileError, hand/YAML file errors
         raise WorkflowError(f"Invalid input, nothing was run:\n{err}") from None
     return cfg
 
+
+# Snakemake read the configuration files itself and kept a repeated key's last value.
+_PROBLEMS = configfile_problems(workflow.configfiles)
+if _PROBLEMS:
+    raise WorkflowError("Invalid input, nothing was run:\n" + "\n".join(_PROBLEMS))
 
 #: The main configuration (scenario `default`), complete (defaults filled in) and checked.
 STUDY = scenario("default")
@@ -158,10 +178,40 @@ def step_cfg(step):
     return lambda wildcards: step_config(scenario_config(wildcards), step, wildcards.get("object"))
 
 
+def _exactly(values):
+    """A wildcard constraint matching exactly one of ``values`` (longest first)."""
+    return "|".join(re.escape(v) for v in sorted(set(values), key=lambda v: (-len(v), v)))
+
+
+#: Every object name the configuration or a scenario's overlay gives (read without checking
+#: the scenarios: a superset of the objects any checked scenario has).
+_OBJECT_NAMES = set(OBJECTS) | {
+    o
+    for over in (config.get("scenarios") or {}).values()
+    if isinstance(over, dict)
+    for o in map(str, over.get("objects") or {})
+}
+# Wildcards match the configured names exactly, so Snakemake's guard against endless
+# recursion may accept a configured name ending in a repeated character (obj_000...0).
+accept_configured_wildcards([*_OBJECT_NAMES, *SCENARIO_ROOT.values()])
+
+
 wildcard_constraints:
-    root="|".join(re.escape(r) for r in SCENARIO_ROOT.values()),
-    object="[A-Za-z0-9_]+",
+    root=_exactly(SCENARIO_ROOT.values()),
+    object=_exactly(_OBJECT_NAMES),
     shard=r"\d+",
+
+
+onstart:
+    # A cluster profile on a machine or shell that cannot submit: one line, before any job.
+    if workflow.executor_plugin.name == "slurm":
+        _raw = {k: r.raw for k, r in workflow.resource_settings.default_resources.items()}
+        _problems = slurm_problems(workflow.executor_settings, _raw)
+        if _problems:
+            raise WorkflowError(
+                "The SLURM profile cannot submit from this shell, nothing was run: "
+                + "; ".join(_problems)
+            )
 
 
 #: `import synergrasp.x[, ...]` and `from synergrasp.x import a, b` (or a parenthesised list),

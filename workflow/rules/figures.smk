@@ -1,5 +1,6 @@
-# Stage 4: the study's figures from the tables (Fig. 4 per object, Fig. 5) and the
-# workflow's own rule graph (Fig. 3).
+# Stage 4: the study's figures: the hand along the synergies (Fig. 1), example grasps
+# (Fig. 2), the workflow's own rule graph (Fig. 3), force maps per object (Fig. 4) and the
+# hierarchy (Fig. 5).
 
 
 rule fig4_force_maps:
@@ -100,6 +101,59 @@ rule fig3_rulegraph:
         configfile=str(ROOT / "config" / "config.yaml"),
     script:
         "../scripts/fig3_rulegraph.py"
+
+
+rule fig1_synergy_postures:
+    input:
+        code=code("fig1_synergy_postures"),
+        data=SHIPPED_DATA,
+        user=user_files,
+    output:
+        png=report(
+            "{root}/figures/fig1_synergy_postures.png",
+            caption="../report/fig1.rst",
+            category="Figures",
+        ),
+        pdf="{root}/figures/fig1_synergy_postures.pdf",
+    log:
+        "{root}/logs/fig1_synergy_postures.log",
+    benchmark:
+        "{root}/benchmarks/fig1_synergy_postures.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("fig1_synergy_postures"),
+        runtime=runtime_min("fig1_synergy_postures"),
+    params:
+        cfg=step_cfg("fig1"),
+    script:
+        "../scripts/fig1_synergy_postures.py"
+
+
+rule fig2_example_grasps:
+    input:
+        contacts=step_inputs("contacts"),
+        code=code("fig2_example_grasps"),
+        data=SHIPPED_DATA,
+        user=user_files,
+    output:
+        png=report(
+            "{root}/figures/fig2_example_grasps.png",
+            caption="../report/fig2.rst",
+            category="Figures",
+        ),
+        pdf="{root}/figures/fig2_example_grasps.pdf",
+    log:
+        "{root}/logs/fig2_example_grasps.log",
+    benchmark:
+        "{root}/benchmarks/fig2_example_grasps.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("fig2_example_grasps"),
+        runtime=runtime_min("fig2_example_grasps"),
+    params:
+        cfg=step_cfg("fig2"),
+    script:
+        "../scripts/fig2_example_grasps.py"
 
 
 rule placement_map:

@@ -1,5 +1,4 @@
-# Stage 1: close the hand on each object at every pose (pybullet), and the pictures of
-# the hand (Fig. 1) and of example grasps (Fig. 2).
+# Stage 1: close the hand on each object at every pose, and select the contacts that count.
 
 
 rule search_placement:
@@ -63,56 +62,3 @@ rule select_contacts:
         cfg=step_cfg("contacts"),
     script:
         "../scripts/select_contacts.py"
-
-
-rule fig1_synergy_postures:
-    input:
-        code=code("fig1_synergy_postures"),
-        data=SHIPPED_DATA,
-        user=user_files,
-    output:
-        png=report(
-            "{root}/figures/fig1_synergy_postures.png",
-            caption="../report/fig1.rst",
-            category="Figures",
-        ),
-        pdf="{root}/figures/fig1_synergy_postures.pdf",
-    log:
-        "{root}/logs/fig1_synergy_postures.log",
-    benchmark:
-        "{root}/benchmarks/fig1_synergy_postures.tsv"
-    threads: 1
-    resources:
-        mem_mb=mem_mb("fig1_synergy_postures"),
-        runtime=runtime_min("fig1_synergy_postures"),
-    params:
-        cfg=step_cfg("fig1"),
-    script:
-        "../scripts/fig1_synergy_postures.py"
-
-
-rule fig2_example_grasps:
-    input:
-        contacts=step_inputs("contacts"),
-        code=code("fig2_example_grasps"),
-        data=SHIPPED_DATA,
-        user=user_files,
-    output:
-        png=report(
-            "{root}/figures/fig2_example_grasps.png",
-            caption="../report/fig2.rst",
-            category="Figures",
-        ),
-        pdf="{root}/figures/fig2_example_grasps.pdf",
-    log:
-        "{root}/logs/fig2_example_grasps.log",
-    benchmark:
-        "{root}/benchmarks/fig2_example_grasps.tsv"
-    threads: 1
-    resources:
-        mem_mb=mem_mb("fig2_example_grasps"),
-        runtime=runtime_min("fig2_example_grasps"),
-    params:
-        cfg=step_cfg("fig2"),
-    script:
-        "../scripts/fig2_example_grasps.py"

@@ -1,7 +1,6 @@
 """Fig. 4 for one object: force maps over (alpha, beta) and exploded views."""
 
-import pandas as pd
-
+from synergrasp import tables
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.figures.study_figures import Fig4Params, figure_exploded_views, figure_force_maps
 from synergrasp.job_log import job_log
@@ -9,8 +8,8 @@ from synergrasp.job_log import job_log
 with job_log(snakemake.log[0]):
     p = Fig4Params.from_config(snakemake.params.cfg, snakemake.wildcards.object)
     weights = {snakemake.wildcards.object: p.weight_N} if p.weight_N is not None else None
-    gfo = with_verdicts(pd.read_parquet(snakemake.input.gfo), p.success, weights, p.bound_multiple)
-    minima = pd.read_parquet(snakemake.input.minima)
+    gfo = with_verdicts(tables.read(tables.GFO, snakemake.input.gfo), p.success, weights, p.bound_multiple)
+    minima = tables.read(tables.MINIMA, snakemake.input.minima)
     name, out, panel_k = snakemake.wildcards.object, snakemake.output, list(p.panel_k)
     figure_force_maps(gfo, minima, panel_k, name, out.maps_png, out.maps_pdf, p.success)
     figure_exploded_views(gfo, panel_k, p.alpha_slice_deg, p.beta_slice_deg,

@@ -1,6 +1,6 @@
 """Local minima of the optimal grasp force over the (α, β) pose grid, and their preservation.
 
-Method (docs/analyses.md, method.md §5): for one object and one synergy set,
+Method (docs/analyses.md, docs/method.md §5): for one object and one synergy set,
 
 1. candidates are force-closure poses whose optimal force is below the median optimal
    force of that set's force-closure poses (by more than FORCE_TIE_RTOL, relative);

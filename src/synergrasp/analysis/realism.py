@@ -19,11 +19,12 @@ import numpy as np
 import pandas as pd
 
 from synergrasp.analysis.verdicts import verdict_columns
+from synergrasp.hand.synergies import Synergies, synergy_values
 from synergrasp.ids import incremental_set_id
 from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 
-__all__ = ["RealismParams", "SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "link_categories", "grasp_realism",
-           "representative_grasps"]
+__all__ = ["RealismParams", "SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "LONG_FINGERS",
+           "link_categories", "grasp_realism", "link_shares", "representative_grasps"]
 
 #: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.STATUSES): a
 #: ``no_contact`` closure is a simulated grasp with 0 contacts; any other status is a dropped pose.
@@ -32,6 +33,8 @@ SIMULATED_STATUSES: tuple[str, ...] = ("grasp", "no_contact")
 CONTACT_BINS: tuple[int, ...] = (0, 1, 2, 3, 4, 5, 6)
 #: Contacts column: normal force per contact, N (NaN entries where the model computes none).
 NORMAL_FORCE_COLUMN = "contact_normal_force_N"
+#: The long fingers, each a column of the table (grasps touching the box with that finger).
+LONG_FINGERS: tuple[str, ...] = ("index", "middle", "ring", "little")
 #: Segments (the part of a link name after the finger) counted as proximal or middle phalanges.
 _PROXIMAL_OR_MIDDLE = ("proximal", "middle")
 
@@ -40,31 +43,51 @@ _PROXIMAL_OR_MIDDLE = ("proximal", "middle")
 @dataclass(frozen=True)
 class RealismParams:
     """The grasp-realism table (the ``realism`` step): hand file, the full set's id, each
-    object's weight (N), and the least normal force (N) of a load-carrying contact (None:
-    the closure model records no loads)."""
+    object's weight (N), the least normal force (N) of a load-carrying contact (None: the
+    closure model records no loads), and for the equilibrium checks the mean posture q_m and
+    S1 of the synergy table (rad, the hand's joint order), the joint stiffness k_ss (N·mm/rad)
+    and μ."""
 
     hand: str | None
     full_set_id: str
     weights_N: dict[str, float]
     load_threshold_N: float | None
+    mean_rad: tuple[float, ...]
+    s1: tuple[float, ...]
+    k_ss_Nmm_per_rad: float
+    mu: float
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> RealismParams:
-        """From a configuration or the step's own part of it (``obj`` is not read)."""
-        g = config["mechanics"]["g_m_per_s2"]
+        """From a configuration, or from the step's own part of it (whose ``synergies`` holds
+        q_m and S1 themselves; ``obj`` is not read)."""
+        mechanics = config["mechanics"]
         closure = config["closure"]
         threshold = closure["dynamic"]["load_threshold_N"] if closure["model"] == "dynamic" else None
+        values = config["synergies"]
+        if not isinstance(values, Mapping):
+            values = synergy_values(config["hand"], values, (1,))
         return cls(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),
-                   {name: spec["mass_kg"] * g for name, spec in config["objects"].items()}, threshold)
+                   {name: spec["mass_kg"] * mechanics["g_m_per_s2"] for name, spec in config["objects"].items()},
+                   threshold, tuple(values["mean_rad"]), tuple(values["S1"]), float(mechanics["k_ss_Nmm_per_rad"]),
+                   float(mechanics["mu"]))
+
+    def synergies(self, joint_names: tuple[str, ...]) -> Synergies:
+        """q_m and S1 as a one-synergy :class:`Synergies` of the hand's joints."""
+        return Synergies(tuple(joint_names), np.array(self.mean_rad), np.array(self.s1)[:, None], ("S1",))
+
 
 def link_categories(link_names: Sequence[str], link_finger: Sequence[str]) -> dict[str, frozenset[int]]:
     """Hand link indices per category: ``thumb`` (every thumb link), ``palm`` (links of the
-    palm), ``proximal_or_middle`` (links named ``<finger>_proximal`` or ``<finger>_middle``)."""
-    thumb = frozenset(i for i, f in enumerate(link_finger) if f == "thumb")
-    palm = frozenset(i for i, f in enumerate(link_finger) if f == "palm")
+    palm), ``proximal_or_middle`` (links named ``<finger>_proximal`` or ``<finger>_middle``),
+    and every long finger's links (``index``, ``middle``, ``ring``, ``little``)."""
+    def finger(name: str) -> frozenset[int]:
+        return frozenset(i for i, f in enumerate(link_finger) if f == name)
+
     phalanx = frozenset(i for i, (name, f) in enumerate(zip(link_names, link_finger))
                         if f != "palm" and name.rsplit("_", 1)[-1] in _PROXIMAL_OR_MIDDLE)
-    return {"thumb": thumb, "palm": palm, "proximal_or_middle": phalanx}
+    return {"thumb": finger("thumb"), "palm": finger("palm"), "proximal_or_middle": phalanx,
+            **{name: finger(name) for name in LONG_FINGERS}}
 
 
 def _touches(links: pd.Series, category: frozenset[int]) -> pd.Series:
@@ -123,6 +146,8 @@ def _one_group(rows: pd.DataFrame, categories: dict[str, frozenset[int]]) -> dic
     out["pct_force_closure"] = share(grasps["force_closure"].fillna(False).astype(bool))
     out["pct_load_feasible"] = share(grasps["load_feasible"].fillna(False).astype(bool))
     out["median_force_per_weight"] = float(grasps["force_per_weight"].median()) if n else np.nan
+    out["median_torque_residual"] = float(grasps["torque_residual"].median()) if n else np.nan
+    out["pct_s1_outside_cone"] = share(grasps["s1_outside_cone"].fillna(0) > 0)
     loaded = grasps["loaded_contacts"]
     known = loaded[grasps["n_contacts"] > 0].notna().any()  # forces recorded where there are contacts
     out["loaded_contacts_median"] = float(loaded.median()) if known else np.nan
@@ -133,14 +158,19 @@ def _bin_column(b: int) -> str:
     return f"pct_m{b}plus" if b == CONTACT_BINS[-1] else f"pct_m{b}"
 
 
-def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequence[str], link_finger: Sequence[str],
-                  full_set_id: str, weights_N: Mapping[str, float], load_threshold_N: float | None) -> pd.DataFrame:
+def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, equilibrium: pd.DataFrame, link_names: Sequence[str],
+                  link_finger: Sequence[str], full_set_id: str, weights_N: Mapping[str, float],
+                  load_threshold_N: float | None) -> pd.DataFrame:
     """The grasp-realism table (columns of :data:`synergrasp.tables.GRASP_REALISM`).
 
     ``contacts``: contacts tables of the objects (CONTACTS contract; rows are grouped by
     ``closure_model``, loads read from ``contact_normal_force_N``, N).
     ``gfo``: their optimisation results (joined on ``closure_model`` too when it has that
     column); rank(G), force closure and ‖f‖₂ are taken from the full set ``full_set_id`` (e.g. ``"1-2-…-15"``). ``weights_N``: m·g per object, N.
+    ``equilibrium``: the per-grasp equilibrium checks of the same contacts
+    (``synergrasp.optimisation.equilibrium.grasp_equilibrium``: object, closure_model, pose,
+    torque_residual, s1_outside_cone, …); grasps missing from it count as unknown residual and
+    no contact pushed outside its cone.
     ``link_names`` / ``link_finger``: the hand's links (``Hand.link_names``, ``Hand.link_finger``).
     Shares are percent of the simulated poses (``SIMULATED_STATUSES``); a contact carries load if
     its normal force is at least ``load_threshold_N`` (N; the configuration's
@@ -158,10 +188,28 @@ def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequenc
     full = _weight_multiples(gfo, full_set_id, weights_N)
     keys = ["object", "pose", "closure_model"] if "closure_model" in full.columns else ["object", "pose"]
     work = work.merge(full, on=keys, how="left", validate="many_to_one")
+    checks = equilibrium[["object", "closure_model", "pose", "torque_residual", "s1_outside_cone"]]
+    work = work.merge(checks.astype({"pose": int}), on=["object", "closure_model", "pose"], how="left",
+                      validate="one_to_one")
     categories = link_categories(link_names, link_finger)
     rows = [{"object": obj, "closure_model": cm, **_one_group(group, categories)}
             for (obj, cm), group in work.groupby(["object", "closure_model"], sort=True)]
     return pd.DataFrame(rows, columns=list(GRASP_REALISM.names))
+
+
+def link_shares(contacts: pd.DataFrame, link_names: Sequence[str], link_finger: Sequence[str]) -> pd.DataFrame:
+    """Which links touch the box: per (object, closure model) and hand link, the share of the
+    simulated grasps (``SIMULATED_STATUSES``) with a contact on that link (``pct_grasps``, %).
+    Columns: object, closure_model, finger, link, pct_grasps; links in the hand's order."""
+    rows = []
+    for (obj, model), group in contacts.groupby(["object", "closure_model"], sort=True):
+        grasps = group[group["status"].isin(SIMULATED_STATUSES)]
+        touched = grasps["contact_link"].map(lambda ls: {int(i) for i in ls})
+        for index, (name, finger) in enumerate(zip(link_names, link_finger)):
+            hits = int(touched.map(lambda s, i=index: i in s).sum())
+            rows.append({"object": obj, "closure_model": model, "finger": finger, "link": name,
+                         "pct_grasps": 100.0 * hits / len(grasps) if len(grasps) else np.nan})
+    return pd.DataFrame(rows, columns=["object", "closure_model", "finger", "link", "pct_grasps"])
 
 
 def _pattern(links) -> tuple[int, ...]:

@@ -1,9 +1,11 @@
 """The grasp-realism figure, drawn from the grasp-realism table (``synergrasp.analysis.realism``).
 
-Three panels, one bar (group) per object and closure model: (A) contacts per grasp, stacked
-shares 0 … 6+; (B) share of grasps touching with the thumb, the palm, a proximal or middle
-phalanx, and with rank(G) = 6; (C) the median optimal contact force with every synergy
-enrolled, in multiples of the object's weight (log scale).
+Four panels, one bar (group) per object and closure model: (A) contacts per grasp, stacked
+shares 0 … 6+; (B) share of grasps touching with the thumb, the index finger, the palm, a
+proximal or middle phalanx, and with rank(G) = 6; (C) the median optimal contact force with
+every synergy enrolled, in multiples of the object's weight (log scale); (D) equilibrium of the
+end state: the median relative torque residual and the share of grasps with a contact S1
+pushes outside its friction cone (``synergrasp.optimisation.equilibrium``).
 """
 
 from __future__ import annotations
@@ -19,8 +21,11 @@ from synergrasp.figures.output import save_figure
 __all__ = ["figure_grasp_realism"]
 
 #: (column, legend label) of panel B.
-_SHARES = (("pct_thumb", "thumb"), ("pct_palm", "palm"), ("pct_proximal_or_middle", "proximal/middle phalanx"),
-           ("pct_rank6", "rank G = 6"))
+_SHARES = (("pct_thumb", "thumb"), ("pct_index", "index finger"), ("pct_palm", "palm"),
+           ("pct_proximal_or_middle", "proximal/middle phalanx"), ("pct_rank6", "rank G = 6"))
+#: (column, legend label, scale to %) of panel D.
+_EQUILIBRIUM = (("median_torque_residual", "median torque residual", 100.0),
+                ("pct_s1_outside_cone", "S1 pushes a contact outside its cone", 1.0))
 
 
 def _labels(table: pd.DataFrame) -> list[str]:
@@ -45,7 +50,6 @@ def _contacts_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
                         color="white" if b < 4 else "black")
         left += width
     ax.set_yticks(y, labels)
-    ax.invert_yaxis()
     ax.set_xlim(0, 100)
     ax.set_xlabel("share of simulated grasps (%)")
     ax.set_title("A  contacts per grasp", loc="left", fontsize=10)
@@ -55,22 +59,35 @@ def _contacts_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
 
 def _shares_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
     y = np.arange(len(table))
-    height = 0.8 / len(_SHARES)
-    colours = ("#d95f02", "#1b9e77", "#7570b3", "0.45")
-    for k, ((column, label), colour) in enumerate(zip(_SHARES, colours)):
-        value = table[column].to_numpy(dtype=float)
+    colours = ("#d95f02", "#e7298a", "#1b9e77", "#7570b3", "0.45")
+    _grouped_bars(ax, table, [(c, label, 1.0) for c, label in _SHARES], colours)
+    ax.set_xlabel("share of simulated grasps (%)")
+    ax.set_title("B  grasps touching with …", loc="left", fontsize=10)
+    ax.legend(fontsize=7, ncol=2, loc="lower center", bbox_to_anchor=(0.5, -0.5), frameon=False)
+    ax.set_yticks(y, labels)
+
+
+def _grouped_bars(ax, table: pd.DataFrame, columns, colours) -> None:
+    """One bar per (column, label, scale) in each row's group, its value (%) written at its end."""
+    y = np.arange(len(table))
+    height = 0.8 / len(columns)
+    for k, ((column, label, scale), colour) in enumerate(zip(columns, colours)):
+        value = scale * table[column].to_numpy(dtype=float)
         yk = y - 0.4 + (k + 0.5) * height
         ax.barh(yk, np.nan_to_num(value), height=height, color=colour, label=label)
         for yi, v in zip(yk, value):
             inside = np.isfinite(v) and v >= 15.0  # the number at the bar's end, inside it when it fits
             ax.text(v - 1.0 if inside else np.nan_to_num(v) + 1.0, yi, f"{v:.0f}" if np.isfinite(v) else "–",
                     va="center", ha="right" if inside else "left", fontsize=6, color="white" if inside else "black")
-    ax.set_yticks(y, labels)
-    ax.invert_yaxis()
     ax.set_xlim(0, 100)
-    ax.set_xlabel("share of simulated grasps (%)")
-    ax.set_title("B  grasps touching with …", loc="left", fontsize=10)
-    ax.legend(fontsize=7, ncol=2, loc="lower center", bbox_to_anchor=(0.5, -0.5), frameon=False)
+
+
+def _equilibrium_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
+    _grouped_bars(ax, table, _EQUILIBRIUM, ("#a6761d", "#666666"))
+    ax.set_yticks(np.arange(len(table)), labels)
+    ax.set_xlabel("% (residual: of the box joints' torque)")
+    ax.set_title("D  end state an equilibrium?", loc="left", fontsize=10)
+    ax.legend(fontsize=7, ncol=1, loc="lower center", bbox_to_anchor=(0.5, -0.5), frameon=False)
 
 
 def _force_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
@@ -88,7 +105,6 @@ def _force_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
     lo = min(0.1, float(finite.min()) / 2) if finite.size else 0.1
     ax.set_xlim(lo, hi)
     ax.set_yticks(y, labels)
-    ax.invert_yaxis()
     ax.set_xlabel("median ‖f‖ with all synergies / weight")
     ax.set_title("C  force needed (dashed: the weight)", loc="left", fontsize=10)
 
@@ -103,10 +119,12 @@ def figure_grasp_realism(table: pd.DataFrame, png_path: str | Path, pdf_path: st
     if table.empty:
         raise ValueError("the grasp-realism table has no rows: no object was simulated")
     labels = _labels(table)
-    fig, axes = plt.subplots(1, 3, figsize=(13.0, 1.6 + 0.55 * len(table)), sharey=True)
+    fig, axes = plt.subplots(1, 4, figsize=(17.0, 1.8 + 0.6 * len(table)), sharey=True)
     _contacts_panel(axes[0], table, labels)
     _shares_panel(axes[1], table, labels)
     _force_panel(axes[2], table, labels)
+    _equilibrium_panel(axes[3], table, labels)
+    axes[0].invert_yaxis()  # the first row on top (the axes share y: once for all)
     dropped = ", ".join(f"{o}: {int(d)} of {int(p)}" for o, d, p in zip(labels, table["dropped"], table["poses"]))
     fig.suptitle(f"How realistic are the simulated grasps?   Poses dropped — {dropped}".replace("\n", " "),
                  fontsize=10, x=0.01, ha="left")

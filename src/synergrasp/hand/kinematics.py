@@ -16,49 +16,35 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 from numpy.typing import NDArray
 
-FINGERS: tuple[str, ...] = ("thumb", "index", "middle", "ring", "little")
-
-JOINT_NAMES: tuple[str, ...] = (
-    "thumb_abd", "thumb_flex1", "thumb_flex2",
-    "index_abd", "index_mcp", "index_pip", "index_dip",
-    "middle_abd", "middle_mcp", "middle_pip", "middle_dip",
-    "ring_abd", "ring_mcp", "ring_pip", "ring_dip",
-    "little_abd", "little_mcp", "little_pip", "little_dip",
+from synergrasp.hand.geometry import (  # noqa: F401  (the model's geometry, re-exported)
+    SHAPE_KINDS,
+    Shape,
+    axis_rotation,
+    matrix_rpy,
+    pose_matrix,
+    rpy_matrix,
 )
-
-PALM_NORMAL: NDArray[np.float64] = np.array([1.0, 0.0, 0.0])
-"""Unit vector (palm frame) the palm faces: the side toward which every finger flexes."""
+from synergrasp.hand.hand_file import (  # noqa: F401  (the file format, re-exported)
+    FINGERS,
+    JOINT_NAMES,
+    PALM_NORMAL,
+    HandSpec,
+    check_hand_doc,
+    default_hand_path,
+    hand_spec,
+    read_hand_file,
+)
 
 FINGERTIP_LINKS: tuple[str, ...] = (
     "thumb_distal", "index_distal", "middle_distal", "ring_distal", "little_distal",
 )
 """Last link of each finger chain, in FINGERS order (shipped model)."""
-
-SHAPE_KINDS = ("capsule", "box")
-
-
-@dataclass(frozen=True)
-class Shape:
-    """One collision shape of a link.
-
-    ``pose`` (4 × 4, mm) places the shape in its link frame. A capsule lies along the
-    pose's local z axis: ``length`` mm between the centres of its two end spheres of
-    ``radius`` mm. A box is centred on the pose with full edge lengths ``size`` (mm).
-    """
-
-    kind: str
-    pose: NDArray[np.float64]
-    radius: float = 0.0
-    length: float = 0.0
-    size: NDArray[np.float64] | None = None
 
 
 @dataclass(frozen=True)
@@ -91,6 +77,7 @@ class Hand:
     fingertip_point: NDArray[np.float64]  # (5, 3) fingertip point in its distal link frame, mm
     ignored_link_pairs: tuple[tuple[int, int], ...]  # self-collision pairs to skip (touching by design)
     palm_normal: NDArray[np.float64]
+    source: str = "the shipped hand"      # where the model was read from (for messages)
 
     @property
     def n_joints(self) -> int:
@@ -113,310 +100,89 @@ class Hand:
             raise ValueError(f"link must be one of {self.link_names}, got {name!r}") from None
 
 
-# --------------------------------------------------------------------------- geometry helpers
-
-
-def rpy_matrix(rpy: NDArray | tuple[float, float, float]) -> NDArray[np.float64]:
-    """Rotation matrix of URDF roll-pitch-yaw angles (rad): Rz(yaw) @ Ry(pitch) @ Rx(roll)."""
-    r, p, y = (float(a) for a in rpy)
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    return np.array([
-        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-        [-sp, cp * sr, cp * cr],
-    ])
-
-
-def matrix_rpy(rotation: NDArray) -> NDArray[np.float64]:
-    """URDF roll-pitch-yaw angles (rad) of a rotation matrix (inverse of ``rpy_matrix``)."""
-    m = np.asarray(rotation, dtype=float)
-    pitch = math.asin(-max(-1.0, min(1.0, m[2, 0])))
-    if abs(m[2, 0]) < 1.0 - 1e-12:
-        roll = math.atan2(m[2, 1], m[2, 2])
-        yaw = math.atan2(m[1, 0], m[0, 0])
-    else:  # gimbal lock: put everything into yaw
-        roll = 0.0
-        yaw = math.atan2(-m[0, 1], m[1, 1])
-    return np.array([roll, pitch, yaw])
-
-
-def pose_matrix(xyz: NDArray | tuple[float, ...], rpy: NDArray | tuple[float, ...] = (0.0, 0.0, 0.0)) -> NDArray[np.float64]:
-    """4 × 4 homogeneous transform from a translation (mm) and URDF rpy (rad)."""
-    t = np.eye(4)
-    t[:3, :3] = rpy_matrix(rpy)
-    t[:3, 3] = np.asarray(xyz, dtype=float)
-    return t
-
-
-def axis_rotation(axis: NDArray, angle: float) -> NDArray[np.float64]:
-    """Rotation matrix of ``angle`` rad about the unit vector ``axis`` (Rodrigues)."""
-    x, y, z = axis
-    c, s = math.cos(angle), math.sin(angle)
-    v = 1.0 - c
-    return np.array([
-        [c + x * x * v, x * y * v - z * s, x * z * v + y * s],
-        [y * x * v + z * s, c + y * y * v, y * z * v - x * s],
-        [z * x * v - y * s, z * y * v + x * s, c + z * z * v],
-    ])
-
-
-def _z_to(direction: NDArray) -> NDArray[np.float64]:
-    """A rotation taking the z axis onto the unit vector ``direction`` (shortest arc)."""
-    d = direction / np.linalg.norm(direction)
-    z = np.array([0.0, 0.0, 1.0])
-    c = float(d @ z)
-    if c > 1.0 - 1e-12:
-        return np.eye(3)
-    if c < -1.0 + 1e-12:
-        return np.diag([1.0, -1.0, -1.0])
-    k = np.cross(z, d)
-    return axis_rotation(k / np.linalg.norm(k), math.acos(c))
-
-
-# --------------------------------------------------------------------------- loading
-
-
-def _err(field: str, message: str) -> ValueError:
-    return ValueError(f"hand file: {field}: {message}")
-
-
-def _vector(node: dict, key: str, field: str, n: int = 3) -> NDArray[np.float64]:
-    if key not in node:
-        raise _err(f"{field}.{key}", f"missing (a list of {n} numbers)")
-    value = node[key]
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise _err(f"{field}.{key}", f"must be a list of {n} numbers, got {value!r}") from None
-    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-        raise _err(f"{field}.{key}", f"must be a list of {n} finite numbers, got {value!r}")
-    return arr
-
-
-def _number(node: dict, key: str, field: str, minimum: float | None = None) -> float:
-    if key not in node:
-        raise _err(f"{field}.{key}", "missing (a number)")
-    value = node[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise _err(f"{field}.{key}", f"must be a finite number, got {value!r}")
-    if minimum is not None and value < minimum:
-        raise _err(f"{field}.{key}", f"must be >= {minimum}, got {value!r}")
-    return float(value)
-
-
-#: The keys allowed at each level of a hand file (a misspelt optional key is an error).
-_HAND_KEYS: dict[str, tuple[str, ...]] = {
-    "<top level>": ("name", "palm_normal", "palm", "fingers"),
-    "palm": ("shapes",),
-    "finger": ("knuckle", "tip_mm", "joints"),
-    "knuckle": ("xyz_mm", "rpy_rad"),
-    "joint": ("name", "offset_mm", "rpy_rad", "axis", "rolling_gap_mm", "limits_deg", "link", "shapes"),
-    "capsule": ("from_mm", "to_mm", "radius_mm"),
-    "box": ("center_mm", "size_mm", "rpy_rad"),
-}
-
-
-def _mapping(node: Any, field: str, kind: str | None = None) -> dict:
-    if not isinstance(node, dict):
-        raise _err(field, f"must be a mapping, got {type(node).__name__}")
-    allowed = _HAND_KEYS.get(kind or "", None)
-    unknown = [k for k in node if k not in allowed] if allowed else []
-    if unknown:
-        raise _err(field, f"unknown key(s) {unknown}; allowed keys: {list(allowed)}")
-    return node
-
-
-def _shape(node: Any, field: str) -> Shape:
-    node = _mapping(node, field)
-    if len(node) != 1 or next(iter(node)) not in SHAPE_KINDS:
-        raise _err(field, f"must be a single key, one of {SHAPE_KINDS}, got {list(node)}")
-    kind = next(iter(node))
-    spec = _mapping(node[kind], f"{field}.{kind}", kind)
-    f = f"{field}.{kind}"
-    if kind == "capsule":
-        a = _vector(spec, "from_mm", f)
-        b = _vector(spec, "to_mm", f)
-        radius = _number(spec, "radius_mm", f, minimum=1e-6)
-        pose = np.eye(4)
-        pose[:3, 3] = 0.5 * (a + b)
-        length = float(np.linalg.norm(b - a))
-        if length > 0:
-            pose[:3, :3] = _z_to(b - a)
-        return Shape("capsule", pose, radius=radius, length=length)
-    size = _vector(spec, "size_mm", f)
-    if np.any(size <= 0):
-        raise _err(f"{f}.size_mm", f"must be positive, got {size.tolist()}")
-    center = _vector(spec, "center_mm", f)
-    rpy = _vector(spec, "rpy_rad", f) if "rpy_rad" in spec else np.zeros(3)
-    return Shape("box", pose_matrix(center, rpy), size=size)
-
-
-def _shapes(node: dict, field: str) -> tuple[Shape, ...]:
-    shapes = node.get("shapes", [])
-    if not isinstance(shapes, list):
-        raise _err(f"{field}.shapes", "must be a list of {capsule: ...} or {box: ...}")
-    return tuple(_shape(s, f"{field}.shapes[{i}]") for i, s in enumerate(shapes))
-
-
-def default_hand_path() -> Path:
-    """Path of the shipped SoftHand-like model."""
-    return Path(str(resources.files("synergrasp") / "data" / "hand.yaml"))
+# --------------------------------------------------------------------------- loading: read, check, build
 
 
 def load_hand(path: str | Path | None = None) -> Hand:
-    """Load a hand model from a YAML file (None: the shipped SoftHand-like model).
+    """Load a hand model from a YAML file (None: the shipped SoftHand-like model): read and
+    check it (``hand_file.hand_spec``), then build it (:func:`build_hand`).
 
     The file format is documented in docs/hand.md and in the header of data/hand.yaml.
-    Raises ValueError naming the offending field.
+    Raises ValueError naming the file and the offending field.
     """
-    path = default_hand_path() if path is None else Path(path)
-    try:
-        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc).splitlines()[0]
-        raise ValueError(f"hand file '{path}': not a readable YAML file ({reason})") from None
-    if doc is None:
-        raise ValueError(f"hand file '{path}': is empty; the format is in docs/hand.md")
-    try:
-        return hand_from_dict(doc)
-    except ValueError as exc:
-        raise ValueError(str(exc).replace("hand file:", f"hand file '{path}':", 1)) from None
+    return build_hand(*hand_spec(path))
 
 
 def hand_from_dict(doc: Any) -> Hand:
     """Build a Hand from the parsed content of a hand file (see ``load_hand``)."""
-    doc = _mapping(doc, "<top level>", "<top level>")
-    for key in ("palm", "fingers"):
-        if key not in doc:
-            raise _err(key, "missing")
-    name = str(doc.get("name", "hand"))
-    palm_normal = _vector(doc, "palm_normal", "<top level>") if "palm_normal" in doc else PALM_NORMAL.copy()
-    if not np.isclose(np.linalg.norm(palm_normal), 1.0, atol=1e-6):
-        raise _err("palm_normal", f"must be a unit vector, got {palm_normal.tolist()}")
-    fingers = _mapping(doc["fingers"], "fingers")
-    if sorted(fingers) != sorted(FINGERS):
-        raise _err("fingers", f"must have exactly the keys {FINGERS}, got {tuple(fingers)}")
+    return build_hand(check_hand_doc(doc))
 
-    frame_names = ["palm"]
-    frame_parent = [-1]
-    frame_offset = [np.eye(4)]
-    frame_axis = [np.zeros(3)]
-    frame_joint = [-1]
-    frame_scale = [0.0]
-    frame_joint_names = [""]
-    link_names = ["palm"]
-    link_finger = ["palm"]
-    link_frame = [0]
-    link_parent = [-1]
-    link_parent_joint = [-1]
-    link_shapes = [_shapes(_mapping(doc["palm"], "palm", "palm"), "palm")]
+
+class _Tree:
+    """The frame tree and the links of a hand, filled joint by joint."""
+
+    def __init__(self, palm_shapes: tuple[Shape, ...]) -> None:
+        self.frames: list[tuple[str, int, NDArray, NDArray, int, float, str]] = [
+            ("palm", -1, np.eye(4), np.zeros(3), -1, 0.0, "")]
+        self.links: list[tuple[str, str, int, int, int, tuple[Shape, ...]]] = [
+            ("palm", "palm", 0, -1, -1, palm_shapes)]
+
+    def frame(self, name: str, parent: int, offset: NDArray, axis: NDArray, joint: int, scale: float,
+              jname: str) -> int:
+        self.frames.append((name, parent, offset, axis, joint, scale, jname))
+        return len(self.frames) - 1
+
+    def column(self, items: list, i: int, **kwargs: Any) -> NDArray:
+        return np.array([item[i] for item in items], **kwargs)
+
+
+def build_hand(spec: HandSpec, source: str = "the shipped hand") -> Hand:
+    """The Hand (frame tree, links, limits) of a checked hand file (``check_hand_doc``)."""
+    tree = _Tree(spec.palm_shapes)
     joint_names: list[str] = []
     lower: list[float] = []
     upper: list[float] = []
     finger_joints: list[tuple[int, ...]] = []
     finger_links: list[tuple[int, ...]] = []
-    tips: list[NDArray] = []
-    ignored: list[tuple[int, int]] = []
-
-    def add_frame(fname: str, parent: int, offset: NDArray, axis: NDArray, joint: int, scale: float, jname: str) -> int:
-        frame_names.append(fname)
-        frame_parent.append(parent)
-        frame_offset.append(offset)
-        frame_axis.append(axis)
-        frame_joint.append(joint)
-        frame_scale.append(scale)
-        frame_joint_names.append(jname)
-        return len(frame_names) - 1
-
-    for finger in FINGERS:
-        ff = f"fingers.{finger}"
-        fnode = _mapping(fingers[finger], ff, "finger")
-        knuckle = _mapping(fnode.get("knuckle"), f"{ff}.knuckle", "knuckle")
-        knuckle_pose = pose_matrix(_vector(knuckle, "xyz_mm", f"{ff}.knuckle"), _vector(knuckle, "rpy_rad", f"{ff}.knuckle"))
-        tips.append(_vector(fnode, "tip_mm", ff))
-        joints = fnode.get("joints")
-        if not isinstance(joints, list) or not joints:
-            raise _err(f"{ff}.joints", "must be a non-empty list of joints")
-        parent_frame, parent_link = 0, 0
-        pending = knuckle_pose  # the knuckle pose is folded into the first joint's offset
-        fj: list[int] = []
-        fl: list[int] = []
-        for i, jnode in enumerate(joints):
-            jf = f"{ff}.joints[{i}]"
-            jnode = _mapping(jnode, jf, "joint")
-            jname = jnode.get("name")
+    ignored: set[tuple[int, int]] = set()
+    for finger in spec.fingers:
+        parent_frame, parent_link, fj, fl = 0, 0, [], []
+        for joint in finger.joints:
             k = len(joint_names)
-            if k >= len(JOINT_NAMES) or jname != JOINT_NAMES[k]:
-                expected = JOINT_NAMES[k] if k < len(JOINT_NAMES) else "(no more joints: 19 in all)"
-                raise _err(f"{jf}.name", f"must be {expected!r} (joint order of docs/design.md), got {jname!r}")
-            axis = _vector(jnode, "axis", jf)
-            if np.linalg.norm(axis) < 1e-9:
-                raise _err(f"{jf}.axis", "must be a non-zero vector")
-            axis = axis / np.linalg.norm(axis)
-            offset = pending @ pose_matrix(_vector(jnode, "offset_mm", jf),
-                                           _vector(jnode, "rpy_rad", jf) if "rpy_rad" in jnode else np.zeros(3))
-            pending = np.eye(4)
-            gap = _number(jnode, "rolling_gap_mm", jf, minimum=0.0) if "rolling_gap_mm" in jnode else 0.0
-            lim = jnode.get("limits_deg")
-            if (not isinstance(lim, list) or len(lim) != 2
-                    or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in lim)
-                    or not lim[0] < lim[1]):
-                raise _err(f"{jf}.limits_deg", f"must be [lower, upper] in degrees with lower < upper, got {lim!r}")
-            link = jnode.get("link")
-            if not isinstance(link, str) or not link.startswith(f"{finger}_") or link in link_names:
-                raise _err(f"{jf}.link", f"must be a new link name starting with '{finger}_', got {link!r}")
-            if gap > 0:
-                first = add_frame(f"{jname}_half", parent_frame, offset, axis, k, 0.5, f"{jname}_a")
-                last = add_frame(link, first, pose_matrix([gap, 0.0, 0.0]), axis, k, 0.5, f"{jname}_b")
+            if joint.rolling_gap_mm > 0:
+                first = tree.frame(f"{joint.name}_half", parent_frame, joint.offset, joint.axis, k, 0.5,
+                                   f"{joint.name}_a")
+                last = tree.frame(joint.link, first, pose_matrix([joint.rolling_gap_mm, 0.0, 0.0]), joint.axis,
+                                  k, 0.5, f"{joint.name}_b")
             else:
-                last = add_frame(link, parent_frame, offset, axis, k, 1.0, jname)
-            joint_names.append(jname)
-            lower.append(math.radians(lim[0]))
-            upper.append(math.radians(lim[1]))
-            link_names.append(link)
-            link_finger.append(finger)
-            link_frame.append(last)
-            link_parent.append(parent_link)
-            link_parent_joint.append(k)
-            link_shapes.append(_shapes(jnode, jf))
-            li = len(link_names) - 1
+                last = tree.frame(joint.link, parent_frame, joint.offset, joint.axis, k, 1.0, joint.name)
+            joint_names.append(joint.name)
+            lower.append(joint.lower_rad)
+            upper.append(joint.upper_rad)
+            tree.links.append((joint.link, finger.name, last, parent_link, k, joint.shapes))
+            li = len(tree.links) - 1
             # a link touches its parent at the joint by design (rolling surfaces, knuckle in the palm)
-            ignored.append((parent_link, li))
+            ignored.add((parent_link, li))
             fj.append(k)
             fl.append(li)
             parent_frame, parent_link = last, li
         finger_joints.append(tuple(fj))
         finger_links.append(tuple(fl))
-    if tuple(joint_names) != JOINT_NAMES:
-        raise _err("fingers", f"joints must be exactly {JOINT_NAMES}, got {tuple(joint_names)}")
-    ignored_set = set(ignored)
     # the knuckles sit in the palm: none of them may be tested against it
-    ignored_set.update((0, fl[0]) for fl in finger_links)
+    ignored.update((0, fl[0]) for fl in finger_links)
+    frames, links = tree.frames, tree.links
     return Hand(
-        name=name,
-        joint_names=tuple(joint_names),
-        lower=np.array(lower),
-        upper=np.array(upper),
-        link_names=tuple(link_names),
-        link_finger=tuple(link_finger),
-        link_frame=np.array(link_frame),
-        link_parent=np.array(link_parent),
-        link_parent_joint=np.array(link_parent_joint),
-        link_shapes=tuple(link_shapes),
-        frame_names=tuple(frame_names),
-        frame_parent=np.array(frame_parent),
-        frame_offset=np.array(frame_offset),
-        frame_axis=np.array(frame_axis),
-        frame_joint=np.array(frame_joint),
-        frame_scale=np.array(frame_scale),
-        frame_joint_names=tuple(frame_joint_names),
-        finger_joints=tuple(finger_joints),
-        finger_links=tuple(finger_links),
-        fingertip_link=np.array([fl[-1] for fl in finger_links]),
-        fingertip_point=np.array(tips),
-        ignored_link_pairs=tuple(sorted(ignored_set)),
-        palm_normal=palm_normal,
-    )
+        name=spec.name, joint_names=tuple(joint_names), lower=np.array(lower), upper=np.array(upper),
+        link_names=tuple(link[0] for link in links), link_finger=tuple(link[1] for link in links),
+        link_frame=tree.column(links, 2), link_parent=tree.column(links, 3),
+        link_parent_joint=tree.column(links, 4), link_shapes=tuple(link[5] for link in links),
+        frame_names=tuple(f[0] for f in frames), frame_parent=tree.column(frames, 1),
+        frame_offset=tree.column(frames, 2), frame_axis=tree.column(frames, 3),
+        frame_joint=tree.column(frames, 4), frame_scale=tree.column(frames, 5, dtype=float),
+        frame_joint_names=tuple(f[6] for f in frames), finger_joints=tuple(finger_joints),
+        finger_links=tuple(finger_links), fingertip_link=np.array([fl[-1] for fl in finger_links]),
+        fingertip_point=np.array([f.tip_mm for f in spec.fingers]),
+        ignored_link_pairs=tuple(sorted(ignored)), palm_normal=spec.palm_normal, source=source)
 
 
 # --------------------------------------------------------------------------- kinematics
@@ -519,11 +285,6 @@ def contact_jacobian(hand: Hand, q: NDArray, links: NDArray, points_mm: NDArray)
     for i, (link, point) in enumerate(zip(links, points)):
         jac[3 * i:3 * i + 3] = _jacobian_rows(hand, frames, _check_link(hand, int(link)), point)
     return jac
-
-
-def clip_to_limits(hand: Hand, q: NDArray) -> NDArray[np.float64]:
-    """q clipped into the joint limits (rad)."""
-    return np.clip(_check_q(hand, q), hand.lower, hand.upper)
 
 
 # --------------------------------------------------------------------------- URDF

@@ -21,10 +21,10 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-import yaml
 from numpy.typing import ArrayLike, NDArray
 
 from synergrasp.hand.kinematics import JOINT_NAMES, load_hand
+from synergrasp.yaml_io import read_yaml
 
 __all__ = [
     "Synergies",
@@ -254,8 +254,7 @@ def load_synergy_mapping(path: str | Path | None = None) -> dict[str, Any]:
     default table's), a shipped table's name or a path."""
     if path is None or str(path) in SHIPPED_TABLES:
         path = mapping_path(DEFAULT_TABLE if path is None else str(path))
-    with open(path, encoding="utf-8") as handle:
-        return yaml.safe_load(handle)
+    return read_yaml(path, "synergy mapping file")
 
 
 def map_human_synergies(human_table: Synergies, mapping: Mapping[str, Any],

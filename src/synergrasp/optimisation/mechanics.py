@@ -211,11 +211,6 @@ class GraspMechanics:
     def n_contacts(self) -> int:
         return int(self.normals.shape[0])
 
-    @property
-    def force_closure_possible(self) -> bool:
-        """rank(G) = 6: the contacts can resist any wrench (first half of Bicchi's test)."""
-        return self.rank_G == 6
-
 
 def grasp_mechanics(
     grasp: Grasp,

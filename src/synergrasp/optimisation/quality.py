@@ -28,16 +28,19 @@ centre to its surface): a torque of L·|f| is then worth a force |f|.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import pandas as pd
 from numpy.typing import NDArray
 from scipy.spatial import ConvexHull, QhullError
 
 from synergrasp.optimisation.mechanics import Grasp, contact_frames, grasp_matrix
 
 __all__ = ["GraspQuality", "grasp_quality", "scaled_grasp_matrix", "primitive_wrenches", "ferrari_canny_l1",
-           "synergy_manipulability", "QUALITY_EDGES", "RANK_RTOL"]
+           "synergy_manipulability", "QualityParams", "quality_table", "QUALITY_EDGES", "RANK_RTOL"]
 
 #: Edges of the linearised friction cone in ε (GraspIt! uses 8).
 QUALITY_EDGES = 8
@@ -145,3 +148,52 @@ def grasp_quality(grasp: Grasp, mu: float, length_mm: float, synergies: NDArray 
         rank_G=rank, sigma_min=sigma_min, isotropy=sigma_min / float(sv[0]) if rank == 6 else 0.0,
         epsilon=ferrari_canny_l1(primitive_wrenches(grasp, mu, length_mm, edges)),
         manipulability=manip, torque_length_mm=float(length_mm))
+
+
+@dataclass(frozen=True)
+class QualityParams:
+    """The quality table of one object (the ``quality`` step): the hand and synergy files
+    (None: shipped; all synergies enter the manipulability ellipsoid), μ, the full set's id,
+    the object's weight (N) and its bounding radius L (mm), the torque scale."""
+
+    hand: str | None
+    synergies: str | None
+    mu: float
+    full_set_id: str
+    weight_N: float
+    torque_length_mm: float
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str) -> QualityParams:
+        from synergrasp.ids import incremental_set_id
+        from synergrasp.simulation.objects import GraspedObject
+
+        grasped = GraspedObject.from_config(config, obj)
+        return cls(config["hand"], config["synergies"], float(config["mechanics"]["mu"]),
+                   incremental_set_id(config["synergy_sets"]["incremental_max"]),
+                   float(grasped.mass_kg) * float(config["mechanics"]["g_m_per_s2"]),
+                   grasped.shape.bounding_radius_mm)
+
+
+def quality_table(contacts: pd.DataFrame, gfo: pd.DataFrame, grasps: Sequence[Grasp | None],
+                  synergy_matrix: NDArray, params: QualityParams) -> pd.DataFrame:
+    """One row per pose of ``contacts`` (columns of ``synergrasp.tables.QUALITY``): the quality
+    indices of its grasp (``grasps``, one per row; None: no grasp, indices NaN) and the full
+    set's verdict and optimal force over the weight from ``gfo``."""
+    full = gfo[gfo["set_id"] == params.full_set_id].set_index("pose")
+    rows = []
+    for (_, row), grasp in zip(contacts.iterrows(), grasps):
+        out = {"object": row["object"], "pose": row["pose"], "alpha_deg": row["alpha_deg"],
+               "beta_deg": row["beta_deg"], "n_contacts": int(row["n_contacts"]), "rank_G": 0,
+               "sigma_min": np.nan, "isotropy": np.nan, "epsilon": np.nan, "manipulability": [np.nan] * 6}
+        if grasp is not None:
+            q = grasp_quality(grasp, params.mu, params.torque_length_mm, synergies=synergy_matrix)
+            out.update(rank_G=q.rank_G, sigma_min=q.sigma_min, isotropy=q.isotropy, epsilon=q.epsilon,
+                       manipulability=q.manipulability.tolist())
+        set_row = full.loc[row["pose"]] if row["pose"] in full.index else None
+        out["force_closure"] = bool(set_row is not None and set_row["strict_internal"] and set_row["rank_G"] == 6)
+        out["force_per_weight"] = (float(set_row["force_norm"]) / params.weight_N if set_row is not None
+                                   else np.nan)
+        out["torque_length_mm"] = params.torque_length_mm
+        rows.append(out)
+    return pd.DataFrame(rows)

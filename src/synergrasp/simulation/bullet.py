@@ -350,8 +350,11 @@ def apply_force(client: int, body: int, force_N: NDArray) -> None:
 def load_free_object(client: int, shape: Any, mass_kg: float, friction: float, damping_per_s: float) -> int:
     """A free (dynamic) body of ``shape`` (``synergrasp.simulation.shapes``) and mass
     ``mass_kg``, uniform density (the engine's inertia of the shape), lateral friction
-    ``friction``, linear and angular drag at the rate ``damping_per_s`` (1/s). Place it with
-    ``move_body``; returns its body id."""
+    ``friction``, linear and angular drag at the rate ``damping_per_s`` (1/s); with ``mass_kg``
+    = 0 a fixed body (Bullet's static body: it never moves, what touches it slides on it with
+    the same friction). Place it with ``move_body``; returns its body id."""
+    if not mass_kg >= 0:
+        raise ValueError(f"mass_kg must be >= 0 (0: a fixed body), got {mass_kg!r}")
     body = pb.createMultiBody(baseMass=float(mass_kg), baseCollisionShapeIndex=collision_shape(client, shape),
                               physicsClientId=client)
     pb.changeDynamics(body, -1, lateralFriction=float(friction), linearDamping=float(damping_per_s),

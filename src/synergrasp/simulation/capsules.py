@@ -20,6 +20,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from synergrasp.hand.checks import closure_shape_problems
 from synergrasp.simulation.shapes.kernels import segment_cylinder, segment_sphere, sort_knots
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -349,22 +350,20 @@ class HandCapsules:
 
     @classmethod
     def of(cls, hand: Hand) -> HandCapsules:
-        """The shapes of ``hand``; ValueError unless every finger link is one capsule and the
-        palm is made of boxes (the shipped hand)."""
+        """The shapes of ``hand``; ValueError naming the hand file and the field unless every
+        finger link is one capsule and the palm is made of boxes
+        (``synergrasp.hand.checks.closure_shape_problems``)."""
+        problems = closure_shape_problems(hand)
+        if problems:
+            raise ValueError(f"{hand.source}: {problems[0]}")
         links, ends, radius = [], [], []
         for link in range(1, hand.n_links):
-            shapes = hand.link_shapes[link]
-            if len(shapes) != 1 or shapes[0].kind != "capsule":
-                raise ValueError(f"the kinematic closure needs one capsule per finger link; link "
-                                 f"{hand.link_names[link]!r} has {[s.kind for s in shapes]}")
-            shape = shapes[0]
+            shape = hand.link_shapes[link][0]
             axis = 0.5 * shape.length * shape.pose[:3, 2]
             links.append(link)
             ends.append([shape.pose[:3, 3] - axis, shape.pose[:3, 3] + axis])
             radius.append(shape.radius)
         palm = hand.link_shapes[0]
-        if not palm or any(s.kind != "box" for s in palm):
-            raise ValueError("the kinematic closure needs a palm made of boxes")
         links_arr = np.asarray(links, dtype=np.int64)
         return cls(hand, links_arr, np.asarray(hand.link_frame, dtype=np.int64)[links_arr], np.asarray(ends),
                    np.asarray(radius), np.stack([s.pose[:3, :3] for s in palm]),

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from synergrasp.config import build, dataclass_fields, overlay
 from synergrasp.hand.synergies import Synergies, synergy_values
-from synergrasp.simulation.closure_params import ClosureParams, DynamicParams
+from synergrasp.simulation.closure_params import ClosureMechanics, ClosureParams, DynamicParams
 from synergrasp.simulation.contacts import contacts_row, contacts_table
 from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.placement import ObjectPose, Placement, approach_line, object_pose, pose_grid
@@ -39,8 +39,8 @@ class SimulateParams:
     """The closure of one object (the ``simulate`` step): the hand file (None: the shipped
     hand), the mean posture q_m and the first synergy S1 of the synergy table (rad, in the
     hand's joint order: all the closure reads of the table), the object, its effective placement
-    (with the pose grid), the closure settings, and the ``mechanics`` block where the dynamic
-    model reads it (else None)."""
+    (with the pose grid), the closure settings, and what the dynamic model reads of
+    ``mechanics`` (else None)."""
 
     hand: str | None
     mean_rad: tuple[float, ...]
@@ -48,7 +48,7 @@ class SimulateParams:
     object: GraspedObject
     placement: Placement
     closure: ClosureParams
-    mechanics: dict[str, Any] | None = None
+    mechanics: ClosureMechanics | None = None
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> SimulateParams:
@@ -66,16 +66,17 @@ class SimulateParams:
             placement=Placement.from_config(overlay(config["placement"], config["objects"][obj].get("placement")),
                                             config["grid"]),
             closure=build(ClosureParams, "closure", **{**dataclass_fields(ClosureParams, closure), "dynamic": dynamic}),
-            mechanics=config["mechanics"] if dynamic_model else None)
+            mechanics=build(ClosureMechanics, "mechanics", **dataclass_fields(ClosureMechanics, config["mechanics"]))
+            if dynamic_model else None)
 
     def synergies(self, joint_names: tuple[str, ...]) -> Synergies:
         """q_m and S1 as a one-synergy :class:`Synergies` of the hand's joints."""
         return Synergies(tuple(joint_names), np.array(self.mean_rad), np.array(self.s1)[:, None], ("S1",))
 
 def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams,
-                  mechanics: Mapping[str, Any] | None = None, mass_kg: float | None = None):
+                  mechanics: ClosureMechanics | None = None, mass_kg: float | None = None):
     """The closure model of ``params`` on a new pybullet scene of ``hand``; the dynamic model
-    also needs the config's ``mechanics`` block (k_ss, μ, gravity) and the object's mass (kg)."""
+    also needs the :class:`ClosureMechanics` (k_ss, μ, gravity) and the object's mass (kg)."""
     if params.model == "dynamic":
         from synergrasp.simulation.dynamic_closure import DynamicClosure
 
@@ -103,7 +104,7 @@ def place_object(scene: HandScene, q_open: NDArray, placement: Placement, shape:
 
 def simulate_object(hand: Hand, synergies: Synergies, grasped: GraspedObject, placement: Placement,
                     closure_params: ClosureParams, poses: Iterable[int] | None = None,
-                    mechanics: Mapping[str, Any] | None = None) -> pd.DataFrame:
+                    mechanics: ClosureMechanics | None = None) -> pd.DataFrame:
     """Close the hand on the object ``grasped`` (name, shape, mass) at every pose of the
     placement's grid (or at ``poses``).
 

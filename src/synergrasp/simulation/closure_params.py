@@ -1,5 +1,6 @@
-"""Settings of the closure (config ``closure``; docs/closure.md): :class:`ClosureParams`, and
-:class:`DynamicParams` of the dynamic model (``closure.dynamic``). Data only, so that the
+"""Settings of the closure (config ``closure``; docs/closure.md): :class:`ClosureParams`,
+:class:`DynamicParams` of the dynamic model (``closure.dynamic``) and
+:class:`ClosureMechanics`, what the dynamic model reads of ``mechanics``. Data only, so that the
 closure models and the study loop (:mod:`synergrasp.simulation.closure`) all read them
 without importing one another.
 """
@@ -8,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["ClosureParams", "DynamicParams"]
+__all__ = ["ClosureParams", "DynamicParams", "ClosureMechanics"]
 
 
 @dataclass(frozen=True)
@@ -42,6 +43,10 @@ class DynamicParams:
                            ``caged`` if its centre is inside the closed hand
                            (``HandCapsules.encloses``), ``lost`` (pushed out) if not.
 
+    object:                ``free`` (the box is a free rigid body) or ``held`` (the box cannot
+                           move: a fixed body in the engine, as if the arm held it; the compliant
+                           fingers slide on it with friction μ and settle).
+
     Every hand link touching the box is listed with the normal force it carries; which of
     them count (``closure.dynamic.unloaded_contacts``) is decided downstream
     (``synergrasp.simulation.contacts.load_carrying_contacts``), so both choices share one closure.
@@ -62,6 +67,11 @@ class DynamicParams:
     hand_hand_mu: float
     gravity: bool
     lost_distance_mm: float
+    object: str
+
+    @property
+    def held(self) -> bool:
+        return self.object == "held"
 
     @property
     def ramp_steps(self) -> int:
@@ -107,3 +117,20 @@ class ClosureParams:
         # Checked once, by the schema and config.check_relations (built by SimulateParams.from_config).
         for name in ("tolerance_mm", "contact_distance_mm", "penetration_tolerance_mm", "step_mm"):
             object.__setattr__(self, name, float(getattr(self, name)))
+
+
+@dataclass(frozen=True)
+class ClosureMechanics:
+    """What the dynamic closure reads of the configuration's ``mechanics``: the joint
+    stiffness k_ss (N·mm/rad), the hand–box friction μ, the direction of gravity (palm frame;
+    normalised where used) and g (m/s²)."""
+
+    k_ss_Nmm_per_rad: float
+    mu: float
+    gravity_direction: tuple[float, float, float]
+    g_m_per_s2: float
+
+    def __post_init__(self) -> None:
+        for name in ("k_ss_Nmm_per_rad", "mu", "g_m_per_s2"):
+            object.__setattr__(self, name, float(getattr(self, name)))
+        object.__setattr__(self, "gravity_direction", tuple(float(v) for v in self.gravity_direction))

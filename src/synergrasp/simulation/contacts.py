@@ -62,7 +62,7 @@ class ClosureResult:
     normals:       (m, 3) object's inward unit normals
     jacobian:      (3m, 19) translational Jacobian of the contact points, mm/rad
     max_penetration_mm: deepest penetration among the contacts (0 if none)
-    model:         closure model that made it (``kinematic`` or ``dynamic``)
+    model:         closure model that made it (``kinematic``, ``dynamic`` or ``dynamic_held``)
     normal_force_N: (m,) normal force per contact at the settled state, N (NaN if unknown)
     settled_pose:  the box's final pose (``ObjectPose``) when it moved (dynamic model);
                    None: it stayed where it was placed

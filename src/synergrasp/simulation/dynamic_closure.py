@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -39,7 +38,7 @@ from synergrasp.simulation.placement import ObjectPose
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
-    from synergrasp.simulation.closure_params import ClosureParams
+    from synergrasp.simulation.closure_params import ClosureMechanics, ClosureParams
     from synergrasp.simulation.shapes import Shape
 
 __all__ = ["DynamicClosure", "compliant_self_pairs"]
@@ -70,29 +69,26 @@ class DynamicClosure:
 
     ``params`` is the closure's :class:`synergrasp.simulation.closure.ClosureParams` (contact
     distance, penetration tolerance, ``params.dynamic``); the σ path is the kinematic
-    model's (``SynergyPath.closure_range``); ``mechanics`` the config's mechanics block (k_ss,
+    model's (``SynergyPath.closure_range``); ``mechanics`` the :class:`ClosureMechanics` (k_ss,
     μ, gravity direction and g); ``mass_kg`` the box's mass (its weight, if gravity is on).
     """
 
-    def __init__(self, hand: Hand, synergies: Synergies, params: ClosureParams, mechanics: Mapping[str, Any],
+    def __init__(self, hand: Hand, synergies: Synergies, params: ClosureParams, mechanics: ClosureMechanics,
                  mass_kg: float = 1.0) -> None:
         from synergrasp.simulation import bullet
 
         names = tuple(synergies.joint_names)
         if names != tuple(hand.joint_names):
             raise ValueError(f"synergies.joint_names must equal hand.joint_names {hand.joint_names}, got {names}")
-        missing = [k for k in ("mu", "k_ss_Nmm_per_rad", "gravity_direction", "g_m_per_s2") if k not in mechanics]
-        if missing:
-            raise ValueError(f"mechanics: the dynamic closure needs key(s) {missing}")
         self.bullet = bullet
         self.hand = hand
         self.closure = params
         self.params = p = params.dynamic
-        self.k_ss = float(mechanics["k_ss_Nmm_per_rad"])
-        self.mu = float(mechanics["mu"])
-        down = np.asarray(mechanics["gravity_direction"], dtype=float)
+        self.k_ss = mechanics.k_ss_Nmm_per_rad
+        self.mu = mechanics.mu
+        down = np.asarray(mechanics.gravity_direction, dtype=float)
         # weight of the box, N (palm frame), applied only when params.dynamic.gravity is true
-        self.weight = float(mass_kg) * float(mechanics["g_m_per_s2"]) * down / np.linalg.norm(down)
+        self.weight = float(mass_kg) * mechanics.g_m_per_s2 * down / np.linalg.norm(down)
         self.path = SynergyPath.along(synergies, hand.lower, hand.upper)
         # the same path as the kinematic model: fully open hand to every S1 joint at a limit
         self.sigma_open, self.sigma_closed = self.path.closure_range(hand.flexion_joints)
@@ -113,6 +109,11 @@ class DynamicClosure:
         self.box: int | None = None  # the object's body
         self.shape: Shape | None = None
 
+    @property
+    def model_name(self) -> str:
+        """The contacts table's ``closure_model``: ``dynamic`` (free box) or ``dynamic_held``."""
+        return "dynamic_held" if self.params.held else "dynamic"
+
     def close(self) -> None:
         self.bullet.disconnect(self.client)
 
@@ -124,8 +125,9 @@ class DynamicClosure:
         if self.box is None or self.shape != placed.shape:
             if self.box is not None:
                 self.bullet.remove_body(self.client, self.box)
-            self.box = self.bullet.load_free_object(self.client, placed.shape, self.params.object_mass_kg,
-                                                    self.mu / self.link_friction, self.params.object_damping_per_s)
+            mass = 0.0 if self.params.held else self.params.object_mass_kg  # mass 0: a fixed body
+            self.box = self.bullet.load_free_object(self.client, placed.shape, mass, self.mu / self.link_friction,
+                                                    self.params.object_damping_per_s)
             self.shape = placed.shape
         self.bullet.reset_body(self.client, self.box, placed.center_mm, placed.rotation)
 
@@ -153,7 +155,7 @@ class DynamicClosure:
         gaps = b.closest_points(self.client, self.box, self.body, c.contact_distance_mm)
         if len(gaps) and float(gaps.distance.min()) < -c.penetration_tolerance_mm:
             return self._result("intersects_open_hand", q_open, (), None, True)
-        weight = self.weight if p.gravity else None
+        weight = self.weight if p.gravity and not p.held else None
         radius = placed.shape.bounding_radius_mm
         settled, steps = False, p.max_steps
         scale, axis_joint = self.axis_scale, self.axis_joint
@@ -192,7 +194,7 @@ class DynamicClosure:
         points_a = np.asarray(points, dtype=float).reshape(-1, 3)
         jac = contact_jacobian(self.hand, q, links_a, points_a) if len(links_a) else np.zeros((0, self.hand.n_joints))
         return ClosureResult(status, q, state, links_a, points_a, np.asarray(normals, dtype=float).reshape(-1, 3),
-                             jac, float(depth), model="dynamic", normal_force_N=np.asarray(loads, dtype=float),
+                             jac, float(depth), model=self.model_name, normal_force_N=np.asarray(loads, dtype=float),
                              settled_pose=settled_pose, settled=settled)
 
     def _finger_states(self, touching: list[int]) -> tuple[str, ...]:

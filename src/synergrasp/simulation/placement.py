@@ -206,7 +206,8 @@ def palm_centre(hand: Hand) -> NDArray:
             local = np.concatenate([ends + d for d in r * np.vstack([np.eye(3), -np.eye(3)])])
         corners.append(local @ shape.pose[:3, :3].T + shape.pose[:3, 3])
     if not corners:
-        raise ValueError("the hand's palm has no collision shape: give placement.approach_point_mm")
+        raise ValueError(f"{hand.source}: palm.shapes: the palm has no collision shape; give "
+                         "placement.approach_point_mm")
     pts = np.vstack(corners)
     n = _unit(hand.palm_normal)
     centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))

@@ -1,0 +1,78 @@
+"""Which objects the study can grasp at all, and why not: the graspable-objects table.
+
+An object whose every pose fails at one stage leaves its rows of Table II undefined (NaN);
+this table says so per object with the first stage at which every pose failed:
+
+1. ``every pose dropped``: no closure ran (the box intersects the open hand at every pose, or
+   the closure model dropped it: ``caged``/``lost``; counts per status);
+2. ``nothing touched``: closures ran and no link touches the box at the end of any;
+3. ``no pose settled``: (dynamic closure) touching grasps exist but none came to rest before
+   ``closure.dynamic.time_limit_s``, and none reaches force closure with the full set;
+4. ``no force closure with the full set``: touching grasps exist, none is in force closure
+   (the study's definition, ``analysis.verdicts``) with every synergy enrolled.
+
+Columns: :data:`synergrasp.tables.GRASPABLE_OBJECTS`. Pure functions: DataFrames in, a
+DataFrame (or lines) out.
+"""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from synergrasp.analysis.verdicts import verdict_columns
+from synergrasp.tables import GRASPABLE_OBJECTS
+
+__all__ = ["graspable_objects", "ungraspable_lines"]
+
+#: Statuses of a closure that ran (synergrasp.simulation.contacts.STATUSES).
+_RAN = ("grasp", "no_contact")
+
+
+def _counts(statuses: pd.Series) -> str:
+    return ", ".join(f"{s}: {c}" for s, c in statuses.value_counts().sort_index().items())
+
+
+def _set_name(set_id: str) -> str:
+    """{S1..Sk} for an incremental set id "1-2-…-k", else {S…} of its members."""
+    ids = [int(i) for i in set_id.split("-")]
+    if ids == list(range(1, len(ids) + 1)) and len(ids) > 2:
+        return f"{{S1..S{len(ids)}}}"
+    return "{" + ",".join(f"S{i}" for i in ids) + "}"
+
+
+def _reason(rows: pd.DataFrame, n_fc: int, dynamic: bool, full_set_id: str) -> str:
+    ran = rows["status"].isin(_RAN)
+    grasps = rows["status"] == "grasp"
+    if not ran.any():
+        return f"every pose dropped ({_counts(rows['status'])})"
+    if not grasps.any():
+        return f"nothing touched: no closure ends touching the box ({_counts(rows['status'])})"
+    if n_fc:
+        return ""
+    if dynamic and not rows.loc[grasps, "settled"].astype(bool).any():
+        return ("no pose settled: every closure stopped at closure.dynamic.time_limit_s, and no force closure "
+                f"with the full set {_set_name(full_set_id)}")
+    return f"no force closure with the full set {_set_name(full_set_id)} at any of the {int(grasps.sum())} grasps"
+
+
+def graspable_objects(contacts: pd.DataFrame, gfo: pd.DataFrame, full_set_id: str) -> pd.DataFrame:
+    """One row per object of ``contacts`` (contacts tables of every object): poses, closures
+    that ran, touching grasps, grasps that settled, force-closure poses with the full set
+    ``full_set_id`` (from ``gfo``), whether any pose is graspable and, if none is, why."""
+    full = gfo[gfo["set_id"].astype(str) == full_set_id]
+    fc = full.loc[verdict_columns(full)["force_closure"], "object"].value_counts() if len(full) else pd.Series()
+    rows = []
+    for obj, group in contacts.groupby("object", sort=True):
+        n_fc = int(fc.get(obj, 0))
+        dynamic = bool((group["closure_model"] == "dynamic").any())
+        grasps = group["status"] == "grasp"
+        reason = _reason(group, n_fc, dynamic, full_set_id)
+        rows.append({"object": obj, "poses": len(group), "simulated": int(group["status"].isin(_RAN).sum()),
+                     "grasps": int(grasps.sum()), "settled": int(group.loc[grasps, "settled"].astype(bool).sum()),
+                     "force_closure_full_set": n_fc, "graspable": not reason, "reason": reason})
+    return pd.DataFrame(rows, columns=list(GRASPABLE_OBJECTS.names))
+
+
+def ungraspable_lines(table: pd.DataFrame) -> list[str]:
+    """One line per object of a graspable-objects table that can never be grasped."""
+    return [f"{row.object} can never be grasped: {row.reason}" for row in table.itertuples() if not row.graspable]

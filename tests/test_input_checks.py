@@ -1,0 +1,281 @@
+"""The checks that run before any job, one kind of bad input at a time (issue 27): repeated
+YAML keys, hand files the closure cannot use or far from a human hand, names the file system
+or Snakemake cannot take, relations that make a step impossible, a SLURM profile in a shell
+that cannot submit; and objects that can never be grasped, said per object with the reason."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from synergrasp.analysis.graspability import graspable_objects, ungraspable_lines
+from synergrasp.config import SCHEMA_PATH, ConfigError, defaults, validate_config
+from synergrasp.hand.checks import check_hand, closure_shape_problems
+from synergrasp.hand.kinematics import default_hand_path, load_hand
+from synergrasp.preflight import configfile_problems, slurm_problems
+from synergrasp.simulation.capsules import HandCapsules
+from synergrasp.yaml_io import YamlFileError, read_yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+# --------------------------------------------------------------------------- kind 6: repeated keys
+
+
+def test_a_repeated_key_names_the_file_the_line_and_the_key(tmp_path):
+    path = tmp_path / "my.yaml"
+    path.write_text("scenarios:\n  s: {mechanics: {mu: 1.0}}\n  s: {mechanics: {mu: 2.0}}\n"
+                    "objects:\n  - {a: 1, b: 2, a: 3}\n")
+    with pytest.raises(YamlFileError) as info:
+        read_yaml(path, "config file")
+    lines = str(info.value).splitlines()
+    assert lines == [f"config file '{path}', line 3: key 'scenarios.s' appears twice (first at line 2); "
+                     "each key may appear once",
+                     f"config file '{path}', line 5: key 'objects[0].a' appears twice (first at line 5); "
+                     "each key may appear once"]
+
+
+def test_keys_that_differ_only_in_type_or_nesting_are_not_repeats(tmp_path):
+    path = tmp_path / "ok.yaml"
+    path.write_text("a: {x: 1}\nb: {x: 2}\n'1': one\n1: int one\n")
+    assert read_yaml(path) == {"a": {"x": 1}, "b": {"x": 2}, "1": "one", 1: "int one"}
+
+
+@pytest.mark.parametrize("path", [
+    ROOT / "config" / "config.yaml", ROOT / "config" / "sensitivity.yaml", ROOT / "tests" / "config" / "small.yaml",
+    SCHEMA_PATH, default_hand_path(),
+    *sorted((ROOT / "src" / "synergrasp" / "data").glob("synergy_mapping_*.yaml"))], ids=lambda p: p.name)
+def test_every_shipped_yaml_reads_as_plain_yaml_does(path):
+    assert read_yaml(path) == yaml.safe_load(path.read_text(encoding="utf-8"))
+
+
+def test_configfile_problems_lists_each_file_once(tmp_path):
+    good, bad = tmp_path / "good.yaml", tmp_path / "bad.yaml"
+    good.write_text("objects: {obj1: {mass_kg: 1.0}}\n")
+    bad.write_text("hand: a.yaml\nhand: b.yaml\n")
+    assert configfile_problems([good, bad, str(bad)]) == [
+        f"config file '{bad}', line 2: key 'hand' appears twice (first at line 1); each key may appear once"]
+
+
+def test_a_hand_file_with_a_repeated_key_is_refused_naming_it(tmp_path):
+    text = default_hand_path().read_text()
+    path = tmp_path / "hand.yaml"
+    path.write_text(text.replace("name: softhand_like\n", "name: softhand_like\nname: other\n", 1))
+    line = text.splitlines().index("name: softhand_like") + 1  # 1-based line of the first 'name'
+    with pytest.raises(ValueError, match=f"hand file '{path}', line {line + 1}: key 'name' appears twice "
+                                         f"\\(first at line {line}\\)"):
+        load_hand(path)
+
+
+# --------------------------------------------------------------------------- kind 1/7: hand files
+
+
+def _hand_doc() -> dict:
+    return yaml.safe_load(default_hand_path().read_text())
+
+
+def _write(tmp_path: Path, doc: dict) -> Path:
+    path = tmp_path / "hand.yaml"
+    path.write_text(yaml.safe_dump(doc, sort_keys=False))
+    return path
+
+
+def _capsule_palm(doc):
+    doc["palm"]["shapes"] = [{"capsule": {"from_mm": [0, 0, 20], "to_mm": [0, 0, 80], "radius_mm": 20}}]
+
+
+@pytest.mark.parametrize("mutate, field", [
+    (lambda d: d["palm"].update(shapes=[]), "palm.shapes: the closure needs a palm made of one or more boxes, got []"),
+    (_capsule_palm, "palm.shapes: the closure needs a palm made of one or more boxes, got ['capsule']"),
+    (lambda d: d["fingers"]["ring"]["joints"][2].pop("shapes"),
+     "fingers.ring.joints[2].shapes: the closure needs exactly one capsule per finger link (link 'ring_middle'), got []"),
+    (lambda d: d["fingers"]["thumb"]["joints"][0]["shapes"].append(
+        {"box": {"center_mm": [0, 0, 0], "size_mm": [5, 5, 5]}}),
+     "fingers.thumb.joints[0].shapes: the closure needs exactly one capsule per finger link "
+     "(link 'thumb_knuckle'), got ['capsule', 'box']"),
+])
+def test_a_hand_the_closure_cannot_collide_is_a_problem_naming_file_and_field(tmp_path, mutate, field):
+    doc = _hand_doc()
+    mutate(doc)
+    path = _write(tmp_path, doc)
+    hand, problems, warnings = check_hand(path)
+    assert problems == [f"hand file '{path}': {field}"]
+    assert warnings == []
+    # the same requirement, raised inside a job, names the file and the field too
+    with pytest.raises(ValueError) as info:
+        HandCapsules.of(hand)
+    assert str(info.value) == problems[0]
+
+
+def test_the_shipped_hand_has_no_problem_and_no_warning():
+    hand, problems, warnings = check_hand(None)
+    assert problems == [] and warnings == []
+    assert closure_shape_problems(load_hand()) == []
+
+
+def test_a_link_offset_of_minus_9000_mm_is_warned_naming_the_field(tmp_path):
+    doc = _hand_doc()
+    doc["fingers"]["index"]["joints"][1]["offset_mm"] = [-9000.0, 0.0, 0.0]
+    path = _write(tmp_path, doc)
+    _, problems, warnings = check_hand(path)
+    assert problems == []
+    assert warnings == [f"hand file '{path}': fingers.index.joints[1].offset_mm: 9000 mm is far from a human "
+                        "hand's dimensions (a hand is about 190 mm long; lengths are in mm)"]
+
+
+def test_a_hand_file_in_metres_is_warned(tmp_path):
+    doc = _hand_doc()
+
+    def scale(node):
+        if isinstance(node, dict):
+            return {k: (scale(v) if not k.endswith(("_rad", "_deg")) and k != "axis" else v) for k, v in node.items()}
+        if isinstance(node, list):
+            return [scale(v) for v in node]
+        return node / 1000.0 if isinstance(node, float | int) and not isinstance(node, bool) else node
+
+    metres = scale(doc)
+    metres["palm_normal"] = doc["palm_normal"]
+    path = _write(tmp_path, metres)
+    _, _, warnings = check_hand(path)
+    assert len(warnings) == 1 and "<top level>: no length of the hand exceeds 0.1" in warnings[0]
+    assert "lengths are in mm, not m" in warnings[0]
+
+
+# --------------------------------------------------------------------------- kinds 3 and 5: the configuration
+
+
+def _with_object(name: str) -> dict:
+    config = defaults()
+    config["objects"] = {name: config["objects"]["obj1"]}
+    return config
+
+
+def test_a_300_character_object_name_is_refused_naming_the_key():
+    with pytest.raises(ConfigError) as info:
+        validate_config(_with_object("o" * 300))
+    assert str(info.value).startswith("config error at 'objects': name 'oooooooooooooooooooooooooooooooooooooooo…' "
+                                      "(300 characters) is not allowed")
+    assert "at most 64 characters" in str(info.value)
+
+
+def test_names_up_to_64_characters_and_periodic_names_are_valid():
+    assert "obj_00000000000000000000" in validate_config(_with_object("obj_" + "0" * 20))["objects"]
+    assert validate_config(_with_object("a" * 64))
+    config = defaults()
+    config["scenarios"] = {"s" * 65: {}}
+    with pytest.raises(ConfigError, match="config error at 'scenarios': name 's{65}' is not allowed.*at most 64"):
+        validate_config(config)
+
+
+@pytest.mark.parametrize("window, ok", [(0.69, True), (0.7, False), (0.8, False)])
+def test_a_settle_window_the_time_limit_cannot_hold_is_a_config_error(window, ok):
+    # ramp 0.3 s, limit 1.0 s, step 1/240 s: 168 steps after the ramp hold a window of 167
+    config = defaults()
+    config["closure"]["dynamic"].update(ramp_time_s=0.3, time_limit_s=1.0, time_step_s=1 / 240,
+                                        settle_window_s=window)
+    if ok:
+        assert validate_config(config)
+    else:
+        with pytest.raises(ConfigError, match="config error at 'closure.dynamic.settle_window_s': .* must be "
+                                              "shorter than closure.dynamic.time_limit_s - ramp_time_s"):
+            validate_config(config)
+
+
+# --------------------------------------------------------------------------- kind 3: never graspable
+
+
+def _contacts(obj: str, statuses: list[str], settled: bool = True, model: str = "kinematic") -> pd.DataFrame:
+    return pd.DataFrame({"object": obj, "pose": range(len(statuses)), "status": statuses,
+                         "settled": settled, "closure_model": model})
+
+
+def _gfo(obj: str, fc_poses: list[int], n_poses: int, full: str = "1-2-3") -> pd.DataFrame:
+    rows = [{"object": obj, "pose": p, "set_id": s, "status": "force_closure" if p in fc_poses else "infeasible",
+             "force_closure": p in fc_poses, "strict_internal": p in fc_poses, "rank_G": 6, "force_norm": np.nan}
+            for p in range(n_poses) for s in ("1", full)]
+    return pd.DataFrame(rows)
+
+
+def test_each_object_that_can_never_be_grasped_has_its_reason():
+    contacts = pd.concat([
+        _contacts("a", ["intersects_open_hand"] * 3 + ["lost"]),
+        _contacts("b", ["no_contact"] * 2 + ["caged"]),
+        _contacts("c", ["grasp"] * 3, settled=False, model="dynamic"),
+        _contacts("d", ["grasp", "no_contact"]),
+        _contacts("e", ["grasp", "grasp"]),
+    ], ignore_index=True)
+    gfo = pd.concat([_gfo("a", [], 4), _gfo("b", [], 3), _gfo("c", [], 3), _gfo("d", [], 2), _gfo("e", [1], 2)],
+                    ignore_index=True)
+    table = graspable_objects(contacts, gfo, "1-2-3")
+    assert list(table["object"]) == ["a", "b", "c", "d", "e"]
+    assert list(table["graspable"]) == [False, False, False, False, True]
+    assert list(table["force_closure_full_set"]) == [0, 0, 0, 0, 1]
+    assert list(table["reason"]) == [
+        "every pose dropped (intersects_open_hand: 3, lost: 1)",
+        "nothing touched: no closure ends touching the box (caged: 1, no_contact: 2)",
+        "no pose settled: every closure stopped at closure.dynamic.time_limit_s, and no force closure with "
+        "the full set {S1..S3}",
+        "no force closure with the full set {S1..S3} at any of the 1 grasps",
+        ""]
+    assert ungraspable_lines(table)[0] == "a can never be grasped: every pose dropped (intersects_open_hand: 3, lost: 1)"
+    assert len(ungraspable_lines(table)) == 4
+
+
+# --------------------------------------------------------------------------- kind 4: the SLURM profile
+
+
+class _Settings:
+    def __init__(self, status_command=None, no_account=False):
+        self.status_command, self.no_account = status_command, no_account
+
+
+_PROFILE = {"slurm_partition": "$SBATCH_PARTITION", "slurm_account": "$SBATCH_ACCOUNT", "mem_mb": 1000}
+
+
+def _which(available):
+    return lambda name: f"/usr/bin/{name}" if name in available else None
+
+
+def test_slurm_profile_without_variables_or_commands_names_them():
+    problems = slurm_problems(_Settings(), _PROFILE, environ={}, which=_which(set()))
+    assert problems == [
+        "$SBATCH_PARTITION is not set (the profile's slurm_partition reads it; export it, empty if your site has none)",
+        "$SBATCH_ACCOUNT is not set (the profile's slurm_account reads it; export it, empty if your site has none)",
+        "not on PATH: sbatch, scancel, sacct or squeue"]
+
+
+def test_slurm_profile_needs_what_its_account_setting_calls():
+    everything = {"sbatch", "scancel", "squeue", "sacct", "sacctmgr"}
+    env = {"SBATCH_PARTITION": "main", "SBATCH_ACCOUNT": ""}
+    assert slurm_problems(_Settings("squeue"), _PROFILE, env, _which(everything)) == []
+    # no account given: the executor guesses one with sacct
+    assert slurm_problems(_Settings("squeue"), _PROFILE, env, _which(everything - {"sacct"})) == [
+        "not on PATH: sacct"]
+    assert slurm_problems(_Settings("squeue", no_account=True), _PROFILE, env, _which(everything - {"sacct"})) == []
+    # an account given: the executor checks it with sacctmgr or sshare
+    env["SBATCH_ACCOUNT"] = "lab"
+    assert slurm_problems(_Settings("squeue"), _PROFILE, env, _which(everything - {"sacctmgr"})) == [
+        "not on PATH: sacctmgr or sshare"]
+
+
+
+# --------------------------------------------------------------------------- kind 8: make report first
+
+
+def test_make_report_before_the_study_says_it_must_run_first(tmp_path):
+    for name in ("Makefile", "environment.lock", "pyproject.toml"):
+        shutil.copy2(ROOT / name, tmp_path / name)
+    venv = Path(sys.executable).parent.parent  # this venv, taken as built (-o: not remade)
+    out = subprocess.run(["make", "-s", "-o", str(venv / "bin" / ".installed"), "report", f"VENV={venv}"],
+                         cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    assert out.returncode != 0
+    assert out.stdout.strip() == ("make report: the study has not run yet (no results/tables/claims.csv): "
+                                  "run 'make study' first")
+    assert not (tmp_path / "results").exists()
