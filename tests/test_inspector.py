@@ -92,3 +92,24 @@ def test_json_output_holds_the_same_numbers(capsys, small):
     assert data["pose"] == direct.pose
     assert data["sets"][0]["force_N"] == pytest.approx(direct.sets[0].force_N, nan_ok=True)
     assert data["quality"]["epsilon"] == pytest.approx(direct.quality.epsilon)
+
+
+def test_a_searched_placement_takes_its_target_from_the_search_table(small, tmp_path):
+    from synergrasp import tables
+
+    target = (38.0, 5.0, 112.0)
+    folder = tmp_path / "objects" / "obj1"
+    folder.mkdir(parents=True)
+    row = {"object": "obj1", "rank": 1, "chosen": True, "distinct_rank": 1, "x_mm": target[0], "y_mm": target[1],
+           "z_mm": target[2], "round": 0, "n_poses": 27, "force_closure_percent": 100.0,
+           "median_force_per_weight": 1.0, "median_contacts": 5.0, "distance_to_chosen_mm": 0.0}
+    import pandas as pd
+
+    pd.DataFrame([{c: row.get(c, 0) for c in tables.PLACEMENT.names}]).to_csv(folder / "placement.csv", index=False)
+    searched = {**small, "placement": {**small["placement"], "mode": "searched"}}
+    fixed = {**small, "placement": {**small["placement"], "mode": "fixed", "center_mm": list(target)}}
+    a = inspect_grasp(searched, "obj1", -30.0, 0.0, [(1, 2)], results=tmp_path)
+    b = inspect_grasp(fixed, "obj1", -30.0, 0.0, [(1, 2)])
+    assert a.to_dict() == b.to_dict()
+    with pytest.raises(ValueError, match="placement: mode 'searched'"):
+        inspect_grasp(searched, "obj1", -30.0, 0.0, [(1, 2)], results=tmp_path / "nowhere")

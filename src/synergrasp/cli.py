@@ -87,6 +87,8 @@ def _parser() -> argparse.ArgumentParser:
     grasp.add_argument("--configfile", nargs="+", default=[], help="overlays on the study's configuration")
     grasp.add_argument("--sets", nargs="+", help="synergy sets: k, a-b (S_a..S_b) or a,b,c (default: each "
                                                  "single synergy and {S1..Sk} for every k)")
+    grasp.add_argument("--results", default="results", help="where the study's outputs are (the searched "
+                                                            "placement's target: <results>/objects/<object>/placement.csv)")
     grasp.add_argument("--json", action="store_true", help="print the result as JSON")
     return parser
 
@@ -108,7 +110,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             cfg = validate_config(config)
             n = load_synergies(cfg["synergies"], joint_names=load_hand(cfg["hand"]).joint_names).matrix.shape[1]
             sets = parse_sets(args.sets, n)
-        result = inspect_grasp(config, args.object, args.alpha, args.beta, sets)
+        result = inspect_grasp(config, args.object, args.alpha, args.beta, sets, args.results)
     except (InspectionError, ConfigError) as err:
         print(f"synergrasp grasp: {err}", file=sys.stderr)
         return 2

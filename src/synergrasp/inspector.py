@@ -11,6 +11,7 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -139,14 +140,26 @@ def _contacts_frame(hand: Any, row: pd.Series) -> pd.DataFrame:
                          "point_mm": [tuple(p) for p in points], "normal": [tuple(n) for n in normals]})
 
 
+def _searched(placement: Any, path: Path) -> Any:
+    """The searched placement with the target the object's search chose (its placement.csv)."""
+    from synergrasp import tables
+    from synergrasp.simulation.placement import searched_placement
+
+    if not path.is_file():
+        raise InspectionError(f"placement: mode 'searched' takes the object's target from {path}, which does not "
+                              f"exist: make it with `snakemake -j2 {path}`, or give placement.mode approach or fixed")
+    return searched_placement(placement, tables.read_csv(tables.PLACEMENT, path))
+
+
 def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_deg: float,
-                  sets: Sequence[Sequence[int]] | None = None) -> GraspInspection:
+                  sets: Sequence[Sequence[int]] | None = None, results: str | Path = "results") -> GraspInspection:
     """Close the hand on object ``obj`` at pose (α, β) deg with the configuration's hand,
     synergies, placement and closure, then optimise the grasp for each synergy set in ``sets``
     (1-based synergies; None: :func:`default_sets`), as the study's steps do.
 
     ``config`` is a configuration as read from YAML (an overlay on the defaults); it is
-    checked like the workflow's. Raises InspectionError (naming the argument) or
+    checked like the workflow's. With ``placement.mode: searched`` the object's target is read
+    from the search's table ``<results>/objects/<obj>/placement.csv``. Raises InspectionError (naming the argument) or
     ``synergrasp.config.ConfigError``; a closure or solver failure is a status in the result.
     """
     from synergrasp.config import validate_config
@@ -162,10 +175,13 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
         raise InspectionError(f"object: {obj!r} is not an object of the configuration; objects: {list(cfg['objects'])}")
     sim = SimulateParams.from_config(cfg, obj)
     pose, _ = _pose_index(sim.placement, alpha_deg, beta_deg)
+    placement = sim.placement
+    if placement.mode == "searched":
+        placement = _searched(placement, Path(results) / "objects" / obj / "placement.csv")
     hand = load_hand(sim.hand)
     full = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
     chosen = default_sets(full.matrix.shape[1]) if sets is None else [tuple(sorted(set(s))) for s in sets]
-    table = simulate_object(hand, sim.synergies(hand.joint_names), sim.object, sim.placement, sim.closure,
+    table = simulate_object(hand, sim.synergies(hand.joint_names), sim.object, placement, sim.closure,
                             poses=[pose], mechanics=sim.mechanics)
     selection = ContactsParams.from_config(cfg, obj)
     if selection.drop_unloaded:
