@@ -252,7 +252,7 @@ def test_code_inputs_hold_every_module_a_job_loads(run_j2):
         loaded.setdefault(script, set()).update(files)
     assert set(loaded) == {"simulate_contacts", "optimise_shard", "aggregate_gfo", "local_minima",
                            "study_tables", "fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph",
-                           "fig4_force_maps", "fig5_hierarchy", "grasp_realism"}
+                           "fig4_force_maps", "fig5_hierarchy", "grasp_realism", "grasp_quality"}
     for script, files in loaded.items():
         assert files, script
         assert files <= declared[script], (script, sorted(files - declared[script]))
