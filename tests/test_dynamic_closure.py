@@ -196,7 +196,8 @@ def test_a_box_moved_but_left_inside_the_closed_hand_is_caged(hand, synergies):
     """obj1 (30 mm cube, approach placement) at α = −180°, β = −60°: the closing fingers push it
     toward the wrist and close past it; nothing touches it at the end, and its centre is inside
     the closed hand's hull, so it is caged, not lost."""
-    config = {**defaults(), "closure": {**defaults()["closure"], "model": "dynamic"}}
+    config = {**defaults(), "closure": {**defaults()["closure"], "model": "dynamic"},
+              "placement": {**defaults()["placement"], "mode": "approach"}}
     sim = SimulateParams.from_config(config, "obj1")
     row = simulate_object(hand, synergies, sim.object, sim.placement, sim.closure, poses=[0],
                           mechanics=sim.mechanics).iloc[0]

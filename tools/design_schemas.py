@@ -11,18 +11,20 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from synergrasp.tables import CONTACTS, GFO, MINIMA, QUALITY, Table
+from synergrasp.tables import CONTACTS, GFO, MINIMA, PLACEMENT, QUALITY, Table
 
 DESIGN = Path(__file__).resolve().parents[1] / "docs" / "design.md"
 BEGIN = "<!-- schemas: written by tools/design_schemas.py from src/synergrasp/tables.py; do not edit -->"
 END = "<!-- end of schemas -->"
 
-#: Each Parquet table between steps and the files that hold it, under a scenario's root.
+#: Each table between steps (Parquet; the placement search's CSV) and the files that hold it,
+#: under a scenario's root.
 FILES: tuple[tuple[Table, str], ...] = (
     (CONTACTS, "objects/<object>/contacts.parquet"),
     (GFO, "objects/<object>/gfo.parquet"),
     (MINIMA, "objects/<object>/minima.parquet"),
     (QUALITY, "objects/<object>/quality.parquet"),
+    (PLACEMENT, "objects/<object>/placement.csv"),
 )
 
 
