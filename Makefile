@@ -3,7 +3,8 @@
 #   make study          - build .venv from environment.lock, then run the full study
 #   make test           - build .venv from environment.lock, then run the fast tier of the tests
 #                         (all but the end-to-end workflow runs, marker `workflow`)
-#   make test-all       - every test, the end-to-end workflow runs included (CI)
+#   make test-workflow  - the end-to-end workflow tier alone (CI runs make test, then this)
+#   make test-all       - every test, the end-to-end workflow runs included
 #   make lint           - snakefmt --check, snakemake --lint (conda/container advice aside) and
 #                         the package's layers and no import circle (import-linter, pyproject.toml)
 #   make cluster-test   - the small study on a single-node SLURM started here (root; installs SLURM)
@@ -12,7 +13,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 CORES  ?= 2
 
-.PHONY: venv study test test-all lint cluster-test bench lock report clean-venv
+.PHONY: venv study test test-workflow test-all lint cluster-test bench lock report clean-venv
 
 $(BIN)/.installed: environment.lock pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -42,6 +43,11 @@ PYTEST = rc=0; $(BIN)/python -m pytest $(1) || rc=$$?; if [ $$rc -eq 5 ]; then e
 test: $(BIN)/.installed
 	$(WARM_UP)
 	$(call PYTEST,-m "not workflow")
+
+# The end-to-end tier alone (what `make test` leaves out); CI runs `make test` then this.
+test-workflow: $(BIN)/.installed
+	$(WARM_UP)
+	$(call PYTEST,-m workflow)
 
 test-all: $(BIN)/.installed
 	$(WARM_UP)
