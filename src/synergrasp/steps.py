@@ -124,7 +124,7 @@ STEPS: dict[str, Step] = {
         reads=STEPS_SEARCH_READS, not_reads=STEPS_SEARCH_NOT_READS,
         params="synergrasp.optimisation.placement_search:SearchStepParams"),
     "simulate": Step(
-        rules={"simulate_contacts": Cost("closure_pose", 1.5, 178, 4.5e-2, 7.6e-3, local=False)},
+        rules={"simulate_contacts": Cost("closure_pose", 1.5, 178, 4.5e-3, 7.6e-3, local=False)},
         outputs={"contacts": "contacts.parquet"}, scope="object",
         reads=("hand", "synergies", "grid", "placement", "closure", "objects.{object}.shape",
                "objects.{object}.placement"),
