@@ -43,3 +43,8 @@ def test_measurements_page_gives_cpu_per_pose_from_the_benchmarks_and_the_tables
     text = measurements.page(tmp_path, "quiet")
     assert "| `simulate_contacts` | 2 | 8.0 | 3.0 | 100 | 1 | 3 ms per pose (1,000 poses) |" in text
     assert "(quiet)." in text
+    # then the dynamic closure's engines and variants, one table row per row of their CSV
+    engines = pd.read_csv(measurements.CLOSURE_ENGINES)
+    section = text.split("## Dynamic closure: engines and variants")[1]
+    assert [line.split(" | ")[0] for line in section.splitlines() if line.startswith("| ") and "`" in line] == [
+        f"| {v}" for v in engines["variant"]]

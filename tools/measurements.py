@@ -30,6 +30,31 @@ UNITS = {
 }
 
 
+#: The dynamic closure's engines and variants side by side on the closure benchmark's poses
+#: (tools/closure_agreement.py), each row with the command that measured it.
+CLOSURE_ENGINES = Path(__file__).resolve().parents[1] / "benchmarks" / "closure_engines.csv"
+
+
+def closure_engines(path: Path = CLOSURE_ENGINES) -> list[str]:
+    """The page's section on the dynamic closure's engines and variants (none if ``path`` is missing)."""
+    if not path.exists():
+        return []
+    table = pd.read_csv(path, keep_default_na=False)
+    lines = ["## Dynamic closure: engines and variants", "",
+             f"From `{path.relative_to(path.parents[1])}` (docs/dynamic_closure.md, Cost): CPU ms per grasp",
+             "(`time.process_time`, one core) and, on the 240 poses of `benchmarks/bench_closure.py` (60 per",
+             "study box), the share of poses with the same status and the same full-set force-closure",
+             "verdict as main's pybullet model before this work (table made with main's code). Measured",
+             "on the shared 2-core machine (load average 9-15): the ms are inflated alike; the two medians",
+             "of 5 were interleaved, the single runs were not.", "",
+             "| engine / variant | ms per grasp | same status | same verdict | grasps | force closure | command |",
+             "|---|---|---|---|---|---|---|"]
+    for row in table.itertuples(index=False):
+        lines.append(f"| {row.variant} | {row.ms_per_grasp} | {row.same_status_pct} % | {row.same_verdict_pct} % | "
+                     f"{row.grasps} | {row.force_closure} | `{row.command}` |")
+    return lines + [""]
+
+
 def units_done(results: Path, table: str) -> int:
     """Rows of every object's ``table`` under ``results`` (the default study's only)."""
     return sum(len(pd.read_parquet(p, columns=["pose"])) for p in sorted((results / "objects").glob(f"*/{table}")))
@@ -62,7 +87,7 @@ def page(results: Path, note: str = "") -> str:
                      f"{row['cpu_percent']:.0f} | {row['peak_mb']:.0f} | {per} |")
     lines += ["", f"Total: {int(times['jobs'].sum())} jobs, {times['wall_s'].sum():.0f} job-seconds, "
               f"{times['cpu_s'].sum():.0f} CPU seconds.", ""]
-    return "\n".join(lines)
+    return "\n".join(lines + closure_engines())
 
 
 if __name__ == "__main__":

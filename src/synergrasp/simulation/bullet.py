@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import tempfile
 from dataclasses import dataclass, fields
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +40,11 @@ class HandBody:
     joint_scale: NDArray[np.float64]
     link_index: NDArray[np.int64]
     hand_link: dict[int, int]
+
+    @cached_property
+    def joint_list(self) -> list[int]:
+        """``joint_indices`` as the list pybullet's calls take."""
+        return self.joint_indices.tolist()
 
 
 @dataclass(frozen=True)
@@ -395,8 +401,14 @@ def reset_body(client: int, body: int, center_mm: NDArray, rotation: NDArray) ->
 
 def axis_states(client: int, body: HandBody) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Angles (rad) and angular velocities (rad/s) of every elementary axis, HandBody order."""
-    states = pb.getJointStates(body.body, body.joint_indices.tolist(), physicsClientId=client)
+    states = pb.getJointStates(body.body, body.joint_list, physicsClientId=client)
     return np.array([s[0] for s in states]), np.array([s[1] for s in states])
+
+
+def body_pose(client: int, body: int) -> tuple[NDArray, NDArray]:
+    """Centre (mm) and rotation (3 × 3) of a body."""
+    pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+    return np.array(pos) / MM, np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
 
 
 def body_state(client: int, body: int) -> tuple[NDArray, NDArray, NDArray, NDArray]:
@@ -419,7 +431,7 @@ def contact_forces(client: int, body_a: int | HandBody, body_b: HandBody) -> Con
 
 def step_with_torques(client: int, body: HandBody, torques_Nmm: NDArray) -> None:
     """Apply ``torques_Nmm`` (N·mm, one per elementary axis, HandBody order) and take one step."""
-    pb.setJointMotorControlArray(body.body, body.joint_indices.tolist(), pb.TORQUE_CONTROL,
+    pb.setJointMotorControlArray(body.body, body.joint_list, pb.TORQUE_CONTROL,
                                  forces=(np.asarray(torques_Nmm, dtype=float) * MM).tolist(), physicsClientId=client)
     pb.stepSimulation(physicsClientId=client)
 

@@ -388,8 +388,9 @@ class HandCapsules:
     def encloses(self, q: NDArray, point_mm: NDArray) -> bool:
         """Whether ``point_mm`` (palm frame) lies inside the hand at q (rad): within the convex
         hull of the hand's volume, the capsules (each axis end point widened by its radius in
-        14 directions, a polyhedron inside the sphere) and the palm boxes' corners."""
-        from scipy.spatial import Delaunay
+        14 directions, a polyhedron inside the sphere) and the palm boxes' corners. The hull's
+        facets, not a triangulation of its inside: 0.3 ms against ~100 ms for the ~540 points."""
+        from scipy.spatial import ConvexHull
 
         p0, p1 = self.segments(q)
         cube = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
@@ -397,5 +398,5 @@ class HandCapsules:
         widened = (np.vstack([p0, p1])[:, None, :]
                    + np.concatenate([self.radius, self.radius])[:, None, None] * directions[None]).reshape(-1, 3)
         corners = [c + (cube * h) @ r.T for r, c, h in zip(self.palm_rotation, self.palm_centre, self.palm_half)]
-        hull = Delaunay(np.vstack([widened, *corners]))
-        return bool(hull.find_simplex(np.asarray(point_mm, dtype=float)) >= 0)
+        facets = ConvexHull(np.vstack([widened, *corners])).equations  # rows (outward n, offset): n·x + offset ≤ 0 inside
+        return bool(np.max(facets[:, :3] @ np.asarray(point_mm, dtype=float) + facets[:, 3]) <= 1e-9)
