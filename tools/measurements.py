@@ -49,8 +49,11 @@ def closure_engines(path: Path = CLOSURE_ENGINES) -> list[str]:
              "of 5 were interleaved, the single runs were not.", "",
              "| engine / variant | ms per grasp | same status | same verdict | grasps | force closure | command |",
              "|---|---|---|---|---|---|---|"]
+    def pct(value: object) -> str:
+        return f"{value} %" if str(value)[:1].isdigit() else str(value)
+
     for row in table.itertuples(index=False):
-        lines.append(f"| {row.variant} | {row.ms_per_grasp} | {row.same_status_pct} % | {row.same_verdict_pct} % | "
+        lines.append(f"| {row.variant} | {row.ms_per_grasp} | {pct(row.same_status_pct)} | {pct(row.same_verdict_pct)} | "
                      f"{row.grasps} | {row.force_closure} | `{row.command}` |")
     return lines + [""]
 
