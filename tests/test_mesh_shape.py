@@ -73,7 +73,7 @@ def test_a_mesh_is_centred_on_its_solid_and_scaled(tmp_path):
     assert mesh.geometry.convex and len(mesh.geometry.parts) == 1
     np.testing.assert_allclose(np.sort(mesh.geometry.parts[0], axis=0), np.sort(_CORNERS * HALF, axis=0), atol=1e-12)
     assert mesh.bounding_radius_mm == pytest.approx(np.linalg.norm(HALF))
-    assert mesh.label == "mesh shifted.obj, 30 × 60 × 100 mm"
+    assert mesh.label == "mesh, 30 × 60 × 100 mm"
 
 
 # ------------------------------------------------------------------------ bad files, bad scales
@@ -202,6 +202,9 @@ def test_a_mesh_of_a_box_has_the_boxs_distances_normals_and_symmetry(pair):
         for got, want in zip(mesh.surface_point(c + x, R, c), box.surface_point(c + x, R, c)):
             np.testing.assert_allclose(got, want, atol=1e-9)
     np.testing.assert_allclose(mesh.gap(p0, R, c), box.gap(p0, R, c), atol=1e-9)
+    for x in ([15.2, 30.1, 0.0], [15.0, 0.0, 0.0], [14.7, -29.8, 49.9], [0.0, 0.0, 60.0]):  # faces within reach
+        normals = [sorted(map(tuple, np.round(s.normals_near(c + R @ np.array(x), R, c, 0.5), 12))) for s in pair]
+        assert normals[0] == normals[1]
     palm = np.eye(4)
     palm[:3, 3] = [-70.0, 10.0, 60.0]
     assert mesh.box_gap(R, c, palm, np.array([12.0, 39.0, 38.0]))[0] == pytest.approx(
@@ -239,3 +242,55 @@ def test_a_mesh_of_a_box_gets_the_boxs_period_and_contacts(pair, hand, synergies
 
 def test_defaults_hold_no_mesh():
     assert all("mesh" not in spec["shape"] for spec in defaults()["objects"].values())
+
+
+# ----------------------------------------------------------------- the example study's meshes, fast
+
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _example_config() -> dict:
+    """config/config.yaml with the example study's overlay, at the palm centre (the searched
+    targets need the search's output; the full example runs it)."""
+    import yaml
+
+    from synergrasp.config import overlay
+
+    base = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+    config = overlay(base, yaml.safe_load((ROOT / "config" / "examples" / "everyday_objects.yaml").read_text()))
+    config["placement"] = {**config["placement"], "mode": "approach"}
+    return config
+
+
+@pytest.mark.parametrize("obj, alpha, beta", [("duck", -30.0, 0.0), ("duck", 95.0, -40.0), ("blob", 10.0, 25.0)])
+def test_the_example_studys_meshes_are_grasped_and_optimised(monkeypatch, obj, alpha, beta):
+    """The mesh path of `snakemake figures --configfile config/examples/everyday_objects.yaml`
+    on a few poses through the one-grasp front door (its files read from the project's
+    root): closed without intersecting the open hand, the contacts on the mesh's parts with
+    unit normals pointing into it, and optimised with every synergy."""
+    from synergrasp.inspector import inspect_grasp
+
+    monkeypatch.chdir(ROOT)
+    full = tuple(range(1, 16))
+    result = inspect_grasp(_example_config(), obj, alpha, beta, sets=[(1,), full])
+    assert result.closure_status == "grasp" and len(result.contacts) >= 2
+    np.testing.assert_allclose(np.linalg.norm(np.array(result.contacts["normal"].tolist()), axis=1), 1.0, atol=1e-9)
+    (one, every) = result.sets
+    assert every.status in {"force_closure", "infeasible", "rank_deficient"} and not (one.force_closure
+                                                                                      and not every.force_closure)
+
+
+def test_fig2_draws_a_mesh(hand, synergies, tmp_path, monkeypatch):
+    """Fig. 2's picture of a grasp of the duck: written, the same bytes on a rerun."""
+    from conftest import study_closure_params, study_placement
+    from synergrasp.figures.hand_figures import figure_example_grasps
+    from synergrasp.simulation.closure import simulate_object
+
+    monkeypatch.chdir(ROOT)
+    duck = GraspedObject("duck", Mesh("config/examples/meshes/duck.obj", 50.0), 0.1)
+    table = simulate_object(hand, synergies, duck, study_placement(), study_closure_params(), poses=[300, 900])
+    for run in ("a", "b"):
+        figure_example_grasps(hand, [duck], [table], tmp_path / f"f{run}.png", tmp_path / f"f{run}.pdf", n_grasps=2)
+    first = (tmp_path / "fa.png").read_bytes()
+    assert len(first) > 10_000 and first == (tmp_path / "fb.png").read_bytes()

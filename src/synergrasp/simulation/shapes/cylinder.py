@@ -45,7 +45,7 @@ class Cylinder(Shape):
 
     @property
     def label(self) -> str:
-        return f"cylinder, radius {self.radius_mm:g} mm, height {self.height_mm:g} mm"
+        return f"cylinder, r {self.radius_mm:g} × h {self.height_mm:g} mm"
 
     def surface_point(self, point: NDArray, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
         r, hh = self.radius_mm, self.half_height_mm

@@ -126,7 +126,7 @@ class Mesh(Shape):
 
     @property
     def label(self) -> str:
-        return f"mesh {Path(self.path).name}, {' × '.join(f'{v:.0f}' for v in self.geometry.size)} mm"
+        return f"mesh, {' × '.join(f'{v:.0f}' for v in self.geometry.size)} mm"
 
     def surface_point(self, point: NDArray, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
         local = rotation.T @ (np.asarray(point, dtype=float) - center)
@@ -146,9 +146,8 @@ class Mesh(Shape):
         local = rotation.T @ (np.asarray(point, dtype=float) - center)
         out = []
         for vertices, planes in zip(self.geometry.parts, self.geometry.planes):
-            for n, b in zip(planes[:, :3], planes[:, 3]):
-                if abs(n @ local - b) > reach_mm:
-                    continue
+            for plane in planes[np.abs(planes[:, :3] @ local - planes[:, 3]) <= reach_mm]:  # the planes in reach
+                n, b = plane[:3], plane[3]
                 face = vertices[np.abs(vertices @ n - b) <= 1e-6 * max(self.geometry.size)]
                 face_params = pack_parts([(np.ascontiguousarray(face), np.zeros((0, 4)))])
                 if convex_distance(face_params, 0, local[None])[0] <= reach_mm:
