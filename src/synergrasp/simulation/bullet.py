@@ -164,7 +164,22 @@ def collision_shape(client: int, shape: Any) -> int:
     if kind == "cylinder":  # along the shape's own z axis, as pybullet's
         return pb.createCollisionShape(pb.GEOM_CYLINDER, radius=float(geometry["radius_mm"]) * MM,
                                        height=float(geometry["height_mm"]) * MM, physicsClientId=client)
+    if kind == "convex_parts":  # one convex hull per part (a file of several: the engine's compound)
+        parts = geometry["parts_mm"]
+        if len(parts) == 1:
+            return pb.createCollisionShape(pb.GEOM_MESH, vertices=(parts[0] * MM).tolist(), physicsClientId=client)
+        from synergrasp.simulation.shapes.convex_parts import bullet_file
+
+        return pb.createCollisionShape(pb.GEOM_MESH, fileName=str(bullet_file(parts)), meshScale=[MM] * 3,
+                                       physicsClientId=client)
     raise ValueError(f"no collision shape for a {kind!r}")
+
+
+def _exact_surface(client: int, body: int, shape: Any) -> None:
+    """No collision margin on a convex hull (the engine rounds one by 1 mm otherwise; its
+    primitives keep their own surface): contacts lie on the shape's surface."""
+    if shape.collision_geometry()[0] == "convex_parts":
+        pb.changeDynamics(body, -1, collisionMargin=0.0, physicsClientId=client)
 
 
 def load_object(client: int, shape: Any, center_mm: NDArray, rotation: NDArray | None = None) -> int:
@@ -173,6 +188,7 @@ def load_object(client: int, shape: Any, center_mm: NDArray, rotation: NDArray |
     Returns its body id."""
     body = pb.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=collision_shape(client, shape),
                               physicsClientId=client)
+    _exact_surface(client, body, shape)
     move_body(client, body, center_mm, rotation)
     return body
 
@@ -365,6 +381,7 @@ def load_free_object(client: int, shape: Any, mass_kg: float, friction: float, d
                               physicsClientId=client)
     pb.changeDynamics(body, -1, lateralFriction=float(friction), linearDamping=float(damping_per_s),
                       angularDamping=float(damping_per_s), physicsClientId=client)
+    _exact_surface(client, body, shape)
     return body
 
 

@@ -25,21 +25,22 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["Shape", "ShapeError", "SHAPES", "shape_from_config", "start_rotation", "positive_length", "Box", "Sphere",
-           "Cylinder"]
+           "Cylinder", "Mesh"]
 
 
 class ShapeError(ValueError):
     """A shape description is invalid; the message names the field."""
 
 
-def positive_length(field: str, value: Any) -> float:
-    """``value`` as a finite positive length in mm; ShapeError("<field>: ...") otherwise."""
+def positive_length(field: str, value: Any, what: str = "a finite positive length in mm") -> float:
+    """``value`` as a finite positive number (``what``, a length in mm unless said);
+    ShapeError("<field>: ...") otherwise."""
     try:
         out = float(value)
     except (TypeError, ValueError):
         out = math.nan
     if isinstance(value, (bool, str)) or not (math.isfinite(out) and out > 0):
-        raise ShapeError(f"{field}: {value!r} is not allowed; a finite positive length in mm is required")
+        raise ShapeError(f"{field}: {value!r} is not allowed; {what} is required")
     return out
 
 
@@ -165,7 +166,8 @@ def shape_from_config(spec: Mapping[str, Any], where: str = "shape") -> Shape:
 
 from synergrasp.simulation.shapes.box import Box  # noqa: E402
 from synergrasp.simulation.shapes.cylinder import Cylinder  # noqa: E402
+from synergrasp.simulation.shapes.mesh import Mesh  # noqa: E402
 from synergrasp.simulation.shapes.sphere import Sphere  # noqa: E402
 
 #: The shapes by the key that names them in the configuration.
-SHAPES: dict[str, type[Shape]] = {cls.kind: cls for cls in (Box, Sphere, Cylinder)}
+SHAPES: dict[str, type[Shape]] = {cls.kind: cls for cls in (Box, Sphere, Cylinder, Mesh)}
