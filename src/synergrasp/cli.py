@@ -1,6 +1,7 @@
 """The ``synergrasp`` console command (docs/inspector.md).
 
     synergrasp grasp obj4 --alpha -30 --beta 0 [--configfile my.yaml] [--sets 1 1-5 1-15] [--json]
+                     [--png grasp.png]
 
 Bad arguments end with one line naming the argument and exit status 2.
 """
@@ -90,6 +91,7 @@ def _parser() -> argparse.ArgumentParser:
     grasp.add_argument("--results", default="results", help="where the study's outputs are (the searched "
                                                             "placement's target: <results>/objects/<object>/placement.csv)")
     grasp.add_argument("--json", action="store_true", help="print the result as JSON")
+    grasp.add_argument("--png", metavar="PATH", help="write the grasp drawn as in Fig. 2 from two views (PNG)")
     return parser
 
 
@@ -115,6 +117,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"synergrasp grasp: {err}", file=sys.stderr)
         return 2
     print(json.dumps(result.to_dict(), indent=1) if args.json else format_inspection(result))
+    if args.png:
+        from synergrasp.inspector import grasp_picture
+
+        grasp_picture(result, args.png)
+        if not args.json:
+            print(f"picture: {args.png}")
     return 0
 
 
