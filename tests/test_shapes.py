@@ -194,6 +194,34 @@ def test_bounding_radius_holds_the_shape_and_is_reached(shape, surface):
     assert reach.max() >= shape.bounding_radius_mm - SPACING_MM
 
 
+def _volume(shape) -> float:
+    if shape.kind == "box":
+        return float(np.prod(shape.size_mm))
+    if shape.kind == "sphere":
+        return 4.0 / 3.0 * np.pi * shape.radius_mm ** 3
+    return np.pi * shape.radius_mm ** 2 * shape.height_mm
+
+
+def test_the_surface_mesh_is_closed_outward_and_on_the_surface(shape):
+    R, c = _pose()
+    vertices, triangles = shape.surface_mesh(R, c)
+    local = (vertices - c) @ R
+    # every vertex on the surface: inside the shape, and outside it a hair further out
+    outward = local * (1.0 + 1e-6) + 1e-9 * np.sign(local)
+    assert inside(shape, local * (1.0 - 1e-9)).all() and not inside(shape, outward).any()
+    # welded at shared positions, every edge is used once in each direction (closed, one orientation)
+    _, weld = np.unique(np.round(local, 6), axis=0, return_inverse=True)
+    t = weld.ravel()[triangles]
+    t = t[(t[:, 0] != t[:, 1]) & (t[:, 1] != t[:, 2]) & (t[:, 0] != t[:, 2])]
+    edges = np.vstack([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
+    forward = {tuple(e) for e in edges}
+    assert len(forward) == len(edges) and forward == {(b, a) for a, b in edges}
+    # outward: the divergence theorem gives the volume, positive (a polygon's: the exact one or a little less)
+    a, b, d = (local[triangles[:, k]] for k in range(3))
+    volume = float(np.einsum("ij,ij->i", a, np.cross(b, d)).sum() / 6.0)
+    assert 0.97 * _volume(shape) <= volume <= _volume(shape) * (1.0 + 1e-9)
+
+
 def test_start_rotation_puts_the_own_axes_on_the_palm_axes():
     for axes in [(0, 1, 2), (1, 0, 2), (2, 0, 1), (0, 2, 1)]:
         R0 = start_rotation(axes)
