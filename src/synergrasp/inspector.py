@@ -17,11 +17,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from synergrasp.ids import set_id
+from synergrasp.ids import set_id, set_name
 from synergrasp.optimisation.quality import GraspQuality, grasp_quality
 
 __all__ = ["InspectionError", "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp",
-           "grasp_picture"]
+           "grasp_picture", "grasp_view"]
 
 
 class InspectionError(ValueError):
@@ -93,25 +93,25 @@ class GraspInspection:
 _TOKEN = re.compile(r"^(\d+)(?:-(\d+))?$|^(\d+(?:,\d+)+)$")
 
 
-def parse_sets(tokens: Sequence[str], n_synergies: int) -> list[tuple[int, ...]]:
+def parse_sets(tokens: Sequence[str], n_synergies: int, argument: str = "--sets") -> list[tuple[int, ...]]:
     """Synergy sets from command-line tokens: ``3`` = {S3}, ``1-5`` = {S1..S5} (a range),
-    ``2,5`` = {S2, S5}; 1-based, within 1 … ``n_synergies``."""
+    ``2,5`` = {S2, S5}; 1-based, within 1 … ``n_synergies``; an error names ``argument``."""
     out = []
     for token in tokens:
         match = _TOKEN.match(str(token).strip())
         if not match:
-            raise InspectionError(f"--sets: {token!r} is not a set; give k, a-b (S_a..S_b) or a,b,c")
+            raise InspectionError(f"{argument}: {token!r} is not a set; give k, a-b (S_a..S_b) or a,b,c")
         if match.group(3):
             members = tuple(sorted({int(v) for v in match.group(3).split(",")}))
         else:
             lo = int(match.group(1))
             hi = int(match.group(2)) if match.group(2) else lo
             if hi < lo:
-                raise InspectionError(f"--sets: {token!r} is an empty range")
+                raise InspectionError(f"{argument}: {token!r} is an empty range")
             members = tuple(range(lo, hi + 1))
         bad = [v for v in members if not 1 <= v <= n_synergies]
         if bad:
-            raise InspectionError(f"--sets: {token!r} names synergies {bad}; the table has S1..S{n_synergies}")
+            raise InspectionError(f"{argument}: {token!r} names synergies {bad}; the table has S1..S{n_synergies}")
         out.append(members)
     return out
 
@@ -232,7 +232,8 @@ def _object_in_picture(result: GraspInspection) -> Any:
 
 
 def _title(result: GraspInspection) -> str:
-    return (f"{result.object} ({result.shape.kind} {result.shape.label}) at α = {result.alpha_deg:g}°, "
+    shape = result.shape.label if result.shape.kind in result.shape.label else f"{result.shape.kind} {result.shape.label}"
+    return (f"{result.object} ({shape}) at α = {result.alpha_deg:g}°, "
             f"β = {result.beta_deg:g}° (pose {result.pose}): {result.closure_status}, {len(result.contacts)} contacts")
 
 
@@ -243,3 +244,23 @@ def grasp_picture(result: GraspInspection, png_path: str | Path) -> None:
     links = result.contacts["link"] if len(result.contacts) else []
     points = np.array(list(result.contacts["point_mm"]), dtype=float) if len(result.contacts) else np.zeros((0, 3))
     figure_grasp_views(result.hand, _object_in_picture(result), result.q_rad, links, points, _title(result), png_path)
+
+
+def grasp_view(result: GraspInspection, synergies: Sequence[int] | None = None) -> Any:
+    """The inspected grasp in 3-D (``synergrasp.figures.grasp_3d.grasp_figure``, a plotly
+    figure) with the optimal contact forces of the set ``synergies`` (1-based; None: the last
+    set inspected) as arrows; ``grasp_page(grasp_view(...))`` is the page ``--html`` writes."""
+    from synergrasp.figures.grasp_3d import GraspScene, grasp_figure
+
+    chosen = result.sets[-1] if synergies is None and result.sets else None
+    if synergies is not None:
+        wanted = tuple(sorted(set(synergies)))
+        chosen = next((s for s in result.sets if s.synergies == wanted), None)
+        if chosen is None:
+            raise InspectionError(f"--forces: {set_name(wanted)} is not among the sets inspected")
+    links = result.contacts["link"] if len(result.contacts) else []
+    points = np.array(list(result.contacts["point_mm"]), dtype=float) if len(result.contacts) else np.zeros((0, 3))
+    name = set_name(chosen.synergies) if chosen is not None else "no set"
+    scene = GraspScene.of(result.hand, result.q_rad, _object_in_picture(result), links, points,
+                          chosen.forces_N if chosen is not None else None, name, _title(result))
+    return grasp_figure(scene)

@@ -22,10 +22,12 @@ from synergrasp.hand.synergies import SynergyPath
 from synergrasp.simulation.objects import GraspedObject
 
 __all__ = ["figure_synergy_postures", "figure_example_grasps", "figure_grasp_views", "draw_grasp", "draw_grasp_row",
-           "PANEL_PX", "GRASP_VIEWS"]
+           "object_of", "PANEL_PX", "GRASP_VIEWS", "FIG2_GRASPS"]
 
 #: Rendered panel size, pixels (width, height).
 PANEL_PX = (330, 330)
+#: Grasps per object in Fig. 2.
+FIG2_GRASPS = 3
 _CONTACT = "#c2000b"
 
 
@@ -192,7 +194,8 @@ def _touching_words(hand: Any, links: Sequence[int]) -> str:
     return "\n".join(textwrap.wrap("touching: " + ", ".join(parts), 48))
 
 
-def _object_of(row: pd.Series, shape: Any) -> ShapeInPicture:
+def object_of(row: pd.Series, shape: Any) -> ShapeInPicture:
+    """The object of a contacts table's row (its end pose) with its ``shape``."""
     return ShapeInPicture(shape, np.asarray(row["object_center"], dtype=float),
                           np.asarray(row["object_rotation"], dtype=float).reshape(3, 3))
 
@@ -234,7 +237,7 @@ def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame
     simulated = int(table["status"].isin(SIMULATED_STATUSES).sum())
     rows = [table[table["pose"] == pose].iloc[0] for pose in chosen["pose"]]
     row_camera = _fit(camera, hand, [np.asarray(row["q"], dtype=float) for row in rows],
-                      [_object_of(row, obj.shape) for row in rows]) if rows else camera
+                      [object_of(row, obj.shape) for row in rows]) if rows else camera
     pictures, thumbs = [], []
     axes[0].set_ylabel(f"{obj.name}\n{obj.shape.label}", fontsize=10)
     for c in range(n_grasps):
@@ -246,7 +249,7 @@ def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame
             continue
         pick, row = chosen.iloc[c], rows[c]
         q = np.asarray(row["q"], dtype=float)
-        picture = draw_grasp(ax, hand, q, _object_of(row, obj.shape), pick["pattern"], row["contact_point"],
+        picture = draw_grasp(ax, hand, q, object_of(row, obj.shape), pick["pattern"], row["contact_point"],
                              row_camera)
         pictures.append(picture)
         thumbs.append((picture, q))
@@ -262,7 +265,7 @@ def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame
 
 
 def figure_example_grasps(hand: Any, objects: Sequence[Any], tables: Sequence[pd.DataFrame], png_path: str | Path,
-                          pdf_path: str | Path, n_grasps: int = 3, camera: Camera = PALM_CAMERA) -> None:
+                          pdf_path: str | Path, n_grasps: int = FIG2_GRASPS, camera: Camera = PALM_CAMERA) -> None:
     """Fig. 2: representative simulated grasps, one row per object, chosen by rule
     (``synergrasp.analysis.realism.representative_grasps``: the most common set of touching
     links, the most common one at the typical contact count, the next most common), each at
