@@ -62,7 +62,27 @@ def page(results: Path, note: str = "") -> str:
                      f"{row['cpu_percent']:.0f} | {row['peak_mb']:.0f} | {per} |")
     lines += ["", f"Total: {int(times['jobs'].sum())} jobs, {times['wall_s'].sum():.0f} job-seconds, "
               f"{times['cpu_s'].sum():.0f} CPU seconds.", ""]
-    return "\n".join(lines)
+    return "\n".join(lines + inspector_lines(results))
+
+
+#: The inspector's variants as benchmarks/bench_inspector.py names them, in words.
+INSPECTOR_VARIANTS = {"text": "the text (every default set)", "png": "and `--png`", "html": "and `--html`",
+                      "png_html": "and `--png` and `--html`"}
+
+
+def inspector_lines(results: Path) -> list[str]:
+    """The one-grasp command's cost (benchmarks/bench_inspector.py's file), if it was measured."""
+    path = results / "benchmarks" / "bench_inspector.tsv"
+    if not path.is_file():
+        return []
+    bench = pd.read_csv(path, sep="\t")
+    lines = ["## One grasp in full", "",
+             "`synergrasp grasp obj4 --alpha -30 --beta 0` (29 sets), warm, each in a fresh process, median of its",
+             f"runs (`.venv/bin/python benchmarks/bench_inspector.py`; load average {bench['load'].iloc[0]:.2f} when it "
+             "started):", "", "| command | wall s | CPU s |", "|---|---|---|"]
+    for row in bench.itertuples():
+        lines.append(f"| {INSPECTOR_VARIANTS.get(row.variant, row.variant)} | {row.wall_s:.2f} | {row.cpu_s:.2f} |")
+    return lines + [""]
 
 
 if __name__ == "__main__":
