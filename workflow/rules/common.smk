@@ -172,6 +172,16 @@ def step_inputs(step):
     ]
 
 
+def searched_inputs(step):
+    """Input function: the per-object ``step`` output of every object of the job's scenario
+    whose placement is searched."""
+    return lambda w: [
+        step_file(_ROOT_SCENARIO[w.root], step, o)
+        for o in scenario_config(w)["objects"]
+        if searched(_ROOT_SCENARIO[w.root], o)
+    ]
+
+
 def step_cfg(step):
     """A rule's ``params``: the part of the job's scenario configuration its step reads (for
     the job's object; synergrasp.steps.STEPS), so that a job reruns only when a key it reads
@@ -280,14 +290,20 @@ def user_files(wildcards):
     return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in SHIPPED_TABLES]
 
 
-SHIPPED_DATA = sorted(str(p) for p in (SRC / "data").glob("*") if p.is_file())
+#: The shipped hand and synergy files. Not the schema: its defaults reach a job through its
+#: params (the step's part of the configuration), so a new key reruns nothing.
+SHIPPED_DATA = sorted(
+    str(p)
+    for p in (SRC / "data").glob("*")
+    if p.is_file() and p.name not in ("config.schema.yaml", "README.md")
+)
 
 
 def object_targets(name, scenario_name="default"):
     """One object's outputs in a scenario: the outputs of every per-object step (wherever shared)."""
     files = {}
     for step, spec in STEPS.items():
-        if spec.scope != "object" or not spec.rules or not _shown(scenario_name, step, name):
+        if spec.scope != "object" or spec.optional or not _shown(scenario_name, step, name):
             continue
         if len(spec.outputs) == 1:
             files[step_file(scenario_name, step, name)] = None
@@ -320,7 +336,7 @@ def study_targets(name="default"):
     files = [
         study_file(name, step, rel)
         for step, spec in STEPS.items()
-        if spec.scope == "scenario" and spec.rules
+        if spec.scope == "scenario" and not spec.optional
         for rel in spec.outputs.values()
     ]
     files += workflow_files("fig3")
@@ -344,6 +360,14 @@ def scenario_tables(table):
 
 
 SENSITIVITY_FILES = workflow_files("sensitivity")
+
+
+def placement_claims_targets(name="default"):
+    """The claims over the placement search's targets (the optional steps) of scenario ``name``."""
+    return [
+        study_file(name, "placement_claims", rel)
+        for rel in STEPS["placement_claims"].outputs.values()
+    ]
 
 
 def _report_archive(argv):
