@@ -73,7 +73,8 @@ def _check_scene(page, expected_legend):
     canvas = page.locator("#grasp .gl-container canvas").first
     drawn = _rgb(canvas.screenshot())
     assert len(np.unique((drawn * 255).astype(np.uint8).reshape(-1, 3), axis=0)) > 200  # shaded, not blank
-    page.evaluate("() => Plotly.restyle('grasp', {visible: false})")
+    # hidden but kept in the legend, so that the scene keeps its size
+    page.evaluate("() => Plotly.restyle('grasp', {visible: 'legendonly'})")
     page.wait_for_timeout(500)
     empty = _rgb(canvas.screenshot())
     changed = np.abs(drawn - empty).max(axis=2) > 0.1
