@@ -1,20 +1,19 @@
 """What one grasp in full costs: `synergrasp grasp obj4 --alpha -30 --beta 0` (every default
-set: 15 single synergies and {S1..Sk} for k = 2..15), warm (the solver kernel compiled and
-cached, one run before the measured ones), alone and with `--png` and `--html`.
+set: the 15 single synergies and {S1..Sk} for k = 2..15), warm (the solver kernel compiled and
+cached, one run before the measured ones), alone and with `--png` and `--html`; then the
+workflow's `grasps_3d` step's work (the 3-D pages of Fig. 2's grasps) in this process.
 
     .venv/bin/python benchmarks/bench_inspector.py [--results results] [--runs 3]
 
-Each variant runs the command in a fresh process `--runs` times; printed: the median wall
-time and the median CPU time (user + system of the process), seconds, and the machine's load
-average when it started. Needs the searched target of obj4 (`--results`, the default study's
-`results/objects/obj4/placement.csv`). Writes `<results>/benchmarks/bench_inspector.tsv`,
-which `tools/measurements.py` puts on docs/measurements.md.
+Each command variant runs in a fresh process `--runs` times: the median wall time and the
+median CPU time (user + system of the process). Needs a finished default study under
+`--results` (obj4's searched target, every object's contacts). The machine-read lines
+(`key: number  (what it is)`) are what `make bench` records (tools/measurements.py).
 """
 
 from __future__ import annotations
 
 import argparse
-import os
 import resource
 import statistics
 import subprocess
@@ -26,15 +25,35 @@ from pathlib import Path
 COMMAND = ["grasp", "obj4", "--alpha", "-30", "--beta", "0"]
 
 
+def _cpu_children() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
 def run_once(args: list[str], results: Path) -> tuple[float, float]:
     """Wall and CPU seconds of one run of the command in its own process."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.perf_counter()
+    cpu, start = _cpu_children(), time.perf_counter()
     subprocess.run([sys.executable, "-m", "synergrasp.cli", *COMMAND, "--results", str(results), *args],
                    check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    wall = time.perf_counter() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return time.perf_counter() - start, _cpu_children() - cpu
+
+
+def pages_cost(results: Path, folder: Path) -> tuple[float, float]:
+    """Wall and CPU seconds of the grasps_3d step's work on the study under ``results``
+    (imports and the solver kernel's load from its cache included)."""
+    cpu, start = time.process_time(), time.perf_counter()
+    from synergrasp import tables
+    from synergrasp.config import validate_config
+    from synergrasp.figures.grasp_3d import Grasps3dParams, fig2_scenes, write_grasp_pages
+    from synergrasp.hand.kinematics import load_hand
+    from synergrasp.hand.synergies import load_synergies
+
+    params = Grasps3dParams.from_config(validate_config({}))
+    hand = load_hand(params.hand)
+    matrix = load_synergies(params.synergies, joint_names=hand.joint_names).matrix
+    contacts = [tables.read(tables.CONTACTS, results / "objects" / o.name / "contacts.parquet") for o in params.objects]
+    write_grasp_pages(folder, fig2_scenes(hand, matrix, params, contacts), "pages")
+    return time.perf_counter() - start, time.process_time() - cpu
 
 
 def main() -> None:
@@ -43,25 +62,21 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=3)
     args = ap.parse_args()
     if not (args.results / "objects" / "obj4" / "placement.csv").is_file():
-        raise SystemExit(f"no searched target of obj4 under {args.results}: run `make study` first")
-    load = os.getloadavg()[0]
+        raise SystemExit(f"no finished default study under {args.results} (obj4's placement.csv): run `make study`")
+    what = f"synergrasp grasp obj4 --alpha -30 --beta 0, 29 sets, warm, median of {args.runs} runs"
     with tempfile.TemporaryDirectory() as tmp:
-        variants = {"text": [], "png": ["--png", f"{tmp}/g.png"], "html": ["--html", f"{tmp}/g.html"],
-                    "png_html": ["--png", f"{tmp}/g.png", "--html", f"{tmp}/g.html"]}
+        variants = {"": [], "_png": ["--png", f"{tmp}/g.png"], "_html": ["--html", f"{tmp}/g.html"],
+                    "_png_html": ["--png", f"{tmp}/g.png", "--html", f"{tmp}/g.html"]}
         run_once([], args.results)  # warm: the kernel's cache and the files in the page cache
-        rows = []
         for name, extra in variants.items():
             times = [run_once(extra, args.results) for _ in range(args.runs)]
-            rows.append((name, statistics.median(t[0] for t in times), statistics.median(t[1] for t in times)))
-    print(f"load average at the start: {load:.2f}; median of {args.runs} runs")
-    lines = ["variant\twall_s\tcpu_s\tload"]
-    for name, wall, cpu in rows:
-        print(f"inspector_{name}: wall {wall:.2f} s, CPU {cpu:.2f} s")
-        lines.append(f"{name}\t{wall:.3f}\t{cpu:.3f}\t{load:.2f}")
-    out = args.results / "benchmarks" / "bench_inspector.tsv"
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text("\n".join(lines) + "\n")
-    print(f"wrote {out}")
+            flags = " ".join(a for a in extra if a.startswith("--")) or "alone"
+            print(f"inspector{name}_wall_s: {statistics.median(t[0] for t in times):.2f}  ({what}; {flags}: wall s)")
+            print(f"inspector{name}_cpu_s: {statistics.median(t[1] for t in times):.2f}  ({what}; {flags}: CPU s)")
+        wall, cpu = pages_cost(args.results, Path(tmp) / "pages")
+    print(f"grasps_3d_pages_wall_s: {wall:.2f}  (the 3-D pages of Fig. 2's 12 grasps with the full set's forces, "
+          "imports included: wall s)")
+    print(f"grasps_3d_pages_cpu_s: {cpu:.2f}  (the same: CPU s)")
 
 
 if __name__ == "__main__":

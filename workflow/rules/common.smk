@@ -282,12 +282,20 @@ def code(script):
 
 
 def user_files(wildcards):
-    """Input function: the scenario's own hand/synergy files, so that a change of their
-    content reruns what uses them (a shipped synergy table given by name is under SHIPPED_DATA)."""
+    """Input function: the scenario's own hand/synergy files and the mesh files of its objects
+    (the job's object only, for a job per object), so that a change of their content reruns
+    what uses them (a shipped synergy table given by name is under SHIPPED_DATA)."""
     from synergrasp.hand.synergies import SHIPPED_TABLES
 
     cfg = scenario_config(wildcards)
-    return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in SHIPPED_TABLES]
+    obj = getattr(wildcards, "object", None)
+    objects = [obj] if obj in cfg["objects"] else list(cfg["objects"])
+    meshes = [
+        cfg["objects"][o]["shape"]["mesh"]["path"]
+        for o in objects
+        if "mesh" in cfg["objects"][o]["shape"]
+    ]
+    return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in SHIPPED_TABLES] + meshes
 
 
 #: The shipped hand and synergy files. Not the schema: its defaults reach a job through its

@@ -22,7 +22,7 @@ import pandas as pd
 from synergrasp import tables
 from synergrasp.analysis.claims import FAILS, HOLDS, UNDEFINED
 from synergrasp.analysis.minima import MinimaParams, minima_table
-from synergrasp.analysis.summaries import TablesParams, study_tables
+from synergrasp.analysis.summaries import TablesParams, study_claims
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.ids import synergy_sets
 from synergrasp.optimisation.placement_search import SearchStepParams, TargetScorer, full_synergy_set, pose_subset
@@ -37,7 +37,7 @@ VERDICTS = (HOLDS, FAILS, UNDEFINED)
 @dataclass(frozen=True)
 class TargetClaimsParams:
     """The claims at the scored targets of one object (the ``target_claims`` step): the
-    search's closure and placement, the study's synergy sets and mechanics, its minima and
+    search's closure and placement, the synergy sets the claims read, its minima and
     table settings, the lattice of poses (every n-th α and β of the grid from its start,
     over the first α-period) and how many of the best-ranked targets (0: all)."""
 
@@ -56,9 +56,16 @@ class TargetClaimsParams:
         # the tables of this object alone; its α-period does not depend on the placement's target
         placement = {**config["placement"], "mode": "searched", "approach_point_mm": None, "center_mm": (0.0, 0.0, 0.0)}
         alone = {**config, "objects": {obj: config["objects"][obj]}, "placement": placement}
-        return cls(SearchStepParams.from_config(config, obj), synergy_sets(config["synergy_sets"]),
+        return cls(SearchStepParams.from_config(config, obj), claim_sets(config["synergy_sets"]),
                    MinimaParams.from_config(config, obj), TablesParams.from_config(alone, obj),
                    int(spec["alpha_every"]), int(spec["beta_every"]), int(spec["max_targets"]))
+
+
+def claim_sets(sets_config: Mapping[str, int]) -> dict[str, tuple[int, ...]]:
+    """The study's sets that its claims read (``synergrasp.analysis.claims``): the
+    incremental sets {S1..Sk} and the sets of one or two of the first
+    ``hierarchy_first`` synergies (the triples of Fig. 5 are read by no claim)."""
+    return synergy_sets({**sets_config, "hierarchy_max_size": min(2, int(sets_config["hierarchy_max_size"]))})
 
 
 class ClaimsAtTargets:
@@ -86,7 +93,7 @@ class ClaimsAtTargets:
         weights = {name: p.minima.weight_N} if p.minima.weight_N is not None else None
         judged = with_verdicts(gfo, p.minima.success, weights, p.minima.bound_multiple)
         minima = minima_table(judged, p.minima.radius_deg, alpha_period_deg=self.period_deg)
-        claims = study_tables(gfo, minima, p.tables.synergy_sets, p.tables.table2_k_max, p.tables.settings)["claims"][1]
+        claims = study_claims(gfo, minima, p.tables.synergy_sets, p.tables.settings)
         return claims[claims["headline"]].reset_index(drop=True)
 
 

@@ -30,7 +30,7 @@ from synergrasp.figures.hand_pictures import BOX, PALM_CAMERA, SKIN, ShapeInPict
 from synergrasp.ids import set_name
 from synergrasp.optimisation.study import GFOParams
 from synergrasp.simulation.objects import GraspedObject
-from synergrasp.simulation.shapes.mesh import Mesh, frame_along, merge_meshes, placed, revolution_mesh
+from synergrasp.simulation.shapes.surface import Surface, frame_along, merge_meshes, placed, revolution_mesh
 
 __all__ = ["GraspScene", "Grasps3dParams", "grasp_figure", "grasp_page", "write_grasp_pages", "fig2_scenes",
            "arrow_scale", "PLOTLY_JS", "ZERO_FORCE_N", "ARROW_REACH"]
@@ -78,7 +78,7 @@ class GraspScene:
                    else np.asarray(forces_N, dtype=float).reshape(m, 3), force_set, title)
 
 
-def _capsule_mesh(a: NDArray, b: NDArray, r: float) -> Mesh:
+def _capsule_mesh(a: NDArray, b: NDArray, r: float) -> Surface:
     """A capsule (segment a–b, radius r, mm) as a mesh: two half spheres and a cylinder."""
     length = float(np.linalg.norm(b - a))
     polar = np.linspace(0.0, 0.5 * np.pi, 5)
@@ -89,10 +89,10 @@ def _capsule_mesh(a: NDArray, b: NDArray, r: float) -> Mesh:
     return placed(revolution_mesh(profile, _CAPSULE_SEGMENTS), frame_along(axis), a)
 
 
-def _link_meshes(hand: Any, q: NDArray) -> dict[int, Mesh]:
+def _link_meshes(hand: Any, q: NDArray) -> dict[int, Surface]:
     """Each hand link's bodies as one mesh: its capsules, and for the palm its boxes."""
     shapes = hand_shapes(hand, q)
-    parts: dict[int, list[Mesh]] = {}
+    parts: dict[int, list[Surface]] = {}
     for box in shapes.boxes:
         parts.setdefault(0, []).append(box.shape.surface_mesh(np.asarray(box.rotation), np.asarray(box.center_mm)))
     for (a, b), r, link in zip(shapes.ends, shapes.radius, shapes.link):
@@ -100,7 +100,7 @@ def _link_meshes(hand: Any, q: NDArray) -> dict[int, Mesh]:
     return {link: merge_meshes(meshes) for link, meshes in parts.items()}
 
 
-def _mesh_trace(mesh: Mesh, colour: str, name: str, opacity: float = 1.0, **extra: Any) -> Any:
+def _mesh_trace(mesh: Surface, colour: str, name: str, opacity: float = 1.0, **extra: Any) -> Any:
     import plotly.graph_objects as go
 
     (x, y, z), (i, j, k) = mesh[0].T, mesh[1].T

@@ -25,21 +25,22 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["Shape", "ShapeError", "SHAPES", "shape_from_config", "start_rotation", "positive_length", "Box", "Sphere",
-           "Cylinder"]
+           "Cylinder", "Mesh"]
 
 
 class ShapeError(ValueError):
     """A shape description is invalid; the message names the field."""
 
 
-def positive_length(field: str, value: Any) -> float:
-    """``value`` as a finite positive length in mm; ShapeError("<field>: ...") otherwise."""
+def positive_length(field: str, value: Any, what: str = "a finite positive length in mm") -> float:
+    """``value`` as a finite positive number (``what``, a length in mm unless said);
+    ShapeError("<field>: ...") otherwise."""
     try:
         out = float(value)
     except (TypeError, ValueError):
         out = math.nan
     if isinstance(value, (bool, str)) or not (math.isfinite(out) and out > 0):
-        raise ShapeError(f"{field}: {value!r} is not allowed; a finite positive length in mm is required")
+        raise ShapeError(f"{field}: {value!r} is not allowed; {what} is required")
     return out
 
 
@@ -144,13 +145,13 @@ class Shape(ABC):
 
     @abstractmethod
     def own_mesh(self) -> tuple[NDArray, NDArray]:
-        """Triangles of its surface in its own frame (``synergrasp.simulation.shapes.mesh``):
+        """Triangles of its surface in its own frame (``synergrasp.simulation.shapes.surface``):
         vertices (k, 3) mm, triangles (t, 3) vertex indices, counter-clockwise from outside."""
 
     def surface_mesh(self, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
         """Its surface's triangles at its pose: vertices (k, 3) palm frame, mm, and triangles
         (t, 3) (3-D views)."""
-        from synergrasp.simulation.shapes.mesh import placed
+        from synergrasp.simulation.shapes.surface import placed
 
         return placed(self.own_mesh(), rotation, center)
 
@@ -177,7 +178,8 @@ def shape_from_config(spec: Mapping[str, Any], where: str = "shape") -> Shape:
 
 from synergrasp.simulation.shapes.box import Box  # noqa: E402
 from synergrasp.simulation.shapes.cylinder import Cylinder  # noqa: E402
+from synergrasp.simulation.shapes.mesh import Mesh  # noqa: E402
 from synergrasp.simulation.shapes.sphere import Sphere  # noqa: E402
 
 #: The shapes by the key that names them in the configuration.
-SHAPES: dict[str, type[Shape]] = {cls.kind: cls for cls in (Box, Sphere, Cylinder)}
+SHAPES: dict[str, type[Shape]] = {cls.kind: cls for cls in (Box, Sphere, Cylinder, Mesh)}

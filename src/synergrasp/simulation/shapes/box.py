@@ -163,6 +163,6 @@ class Box(Shape):
         return self._corners(rotation, center), np.zeros(8)
 
     def own_mesh(self) -> tuple[NDArray, NDArray]:
-        from synergrasp.simulation.shapes.mesh import box_mesh
+        from synergrasp.simulation.shapes.surface import box_mesh
 
         return box_mesh(self._half)

@@ -165,7 +165,7 @@ class Cylinder(Shape):
         return corners @ rotation.T + center, np.zeros(8)
 
     def own_mesh(self) -> tuple[NDArray, NDArray]:
-        from synergrasp.simulation.shapes.mesh import merge_meshes, revolution_mesh
+        from synergrasp.simulation.shapes.surface import merge_meshes, revolution_mesh
 
         r, hh = self.radius_mm, self.half_height_mm
         # caps and side apart, so that the rims stay sharp
