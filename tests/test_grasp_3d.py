@@ -97,7 +97,7 @@ def test_an_infeasible_set_draws_no_arrows(inspection):
     cones = sum(len(values(t["x"])) for t in data if t["type"] == "cone")
     assert cones == (0 if not single.load_feasible else len(inspection.contacts))
     if not single.load_feasible:
-        assert "not feasible" in layout["legend"]["title"]["text"]
+        assert "no arrows: {S1} is not feasible" in layout["legend"]["title"]["text"]
 
 
 def test_arrow_scale_is_a_1_2_5_step_within_the_reach():

@@ -247,9 +247,10 @@ def grasp_picture(result: GraspInspection, png_path: str | Path) -> None:
 
 
 def grasp_view(result: GraspInspection, synergies: Sequence[int] | None = None) -> Any:
-    """The inspected grasp in 3-D (``synergrasp.figures.grasp_3d.grasp_figure``, a plotly
-    figure) with the optimal contact forces of the set ``synergies`` (1-based; None: the last
-    set inspected) as arrows; ``grasp_page(grasp_view(...))`` is the page ``--html`` writes."""
+    """The inspected grasp in 3-D (``synergrasp.figures.grasp_3d.grasp_figure``: a plotly
+    figure as its dict) with the optimal contact forces of the set ``synergies`` (1-based;
+    None: the last set inspected) as arrows; ``grasp_page(grasp_view(...))`` is the page
+    ``--html`` writes."""
     from synergrasp.figures.grasp_3d import GraspScene, grasp_figure
 
     chosen = result.sets[-1] if synergies is None and result.sets else None
@@ -260,7 +261,7 @@ def grasp_view(result: GraspInspection, synergies: Sequence[int] | None = None) 
             raise InspectionError(f"--forces: {set_name(wanted)} is not among the sets inspected")
     links = result.contacts["link"] if len(result.contacts) else []
     points = np.array(list(result.contacts["point_mm"]), dtype=float) if len(result.contacts) else np.zeros((0, 3))
-    name = set_name(chosen.synergies) if chosen is not None else "no set"
+    name = set_name(chosen.synergies) if chosen is not None else ""
     scene = GraspScene.of(result.hand, result.q_rad, _object_in_picture(result), links, points,
                           chosen.forces_N if chosen is not None else None, name, _title(result))
     return grasp_figure(scene)

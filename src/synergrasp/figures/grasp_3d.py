@@ -100,13 +100,11 @@ def _link_meshes(hand: Any, q: NDArray) -> dict[int, Surface]:
     return {link: merge_meshes(meshes) for link, meshes in parts.items()}
 
 
-def _mesh_trace(mesh: Surface, colour: str, name: str, opacity: float = 1.0, **extra: Any) -> Any:
-    import plotly.graph_objects as go
-
+def _mesh_trace(mesh: Surface, colour: str, name: str, opacity: float = 1.0, **extra: Any) -> dict[str, Any]:
     (x, y, z), (i, j, k) = mesh[0].T, mesh[1].T
-    return go.Mesh3d(x=x, y=y, z=z, i=i, j=j, k=k, color=colour, opacity=opacity, name=name,
-                     hovertemplate=f"{html.escape(name)}<extra></extra>",
-                     lighting=dict(ambient=0.55, diffuse=0.7, specular=0.15, roughness=0.6), **extra)
+    return dict(type="mesh3d", x=x, y=y, z=z, i=i, j=j, k=k, color=colour, opacity=opacity, name=name,
+                hovertemplate=f"{html.escape(name)}<extra></extra>",
+                lighting=dict(ambient=0.55, diffuse=0.7, specular=0.15, roughness=0.6), **extra)
 
 
 def arrow_scale(forces_N: NDArray, reach_mm: float) -> float:
@@ -119,10 +117,9 @@ def arrow_scale(forces_N: NDArray, reach_mm: float) -> float:
     return max(m * step for m in (1.0, 2.0, 5.0) if m * step <= raw)
 
 
-def _arrow_traces(points: NDArray, forces: NDArray, scale: float, colour: str, group: str, name: str) -> list[Any]:
+def _arrow_traces(points: NDArray, forces: NDArray, scale: float, colour: str, group: str,
+                  name: str) -> list[dict[str, Any]]:
     """Shafts and heads (cones) of the forces at ``points``, ``scale`` mm per N; none for a zero force."""
-    import plotly.graph_objects as go
-
     norms = np.linalg.norm(forces, axis=1)
     keep = norms > ZERO_FORCE_N
     if not keep.any():
@@ -131,24 +128,26 @@ def _arrow_traces(points: NDArray, forces: NDArray, scale: float, colour: str, g
     unit = f / n[:, None]
     tip = p + f * scale
     base = tip - unit * np.minimum(_HEAD_MM, 0.5 * n * scale)[:, None]  # a short arrow is half head
-    shafts = np.full((3 * len(p), 3), np.nan)
-    shafts[0::3], shafts[1::3] = p, base
+    shafts: list[Any] = []  # segments apart: a gap (None) after each
+    for a, b in zip(p.tolist(), base.tolist()):
+        shafts += [a, b, [None, None, None]]
+    sx, sy, sz = (list(c) for c in zip(*shafts))
     text = [f"{name}: |f| = {v:.3g} N<br>f = ({a:.3g}, {b:.3g}, {c:.3g}) N" for v, (a, b, c) in zip(n, f)]
     head = unit * np.minimum(_HEAD_MM, 0.5 * n * scale)[:, None]
-    return [go.Scatter3d(x=shafts[:, 0], y=shafts[:, 1], z=shafts[:, 2], mode="lines", line=dict(color=colour, width=8),
-                         legendgroup=group, showlegend=False, hoverinfo="skip", name=f"{name} force"),
-            go.Cone(x=tip[:, 0], y=tip[:, 1], z=tip[:, 2], u=head[:, 0], v=head[:, 1], w=head[:, 2], anchor="tip",
-                    sizemode="raw", sizeref=1.0, colorscale=[[0, colour], [1, colour]], showscale=False,
-                    legendgroup=group, showlegend=False, name=f"{name} force", text=text,
-                    hovertemplate="%{text}<extra></extra>")]
+    return [dict(type="scatter3d", x=sx, y=sy, z=sz, mode="lines", line=dict(color=colour, width=8),
+                 legendgroup=group, showlegend=False, hoverinfo="skip", name=f"{name} force"),
+            dict(type="cone", x=tip[:, 0], y=tip[:, 1], z=tip[:, 2], u=head[:, 0], v=head[:, 1], w=head[:, 2],
+                 anchor="tip", sizemode="raw", sizeref=1.0, colorscale=[[0, colour], [1, colour]], showscale=False,
+                 legendgroup=group, showlegend=False, name=f"{name} force", text=text,
+                 hovertemplate="%{text}<extra></extra>")]
 
 
-def grasp_figure(scene: GraspScene) -> Any:
-    """The grasp as a plotly figure (``plotly.graph_objects.Figure``): the hand's links, the
-    object see-through, the contact points and force arrows; the legend lists the links
-    touching the object (a click hides one with its contacts and arrows)."""
-    import plotly.graph_objects as go
-
+def grasp_figure(scene: GraspScene) -> dict[str, Any]:
+    """The grasp as a plotly figure, as its dict (``data``, ``layout``; plotly's own object:
+    ``plotly.graph_objects.Figure(it)``): the hand's links, the object see-through, the
+    contact points and force arrows; the legend lists the links touching the object (a click
+    hides one with its contacts and arrows). A dict, as plotly's objects check every value
+    as they are built, which takes longer than all the rest."""
     hand, meshes = scene.hand, _link_meshes(scene.hand, scene.q)
     touching = sorted(set(scene.links.tolist()))
     colours = {link: LINK_COLOURS[k % len(LINK_COLOURS)] for k, link in enumerate(touching)}
@@ -170,19 +169,19 @@ def grasp_figure(scene: GraspScene) -> Any:
         if link in meshes:
             traces.append(_mesh_trace(meshes[link], colours[link], label, legendgroup=group, showlegend=True))
         p = scene.points_mm[at]
-        traces.append(go.Scatter3d(x=p[:, 0], y=p[:, 1], z=p[:, 2], mode="markers", legendgroup=group,
-                                   showlegend=False, name=f"{name} contact",
-                                   marker=dict(size=5, color="white", line=dict(color=colours[link], width=3)),
-                                   hovertemplate=f"{name} contact<br>(%{{x:.1f}}, %{{y:.1f}}, %{{z:.1f}}) mm"
-                                                 "<extra></extra>"))
+        traces.append(dict(type="scatter3d", x=p[:, 0], y=p[:, 1], z=p[:, 2], mode="markers", legendgroup=group,
+                           showlegend=False, name=f"{name} contact",
+                           marker=dict(size=5, color="white", line=dict(color=colours[link], width=3)),
+                           hovertemplate=f"{name} contact<br>(%{{x:.1f}}, %{{y:.1f}}, %{{z:.1f}}) mm<extra></extra>"))
         if forces is not None:
             traces += _arrow_traces(p, forces[at], scale, colours[link], group, name)
     arrows = (f"arrows: optimal contact forces of {scene.force_set} on the object, 1 N = {scale:g} mm"
-              if forces is not None else f"no forces: {scene.force_set} is not feasible under the weight")
-    fig = go.Figure(traces)
+              if forces is not None else f"no arrows: {scene.force_set} is not feasible under the weight"
+              if scene.force_set else "no arrows: no set optimised (no grasp)")
     eye = -np.asarray(PALM_CAMERA.direction) / np.linalg.norm(PALM_CAMERA.direction) * 2.3
-    axis = dict(backgroundcolor="rgb(245, 245, 245)", gridcolor="white", showspikes=False)
-    fig.update_layout(
+    axis = dict(showbackground=True, backgroundcolor="rgb(235, 238, 243)", gridcolor="white", zerolinecolor="white",
+                linecolor="white", showspikes=False)
+    layout = dict(
         title=dict(text=f"{html.escape(scene.title)}<br><sup>palm frame, mm; hand skin-coloured, object blue "
                         f"and see-through; drag to turn, scroll to zoom</sup>", x=0.01, font=dict(size=15)),
         legend=dict(title=dict(text=f"links touching the object<br><sup>{html.escape(arrows)}</sup>"),
@@ -192,7 +191,7 @@ def grasp_figure(scene: GraspScene) -> Any:
                    yaxis=dict(title=dict(text="y (mm)"), **axis),
                    zaxis=dict(title=dict(text="z: along the fingers (mm)"), **axis)),
         margin=dict(l=0, r=0, t=70, b=0), paper_bgcolor="white")
-    return fig
+    return {"data": traces, "layout": layout}
 
 
 def _shape_words(shape: Any) -> str:
@@ -200,12 +199,14 @@ def _shape_words(shape: Any) -> str:
 
 
 def grasp_page(fig: Any, plotly_js: str | None = None) -> str:
-    """The figure as one HTML page: plotly's script inside it (``plotly_js`` None: a page that
-    stands alone) or loaded from the relative path ``plotly_js``. Nothing is fetched from the
-    network; the same figure gives the same page."""
-    return fig.to_html(full_html=True, include_plotlyjs=True if plotly_js is None else plotly_js,
+    """The figure (``grasp_figure``'s dict or a plotly Figure) as one HTML page: plotly's
+    script inside it (``plotly_js`` None: a page that stands alone) or loaded from the relative
+    path ``plotly_js``. Nothing is fetched from the network; the same figure gives the same page."""
+    import plotly.io as pio
+
+    return pio.to_html(fig, full_html=True, include_plotlyjs=True if plotly_js is None else plotly_js,
                        include_mathjax=False, div_id="grasp", default_width="100%", default_height="100vh",
-                       config={"displaylogo": False, "responsive": True})
+                       config={"displaylogo": False, "responsive": True}, validate=False)
 
 
 def write_grasp_pages(folder: str | Path, pages: Mapping[str, tuple[str, GraspScene]], title: str) -> None:
