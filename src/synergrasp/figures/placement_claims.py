@@ -43,7 +43,7 @@ def figure_placement_claims(summary: pd.DataFrame, png_path: str | Path, pdf_pat
             left += width
         for yi, at_chosen in zip(y, rows["at_chosen_target"]):
             ax.text(102, yi, _MARK.get(at_chosen, ""), va="center", fontsize=8, fontweight="bold",
-                    color=VERDICT_COLOURS.get(at_chosen, "black"))
+                    color="0.35" if at_chosen == "undefined" else VERDICT_COLOURS.get(at_chosen, "black"))
         ax.set_yticks(y, [f"claim {int(c)}" for c in rows["claim"]], fontsize=7)
         ax.set_xlim(0, 110)
         ax.set_xticks([0, 25, 50, 75, 100])
