@@ -2,9 +2,12 @@
 #   make venv           - build .venv from environment.lock only
 #   make study          - build .venv from environment.lock, then run the full study
 #   make test           - build .venv from environment.lock, then run the fast tier of the tests
-#                         (all but the end-to-end workflow runs, marker `workflow`)
+#                         (all but the end-to-end workflow runs, marker `workflow`, and the
+#                         pages in a real browser, marker `browser`)
 #   make test-workflow  - the end-to-end workflow tier alone (CI runs make test, then this)
-#   make test-all       - every test, the end-to-end workflow runs included
+#   make test-browser   - the browser tier alone: the 3-D pages in headless Chromium
+#                         (/usr/bin/chromium: apt-get install chromium; CI installs it)
+#   make test-all       - every test, the end-to-end workflow runs and the browser included
 #   make lint           - snakefmt --check, snakemake --lint (conda/container advice aside) and
 #                         the package's layers and no import circle (import-linter, pyproject.toml)
 #   make cluster-test   - the small study on a single-node SLURM started here (root; installs SLURM)
@@ -15,7 +18,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 CORES  ?= 2
 
-.PHONY: venv study test test-workflow test-all lint cluster-test bench bench-study lock report clean-venv
+.PHONY: venv study test test-workflow test-browser test-all lint cluster-test bench bench-study lock report clean-venv
 
 $(BIN)/.installed: environment.lock pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -44,12 +47,16 @@ PYTEST = rc=0; $(BIN)/python -m pytest $(1) || rc=$$?; if [ $$rc -eq 5 ]; then e
 
 test: $(BIN)/.installed
 	$(WARM_UP)
-	$(call PYTEST,-m "not workflow")
+	$(call PYTEST,-m "not workflow and not browser")
 
 # The end-to-end tier alone (what `make test` leaves out); CI runs `make test` then this.
 test-workflow: $(BIN)/.installed
 	$(WARM_UP)
 	$(call PYTEST,-m workflow)
+
+# The browser tier alone (what `make test` leaves out besides the workflow runs); CI runs it.
+test-browser: $(BIN)/.installed
+	$(call PYTEST,-m browser)
 
 test-all: $(BIN)/.installed
 	$(WARM_UP)
@@ -75,6 +82,7 @@ bench: $(BIN)/.installed
 	$(RECORD) closure -- $(BIN)/python benchmarks/bench_closure.py
 	$(RECORD) search -- $(BIN)/python benchmarks/bench_search.py
 	-$(RECORD) study_rate -- $(BIN)/python benchmarks/bench_study.py --root results
+	-$(RECORD) inspector -- $(BIN)/python benchmarks/bench_inspector.py --results results
 	$(BIN)/python tools/measurements.py
 
 # The default study timed from an empty results/ (move a previous one away first) and recorded

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -226,6 +227,39 @@ def test_bounding_radius_holds_the_shape_and_is_reached(shape, surface):
     reach = np.linalg.norm(surface.points, axis=1)
     assert reach.max() <= shape.bounding_radius_mm + 1e-9
     assert reach.max() >= shape.bounding_radius_mm - SPACING_MM
+
+
+def _volume(shape) -> float:
+    if shape.kind == "box":
+        return float(np.prod(shape.size_mm))
+    if shape.kind == "sphere":
+        return 4.0 / 3.0 * np.pi * shape.radius_mm ** 3
+    if shape.kind == "cylinder":
+        return np.pi * shape.radius_mm ** 2 * shape.height_mm
+    return sum(ConvexHull(part).volume for part in shape.geometry.parts)  # a mesh: its convex parts
+
+
+def test_the_surface_mesh_is_closed_outward_and_on_the_surface(shape):
+    R, c = _pose()
+    vertices, triangles = shape.surface_mesh(R, c)
+    local = (vertices - c) @ R
+    if shape.kind == "mesh":  # its parts' own vertices
+        known = {tuple(v) for v in np.round(np.concatenate(shape.geometry.parts), 6)}
+        assert {tuple(v) for v in np.round(local, 6)} <= known
+    else:  # convex about its centre: inside it, and outside it a hair further out
+        outward = local * (1.0 + 1e-6) + 1e-9 * np.sign(local)
+        assert inside(shape, local * (1.0 - 1e-9)).all() and not inside(shape, outward).any()
+    # welded at shared positions, every edge is used as often in one direction as in the other:
+    # closed surfaces (one per convex part of a mesh), each of one orientation
+    _, weld = np.unique(np.round(local, 6), axis=0, return_inverse=True)
+    t = weld.ravel()[triangles]
+    t = t[(t[:, 0] != t[:, 1]) & (t[:, 1] != t[:, 2]) & (t[:, 0] != t[:, 2])]
+    edges = [tuple(e) for e in np.vstack([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])]
+    assert Counter(edges) == Counter((b, a) for a, b in edges)
+    # outward: the divergence theorem gives the volume, positive (a polygon's: the exact one or a little less)
+    a, b, d = (local[triangles[:, k]] for k in range(3))
+    volume = float(np.einsum("ij,ij->i", a, np.cross(b, d)).sum() / 6.0)
+    assert 0.97 * _volume(shape) <= volume <= _volume(shape) * (1.0 + 1e-9)
 
 
 def test_start_rotation_puts_the_own_axes_on_the_palm_axes():

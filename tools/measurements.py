@@ -64,6 +64,12 @@ SECTIONS = (
     ("Grasp-force optimisation", ("gfo", "pyramid", "compile", "study_rate"),
      "`benchmarks/bench_gfo.py`, `bench_pyramid.py`, `bench_compile.py` and `bench_study.py` (in `make bench`; "
      "one core, OMP_NUM_THREADS=1); docs/batched_solver.md says what made each figure."),
+    ("One grasp in full", ("inspector",),
+     "`benchmarks/bench_inspector.py` (in `make bench`, after a study: it reads obj4's searched target): "
+     "`synergrasp grasp obj4 --alpha -30 --beta 0` with its 29 default sets, warm, each run in a fresh process "
+     "(median of 3), alone and with `--png` and `--html`; the target is at most 3 s wall on a quiet machine. "
+     "Then the workflow's `grasps_3d` step's work in one process: the 3-D pages of Fig. 2's 12 grasps from the "
+     "study's contacts (docs/inspector.md)."),
     ("Placement search", ("search",),
      "`benchmarks/bench_search.py` (in `make bench`): the default study's search of each object with 2 "
      "processes; the target is at most 30 s wall per object on 2 quiet cores (the study's own searches: "

@@ -190,6 +190,14 @@ STEPS: dict[str, Step] = {
         outputs=_files(("fig2_example_grasps",), "figures", _PNG_PDF),
         reads=("hand", "objects.*.shape"), upstream=("contacts",),
         params="synergrasp.figures.hand_figures:Fig2Params"),
+    # the Fig. 2 grasps in 3-D with the full set's optimal forces: pages sharing one plotly
+    # script (docs/inspector.md); a dozen optimisations and the pages' drawing
+    "grasps_3d": Step(
+        rules={"grasps_3d": Cost("none", 4.0, 400)},
+        outputs={"pages": "figures/grasps_3d"},
+        reads=("hand", "synergies", "mechanics", "synergy_sets.incremental_max", "objects.*.shape",
+               "objects.*.mass_kg"),
+        upstream=("contacts",), params="synergrasp.figures.grasp_3d:Grasps3dParams"),
     "fig4": Step(
         rules={"fig4_force_maps": Cost("pose_set", 4.3, 257, 5.1e-6, 4.0e-4)},
         outputs=_files(("fig4_force_maps", "fig4_exploded"), "", _PNG_PDF), scope="object",

@@ -3,6 +3,7 @@
 import functools
 import math
 import re
+import sys
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
@@ -375,3 +376,23 @@ def placement_claims_targets(name="default"):
         study_file(name, "placement_claims", rel)
         for rel in STEPS["placement_claims"].outputs.values()
     ]
+
+
+def _report_archive(argv):
+    """Whether the command writes the report as an archive (`--report <path>.zip`)."""
+    for k, arg in enumerate(argv):
+        path = arg.split("=", 1)[1] if arg.startswith("--report=") else None
+        if arg == "--report" and k + 1 < len(argv):
+            path = argv[k + 1]
+        if path is not None:
+            return path.endswith(".zip")
+    return False
+
+
+def pages_in_report(path, **report_args):
+    """A folder of pages (its index.html first), in the report when the report is an archive:
+    Snakemake's one-file HTML report refuses folders (and Chromium would not open a page of
+    several MB from it), so results/report.zip holds the 3-D pages and report.html does not."""
+    if _report_archive(sys.argv):
+        return report(directory(path), htmlindex="index.html", **report_args)
+    return directory(path)

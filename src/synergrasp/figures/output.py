@@ -12,14 +12,17 @@ _PNG_METADATA = {"Software": None}
 _PDF_METADATA = {"CreationDate": None, "ModDate": None, "Producer": None, "Creator": None}
 
 
-def save_figure(fig: Any, png_path: str | Path, pdf_path: str | Path, dpi: int = 150, tight: bool = False) -> None:
-    """Write a matplotlib figure as PNG (``dpi``) and PDF without dates or software
-    versions in their metadata, so that a rerun writes the same bytes; then close it."""
+def save_figure(fig: Any, png_path: str | Path, pdf_path: str | Path | None, dpi: int = 150,
+                tight: bool = False) -> None:
+    """Write a matplotlib figure as PNG (``dpi``) and PDF (none if ``pdf_path`` is None)
+    without dates or software versions in their metadata, so that a rerun writes the same
+    bytes; then close it."""
     import matplotlib.pyplot as plt
 
     extra = {"bbox_inches": "tight"} if tight else {}
     fig.savefig(png_path, dpi=dpi, metadata=_PNG_METADATA, **extra)
-    fig.savefig(pdf_path, metadata=_PDF_METADATA, **extra)
+    if pdf_path is not None:
+        fig.savefig(pdf_path, metadata=_PDF_METADATA, **extra)
     plt.close(fig)
 
 

@@ -6,7 +6,7 @@ distance queries (the nearest surface point and inward normal from a point,
 ``kernel_code`` and ``kernel_params`` in :mod:`synergrasp.simulation.capsules`), the distance
 to a box of the palm (intersection with the open hand), the bounding radius, the starting
 orientation, its symmetries (the α-period of the pose grid), the collision shape of the
-dynamic closure and the ray casting of the pictures. A shape is described in its own
+dynamic closure, the ray casting of the pictures and the triangles of the 3-D views. A shape is described in its own
 frame, centred on the origin (mm); the methods that answer in the palm frame take the
 object's pose: ``rotation`` (3 × 3, own frame → palm frame) and ``center`` (3,) mm.
 
@@ -142,6 +142,18 @@ class Shape(ABC):
     @abstractmethod
     def extent(self, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
         """Points (k, 3) (palm frame) and radii (k,) whose spheres cover the shape (pictures)."""
+
+    @abstractmethod
+    def own_mesh(self) -> tuple[NDArray, NDArray]:
+        """Triangles of its surface in its own frame (``synergrasp.simulation.shapes.surface``):
+        vertices (k, 3) mm, triangles (t, 3) vertex indices, counter-clockwise from outside."""
+
+    def surface_mesh(self, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
+        """Its surface's triangles at its pose: vertices (k, 3) palm frame, mm, and triangles
+        (t, 3) (3-D views)."""
+        from synergrasp.simulation.shapes.surface import placed
+
+        return placed(self.own_mesh(), rotation, center)
 
 
 def shape_from_config(spec: Mapping[str, Any], where: str = "shape") -> Shape:

@@ -189,3 +189,8 @@ class Mesh(Shape):
     def extent(self, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
         return self._hull @ rotation.T + center, np.zeros(len(self._hull))
 
+
+    def own_mesh(self) -> tuple[NDArray, NDArray]:
+        from synergrasp.simulation.shapes.surface import hull_mesh, merge_meshes
+
+        return merge_meshes([hull_mesh(part) for part in self.geometry.parts])  # the object is its convex parts
