@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from synergrasp.hand.kinematics import forward_kinematics, load_hand
-from synergrasp.simulation.capsules import HandCapsules, segment_box_distance, segment_segment_distance
+from synergrasp.simulation.capsules import HandCapsules, segment_segment_distance
+from synergrasp.simulation.shapes.kernels import segment_box_distance
 
 RNG = np.random.default_rng(7)
 

@@ -4,11 +4,11 @@ The shipped hand is a palm box and one capsule per finger link (docs/hand.md). T
 kinematic closure asks, at every posture it tries, how far each link is from the box and
 from the hand links it may run into; the closed forms here answer for all of them at once
 on the exact shapes (the box has no collision margin, so contact points lie on its
-surface). They are compiled with numba (cached next to the source, like the batched
-solver): a posture costs a few microseconds instead of the milliseconds of a collision
-library's per-pair queries. Signed distances: negative = overlap (a capsule crossing a
-box: minus its deepest penetration among the breaks, the pieces' middles and nine points
-of its axis; the closure only needs the sign there).
+surface). They are compiled with numba (cached next to the source): a posture costs a few
+microseconds instead of the milliseconds of a collision library's per-pair queries. Signed distances: negative =
+overlap (a capsule crossing the object or a palm box: minus the deepest penetration found;
+the closure only needs the sign there). The queries of a segment against each shape, the
+palm's boxes included, are ``synergrasp.simulation.shapes.kernels``.
 """
 
 from __future__ import annotations
@@ -21,17 +21,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from synergrasp.hand.checks import closure_shape_problems
-from synergrasp.simulation.shapes.kernels import segment_cylinder, segment_sphere, sort_knots
-from synergrasp.simulation.shapes.polytope import WORK, segment_parts
+from synergrasp.simulation.shapes.kernels import segment_box, segment_object
+from synergrasp.simulation.shapes.polytope import WORK
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
 
-__all__ = ["HandCapsules", "segment_segment_distance", "segment_box_distance", "segment_object_distance",
-           "capsule_object", "pair_gaps", "nearest_per_link", "posture_gaps"]
+__all__ = ["HandCapsules", "segment_segment_distance", "capsule_object", "pair_gaps", "nearest_per_link",
+           "posture_gaps"]
 
 _EPS = 1e-12
-_FLAT_MM2 = 1e-9  # squared distances (mm²) this close count as equal (flat stretch of a segment)
 
 
 @numba.njit(cache=True)
@@ -61,98 +60,6 @@ def _seg_seg(p0: NDArray, p1: NDArray, q0: NDArray, q1: NDArray) -> float:
         s = min(max((b - c) / a, 0.0), 1.0) if a > _EPS else 0.0
     g0, g1, g2 = r0 + s * d10 - t * d20, r1 + s * d11 - t * d21, r2 + s * d12 - t * d22
     return np.sqrt(_dot(g0, g1, g2, g0, g1, g2))
-
-
-@numba.njit(cache=True)
-def _sq_excess(p0: NDArray, d: NDArray, half: NDArray, t: float) -> float:
-    total = 0.0
-    for i in range(3):
-        e = abs(p0[i] + t * d[i]) - half[i]
-        if e > 0.0:
-            total += e * e
-    return total
-
-
-@numba.njit(cache=True)
-def _depth(p0: NDArray, d: NDArray, half: NDArray, t: float) -> float:
-    slack = np.inf
-    for i in range(3):
-        slack = min(slack, half[i] - abs(p0[i] + t * d[i]))
-    return slack
-
-
-@numba.njit(cache=True)
-def _seg_box(p0: NDArray, p1: NDArray, half: NDArray) -> tuple[float, float]:
-    """See ``_seg_box_into`` (allocates its own work arrays)."""
-    return _seg_box_into(p0, p1 - p0, half, np.empty(8))
-
-
-@numba.njit(cache=True)
-def _seg_box_into(p0: NDArray, d: NDArray, half: NDArray, knots: NDArray) -> tuple[float, float]:
-    """Signed distance (mm) from segment p0–p1 (box frame) to the box [-half, half] and the
-    segment parameter t in [0, 1] attaining it. The squared distance along the segment is
-    convex and piecewise quadratic with breaks where a coordinate crosses ±half: its
-    minimum is at a break, an end, or the vertex of one piece. ``d`` = p1 − p0; ``knots`` is
-    work space of 8 values."""
-    knots[0], knots[1] = 0.0, 1.0
-    n = 2
-    for i in range(3):
-        if abs(d[i]) > _EPS:
-            for k in range(2):
-                tb = ((half[i] if k == 0 else -half[i]) - p0[i]) / d[i]
-                if 0.0 < tb < 1.0:
-                    knots[n] = tb
-                    n += 1
-    sort_knots(knots, n)
-    best_sq, best_t = np.inf, 0.0
-    for k in range(n):
-        sq = _sq_excess(p0, d, half, knots[k])
-        if sq < best_sq:
-            best_sq, best_t = sq, knots[k]
-    for k in range(n - 1):
-        lo, hi = knots[k], knots[k + 1]
-        mid = 0.5 * (lo + hi)
-        num, den = 0.0, 0.0
-        for i in range(3):
-            x = p0[i] + mid * d[i]
-            if x > half[i] or x < -half[i]:
-                a = p0[i] - (half[i] if x > 0.0 else -half[i])
-                num -= a * d[i]
-                den += d[i] * d[i]
-        tv = min(max(num / den, lo), hi) if den > _EPS else mid
-        sq = _sq_excess(p0, d, half, tv)
-        if sq < best_sq:
-            best_sq, best_t = sq, tv
-    if best_sq > 0.0:
-        # a segment parallel to a face or edge is nearest along an interval (bounded by
-        # knots): take its middle, which does not depend on the box's own axes
-        t_lo, t_hi = best_t, best_t
-        for k in range(n):
-            if _sq_excess(p0, d, half, knots[k]) <= best_sq + _FLAT_MM2:
-                t_lo, t_hi = min(t_lo, knots[k]), max(t_hi, knots[k])
-        return np.sqrt(best_sq), 0.5 * (t_lo + t_hi)
-    deepest, at = 0.0, best_t  # crossing the box: minus the deepest penetration found
-    for k in range(2 * n):
-        tc = knots[k // 2] if k % 2 == 0 else 0.5 * (knots[k // 2] + knots[min(k // 2 + 1, n - 1)])
-        dep = _depth(p0, d, half, tc)
-        if dep > deepest:
-            deepest, at = dep, tc
-    for j in range(9):
-        dep = _depth(p0, d, half, j / 8.0)
-        if dep > deepest:
-            deepest, at = dep, j / 8.0
-    return -deepest, at
-
-
-@numba.njit(cache=True)
-def segment_box_distance(p0: NDArray, p1: NDArray, half: NDArray) -> tuple[NDArray, NDArray]:
-    """Signed distances (k,) from segments p0–p1 ((k, 3), each in its box's frame) to the
-    boxes [-half, half] ((k, 3)), and the segment parameters (k,) attaining them."""
-    k = p0.shape[0]
-    dist, t = np.empty(k), np.empty(k)
-    for i in range(k):
-        dist[i], t[i] = _seg_box(p0[i], p1[i], half[i])
-    return dist, t
 
 
 @numba.njit(cache=True)
@@ -221,35 +128,7 @@ def _capsule_to_box(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray
     _to_box(p1, rotation, centre, work[1])
     for i in range(3):
         work[1, i] -= work[0, i]
-    return _seg_box_into(work[0, :3], work[1, :3], half, work[2])
-
-
-@numba.njit(cache=True)
-def _seg_object(p0: NDArray, d: NDArray, code: int, params: NDArray, work: NDArray) -> tuple[float, float]:
-    """Signed distance (mm) from the segment p0 + t·d, t in [0, 1] (the object's own frame),
-    to the object's shape (``code``, ``params``: ``synergrasp.simulation.shapes``) and the t
-    attaining it; ``work`` is scratch space of ``WORK`` values. 0: a box, params its half extents;
-    1: a sphere about the origin, (radius); 2: a cylinder about the z axis, (radius, half height);
-    3: convex parts (a mesh), ``polytope.pack_parts``."""
-    if code == 0:
-        return _seg_box_into(p0, d, params, work)
-    if code == 1:
-        return segment_sphere(p0, d, params[0])
-    if code == 2:
-        return segment_cylinder(p0, d, params[0], params[1], work)
-    return segment_parts(p0, d, params, work)
-
-
-@numba.njit(cache=True)
-def segment_object_distance(p0: NDArray, p1: NDArray, code: int, params: NDArray) -> tuple[NDArray, NDArray]:
-    """Signed distances (k,) from segments p0–p1 ((k, 3), the object's own frame) to one
-    object shape (``code``, ``params``) and the segment parameters (k,) attaining them."""
-    k = p0.shape[0]
-    dist, t = np.empty(k), np.empty(k)
-    work = np.empty(WORK)
-    for i in range(k):
-        dist[i], t[i] = _seg_object(p0[i], p1[i] - p0[i], code, params, work)
-    return dist, t
+    return segment_box(work[0, :3], work[1, :3], half, work[2])
 
 
 @numba.njit(cache=True)
@@ -261,7 +140,7 @@ def _capsule_to_object(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDAr
     _to_box(p1, rotation, centre, work[1])
     for i in range(3):
         work[1, i] -= work[0, i]
-    return _seg_object(work[0, :3], work[1, :3], code, params, work[2])
+    return segment_object(work[0, :3], work[1, :3], code, params, work[2])
 
 
 @numba.njit(cache=True)

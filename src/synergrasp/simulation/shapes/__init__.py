@@ -3,7 +3,7 @@
 Every step that needs to know what is grasped asks its :class:`Shape`: the closure's
 distance queries (the nearest surface point and inward normal from a point,
 :meth:`Shape.surface_point`; the signed distance from a capsule's axis, compiled, by
-``kernel_code`` and ``kernel_params`` in :mod:`synergrasp.simulation.capsules`), the distance
+``kernel_code`` and ``kernel_params`` in :mod:`synergrasp.simulation.shapes.kernels`), the distance
 to a box of the palm (intersection with the open hand), the bounding radius, the starting
 orientation, its symmetries (the α-period of the pose grid), the collision shape of the
 dynamic closure, the ray casting of the pictures and the triangles of the 3-D views. A shape is described in its own
@@ -23,6 +23,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
+
+from synergrasp.simulation.shapes.kernels import segment_object_distance
 
 __all__ = ["Shape", "ShapeError", "SHAPES", "shape_from_config", "start_rotation", "positive_length", "Box", "Sphere",
            "Cylinder", "Mesh"]
@@ -99,8 +101,6 @@ class Shape(ABC):
         """Signed distances (k,) from segments p0–p1 ((k, 3), own frame, mm) to the shape and
         the segment parameters in [0, 1] attaining them (negative: the segment crosses it,
         minus a penetration depth). The closure's compiled query, here for tests."""
-        from synergrasp.simulation.capsules import segment_object_distance
-
         return segment_object_distance(np.ascontiguousarray(p0, dtype=float), np.ascontiguousarray(p1, dtype=float),
                                        self.kernel_code, self.kernel_params)
 

@@ -1,12 +1,14 @@
-"""Compiled segment queries of the round shapes (numba, cached next to the source; mm).
+"""Compiled segment queries of the shapes (numba; mm) and the dispatch on a shape's code.
 
 The closure asks, at every posture, for the signed distance from each capsule's axis to the
-object (``synergrasp.simulation.capsules._seg_object`` dispatches on the shape's code; the
-box's query lives there, as the palm is made of boxes too). Both answers here are in the
-shape's own frame and follow the box's conventions: the segment is p0 + t·d, t in [0, 1];
-outside, the exact distance and the t attaining it (on a stretch of equal distance, the
-middle of the stretch, so that t does not depend on how the segment is oriented along it);
-crossing the shape, minus the deepest penetration of a point of the segment.
+object (``segment_object`` dispatches on the shape's ``kernel_code``; the box's query also
+serves the palm's boxes in ``synergrasp.simulation.capsules``, and the convex parts' is
+``polytope.segment_parts``). Every answer is in the shape's own frame and follows the same
+conventions: the segment is p0 + t·d, t in [0, 1]; outside, the exact distance and the t
+attaining it (on a stretch of equal distance, the middle of the stretch, so that t does not
+depend on how the segment is oriented along it); crossing the shape, minus the deepest
+penetration found (the box: among the breaks, the pieces' middles and nine points of the
+segment).
 """
 
 from __future__ import annotations
@@ -15,10 +17,14 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["sort_knots", "segment_sphere", "segment_cylinder", "cylinder_sdf"]
+from synergrasp.simulation.shapes.polytope import WORK, segment_parts
+
+__all__ = ["sort_knots", "segment_sphere", "segment_cylinder", "cylinder_sdf", "segment_box", "segment_box_distance",
+           "segment_object", "segment_object_distance"]
 
 _EPS = 1e-12
 _FLAT_MM = 1e-9  # distances (mm) this close count as equal (a flat stretch of the segment)
+_FLAT_MM2 = 1e-9  # squared distances (mm²) this close count as equal (the box's flat stretch)
 _GOLDEN = 0.6180339887498949
 _GOLDEN_STEPS = 60
 
@@ -143,3 +149,118 @@ def segment_cylinder(p0: NDArray, d: NDArray, radius: float, half_height: float,
             best_t = 0.5 * (t_lo + t_hi)
             best = min(best, _sdf_at(p0, d, best_t, radius, half_height))
     return best, best_t
+
+
+@numba.njit(cache=True)
+def _sq_excess(p0: NDArray, d: NDArray, half: NDArray, t: float) -> float:
+    total = 0.0
+    for i in range(3):
+        e = abs(p0[i] + t * d[i]) - half[i]
+        if e > 0.0:
+            total += e * e
+    return total
+
+
+@numba.njit(cache=True)
+def _depth(p0: NDArray, d: NDArray, half: NDArray, t: float) -> float:
+    slack = np.inf
+    for i in range(3):
+        slack = min(slack, half[i] - abs(p0[i] + t * d[i]))
+    return slack
+
+
+@numba.njit(cache=True)
+def segment_box(p0: NDArray, d: NDArray, half: NDArray, knots: NDArray) -> tuple[float, float]:
+    """Signed distance (mm) from segment p0–p1 (box frame) to the box [-half, half] and the
+    segment parameter t in [0, 1] attaining it. The squared distance along the segment is
+    convex and piecewise quadratic with breaks where a coordinate crosses ±half: its
+    minimum is at a break, an end, or the vertex of one piece. ``d`` = p1 − p0; ``knots`` is
+    work space of 8 values."""
+    knots[0], knots[1] = 0.0, 1.0
+    n = 2
+    for i in range(3):
+        if abs(d[i]) > _EPS:
+            for k in range(2):
+                tb = ((half[i] if k == 0 else -half[i]) - p0[i]) / d[i]
+                if 0.0 < tb < 1.0:
+                    knots[n] = tb
+                    n += 1
+    sort_knots(knots, n)
+    best_sq, best_t = np.inf, 0.0
+    for k in range(n):
+        sq = _sq_excess(p0, d, half, knots[k])
+        if sq < best_sq:
+            best_sq, best_t = sq, knots[k]
+    for k in range(n - 1):
+        lo, hi = knots[k], knots[k + 1]
+        mid = 0.5 * (lo + hi)
+        num, den = 0.0, 0.0
+        for i in range(3):
+            x = p0[i] + mid * d[i]
+            if x > half[i] or x < -half[i]:
+                a = p0[i] - (half[i] if x > 0.0 else -half[i])
+                num -= a * d[i]
+                den += d[i] * d[i]
+        tv = min(max(num / den, lo), hi) if den > _EPS else mid
+        sq = _sq_excess(p0, d, half, tv)
+        if sq < best_sq:
+            best_sq, best_t = sq, tv
+    if best_sq > 0.0:
+        # a segment parallel to a face or edge is nearest along an interval (bounded by
+        # knots): take its middle, which does not depend on the box's own axes
+        t_lo, t_hi = best_t, best_t
+        for k in range(n):
+            if _sq_excess(p0, d, half, knots[k]) <= best_sq + _FLAT_MM2:
+                t_lo, t_hi = min(t_lo, knots[k]), max(t_hi, knots[k])
+        return np.sqrt(best_sq), 0.5 * (t_lo + t_hi)
+    deepest, at = 0.0, best_t  # crossing the box: minus the deepest penetration found
+    for k in range(2 * n):
+        tc = knots[k // 2] if k % 2 == 0 else 0.5 * (knots[k // 2] + knots[min(k // 2 + 1, n - 1)])
+        dep = _depth(p0, d, half, tc)
+        if dep > deepest:
+            deepest, at = dep, tc
+    for j in range(9):
+        dep = _depth(p0, d, half, j / 8.0)
+        if dep > deepest:
+            deepest, at = dep, j / 8.0
+    return -deepest, at
+
+
+@numba.njit(cache=True)
+def segment_box_distance(p0: NDArray, p1: NDArray, half: NDArray) -> tuple[NDArray, NDArray]:
+    """Signed distances (k,) from segments p0–p1 ((k, 3), each in its box's frame) to the
+    boxes [-half, half] ((k, 3)), and the segment parameters (k,) attaining them."""
+    k = p0.shape[0]
+    dist, t = np.empty(k), np.empty(k)
+    knots = np.empty(8)
+    for i in range(k):
+        dist[i], t[i] = segment_box(p0[i], p1[i] - p0[i], half[i], knots)
+    return dist, t
+
+
+@numba.njit(cache=True)
+def segment_object(p0: NDArray, d: NDArray, code: int, params: NDArray, work: NDArray) -> tuple[float, float]:
+    """Signed distance (mm) from the segment p0 + t·d, t in [0, 1] (the object's own frame),
+    to the object's shape (``code``, ``params``: ``synergrasp.simulation.shapes``) and the t
+    attaining it; ``work`` is scratch space of ``WORK`` values. 0: a box, params its half extents;
+    1: a sphere about the origin, (radius); 2: a cylinder about the z axis, (radius, half height);
+    3: convex parts (a mesh), ``polytope.pack_parts``."""
+    if code == 0:
+        return segment_box(p0, d, params, work)
+    if code == 1:
+        return segment_sphere(p0, d, params[0])
+    if code == 2:
+        return segment_cylinder(p0, d, params[0], params[1], work)
+    return segment_parts(p0, d, params, work)
+
+
+@numba.njit(cache=True)
+def segment_object_distance(p0: NDArray, p1: NDArray, code: int, params: NDArray) -> tuple[NDArray, NDArray]:
+    """Signed distances (k,) from segments p0–p1 ((k, 3), the object's own frame) to one
+    object shape (``code``, ``params``) and the segment parameters (k,) attaining them."""
+    k = p0.shape[0]
+    dist, t = np.empty(k), np.empty(k)
+    work = np.empty(WORK)
+    for i in range(k):
+        dist[i], t[i] = segment_object(p0[i], p1[i] - p0[i], code, params, work)
+    return dist, t
