@@ -195,24 +195,3 @@ def test_range_basis_against_lapack_svd(seed):
     # the kept directions span F up to the dropped singular values
     dropped = lapack[lapack <= 1e-9].max(initial=0.0)
     assert np.linalg.norm(F - E @ (E.T @ F), 2) <= dropped + 1e-13 * lapack[0]
-
-
-def test_kernel_cache_is_named_by_its_sources_not_by_the_checkout_path():
-    """The compiled kernel is cached under `cache_dir()` (any checkout of the same sources
-    loads it), and every module of the package is in the hash (a caller's cache embeds its
-    callees, so an unlisted module could leave stale machine code)."""
-    import hashlib
-    from pathlib import Path
-
-    from synergrasp.optimisation.ipm import compiled, iteration, sets
-
-    package = Path(compiled.__file__).parent
-    assert {p.name for p in package.glob("*.py")} - {"__init__.py"} == set(compiled.KERNEL_SOURCES)
-    digest = hashlib.sha256()
-    for name in compiled.KERNEL_SOURCES:
-        digest.update(name.encode())
-        digest.update((package / name).read_bytes())
-    assert compiled.cache_dir().name == digest.hexdigest()[:16]
-    for dispatcher in (sets.solve_sets, iteration.hsde):
-        assert dispatcher._cache.cache_path == str(compiled.cache_dir())
-        assert str(package) not in dispatcher._cache.cache_path

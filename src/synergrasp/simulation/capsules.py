@@ -4,8 +4,9 @@ The shipped hand is a palm box and one capsule per finger link (docs/hand.md). T
 kinematic closure asks, at every posture it tries, how far each link is from the box and
 from the hand links it may run into; the closed forms here answer for all of them at once
 on the exact shapes (the box has no collision margin, so contact points lie on its
-surface). They are compiled with numba (cached next to the source): a posture costs a few
-microseconds instead of the milliseconds of a collision library's per-pair queries. Signed distances: negative =
+surface). They are compiled with numba, cached with the shapes' queries they call
+(``synergrasp.simulation.shapes.compiled``): a posture costs a few microseconds instead of
+the milliseconds of a collision library's per-pair queries. Signed distances: negative =
 overlap (a capsule crossing the object or a palm box: minus the deepest penetration found;
 the closure only needs the sign there). The queries of a segment against each shape, the
 palm's boxes included, are ``synergrasp.simulation.shapes.kernels``.
@@ -16,11 +17,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
 
 from synergrasp.hand.checks import closure_shape_problems
+from synergrasp.simulation.shapes.compiled import jit
 from synergrasp.simulation.shapes.kernels import segment_box, segment_object
 from synergrasp.simulation.shapes.polytope import WORK
 
@@ -33,12 +34,12 @@ __all__ = ["HandCapsules", "segment_segment_distance", "capsule_object", "pair_g
 _EPS = 1e-12
 
 
-@numba.njit(cache=True)
+@jit
 def _dot(a0: float, a1: float, a2: float, b0: float, b1: float, b2: float) -> float:
     return a0 * b0 + a1 * b1 + a2 * b2
 
 
-@numba.njit(cache=True)
+@jit
 def _seg_seg(p0: NDArray, p1: NDArray, q0: NDArray, q1: NDArray) -> float:
     """Distance (mm) between segments p0–p1 and q0–q1: the clamped closed form."""
     d10, d11, d12 = p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]
@@ -62,7 +63,7 @@ def _seg_seg(p0: NDArray, p1: NDArray, q0: NDArray, q1: NDArray) -> float:
     return np.sqrt(_dot(g0, g1, g2, g0, g1, g2))
 
 
-@numba.njit(cache=True)
+@jit
 def segment_segment_distance(p0: NDArray, p1: NDArray, q0: NDArray, q1: NDArray) -> NDArray:
     """(k,) distances (mm) between the segments p0–p1 and q0–q1 ((k, 3) each)."""
     out = np.empty(p0.shape[0])
@@ -71,7 +72,7 @@ def segment_segment_distance(p0: NDArray, p1: NDArray, q0: NDArray, q1: NDArray)
     return out
 
 
-@numba.njit(cache=True)
+@jit
 def _frames(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: NDArray,
             scale: NDArray) -> NDArray:
     """(n_frames, 4, 4) frame transforms at q (the same chain as ``hand.frame_transforms``)."""
@@ -99,7 +100,7 @@ def _frames(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: 
     return out
 
 
-@numba.njit(cache=True)
+@jit
 def _segments(frames: NDArray, cap_frame: NDArray, ends: NDArray) -> tuple[NDArray, NDArray]:
     c = cap_frame.shape[0]
     p0, p1 = np.empty((c, 3)), np.empty((c, 3))
@@ -111,7 +112,7 @@ def _segments(frames: NDArray, cap_frame: NDArray, ends: NDArray) -> tuple[NDArr
     return p0, p1
 
 
-@numba.njit(cache=True)
+@jit
 def _to_box(p: NDArray, rotation: NDArray, centre: NDArray, out: NDArray) -> None:
     """p (palm frame) in the frame of a box at (rotation, centre): out = rotationᵀ (p − centre)."""
     for j in range(3):
@@ -119,7 +120,7 @@ def _to_box(p: NDArray, rotation: NDArray, centre: NDArray, out: NDArray) -> Non
                   + (p[2] - centre[2]) * rotation[2, j])
 
 
-@numba.njit(cache=True)
+@jit
 def _capsule_to_box(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray, half: NDArray,
                     work: NDArray) -> tuple[float, float]:
     """Signed distance of the axis p0–p1 (palm frame) to a box at (rotation, centre) and its
@@ -131,7 +132,7 @@ def _capsule_to_box(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray
     return segment_box(work[0, :3], work[1, :3], half, work[2])
 
 
-@numba.njit(cache=True)
+@jit
 def _capsule_to_object(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray, code: int, params: NDArray,
                        work: NDArray) -> tuple[float, float]:
     """Signed distance of the axis p0–p1 (palm frame) to an object at (rotation, centre) and
@@ -143,7 +144,7 @@ def _capsule_to_object(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDAr
     return segment_object(work[0, :3], work[1, :3], code, params, work[2])
 
 
-@numba.njit(cache=True)
+@jit
 def capsule_object(p0: NDArray, p1: NDArray, radius: NDArray, rotation: NDArray, centre: NDArray, code: int,
                    params: NDArray) -> tuple[NDArray, NDArray]:
     """Signed distance (c,) of every capsule to the object (shape ``code``, ``params``; palm
@@ -157,7 +158,7 @@ def capsule_object(p0: NDArray, p1: NDArray, radius: NDArray, rotation: NDArray,
     return dist, t
 
 
-@numba.njit(cache=True)
+@jit
 def pair_gaps(p0: NDArray, p1: NDArray, radius: NDArray, first: NDArray, second: NDArray,
               palm_rotation: NDArray, palm_centre: NDArray, palm_half: NDArray) -> NDArray:
     """Signed distance (p,) of pairs of capsules (rows ``first``, ``second``); ``second`` = -1:
@@ -177,7 +178,7 @@ def pair_gaps(p0: NDArray, p1: NDArray, radius: NDArray, first: NDArray, second:
     return out
 
 
-@numba.njit(cache=True)
+@jit
 def nearest_per_link(gaps: NDArray, ends: NDArray, n_links: int) -> tuple[NDArray, NDArray]:
     """Per link, the smallest gap (mm) of the pairs ``ends`` (p, 2) it belongs to and the other
     link of that pair: (n_links,) distances (+inf where none) and partners (-1 where none)."""
@@ -191,7 +192,7 @@ def nearest_per_link(gaps: NDArray, ends: NDArray, n_links: int) -> tuple[NDArra
     return d, partner
 
 
-@numba.njit(cache=True)
+@jit
 def posture_gaps(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: NDArray, scale: NDArray,
                  cap_frame: NDArray, ends: NDArray, radius: NDArray, cap_link: NDArray, palm_gap: float,
                  object_rotation: NDArray, object_centre: NDArray, code: int, params: NDArray, first: NDArray,

@@ -13,10 +13,10 @@ segment).
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from synergrasp.simulation.shapes.compiled import jit
 from synergrasp.simulation.shapes.polytope import WORK, segment_parts
 
 __all__ = ["sort_knots", "segment_sphere", "segment_cylinder", "cylinder_sdf", "segment_box", "segment_box_distance",
@@ -29,7 +29,7 @@ _GOLDEN = 0.6180339887498949
 _GOLDEN_STEPS = 60
 
 
-@numba.njit(cache=True)
+@jit
 def sort_knots(knots: NDArray, n: int) -> None:
     """Sort the first ``n`` values of ``knots`` in place (insertion sort: n is at most 8)."""
     for k in range(1, n):
@@ -40,7 +40,7 @@ def sort_knots(knots: NDArray, n: int) -> None:
         knots[j + 1] = v
 
 
-@numba.njit(cache=True)
+@jit
 def segment_sphere(p0: NDArray, d: NDArray, radius: float) -> tuple[float, float]:
     """Signed distance from the segment p0 + t·d to the sphere of ``radius`` about the origin
     and the t attaining it: the axis point nearest the centre (exact, also when crossing)."""
@@ -52,7 +52,7 @@ def segment_sphere(p0: NDArray, d: NDArray, radius: float) -> tuple[float, float
     return np.sqrt(x * x + y * y + z * z) - radius, t
 
 
-@numba.njit(cache=True)
+@jit
 def cylinder_sdf(x: float, y: float, z: float, radius: float, half_height: float) -> float:
     """Signed distance (mm) of the point (x, y, z) to the solid cylinder about the z axis
     (radius, |z| ≤ half_height): negative inside (minus the depth)."""
@@ -63,12 +63,12 @@ def cylinder_sdf(x: float, y: float, z: float, radius: float, half_height: float
     return max(dr, dz)
 
 
-@numba.njit(cache=True)
+@jit
 def _sdf_at(p0: NDArray, d: NDArray, t: float, radius: float, half_height: float) -> float:
     return cylinder_sdf(p0[0] + t * d[0], p0[1] + t * d[1], p0[2] + t * d[2], radius, half_height)
 
 
-@numba.njit(cache=True)
+@jit
 def _golden(p0: NDArray, d: NDArray, lo: float, hi: float, radius: float, half_height: float) -> float:
     """The t of least signed distance on [lo, hi] (a convex function of t): golden section."""
     a, b = lo, hi
@@ -86,7 +86,7 @@ def _golden(p0: NDArray, d: NDArray, lo: float, hi: float, radius: float, half_h
     return 0.5 * (a + b)
 
 
-@numba.njit(cache=True)
+@jit
 def segment_cylinder(p0: NDArray, d: NDArray, radius: float, half_height: float,
                      knots: NDArray) -> tuple[float, float]:
     """Signed distance from the segment p0 + t·d to the solid cylinder about the z axis and
@@ -151,7 +151,7 @@ def segment_cylinder(p0: NDArray, d: NDArray, radius: float, half_height: float,
     return best, best_t
 
 
-@numba.njit(cache=True)
+@jit
 def _sq_excess(p0: NDArray, d: NDArray, half: NDArray, t: float) -> float:
     total = 0.0
     for i in range(3):
@@ -161,7 +161,7 @@ def _sq_excess(p0: NDArray, d: NDArray, half: NDArray, t: float) -> float:
     return total
 
 
-@numba.njit(cache=True)
+@jit
 def _depth(p0: NDArray, d: NDArray, half: NDArray, t: float) -> float:
     slack = np.inf
     for i in range(3):
@@ -169,7 +169,7 @@ def _depth(p0: NDArray, d: NDArray, half: NDArray, t: float) -> float:
     return slack
 
 
-@numba.njit(cache=True)
+@jit
 def segment_box(p0: NDArray, d: NDArray, half: NDArray, knots: NDArray) -> tuple[float, float]:
     """Signed distance (mm) from segment p0–p1 (box frame) to the box [-half, half] and the
     segment parameter t in [0, 1] attaining it. The squared distance along the segment is
@@ -226,7 +226,7 @@ def segment_box(p0: NDArray, d: NDArray, half: NDArray, knots: NDArray) -> tuple
     return -deepest, at
 
 
-@numba.njit(cache=True)
+@jit
 def segment_box_distance(p0: NDArray, p1: NDArray, half: NDArray) -> tuple[NDArray, NDArray]:
     """Signed distances (k,) from segments p0–p1 ((k, 3), each in its box's frame) to the
     boxes [-half, half] ((k, 3)), and the segment parameters (k,) attaining them."""
@@ -238,7 +238,7 @@ def segment_box_distance(p0: NDArray, p1: NDArray, half: NDArray) -> tuple[NDArr
     return dist, t
 
 
-@numba.njit(cache=True)
+@jit
 def segment_object(p0: NDArray, d: NDArray, code: int, params: NDArray, work: NDArray) -> tuple[float, float]:
     """Signed distance (mm) from the segment p0 + t·d, t in [0, 1] (the object's own frame),
     to the object's shape (``code``, ``params``: ``synergrasp.simulation.shapes``) and the t
@@ -254,7 +254,7 @@ def segment_object(p0: NDArray, d: NDArray, code: int, params: NDArray, work: ND
     return segment_parts(p0, d, params, work)
 
 
-@numba.njit(cache=True)
+@jit
 def segment_object_distance(p0: NDArray, p1: NDArray, code: int, params: NDArray) -> tuple[NDArray, NDArray]:
     """Signed distances (k,) from segments p0–p1 ((k, 3), the object's own frame) to one
     object shape (``code``, ``params``) and the segment parameters (k,) attaining them."""

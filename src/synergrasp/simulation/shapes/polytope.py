@@ -18,9 +18,10 @@ entries and penetration depths: ``polytope_axes``."""
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
+
+from synergrasp.simulation.shapes.compiled import jit
 
 __all__ = ["WORK", "pack_parts", "segment_parts", "point_parts", "points_gap", "convex_distance"]
 
@@ -71,18 +72,18 @@ def _vertex_graph(vertices: NDArray) -> tuple[NDArray, NDArray]:
     return starts.astype(float), edges[:, 1].astype(float)
 
 
-@numba.njit(cache=True)
+@jit
 def _d3(a: NDArray, b: NDArray) -> float:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@numba.njit(cache=True)
+@jit
 def _part(params: NDArray, k: int) -> tuple[int, int, int, int]:
     h = 1 + _HEADER * k
     return int(params[h]), int(params[h + 1]), int(params[h + 2]), int(params[h + 3])
 
 
-@numba.njit(cache=True)
+@jit
 def _support(params: NDArray, part: int, start: int, x: float, y: float, z: float) -> int:
     """Index of a vertex of the part farthest along (x, y, z): from ``start``, on to a better
     neighbour while there is one. On a convex polytope a vertex no neighbour of which is
@@ -105,13 +106,13 @@ def _support(params: NDArray, part: int, start: int, x: float, y: float, z: floa
     return i
 
 
-@numba.njit(cache=True)
+@jit
 def _dot(w: NDArray, i: int, j: int, k: int) -> float:
     """(w[j] − w[i]) · (−w[k])."""
     return -((w[j, 0] - w[i, 0]) * w[k, 0] + (w[j, 1] - w[i, 1]) * w[k, 1] + (w[j, 2] - w[i, 2]) * w[k, 2])
 
 
-@numba.njit(cache=True)
+@jit
 def _on_edge(w: NDArray, a: int, b: int) -> float:
     """The parameter s in [0, 1] of the point of edge w[a]–w[b] nearest the origin."""
     ex, ey, ez = w[b, 0] - w[a, 0], w[b, 1] - w[a, 1], w[b, 2] - w[a, 2]
@@ -121,7 +122,7 @@ def _on_edge(w: NDArray, a: int, b: int) -> float:
     return min(max(-(w[a, 0] * ex + w[a, 1] * ey + w[a, 2] * ez) / ee, 0.0), 1.0)
 
 
-@numba.njit(cache=True)
+@jit
 def _closest_on_triangle(w: NDArray, a: int, b: int, c: int, lam: NDArray) -> None:
     """Barycentric weights (lam[0..2] for a, b, c) of the point of triangle w[a] w[b] w[c]
     nearest the origin, from the Voronoi region holding the origin (a vertex, an edge or
@@ -171,7 +172,7 @@ def _closest_on_triangle(w: NDArray, a: int, b: int, c: int, lam: NDArray) -> No
     lam[0], lam[1], lam[2] = va / total, vb / total, vc / total
 
 
-@numba.njit(cache=True)
+@jit
 def _beyond(w: NDArray, a: int, b: int, c: int, o: int) -> bool:
     """Whether the origin lies beyond the face a b c of the tetrahedron (opposite vertex o),
     or the tetrahedron is flat (then every face counts)."""
@@ -186,7 +187,7 @@ def _beyond(w: NDArray, a: int, b: int, c: int, o: int) -> bool:
     return to_origin * to_other < 0.0
 
 
-@numba.njit(cache=True)
+@jit
 def _reduce(w: NDArray, ia: NDArray, ib: NDArray, n: int, lam: NDArray, tmp: NDArray) -> tuple[int, bool]:
     """Replace the simplex w[:n] by the smallest face holding its point nearest the origin, with
     its barycentric weights in lam; (new size, whether the origin is inside a tetrahedron)."""
@@ -223,7 +224,7 @@ def _reduce(w: NDArray, ia: NDArray, ib: NDArray, n: int, lam: NDArray, tmp: NDA
     return k, False
 
 
-@numba.njit(cache=True)
+@jit
 def _farthest(other: NDArray, x: float, y: float, z: float) -> int:
     """Index of a row of ``other`` farthest along (x, y, z)."""
     j, top = 0, -np.inf
@@ -234,7 +235,7 @@ def _farthest(other: NDArray, x: float, y: float, z: float) -> int:
     return j
 
 
-@numba.njit(cache=True)
+@jit
 def _gjk(params: NDArray, part: int, other: NDArray, work: NDArray) -> tuple[int, bool]:
     """GJK between a part's vertices and the points ``other`` (m, 3). ``work`` (WORK values):
     the final simplex is left in it (``_simplex``), its size returned; True if they touch.
@@ -278,14 +279,14 @@ def _gjk(params: NDArray, part: int, other: NDArray, work: NDArray) -> tuple[int
     return n, False
 
 
-@numba.njit(cache=True)
+@jit
 def _simplex(work: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray]:
     """Views of ``work``: the simplex (4, 3), its vertices' indices in each set (stored as
     floats), its weights and scratch (4 each); the closest points follow (``_closest``)."""
     return work[8:20].reshape((4, 3)), work[20:24], work[24:28], work[28:32], work[32:36]
 
 
-@numba.njit(cache=True)
+@jit
 def _closest(params: NDArray, part: int, other: NDArray, work: NDArray, n: int) -> float:
     """The closest points of the part and ``other`` from GJK's simplex (into work[36:39] and
     work[39:42]) and their distance."""
@@ -302,7 +303,7 @@ def _closest(params: NDArray, part: int, other: NDArray, work: NDArray, n: int) 
     return np.sqrt(gap)
 
 
-@numba.njit(cache=True)
+@jit
 def convex_distance(params: NDArray, part: int, other: NDArray) -> tuple[float, NDArray, NDArray, bool]:
     """GJK distance (mm) between a part and the convex hull of the points ``other`` (m, 3),
     the closest points of each (3,) and whether they touch or overlap (then distance 0)."""
@@ -312,7 +313,7 @@ def convex_distance(params: NDArray, part: int, other: NDArray) -> tuple[float, 
     return (0.0 if touching else dist), work[36:39].copy(), work[39:42].copy(), touching
 
 
-@numba.njit(cache=True)
+@jit
 def _plane_depth(params: NDArray, part: int, x: float, y: float, z: float) -> tuple[float, int]:
     """Largest signed plane distance of the point (≤ 0 inside the part) and its face."""
     _, _, p_off, n_p = _part(params, part)
@@ -325,7 +326,7 @@ def _plane_depth(params: NDArray, part: int, x: float, y: float, z: float) -> tu
     return best, arg
 
 
-@numba.njit(cache=True)
+@jit
 def _depth_along(params: NDArray, part: int, p0: NDArray, d: NDArray, t: float) -> tuple[float, float]:
     """The plane depth at p0 + t·d and its slope in t (the face attaining it)."""
     depth, f = _plane_depth(params, part, p0[0] + t * d[0], p0[1] + t * d[1], p0[2] + t * d[2])
@@ -333,7 +334,7 @@ def _depth_along(params: NDArray, part: int, p0: NDArray, d: NDArray, t: float) 
     return depth, params[j] * d[0] + params[j + 1] * d[1] + params[j + 2] * d[2]
 
 
-@numba.njit(cache=True)
+@jit
 def _deepest_on_segment(params: NDArray, part: int, p0: NDArray, d: NDArray) -> tuple[float, float]:
     """The least plane depth along p0 + t·d, t in [0, 1], and its t. The depth is the upper
     envelope of one line per face (convex, piecewise linear): cutting planes, i.e. the two
@@ -358,7 +359,7 @@ def _deepest_on_segment(params: NDArray, part: int, p0: NDArray, d: NDArray) -> 
     return (f_lo, lo) if f_lo <= f_hi else (f_hi, hi)
 
 
-@numba.njit(cache=True)
+@jit
 def _flat_middle(params: NDArray, part: int, p0: NDArray, d: NDArray, t: float, work: NDArray,
                  dist: float) -> float:
     """A segment parallel to the part's nearest feature is nearest along a stretch: the t in
@@ -384,7 +385,7 @@ def _flat_middle(params: NDArray, part: int, p0: NDArray, d: NDArray, t: float, 
     return t
 
 
-@numba.njit(cache=True)
+@jit
 def _sphere_gap(params: NDArray, part: int, p0: NDArray, d: NDArray, dd: float) -> float:
     """Distance of the segment p0 + t·d to the part's bounding sphere's centre, less its radius:
     a lower bound of the distance to the part."""
@@ -395,7 +396,7 @@ def _sphere_gap(params: NDArray, part: int, p0: NDArray, d: NDArray, dd: float) 
     return np.sqrt(gx * gx + gy * gy + gz * gz) - params[h + 7]
 
 
-@numba.njit(cache=True)
+@jit
 def segment_parts(p0: NDArray, d: NDArray, params: NDArray, work: NDArray) -> tuple[float, float]:
     """Signed distance (mm) from the segment p0 + t·d, t in [0, 1] (own frame) to the union of
     parts and the t attaining it; crossing a part: minus the deepest penetration of a point
@@ -422,7 +423,7 @@ def segment_parts(p0: NDArray, d: NDArray, params: NDArray, work: NDArray) -> tu
     return best, best_t
 
 
-@numba.njit(cache=True)
+@jit
 def point_parts(x: NDArray, params: NDArray) -> tuple[float, NDArray, NDArray]:
     """Signed distance (mm) of the point x to the union of parts, the nearest surface point and
     the inward unit normal there: outside, from x toward that point (a face's normal where it
@@ -450,7 +451,7 @@ def point_parts(x: NDArray, params: NDArray) -> tuple[float, NDArray, NDArray]:
     return best, near, normal
 
 
-@numba.njit(cache=True)
+@jit
 def points_gap(points: NDArray, params: NDArray) -> NDArray:
     """(k,) distance (mm, 0 inside) of points (k, 3) to the union of parts."""
     out = np.empty(points.shape[0])

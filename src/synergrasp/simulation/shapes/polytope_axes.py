@@ -5,16 +5,16 @@ axes of a part and a box that overlap (the penetration depth). The parts as
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from synergrasp.simulation.shapes.compiled import jit
 from synergrasp.simulation.shapes.polytope import _HEADER, _d3, _part, _support
 
 __all__ = ["part_box_overlap", "ray_parts"]
 
 
-@numba.njit(cache=True)
+@jit
 def _separation(params: NDArray, part: int, corners: NDArray, start: int, x: float, y: float, z: float) -> float:
     """The gap between the part and the points ``corners`` along the axis (x, y, z) (either
     way; negative where their projections overlap, by the overlap), in units of its length;
@@ -31,7 +31,7 @@ def _separation(params: NDArray, part: int, corners: NDArray, start: int, x: flo
     return max(b_lo - a_hi, a_lo - b_hi) / np.sqrt(x * x + y * y + z * z)
 
 
-@numba.njit(cache=True)
+@jit
 def part_box_overlap(params: NDArray, part: int, corners: NDArray, box_axes: NDArray) -> float:
     """Signed distance (mm) between a part and a box overlapping or touching it (``corners``
     (8, 3), ``box_axes`` (3, 3) rows, own frame): minus the penetration depth, the least
@@ -82,7 +82,7 @@ def part_box_overlap(params: NDArray, part: int, corners: NDArray, box_axes: NDA
     return min(best, 0.0)
 
 
-@numba.njit(cache=True)
+@jit
 def ray_parts(origins: NDArray, direction: NDArray, params: NDArray, region: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     """Nearest entry of rays (origins (r, 3), one direction (3,), own frame) into the union:
     distance t (+inf: missed), the outward normal of the face entered and its region
