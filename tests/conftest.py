@@ -1,5 +1,5 @@
-"""Fixtures shared by the test modules: the shipped hand and its synergies, the study's
-GFO parameters."""
+"""Fixtures shared by the test modules: the shipped hand and its synergies, the generated
+GFO problems that the solvers are checked on, the study's GFO parameters."""
 import os
 
 # One BLAS thread per test process, set before numpy loads: the tests' matrices are small, and
@@ -18,6 +18,7 @@ from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
 from synergrasp.optimisation.study import OptimiseParams  # noqa: E402
 from synergrasp.simulation.closure import SimulateParams  # noqa: E402
+from grasp_problems import random_gfo_problems  # noqa: E402
 
 
 @pytest.fixture(scope="session")
@@ -28,6 +29,14 @@ def hand():
 @pytest.fixture(scope="session")
 def synergies(hand):
     return load_synergies(None, joint_names=hand.joint_names)
+
+
+@pytest.fixture(scope="session")
+def generated_problems():
+    """600 generated GFO problems (`grasp_problems.random_gfo_problems`, seed 2018), made once
+    for the modules that check the solvers on them (each problem's critical friction is
+    bisected: they take about 16 CPU s to make)."""
+    return random_gfo_problems(2018, 600)
 
 
 #: Near-boundary band (docs/batched_solver.md): problems whose friction coefficient is within

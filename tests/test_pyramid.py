@@ -62,9 +62,8 @@ def test_pinch_closed_form(sides, inscribed, method):
 
 
 @pytest.fixture(scope="module")
-def generated():
-    problems = random_gfo_problems(31, 150)
-    base = [p.problem for p in problems]
+def generated(generated_problems):
+    base = [p.problem for p in generated_problems[:150]]
 
     def with_cone(cone_of):
         return [GFOProblem(p.f_p, p.E, p.normals, p.f_min, cone_of(p.cone.mu)) for p in base]
