@@ -79,10 +79,10 @@ class IPMSettings:
                 raise ValueError(f"{name} must be an int in 0..10, got {value!r}")
 
 
-def _kernel_settings(settings: IPMSettings, violation_tol: float) -> Settings:
+def _kernel_settings(settings: IPMSettings, violation_tol: float, feasibility: bool = False) -> Settings:
     return Settings(float(settings.tol), float(settings.reduced_tol), int(settings.max_iter),
                     float(settings.step_fraction), float(settings.stall_step), int(settings.refine),
-                    int(settings.retry_refine), float(settings.polish_from), float(violation_tol))
+                    int(settings.retry_refine), float(settings.polish_from), float(violation_tol), bool(feasibility))
 
 
 #: A friction cone as the compiled code takes it: mu dividing the tangent rows of the contact
@@ -150,5 +150,6 @@ def _solve(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_co
     data = cone_data(cone, frames)
     sets.solve_sets(F_all, np.ascontiguousarray(f_p, dtype=float), frames, columns, n_columns, thresholds, given, data,
                     data if strict_cone is None else cone_data(strict_cone, frames), float(f_min),
-                    strict_cone is not None, _kernel_settings(settings, violation_tol), out)
+                    strict_cone is not None, _kernel_settings(settings, violation_tol),
+                    _kernel_settings(settings, violation_tol, feasibility=True), out)
     return out

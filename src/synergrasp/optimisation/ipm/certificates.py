@@ -38,7 +38,7 @@ def inside(P, h, Gx, tau):
     return True
 
 
-@jit_inline
+@jit_call
 def proves_feasible(P, h, Gx, tau):
     """Whether x = (t, y) proves the problem feasible: y / tau satisfies every constraint
     strictly, or y is a strictly interior direction (-G x = A y inside every cone, so

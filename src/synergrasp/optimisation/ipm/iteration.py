@@ -146,17 +146,18 @@ def start(P, W):
 
 
 @jit_call
-def hsde(P, W, Q, opt, refine, feasibility, y):
+def hsde(P, W, Q, opt, refine, y):
     """Solve one GFO problem by the homogeneous self-dual embedding with `refine` steps of
     iterative refinement per linear solve, Q the polish's work arrays (`layout.PolishWork`).
     Returns (code, iterations); fills y (N) when optimal.
-    feasibility: only whether the problem is feasible matters (the strict internal-force
-    test): OPTIMAL as soon as an iterate proves it (`proves_feasible`; y is then that
-    point, not the optimum)."""
+    With opt.feasibility only whether the problem is feasible matters (the strict
+    internal-force test): OPTIMAL as soon as an iterate proves it (`proves_feasible`; y is
+    then that point, not the optimum)."""
     q, L, e, h, x, s, z = P.q, P.L, P.e, W.h, W.x, W.s, W.z
     o = L + 3 * q
     N, n = o + e + 2, e + 1
     rho, h_norm = start(P, W)
+    Q.last[0] = -1  # no failed polish yet
     n_deg = float(L + q) + 1.0  # degree: L linear, q + 1 second-order cones
     tau = 1.0
     kappa = 1.0
@@ -172,7 +173,7 @@ def hsde(P, W, Q, opt, refine, feasibility, y):
         gtz_norm = math.sqrt(gtz)
         r_x[0] += tau
         G_mul(P, x, r_z)
-        if feasibility and tau > 0.0 and proves_feasible(P, h, r_z, tau):
+        if opt.feasibility and tau > 0.0 and proves_feasible(P, h, r_z, tau):
             for j in range(e):
                 y[j] = x[1 + j] / tau * rho
             return OPTIMAL, it

@@ -24,9 +24,11 @@ __all__ = ["INFEASIBLE", "NOT_SOLVED", "OPTIMAL", "UNDECIDED", "Homogeneous", "P
 #: Codes of the kernel's verdicts.
 NOT_SOLVED, OPTIMAL, INFEASIBLE, UNDECIDED = 0, 1, 2, 3
 
-#: The settings as the compiled code takes them: `IPMSettings` and the force-check tolerance.
+#: The settings as the compiled code takes them: `IPMSettings`, the force-check tolerance and
+#: whether only feasibility is asked (the strict test; a runtime value, not a literal passed
+#: down the calls: numba would compile the iteration once for each literal).
 Settings = namedtuple("Settings", "tol reduced_tol max_iter step_fraction stall_step refine retry_refine polish_from "
-                                   "violation_tol")
+                                   "violation_tol feasibility")
 
 #: One problem as the iteration sees it: contact rows D (m, 3, >= e) applied to E, hv (m, 3)
 #: the rows applied to f_p (N), a = E^T f_p (N), r0 = ||f_p - E a|| (N), mu (1 for a pyramid,
@@ -52,8 +54,9 @@ Work = namedtuple("Work", [
 
 #: Work arrays of the active-set polish (`polish`), apart from `Work` (every array of a tuple
 #: is an argument of each call that takes it): the active rows, the Jacobian J, H, its
-#: factor, H^-1 J^T, J H^-1 J^T and its factor (e_max, e_max); u of one cone (3); vectors (e_max).
-PolishWork = namedtuple("PolishWork", "act J H R Y S RS u c lam v w g Hg b")
+#: factor, H^-1 J^T, J H^-1 J^T and its factor (e_max, e_max); u of one cone (3); vectors (e_max);
+#: the last guess that failed (its size, then its rows; e_max + 1).
+PolishWork = namedtuple("PolishWork", "act J H R Y S RS u c lam v w g Hg b last")
 
 #: The homogenising pair (tau, kappa), the tau-row residual and c^T x1 + h^T z1 of the tau
 #: column, shared by the predictor and the corrector of an iteration.
@@ -81,4 +84,5 @@ def polish_workspace(e_max):
     return PolishWork(np.empty(e_max, dtype=np.int64), np.empty((e_max, e_max)), np.empty((e_max, e_max)),
                       np.empty((e_max, e_max)), np.empty((e_max, e_max)), np.empty((e_max, e_max)),
                       np.empty((e_max, e_max)), np.empty(3), np.empty(e_max), np.empty(e_max), np.empty(e_max),
-                      np.empty(e_max), np.empty(e_max), np.empty(e_max), np.empty(e_max))
+                      np.empty(e_max), np.empty(e_max), np.empty(e_max), np.empty(e_max),
+                      np.full(e_max + 1, -1, dtype=np.int64))

@@ -196,14 +196,45 @@ def accepted(P, W, Q, n_act, y, tol, h_norm):
     return math.sqrt(res) <= tol * t and gap <= tol * t * max(1.0, t)
 
 
+@jit_inline
+def multipliers_plausible(Q, n_act, t):
+    """False once a multiplier is clearly negative (the guess holds a constraint that the
+    optimum leaves inactive; Newton does not repair that)."""
+    for a in range(n_act):
+        if Q.lam[a] < -1e-3 * abs(t):
+            return False
+    return True
+
+
+@jit_inline
+def same_as_last_failure(Q, n_act):
+    if Q.last[0] != n_act:
+        return False
+    for a in range(n_act):
+        if Q.last[1 + a] != Q.act[a]:
+            return False
+    return True
+
+
+@jit_inline
+def remember_failure(Q, n_act):
+    Q.last[0] = n_act
+    for a in range(n_act):
+        Q.last[1 + a] = Q.act[a]
+
+
 @jit_call
 def polish(P, W, Q, tau, tol, h_norm, y):
     """Polish the iterate (W.x, W.s, W.z, tau) of `iteration.hsde`; True if the polished
     point passes the optimality test at `tol`, with y (scaled units) filled. Multipliers
-    start from the dual iterate (t z / tau) and are updated by each Newton step."""
+    start from the dual iterate (t z / tau) and are updated by each Newton step. A guess that
+    failed is remembered (Q.last; `iteration.hsde` clears it per problem)."""
     n_act = active_set(P, W, Q)
     if n_act <= 0:  # none active: the iteration's own test decides
         return False
+    cones = Q.act[n_act - 1] >= P.L
+    if not cones and same_as_last_failure(Q, n_act):
+        return False  # linear rows only: the same guess gives the same point, whatever the start
     t = W.x[0] / tau
     for j in range(P.e):
         y[j] = W.x[1 + j] / tau
@@ -211,10 +242,15 @@ def polish(P, W, Q, tau, tol, h_norm, y):
         Q.lam[a] = t * W.z[P.L + 3 * (Q.act[a] - P.L)] / tau if Q.act[a] >= P.L else 0.0
     for _ in range(NEWTON_STEPS):
         if not linearise(P, W, Q, n_act, y):
-            return False
+            break
         step = newton_step(P, W, Q, n_act, y)
-        if step < 0.0:
-            return False
-        if Q.act[n_act - 1] < P.L or step <= 1e-14 * (1.0 + abs(t)):
-            break  # linear rows only (the first step is exact), or converged
-    return accepted(P, W, Q, n_act, y, tol, h_norm)
+        if step < 0.0 or not multipliers_plausible(Q, n_act, t):
+            break
+        # linear rows only: the first step is exact; cones: the error after a step of
+        # relative size 1e-7 is of order 1e-14
+        if not cones or step <= 1e-7 * (1.0 + abs(t)):
+            if accepted(P, W, Q, n_act, y, tol, h_norm):
+                return True
+            break
+    remember_failure(Q, n_act)
+    return False
