@@ -2,18 +2,23 @@
 #   make venv           - build .venv from environment.lock only
 #   make study          - build .venv from environment.lock, then run the full study
 #   make test           - build .venv from environment.lock, then run the fast tier of the tests
-#                         (all but the end-to-end workflow runs, marker `workflow`)
+#                         (all but the end-to-end workflow runs, marker `workflow`, and the
+#                         pages in a real browser, marker `browser`)
 #   make test-workflow  - the end-to-end workflow tier alone (CI runs make test, then this)
-#   make test-all       - every test, the end-to-end workflow runs included
+#   make test-browser   - the browser tier alone: the 3-D pages in headless Chromium
+#                         (/usr/bin/chromium: apt-get install chromium; CI installs it)
+#   make test-all       - every test, the end-to-end workflow runs and the browser included
 #   make lint           - snakefmt --check, snakemake --lint (conda/container advice aside) and
 #                         the package's layers and no import circle (import-linter, pyproject.toml)
 #   make cluster-test   - the small study on a single-node SLURM started here (root; installs SLURM)
+#   make bench          - the benchmarks, recorded in benchmarks/results/, and docs/measurements.md
+#   make bench-study    - the default study timed from an empty results/, recorded likewise
 PYTHON ?= python3.11
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 CORES  ?= 2
 
-.PHONY: venv study test test-workflow test-all lint cluster-test bench lock report clean-venv
+.PHONY: venv study test test-workflow test-browser test-all lint cluster-test bench bench-study lock report clean-venv
 
 $(BIN)/.installed: environment.lock pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -42,12 +47,16 @@ PYTEST = rc=0; $(BIN)/python -m pytest $(1) || rc=$$?; if [ $$rc -eq 5 ]; then e
 
 test: $(BIN)/.installed
 	$(WARM_UP)
-	$(call PYTEST,-m "not workflow")
+	$(call PYTEST,-m "not workflow and not browser")
 
 # The end-to-end tier alone (what `make test` leaves out); CI runs `make test` then this.
 test-workflow: $(BIN)/.installed
 	$(WARM_UP)
 	$(call PYTEST,-m workflow)
+
+# The browser tier alone (what `make test` leaves out besides the workflow runs); CI runs it.
+test-browser: $(BIN)/.installed
+	$(call PYTEST,-m browser)
 
 test-all: $(BIN)/.installed
 	$(WARM_UP)
@@ -62,13 +71,28 @@ cluster-test: $(BIN)/.installed
 	$(WARM_UP)
 	tools/cluster_test.sh $(BIN)
 
-# One core, as the targets are stated per core. bench_study describes the last `make study`.
+# One core, as the targets are stated per core. Each benchmark's machine-read lines are recorded
+# in benchmarks/results/ (tools/measurements.py record), then docs/measurements.md is rewritten
+# from them. bench_study describes the last `make study` (nothing recorded if there was none).
+RECORD = OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python tools/measurements.py record
 bench: $(BIN)/.installed
-	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_compile.py
-	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_gfo.py
-	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_pyramid.py
-	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/bench_closure.py
-	$(BIN)/python benchmarks/bench_study.py --root results
+	$(RECORD) compile -- $(BIN)/python benchmarks/bench_compile.py
+	$(RECORD) gfo -- $(BIN)/python benchmarks/bench_gfo.py
+	$(RECORD) pyramid -- $(BIN)/python benchmarks/bench_pyramid.py
+	$(RECORD) closure -- $(BIN)/python benchmarks/bench_closure.py
+	$(RECORD) search -- $(BIN)/python benchmarks/bench_search.py
+	-$(RECORD) study_rate -- $(BIN)/python benchmarks/bench_study.py --root results
+	-$(RECORD) inspector -- $(BIN)/python benchmarks/bench_inspector.py --results results
+	$(BIN)/python tools/measurements.py
+
+# The default study timed from an empty results/ (move a previous one away first) and recorded
+# with its jobs' costs in benchmarks/results/, then docs/measurements.md rewritten.
+bench-study: $(BIN)/.installed
+	@test -z "$$(ls results)" || { echo "make bench-study: results/ is not empty: move it away first"; exit 1; }
+	$(WARM_UP)
+	$(BIN)/python tools/measurements.py record study --timed -- $(BIN)/snakemake -j$(CORES) figures
+	$(BIN)/python tools/measurements.py jobs results
+	$(BIN)/python tools/measurements.py
 
 # Regenerate the pinned, hashed lock from pyproject.toml (Python 3.11, Linux x86_64).
 lock:

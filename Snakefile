@@ -3,6 +3,7 @@
 #   snakemake -j2 object_obj4        one object's own outputs (contacts, forces, minima, Fig. 4)
 #   snakemake -j2 scenario_<name>    one scenario of `scenarios:` (config/README.md); `scenarios`: all
 #   snakemake -j2 sensitivity        every scenario and the summary across them (docs/sensitivity.md)
+#   snakemake -j2 placement_claims   the claims at every target of the placement search (~15 min)
 #   snakemake --report results/report.html   (or results/report.zip)
 from snakemake.utils import min_version
 
@@ -64,6 +65,12 @@ for _scenario in SCENARIOS:
 rule scenarios:
     input:
         every_scenario_targets,
+
+
+# The study's claims at every target the placement search scored (docs/placement_search.md).
+rule placement_claims:
+    input:
+        placement_claims_targets(),
 
 
 # Every scenario and the summary across them (docs/sensitivity.md).

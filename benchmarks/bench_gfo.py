@@ -5,8 +5,9 @@ Realistic study mix: random grasps with 4-12 contacts (some on the palm) x the 7
 sets of the study (15 incremental + subsets of 1-3 of S1..S7). The "ipm" figure is the
 study's loop (`study.optimise_grasps`, GFO only): mechanics, bases, rows and solves,
 measured after one warm-up call that loads the compiled kernel (its one-time cost per
-process is printed separately), median of 5 runs (`--repeats`). Run on one core with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1. The last two
-lines are machine-read.
+process is printed separately), median of 5 runs (`--repeats`). Run on one core with
+OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1. The last six lines are machine-read (`key: N  (what)`,
+tools/measurements.py).
 """
 
 from __future__ import annotations
@@ -91,16 +92,16 @@ def main() -> None:
     print(f"problems: {n} ({n_poses} grasps x {len(sets)} sets), statuses {statuses}")
     print(f"mean interior-point iterations: {out['iterations'][out['solver'] == 'ipm'].mean():.2f}")
     print(f"compiled kernel load (once per process): {t_load:.2f} s")
-    print(f"ipm (incl. mechanics and building, median of {args.repeats} runs): {ipm_rate:.0f} solves/s ({t_ipm:.2f} s;"
-          f" runs {min(walls):.2f}-{max(walls):.2f} s);"
-          f" with the load: {n / (t_ipm + t_load):.0f} solves/s")
-    print(f"ipm per CPU second (time.process_time, steadier on a loaded machine): {n / c_ipm:.0f} solves/s")
-    print(f"per-problem exact (Clarabel, {min(args.exact, n)} problems): {exact_rate:.0f} solves/s")
-    print(f"per-problem cvxpy ({min(args.cvxpy, n)} problems): {cvxpy_rate:.1f} solves/s")
-    print(f"ipm / exact: {ipm_rate / exact_rate:.2f}x; ipm / cvxpy: {ipm_rate / cvxpy_rate:.0f}x")
-    print(f"fallback share: {fallback:.4f}")
-    print(f"gfo_solves_per_s: {ipm_rate:.0f}")
-    print(f"gfo_speedup_vs_cvxpy: {ipm_rate / cvxpy_rate:.0f}")
+    print(f"gfo_solves_per_s: {ipm_rate:.0f}  (the study's loop, solves per second, wall; mechanics, bases and "
+          f"building included; median of {args.repeats} runs of {n:,} problems, {min(walls):.2f}-{max(walls):.2f} s)")
+    print(f"gfo_solves_per_cpu_s: {n / c_ipm:.0f}  (the same loop, solves per CPU second: steadier on a loaded "
+          f"machine)")
+    print(f"clarabel_solves_per_s: {exact_rate:.0f}  (per-problem Clarabel, solves per second, "
+          f"{min(args.exact, n)} problems)")
+    print(f"cvxpy_solves_per_s: {cvxpy_rate:.1f}  (per-problem cvxpy, solves per second, "
+          f"{min(args.cvxpy, n)} problems)")
+    print(f"gfo_speedup_vs_cvxpy: {ipm_rate / cvxpy_rate:.0f}  (the study's loop over per-problem cvxpy)")
+    print(f"gfo_fallback_share: {fallback:.4f}  (share of the problems the Clarabel fallback decided)")
 
 
 if __name__ == "__main__":

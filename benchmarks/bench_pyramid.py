@@ -5,7 +5,8 @@ study's method, `gfo.FASTEST_METHOD["pyramid"] == "ipm"`) against PIQP per probl
 benchmarks/bench_gfo.py x the 75 study sets, for each pyramid model and the circular cone;
 the PIQP runs set `FASTEST_METHOD["pyramid"]` to "piqp" for their duration. CPU time
 (`time.process_time`), runs of the two methods interleaved, median of `--repeats`. Run on
-one core with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1.
+one core with OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1. Machine-read lines:
+`pairs_per_cpu_s_<model>_<method>: N  (what)` (tools/measurements.py).
 """
 
 from __future__ import annotations
@@ -58,6 +59,9 @@ def main() -> None:
         fallback = float(np.mean(out["solver"] == "clarabel_fallback"))
         line = ", ".join(f"{m} {statistics.median(r):,.0f}" for m, r in rates.items())
         print(f"{model}: {line}; fallback share of the last method {fallback:.4f}")
+        for method, rate in rates.items():
+            print(f"pairs_per_cpu_s_{model}_{method}: {statistics.median(rate):.0f}  ({model}, {method}, (pose, set) "
+                  f"pairs per CPU second with the strict test, median of {args.repeats}, {n:,} pairs)")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
 """Benchmark of the placement search (docs/placement_search.md): the default study's search
 of each object (or of the objects named on the command line), with 2 processes; prints the
 wall time, the CPU time of the search's processes, the number of targets scored and the
-machine's load average (the targets: at most 30 s wall per object on 2 quiet cores).
+machine's load average (the targets: at most 30 s wall per object on 2 quiet cores); the
+lines `search_wall_s_<object>: N` and `search_cpu_s_<object>: N` are machine-read.
 
     .venv/bin/python benchmarks/bench_search.py [obj1 obj2 ...]
 """
@@ -44,6 +45,9 @@ def main(objects: list[str], processes: int = 2) -> None:
         print(f"{name}: {len(result.ranked)} targets x {n_poses} poses, {processes} processes: wall {wall:.1f} s, "
               f"CPU {cpu:.1f} s ({1e3 * cpu / (len(result.ranked) * n_poses):.1f} ms per grasp), "
               f"load average {os.getloadavg()[0]:.1f}; chosen {result.chosen.target_mm}", flush=True)
+        print(f"search_wall_s_{name}: {wall:.1f}  ({name}: wall s of the search, {processes} processes)")
+        print(f"search_cpu_s_{name}: {cpu:.1f}  ({name}: CPU s of the search's processes, {len(result.ranked)} targets x "
+              f"{n_poses} poses)", flush=True)
 
 
 if __name__ == "__main__":

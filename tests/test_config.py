@@ -14,6 +14,7 @@ from synergrasp.config import (
     defaults,
     overlay,
     scenario_configs,
+    scenario_names,
     validate_config,
 )
 
@@ -193,6 +194,14 @@ def test_scenarios_are_overlays_of_the_main_config():
     assert configs["mu1"]["mechanics"]["f_min_N"] == 0.1
     assert list(configs["one_object"]["objects"]) == ["obj1"]
     assert configs["default"] == {**validate_config(SMALL)}
+
+
+def test_a_scenario_set_to_null_by_an_overlay_is_removed():
+    """`--configfile` with `scenarios: {mu1: null}` runs the sweep without mu1 (the overlay rule)."""
+    merged = _with_scenarios({"mu1": None, "kss": {"mechanics": {"k_ss_Nmm_per_rad": 100.0}}})
+    assert scenario_names(merged) == ["default", "kss"]
+    assert list(scenario_configs(merged)) == ["default", "kss"]
+    assert list(validate_config(merged)["scenarios"]) == ["kss"]
 
 
 @pytest.mark.parametrize("scenarios, expected", [

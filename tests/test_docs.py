@@ -31,3 +31,18 @@ def test_every_doc_the_docs_cite_exists():
         if path.is_file():
             cited |= set(re.findall(r"docs/([a-z_]+\.md)", path.read_text(errors="ignore")))
     assert cited and not [name for name in cited if not (ROOT / "docs" / name).is_file()]
+
+
+def test_measurements_page_is_what_the_tool_writes_from_the_committed_files():
+    """docs/measurements.md is tools/measurements.py's page of benchmarks/results/ (rerun the tool,
+    or `make bench`, after changing a file there), and every section of it the documentation
+    links to is on it."""
+    import re
+
+    page = (ROOT / "docs" / "measurements.md").read_text()
+    assert _tool("measurements").page() == page
+    anchors = {re.sub(r"[^a-z0-9 -]", "", title.lower()).replace(" ", "-")
+               for title in re.findall(r"^## (.+)$", page, flags=re.M)}
+    linked = {anchor for path in [*ROOT.glob("*.md"), *(ROOT / "docs").glob("*.md")]
+              for anchor in re.findall(r"measurements\.md#([a-z0-9-]+)", path.read_text())}
+    assert "closure" in anchors and not linked - anchors

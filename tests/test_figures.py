@@ -1,5 +1,6 @@
 """Figure helpers: the force grid, the rule-graph parser, and files written for the study's plots."""
 import numpy as np
+import pytest
 import pandas as pd
 
 from synergrasp.figures.study_figures import (figure_exploded_views, figure_force_maps, figure_hierarchy,
@@ -64,3 +65,16 @@ def test_hierarchy_grey_scale_is_black_at_the_low_end_and_prints_every_cell():
     assert tuple(image.cmap(image.norm(100.0))[:3]) == (1.0, 1.0, 1.0)    # 100 % white
     assert sorted(t.get_text() for t in ax.texts) == ["0", "100", "50", "–"]
     plt.close(fig)
+
+
+def test_a_map_constant_to_round_off_is_one_colour():
+    """A sphere's grasp is the same at every pose to ~1e-12: its maps (Fig. 4, the quality
+    maps) get a range about their value, not their round-off stretched over the colour bar."""
+    from synergrasp.figures.output import colour_range
+
+    noise = 0.2557 + 1e-12 * np.random.default_rng(3).normal(size=(25, 72))
+    lo, hi = colour_range(noise)
+    assert lo < 0.2557 - 0.1 and hi > 0.2557 + 0.1 and abs(0.5 * (lo + hi) - 0.2557) < 1e-9
+    assert colour_range(np.full(4, np.nan)) == (0.0, 1.0)
+    varied = np.linspace(0.0, 1.0, 101)
+    assert colour_range(varied) == pytest.approx((0.01, 0.99))  # the 1st and 99th percentiles, as before

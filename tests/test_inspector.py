@@ -113,3 +113,31 @@ def test_a_searched_placement_takes_its_target_from_the_search_table(small, tmp_
     assert a.to_dict() == b.to_dict()
     with pytest.raises(ValueError, match="placement: mode 'searched'"):
         inspect_grasp(searched, "obj1", -30.0, 0.0, [(1, 2)], results=tmp_path / "nowhere")
+
+
+def test_the_optimal_forces_are_kept_per_contact(small):
+    result = inspect_grasp(small, "obj4", -150.0, -20.0, [(1,), tuple(range(1, 16))])
+    assert result.closure_status == "grasp" and len(result.contacts)
+    for s in result.sets:
+        if s.load_feasible:
+            assert len(s.forces_N) == 3 * len(result.contacts)
+            assert np.linalg.norm(s.forces_N) == pytest.approx(s.force_N, rel=1e-9)
+        else:
+            assert s.forces_N == ()
+    assert any(s.load_feasible for s in result.sets)
+
+
+def test_png_draws_the_grasp_from_two_views_with_its_touching_links(tmp_path):
+    from matplotlib.image import imread
+
+    from synergrasp.figures.hand_pictures import TOUCHING
+
+    out = tmp_path / "grasp.png"
+    assert main(["grasp", "obj4", "--alpha", "-150", "--beta", "-20", "--sets", "1-15", "--png", str(out),
+                 "--configfile", str(SMALL)]) == 0
+    rgb = imread(out)[..., :3].astype(float)
+    # the highlight's hue (shading scales brightness, not hue) in the left and in the right view
+    chroma = rgb / np.maximum(rgb.sum(axis=2, keepdims=True), 1e-9)
+    lit = np.linalg.norm(chroma - np.asarray(TOUCHING) / sum(TOUCHING), axis=2) < 0.03
+    half = rgb.shape[1] // 2
+    assert lit[:, :half].sum() > 500 and lit[:, half:].sum() > 500

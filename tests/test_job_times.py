@@ -29,17 +29,49 @@ def test_rules_are_summed_over_the_default_study_and_every_scenario(tmp_path):
     assert list(table.index) == ["simulate_contacts", "optimise", "fig1_synergy_postures"]  # largest CPU first
 
 
-def test_measurements_page_gives_cpu_per_pose_from_the_benchmarks_and_the_tables(tmp_path):
-    """tools/measurements.py: 3 CPU s of closure over 2 objects x 500 poses = 3 ms per pose."""
-    import pandas as pd
-
+def _measurements():
     spec = importlib.util.spec_from_file_location("measurements", Path(__file__).parents[1] / "tools" / "measurements.py")
     measurements = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(measurements)
+    return measurements
+
+
+def test_measurements_page_gives_cpu_per_pose_from_the_benchmarks_and_the_tables(tmp_path):
+    """tools/measurements.py jobs: 3 CPU s of closure over 2 objects x 500 poses = 3 ms per pose."""
+    import pandas as pd
+
+    measurements = _measurements()
+    results, inputs = tmp_path / "results", tmp_path / "inputs"
     for obj, cpu in (("a", 1.0), ("b", 2.0)):
-        _bench(tmp_path / "benchmarks" / "simulate_contacts" / f"{obj}.tsv", 4.0, cpu)
-        (tmp_path / "objects" / obj).mkdir(parents=True)
-        pd.DataFrame({"pose": range(500)}).to_parquet(tmp_path / "objects" / obj / "contacts.parquet")
-    text = measurements.page(tmp_path, "quiet")
-    assert "| `simulate_contacts` | 2 | 8.0 | 3.0 | 100 | 1 | 3 ms per pose (1,000 poses) |" in text
-    assert "(quiet)." in text
+        _bench(results / "benchmarks" / "simulate_contacts" / f"{obj}.tsv", 4.0, cpu)
+        (results / "objects" / obj).mkdir(parents=True)
+        pd.DataFrame({"pose": range(500)}).to_parquet(results / "objects" / obj / "contacts.parquet")
+    _bench(results / "benchmarks" / "fig1_synergy_postures.tsv", 1.0, 1.0)
+    inputs.mkdir()
+    measurements.study_jobs(results).to_csv(inputs / "study_jobs.csv", index=False)
+    text = measurements.page(inputs)
+    assert "| `simulate_contacts` | 2 | 8.0 | 3.0 | 75 | 1 | 3 ms per pose over 1,000 |" in text
+    assert "| `fig1_synergy_postures` | 1 | 1.0 | 1.0 | 25 | 1 |  |" in text
+    assert "`benchmarks/results/gfo.csv`: not recorded yet" in text  # a benchmark not run yet is said so
+
+
+def test_record_keeps_a_commands_machine_read_lines_with_its_load_and_time(tmp_path):
+    """`record` writes one row per `key: number  (what)` line the command printed, and with
+    --timed the command's wall and CPU seconds first; a failing command records nothing."""
+    import sys
+
+    import pandas as pd
+
+    measurements = _measurements()
+    script = "print('closure_median_ms: 6.10  (kinematic closure)'); print('status: {1: 2}'); print('n: 3')"
+    path = measurements.record("closure", [sys.executable, "-c", script], timed=True, out=tmp_path)
+    rows = pd.read_csv(path, dtype=str, keep_default_na=False)
+    assert list(rows["figure"]) == ["wall_s", "cpu_s", "closure_median_ms", "n"]
+    assert list(rows["value"][2:]) == ["6.10", "3"] and rows["description"][2] == "kinematic closure"
+    assert rows["value"][1].isdigit()
+    assert rows["load_average"][0].count("-") == 1 and rows["command"][0].endswith("print('n: 3')")
+    with pytest.raises(SystemExit, match="exit code 3"):
+        measurements.record("broken", [sys.executable, "-c", "raise SystemExit(3)"], out=tmp_path)
+    assert not (tmp_path / "broken.csv").exists()
+    text = measurements.page(tmp_path).split("## Closure")[1]  # the page shows it in its section
+    assert "| `closure_median_ms` | 6.10 | kinematic closure |" in text and f"`{sys.executable} -c " in text

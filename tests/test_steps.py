@@ -187,7 +187,7 @@ def _rules():
                 for rule in wf._workflow.rules}
 
 
-TARGET_RULES = ("all", "figures", "scenarios", "sensitivity")
+TARGET_RULES = ("all", "figures", "scenarios", "sensitivity", "placement_claims")
 #: Steps declared (their keys are read) whose rule is still to be written.
 NOT_YET_IN_THE_WORKFLOW = ()
 
@@ -317,9 +317,9 @@ def test_the_closure_reads_no_contact_selection_key():
 
 
 def test_resources_follow_each_scenarios_own_size(tmp_path):
-    """A job's requests come from its scenario: on the study's 5° grid a closure asks for more
-    than on the small config's grid, a dynamic one for more than a kinematic one."""
-    fine = {"alpha_deg": {"start": -180, "stop": 175, "step": 5}, "beta_deg": {"start": -60, "stop": 60, "step": 5}}
+    """A job's requests come from its scenario: on a 2.5° grid (7,056 poses) a closure asks for
+    more than on the small config's grid, a dynamic one for more than a kinematic one."""
+    fine = {"alpha_deg": {"start": -180, "stop": 177.5, "step": 2.5}, "beta_deg": {"start": -60, "stop": 60, "step": 2.5}}
     scenarios = {"fine": {"grid": fine}, "fine_dyn": {"grid": fine, "closure": {"model": "dynamic"}}}
     code, out, _ = _dry_run(tmp_path, "scenarios", scenarios)
     assert code == 0, out[-3000:]

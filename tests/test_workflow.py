@@ -81,9 +81,9 @@ def run_j2(tmp_path_factory) -> Path:
 
 
 def expected_targets() -> list[str]:
-    """Every output of the small study, from the step registry: the sweep's summary aside, and
-    the contacts step's own table too, as the small study's kinematic closure records no
-    loads to select contacts by."""
+    """Every output of the small study, from the step registry: the sweep's summary and the
+    steps made only by their own target (optional) aside, and the contacts step's own table
+    too, as the small study's kinematic closure records no loads to select contacts by."""
     from synergrasp.config import validate_config
     from synergrasp.steps import STEPS
 
@@ -94,15 +94,20 @@ def expected_targets() -> list[str]:
     # the small study's placement is not searched: its small sweep's placement_searched scenario
     # makes the search's table and the placement maps
     skipped = ("sensitivity", "contacts", "search", "placement_map")
-    return [root + rel for name, step in STEPS.items() if name not in skipped and step.rules
+    return [root + rel for name, step in STEPS.items() if name not in skipped and step.rules and not step.optional
             for root in where[step.scope] for rel in step.outputs.values()]
+
+
+def made(path: Path) -> bool:
+    """A file target exists and is not empty; a folder of pages (the 3-D pages) has its non-empty index."""
+    if path.is_dir():
+        path = path / "index.html"
+    return path.is_file() and path.stat().st_size > 0
 
 
 def test_every_target_exists_and_is_not_empty(run_j2):
     for rel in expected_targets():
-        path = run_j2 / rel
-        assert path.is_file(), rel
-        assert path.stat().st_size > 0, rel
+        assert made(run_j2 / rel), rel
 
 
 def test_tables_have_documented_columns_and_sane_values(run_j2):
@@ -173,6 +178,10 @@ def test_j1_gives_the_same_tables(run_j2, tmp_path):
     assert len(figures) >= 11
     for figure in figures:
         assert figure.read_bytes() == (tmp_path / figure.relative_to(run_j2)).read_bytes(), figure.name
+    pages = list((run_j2 / "results" / "figures" / "grasps_3d").iterdir())  # the 3-D pages and their script
+    assert len(pages) >= 3
+    for page in pages:
+        assert page.read_bytes() == (tmp_path / page.relative_to(run_j2)).read_bytes(), page.name
 
 
 def test_broken_config_fails_before_work_and_keeps_results(run_j2, tmp_path):
@@ -208,6 +217,15 @@ def test_report_holds_every_figure_and_table(run_j2):
         names = archive.namelist()
     assert "report/report.html" in names
     assert any(name.endswith("fig3_rulegraph.png") for name in names)
+    # the archive holds the 3-D pages of Fig. 2's grasps beside their index, with one plotly
+    # script for all; the one-file report (which cannot hold a folder) does not
+    pages = sorted(p.name for p in (run_j2 / "results" / "figures" / "grasps_3d").glob("*.html"))
+    folders = {name.rsplit("/", 1)[0] for name in names if name.endswith("/index.html")}
+    assert len(folders) == 1
+    (folder,) = folders
+    assert sorted(n.rsplit("/", 1)[1] for n in names if n.startswith(folder + "/") and n.endswith(".html")) == pages
+    assert sum(name.endswith("/plotly.min.js") for name in names) == 1
+    assert "data:text/html" not in html  # no page embedded in the one-file report
 
 
 def planned_jobs(workdir: Path, root: Path = ROOT, env: dict[str, str] | None = None) -> dict[str, int]:
@@ -252,7 +270,7 @@ def test_code_inputs_hold_every_module_a_job_loads(run_j2):
         loaded.setdefault(script, set()).update(files)
     assert set(loaded) == {"simulate_contacts", "optimise_shard", "aggregate_gfo", "local_minima",
                            "study_tables", "fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph",
-                           "fig4_force_maps", "fig5_hierarchy", "grasp_realism", "grasp_quality"}
+                           "fig4_force_maps", "fig5_hierarchy", "grasp_realism", "grasp_quality", "grasps_3d"}
     for script, files in loaded.items():
         assert files, script
         assert files <= declared[script], (script, sorted(files - declared[script]))
@@ -312,7 +330,7 @@ def _planned_after_edit(project_copy, module: str) -> dict[str, int]:
 
 
 FIGURE_RULES = {"fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph", "fig4_force_maps",
-                "fig5_hierarchy", "grasp_realism", "figures"}
+                "fig5_hierarchy", "grasp_realism", "grasps_3d", "figures"}
 
 
 def test_changing_the_config_module_reruns_the_optimisation(project_copy):
@@ -377,12 +395,14 @@ def test_a_killed_run_reruns_only_what_did_not_finish(run_j2, tmp_path, kill):
     assert rerun.returncode == 0, rerun.stderr[-5000:]
 
     after = _outputs(tmp_path)
-    kept = {path for path in finished if path not in unfinished and path in after}
+    # a file of a folder output (the 3-D pages) is unfinished when its folder is
+    kept = {path for path in finished if path in after
+            and not any(path == u or path.startswith(u.rstrip("/") + "/") for u in unfinished)}
     assert kept, "nothing had finished before the kill"
     for path in kept:  # finished work is not recomputed
         assert after[path] == finished[path], path
     for rel in missing:  # what was missing is made
-        assert (tmp_path / rel).is_file(), rel
+        assert made(tmp_path / rel), rel
     for table in sorted((run_j2 / "results" / "tables").iterdir()):
         assert table.read_bytes() == (tmp_path / "results" / "tables" / table.name).read_bytes(), table.name
     for parquet in sorted((run_j2 / "results" / "objects").rglob("*.parquet")):

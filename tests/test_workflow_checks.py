@@ -128,6 +128,21 @@ def test_a_settle_window_longer_than_the_time_limit_allows_is_a_config_error(run
     _one_line(text, "config error at 'closure.dynamic.settle_window_s': 0.8 s leaves no pose able to settle")
 
 
+def test_a_mesh_file_that_bounds_no_solid_starts_no_job(run, tmp_path):
+    """A box mesh with one face missing: one line naming the object's key, before any job."""
+    corners = [(x, y, z) for x in (-15, 15) for y in (-15, 15) for z in (-15, 15)]
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4)]  # no sixth face
+    mesh = tmp_path / "open.obj"
+    mesh.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in corners)
+                    + "".join("f " + " ".join(str(k + 1) for k in q) + "\n" for q in quads))
+    config = yaml.safe_load(SMALL.read_text())
+    config["objects"]["obj1"] = {"shape": {"mesh": {"path": str(mesh), "scale": 1.0}}, "mass_kg": 1.0}
+    path = tmp_path / "my.yaml"
+    path.write_text(yaml.safe_dump(config))
+    text = _refused(run, path)
+    _one_line(text, "config error at 'objects.obj1.shape.mesh.path'", "is not closed: 4 edges belong to one triangle")
+
+
 # --------------------------------------------------------------------------- kind 4: SLURM profile
 
 

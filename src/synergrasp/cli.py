@@ -1,6 +1,7 @@
 """The ``synergrasp`` console command (docs/inspector.md).
 
     synergrasp grasp obj4 --alpha -30 --beta 0 [--configfile my.yaml] [--sets 1 1-5 1-15] [--json]
+                     [--png grasp.png] [--html grasp.html [--forces 1-15]]
 
 Bad arguments end with one line naming the argument and exit status 2.
 """
@@ -12,6 +13,7 @@ import json
 import math
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 __all__ = ["main", "format_inspection"]
@@ -42,16 +44,10 @@ _WEIGHT_WORDS = {"force_closure": "feasible", "infeasible": "infeasible", "rank_
                  "no_grasp": "no grasp", "numerical_failure": "solver failed"}
 
 
-def _set_name(synergies: Sequence[int]) -> str:
-    """{S1..S7} for a run of consecutive synergies, {S2,S5} otherwise."""
-    s = list(synergies)
-    if len(s) > 2 and s == list(range(s[0], s[-1] + 1)):
-        return f"{{S{s[0]}..S{s[-1]}}}"
-    return "{" + ",".join(f"S{k}" for k in s) + "}"
-
-
 def format_inspection(result: Any) -> str:
     """The inspection as text: pose, contacts, quality indices, one line per synergy set."""
+    from synergrasp.ids import set_name
+
     lines = [f"{result.object} at alpha = {result.alpha_deg:g} deg, beta = {result.beta_deg:g} deg (pose {result.pose}): "
              f"{result.closure_status}, {len(result.contacts)} contacts; weight {result.weight_N:.3g} N"]
     if len(result.contacts):
@@ -70,7 +66,7 @@ def format_inspection(result: Any) -> str:
         lines.append(f"  {'set':<22} {'force closure':<14} {'under the weight':<17} {'force N':>9} {'/ weight':>9} "
                      f"{'e_s':>4} {'cone use':>9}")
         for s in result.sets:
-            lines.append(f"  {_set_name(s.synergies):<22} "
+            lines.append(f"  {set_name(s.synergies):<22} "
                          f"{'yes' if s.force_closure else 'no':<14} {_WEIGHT_WORDS.get(s.status, s.status):<17} "
                          f"{_number(s.force_N, 4):>9} {_number(s.force_N / result.weight_N, 3):>9} {s.e_s:>4} "
                          f"{'—' if math.isnan(s.cone_use) else f'{s.cone_use:.3f}':>9}")
@@ -90,6 +86,11 @@ def _parser() -> argparse.ArgumentParser:
     grasp.add_argument("--results", default="results", help="where the study's outputs are (the searched "
                                                             "placement's target: <results>/objects/<object>/placement.csv)")
     grasp.add_argument("--json", action="store_true", help="print the result as JSON")
+    grasp.add_argument("--png", metavar="PATH", help="write the grasp drawn as in Fig. 2 from two views (PNG)")
+    grasp.add_argument("--html", metavar="PATH", help="write the grasp in 3-D, with the optimal contact forces of "
+                                                      "one set as arrows, as one self-contained page")
+    grasp.add_argument("--forces", metavar="SET", help="the set whose forces --html draws (default: the last set "
+                                                       "asked, {S1..Sk} of every synergy by default)")
     return parser
 
 
@@ -103,18 +104,35 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     config = _read_overlays(args.configfile)
     try:
-        sets = None
-        if args.sets:
+        sets, forces = None, None
+        if args.sets or args.forces:
             from synergrasp.config import validate_config
+            from synergrasp.inspector import default_sets
 
             cfg = validate_config(config)
             n = load_synergies(cfg["synergies"], joint_names=load_hand(cfg["hand"]).joint_names).matrix.shape[1]
-            sets = parse_sets(args.sets, n)
+            sets = parse_sets(args.sets, n) if args.sets else default_sets(n)
+            if args.forces:
+                (forces,) = parse_sets([args.forces], n, "--forces")
+                sets += [forces] if forces not in sets else []
         result = inspect_grasp(config, args.object, args.alpha, args.beta, sets, args.results)
     except (InspectionError, ConfigError) as err:
         print(f"synergrasp grasp: {err}", file=sys.stderr)
         return 2
     print(json.dumps(result.to_dict(), indent=1) if args.json else format_inspection(result))
+    if args.png:
+        from synergrasp.inspector import grasp_picture
+
+        grasp_picture(result, args.png)
+        if not args.json:
+            print(f"picture: {args.png}")
+    if args.html:
+        from synergrasp.figures.grasp_3d import grasp_page
+        from synergrasp.inspector import grasp_view
+
+        Path(args.html).write_text(grasp_page(grasp_view(result, forces)), encoding="utf-8")
+        if not args.json:
+            print(f"3-D page: {args.html}")
     return 0
 
 

@@ -152,10 +152,15 @@ def overlay(base: Mapping[str, Any], over: Mapping[str, Any] | None) -> dict[str
 
 def _drop_nulls(config: Mapping[str, Any], top: bool = True) -> dict[str, Any]:
     """Keys whose value is None removed at every depth (the overlay rule applied to a
-    configuration that Snakemake merged from several files); scenarios keep theirs, as
-    they are overlays still to be applied."""
-    return {k: v if top and k == "scenarios" else _drop_nulls(v, False) if isinstance(v, Mapping) else v
-            for k, v in config.items() if v is not None}
+    configuration that Snakemake merged from several files); a scenario set to None is
+    removed, the others keep their nulls, as they are overlays still to be applied."""
+    return {k: _live_scenarios(v) if top and k == "scenarios" else _drop_nulls(v, False) if isinstance(v, Mapping)
+            else v for k, v in config.items() if v is not None}
+
+
+def _live_scenarios(scenarios: Any) -> Any:
+    """The scenarios that an overlay did not remove (``name: null``)."""
+    return {n: s for n, s in scenarios.items() if s is not None} if isinstance(scenarios, Mapping) else scenarios
 
 
 # --------------------------------------------------------------------------- validation
@@ -383,7 +388,7 @@ def _pose_problems(config: Mapping[str, Any]) -> list[str]:
 def scenario_names(config: Mapping[str, Any]) -> list[str]:
     """The scenarios' names, ``default`` (the configuration itself) first, then the
     ``scenarios:`` in their given order; nothing of them is checked here."""
-    return [DEFAULT_SCENARIO, *(config.get("scenarios") or {})]
+    return [DEFAULT_SCENARIO, *(_live_scenarios(config.get("scenarios")) or {})]
 
 
 def scenario_config(config: Mapping[str, Any], name: str) -> dict[str, Any]:

@@ -8,12 +8,20 @@ from __future__ import annotations
 import itertools
 from collections.abc import Mapping, Sequence
 
-__all__ = ["set_id", "incremental_set_id", "synergy_sets"]
+__all__ = ["set_id", "set_name", "incremental_set_id", "synergy_sets"]
 
 
 def set_id(synergies: Sequence[int]) -> str:
     """Canonical id of a synergy set: 1-based indices, sorted, joined by '-' ("1-2-3")."""
     return "-".join(str(i) for i in sorted(set(synergies)))
+
+
+def set_name(synergies: Sequence[int]) -> str:
+    """A set in words: {S1..S7} for a run of three or more consecutive synergies, {S2,S5} otherwise."""
+    s = sorted(set(synergies))
+    if len(s) > 2 and s == list(range(s[0], s[-1] + 1)):
+        return f"{{S{s[0]}..S{s[-1]}}}"
+    return "{" + ",".join(f"S{k}" for k in s) + "}"
 
 
 def incremental_set_id(k: int) -> str:

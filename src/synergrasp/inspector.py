@@ -17,10 +17,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from synergrasp.ids import set_id
+from synergrasp.ids import set_id, set_name
 from synergrasp.optimisation.quality import GraspQuality, grasp_quality
 
-__all__ = ["InspectionError", "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp"]
+__all__ = ["InspectionError", "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp",
+           "grasp_picture", "grasp_view"]
 
 
 class InspectionError(ValueError):
@@ -40,6 +41,8 @@ class SetResult:
     e_s: dimension of the synergy-reachable internal forces
     cone_use: largest ‖f_t‖ / (μ f_n) over the contacts of the optimal forces (≤ 1: inside
         every circular cone; NaN unless feasible)
+    forces_N: the optimal contact forces on the object, (f_x, f_y, f_z) of each contact in
+        turn (3m, N, palm frame; empty unless load-feasible)
     """
 
     set_id: str
@@ -50,12 +53,15 @@ class SetResult:
     force_N: float
     e_s: int
     cone_use: float
+    forces_N: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
 class GraspInspection:
     """Everything about one grasp: the pose, the closure's contacts, each set's optimisation
-    and the quality indices (``quality`` None where the closure made no grasp)."""
+    and the quality indices (``quality`` None where the closure made no grasp); the posture
+    ``q_rad`` (19 joint angles, rad) and the object's pose (centre mm, row-major rotation,
+    palm frame) the closure ended at; the ``hand`` and the object's ``shape`` (for drawing)."""
 
     object: str
     pose: int
@@ -66,6 +72,11 @@ class GraspInspection:
     contacts: pd.DataFrame = field(repr=False)  # link, link_name, point_mm, normal, finger
     sets: tuple[SetResult, ...] = ()
     quality: GraspQuality | None = None
+    q_rad: tuple[float, ...] = ()
+    object_center_mm: tuple[float, ...] = ()
+    object_rotation: tuple[float, ...] = ()
+    hand: Any = field(default=None, repr=False, compare=False)
+    shape: Any = field(default=None, repr=False, compare=False)
 
     def to_dict(self) -> dict[str, Any]:
         """The inspection as plain data (lists and numbers), for ``--json``."""
@@ -75,31 +86,32 @@ class GraspInspection:
                 "closure_status": self.closure_status, "weight_N": self.weight_N,
                 "contacts": [{"link": int(r.link), "link_name": r.link_name, "point_mm": list(r.point_mm),
                               "normal": list(r.normal)} for r in self.contacts.itertuples()],
-                "sets": [asdict(s) for s in self.sets], "quality": q}
+                "sets": [asdict(s) for s in self.sets], "quality": q, "q_rad": list(self.q_rad),
+                "object_center_mm": list(self.object_center_mm), "object_rotation": list(self.object_rotation)}
 
 
 _TOKEN = re.compile(r"^(\d+)(?:-(\d+))?$|^(\d+(?:,\d+)+)$")
 
 
-def parse_sets(tokens: Sequence[str], n_synergies: int) -> list[tuple[int, ...]]:
+def parse_sets(tokens: Sequence[str], n_synergies: int, argument: str = "--sets") -> list[tuple[int, ...]]:
     """Synergy sets from command-line tokens: ``3`` = {S3}, ``1-5`` = {S1..S5} (a range),
-    ``2,5`` = {S2, S5}; 1-based, within 1 … ``n_synergies``."""
+    ``2,5`` = {S2, S5}; 1-based, within 1 … ``n_synergies``; an error names ``argument``."""
     out = []
     for token in tokens:
         match = _TOKEN.match(str(token).strip())
         if not match:
-            raise InspectionError(f"--sets: {token!r} is not a set; give k, a-b (S_a..S_b) or a,b,c")
+            raise InspectionError(f"{argument}: {token!r} is not a set; give k, a-b (S_a..S_b) or a,b,c")
         if match.group(3):
             members = tuple(sorted({int(v) for v in match.group(3).split(",")}))
         else:
             lo = int(match.group(1))
             hi = int(match.group(2)) if match.group(2) else lo
             if hi < lo:
-                raise InspectionError(f"--sets: {token!r} is an empty range")
+                raise InspectionError(f"{argument}: {token!r} is an empty range")
             members = tuple(range(lo, hi + 1))
         bad = [v for v in members if not 1 <= v <= n_synergies]
         if bad:
-            raise InspectionError(f"--sets: {token!r} names synergies {bad}; the table has S1..S{n_synergies}")
+            raise InspectionError(f"{argument}: {token!r} names synergies {bad}; the table has S1..S{n_synergies}")
         out.append(members)
     return out
 
@@ -190,16 +202,66 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     opt = OptimiseParams.from_config(cfg, obj)
     grasp = read_grasps(table)[0]
     weight = float(opt.gfo.mass_kg * opt.gfo.g_m_per_s2)
+    drawing = dict(q_rad=_floats(row["q"]), object_center_mm=_floats(row["object_center"]),
+                   object_rotation=_floats(row["object_rotation"]), hand=hand, shape=sim.object.shape)
     if grasp is None:
         return GraspInspection(obj, pose, float(row["alpha_deg"]), float(row["beta_deg"]), str(row["status"]),
-                               weight, _contacts_frame(hand, row) if int(row["n_contacts"]) else pd.DataFrame())
+                               weight, _contacts_frame(hand, row) if int(row["n_contacts"]) else pd.DataFrame(),
+                               **drawing)
     out = optimise_grasps([grasp], SynergySets(full.matrix, tuple(chosen)), opt.gfo, forces=True)
     mu = float(opt.gfo.mu)
     results = tuple(
         SetResult(set_id(s), s, str(out["status"][k]), bool(out["strict_internal"][k] and out["rank_G"][k] == 6),
                   bool(out["force_closure"][k]), float(out["force_norm"][k]), int(out["e_s"][k]),
-                  cone_use(out["forces"][k], grasp.normals, mu) if out["forces"][k] is not None else float("nan"))
+                  cone_use(out["forces"][k], grasp.normals, mu) if out["forces"][k] is not None else float("nan"),
+                  _floats(out["forces"][k]) if out["forces"][k] is not None else ())
         for k, s in enumerate(chosen))
     quality = grasp_quality(grasp, mu, sim.object.shape.bounding_radius_mm, synergies=full.matrix)
     return GraspInspection(obj, pose, float(row["alpha_deg"]), float(row["beta_deg"]), str(row["status"]), weight,
-                           _contacts_frame(hand, row), results, quality)
+                           _contacts_frame(hand, row), results, quality, **drawing)
+
+
+def _floats(values: Any) -> tuple[float, ...]:
+    return tuple(float(v) for v in np.ravel(np.asarray(values, dtype=float)))
+
+
+def _object_in_picture(result: GraspInspection) -> Any:
+    from synergrasp.figures.hand_pictures import ShapeInPicture
+
+    return ShapeInPicture(result.shape, np.asarray(result.object_center_mm), np.asarray(result.object_rotation).reshape(3, 3))
+
+
+def _title(result: GraspInspection) -> str:
+    shape = result.shape.label if result.shape.kind in result.shape.label else f"{result.shape.kind} {result.shape.label}"
+    return (f"{result.object} ({shape}) at α = {result.alpha_deg:g}°, "
+            f"β = {result.beta_deg:g}° (pose {result.pose}): {result.closure_status}, {len(result.contacts)} contacts")
+
+
+def grasp_picture(result: GraspInspection, png_path: str | Path) -> None:
+    """The inspected grasp drawn as in Fig. 2 from two views (``figure_grasp_views``), as a PNG."""
+    from synergrasp.figures.hand_figures import figure_grasp_views
+
+    links = result.contacts["link"] if len(result.contacts) else []
+    points = np.array(list(result.contacts["point_mm"]), dtype=float) if len(result.contacts) else np.zeros((0, 3))
+    figure_grasp_views(result.hand, _object_in_picture(result), result.q_rad, links, points, _title(result), png_path)
+
+
+def grasp_view(result: GraspInspection, synergies: Sequence[int] | None = None) -> Any:
+    """The inspected grasp in 3-D (``synergrasp.figures.grasp_3d.grasp_figure``: a plotly
+    figure as its dict) with the optimal contact forces of the set ``synergies`` (1-based;
+    None: the last set inspected) as arrows; ``grasp_page(grasp_view(...))`` is the page
+    ``--html`` writes."""
+    from synergrasp.figures.grasp_3d import GraspScene, grasp_figure
+
+    chosen = result.sets[-1] if synergies is None and result.sets else None
+    if synergies is not None:
+        wanted = tuple(sorted(set(synergies)))
+        chosen = next((s for s in result.sets if s.synergies == wanted), None)
+        if chosen is None:
+            raise InspectionError(f"--forces: {set_name(wanted)} is not among the sets inspected")
+    links = result.contacts["link"] if len(result.contacts) else []
+    points = np.array(list(result.contacts["point_mm"]), dtype=float) if len(result.contacts) else np.zeros((0, 3))
+    name = set_name(chosen.synergies) if chosen is not None else ""
+    scene = GraspScene.of(result.hand, result.q_rad, _object_in_picture(result), links, points,
+                          chosen.forces_N if chosen is not None else None, name, _title(result))
+    return grasp_figure(scene)

@@ -71,6 +71,8 @@ class Step:
     synergy_columns: the synergies (1-based) it reads besides the mean posture; it is handed
                their values instead of the synergy table.
     params:    "module:Class" whose ``from_config`` builds its typed parameters.
+    optional:  made only by its own target (``snakemake -j2 placement_claims``), not by the
+               study's (``figures``, ``scenario_<name>``): a report too costly for every run.
     """
 
     rules: Mapping[str, Cost]
@@ -83,6 +85,7 @@ class Step:
     upstream_when: tuple[tuple[str, Any, str], ...] = ()
     synergy_columns: tuple[int, ...] = ()
     params: str | None = None
+    optional: bool = False
 
 
 def _files(names: tuple[str, ...], folder: str, exts: tuple[str, ...]) -> dict[str, str]:
@@ -121,7 +124,7 @@ STEPS: dict[str, Step] = {
         reads=STEPS_SEARCH_READS, not_reads=STEPS_SEARCH_NOT_READS,
         params="synergrasp.optimisation.placement_search:SearchStepParams"),
     "simulate": Step(
-        rules={"simulate_contacts": Cost("closure_pose", 1.5, 178, 4.5e-2, 7.6e-3, local=False)},
+        rules={"simulate_contacts": Cost("closure_pose", 1.5, 178, 4.5e-3, 7.6e-3, local=False)},
         outputs={"contacts": "contacts.parquet"}, scope="object",
         reads=("hand", "synergies", "grid", "placement", "closure", "objects.{object}.shape",
                "objects.{object}.placement"),
@@ -187,6 +190,14 @@ STEPS: dict[str, Step] = {
         outputs=_files(("fig2_example_grasps",), "figures", _PNG_PDF),
         reads=("hand", "objects.*.shape"), upstream=("contacts",),
         params="synergrasp.figures.hand_figures:Fig2Params"),
+    # the Fig. 2 grasps in 3-D with the full set's optimal forces: pages sharing one plotly
+    # script (docs/inspector.md); a dozen optimisations and the pages' drawing
+    "grasps_3d": Step(
+        rules={"grasps_3d": Cost("none", 4.0, 400)},
+        outputs={"pages": "figures/grasps_3d"},
+        reads=("hand", "synergies", "mechanics", "synergy_sets.incremental_max", "objects.*.shape",
+               "objects.*.mass_kg"),
+        upstream=("contacts",), params="synergrasp.figures.grasp_3d:Grasps3dParams"),
     "fig4": Step(
         rules={"fig4_force_maps": Cost("pose_set", 4.3, 257, 5.1e-6, 4.0e-4)},
         outputs=_files(("fig4_force_maps", "fig4_exploded"), "", _PNG_PDF), scope="object",
@@ -199,6 +210,20 @@ STEPS: dict[str, Step] = {
         outputs=_files(("placement_map",), "", _PNG_PDF), scope="object",
         reads=STEPS_SEARCH_READS, not_reads=STEPS_SEARCH_NOT_READS, upstream=("search", "contacts"),
         params="synergrasp.optimisation.placement_search:SearchStepParams"),
+    # the study's claims at every scored target of the search (docs/placement_search.md): the
+    # closure and every set's optimisation on a 117-pose lattice, ~1 s of CPU per target, 2 processes
+    "target_claims": Step(
+        rules={"target_claims": Cost("none", 400.0, 900, local=False)},
+        outputs={"claims": "target_claims.parquet"}, scope="object",
+        reads=(*STEPS_SEARCH_READS, "synergy_sets", "analyses", "objects.{object}"),
+        reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
+        not_reads=(*STEPS_SEARCH_NOT_READS, "analyses.fig4"), upstream=("search",),
+        params="synergrasp.analysis.target_claims:TargetClaimsParams", optional=True),
+    "placement_claims": Step(
+        rules={"summarise_target_claims": Cost("none", 4.0, 300)},
+        outputs={"csv": "tables/placement_claims.csv", "md": "tables/placement_claims.md",
+                 **_files(("placement_claims",), "figures", _PNG_PDF)},
+        upstream=("target_claims",), optional=True),
     "fig5": Step(
         rules={"fig5_hierarchy": Cost("none", 9.6, 268)},
         outputs=_files(("fig5a_hierarchy_success", "fig5a_hierarchy_success_pooled", "fig5b_hierarchy_force"),

@@ -15,7 +15,7 @@ from pathlib import Path
 import pandas as pd
 
 __all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT",
-           "QUALITY", "write", "read", "write_csv", "read_csv", "empty", "write_study_table"]
+           "QUALITY", "TARGET_CLAIMS", "write", "read", "write_csv", "read_csv", "empty", "write_study_table"]
 
 
 @dataclass(frozen=True)
@@ -106,6 +106,10 @@ MINIMA = Table("minima", "one row per local minimum of (object, synergy set)", (
     Column("force_norm", "float64", "N", "optimal contact-force norm at the minimum"),
 ))
 
+def _target_columns() -> tuple[Column, ...]:
+    return tuple(Column(f"{axis}_mm", "float64", "mm", "target point, palm frame") for axis in "xyz")
+
+
 def _realism_columns() -> tuple[Column, ...]:
     bins = tuple(Column(f"pct_m{m}", "float64", "%", f"grasps with exactly {m} contacts") for m in range(6))
     return (
@@ -168,9 +172,7 @@ PLACEMENT = Table("placement", "one row per scored target of one object, best fi
     Column("rank", "int32", "", "rank by the tie rules, 1 = the chosen target"),
     Column("chosen", "bool", "", "rank 1"),
     Column("distinct_rank", "int32", "", "rank among the targets at least search.distinct_mm from every better one (0: closer)"),
-    Column("x_mm", "float64", "mm", "target point, palm frame"),
-    Column("y_mm", "float64", "mm", "target point, palm frame"),
-    Column("z_mm", "float64", "mm", "target point, palm frame"),
+    *_target_columns(),
     Column("round", "int32", "", "search round that scored it (0 = the coarse lattice)"),
     Column("n_poses", "int32", "", "scored poses"),
     Column("force_closure_percent", "float64", "%", "share of the scored poses in force closure with the full set"),
@@ -193,7 +195,26 @@ QUALITY = Table("quality", "one row per pose", _pose_columns() + (
     Column("torque_length_mm", "float64", "mm", "the length torques are divided by: the object's bounding radius"),
 ))
 
-TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, QUALITY)}
+#: The study's claims at every scored target of one object's placement search
+#: (docs/placement_search.md), Parquet (results/objects/<object>/target_claims.parquet).
+TARGET_CLAIMS = Table("target_claims", "one row per (scored target, claim), targets best first", (
+    Column("object", "string", "", "object name"),
+    Column("rank", "int32", "", "the target's rank in the placement search (1 = the chosen target)"),
+    *_target_columns(),
+    Column("force_closure_percent", "float64", "%", "the search's score F at the target"),
+    Column("n_poses", "int32", "", "poses of the lattice the claims rest on (first alpha-period)"),
+    Column("claim", "int32", "", "claim number (docs/analyses.md)"),
+    Column("view", "string", "", "the claim's headline view"),
+    Column("verdict", "string", "", "holds | does not hold | undefined, by the study's rules"),
+    Column("difference", "float64", "", "the compared difference (unit as in the claims table)"),
+    Column("low", "float64", "", "its interval's lower end"),
+    Column("high", "float64", "", "its interval's upper end"),
+    Column("n_distinct_poses", "int32", "", "distinct poses behind the comparison"),
+    Column("reason", "string", "", "why the verdict"),
+))
+
+TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, QUALITY,
+                                                TARGET_CLAIMS)}
 
 
 def _check(table: Table, frame: pd.DataFrame, where: str) -> None:

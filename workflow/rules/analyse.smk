@@ -124,3 +124,56 @@ rule grasp_quality:
         cfg=step_cfg("quality"),
     script:
         "../scripts/grasp_quality.py"
+
+
+# The study's claims at every target of the placement search (docs/placement_search.md):
+# made by `snakemake -j2 placement_claims` only (~1 s of CPU per target), not by `figures`.
+rule target_claims:
+    input:
+        placement=step_input("search"),
+        code=code("target_claims"),
+        data=SHIPPED_DATA,
+        user=user_files,
+    output:
+        "{root}/objects/{object}/target_claims.parquet",
+    log:
+        "{root}/logs/target_claims/{object}.log",
+    benchmark:
+        "{root}/benchmarks/target_claims/{object}.tsv"
+    threads: 2
+    resources:
+        mem_mb=mem_mb("target_claims"),
+        runtime=runtime_min("target_claims"),
+    params:
+        cfg=step_cfg("target_claims"),
+    script:
+        "../scripts/target_claims.py"
+
+
+rule summarise_target_claims:
+    input:
+        claims=searched_inputs("target_claims"),
+        code=code("summarise_target_claims"),
+    output:
+        csv=report(
+            "{root}/tables/placement_claims.csv",
+            caption="../report/placement_claims.rst",
+            category="Placement search",
+        ),
+        md="{root}/tables/placement_claims.md",
+        png=report(
+            "{root}/figures/placement_claims.png",
+            caption="../report/placement_claims.rst",
+            category="Placement search",
+        ),
+        pdf="{root}/figures/placement_claims.pdf",
+    log:
+        "{root}/logs/summarise_target_claims.log",
+    benchmark:
+        "{root}/benchmarks/summarise_target_claims.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("summarise_target_claims"),
+        runtime=runtime_min("summarise_target_claims"),
+    script:
+        "../scripts/summarise_target_claims.py"

@@ -3,6 +3,7 @@
 import functools
 import math
 import re
+import sys
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
@@ -171,6 +172,16 @@ def step_inputs(step):
     ]
 
 
+def searched_inputs(step):
+    """Input function: the per-object ``step`` output of every object of the job's scenario
+    whose placement is searched."""
+    return lambda w: [
+        step_file(_ROOT_SCENARIO[w.root], step, o)
+        for o in scenario_config(w)["objects"]
+        if searched(_ROOT_SCENARIO[w.root], o)
+    ]
+
+
 def step_cfg(step):
     """A rule's ``params``: the part of the job's scenario configuration its step reads (for
     the job's object; synergrasp.steps.STEPS), so that a job reruns only when a key it reads
@@ -271,22 +282,36 @@ def code(script):
 
 
 def user_files(wildcards):
-    """Input function: the scenario's own hand/synergy files, so that a change of their
-    content reruns what uses them (a shipped synergy table given by name is under SHIPPED_DATA)."""
+    """Input function: the scenario's own hand/synergy files and the mesh files of its objects
+    (the job's object only, for a job per object), so that a change of their content reruns
+    what uses them (a shipped synergy table given by name is under SHIPPED_DATA)."""
     from synergrasp.hand.synergies import SHIPPED_TABLES
 
     cfg = scenario_config(wildcards)
-    return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in SHIPPED_TABLES]
+    obj = getattr(wildcards, "object", None)
+    objects = [obj] if obj in cfg["objects"] else list(cfg["objects"])
+    meshes = [
+        cfg["objects"][o]["shape"]["mesh"]["path"]
+        for o in objects
+        if "mesh" in cfg["objects"][o]["shape"]
+    ]
+    return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in SHIPPED_TABLES] + meshes
 
 
-SHIPPED_DATA = sorted(str(p) for p in (SRC / "data").glob("*") if p.is_file())
+#: The shipped hand and synergy files. Not the schema: its defaults reach a job through its
+#: params (the step's part of the configuration), so a new key reruns nothing.
+SHIPPED_DATA = sorted(
+    str(p)
+    for p in (SRC / "data").glob("*")
+    if p.is_file() and p.name not in ("config.schema.yaml", "README.md")
+)
 
 
 def object_targets(name, scenario_name="default"):
     """One object's outputs in a scenario: the outputs of every per-object step (wherever shared)."""
     files = {}
     for step, spec in STEPS.items():
-        if spec.scope != "object" or not spec.rules or not _shown(scenario_name, step, name):
+        if spec.scope != "object" or spec.optional or not _shown(scenario_name, step, name):
             continue
         if len(spec.outputs) == 1:
             files[step_file(scenario_name, step, name)] = None
@@ -319,7 +344,7 @@ def study_targets(name="default"):
     files = [
         study_file(name, step, rel)
         for step, spec in STEPS.items()
-        if spec.scope == "scenario" and spec.rules
+        if spec.scope == "scenario" and not spec.optional
         for rel in spec.outputs.values()
     ]
     files += workflow_files("fig3")
@@ -343,3 +368,31 @@ def scenario_tables(table):
 
 
 SENSITIVITY_FILES = workflow_files("sensitivity")
+
+
+def placement_claims_targets(name="default"):
+    """The claims over the placement search's targets (the optional steps) of scenario ``name``."""
+    return [
+        study_file(name, "placement_claims", rel)
+        for rel in STEPS["placement_claims"].outputs.values()
+    ]
+
+
+def _report_archive(argv):
+    """Whether the command writes the report as an archive (`--report <path>.zip`)."""
+    for k, arg in enumerate(argv):
+        path = arg.split("=", 1)[1] if arg.startswith("--report=") else None
+        if arg == "--report" and k + 1 < len(argv):
+            path = argv[k + 1]
+        if path is not None:
+            return path.endswith(".zip")
+    return False
+
+
+def pages_in_report(path, **report_args):
+    """A folder of pages (its index.html first), in the report when the report is an archive:
+    Snakemake's one-file HTML report refuses folders (and Chromium would not open a page of
+    several MB from it), so results/report.zip holds the 3-D pages and report.html does not."""
+    if _report_archive(sys.argv):
+        return report(directory(path), htmlindex="index.html", **report_args)
+    return directory(path)

@@ -1,6 +1,6 @@
 # Stage 4: the study's figures: the hand along the synergies (Fig. 1), example grasps
-# (Fig. 2), the workflow's own rule graph (Fig. 3), force maps per object (Fig. 4) and the
-# hierarchy (Fig. 5).
+# (Fig. 2, and in 3-D in the browser), the workflow's own rule graph (Fig. 3), force maps per
+# object (Fig. 4) and the hierarchy (Fig. 5).
 
 
 rule fig4_force_maps:
@@ -154,6 +154,32 @@ rule fig2_example_grasps:
         cfg=step_cfg("fig2"),
     script:
         "../scripts/fig2_example_grasps.py"
+
+
+rule grasps_3d:
+    input:
+        contacts=step_inputs("contacts"),
+        code=code("grasps_3d"),
+        data=SHIPPED_DATA,
+        user=user_files,
+    output:
+        pages=pages_in_report(
+            "{root}/figures/grasps_3d",
+            caption="../report/grasps_3d.rst",
+            category="Figures",
+        ),
+    log:
+        "{root}/logs/grasps_3d.log",
+    benchmark:
+        "{root}/benchmarks/grasps_3d.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("grasps_3d"),
+        runtime=runtime_min("grasps_3d"),
+    params:
+        cfg=step_cfg("grasps_3d"),
+    script:
+        "../scripts/grasps_3d.py"
 
 
 rule placement_map:

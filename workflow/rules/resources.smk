@@ -10,8 +10,9 @@ from synergrasp.steps import rule_costs
 
 JOB_COST = rule_costs()
 # Closure cost per pose relative to the kinematic closure measured in STEPS, per closure
-# model; a model not listed is charged CLOSURE_UNMEASURED_FACTOR until its cost is measured.
-CLOSURE_COST_FACTOR = {"kinematic": 1.0, "dynamic": 1.8}
+# model (docs/cluster.md); a model not listed is charged CLOSURE_UNMEASURED_FACTOR until its
+# cost is measured.
+CLOSURE_COST_FACTOR = {"kinematic": 1.0, "dynamic": 9.0}
 CLOSURE_UNMEASURED_FACTOR = 20.0
 # A cold compiled-solver cache (a node whose CPU model has no cached build) compiles the
 # solver once in the job: about 50 s and 150 MB on the measuring machine.

@@ -20,6 +20,7 @@ from __future__ import annotations
 import pandas as pd
 
 from synergrasp.analysis.verdicts import verdict_columns
+from synergrasp.ids import set_name
 from synergrasp.tables import GRASPABLE_OBJECTS
 
 __all__ = ["graspable_objects", "ungraspable_lines"]
@@ -33,11 +34,7 @@ def _counts(statuses: pd.Series) -> str:
 
 
 def _set_name(set_id: str) -> str:
-    """{S1..Sk} for an incremental set id "1-2-…-k", else {S…} of its members."""
-    ids = [int(i) for i in set_id.split("-")]
-    if ids == list(range(1, len(ids) + 1)) and len(ids) > 2:
-        return f"{{S1..S{len(ids)}}}"
-    return "{" + ",".join(f"S{i}" for i in ids) + "}"
+    return set_name(int(i) for i in set_id.split("-"))
 
 
 def _reason(rows: pd.DataFrame, n_fc: int, dynamic: bool, full_set_id: str) -> str:

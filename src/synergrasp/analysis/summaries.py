@@ -40,6 +40,7 @@ __all__ = [
     "verdict_disagreements",
     "set_sort_key",
     "study_tables",
+    "study_claims",
 ]
 
 ALL_OBJECTS = "all"
@@ -415,6 +416,26 @@ def verdict_disagreements(table: pd.DataFrame) -> pd.DataFrame:
     return out[cols].astype({c: "int64" for c in cols[3:7]})
 
 
+def _claims(gfo: pd.DataFrame, minima: pd.DataFrame, k_max: int, first: int, settings: AnalysisSettings
+            ) -> tuple[pd.DataFrame, StudyCounts, tuple[pd.DataFrame, pd.DataFrame], pd.DataFrame]:
+    """The gfo table with its verdicts, the resampled counts, the null model's (summary,
+    pairs) and the claims table."""
+    full = incremental_set_id(k_max)
+    table = with_verdicts(gfo, settings.success, settings.weights_N, settings.marginal_weight_multiple)
+    resampler = PoseResampler(table[table["set_id"] == full], dict(settings.periods_deg), settings.bootstrap)
+    counts = StudyCounts(table, full, resampler)
+    chance = preservation_vs_chance(table, minima, k_max, settings.radius_deg, dict(settings.periods_deg),
+                                    settings.null_draws, settings.null_seed)
+    kept = resampled_preservation(minima, k_max, settings.radius_deg, resampler)
+    return table, counts, chance, claims_table(counts, kept, chance[0], settings.rules, first)
+
+
+def study_claims(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[str, int],
+                 settings: AnalysisSettings) -> pd.DataFrame:
+    """The claims table of :func:`study_tables` alone (the other tables are not made)."""
+    return _claims(gfo, minima, int(sets_config["incremental_max"]), int(sets_config["hierarchy_first"]), settings)[3]
+
+
 def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[str, int], table2_k_max: int,
                  settings: AnalysisSettings) -> dict[str, tuple[str, pd.DataFrame]]:
     """Every study table by name: (title, table).
@@ -428,21 +449,15 @@ def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
     first = int(sets_config["hierarchy_first"])
     full = incremental_set_id(k_max)
     first_n = incremental_set_id(first)
-    table = with_verdicts(gfo, settings.success, settings.weights_N, settings.marginal_weight_multiple)
     periods = dict(settings.periods_deg)
-    resampler = PoseResampler(table[table["set_id"] == full], periods, settings.bootstrap)
-    counts = StudyCounts(table, full, resampler)
+    table, counts, (chance, pairs), claims = _claims(gfo, minima, k_max, first, settings)
     rates = success_rates(table, full, periods)
     checks = invariant_checks(table, rates, periods, settings.success_rate_tolerance_percent)
     lost = (full_but_not_first7(table, full, first_n) if first_n in set(table["set_id"]) else None)
-    chance, pairs = preservation_vs_chance(table, minima, k_max, settings.radius_deg, periods,
-                                           settings.null_draws, settings.null_seed)
     preservation = minimum_preservation(table, minima, k_max, settings.radius_deg, periods)
     preservation = preservation.merge(pairs.astype({"k": "Int64"}), on=["object", "k"], how="left")
     table2 = incrementality_table(rates, table2_k_max)
     rates = with_intervals(rates, counts)
-    kept = resampled_preservation(minima, k_max, settings.radius_deg, resampler)
-    claims = claims_table(counts, kept, chance, settings.rules, first)
     verdict = f"success = {settings.success}"
     level = f"{100 * settings.bootstrap.level:g} % intervals: block bootstrap over distinct poses"
     return {

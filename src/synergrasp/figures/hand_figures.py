@@ -21,10 +21,13 @@ from synergrasp.figures.output import save_figure
 from synergrasp.hand.synergies import SynergyPath
 from synergrasp.simulation.objects import GraspedObject
 
-__all__ = ["figure_synergy_postures", "figure_example_grasps", "draw_grasp_row", "PANEL_PX"]
+__all__ = ["figure_synergy_postures", "figure_example_grasps", "figure_grasp_views", "draw_grasp", "draw_grasp_row",
+           "object_of", "PANEL_PX", "GRASP_VIEWS", "FIG2_GRASPS"]
 
 #: Rendered panel size, pixels (width, height).
 PANEL_PX = (330, 330)
+#: Grasps per object in Fig. 2.
+FIG2_GRASPS = 3
 _CONTACT = "#c2000b"
 
 
@@ -191,12 +194,13 @@ def _touching_words(hand: Any, links: Sequence[int]) -> str:
     return "\n".join(textwrap.wrap("touching: " + ", ".join(parts), 48))
 
 
-def _object_of(row: pd.Series, shape: Any) -> ShapeInPicture:
+def object_of(row: pd.Series, shape: Any) -> ShapeInPicture:
+    """The object of a contacts table's row (its end pose) with its ``shape``."""
     return ShapeInPicture(shape, np.asarray(row["object_center"], dtype=float),
                           np.asarray(row["object_rotation"], dtype=float).reshape(3, 3))
 
 
-def _legend(fig: Any) -> None:
+def _legend(fig: Any, ncol: int = 5) -> None:
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -206,7 +210,21 @@ def _legend(fig: Any) -> None:
                Line2D([], [], ls="", marker="o", color=_CONTACT, markeredgecolor="white", label="contact point"),
                Line2D([], [], ls="", marker="o", markerfacecolor="none", color=_CONTACT,
                       label="contact point behind the hand")]
-    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, frameon=False)
+    fig.legend(handles=handles, loc="lower center", ncol=ncol, fontsize=8, frameon=False)
+
+
+def draw_grasp(ax: Any, hand: Any, q: NDArray, shape: ShapeInPicture, touching: Sequence[int], points_mm: ArrayLike,
+               camera: Camera) -> Any:
+    """One grasp of Fig. 2 on ``ax``: the hand at q (rad) seen by ``camera``, the links in
+    ``touching`` highlighted, the object see-through, the contact points (mm, palm frame;
+    hollow where the hand hides them). Returns the rendered ``Picture``."""
+    points = np.asarray(points_mm, dtype=float).reshape(-1, 3)
+    picture = render(hand, q, camera, PANEL_PX, shape=shape, touching=touching)
+    ax.imshow(picture.rgb, interpolation="antialiased")
+    px, hidden = picture.pixels(points), picture.hidden(points)
+    ax.scatter(px[~hidden, 0], px[~hidden, 1], s=16, c=_CONTACT, edgecolors="white", linewidths=0.6, zorder=3)
+    ax.scatter(px[hidden, 0], px[hidden, 1], s=16, facecolors="none", edgecolors=_CONTACT, linewidths=0.9, zorder=3)
+    return picture
 
 
 def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame, camera: Camera = PALM_CAMERA) -> None:
@@ -219,7 +237,7 @@ def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame
     simulated = int(table["status"].isin(SIMULATED_STATUSES).sum())
     rows = [table[table["pose"] == pose].iloc[0] for pose in chosen["pose"]]
     row_camera = _fit(camera, hand, [np.asarray(row["q"], dtype=float) for row in rows],
-                      [_object_of(row, obj.shape) for row in rows]) if rows else camera
+                      [object_of(row, obj.shape) for row in rows]) if rows else camera
     pictures, thumbs = [], []
     axes[0].set_ylabel(f"{obj.name}\n{obj.shape.label}", fontsize=10)
     for c in range(n_grasps):
@@ -230,16 +248,11 @@ def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame
                     ha="center", va="center", transform=ax.transAxes, fontsize=8, color="0.4")
             continue
         pick, row = chosen.iloc[c], rows[c]
-        points = np.asarray(row["contact_point"], dtype=float).reshape(-1, 3)
-        picture = render(hand, np.asarray(row["q"], dtype=float), row_camera, PANEL_PX,
-                         shape=_object_of(row, obj.shape), touching=pick["pattern"])
-        ax.imshow(picture.rgb, interpolation="antialiased")
+        q = np.asarray(row["q"], dtype=float)
+        picture = draw_grasp(ax, hand, q, object_of(row, obj.shape), pick["pattern"], row["contact_point"],
+                             row_camera)
         pictures.append(picture)
-        thumbs.append((picture, np.asarray(row["q"], dtype=float)))
-        px, hidden = picture.pixels(points), picture.hidden(points)
-        ax.scatter(px[~hidden, 0], px[~hidden, 1], s=16, c=_CONTACT, edgecolors="white", linewidths=0.6, zorder=3)
-        ax.scatter(px[hidden, 0], px[hidden, 1], s=16, facecolors="none", edgecolors=_CONTACT, linewidths=0.9,
-                   zorder=3)
+        thumbs.append((picture, q))
         ax.set_title(f"{pick['reason']}: {pick['share_pct']:.0f} % of grasps\n"
                      f"α = {pick['alpha_deg']:g}°, β = {pick['beta_deg']:g}°, {int(row['n_contacts'])} contacts",
                      fontsize=8)
@@ -252,7 +265,7 @@ def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame
 
 
 def figure_example_grasps(hand: Any, objects: Sequence[Any], tables: Sequence[pd.DataFrame], png_path: str | Path,
-                          pdf_path: str | Path, n_grasps: int = 3, camera: Camera = PALM_CAMERA) -> None:
+                          pdf_path: str | Path, n_grasps: int = FIG2_GRASPS, camera: Camera = PALM_CAMERA) -> None:
     """Fig. 2: representative simulated grasps, one row per object, chosen by rule
     (``synergrasp.analysis.realism.representative_grasps``: the most common set of touching
     links, the most common one at the typical contact count, the next most common), each at
@@ -276,4 +289,39 @@ def figure_example_grasps(hand: Any, objects: Sequence[Any], tables: Sequence[pd
         draw_grasp_row(axes[r], hand, obj, table, camera)
     _legend(fig)
     fig.tight_layout(rect=(0, 0.035, 1, 1), h_pad=0.6, w_pad=0.3)
+    save_figure(fig, png_path, pdf_path)
+
+
+#: The two views of one grasp (``figure_grasp_views``): Fig. 2's, and from above the
+#: fingertips with the palm at the bottom and the palm normal up, where the tips and the thumb
+#: are seen on the object side by side.
+GRASP_VIEWS = (("palm side (as Fig. 2)", PALM_CAMERA),
+               ("from above the fingertips (palm below)", Camera(direction=(-0.45, 0.3, -1.0), up=(1.0, 0.0, 0.0))))
+
+
+def figure_grasp_views(hand: Any, shape: ShapeInPicture, q: ArrayLike, links: Sequence[int], points_mm: ArrayLike,
+                       title: str, png_path: str | Path, pdf_path: str | Path | None = None,
+                       views: Sequence[tuple[str, Camera]] = GRASP_VIEWS) -> None:
+    """One grasp drawn as in Fig. 2 from each of ``views`` (name, camera): the hand at q
+    (rad), the object ``shape`` see-through, the ``links`` touching it highlighted (hand
+    link indices, one per contact), the contact points (mm, palm frame)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    q = np.asarray(q, dtype=float)
+    touching = sorted({int(k) for k in links})
+    panel = 3.0  # inches
+    fig, axes = plt.subplots(1, len(views), figsize=(panel * len(views) + 0.4, panel + 1.3), squeeze=False)
+    for ax, (name, camera) in zip(axes[0], views):
+        picture = draw_grasp(ax, hand, q, shape, touching, points_mm, _fit(camera, hand, [q], [shape]))
+        _bare(ax)
+        _frame([ax], [picture])
+        _label(ax, "thumb", picture.pixels(_thumb_point(hand, q)[None])[0], picture.pixels(_palm_point(hand)[None])[0])
+        ax.set_title(name, fontsize=9)
+    fig.suptitle(title, fontsize=9)
+    fig.text(0.5, 0.13, _touching_words(hand, touching).replace("\n", " "), ha="center", va="bottom", fontsize=8)
+    _legend(fig, ncol=3)
+    fig.tight_layout(rect=(0, 0.16, 1, 1), w_pad=0.4)
     save_figure(fig, png_path, pdf_path)

@@ -12,7 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from synergrasp.figures.output import save_figure  # noqa: E402
+from synergrasp.figures.output import colour_range, save_figure  # noqa: E402
 
 __all__ = ["quality_grid", "figure_quality_maps", "QUALITY_PANELS"]
 
@@ -47,10 +47,7 @@ def figure_quality_maps(quality: pd.DataFrame, object_name: str, png: str | Path
         alphas, betas, values = quality_grid(shown, column)
         with np.errstate(divide="ignore", invalid="ignore"):
             values = np.log10(values) if log else values
-        finite = values[np.isfinite(values)]
-        lo, hi = (np.percentile(finite, [1, 99]) if finite.size else (0.0, 1.0))
-        if hi <= lo:  # a constant map (a sphere's): a visible, centred colour range
-            lo, hi = lo - 0.5 * max(abs(lo), 1e-3), hi + 0.5 * max(abs(hi), 1e-3)
+        lo, hi = colour_range(values)  # one colour where it is constant (a sphere's)
         step_a = alphas[1] - alphas[0] if alphas.size > 1 else 5.0
         step_b = betas[1] - betas[0] if betas.size > 1 else 5.0
         image = ax.imshow(np.ma.masked_invalid(values), origin="lower", aspect="auto", cmap=cmap, vmin=lo, vmax=hi,

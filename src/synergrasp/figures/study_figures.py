@@ -23,7 +23,7 @@ import pandas as pd  # noqa: E402
 
 from synergrasp.analysis.verdicts import force_bound  # noqa: E402
 from synergrasp.ids import incremental_set_id  # noqa: E402
-from synergrasp.figures.output import save_figure  # noqa: E402
+from synergrasp.figures.output import colour_range, save_figure  # noqa: E402
 
 __all__ = [
     "Fig4Params",
@@ -104,7 +104,7 @@ def figure_force_maps(gfo: pd.DataFrame, minima: pd.DataFrame, panel_k: Sequence
     verdict in use, labels the titles), dots on the local minima."""
     grids = [force_grid(gfo, incremental_set_id(k)) for k in panel_k]
     finite = np.concatenate([np.log10(g[2][np.isfinite(g[2])]) for g in grids] + [np.zeros(0)])
-    vmin, vmax = (np.percentile(finite, [1, 99]) if finite.size else (0.0, 1.0))
+    vmin, vmax = colour_range(finite)  # one colour where it is constant (a sphere's)
     fig, axes = plt.subplots(len(panel_k), 1, figsize=(9, 2.4 * len(panel_k) + 0.6),
                              sharex=True, squeeze=False)
     cmap = matplotlib.colormaps["viridis"].with_extremes(bad="white")

@@ -118,8 +118,7 @@ class SearchStepParams:
             placement=Placement.from_config({**placement, "mode": "searched", "approach_point_mm": None,
                                              "center_mm": (0.0, 0.0, 0.0)}, config["grid"]),
             closure=build(ClosureParams, "closure", **{**dataclass_fields(ClosureParams, closure), "dynamic": None}),
-            gfo=build(GFOParams, "mechanics", **dataclass_fields(GFOParams, config["mechanics"]),
-                      mass_kg=float(config["objects"][obj]["mass_kg"])),
+            gfo=GFOParams.from_config(config, obj),
             full_set_size=int(config["synergy_sets"]["incremental_max"]), search=search,
             distinct_mm=float(spec["distinct_mm"]))
 

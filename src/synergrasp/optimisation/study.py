@@ -81,6 +81,12 @@ class GFOParams:
         for name in ("mu", "f_min_N", "k_stru_N_per_mm", "k_ss_Nmm_per_rad", "mass_kg", "g_m_per_s2"):
             object.__setattr__(self, name, float(getattr(self, name)))
 
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str) -> GFOParams:
+        """The configuration's ``mechanics`` with the weight of the object ``obj``."""
+        return build(cls, "mechanics", **dataclass_fields(cls, config["mechanics"]),
+                     mass_kg=float(config["objects"][obj]["mass_kg"]))
+
     def wrench(self) -> NDArray:
         """w_e (6,) the contacts must apply against the weight, N and N·mm."""
         return object_wrench(self.mass_kg, np.asarray(self.gravity_direction), self.g_m_per_s2)
@@ -105,9 +111,7 @@ class OptimiseParams:
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> OptimiseParams:
         """From a configuration or the step's own part of it, for the object ``obj``."""
-        gfo = build(GFOParams, "mechanics", **dataclass_fields(GFOParams, config["mechanics"]),
-                    mass_kg=float(config["objects"][obj]["mass_kg"]))
-        return cls(config["synergies"], synergy_sets(config["synergy_sets"]), gfo,
+        return cls(config["synergies"], synergy_sets(config["synergy_sets"]), GFOParams.from_config(config, obj),
                    int(config["solver"]["pose_shards"]))
 
 

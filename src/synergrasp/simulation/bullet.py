@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import tempfile
 from dataclasses import dataclass, fields
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +40,11 @@ class HandBody:
     joint_scale: NDArray[np.float64]
     link_index: NDArray[np.int64]
     hand_link: dict[int, int]
+
+    @cached_property
+    def joint_list(self) -> list[int]:
+        """``joint_indices`` as the list pybullet's calls take."""
+        return self.joint_indices.tolist()
 
 
 @dataclass(frozen=True)
@@ -158,7 +164,22 @@ def collision_shape(client: int, shape: Any) -> int:
     if kind == "cylinder":  # along the shape's own z axis, as pybullet's
         return pb.createCollisionShape(pb.GEOM_CYLINDER, radius=float(geometry["radius_mm"]) * MM,
                                        height=float(geometry["height_mm"]) * MM, physicsClientId=client)
+    if kind == "convex_parts":  # one convex hull per part (a file of several: the engine's compound)
+        parts = geometry["parts_mm"]
+        if len(parts) == 1:
+            return pb.createCollisionShape(pb.GEOM_MESH, vertices=(parts[0] * MM).tolist(), physicsClientId=client)
+        from synergrasp.simulation.shapes.convex_parts import bullet_file
+
+        return pb.createCollisionShape(pb.GEOM_MESH, fileName=str(bullet_file(parts)), meshScale=[MM] * 3,
+                                       physicsClientId=client)
     raise ValueError(f"no collision shape for a {kind!r}")
+
+
+def _exact_surface(client: int, body: int, shape: Any) -> None:
+    """No collision margin on a convex hull (the engine rounds one by 1 mm otherwise; its
+    primitives keep their own surface): contacts lie on the shape's surface."""
+    if shape.collision_geometry()[0] == "convex_parts":
+        pb.changeDynamics(body, -1, collisionMargin=0.0, physicsClientId=client)
 
 
 def load_object(client: int, shape: Any, center_mm: NDArray, rotation: NDArray | None = None) -> int:
@@ -167,6 +188,7 @@ def load_object(client: int, shape: Any, center_mm: NDArray, rotation: NDArray |
     Returns its body id."""
     body = pb.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=collision_shape(client, shape),
                               physicsClientId=client)
+    _exact_surface(client, body, shape)
     move_body(client, body, center_mm, rotation)
     return body
 
@@ -359,6 +381,7 @@ def load_free_object(client: int, shape: Any, mass_kg: float, friction: float, d
                               physicsClientId=client)
     pb.changeDynamics(body, -1, lateralFriction=float(friction), linearDamping=float(damping_per_s),
                       angularDamping=float(damping_per_s), physicsClientId=client)
+    _exact_surface(client, body, shape)
     return body
 
 
@@ -378,8 +401,14 @@ def reset_body(client: int, body: int, center_mm: NDArray, rotation: NDArray) ->
 
 def axis_states(client: int, body: HandBody) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Angles (rad) and angular velocities (rad/s) of every elementary axis, HandBody order."""
-    states = pb.getJointStates(body.body, body.joint_indices.tolist(), physicsClientId=client)
+    states = pb.getJointStates(body.body, body.joint_list, physicsClientId=client)
     return np.array([s[0] for s in states]), np.array([s[1] for s in states])
+
+
+def body_pose(client: int, body: int) -> tuple[NDArray, NDArray]:
+    """Centre (mm) and rotation (3 × 3) of a body."""
+    pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+    return np.array(pos) / MM, np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
 
 
 def body_state(client: int, body: int) -> tuple[NDArray, NDArray, NDArray, NDArray]:
@@ -402,7 +431,7 @@ def contact_forces(client: int, body_a: int | HandBody, body_b: HandBody) -> Con
 
 def step_with_torques(client: int, body: HandBody, torques_Nmm: NDArray) -> None:
     """Apply ``torques_Nmm`` (N·mm, one per elementary axis, HandBody order) and take one step."""
-    pb.setJointMotorControlArray(body.body, body.joint_indices.tolist(), pb.TORQUE_CONTROL,
+    pb.setJointMotorControlArray(body.body, body.joint_list, pb.TORQUE_CONTROL,
                                  forces=(np.asarray(torques_Nmm, dtype=float) * MM).tolist(), physicsClientId=client)
     pb.stepSimulation(physicsClientId=client)
 

@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 
 from synergrasp.hand.checks import closure_shape_problems
 from synergrasp.simulation.shapes.kernels import segment_cylinder, segment_sphere, sort_knots
+from synergrasp.simulation.shapes.polytope import WORK, segment_parts
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
@@ -227,13 +228,16 @@ def _capsule_to_box(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray
 def _seg_object(p0: NDArray, d: NDArray, code: int, params: NDArray, work: NDArray) -> tuple[float, float]:
     """Signed distance (mm) from the segment p0 + t·d, t in [0, 1] (the object's own frame),
     to the object's shape (``code``, ``params``: ``synergrasp.simulation.shapes``) and the t
-    attaining it; ``work`` is scratch space of 8 values. 0: a box, params its half extents;
-    1: a sphere about the origin, (radius); 2: a cylinder about the z axis, (radius, half height)."""
+    attaining it; ``work`` is scratch space of ``WORK`` values. 0: a box, params its half extents;
+    1: a sphere about the origin, (radius); 2: a cylinder about the z axis, (radius, half height);
+    3: convex parts (a mesh), ``polytope.pack_parts``."""
     if code == 0:
         return _seg_box_into(p0, d, params, work)
     if code == 1:
         return segment_sphere(p0, d, params[0])
-    return segment_cylinder(p0, d, params[0], params[1], work)
+    if code == 2:
+        return segment_cylinder(p0, d, params[0], params[1], work)
+    return segment_parts(p0, d, params, work)
 
 
 @numba.njit(cache=True)
@@ -242,7 +246,7 @@ def segment_object_distance(p0: NDArray, p1: NDArray, code: int, params: NDArray
     object shape (``code``, ``params``) and the segment parameters (k,) attaining them."""
     k = p0.shape[0]
     dist, t = np.empty(k), np.empty(k)
-    work = np.empty(8)
+    work = np.empty(WORK)
     for i in range(k):
         dist[i], t[i] = _seg_object(p0[i], p1[i] - p0[i], code, params, work)
     return dist, t
@@ -252,7 +256,7 @@ def segment_object_distance(p0: NDArray, p1: NDArray, code: int, params: NDArray
 def _capsule_to_object(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray, code: int, params: NDArray,
                        work: NDArray) -> tuple[float, float]:
     """Signed distance of the axis p0–p1 (palm frame) to an object at (rotation, centre) and
-    its parameter; ``work`` (3, 8) is scratch space."""
+    its parameter; ``work`` (3, WORK) is scratch space."""
     _to_box(p0, rotation, centre, work[0])
     _to_box(p1, rotation, centre, work[1])
     for i in range(3):
@@ -267,7 +271,7 @@ def capsule_object(p0: NDArray, p1: NDArray, radius: NDArray, rotation: NDArray,
     frame pose) and the parameter of the closest point of its axis."""
     c = p0.shape[0]
     dist, t = np.empty(c), np.empty(c)
-    work = np.empty((3, 8))
+    work = np.empty((3, WORK))
     for i in range(c):
         d, ti = _capsule_to_object(p0[i], p1[i], rotation, centre, code, params, work)
         dist[i], t[i] = d - radius[i], ti
@@ -384,8 +388,9 @@ class HandCapsules:
     def encloses(self, q: NDArray, point_mm: NDArray) -> bool:
         """Whether ``point_mm`` (palm frame) lies inside the hand at q (rad): within the convex
         hull of the hand's volume, the capsules (each axis end point widened by its radius in
-        14 directions, a polyhedron inside the sphere) and the palm boxes' corners."""
-        from scipy.spatial import Delaunay
+        14 directions, a polyhedron inside the sphere) and the palm boxes' corners. The hull's
+        facets, not a triangulation of its inside: 0.3 ms against ~100 ms for the ~540 points."""
+        from scipy.spatial import ConvexHull
 
         p0, p1 = self.segments(q)
         cube = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
@@ -393,5 +398,5 @@ class HandCapsules:
         widened = (np.vstack([p0, p1])[:, None, :]
                    + np.concatenate([self.radius, self.radius])[:, None, None] * directions[None]).reshape(-1, 3)
         corners = [c + (cube * h) @ r.T for r, c, h in zip(self.palm_rotation, self.palm_centre, self.palm_half)]
-        hull = Delaunay(np.vstack([widened, *corners]))
-        return bool(hull.find_simplex(np.asarray(point_mm, dtype=float)) >= 0)
+        facets = ConvexHull(np.vstack([widened, *corners])).equations  # rows (outward n, offset): n·x + offset ≤ 0 inside
+        return bool(np.max(facets[:, :3] @ np.asarray(point_mm, dtype=float) + facets[:, 3]) <= 1e-9)

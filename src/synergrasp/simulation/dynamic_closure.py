@@ -104,6 +104,10 @@ class DynamicClosure:
         self.axis_sum = np.zeros((hand.n_joints, len(self.axis_joint)))  # q = axis_sum @ θ
         self.axis_sum[self.axis_joint, np.arange(len(self.axis_joint))] = 1.0
         self.q_open = self.path.reference(self.sigma_open)
+        # the axes' targets s_i·q_r(σ) after each step of the σ ramp, the same for every grasp
+        ramp = p.ramp_steps
+        sigmas = [self.sigma_open + (self.sigma_closed - self.sigma_open) * (step + 1) / ramp for step in range(ramp)]
+        self.ramp_targets = self.axis_scale * self.path.reference(np.array(sigmas))[:, self.axis_joint]
         self.self_pairs = self._colliding_pairs()
         self.capsules = HandCapsules.of(hand)
         self.box: int | None = None  # the object's body
@@ -149,7 +153,6 @@ class DynamicClosure:
         settled state."""
         p, b, c = self.params, self.bullet, self.closure
         q_open = self.q_open
-        sigma_open, sigma_closed = self.sigma_open, self.sigma_closed
         self._place(placed)
         b.reset_hand(self.client, self.body, q_open)
         gaps = b.closest_points(self.client, self.box, self.body, c.contact_distance_mm)
@@ -158,30 +161,29 @@ class DynamicClosure:
         weight = self.weight if p.gravity and not p.held else None
         radius = placed.shape.bounding_radius_mm
         settled, steps = False, p.max_steps
-        scale, axis_joint = self.axis_scale, self.axis_joint
-        target = scale * q_open[axis_joint]
-        axis_k = self.k_ss / scale  # N·mm/rad per axis (2·k_ss for each half of a rolling joint)
+        ramp, targets, window_steps = p.ramp_steps, self.ramp_targets, p.window_steps
+        axis_k = self.k_ss / self.axis_scale  # N·mm/rad per axis (2·k_ss for each half of a rolling joint)
+        damping, client, body, box = p.joint_damping_Nmm_s_per_rad, self.client, self.body, self.box
         # settled by the change over a window, not by instantaneous speeds: the engine's
         # contacts jitter and creep (~1 mm/s) long after the grasp has formed
-        window: deque = deque(maxlen=p.window_steps + 1)
+        window: deque = deque(maxlen=window_steps + 1)
         for step in range(p.max_steps):
-            theta, omega = b.axis_states(self.client, self.body)
-            if step >= p.ramp_steps:
-                center, rotation, _, _ = b.body_state(self.client, self.box)
-                window.append((self.joint_values(theta), center, rotation))
-                if len(window) > p.window_steps:
+            theta, omega = b.axis_states(client, body)
+            if step < ramp:
+                target = targets[step]
+            else:
+                center, rotation = b.body_pose(client, box)
+                window.append((self.axis_sum @ theta, center, rotation))
+                if len(window) > window_steps:
                     q0, c0, r0 = window[0]
                     turn = math.acos(min(1.0, max(-1.0, 0.5 * (float(np.sum(r0 * rotation)) - 1.0))))
                     if (np.max(np.abs(window[-1][0] - q0)) < p.settle_joint_change_rad
                             and np.linalg.norm(center - c0) + turn * radius < p.settle_object_change_mm):
                         settled, steps = True, step
                         break
-            else:
-                sigma = sigma_open + (sigma_closed - sigma_open) * (step + 1) / p.ramp_steps
-                target = scale * self.path.reference(sigma)[axis_joint]
             if weight is not None:
-                b.apply_force(self.client, self.box, weight)
-            b.step_with_torques(self.client, self.body, axis_k * (target - theta) - p.joint_damping_Nmm_s_per_rad * omega)
+                b.apply_force(client, box, weight)
+            b.step_with_torques(client, body, axis_k * (target - theta) - damping * omega)
         self.steps = steps
         return self._settled(placed, settled)
 

@@ -6,7 +6,7 @@ distance queries (the nearest surface point and inward normal from a point,
 ``kernel_code`` and ``kernel_params`` in :mod:`synergrasp.simulation.capsules`), the distance
 to a box of the palm (intersection with the open hand), the bounding radius, the starting
 orientation, its symmetries (the α-period of the pose grid), the collision shape of the
-dynamic closure and the ray casting of the pictures. A shape is described in its own
+dynamic closure, the ray casting of the pictures and the triangles of the 3-D views. A shape is described in its own
 frame, centred on the origin (mm); the methods that answer in the palm frame take the
 object's pose: ``rotation`` (3 × 3, own frame → palm frame) and ``center`` (3,) mm.
 
@@ -25,21 +25,22 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["Shape", "ShapeError", "SHAPES", "shape_from_config", "start_rotation", "positive_length", "Box", "Sphere",
-           "Cylinder"]
+           "Cylinder", "Mesh"]
 
 
 class ShapeError(ValueError):
     """A shape description is invalid; the message names the field."""
 
 
-def positive_length(field: str, value: Any) -> float:
-    """``value`` as a finite positive length in mm; ShapeError("<field>: ...") otherwise."""
+def positive_length(field: str, value: Any, what: str = "a finite positive length in mm") -> float:
+    """``value`` as a finite positive number (``what``, a length in mm unless said);
+    ShapeError("<field>: ...") otherwise."""
     try:
         out = float(value)
     except (TypeError, ValueError):
         out = math.nan
     if isinstance(value, (bool, str)) or not (math.isfinite(out) and out > 0):
-        raise ShapeError(f"{field}: {value!r} is not allowed; a finite positive length in mm is required")
+        raise ShapeError(f"{field}: {value!r} is not allowed; {what} is required")
     return out
 
 
@@ -142,6 +143,18 @@ class Shape(ABC):
     def extent(self, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
         """Points (k, 3) (palm frame) and radii (k,) whose spheres cover the shape (pictures)."""
 
+    @abstractmethod
+    def own_mesh(self) -> tuple[NDArray, NDArray]:
+        """Triangles of its surface in its own frame (``synergrasp.simulation.shapes.surface``):
+        vertices (k, 3) mm, triangles (t, 3) vertex indices, counter-clockwise from outside."""
+
+    def surface_mesh(self, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
+        """Its surface's triangles at its pose: vertices (k, 3) palm frame, mm, and triangles
+        (t, 3) (3-D views)."""
+        from synergrasp.simulation.shapes.surface import placed
+
+        return placed(self.own_mesh(), rotation, center)
+
 
 def shape_from_config(spec: Mapping[str, Any], where: str = "shape") -> Shape:
     """The shape of a configuration's ``shape`` mapping (one key, the kind, holding its
@@ -165,7 +178,8 @@ def shape_from_config(spec: Mapping[str, Any], where: str = "shape") -> Shape:
 
 from synergrasp.simulation.shapes.box import Box  # noqa: E402
 from synergrasp.simulation.shapes.cylinder import Cylinder  # noqa: E402
+from synergrasp.simulation.shapes.mesh import Mesh  # noqa: E402
 from synergrasp.simulation.shapes.sphere import Sphere  # noqa: E402
 
 #: The shapes by the key that names them in the configuration.
-SHAPES: dict[str, type[Shape]] = {cls.kind: cls for cls in (Box, Sphere, Cylinder)}
+SHAPES: dict[str, type[Shape]] = {cls.kind: cls for cls in (Box, Sphere, Cylinder, Mesh)}

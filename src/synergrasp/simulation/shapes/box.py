@@ -161,3 +161,8 @@ class Box(Shape):
 
     def extent(self, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
         return self._corners(rotation, center), np.zeros(8)
+
+    def own_mesh(self) -> tuple[NDArray, NDArray]:
+        from synergrasp.simulation.shapes.surface import box_mesh
+
+        return box_mesh(self._half)

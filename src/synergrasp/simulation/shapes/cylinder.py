@@ -45,7 +45,7 @@ class Cylinder(Shape):
 
     @property
     def label(self) -> str:
-        return f"cylinder, radius {self.radius_mm:g} mm, height {self.height_mm:g} mm"
+        return f"cylinder, r {self.radius_mm:g} × h {self.height_mm:g} mm"
 
     def surface_point(self, point: NDArray, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
         r, hh = self.radius_mm, self.half_height_mm
@@ -163,3 +163,11 @@ class Cylinder(Shape):
         r, hh = self.radius_mm, self.half_height_mm
         corners = np.array([[x, y, z] for x in (-r, r) for y in (-r, r) for z in (-hh, hh)])
         return corners @ rotation.T + center, np.zeros(8)
+
+    def own_mesh(self) -> tuple[NDArray, NDArray]:
+        from synergrasp.simulation.shapes.surface import merge_meshes, revolution_mesh
+
+        r, hh = self.radius_mm, self.half_height_mm
+        # caps and side apart, so that the rims stay sharp
+        return merge_meshes([revolution_mesh([(0.0, -hh), (r, -hh)]), revolution_mesh([(r, -hh), (r, hh)]),
+                             revolution_mesh([(r, hh), (0.0, hh)])])

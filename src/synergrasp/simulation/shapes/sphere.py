@@ -80,3 +80,10 @@ class Sphere(Shape):
 
     def extent(self, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
         return np.asarray(center, dtype=float).reshape(1, 3), np.array([self.radius_mm])
+
+    def own_mesh(self) -> tuple[NDArray, NDArray]:
+        from synergrasp.simulation.shapes.surface import revolution_mesh
+
+        polar = np.linspace(0.0, np.pi, 17)
+        return revolution_mesh([(0.0 if k in (0, 16) else self.radius_mm * np.sin(a), -self.radius_mm * np.cos(a))
+                                for k, a in enumerate(polar)])

@@ -1,0 +1,196 @@
+"""A mesh from an OBJ or STL file: its hull if it is convex, else its convex parts (mm).
+
+``path``: the file, absolute or relative to the working directory (the project's root for
+the workflow, which runs there); ``scale``: mm per unit of the file. The own frame is the
+file's axes with the origin moved to the centroid of the solid the mesh bounds (its centre
+of mass at uniform density). The object *is* the convex parts (``convex_parts``): every
+query, the physics engine and the pictures use them. Every query is exact for them
+(``polytope``): distances by GJK, normals from the faces (docs/shapes.md).
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import ConvexHull, cKDTree
+
+from synergrasp.simulation.shapes import Shape, ShapeError, positive_length
+from synergrasp.simulation.shapes.box import box_edges
+from synergrasp.simulation.shapes.convex_parts import convex_parts, is_convex
+from synergrasp.simulation.shapes.mesh_file import MeshFileError, read_mesh
+from synergrasp.simulation.shapes.polytope import convex_distance, pack_parts, point_parts, points_gap
+from synergrasp.simulation.shapes.polytope_axes import part_box_overlap, ray_parts
+
+__all__ = ["Mesh", "MeshGeometry"]
+
+#: Neighbouring faces meeting at less than this angle (deg) are one region of the pictures.
+_CREASE_DEG = 30.0
+
+
+@dataclass(frozen=True)
+class MeshGeometry:
+    """The convex parts of a mesh in mm, centred (``Mesh``): ``parts`` vertices (k, 3) each,
+    ``planes`` (f, 4) each (outward unit normal, offset b: n·x ≤ b inside), ``region`` a label
+    per face over all parts (faces meeting at less than 30° share one), ``convex`` whether
+    the mesh was its own hull, ``size`` (3,) the extent along its own axes."""
+
+    parts: tuple[NDArray, ...]
+    planes: tuple[NDArray, ...]
+    region: NDArray
+    convex: bool
+    size: NDArray
+
+    @property
+    def vertices(self) -> NDArray:
+        return np.concatenate(self.parts)
+
+
+@functools.lru_cache(maxsize=32)
+def _geometry(path: str, stamp: tuple[int, int], scale: float) -> MeshGeometry:
+    """The geometry of the file at ``path`` (``stamp``: its change time and size, so that an
+    edited file is read again) scaled to mm."""
+    del stamp
+    mesh = read_mesh(path)
+    file_parts = convex_parts(mesh, hashlib.sha256(Path(path).read_bytes()).hexdigest())
+    parts, planes, regions, first = [], [], [], 0
+    for part in file_parts:
+        vertices = np.ascontiguousarray((part - mesh.centroid) * scale)
+        hull = ConvexHull(vertices)
+        equations = np.c_[hull.equations[:, :3], -hull.equations[:, 3]]
+        unique, face_of = np.unique(np.round(equations, 9), axis=0, return_inverse=True)
+        planes.append(np.ascontiguousarray(equations[[int(np.flatnonzero(face_of == f)[0]) for f in range(len(unique))]]))
+        labels = _regions(hull, face_of.reshape(-1), len(unique))
+        regions.append(labels + first)
+        first += int(labels.max()) + 1
+        parts.append(vertices)
+    return MeshGeometry(tuple(parts), tuple(planes), np.concatenate(regions).astype(np.int64), is_convex(mesh),
+                        np.ptp(np.concatenate(parts), axis=0))
+
+
+def _regions(hull: ConvexHull, face_of: NDArray, n_faces: int) -> NDArray:
+    """A label per face (plane) of a hull: faces whose triangles neighbour at less than the
+    crease angle are joined."""
+    cos = math.cos(math.radians(_CREASE_DEG))
+    rows, cols = [], []
+    for tri, neighbours in enumerate(hull.neighbors):
+        for other in neighbours:
+            if hull.equations[tri, :3] @ hull.equations[other, :3] >= cos:
+                rows.append(face_of[tri])
+                cols.append(face_of[other])
+    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n_faces, n_faces))
+    return connected_components(graph, directed=False)[1]
+
+
+@dataclass(frozen=True)
+class Mesh(Shape):
+    """A mesh read from ``path`` (OBJ or STL), ``scale`` mm per unit of the file."""
+
+    path: str
+    scale: float
+
+    kind: ClassVar[str] = "mesh"
+    kernel_code: ClassVar[int] = 3
+
+    def __post_init__(self) -> None:
+        scale = positive_length("scale", self.scale, "a finite positive number of mm per unit of the file")
+        if not isinstance(self.path, str) or not self.path:
+            raise ShapeError(f"path: {self.path!r} is not allowed; the path of an OBJ or STL file is required")
+        file = Path(self.path)
+        try:
+            stat = file.stat()
+            geometry = _geometry(str(file.resolve()), (stat.st_mtime_ns, stat.st_size), scale)
+        except FileNotFoundError:
+            raise ShapeError(f"path: {self.path!r} does not exist (relative paths are read from the "
+                             f"working directory, {Path.cwd()})") from None
+        except (MeshFileError, OSError) as err:
+            raise ShapeError(f"path: {err}") from None
+        object.__setattr__(self, "scale", scale)
+        object.__setattr__(self, "geometry", geometry)
+        object.__setattr__(self, "_params", pack_parts(list(zip(geometry.parts, geometry.planes))))
+        self._params.setflags(write=False)
+        object.__setattr__(self, "_every", geometry.vertices)
+        object.__setattr__(self, "_hull", self._every[ConvexHull(self._every).vertices])
+
+    @property
+    def bounding_radius_mm(self) -> float:
+        return float(np.linalg.norm(self._every, axis=1).max())
+
+    @property
+    def label(self) -> str:
+        return f"mesh, {' × '.join(f'{v:.0f}' for v in self.geometry.size)} mm"
+
+    def surface_point(self, point: NDArray, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
+        local = rotation.T @ (np.asarray(point, dtype=float) - center)
+        _, near, normal = point_parts(np.ascontiguousarray(local), self._params)
+        n = rotation @ normal
+        return rotation @ near + center, n / np.linalg.norm(n)
+
+    def gap(self, points: NDArray, rotation: NDArray, center: NDArray) -> NDArray:
+        local = (np.asarray(points, dtype=float).reshape(-1, 3) - center) @ rotation
+        return points_gap(np.ascontiguousarray(local), self._params).reshape(np.shape(points)[:-1])
+
+    def samples(self, rotation: NDArray, center: NDArray) -> NDArray:
+        # the vertices of its hull: those touching a flat palm face span the contact patch
+        return self._hull @ rotation.T + center
+
+    def normals_near(self, point: NDArray, rotation: NDArray, center: NDArray, reach_mm: float) -> list[NDArray]:
+        local = rotation.T @ (np.asarray(point, dtype=float) - center)
+        out = []
+        for vertices, planes in zip(self.geometry.parts, self.geometry.planes):
+            for plane in planes[np.abs(planes[:, :3] @ local - planes[:, 3]) <= reach_mm]:  # the planes in reach
+                n, b = plane[:3], plane[3]
+                face = vertices[np.abs(vertices @ n - b) <= 1e-6 * max(self.geometry.size)]
+                face_params = pack_parts([(np.ascontiguousarray(face), np.zeros((0, 4)))])
+                if convex_distance(face_params, 0, local[None])[0] <= reach_mm:
+                    out.append(-(rotation @ n))
+        return out
+
+    def box_gap(self, rotation: NDArray, center: NDArray, box_pose: NDArray, box_half: NDArray) -> tuple[float, NDArray]:
+        corners = np.unique(np.vstack(box_edges(box_pose, box_half)), axis=0)
+        local = np.ascontiguousarray((corners - center) @ rotation)
+        best, point = np.inf, np.asarray(center, dtype=float).copy()
+        for k in range(len(self.geometry.parts)):
+            d, a, b, touching = convex_distance(self._params, k, local)
+            if touching:
+                d = part_box_overlap(self._params, k, local, np.ascontiguousarray(box_pose[:3, :3].T @ rotation))
+            if d < best:
+                best, point = d, rotation @ (0.5 * (a + b)) + center
+        return float(best), point
+
+    def same_region(self, rotation_a: NDArray, center_a: NDArray, rotation_b: NDArray, center_b: NDArray) -> bool:
+        # a symmetry maps the parts' vertices onto themselves (none declared: found or not)
+        tol = 1e-9 * max(self.geometry.size) + 1e-12
+        a, b = self._every @ rotation_a.T + center_a, self._every @ rotation_b.T + center_b
+        return bool(cKDTree(b).query(a)[0].max() <= tol and cKDTree(a).query(b)[0].max() <= tol)
+
+    def collision_geometry(self) -> tuple[str, dict[str, Any]]:
+        return "convex_parts", {"parts_mm": self.geometry.parts}
+
+    def ray_hits(self, origins: NDArray, direction: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+        o = np.asarray(origins, dtype=float)
+        d = np.broadcast_to(np.asarray(direction, dtype=float), o.shape).reshape(-1, 3)
+        flat = np.ascontiguousarray(o.reshape(-1, 3))
+        t, normal, face = np.full(len(flat), np.inf), np.zeros((len(flat), 3)), np.full(len(flat), -1, np.int64)
+        for u in np.unique(d, axis=0):  # one direction (a picture's) in practice
+            rows = np.flatnonzero((d == u).all(axis=1))
+            t[rows], normal[rows], face[rows] = ray_parts(flat[rows], np.ascontiguousarray(u), self._params,
+                                                          self.geometry.region)
+        return t.reshape(o.shape[:-1]), normal.reshape(o.shape), face.reshape(o.shape[:-1])
+
+    def extent(self, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
+        return self._hull @ rotation.T + center, np.zeros(len(self._hull))
+
+
+    def own_mesh(self) -> tuple[NDArray, NDArray]:
+        from synergrasp.simulation.shapes.surface import hull_mesh, merge_meshes
+
+        return merge_meshes([hull_mesh(part) for part in self.geometry.parts])  # the object is its convex parts
