@@ -22,7 +22,7 @@ def synergies(hand):
     return load_synergies(None, joint_names=hand.joint_names)
 
 
-#: Near-boundary band (docs/batched_solver.md): problems whose friction coefficient is within
+#: Near-boundary band (docs/ipm_solver.md): problems whose friction coefficient is within
 #: this relative distance of the critical one may get either verdict from solvers with 1e-8
 #: tolerances.
 BAND = 1e-4

@@ -1,5 +1,5 @@
 """Back end: the compiled interior-point kernel (numba) for GFO problems with circular or
-pyramid friction cones (docs/batched_solver.md); its compiled parts, by concern, are the
+pyramid friction cones (docs/ipm_solver.md); its compiled parts, by concern, are the
 package `synergrasp.optimisation.ipm`.
 
 Per problem, forces in N: minimise ||f_p + E y||_2 subject to, per contact i,
