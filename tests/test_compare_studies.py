@@ -21,7 +21,8 @@ def _study(root: Path, gfo: pd.DataFrame, claims: pd.DataFrame) -> Path:
 
 GFO = pd.DataFrame({"pose": [0, 0, 1], "set_id": ["1", "1-2", "1"], "status": ["infeasible", "force_closure", "no_grasp"],
                     "strict_internal": [False, True, False], "force_norm": [np.nan, 12.5, np.nan],
-                    "iterations": [9, 14, 0], "solver": ["ipm", "clarabel_fallback", "none"]})
+                    "iterations": [9, 14, 0], "solver": ["ipm", "clarabel_fallback", "none"],
+                    "normal_force_N": [[np.nan], [1.0, 2.0], []]})  # a list column, NaN in it
 CLAIMS = pd.DataFrame({"claim": ["c1"], "holds": [True], "rate_pct": [40.0]})
 
 

@@ -25,6 +25,13 @@ import pandas as pd
 HOW_DECIDED = {"gfo": ("solver", "iterations")}
 
 
+def _equal(x, y) -> bool:
+    """Exact equality of two cells, NaN equal to NaN (list cells: arrays, element by element)."""
+    if isinstance(x, np.ndarray):
+        return np.array_equal(x, y, equal_nan=x.dtype.kind == "f")
+    return x == y or (x != x and y != y)
+
+
 def _column_difference(name: str, ref: pd.Series, other: pd.Series, rtol: float) -> str | None:
     """None if the column agrees, else what differs (rows, the largest relative difference)."""
     if pd.api.types.is_float_dtype(ref) and pd.api.types.is_numeric_dtype(other):
@@ -35,8 +42,7 @@ def _column_difference(name: str, ref: pd.Series, other: pd.Series, rtol: float)
         with np.errstate(divide="ignore", invalid="ignore"):
             worst = np.nanmax(np.abs(b[bad] - a[bad]) / np.abs(a[bad]))
         return f"{name}: {bad.sum()} rows beyond rtol {rtol:g} (largest relative difference {worst:.3g})"
-    same = np.array([np.array_equal(x, y) if isinstance(x, np.ndarray) else (x == y or (x != x and y != y))
-                     for x, y in zip(ref, other)], dtype=bool)
+    same = np.array([_equal(x, y) for x, y in zip(ref, other)], dtype=bool)
     return None if same.all() else f"{name}: {(~same).sum()} rows differ (first at row {np.argmin(same)})"
 
 
