@@ -39,7 +39,7 @@ def generated_problems():
     return random_gfo_problems(2018, 600)
 
 
-#: Near-boundary band (docs/batched_solver.md): problems whose friction coefficient is within
+#: Near-boundary band (docs/ipm_solver.md): problems whose friction coefficient is within
 #: this relative distance of the critical one may get either verdict from solvers with 1e-8
 #: tolerances.
 BAND = 1e-4

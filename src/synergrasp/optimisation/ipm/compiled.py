@@ -38,7 +38,7 @@ __all__ = ["KERNEL_SOURCES", "cache_dir", "jit_alloc", "jit_call", "jit_inline"]
 
 #: The modules whose compiled code one cache directory holds (callers embed their callees).
 KERNEL_SOURCES = ("compiled.py", "layout.py", "cone_algebra.py", "linear_systems.py", "certificates.py",
-                  "iteration.py", "sets.py")
+                  "polish.py", "iteration.py", "sets.py")
 
 _PACKAGE = Path(__file__).resolve().parent
 
