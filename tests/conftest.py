@@ -1,15 +1,24 @@
-"""Fixtures shared by the test modules: the shipped hand and its synergies, the study's
-GFO parameters."""
-from dataclasses import replace
+"""Fixtures shared by the test modules: the shipped hand and its synergies, the generated
+GFO problems that the solvers are checked on, the study's GFO parameters."""
+import os
 
-import pytest
+# One BLAS thread per test process, set before numpy loads: the tests' matrices are small, and
+# OpenBLAS's threads spinning beside the test process took about half of the fast tier's CPU
+# time on the 2-core machine (a generated problem set: 4.5 s against 2.4 s).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-from synergrasp.analysis.summaries import TablesParams
-from synergrasp.config import _resolve, defaults, load_schema
-from synergrasp.hand.kinematics import load_hand
-from synergrasp.hand.synergies import load_synergies
-from synergrasp.optimisation.study import OptimiseParams
-from synergrasp.simulation.closure import SimulateParams
+from dataclasses import replace  # noqa: E402
+
+import pytest  # noqa: E402
+
+from synergrasp.analysis.summaries import TablesParams  # noqa: E402
+from synergrasp.config import _resolve, defaults, load_schema  # noqa: E402
+from synergrasp.hand.kinematics import load_hand  # noqa: E402
+from synergrasp.hand.synergies import load_synergies  # noqa: E402
+from synergrasp.optimisation.study import OptimiseParams  # noqa: E402
+from synergrasp.simulation.closure import SimulateParams  # noqa: E402
+from grasp_problems import random_gfo_problems  # noqa: E402
 
 
 @pytest.fixture(scope="session")
@@ -22,7 +31,15 @@ def synergies(hand):
     return load_synergies(None, joint_names=hand.joint_names)
 
 
-#: Near-boundary band (docs/batched_solver.md): problems whose friction coefficient is within
+@pytest.fixture(scope="session")
+def generated_problems():
+    """600 generated GFO problems (`grasp_problems.random_gfo_problems`, seed 2018), made once
+    for the modules that check the solvers on them (each problem's critical friction is
+    bisected: they take about 16 CPU s to make)."""
+    return random_gfo_problems(2018, 600)
+
+
+#: Near-boundary band (docs/ipm_solver.md): problems whose friction coefficient is within
 #: this relative distance of the critical one may get either verdict from solvers with 1e-8
 #: tolerances.
 BAND = 1e-4

@@ -14,7 +14,7 @@ from synergrasp.optimisation.cones import CircularCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.mechanics import Grasp
 from synergrasp.optimisation.problem import STRICT_SHRINK, GFOProblem, GraspSets, SynergySets
-from grasp_problems import critical_friction, random_gfo_problems
+from grasp_problems import critical_friction
 from synergrasp.optimisation.study import GFOParams, mechanics_for, optimise_grasps
 
 W = 9.81  # N, weight of 1 kg
@@ -206,13 +206,13 @@ def test_bad_input_names_the_field():
 
 
 @pytest.fixture(scope="module")
-def generated():
-    problems = random_gfo_problems(2018, 1000)
-    ours = solve_gfo([p.problem for p in problems], "clarabel")
+def generated(generated_problems):
+    """The shared generated problems (conftest), Clarabel's and cvxpy's rows for each."""
+    ours = solve_gfo([p.problem for p in generated_problems], "clarabel")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # cvxpy's "may be inaccurate" near the boundary
-        ref = solve_gfo([p.problem for p in problems], "cvxpy")
-    return problems, [row(ours, k) for k in range(len(ours))], [row(ref, k) for k in range(len(ref))]
+        ref = solve_gfo([p.problem for p in generated_problems], "cvxpy")
+    return generated_problems, [row(ours, k) for k in range(len(ours))], [row(ref, k) for k in range(len(ref))]
 
 
 def test_generated_problems_cover_the_cases(generated):

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from conftest import BAND
@@ -57,13 +59,31 @@ def test_5000_study_sized_problems_match_the_exact_solver():
     assert set(sol.solver) <= {"ipm", "clarabel_fallback"}
 
 
+def _feasible_point_clarabel_missed(problem: GFOProblem, sol, k: int, ref_status: str) -> bool:
+    """Whether the kernel's force closure against Clarabel's 'infeasible' is a feasible point
+    Clarabel's certificate missed: the forces satisfy every constraint to 1e-9 relative
+    (checked here, in numpy) and cvxpy (another formulation) finds the same optimum. The
+    generated problems' mu* is bisected on Clarabel's verdicts, so near the boundary (forces of
+    1e5 N) it can lie above the true critical friction and delta is not the problem's own."""
+    if not (sol.status[k] == "force_closure" and ref_status == "infeasible"):
+        return False
+    forces = sol.forces[k]
+    assert problem.cone.violation(forces, problem.normals, problem.f_min) <= 1e-9 * np.linalg.norm(forces)
+    cvx = solve_gfo([problem], "cvxpy")
+    assert cvx.status[0] == "force_closure"
+    assert cvx.force_norm[0] == pytest.approx(sol.force_norm[k], rel=RTOL_NORM)
+    return True
+
+
 def test_generated_kinds_match_exact_solver_outside_the_band_and_cvxpy_on_a_subset(generated):
     problems = [p.problem for p in generated]
     sol = solve_gfo(problems, "ipm")
     ref = solve_gfo(problems, "clarabel")
     in_band_differ = 0
     for k, p in enumerate(generated):
-        if sol.status[k] != ref.status[k]:
+        if sol.status[k] != ref.status[k] and _feasible_point_clarabel_missed(problems[k], sol, k, ref.status[k]):
+            in_band_differ += 1
+        elif sol.status[k] != ref.status[k]:
             # Only near-boundary problems inside the stated band may differ; they are counted.
             assert p.kind == "near_boundary" and abs(p.delta) <= BAND, (k, p.kind, p.delta, sol.status[k], ref.status[k])
             in_band_differ += 1
@@ -110,6 +130,87 @@ def test_hand_derivable_problem():
     # Its certificate is exact (the second contact's normal row: G^T z = 0, h^T z = -f_min):
     # the dual start point moved onto G^T z = 0 proves it before any Newton step.
     assert sol.iterations[0] == 0
+
+
+def test_polish_gives_the_hand_derived_optimum_on_a_cone_boundary():
+    # Two contacts pinching along x; f_p loads the first one along z by w (tangential), E is
+    # the squeeze. Friction needs n.f >= w / mu at the first contact, so its cone is active and
+    # the optimum is f = (w/mu, 0, w, -w/mu, 0, 0): ||f|| = 9 N for w = 3 N, mu = 0.5.
+    normals = np.array([[1.0, 0, 0], [-1.0, 0, 0]])
+    E = np.array([1.0, 0, 0, -1.0, 0, 0])[:, None] / np.sqrt(2)
+    problem = GFOProblem(np.array([0, 0, 3.0, 0, 0, 0]), E, normals, 0.1, CircularCone(0.5))
+    polished = solve_gfo([problem], ipm=IPMSettings(polish_from=1e9))  # tried at every iterate
+    plain = solve_gfo([problem], ipm=IPMSettings(polish_from=-1))
+    assert polished.solver[0] == plain.solver[0] == "ipm"
+    assert polished.force_norm[0] == pytest.approx(9.0, rel=1e-14)  # exact: Newton on the active cone
+    np.testing.assert_allclose(polished.forces[0], [6, 0, 3, -6, 0, 0], atol=1e-13)
+    assert plain.force_norm[0] == pytest.approx(9.0, rel=1e-7)  # the iteration's own 1e-8 tests
+    assert polished.iterations[0] < plain.iterations[0]
+
+
+def test_polish_decides_stalled_problems_as_clarabel_and_cvxpy_do():
+    """Problems on which the iteration stalls (left to the fallback without the polish): the
+    polish decides most, with Clarabel's verdict and optimum; polishing at every iterate, from
+    the first (the worst guesses of the active set), changes no verdict."""
+    problems = _study_sized_problems(3000, seed=17)
+    plain = solve_gfo(problems, ipm=IPMSettings(polish_from=-1), strict_shrink=1e-5)
+    stalled = np.flatnonzero(plain.solver == "clarabel_fallback")
+    assert stalled.size >= 20  # the premise
+    sol = solve_gfo(problems, strict_shrink=1e-5)
+    eager = solve_gfo(problems, ipm=IPMSettings(polish_from=1e9), strict_shrink=1e-5)
+    ref = solve_gfo(problems, "clarabel", tol=1e-10, strict_shrink=1e-5)
+    for out in (sol, eager):
+        np.testing.assert_array_equal(out.status, ref.status)
+        np.testing.assert_array_equal(out.strict_internal, ref.strict_internal)
+        fc = ref.force_closure
+        np.testing.assert_allclose(out.force_norm[fc], ref.force_norm[fc], rtol=1e-7)
+    polished = stalled[sol.solver[stalled] == "ipm"]
+    assert polished.size >= 0.8 * stalled.size
+    assert np.all(sol.status[polished] == "force_closure")  # stalls are at optima
+    for k in polished:
+        # feasible and no worse than Clarabel's point; the forces themselves agree to about the
+        # square root of the tolerance (near a degenerate optimum ||f|| is flat along the boundary)
+        assert problems[k].cone.violation(sol.forces[k], problems[k].normals, problems[k].f_min) <= 1e-9 * sol.force_norm[k]
+        assert sol.force_norm[k] <= ref.force_norm[k] * (1 + 1e-9)
+        assert np.linalg.norm(sol.forces[k] - ref.forces[k]) <= 1e-4 * ref.force_norm[k]
+    cvx = solve_gfo([problems[k] for k in polished[:20]], "cvxpy")
+    np.testing.assert_array_equal(cvx.status, "force_closure")
+    np.testing.assert_allclose(sol.force_norm[polished[:20]], cvx.force_norm, rtol=1e-6)
+    assert np.mean(sol.solver == "clarabel_fallback") < 0.2 * np.mean(plain.solver == "clarabel_fallback")
+
+
+def _strict_margin(problem: GFOProblem, shrink: float) -> float:
+    """The largest s with n.f >= s and mu (1 - shrink) n.f - ||f_t|| >= s at every contact
+    over f = E y, ||y|| <= 1 (cvxpy), recomputed in numpy at the maximiser: > 0 proves a
+    strictly internal force in the narrowed cone, whatever the solver's accuracy."""
+    import cvxpy as cp
+
+    y = cp.Variable(problem.E.shape[1])
+    s = cp.Variable()
+    f, mu = problem.E @ y, problem.cone.mu * (1.0 - shrink)
+    cons = [cp.norm(y) <= 1]
+    for i, n in enumerate(problem.normals):
+        fn = n @ f[3 * i:3 * i + 3]
+        cons += [fn >= s, mu * fn - cp.norm(f[3 * i:3 * i + 3] - fn * n) >= s]
+    cp.Problem(cp.Maximize(s), cons).solve(solver="CLARABEL")
+    F = (problem.E @ y.value).reshape(-1, 3)
+    fn = np.einsum("ij,ij->i", F, problem.normals)
+    ft = np.linalg.norm(F - fn[:, None] * problem.normals, axis=1)
+    return float(min(fn.min(), (mu * fn - ft).min()))
+
+
+def test_strict_test_proves_a_thin_strictly_internal_force():
+    """A grasp of the placement search (obj4, target (49.5, 10, 140) mm, full set): strictly
+    internal forces exist only within ~1.6e-5 of mu (inside the near-boundary band), so the
+    strict test (shrink 1e-5) is feasible by a margin of ~1e-6 of ||f||, with forces of ~3e5 N
+    at f_min = 1 N. The kernel's early stop proves it; Clarabel on the strict test fails
+    numerically (the kernel without the early stop left it to Clarabel: strict False)."""
+    data = np.load(Path(__file__).parent / "data" / "thin_strict_grasp.npz")
+    problem = GFOProblem(data["f_p"], data["E"], data["normals"], float(data["f_min"]), CircularCone(1.5))
+    assert _strict_margin(problem, 1e-5) > 5e-7  # 1e9 times round-off: the verdict is True
+    assert _strict_margin(problem, 2e-5) <= 1e-12  # none a little further in: the problem is in the band
+    sol = solve_gfo([problem], strict_shrink=1e-5)
+    assert sol.strict_internal[0]
 
 
 def test_fallback_path_when_the_iteration_cap_is_tiny():
@@ -168,6 +269,8 @@ def test_bad_settings_name_the_field():
         IPMSettings(max_iter=0)
     with pytest.raises(ValueError, match="retry_refine"):
         IPMSettings(retry_refine=-1)
+    with pytest.raises(ValueError, match="polish_from"):
+        IPMSettings(polish_from=float("nan"))
     with pytest.raises(ValueError, match="strict_shrink"):
         solve_gfo([], strict_shrink=1.5)
 

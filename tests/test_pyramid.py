@@ -62,9 +62,8 @@ def test_pinch_closed_form(sides, inscribed, method):
 
 
 @pytest.fixture(scope="module")
-def generated():
-    problems = random_gfo_problems(31, 150)
-    base = [p.problem for p in problems]
+def generated(generated_problems):
+    base = [p.problem for p in generated_problems[:150]]
 
     def with_cone(cone_of):
         return [GFOProblem(p.f_p, p.E, p.normals, p.f_min, cone_of(p.cone.mu)) for p in base]
@@ -159,7 +158,7 @@ def test_kernel_matches_clarabel_and_piqp_on_generated_pyramids(near_pyramid_bou
     assert set(sol.solver) <= {"ipm", "clarabel_fallback", "direct"}
     # 40 % of these problems lie within 1e-2 of the boundary, where a pyramid's optimum is
     # degenerate (several faces active): more of them are left to the fallback than in the
-    # study's mix (0.2-0.5 %, docs/batched_solver.md)
+    # study's mix (0.2-0.5 %, docs/ipm_solver.md)
     assert np.mean(sol.solver == "clarabel_fallback") < 0.1
     fc = sol.force_closure
     assert np.all(sol.max_violation[fc] <= 1e-6 * np.maximum(1.0, sol.force_norm[fc]))

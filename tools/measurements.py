@@ -63,7 +63,7 @@ SECTIONS = (
      "placement included, over poses spread over the grid; the study's closure settings."),
     ("Grasp-force optimisation", ("gfo", "pyramid", "compile", "study_rate"),
      "`benchmarks/bench_gfo.py`, `bench_pyramid.py`, `bench_compile.py` and `bench_study.py` (in `make bench`; "
-     "one core, OMP_NUM_THREADS=1); docs/batched_solver.md says what made each figure."),
+     "one core, OMP_NUM_THREADS=1); docs/ipm_solver.md says what made each figure."),
     ("One grasp in full", ("inspector",),
      "`benchmarks/bench_inspector.py` (in `make bench`, after a study: it reads obj4's searched target): "
      "`synergrasp grasp obj4 --alpha -30 --beta 0` with its 29 default sets, warm, each run in a fresh process "

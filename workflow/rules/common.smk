@@ -251,6 +251,7 @@ def _imported_modules(path):
     return found
 
 
+@functools.cache
 def _module_file(name):
     """Source file of a synergrasp module or package, or None for a name that is not one."""
     rel = Path(*name.split("."))

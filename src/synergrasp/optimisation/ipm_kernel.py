@@ -1,5 +1,5 @@
 """Back end: the compiled interior-point kernel (numba) for GFO problems with circular or
-pyramid friction cones (docs/batched_solver.md); its compiled parts, by concern, are the
+pyramid friction cones (docs/ipm_solver.md); its compiled parts, by concern, are the
 package `synergrasp.optimisation.ipm`.
 
 Per problem, forces in N: minimise ||f_p + E y||_2 subject to, per contact i,
@@ -49,6 +49,10 @@ class IPMSettings:
     retry_refine: refinement steps of a second attempt on a problem the first attempt leaves
         undecided (no second attempt unless it exceeds `refine`); problems still undecided
         fall back to the per-problem exact solver
+    polish_from: the active-set polish (`ipm.polish`) is tried at every iterate whose residuals
+        and relative gap are below this, and where the iteration stalls or ends; 0: only
+        there; negative: never. A polished point is accepted only if it passes the optimality
+        test at `tol`
     """
 
     tol: float = 1e-8
@@ -58,6 +62,7 @@ class IPMSettings:
     stall_step: float = 1e-3
     refine: int = 0
     retry_refine: int = 1
+    polish_from: float = 1e-2
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.tol) and 0 < self.tol < 1):
@@ -66,16 +71,18 @@ class IPMSettings:
             raise ValueError(f"max_iter must be a positive int, got {self.max_iter!r}")
         if not (0 < self.step_fraction < 1):
             raise ValueError(f"step_fraction must be in (0, 1), got {self.step_fraction}")
+        if not math.isfinite(self.polish_from):
+            raise ValueError(f"polish_from must be a finite number, got {self.polish_from}")
         for name in ("refine", "retry_refine"):
             value = getattr(self, name)
             if not (isinstance(value, int) and 0 <= value <= 10):
                 raise ValueError(f"{name} must be an int in 0..10, got {value!r}")
 
 
-def _kernel_settings(settings: IPMSettings, violation_tol: float) -> Settings:
+def _kernel_settings(settings: IPMSettings, violation_tol: float, feasibility: bool = False) -> Settings:
     return Settings(float(settings.tol), float(settings.reduced_tol), int(settings.max_iter),
                     float(settings.step_fraction), float(settings.stall_step), int(settings.refine),
-                    int(settings.retry_refine), float(violation_tol))
+                    int(settings.retry_refine), float(settings.polish_from), float(violation_tol), bool(feasibility))
 
 
 #: A friction cone as the compiled code takes it: mu dividing the tangent rows of the contact
@@ -143,5 +150,6 @@ def _solve(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_co
     data = cone_data(cone, frames)
     sets.solve_sets(F_all, np.ascontiguousarray(f_p, dtype=float), frames, columns, n_columns, thresholds, given, data,
                     data if strict_cone is None else cone_data(strict_cone, frames), float(f_min),
-                    strict_cone is not None, _kernel_settings(settings, violation_tol), out)
+                    strict_cone is not None, _kernel_settings(settings, violation_tol),
+                    _kernel_settings(settings, violation_tol, feasibility=True), out)
     return out

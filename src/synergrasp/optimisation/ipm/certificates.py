@@ -9,7 +9,7 @@ import math
 from synergrasp.optimisation.ipm.compiled import jit_call, jit_inline
 from synergrasp.optimisation.ipm.linear_systems import cho_solve, cholesky, rows_T_col
 
-__all__ = ["factor_rows", "is_certificate", "is_optimal", "polished_certificate"]
+__all__ = ["factor_rows", "is_certificate", "is_optimal", "polished_certificate", "proves_feasible"]
 
 
 @jit_call
@@ -21,6 +21,30 @@ def is_optimal(pres, dres, gap, pcost, eps):
 def is_certificate(hz, gtz_norm, eps):
     """The dual iterate proves infeasibility (Farkas): h^T z < 0 and ||G^T z|| <= eps |h^T z|."""
     return hz < 0.0 and gtz_norm <= eps * -hz
+
+
+@jit_inline
+def inside(P, h, Gx, tau):
+    """Whether the slack h tau - G x lies strictly inside the nonnegative block and every
+    Coulomb cone (the objective cone aside: t can grow). Gx: G x in the cone layout."""
+    for k in range(P.L):
+        if not h[k] * tau - Gx[k] > 0.0:
+            return False
+    for i in range(P.q):
+        c = P.L + 3 * i
+        v0, v1, v2 = h[c] * tau - Gx[c], h[c + 1] * tau - Gx[c + 1], h[c + 2] * tau - Gx[c + 2]
+        if not v0 > math.sqrt(v1 * v1 + v2 * v2):
+            return False
+    return True
+
+
+@jit_call
+def proves_feasible(P, h, Gx, tau):
+    """Whether x = (t, y) proves the problem feasible: y / tau satisfies every constraint
+    strictly, or y is a strictly interior direction (-G x = A y inside every cone, so
+    h + lambda A y is inside them for lambda large enough, whatever h). The second is what
+    the strict internal-force test asks (some E y strictly inside every cone). Needs tau > 0."""
+    return inside(P, h, Gx, tau) or inside(P, h, Gx, 0.0)
 
 
 @jit_inline

@@ -6,11 +6,18 @@ from __future__ import annotations
 
 import math
 
-from synergrasp.optimisation.ipm.certificates import factor_rows, is_certificate, is_optimal, polished_certificate
+from synergrasp.optimisation.ipm.certificates import (
+    factor_rows,
+    is_certificate,
+    is_optimal,
+    polished_certificate,
+    proves_feasible,
+)
 from synergrasp.optimisation.ipm.compiled import jit_call, jit_inline
 from synergrasp.optimisation.ipm.cone_algebra import lin_max_step, soc_apply, soc_div, soc_max_step, soc_prod
 from synergrasp.optimisation.ipm.layout import INFEASIBLE, OPTIMAL, UNDECIDED, Homogeneous
 from synergrasp.optimisation.ipm.linear_systems import G_mul, GT_mul, scaling, solve_kkt
+from synergrasp.optimisation.ipm.polish import polish
 
 __all__ = ["direction", "hsde"]
 
@@ -139,13 +146,18 @@ def start(P, W):
 
 
 @jit_call
-def hsde(P, W, opt, refine, y):
+def hsde(P, W, Q, opt, refine, y):
     """Solve one GFO problem by the homogeneous self-dual embedding with `refine` steps of
-    iterative refinement per linear solve. Returns (code, iterations); fills y (N) when optimal."""
+    iterative refinement per linear solve, Q the polish's work arrays (`layout.PolishWork`).
+    Returns (code, iterations); fills y (N) when optimal.
+    With opt.feasibility only whether the problem is feasible matters (the strict
+    internal-force test): OPTIMAL as soon as an iterate proves it (`proves_feasible`; y is
+    then that point, not the optimum)."""
     q, L, e, h, x, s, z = P.q, P.L, P.e, W.h, W.x, W.s, W.z
     o = L + 3 * q
     N, n = o + e + 2, e + 1
     rho, h_norm = start(P, W)
+    Q.last[0] = -1  # no failed polish yet
     n_deg = float(L + q) + 1.0  # degree: L linear, q + 1 second-order cones
     tau = 1.0
     kappa = 1.0
@@ -161,6 +173,10 @@ def hsde(P, W, opt, refine, y):
         gtz_norm = math.sqrt(gtz)
         r_x[0] += tau
         G_mul(P, x, r_z)
+        if opt.feasibility and tau > 0.0 and proves_feasible(P, h, r_z, tau):
+            for j in range(e):
+                y[j] = x[1 + j] / tau * rho
+            return OPTIMAL, it
         hz = 0.0
         sz = 0.0
         pr = 0.0
@@ -187,6 +203,13 @@ def hsde(P, W, opt, refine, y):
                 factor_rows(P, W)
                 rows_factored = True
             infeasible = polished_certificate(P, W, opt.tol)
+        # The active-set polish: where the iteration stalls, and early once it is near.
+        near = max(pres, dres, gap / max(1.0, abs(pcost))) <= opt.polish_from
+        if ((last and opt.polish_from >= 0.0) or near) and not (optimal or infeasible) and polish(
+                P, W, Q, tau, opt.tol, h_norm, y):
+            for j in range(e):
+                y[j] *= rho
+            return OPTIMAL, it
         if last:
             optimal = optimal or is_optimal(pres, dres, gap, pcost, opt.reduced_tol)
             infeasible = infeasible or (not optimal and is_certificate(hz, gtz_norm, opt.reduced_tol))

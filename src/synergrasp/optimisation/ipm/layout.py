@@ -18,14 +18,17 @@ import numpy as np
 
 from synergrasp.optimisation.ipm.compiled import jit_alloc
 
-__all__ = ["INFEASIBLE", "NOT_SOLVED", "OPTIMAL", "UNDECIDED", "Homogeneous", "Problem", "Settings", "Work",
-           "workspace"]
+__all__ = ["INFEASIBLE", "NOT_SOLVED", "OPTIMAL", "UNDECIDED", "Homogeneous", "PolishWork", "Problem", "Settings",
+           "Work", "polish_workspace", "workspace"]
 
 #: Codes of the kernel's verdicts.
 NOT_SOLVED, OPTIMAL, INFEASIBLE, UNDECIDED = 0, 1, 2, 3
 
-#: The settings as the compiled code takes them: `IPMSettings` and the force-check tolerance.
-Settings = namedtuple("Settings", "tol reduced_tol max_iter step_fraction stall_step refine retry_refine violation_tol")
+#: The settings as the compiled code takes them: `IPMSettings`, the force-check tolerance and
+#: whether only feasibility is asked (the strict test; a runtime value, not a literal passed
+#: down the calls: numba would compile the iteration once for each literal).
+Settings = namedtuple("Settings", "tol reduced_tol max_iter step_fraction stall_step refine retry_refine polish_from "
+                                   "violation_tol feasibility")
 
 #: One problem as the iteration sees it: contact rows D (m, 3, >= e) applied to E, hv (m, 3)
 #: the rows applied to f_p (N), a = E^T f_p (N), r0 = ||f_p - E a|| (N), mu (1 for a pyramid,
@@ -49,6 +52,12 @@ Work = namedtuple("Work", [
     "R_rows",                                 # Cholesky factor of A^T A, A the constraint rows
 ])
 
+#: Work arrays of the active-set polish (`polish`), apart from `Work` (every array of a tuple
+#: is an argument of each call that takes it): the active rows, the Jacobian J, H, its
+#: factor, H^-1 J^T, J H^-1 J^T and its factor (e_max, e_max); u of one cone (3); vectors (e_max);
+#: the last guess that failed (its size, then its rows; e_max + 1).
+PolishWork = namedtuple("PolishWork", "act J H R Y S RS u c lam v w g Hg b last")
+
 #: The homogenising pair (tau, kappa), the tau-row residual and c^T x1 + h^T z1 of the tau
 #: column, shared by the predictor and the corrector of an iteration.
 Homogeneous = namedtuple("Homogeneous", "tau kappa r_tau cx1_hz1")
@@ -68,3 +77,12 @@ def workspace(m, q, nl, e_max):
                  np.empty(n), np.empty(N), np.empty(N), np.empty(n), np.empty(N), np.empty(N),
                  np.empty(n), np.empty(n), np.empty(n), np.empty(N), np.empty(N), np.empty(N), np.empty(N),
                  np.empty((n, n)))
+
+
+@jit_alloc
+def polish_workspace(e_max):
+    return PolishWork(np.empty(e_max, dtype=np.int64), np.empty((e_max, e_max)), np.empty((e_max, e_max)),
+                      np.empty((e_max, e_max)), np.empty((e_max, e_max)), np.empty((e_max, e_max)),
+                      np.empty((e_max, e_max)), np.empty(3), np.empty(e_max), np.empty(e_max), np.empty(e_max),
+                      np.empty(e_max), np.empty(e_max), np.empty(e_max), np.empty(e_max),
+                      np.full(e_max + 1, -1, dtype=np.int64))

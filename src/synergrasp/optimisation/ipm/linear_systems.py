@@ -93,7 +93,7 @@ def V_mul(P, W, v, tmp, out):
     soc_apply(W.w, W.beta[q], tmp, out, o, P.e + 2, False)
 
 
-@jit_inline
+@jit_call
 def cholesky(M, L, n):
     """Lower Cholesky factor L of the leading (n, n) SPD block of M (lower triangle read)."""
     for j in range(n):
@@ -107,7 +107,7 @@ def cholesky(M, L, n):
                 L[i, j] = acc / L[j, j]
 
 
-@jit_inline
+@jit_call
 def cho_solve(L, n, b, x):
     """x with L L^T x = b (leading n entries)."""
     for i in range(n):

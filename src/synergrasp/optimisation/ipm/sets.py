@@ -11,7 +11,7 @@ import numpy as np
 
 from synergrasp.optimisation.ipm.compiled import jit_alloc, jit_call, jit_inline
 from synergrasp.optimisation.ipm.iteration import hsde
-from synergrasp.optimisation.ipm.layout import NOT_SOLVED, OPTIMAL, UNDECIDED, Problem, workspace
+from synergrasp.optimisation.ipm.layout import NOT_SOLVED, OPTIMAL, UNDECIDED, Problem, polish_workspace, workspace
 
 __all__ = ["range_basis", "solve_sets"]
 
@@ -63,12 +63,12 @@ def build(rows, lin, E, fp, e, mu, f_min, W):
 
 
 @jit_inline
-def attempt(P, W, opt, refine, y):
+def attempt(P, W, Q, opt, refine, y):
     """`hsde`, then the force check of an optimal point: (code, ||f|| N, violation N, iterations).
     An optimal point whose forces violate a constraint by more than violation_tol max(1 N, ||f||)
     is 'not decided' (the rule of `solve_gfo` for reduced accuracy)."""
-    code, it = hsde(P, W, opt, refine, y)
-    if code != OPTIMAL:
+    code, it = hsde(P, W, Q, opt, refine, y)
+    if code != OPTIMAL or opt.feasibility:  # a feasibility verdict is proved by `hsde` itself
         return code, math.nan, math.nan, it
     # f = f_p + E y in the contact frames: [n.f, t1.f/mu, t2.f/mu]
     D, hv, DL, hl, e = P.D, P.hv, P.DL, P.hl, P.e
@@ -99,14 +99,14 @@ def attempt(P, W, opt, refine, y):
 
 
 @jit_call
-def solve_one(P, W, opt, y):
+def solve_one(P, W, Q, opt, y):
     """`attempt`, and a second one with refinement if the first leaves the problem undecided.
     Returns (code, ||f|| N, worst violation N, iterations of both); fills y."""
-    code, norm, viol, it = attempt(P, W, opt, opt.refine, y)
+    code, norm, viol, it = attempt(P, W, Q, opt, opt.refine, y)
     if code == UNDECIDED and opt.retry_refine > opt.refine:
         # Undecided problems are mostly stalls at a degenerate optimum, where the normal
         # equations lose accuracy: a second attempt with iterative refinement decides most.
-        code, norm, viol, it2 = attempt(P, W, opt, opt.retry_refine, y)
+        code, norm, viol, it2 = attempt(P, W, Q, opt, opt.retry_refine, y)
         it += it2
     return code, norm, viol, it
 
@@ -176,12 +176,14 @@ def range_basis(F_all, cols, s, threshold, U):
 
 
 @jit_alloc
-def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, cone, cone_strict, f_min, strict, opt, out):
+def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, cone, cone_strict, f_min, strict, opt, opt_strict,
+               out):
     """Every synergy set of one grasp into `out` (`SetsResult`): E_s from the singular vectors
     of F_s = F_all[:, set] whose singular value is above the set's threshold (`range_basis`),
     or, if `given`, F_s itself (orthonormal columns), then the GFO, its forces f_p + E_s y (N)
     and, if `strict`, the strict internal-force test (f_p = 0, f_min = 1 N, cone_strict).
-    cone, cone_strict: `ConeData` of the same kind. Sets with e_s = 0 get code NOT_SOLVED."""
+    cone, cone_strict: `ConeData` of the same kind; opt, opt_strict: `Settings` of the GFO and
+    of the strict test (feasibility only). Sets with e_s = 0 get code NOT_SOLVED."""
     c = F_all.shape[0]
     m, p = c // 3, cone.lin.shape[1]
     rows = np.empty((m, 3, 3))
@@ -190,6 +192,7 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, cone, cone_st
     cone_rows(frames, cone_strict.mu, rows_strict)
     zero = np.zeros(c)
     W = workspace(m, m if p == 0 else 0, m * p, cols.shape[1])
+    Q = polish_workspace(cols.shape[1])
     y = np.empty(cols.shape[1])
     U = np.empty((c, cols.shape[1]))
     for j in range(cols.shape[0]):
@@ -206,7 +209,7 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, cone, cone_st
             continue
         # E_s is the first `rank` columns of U
         code, out.force_norm[j], out.max_violation[j], out.iterations[j] = solve_one(
-            build(rows, cone.lin, U, fp, rank, cone.mu, f_min, W), W, opt, y)
+            build(rows, cone.lin, U, fp, rank, cone.mu, f_min, W), W, Q, opt, y)
         out.code[j] = code
         if code == OPTIMAL:
             for k in range(c):
@@ -216,4 +219,4 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, cone, cone_st
                 out.forces[j, k] = acc
         if strict:
             out.strict_code[j] = solve_one(build(rows_strict, cone_strict.lin, U, zero, rank, cone_strict.mu, 1.0, W),
-                                            W, opt, y)[0]
+                                            W, Q, opt_strict, y)[0]

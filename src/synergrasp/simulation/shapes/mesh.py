@@ -19,16 +19,14 @@ from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import ConvexHull, cKDTree
 
 from synergrasp.simulation.shapes import Shape, ShapeError, positive_length
 from synergrasp.simulation.shapes.box import box_edges
-from synergrasp.simulation.shapes.convex_parts import convex_parts, is_convex
 from synergrasp.simulation.shapes.mesh_file import MeshFileError, read_mesh
-from synergrasp.simulation.shapes.polytope import convex_distance, pack_parts, point_parts, points_gap
-from synergrasp.simulation.shapes.polytope_axes import part_box_overlap, ray_parts
+
+# scipy's sparse graphs and hulls and the compiled polytope queries are imported where a mesh
+# uses them: the shapes package is imported by every Snakemake start (the configuration's
+# checks), for most configurations without a mesh, and they were a third of a dry run's CPU.
 
 __all__ = ["Mesh", "MeshGeometry"]
 
@@ -58,6 +56,10 @@ class MeshGeometry:
 def _geometry(path: str, stamp: tuple[int, int], scale: float) -> MeshGeometry:
     """The geometry of the file at ``path`` (``stamp``: its change time and size, so that an
     edited file is read again) scaled to mm."""
+    from scipy.spatial import ConvexHull
+
+    from synergrasp.simulation.shapes.convex_parts import convex_parts, is_convex
+
     del stamp
     mesh = read_mesh(path)
     file_parts = convex_parts(mesh, hashlib.sha256(Path(path).read_bytes()).hexdigest())
@@ -76,9 +78,12 @@ def _geometry(path: str, stamp: tuple[int, int], scale: float) -> MeshGeometry:
                         np.ptp(np.concatenate(parts), axis=0))
 
 
-def _regions(hull: ConvexHull, face_of: NDArray, n_faces: int) -> NDArray:
-    """A label per face (plane) of a hull: faces whose triangles neighbour at less than the
-    crease angle are joined."""
+def _regions(hull: Any, face_of: NDArray, n_faces: int) -> NDArray:
+    """A label per face (plane) of a hull (a scipy ``ConvexHull``): faces whose triangles
+    neighbour at less than the crease angle are joined."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
     cos = math.cos(math.radians(_CREASE_DEG))
     rows, cols = [], []
     for tri, neighbours in enumerate(hull.neighbors):
@@ -101,6 +106,10 @@ class Mesh(Shape):
     kernel_code: ClassVar[int] = 3
 
     def __post_init__(self) -> None:
+        from scipy.spatial import ConvexHull
+
+        from synergrasp.simulation.shapes.polytope import pack_parts
+
         scale = positive_length("scale", self.scale, "a finite positive number of mm per unit of the file")
         if not isinstance(self.path, str) or not self.path:
             raise ShapeError(f"path: {self.path!r} is not allowed; the path of an OBJ or STL file is required")
@@ -129,12 +138,16 @@ class Mesh(Shape):
         return f"mesh, {' × '.join(f'{v:.0f}' for v in self.geometry.size)} mm"
 
     def surface_point(self, point: NDArray, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
+        from synergrasp.simulation.shapes.polytope import point_parts
+
         local = rotation.T @ (np.asarray(point, dtype=float) - center)
         _, near, normal = point_parts(np.ascontiguousarray(local), self._params)
         n = rotation @ normal
         return rotation @ near + center, n / np.linalg.norm(n)
 
     def gap(self, points: NDArray, rotation: NDArray, center: NDArray) -> NDArray:
+        from synergrasp.simulation.shapes.polytope import points_gap
+
         local = (np.asarray(points, dtype=float).reshape(-1, 3) - center) @ rotation
         return points_gap(np.ascontiguousarray(local), self._params).reshape(np.shape(points)[:-1])
 
@@ -143,6 +156,8 @@ class Mesh(Shape):
         return self._hull @ rotation.T + center
 
     def normals_near(self, point: NDArray, rotation: NDArray, center: NDArray, reach_mm: float) -> list[NDArray]:
+        from synergrasp.simulation.shapes.polytope import convex_distance, pack_parts
+
         local = rotation.T @ (np.asarray(point, dtype=float) - center)
         out = []
         for vertices, planes in zip(self.geometry.parts, self.geometry.planes):
@@ -155,6 +170,9 @@ class Mesh(Shape):
         return out
 
     def box_gap(self, rotation: NDArray, center: NDArray, box_pose: NDArray, box_half: NDArray) -> tuple[float, NDArray]:
+        from synergrasp.simulation.shapes.polytope import convex_distance
+        from synergrasp.simulation.shapes.polytope_axes import part_box_overlap
+
         corners = np.unique(np.vstack(box_edges(box_pose, box_half)), axis=0)
         local = np.ascontiguousarray((corners - center) @ rotation)
         best, point = np.inf, np.asarray(center, dtype=float).copy()
@@ -168,6 +186,8 @@ class Mesh(Shape):
 
     def same_region(self, rotation_a: NDArray, center_a: NDArray, rotation_b: NDArray, center_b: NDArray) -> bool:
         # a symmetry maps the parts' vertices onto themselves (none declared: found or not)
+        from scipy.spatial import cKDTree
+
         tol = 1e-9 * max(self.geometry.size) + 1e-12
         a, b = self._every @ rotation_a.T + center_a, self._every @ rotation_b.T + center_b
         return bool(cKDTree(b).query(a)[0].max() <= tol and cKDTree(a).query(b)[0].max() <= tol)
@@ -176,6 +196,8 @@ class Mesh(Shape):
         return "convex_parts", {"parts_mm": self.geometry.parts}
 
     def ray_hits(self, origins: NDArray, direction: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+        from synergrasp.simulation.shapes.polytope_axes import ray_parts
+
         o = np.asarray(origins, dtype=float)
         d = np.broadcast_to(np.asarray(direction, dtype=float), o.shape).reshape(-1, 3)
         flat = np.ascontiguousarray(o.reshape(-1, 3))
