@@ -119,3 +119,11 @@ def test_a_change_to_a_callees_module_is_compiled_again_not_loaded_stale(tmp_pat
     assert text.count(outside) == 1
     kernels.write_text(text.replace(outside, outside.replace("np.sqrt(best_sq)", "np.sqrt(best_sq) + 100.0")))
     assert gap() == pytest.approx(119.0)
+
+
+def test_the_shapes_package_imports_no_compiled_code():
+    """Every Snakemake start imports the shapes (the configuration's checks): numba only where
+    a compiled query is asked for."""
+    code = "import sys, synergrasp.config, synergrasp.simulation.shapes; print('numba' in sys.modules)"
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert run.stdout.strip() == "False"

@@ -24,8 +24,6 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from synergrasp.simulation.shapes.kernels import segment_object_distance
-
 __all__ = ["Shape", "ShapeError", "SHAPES", "shape_from_config", "start_rotation", "positive_length", "Box", "Sphere",
            "Cylinder", "Mesh"]
 
@@ -101,6 +99,8 @@ class Shape(ABC):
         """Signed distances (k,) from segments p0–p1 ((k, 3), own frame, mm) to the shape and
         the segment parameters in [0, 1] attaining them (negative: the segment crosses it,
         minus a penetration depth). The closure's compiled query, here for tests."""
+        from synergrasp.simulation.shapes.kernels import segment_object_distance  # compiled: numba only when asked
+
         return segment_object_distance(np.ascontiguousarray(p0, dtype=float), np.ascontiguousarray(p1, dtype=float),
                                        self.kernel_code, self.kernel_params)
 

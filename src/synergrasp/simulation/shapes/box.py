@@ -15,7 +15,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from synergrasp.simulation.shapes import Shape, ShapeError
-from synergrasp.simulation.shapes.kernels import segment_box_distance
 
 __all__ = ["Box", "box_samples", "box_gap", "box_edges"]
 
@@ -121,6 +120,8 @@ class Box(Shape):
 
     def box_gap(self, rotation: NDArray, center: NDArray, box_pose: NDArray, box_half: NDArray) -> tuple[float, NDArray]:
         # two convex boxes: the closest points lie on an edge of one of them
+        from synergrasp.simulation.shapes.kernels import segment_box_distance  # compiled: numba only when asked
+
         own_pose, own_half = _pose(rotation, center), self._half
         b0, b1 = box_edges(own_pose, own_half)
         a0, a1 = box_edges(box_pose, box_half)

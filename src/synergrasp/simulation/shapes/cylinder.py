@@ -13,7 +13,6 @@ from numpy.typing import NDArray
 
 from synergrasp.simulation.shapes import Shape, positive_length
 from synergrasp.simulation.shapes.box import box_edges
-from synergrasp.simulation.shapes.kernels import segment_box_distance
 
 __all__ = ["Cylinder"]
 
@@ -103,6 +102,8 @@ class Cylinder(Shape):
         # cylinder's farthest point toward that face (a face parallel to a generator or a cap
         # is reached by an edge where the middle point misses the face): every candidate is
         # the distance of an actual pair of points, and the closest pair is among them.
+        from synergrasp.simulation.shapes.kernels import segment_box_distance  # compiled: numba only when asked
+
         a0, a1 = box_edges(box_pose, box_half)
         d_edge, t_edge = self.segment_distance((a0 - center) @ rotation, (a1 - center) @ rotation)
         on_edges = a0 + t_edge[:, None] * (a1 - a0)
