@@ -8,6 +8,7 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
+import warnings  # noqa: E402
 from dataclasses import replace  # noqa: E402
 
 import pytest  # noqa: E402
@@ -17,6 +18,7 @@ from synergrasp.config import _resolve, defaults, load_schema  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
 from synergrasp.optimisation.study import OptimiseParams  # noqa: E402
+from synergrasp.optimisation.gfo import solve_gfo  # noqa: E402
 from synergrasp.simulation.closure import SimulateParams  # noqa: E402
 from grasp_problems import random_gfo_problems  # noqa: E402
 
@@ -37,6 +39,15 @@ def generated_problems():
     for the modules that check the solvers on them (each problem's critical friction is
     bisected: they take about 16 CPU s to make)."""
     return random_gfo_problems(2018, 600)
+
+
+@pytest.fixture(scope="session")
+def generated_cvxpy(generated_problems):
+    """The independent cvxpy reference's solution of every generated problem (test_gfo checks
+    Clarabel against it, test_ipm_kernel the kernel)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # cvxpy's "may be inaccurate" near the boundary
+        return solve_gfo([p.problem for p in generated_problems], "cvxpy")
 
 
 #: Near-boundary band (docs/ipm_solver.md): problems whose friction coefficient is within

@@ -15,7 +15,7 @@ from synergrasp.optimisation.ipm.sets import range_basis
 from synergrasp.optimisation.ipm_kernel import IPMSettings
 from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_basis, object_wrench
 from synergrasp.optimisation.problem import GFOProblem, GraspSets, SynergySets
-from grasp_problems import random_gfo_problems, random_grasp, random_synergies, random_unit_vector
+from grasp_problems import random_grasp, random_synergies, random_unit_vector
 
 RTOL_NORM = 1e-4
 
@@ -39,8 +39,9 @@ def _study_sized_problems(count: int, seed: int = 11) -> list[GFOProblem]:
 
 
 @pytest.fixture(scope="module")
-def generated():
-    return random_gfo_problems(7, 250)
+def generated(generated_problems):
+    """The generated problems shared with test_gfo and test_pyramid (conftest)."""
+    return generated_problems
 
 
 def test_5000_study_sized_problems_match_the_exact_solver():
@@ -75,7 +76,7 @@ def _feasible_point_clarabel_missed(problem: GFOProblem, sol, k: int, ref_status
     return True
 
 
-def test_generated_kinds_match_exact_solver_outside_the_band_and_cvxpy_on_a_subset(generated):
+def test_generated_kinds_match_exact_solver_outside_the_band_and_cvxpy_on_a_subset(generated, generated_cvxpy):
     problems = [p.problem for p in generated]
     sol = solve_gfo(problems, "ipm")
     ref = solve_gfo(problems, "clarabel")
@@ -91,15 +92,14 @@ def test_generated_kinds_match_exact_solver_outside_the_band_and_cvxpy_on_a_subs
             assert sol.force_norm[k] == pytest.approx(ref.force_norm[k], rel=RTOL_NORM)
     assert {"nominal", "feasible", "infeasible", "near_boundary"} <= {p.kind for p in generated}
     assert in_band_differ <= 0.05 * len(generated)
-    # cvxpy (a different formulation and canonicalisation) on a subset
-    subset = list(range(0, len(generated), 3))
-    cvx = solve_gfo([problems[k] for k in subset], "cvxpy")
-    for i, k in enumerate(subset):
+    # cvxpy (a different formulation and canonicalisation; solved once for test_gfo too) on a subset
+    cvx = generated_cvxpy
+    for k in range(0, len(generated), 3):
         p = generated[k]
-        if sol.status[k] != cvx.status[i]:
+        if sol.status[k] != cvx.status[k]:
             assert p.kind == "near_boundary" and abs(p.delta) <= BAND
-        elif cvx.status[i] == "force_closure":
-            assert sol.force_norm[k] == pytest.approx(cvx.force_norm[i], rel=RTOL_NORM)
+        elif cvx.status[k] == "force_closure":
+            assert sol.force_norm[k] == pytest.approx(cvx.force_norm[k], rel=RTOL_NORM)
 
 
 def test_second_attempt_with_refinement_decides_problems_the_first_leaves_open():

@@ -231,14 +231,15 @@ def test_study_synergy_sets_are_the_75_distinct_sets():  # synergrasp.ids
 
 
 def _dry_run(tmp_path, target, scenarios):
-    """``snakemake -n target`` on the small config with ``scenarios``: (return code, output,
-    {rule: [output files]} of the jobs it would run)."""
+    """``snakemake -n target`` (a target or a list of them) on the small config with
+    ``scenarios``: (return code, output, {rule: [output files]} of the jobs it would run)."""
     import subprocess
     import sys
 
     config = tmp_path / "config.yaml"
     config.write_text(yaml.safe_dump({**SMALL, "scenarios": scenarios}))
-    run = subprocess.run([sys.executable, "-m", "snakemake", target, "-n", "-s", str(ROOT / "Snakefile"),
+    targets = [target] if isinstance(target, str) else list(target)
+    run = subprocess.run([sys.executable, "-m", "snakemake", *targets, "-n", "-s", str(ROOT / "Snakefile"),
                           "--directory", str(tmp_path), "--configfile", str(config),
                           "--replace-workflow-config"], capture_output=True, text=True, timeout=600)
     jobs, rule = {}, None
@@ -362,8 +363,8 @@ def test_scenarios_differing_in_an_analysis_key_draw_each_shared_figure_once(tmp
     fig4 = sorted(p for p in jobs["fig4_force_maps"] if p.endswith("obj1/fig4_force_maps.png"))
     assert fig4 == [f"{r}/objects/obj1/fig4_force_maps.png" for r in
                     ("results", "results/scenarios/panels", "results/scenarios/wide")]
-    default, panels = (_target_inputs(_dry_run(tmp_path, f"scenario_{name}", scenarios)[1], f"scenario_{name}")
-                       for name in ("default", "panels"))
+    out = _dry_run(tmp_path, ["scenario_default", "scenario_panels"], scenarios)[1]
+    default, panels = (_target_inputs(out, f"scenario_{name}") for name in ("default", "panels"))
     assert len(panels) == len(default) == len(set(default))
     assert [p for p in panels if p not in default] == [
         f"results/scenarios/panels/objects/{o}/fig4_{k}.{e}" for o in ("obj1", "obj4")
