@@ -74,6 +74,10 @@ SECTIONS = (
      "`benchmarks/bench_search.py` (in `make bench`): the default study's search of each object with 2 "
      "processes; the target is at most 30 s wall per object on 2 quiet cores (the study's own searches: "
      "`search_placement` in the jobs table above)."),
+    ("Snakemake's own cost", ("scheduler",),
+     "`benchmarks/bench_scheduler.py` (in `make bench`): the CPU time of Snakemake's own process (the jobs "
+     "excluded) per job, on the small sweep from an empty directory with -j2, with Snakemake's default "
+     "job-rate limiter and with the workflow profile's (profiles/default/config.yaml says why it is set)."),
 )
 
 

@@ -29,11 +29,11 @@ def _claim_ids(summary: pd.DataFrame) -> list[str]:
 
 def figure_claims_grid(summary: pd.DataFrame, png: str | Path, pdf: str | Path) -> None:
     """Claims (columns) × scenarios (rows), each cell coloured by the headline verdict and
-    holding the compared difference with its interval (the reason when undefined), or the
-    claims table's ``measured`` for a summary without intervals."""
+    holding the compared difference with its interval (with the reason's first clause when
+    undefined), or the claims table's ``measured`` for a summary without intervals."""
     claims = _claim_ids(summary)
     n_rows, n_cols = len(summary), max(len(claims), 1)
-    fig, ax = plt.subplots(figsize=(2.6 * n_cols + 1.8, 0.75 * n_rows + 1.2))
+    fig, ax = plt.subplots(figsize=(1.7 * n_cols + 2.2, 0.42 * n_rows + 1.0))
     for i in range(n_rows):
         for j, claim in enumerate(claims):
             verdict = summary.iloc[i][f"claim{claim}_verdict"]
@@ -42,8 +42,11 @@ def figure_claims_grid(summary: pd.DataFrame, png: str | Path, pdf: str | Path) 
             colour = VERDICT_COLOURS.get(verdict, _MISSING) if isinstance(verdict, str) else _MISSING
             ax.add_patch(plt.Rectangle((j, i), 1, 1, facecolor=colour, edgecolor="white"))
             text = str(shown) if isinstance(shown, str) else "—"
-            text += f"; {reason[:60]}" if isinstance(reason, str) and verdict == UNDEFINED else ""
-            ax.text(j + 0.5, i + 0.5, _wrap(text, 34), ha="center", va="center", fontsize=5)
+            if isinstance(reason, str) and verdict == UNDEFINED:  # the rest is in claims.md
+                text = _wrap(text, 26) + "\n" + _first_clause(reason)
+            else:
+                text = _wrap(text, 26)
+            ax.text(j + 0.5, i + 0.5, text, ha="center", va="center", fontsize=6)
     ax.set_xlim(0, n_cols)
     ax.set_ylim(n_rows, 0)
     ax.set_xticks(np.arange(n_cols) + 0.5, [f"claim {c}" for c in claims])
@@ -54,6 +57,12 @@ def figure_claims_grid(summary: pd.DataFrame, png: str | Path, pdf: str | Path) 
               ncol=3, frameon=False, fontsize=7)
     fig.tight_layout()
     save_figure(fig, png, pdf)
+
+
+def _first_clause(reason: str, width: int = 34) -> str:
+    """A verdict's reason up to its first colon, semicolon or parenthesis, at most ``width`` characters."""
+    clause = reason.split(":")[0].split(";")[0].split(" (")[0].strip()
+    return clause if len(clause) <= width else clause[: width - 1] + "…"
 
 
 def _wrap(text: str, width: int) -> str:
