@@ -76,8 +76,8 @@ SECTIONS = (
      "`search_placement` in the jobs table above)."),
     ("Snakemake's own cost", ("scheduler",),
      "`benchmarks/bench_scheduler.py` (in `make bench`): the CPU time of Snakemake's own process (the jobs "
-     "excluded) per job, on the small sweep from an empty directory with -j2, with Snakemake's default "
-     "job-rate limiter and with the workflow profile's (profiles/default/config.yaml says why it is set)."),
+     "excluded) per job, on the small sweep from an empty directory with -j2 and the workflow profile "
+     "(profiles/default/config.yaml says what it grows with on long runs)."),
 )
 
 
