@@ -4,6 +4,7 @@ import functools
 import math
 import re
 import sys
+import threading
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
@@ -223,6 +224,23 @@ onstart:
                 "The SLURM profile cannot submit from this shell, nothing was run: "
                 + "; ".join(_problems)
             )
+
+
+def cancel_scheduler_timers():
+    """Cancel the scheduler's pending re-evaluation timers (threading.Timer, not daemon
+    threads) once the run is over, so that Snakemake exits at once instead of a job-rate
+    timespan later (profiles/default/config.yaml). The workflow starts no timer of its own."""
+    for thread in threading.enumerate():
+        if isinstance(thread, threading.Timer):
+            thread.cancel()
+
+
+onsuccess:
+    cancel_scheduler_timers()
+
+
+onerror:
+    cancel_scheduler_timers()
 
 
 #: `import synergrasp.x[, ...]` and `from synergrasp.x import a, b` (or a parenthesised list),
