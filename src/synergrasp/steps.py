@@ -240,7 +240,7 @@ STEPS: dict[str, Step] = {
         rules={"sensitivity_summary": Cost("none", 5.0, 300)},
         outputs={"csv": "sensitivity/claims.csv", "md": "sensitivity/claims.md",
                  **_files(("claims_grid", "table2_curves"), "sensitivity", _PNG_PDF)},
-        scope="workflow", upstream=("tables",)),
+        scope="workflow", upstream=("tables", "realism")),
 }
 #: Keys read by the workflow itself, not by a step.
 WORKFLOW_KEYS: tuple[str, ...] = ("scenarios",)

@@ -381,9 +381,9 @@ def every_scenario_targets(wildcards):
 
 
 # The sensitivity sweep's summary across every scenario (docs/sensitivity.md).
-def scenario_tables(table):
-    """Input function: every scenario's (default first) study table ``table``.csv."""
-    return lambda wildcards: [study_file(s, "tables", f"tables/{table}.csv") for s in SCENARIOS]
+def scenario_tables(table, step="tables"):
+    """Input function: every scenario's (default first) table ``table``.csv made by ``step``."""
+    return lambda wildcards: [study_file(s, step, f"tables/{table}.csv") for s in SCENARIOS]
 
 
 SENSITIVITY_FILES = workflow_files("sensitivity")
