@@ -270,7 +270,7 @@ def test_code_inputs_hold_every_module_a_job_loads(run_j2):
         loaded.setdefault(script, set()).update(files)
     assert set(loaded) == {"simulate_contacts", "optimise_shard", "aggregate_gfo", "local_minima",
                            "study_tables", "fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph",
-                           "fig4_force_maps", "fig5_hierarchy", "grasp_realism", "grasp_quality", "grasps_3d"}
+                           "fig4_force_maps", "fig5_hierarchy", "grasp_realism", "grasp_quality"}
     for script, files in loaded.items():
         assert files, script
         assert files <= declared[script], (script, sorted(files - declared[script]))
@@ -330,7 +330,7 @@ def _planned_after_edit(project_copy, module: str) -> dict[str, int]:
 
 
 FIGURE_RULES = {"fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph", "fig4_force_maps",
-                "fig5_hierarchy", "grasp_realism", "grasps_3d", "figures"}
+                "fig5_hierarchy", "grasp_realism", "figures"}
 
 
 def test_changing_the_config_module_reruns_the_optimisation(project_copy):
