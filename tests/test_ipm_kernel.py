@@ -264,6 +264,30 @@ def test_sets_of_one_grasp_match_the_same_problems_one_by_one():
                 assert np.linalg.norm(fused.forces[j] - ref.forces[j]) <= 1e-2 * ref.force_norm[j]
 
 
+def test_verdicts_implied_by_nested_sets_are_those_of_a_direct_solve():
+    """Two contacts squeezing along x (normals +-x), 1 N of load along z on each. Synergies
+    1 and 2 shear the contacts (no normal force: every set of them infeasible), synergy 3
+    squeezes (feasible from 1/mu N on, strictly internal), synergy 4 is twice synergy 3.
+    {1, 2} is solved infeasible and {1}, {2} are implied so; {3, 4} is solved and {3}, of the
+    same rank 1, takes its optimum; {1, 3} and {3, 4} are implied strictly internal by {3}."""
+    normals = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])
+    S = np.array([[0, 0, 1, 2], [1, 0, 0, 0], [0, 1, 0, 0], [0, 0, -1, -2], [-1, 0, 0, 0], [0, -1, 0, 0]], dtype=float)
+    sets = SynergySets(S, ((1, 2), (1,), (2,), (3,), (1, 3), (3, 4)))
+    g = GraspSets(np.array([0, 0, 1.0, 0, 0, 1.0]), normals, np.eye(6), 1.0, sets, 0.5, CircularCone(0.5))
+    sol = solve_gfo(g, strict_shrink=1e-5)
+    direct = solve_gfo([g.problem(j) for j in range(len(g))], strict_shrink=1e-5)
+    assert list(sol.status) == ["infeasible"] * 3 + ["force_closure"] * 3
+    assert list(sol.solver) == ["ipm", "implied", "implied", "implied", "ipm", "ipm"]
+    assert list(sol.iterations[1:4]) == [0, 0, 0] and list(sol.e_s) == [2, 1, 1, 1, 2, 1]
+    assert list(sol.strict_internal) == [False, False, False, True, True, True]
+    for name in ("status", "strict_internal", "e_s"):
+        np.testing.assert_array_equal(getattr(sol, name), getattr(direct, name))
+    # the squeeze: 1 N of friction per contact needs 1 / mu = 2 N of normal force
+    np.testing.assert_allclose(sol.force_norm[3:], np.sqrt(2 * (2.0**2 + 1.0)), rtol=1e-7)
+    np.testing.assert_allclose(direct.force_norm[3:], sol.force_norm[3:], rtol=1e-7)
+    np.testing.assert_array_equal(sol.forces[3], sol.forces[5])
+
+
 def test_bad_settings_name_the_field():
     with pytest.raises(ValueError, match="max_iter"):
         IPMSettings(max_iter=0)

@@ -10,9 +10,12 @@ import pandas as pd
 import pytest
 
 from conftest import study_gfo_params
+from synergrasp.config import defaults
+from synergrasp.ids import synergy_sets
 from synergrasp import tables
 from synergrasp.optimisation.cones import PyramidCone
 from synergrasp.optimisation.gfo import solve_gfo
+from synergrasp.optimisation.ipm_kernel import IPMSettings
 from synergrasp.optimisation.problem import GraspSets, SynergySets
 from grasp_problems import random_grasp, random_synergies
 from synergrasp.optimisation.study import mechanics_for, merge_shards, optimise_grasps, shard_rows
@@ -83,8 +86,36 @@ def test_pyramid_cone_study_runs_through_the_kernel_and_matches_clarabel():
                         "clarabel", strict_shrink=params.strict_shrink)
         np.testing.assert_array_equal(out["status"][rows], ref.status)
         np.testing.assert_array_equal(out["strict_internal"][rows], ref.strict_internal)
-        assert set(out["solver"][rows]) <= {"ipm", "clarabel_fallback", "direct"}
+        assert set(out["solver"][rows]) <= {"ipm", "implied", "clarabel_fallback", "direct"}
         fc = ref.force_closure
         np.testing.assert_allclose(out["force_norm"][rows][fc], ref.force_norm[fc], rtol=RTOL_NORM)
     with pytest.raises(ValueError, match="friction_cone must be one of"):
         study_gfo_params(friction_cone="pyramid6").cone
+
+
+@pytest.mark.parametrize("cone", ["circular", "pyramid4_inscribed"])
+def test_verdicts_implied_by_nested_sets_are_those_of_solving_every_set(cone):
+    """The study's 75 sets on generated grasps, at two friction coefficients: the verdicts
+    the kernel takes from the sets' nesting (`IPMSettings.nested`) against every set solved."""
+    rng = np.random.default_rng(8)
+    sets = SynergySets(random_synergies(rng), tuple(synergy_sets(defaults()["synergy_sets"]).values()))
+    grasps = [random_grasp(rng, int(rng.integers(4, 13)), palm_contacts=int(rng.integers(0, 2))) for _ in range(24)]
+    for mu in (0.4, 1.5):
+        params = study_gfo_params(gravity_direction=(0.0, 0.0, -1.0), mu=mu, friction_cone=cone)
+        nested = optimise_grasps(grasps, sets, params)
+        every = optimise_grasps(grasps, sets, params, ipm=IPMSettings(nested=False))
+        implied = nested["solver"] == "implied"
+        assert implied.sum() > 100 and "implied" not in set(every["solver"])
+        for name in ("status", "strict_internal", "e_s"):
+            np.testing.assert_array_equal(nested[name], every[name])
+        # a set of its superset's rank takes the superset's optimum: the same problem on
+        # another basis of the same subspace, equal to the solvers' tolerance
+        np.testing.assert_allclose(nested["force_norm"], every["force_norm"], rtol=1e-6)
+        infeasible = nested["status"] == "infeasible"
+        assert (implied & infeasible).sum() > 100 and (implied & ~infeasible).any()
+        assert not nested["strict_internal"][infeasible].any()
+        assert not nested["iterations"][implied].any()
+        solved = ~implied
+        np.testing.assert_array_equal(nested["force_norm"][solved], every["force_norm"][solved])
+        np.testing.assert_array_equal(nested["iterations"][solved], every["iterations"][solved])
+        np.testing.assert_array_equal(nested["solver"][solved], every["solver"][solved])

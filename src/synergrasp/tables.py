@@ -92,8 +92,8 @@ GFO = Table("gfo", "one row per (pose, synergy set)", _pose_columns() + (
     Column("e_s", "int32", "", "rank of the internal-force basis"),
     Column("rank_G", "int32", "", "rank of the grasp matrix"),
     Column("n_contacts", "int32", "", "number of contacts"),
-    Column("iterations", "int32", "", "interior-point iterations"),
-    Column("solver", "string", "", "back end that decided the problem: ipm (compiled interior-point kernel), clarabel_fallback (the kernel left it undecided), direct (e_s = 0: f = f_p judged without a solver), none (no_grasp, rank_deficient: nothing solved)"),
+    Column("iterations", "int32", "", "interior-point iterations of the GFO (0 unless solver ipm or clarabel_fallback)"),
+    Column("solver", "string", "", "back end that decided the problem: ipm (compiled interior-point kernel), implied (not solved: range(E_s) lies in that of each superset of its synergies, so infeasible where a superset is, and of a superset of equal rank the same problem, whose verdict and force_norm it takes; 0 iterations, e_s its own rank), clarabel_fallback (the kernel left it undecided), direct (e_s = 0: f = f_p judged without a solver), none (no_grasp, rank_deficient: nothing solved)"),
 ))
 
 MINIMA = Table("minima", "one row per local minimum of (object, synergy set)", (

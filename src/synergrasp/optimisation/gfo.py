@@ -145,7 +145,7 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
     thresholds = g.basis_rtol * g.response_norm * S.norms
     strict = shrink is not None
     res = ipm_kernel.solve_sets(P @ S.matrix, g.f_p, contact_frames(g.normals), S.table, S.sizes, thresholds,
-                                g.cone, g.cone.narrowed(shrink) if strict else None, g.f_min, ipm, ALMOST_SOLVED_TOL)
+                                S.within, g.cone, g.cone.narrowed(shrink) if strict else None, g.f_min, ipm, ALMOST_SOLVED_TOL)
     n = len(g)
     status = _STATUS_OF_CODE[res.code]
     optimal = res.code == ipm_kernel.OPTIMAL
@@ -155,7 +155,7 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
     sol = GFOSolution(status=status, force_norm=np.where(optimal, res.force_norm, np.nan), forces=forces,
                       e_s=res.e_s.astype(np.int32), iterations=res.iterations,
                       strict_internal=res.strict_code == ipm_kernel.OPTIMAL if strict else None,
-                      solver=np.full(n, "ipm", dtype=object), max_violation=np.where(optimal, res.max_violation, np.nan))
+                      solver=np.where(res.implied, "implied", "ipm").astype(object), max_violation=np.where(optimal, res.max_violation, np.nan))
     for j in np.flatnonzero(status == ""):
         _fallback(sol, j, g.problem(j), tol, max_iter)
     if strict:

@@ -53,6 +53,10 @@ class IPMSettings:
         and relative gap are below this, and where the iteration stalls or ends; 0: only
         there; negative: never. A polished point is accepted only if it passes the optimality
         test at `tol`
+    nested: the sets of one grasp (`solve_sets`) take the verdicts their nesting implies
+        instead of solving them (`ipm.sets.solve_sets`: a subset of an infeasible set is
+        infeasible, a superset of a strictly feasible one strictly feasible, an infeasible
+        set not strictly feasible); False solves every set, to compare the solver with itself
     """
 
     tol: float = 1e-8
@@ -63,6 +67,7 @@ class IPMSettings:
     refine: int = 0
     retry_refine: int = 1
     polish_from: float = 1e-2
+    nested: bool = True
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.tol) and 0 < self.tol < 1):
@@ -103,7 +108,8 @@ def cone_data(cone: FrictionCone, frames: NDArray) -> ConeData:
 class SetsResult(NamedTuple):
     """Kernel output for the sets of one grasp (arrays over the sets): code, ||f|| N,
     worst constraint violation N, iterations, e_s, strict_code (INFEASIBLE where not
-    tested), forces (n_sets, 3m) N (rows of OPTIMAL sets only)."""
+    tested), forces (n_sets, 3m) N (rows of OPTIMAL sets only), implied (the GFO's verdict
+    INFEASIBLE implied by an infeasible superset, not solved; 0 iterations)."""
 
     code: NDArray
     force_norm: NDArray
@@ -112,6 +118,7 @@ class SetsResult(NamedTuple):
     e_s: NDArray
     strict_code: NDArray
     forces: NDArray
+    implied: NDArray
 
 
 def solve_problem(frames: NDArray, E: NDArray, f_p: NDArray, cone: FrictionCone, strict_cone: FrictionCone | None,
@@ -123,32 +130,35 @@ def solve_problem(frames: NDArray, E: NDArray, f_p: NDArray, cone: FrictionCone,
     `solve_sets`, with E as the one set's basis; returns its one-row `SetsResult`."""
     e = E.shape[1]
     return _solve(np.ascontiguousarray(E, dtype=float), f_p, frames, np.arange(e)[None, :], np.array([e]),
-                  np.zeros(1), True, cone, strict_cone, f_min, settings, violation_tol)
+                  np.zeros(1), True, np.zeros((1, 1), dtype=bool), cone, strict_cone, f_min, settings, violation_tol)
 
 
 def solve_sets(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_columns: NDArray,
-               thresholds: NDArray, cone: FrictionCone, strict_cone: FrictionCone | None, f_min: float,
+               thresholds: NDArray, within: NDArray, cone: FrictionCone, strict_cone: FrictionCone | None, f_min: float,
                settings: IPMSettings, violation_tol: float) -> SetsResult:
     """Every set of one grasp in one compiled call. F_all: (3m, k) projector @ S, N per
     unit activation; columns: (n_sets, max size) 0-based columns of F_all per set (the first
     n_columns[j] of row j); thresholds: (n_sets,) rank thresholds of the singular values;
+    within: (n_sets, n_sets) bool, set a a subset of set b (`SynergySets.within`; all False
+    unless `settings.nested`: every set solved);
     cone: the friction-cone model; strict_cone: that of the strict internal-force test (the
     cone narrowed), None for no strict test."""
-    return _solve(np.ascontiguousarray(F_all), f_p, frames, columns, n_columns, thresholds, False, cone, strict_cone,
-                  f_min, settings, violation_tol)
+    within = within if settings.nested else np.zeros_like(within)
+    return _solve(np.ascontiguousarray(F_all), f_p, frames, columns, n_columns, thresholds, False, within, cone,
+                  strict_cone, f_min, settings, violation_tol)
 
 
 def _solve(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_columns: NDArray,
-           thresholds: NDArray, given: bool, cone: FrictionCone, strict_cone: FrictionCone | None, f_min: float,
+           thresholds: NDArray, given: bool, within: NDArray, cone: FrictionCone, strict_cone: FrictionCone | None, f_min: float,
            settings: IPMSettings, violation_tol: float) -> SetsResult:
     n_sets = columns.shape[0]
     out = SetsResult(code=np.zeros(n_sets, dtype=np.int8), force_norm=np.full(n_sets, np.nan),
                      max_violation=np.full(n_sets, np.nan),
                      iterations=np.zeros(n_sets, dtype=np.int32), e_s=np.zeros(n_sets, dtype=np.int64),
                      strict_code=np.full(n_sets, INFEASIBLE, dtype=np.int8),
-                     forces=np.full((n_sets, f_p.size), np.nan))
+                     forces=np.full((n_sets, f_p.size), np.nan), implied=np.zeros(n_sets, dtype=bool))
     data = cone_data(cone, frames)
-    sets.solve_sets(F_all, np.ascontiguousarray(f_p, dtype=float), frames, columns, n_columns, thresholds, given, data,
+    sets.solve_sets(F_all, np.ascontiguousarray(f_p, dtype=float), frames, columns, n_columns, thresholds, given, within, data,
                     data if strict_cone is None else cone_data(strict_cone, frames), float(f_min),
                     strict_cone is not None, _kernel_settings(settings, violation_tol),
                     _kernel_settings(settings, violation_tol, feasibility=True), out)

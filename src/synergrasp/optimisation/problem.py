@@ -113,8 +113,9 @@ class SynergySets:
 
     matrix: (n, k) synergies, rad per unit activation; sets: 1-based synergy indices per set.
     Derived once: `columns` (0-based, sorted, per set), `sizes` (synergies per set), `norms`
-    (||S_set||_2 per set) and `table` (n_sets, largest set) of the columns, padded with 0
-    after each set's size.
+    (||S_set||_2 per set), `table` (n_sets, largest set) of the columns, padded with 0
+    after each set's size, and `within` (n_sets, n_sets) bool: within[a, b] if set a is a
+    subset of set b (a != b), the nesting whose implied verdicts the kernel takes.
     """
 
     matrix: NDArray
@@ -123,6 +124,7 @@ class SynergySets:
     sizes: NDArray = field(init=False, repr=False)
     norms: NDArray = field(init=False, repr=False)
     table: NDArray = field(init=False, repr=False)
+    within: NDArray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         S = np.asarray(self.matrix, dtype=float)
@@ -144,6 +146,9 @@ class SynergySets:
             table[j, :c.size] = c
         object.__setattr__(self, "table", table)
         object.__setattr__(self, "sizes", np.array([c.size for c in columns], dtype=np.int64))
+        members = [set(c.tolist()) for c in columns]
+        object.__setattr__(self, "within", np.array([[a is not b and a <= b for b in members] for a in members],
+                                                    dtype=bool).reshape(len(members), len(members)))
 
     def __len__(self) -> int:
         return len(self.columns)

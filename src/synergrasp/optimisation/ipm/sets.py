@@ -11,7 +11,15 @@ import numpy as np
 
 from synergrasp.optimisation.ipm.compiled import jit_alloc, jit_call, jit_inline
 from synergrasp.optimisation.ipm.iteration import hsde
-from synergrasp.optimisation.ipm.layout import NOT_SOLVED, OPTIMAL, UNDECIDED, Problem, polish_workspace, workspace
+from synergrasp.optimisation.ipm.layout import (
+    INFEASIBLE,
+    NOT_SOLVED,
+    OPTIMAL,
+    UNDECIDED,
+    Problem,
+    polish_workspace,
+    workspace,
+)
 
 __all__ = ["range_basis", "solve_sets"]
 
@@ -176,26 +184,31 @@ def range_basis(F_all, cols, s, threshold, U):
 
 
 @jit_alloc
-def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, cone, cone_strict, f_min, strict, opt, opt_strict,
-               out):
+def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, within, cone, cone_strict, f_min, strict, opt,
+               opt_strict, out):
     """Every synergy set of one grasp into `out` (`SetsResult`): E_s from the singular vectors
     of F_s = F_all[:, set] whose singular value is above the set's threshold (`range_basis`),
     or, if `given`, F_s itself (orthonormal columns), then the GFO, its forces f_p + E_s y (N)
     and, if `strict`, the strict internal-force test (f_p = 0, f_min = 1 N, cone_strict).
     cone, cone_strict: `ConeData` of the same kind; opt, opt_strict: `Settings` of the GFO and
-    of the strict test (feasibility only). Sets with e_s = 0 get code NOT_SOLVED."""
+    of the strict test (feasibility only). Sets with e_s = 0 get code NOT_SOLVED.
+    within (n_sets, n_sets) bool: within[a, b] if set a is a subset of set b (a != b); then
+    range(E_a) is in range(E_b), so b infeasible implies a infeasible and a strictly
+    feasible implies b strictly feasible; of equal rank the two subspaces are equal, the
+    problems the same (a takes b's verdict, ||f|| and forces). A set whose GFO is infeasible
+    has no strictly internal force (one would make the GFO feasible, scaled up). Implied
+    verdicts are not solved (`out.implied`, 0 iterations); all False: every set solved."""
     c = F_all.shape[0]
     m, p = c // 3, cone.lin.shape[1]
     rows = np.empty((m, 3, 3))
-    rows_strict = np.empty((m, 3, 3))
     cone_rows(frames, cone.mu, rows)
-    cone_rows(frames, cone_strict.mu, rows_strict)
-    zero = np.zeros(c)
     W = workspace(m, m if p == 0 else 0, m * p, cols.shape[1])
     Q = polish_workspace(cols.shape[1])
     y = np.empty(cols.shape[1])
-    U = np.empty((c, cols.shape[1]))
-    for j in range(cols.shape[0]):
+    bases = np.empty((cols.shape[0], c, cols.shape[1]))
+    order = np.argsort(-n_cols, kind="mergesort")  # supersets before their subsets
+    for j in order:
+        U = bases[j]
         if given:
             rank = n_cols[j]
             for q in range(rank):
@@ -207,6 +220,14 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, cone, cone_st
         if rank == 0:
             out.code[j] = NOT_SOLVED
             continue
+        k = implying(within[j], out.code, INFEASIBLE, out.e_s, rank)
+        if k >= 0:
+            out.implied[j] = True
+            out.code[j] = out.code[k]
+            if out.code[k] == OPTIMAL:  # the same subspace: the same problem, the same optimum
+                out.force_norm[j], out.max_violation[j] = out.force_norm[k], out.max_violation[k]
+                out.forces[j, :] = out.forces[k, :]
+            continue
         # E_s is the first `rank` columns of U
         code, out.force_norm[j], out.max_violation[j], out.iterations[j] = solve_one(
             build(rows, cone.lin, U, fp, rank, cone.mu, f_min, W), W, Q, opt, y)
@@ -217,6 +238,41 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, cone, cone_st
                 for q in range(rank):
                     acc += U[k, q] * y[q]
                 out.forces[j, k] = acc
-        if strict:
-            out.strict_code[j] = solve_one(build(rows_strict, cone_strict.lin, U, zero, rank, cone_strict.mu, 1.0, W),
+    if strict:
+        strict_tests(bases, within, cone_strict, frames, order[::-1], opt_strict, W, Q, y, out)
+
+
+@jit_call
+def implying(marked, codes, code, e_s, rank):
+    """The set whose verdict a set of rank `rank` takes, among the sets `marked` (bool over
+    the sets; its subsets or supersets): the first with `code`, else the first of the same
+    rank (the same subspace) that the kernel decided; -1 if none."""
+    for k in range(marked.shape[0]):
+        if marked[k] and codes[k] == code:
+            return k
+    for k in range(marked.shape[0]):
+        if marked[k] and e_s[k] == rank and (codes[k] == OPTIMAL or codes[k] == INFEASIBLE):
+            return k
+    return -1
+
+
+@jit_alloc
+def strict_tests(bases, within, cone_strict, frames, order, opt_strict, W, Q, y, out):
+    """The strict internal-force test of every set with e_s > 0, in `order` (subsets before
+    their supersets), on the bases of `solve_sets`: not strictly feasible where the GFO is
+    infeasible, strictly feasible where a subset is, a subset's verdict where it has the same
+    rank (`solve_sets`), else solved."""
+    c = bases.shape[1]
+    rows = np.empty((c // 3, 3, 3))
+    cone_rows(frames, cone_strict.mu, rows)
+    zero = np.zeros(c)
+    for j in order:
+        rank = out.e_s[j]
+        if rank == 0:
+            continue
+        if out.code[j] == INFEASIBLE:
+            out.strict_code[j] = INFEASIBLE
+        else:
+            k = implying(within[:, j], out.strict_code, OPTIMAL, out.e_s, rank)
+            out.strict_code[j] = out.strict_code[k] if k >= 0 else solve_one(build(rows, cone_strict.lin, bases[j], zero, rank, cone_strict.mu, 1.0, W),
                                             W, Q, opt_strict, y)[0]
