@@ -1,0 +1,15 @@
+"""The Fig. 2 grasps in 3-D: one page each with the full set's optimal forces, one shared plotly script."""
+
+from synergrasp import tables
+from synergrasp.figures.grasp_3d import Grasps3dParams, fig2_scenes, write_grasp_pages
+from synergrasp.hand.kinematics import load_hand
+from synergrasp.hand.synergies import load_synergies
+from synergrasp.job_log import job_log
+
+with job_log(snakemake.log[0]):
+    params = Grasps3dParams.from_config(snakemake.params.cfg)
+    hand = load_hand(params.hand)
+    matrix = load_synergies(params.synergies, joint_names=hand.joint_names).matrix
+    contacts = [tables.read(tables.CONTACTS, path) for path in snakemake.input.contacts]
+    write_grasp_pages(snakemake.output.pages, fig2_scenes(hand, matrix, params, contacts),
+                      "The grasps of Fig. 2 in 3-D")
