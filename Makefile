@@ -84,6 +84,7 @@ bench: $(BIN)/.installed
 	-$(RECORD) study_rate -- $(BIN)/python benchmarks/bench_study.py --root results
 	-$(RECORD) inspector -- $(BIN)/python benchmarks/bench_inspector.py --results results
 	$(RECORD) scheduler -- $(BIN)/python benchmarks/bench_scheduler.py
+	-$(RECORD) figure_imports -- $(BIN)/python benchmarks/bench_figure_imports.py --root results
 	$(BIN)/python tools/measurements.py
 
 # The default study timed from an empty results/ (move a previous one away first) and recorded

@@ -1,7 +1,7 @@
 """What one grasp in full costs: `synergrasp grasp obj4 --alpha -30 --beta 0` (every default
 set: the 15 single synergies and {S1..Sk} for k = 2..15), warm (the solver kernel compiled and
 cached, one run before the measured ones), alone and with `--png` and `--html`; then the
-workflow's `grasps_3d` step's work (the 3-D pages of Fig. 2's grasps) in this process.
+3-D pages of Fig. 2's grasps (the `fig2` step's second half) in this process.
 
     .venv/bin/python benchmarks/bench_inspector.py [--results results] [--runs 3]
 
@@ -39,7 +39,7 @@ def run_once(args: list[str], results: Path) -> tuple[float, float]:
 
 
 def pages_cost(results: Path, folder: Path) -> tuple[float, float]:
-    """Wall and CPU seconds of the grasps_3d step's work on the study under ``results``
+    """Wall and CPU seconds of the 3-D pages' work on the study under ``results``
     (imports and the solver kernel's load from its cache included)."""
     cpu, start = time.process_time(), time.perf_counter()
     from synergrasp import tables

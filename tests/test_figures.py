@@ -3,8 +3,9 @@ import numpy as np
 import pytest
 import pandas as pd
 
+from synergrasp.figures.rulegraph import parse_rulegraph
 from synergrasp.figures.study_figures import (figure_exploded_views, figure_force_maps, figure_hierarchy,
-                                force_grid, parse_rulegraph)
+                                force_grid)
 from synergrasp.tables import write_study_table
 
 

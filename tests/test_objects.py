@@ -4,14 +4,14 @@ import numpy as np
 import pytest
 
 from synergrasp.config import defaults
-from synergrasp.figures.hand_figures import Fig2Params
+from synergrasp.figures.grasp_3d import Grasps3dParams
 from synergrasp.optimisation.study import OptimiseParams
 from synergrasp.simulation.objects import GraspedObject, ObjectError
 from synergrasp.simulation.shapes import Box, ShapeError, shape_from_config
 
 
 def test_study_objects_from_the_config_defaults():
-    objects = Fig2Params.from_config(defaults()).objects
+    objects = Grasps3dParams.from_config(defaults()).objects
     assert [o.name for o in objects] == ["obj1", "obj2", "obj3", "obj4"]
     assert all(o.shape.kind == "box" for o in objects)
     assert objects[3].shape.size_mm == (100.0, 60.0, 100.0)

@@ -80,3 +80,21 @@ def test_the_shipped_sweep_is_valid_and_changes_one_factor_per_scenario():
     for name, cfg in configs.items():
         changed = [k for k in default if k != "scenarios" and cfg[k] != default[k]]
         assert len(changed) == (0 if name == "default" else 1), (name, changed)
+
+
+def test_realism_per_object_in_scenario_order():
+    """Each grasp-realism figure is every object's value, in the table's order, joined by "/";
+    a missing value is a dash, and a scenario without the table has no such column."""
+    t = tables("holds", 40.0, 95.0)
+    realism = pd.DataFrame({"object": ["obj1", "obj2"], "contacts_median": [5.0, 6.0],
+                            "pct_palm": [89.6, 18.9], "pct_thumb": [72.7, 100.0], "pct_index": [0.0, 69.3],
+                            "pct_force_closure": [100.0, 92.7], "median_force_per_weight": [0.541, np.nan]})
+    with_realism = ScenarioTables(t.claims, t.table2, t.success_rates, t.preservation, realism)
+    summary = sensitivity_table({"default": with_realism, "other": t})
+    row = summary.iloc[0]
+    assert row["grasp_contacts_median"] == "5/6"
+    assert row["grasp_palm_percent"] == "90/19"
+    assert row["grasp_index_percent"] == "0/69"
+    assert row["grasp_force_closure_percent"] == "100/93"
+    assert row["grasp_force_per_weight_median"] == "0.54/—"
+    assert pd.isna(summary.iloc[1]["grasp_palm_percent"])

@@ -270,7 +270,7 @@ def test_code_inputs_hold_every_module_a_job_loads(run_j2):
         loaded.setdefault(script, set()).update(files)
     assert set(loaded) == {"simulate_contacts", "optimise_shard", "aggregate_gfo", "local_minima",
                            "study_tables", "fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph",
-                           "fig4_force_maps", "fig5_hierarchy", "grasp_realism", "grasp_quality", "grasps_3d"}
+                           "fig4_force_maps", "fig5_hierarchy", "grasp_realism", "grasp_quality"}
     for script, files in loaded.items():
         assert files, script
         assert files <= declared[script], (script, sorted(files - declared[script]))
@@ -330,7 +330,7 @@ def _planned_after_edit(project_copy, module: str) -> dict[str, int]:
 
 
 FIGURE_RULES = {"fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph", "fig4_force_maps",
-                "fig5_hierarchy", "grasp_realism", "grasps_3d", "figures"}
+                "fig5_hierarchy", "grasp_realism", "figures"}
 
 
 def test_changing_the_config_module_reruns_the_optimisation(project_copy):
@@ -410,8 +410,8 @@ def test_a_killed_run_reruns_only_what_did_not_finish(run_j2, tmp_path, kill):
 
 
 def test_small_sweep_summary_has_one_row_per_scenario(run_j2, tmp_path):
-    """The small config with two scenarios: `sensitivity` builds every scenario from the
-    default's results and a summary with one row per scenario, default first."""
+    """The small config with its scenarios: `sensitivity` builds what the summary reads of every
+    scenario from the default's results, and a summary with one row per scenario, default first."""
     config = yaml.safe_load(SMALL.read_text())
     config.update(yaml.safe_load((ROOT / "tests" / "config" / "small_sweep.yaml").read_text()))
     path = tmp_path / "sweep.yaml"
@@ -431,7 +431,12 @@ def test_small_sweep_summary_has_one_row_per_scenario(run_j2, tmp_path):
     scenarios = workdir / "results" / "scenarios"
     assert not list(scenarios.glob("mu_1_0/objects/*/contacts.parquet"))
     assert not list(scenarios.glob("success_load_feasible/objects/*/contacts.parquet"))
-    for name in ("placement.csv", "contacts.parquet", "placement_map.png"):
+    for name in ("placement.csv", "contacts.parquet"):
         assert len(list(scenarios.glob(f"placement_searched/objects/*/{name}"))) == 2, name
+    # the summary reads each scenario's tables and grasp realism, not its figures
+    assert not list(scenarios.glob("*/objects/*/placement_map.png"))
+    assert not list(scenarios.glob("*/objects/*/fig4_force_maps.png"))
+    assert (scenarios / "placement_searched" / "tables" / "grasp_realism.csv").exists()
+    assert summary["grasp_contacts_median"].str.count("/").eq(1).all()  # two objects
     placement = dict(zip(summary["scenario"], summary["placement"]))
     assert placement["default"] == "approach" and placement["placement_searched"] == "searched, rank 1 (own search)"

@@ -68,7 +68,7 @@ SECTIONS = (
      "`benchmarks/bench_inspector.py` (in `make bench`, after a study: it reads obj4's searched target): "
      "`synergrasp grasp obj4 --alpha -30 --beta 0` with its 29 default sets, warm, each run in a fresh process "
      "(median of 3), alone and with `--png` and `--html`; the target is at most 3 s wall on a quiet machine. "
-     "Then the workflow's `grasps_3d` step's work in one process: the 3-D pages of Fig. 2's 12 grasps from the "
+     "Then the 3-D pages of the workflow's `fig2` step in one process: Fig. 2's 12 grasps from the "
      "study's contacts (docs/inspector.md)."),
     ("Placement search", ("search",),
      "`benchmarks/bench_search.py` (in `make bench`): the default study's search of each object with 2 "
@@ -78,6 +78,10 @@ SECTIONS = (
      "`benchmarks/bench_scheduler.py` (in `make bench`): the CPU time of Snakemake's own process (the jobs "
      "excluded) per job, on the small sweep from an empty directory with -j2 and the workflow profile "
      "(profiles/default/config.yaml says what it grows with on long runs)."),
+    ("Figure jobs' imports", ("figure_imports",),
+     "`benchmarks/bench_figure_imports.py` (in `make bench`, after a study): per figure rule, the CPU time of "
+     "its script's imports in a fresh interpreter (start-up subtracted, median of 3) against its jobs' CPU time "
+     "in the last study's benchmark files."),
 )
 
 

@@ -185,16 +185,12 @@ STEPS: dict[str, Step] = {
         rules={"fig1_synergy_postures": Cost("none", 3.0, 565)},
         outputs=_files(("fig1_synergy_postures",), "figures", _PNG_PDF),
         reads=("hand", "synergies"), params="synergrasp.figures.hand_figures:Fig1Params"),
+    # Fig. 2 and the same grasps in 3-D with the full set's optimal forces: pages sharing one
+    # plotly script (docs/inspector.md); one job, so that the pages' imports (the solver, a
+    # dozen optimisations) are not paid by a job of their own
     "fig2": Step(
-        rules={"fig2_example_grasps": Cost("none", 2.3, 311)},
-        outputs=_files(("fig2_example_grasps",), "figures", _PNG_PDF),
-        reads=("hand", "objects.*.shape"), upstream=("contacts",),
-        params="synergrasp.figures.hand_figures:Fig2Params"),
-    # the Fig. 2 grasps in 3-D with the full set's optimal forces: pages sharing one plotly
-    # script (docs/inspector.md); a dozen optimisations and the pages' drawing
-    "grasps_3d": Step(
-        rules={"grasps_3d": Cost("none", 4.0, 400)},
-        outputs={"pages": "figures/grasps_3d"},
+        rules={"fig2_example_grasps": Cost("none", 4.5, 510)},
+        outputs={**_files(("fig2_example_grasps",), "figures", _PNG_PDF), "pages": "figures/grasps_3d"},
         reads=("hand", "synergies", "mechanics", "synergy_sets.incremental_max", "objects.*.shape",
                "objects.*.mass_kg"),
         upstream=("contacts",), params="synergrasp.figures.grasp_3d:Grasps3dParams"),
@@ -240,7 +236,7 @@ STEPS: dict[str, Step] = {
         rules={"sensitivity_summary": Cost("none", 5.0, 300)},
         outputs={"csv": "sensitivity/claims.csv", "md": "sensitivity/claims.md",
                  **_files(("claims_grid", "table2_curves"), "sensitivity", _PNG_PDF)},
-        scope="workflow", upstream=("tables",)),
+        scope="workflow", upstream=("tables", "realism")),
 }
 #: Keys read by the workflow itself, not by a step.
 WORKFLOW_KEYS: tuple[str, ...] = ("scenarios",)

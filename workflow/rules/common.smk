@@ -4,6 +4,7 @@ import functools
 import math
 import re
 import sys
+import threading
 from pathlib import Path
 
 from snakemake.exceptions import WorkflowError
@@ -225,6 +226,23 @@ onstart:
             )
 
 
+def cancel_scheduler_timers():
+    """Cancel the scheduler's pending re-evaluation timers (threading.Timer, not daemon
+    threads) once the run is over, so that Snakemake exits at once instead of a job-rate
+    timespan later (profiles/default/config.yaml). The workflow starts no timer of its own."""
+    for thread in threading.enumerate():
+        if isinstance(thread, threading.Timer):
+            thread.cancel()
+
+
+onsuccess:
+    cancel_scheduler_timers()
+
+
+onerror:
+    cancel_scheduler_timers()
+
+
 #: `import synergrasp.x[, ...]` and `from synergrasp.x import a, b` (or a parenthesised list),
 #: at any indentation (lazy imports inside functions included).
 _IMPORT = re.compile(
@@ -363,9 +381,9 @@ def every_scenario_targets(wildcards):
 
 
 # The sensitivity sweep's summary across every scenario (docs/sensitivity.md).
-def scenario_tables(table):
-    """Input function: every scenario's (default first) study table ``table``.csv."""
-    return lambda wildcards: [study_file(s, "tables", f"tables/{table}.csv") for s in SCENARIOS]
+def scenario_tables(table, step="tables"):
+    """Input function: every scenario's (default first) table ``table``.csv made by ``step``."""
+    return lambda wildcards: [study_file(s, step, f"tables/{table}.csv") for s in SCENARIOS]
 
 
 SENSITIVITY_FILES = workflow_files("sensitivity")

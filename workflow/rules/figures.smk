@@ -142,6 +142,11 @@ rule fig2_example_grasps:
             category="Figures",
         ),
         pdf="{root}/figures/fig2_example_grasps.pdf",
+        pages=pages_in_report(
+            "{root}/figures/grasps_3d",
+            caption="../report/grasps_3d.rst",
+            category="Figures",
+        ),
     log:
         "{root}/logs/fig2_example_grasps.log",
     benchmark:
@@ -154,32 +159,6 @@ rule fig2_example_grasps:
         cfg=step_cfg("fig2"),
     script:
         "../scripts/fig2_example_grasps.py"
-
-
-rule grasps_3d:
-    input:
-        contacts=step_inputs("contacts"),
-        code=code("grasps_3d"),
-        data=SHIPPED_DATA,
-        user=user_files,
-    output:
-        pages=pages_in_report(
-            "{root}/figures/grasps_3d",
-            caption="../report/grasps_3d.rst",
-            category="Figures",
-        ),
-    log:
-        "{root}/logs/grasps_3d.log",
-    benchmark:
-        "{root}/benchmarks/grasps_3d.tsv"
-    threads: 1
-    resources:
-        mem_mb=mem_mb("grasps_3d"),
-        runtime=runtime_min("grasps_3d"),
-    params:
-        cfg=step_cfg("grasps_3d"),
-    script:
-        "../scripts/grasps_3d.py"
 
 
 rule placement_map:

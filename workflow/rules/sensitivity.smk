@@ -7,6 +7,7 @@ rule sensitivity_summary:
         table2=scenario_tables("table2_success_rates"),
         success_rates=scenario_tables("success_rates"),
         preservation=scenario_tables("minimum_preservation"),
+        realism=scenario_tables("grasp_realism", step="realism"),
         code=code("sensitivity_summary"),
     output:
         csv=report(

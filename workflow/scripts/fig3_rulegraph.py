@@ -2,7 +2,7 @@
 import subprocess
 import sys
 
-from synergrasp.figures.study_figures import canonical_rulegraph, figure_rulegraph
+from synergrasp.figures.rulegraph import canonical_rulegraph, figure_rulegraph
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]) as log:

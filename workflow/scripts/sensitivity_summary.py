@@ -9,10 +9,10 @@ from synergrasp.tables import write_study_table
 with job_log(snakemake.log[0]):
     read = lambda kind: [pd.read_csv(p) for p in snakemake.input[kind]]  # noqa: E731
     scenarios = {
-        name: ScenarioTables(claims, table2, rates, preservation)
-        for name, claims, table2, rates, preservation in zip(
+        name: ScenarioTables(claims, table2, rates, preservation, realism)
+        for name, claims, table2, rates, preservation, realism in zip(
             snakemake.params.scenarios, read("claims"), read("table2"), read("success_rates"),
-            read("preservation"))
+            read("preservation"), read("realism"))
     }
     summary = sensitivity_table(scenarios)
     summary.insert(1, "placement", snakemake.params.placements)  # searched again or not (docs/sensitivity.md)

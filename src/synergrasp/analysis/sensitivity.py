@@ -1,9 +1,9 @@
 """The study's findings across scenarios: one row per scenario of a sensitivity sweep.
 
 Each scenario (config/README.md) is a complete study; this module gathers, from each one's
-claims table, Table II, success-rate table and minimum-preservation table, the figures a
-reader needs to see which findings survive which modelling choice (docs/sensitivity.md).
-Success rates and shares are in percent.
+claims table, Table II, success-rate table, minimum-preservation table and grasp-realism
+table, the figures a reader needs to see which findings survive which modelling choice, and
+on which grasps (docs/sensitivity.md). Success rates and shares are in percent.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 __all__ = ["ScenarioTables", "scenario_row", "sensitivity_table", "table2_long",
-           "TABLE2_ROWS", "SINGLE_SYNERGIES"]
+           "TABLE2_ROWS", "SINGLE_SYNERGIES", "REALISM_COLUMNS"]
 
 #: Table II's k shown in the summary (k = 1, 2, 3: where the study's curves rise).
 TABLE2_ROWS: tuple[int, ...] = (1, 2, 3)
@@ -31,6 +31,19 @@ class ScenarioTables:
     table2: pd.DataFrame  #: object, then one column per k (success rate, %)
     success_rates: pd.DataFrame  #: object, set_id, n_synergies, success_rate (%), ...
     preservation: pd.DataFrame  #: object, pairs, preserved_percent, ...
+    realism: pd.DataFrame | None = None  #: tables.GRASP_REALISM: one row per object
+
+
+#: The grasp-realism columns in the summary (tables.GRASP_REALISM), each object's value in the
+#: scenario's object order joined by "/": what the grasps behind a row's verdicts look like.
+REALISM_COLUMNS: dict[str, tuple[str, str]] = {
+    "grasp_contacts_median": ("contacts_median", "{:.0f}"),
+    "grasp_palm_percent": ("pct_palm", "{:.0f}"),
+    "grasp_thumb_percent": ("pct_thumb", "{:.0f}"),
+    "grasp_index_percent": ("pct_index", "{:.0f}"),
+    "grasp_force_closure_percent": ("pct_force_closure", "{:.0f}"),
+    "grasp_force_per_weight_median": ("median_force_per_weight", "{:.2f}"),
+}
 
 
 def _k_column(table2: pd.DataFrame, k: int) -> pd.Series:
@@ -76,7 +89,8 @@ def _preservation_share(preservation: pd.DataFrame) -> float:
 def scenario_row(name: str, tables: ScenarioTables) -> dict[str, object]:
     """One scenario's summary: per claim its headline verdict, the compared difference with its
     interval, the reason, the other view's verdict and the figures behind it; Table II at
-    k = 1, 2, 3 per object; S1..S7 alone (the study's view); minima preserved (%)."""
+    k = 1, 2, 3 per object; S1..S7 alone (the study's view); minima preserved (%); the grasps'
+    realism per object (REALISM_COLUMNS)."""
     row: dict[str, object] = {"scenario": name}
     claims = tables.claims
     headline = claims[claims["headline"].astype(bool)] if "headline" in claims.columns else claims
@@ -97,7 +111,16 @@ def scenario_row(name: str, tables: ScenarioTables) -> dict[str, object]:
     for synergy in SINGLE_SYNERGIES:
         row[f"S{synergy}_success_percent"] = _single_rate(tables.success_rates, synergy)
     row["minima_preserved_percent"] = _preservation_share(tables.preservation)
+    if tables.realism is not None:
+        row.update(_realism_row(tables.realism))
     return row
+
+
+def _realism_row(realism: pd.DataFrame) -> dict[str, str]:
+    """The grasp-realism summary (REALISM_COLUMNS) of one scenario: per column, each object's
+    value joined by "/" (NaN: "—")."""
+    return {name: "/".join("—" if pd.isna(v) else fmt.format(v) for v in realism[column])
+            for name, (column, fmt) in REALISM_COLUMNS.items() if column in realism.columns}
 
 
 def sensitivity_table(scenarios: Mapping[str, ScenarioTables]) -> pd.DataFrame:

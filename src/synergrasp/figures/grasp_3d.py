@@ -229,9 +229,9 @@ def write_grasp_pages(folder: str | Path, pages: Mapping[str, tuple[str, GraspSc
 
 @dataclass(frozen=True)
 class Grasps3dParams:
-    """The 3-D pages of the Fig. 2 grasps (the ``grasps_3d`` step): the hand and synergy
-    files (None: the shipped ones), the set {S1..Sk} whose optimal forces they draw, and
-    every object with the GFO parameters of its weight."""
+    """Fig. 2 and its grasps' 3-D pages (the ``fig2`` step): the hand and synergy files
+    (None: the shipped ones), the set {S1..Sk} whose optimal forces the pages draw, and every
+    object with the GFO parameters of its weight."""
 
     hand: str | None
     synergies: str | None

@@ -19,7 +19,6 @@ from synergrasp.figures.hand_pictures import (BOX, PALM_CAMERA, SKIN, TOUCHING, 
                                               render)
 from synergrasp.figures.output import save_figure
 from synergrasp.hand.synergies import SynergyPath
-from synergrasp.simulation.objects import GraspedObject
 
 __all__ = ["figure_synergy_postures", "figure_example_grasps", "figure_grasp_views", "draw_grasp", "draw_grasp_row",
            "object_of", "PANEL_PX", "GRASP_VIEWS", "FIG2_GRASPS"]
@@ -41,18 +40,6 @@ class Fig1Params:
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> Fig1Params:
         return cls(config["hand"], config["synergies"])
-
-
-@dataclass(frozen=True)
-class Fig2Params:
-    """Fig. 2 (the ``fig2`` step): the hand file and every object (no mass)."""
-
-    hand: str | None
-    objects: tuple[GraspedObject, ...]
-
-    @classmethod
-    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> Fig2Params:
-        return cls(config["hand"], tuple(GraspedObject.from_config(config, n, with_mass=False) for n in config["objects"]))
 
 
 def _bare(ax: Any) -> None:
