@@ -11,7 +11,7 @@ from conftest import BAND
 
 from synergrasp.optimisation.cones import CircularCone
 from synergrasp.optimisation.gfo import solve_gfo
-from synergrasp.optimisation.ipm.sets import range_basis
+from synergrasp.optimisation.ipm.sets import range_basis, set_bases
 from synergrasp.optimisation.ipm_kernel import IPMSettings
 from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_basis, object_wrench
 from synergrasp.optimisation.problem import GFOProblem, GraspSets, SynergySets
@@ -321,4 +321,14 @@ def test_range_basis_against_lapack_svd(seed):
     np.testing.assert_allclose(E.T @ E, np.eye(rank), atol=1e-13)
     # the kept directions span F up to the dropped singular values
     dropped = lapack[lapack <= 1e-9].max(initial=0.0)
+    assert np.linalg.norm(F - E @ (E.T @ F), 2) <= dropped + 1e-13 * lapack[0]
+    # the same set started from its parent's rotated columns (the set without its last column)
+    table = np.zeros((2, s), dtype=np.int64)
+    table[0, :s - 1], table[1] = cols[:s - 1], cols
+    rotated, bases, e_s = np.zeros((2, c, s)), np.full((2, c, s), np.nan), np.zeros(2, dtype=np.int64)
+    set_bases(F_all, table, np.array([s - 1, s]), np.full(2, 1e-9), np.array([-1, 0]), np.arange(2), rotated, bases,
+              e_s)
+    E = bases[1, :, :e_s[1]]
+    assert e_s[1] == rank
+    np.testing.assert_allclose(E.T @ E, np.eye(rank), atol=1e-13)
     assert np.linalg.norm(F - E @ (E.T @ F), 2) <= dropped + 1e-13 * lapack[0]

@@ -108,14 +108,12 @@ def test_verdicts_implied_by_nested_sets_are_those_of_solving_every_set(cone):
         assert implied.sum() > 100 and "implied" not in set(every["solver"])
         for name in ("status", "strict_internal", "e_s"):
             np.testing.assert_array_equal(nested[name], every[name])
-        # a set of its superset's rank takes the superset's optimum: the same problem on
-        # another basis of the same subspace, equal to the solvers' tolerance
+        # a set of its superset's rank takes the superset's optimum, and a basis starts from
+        # its parent's: the same problems on other bases of the same subspaces, equal to the
+        # solvers' tolerance
         np.testing.assert_allclose(nested["force_norm"], every["force_norm"], rtol=1e-6)
         infeasible = nested["status"] == "infeasible"
         assert (implied & infeasible).sum() > 100 and (implied & ~infeasible).any()
         assert not nested["strict_internal"][infeasible].any()
         assert not nested["iterations"][implied].any()
-        solved = ~implied
-        np.testing.assert_array_equal(nested["force_norm"][solved], every["force_norm"][solved])
-        np.testing.assert_array_equal(nested["iterations"][solved], every["iterations"][solved])
-        np.testing.assert_array_equal(nested["solver"][solved], every["solver"][solved])
+        assert set(nested["solver"][~implied]) <= {"ipm", "clarabel_fallback"}

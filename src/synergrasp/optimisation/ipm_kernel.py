@@ -28,9 +28,10 @@ from numpy.typing import NDArray
 
 from synergrasp.optimisation.cones import FrictionCone
 from synergrasp.optimisation.ipm import sets
-from synergrasp.optimisation.ipm.layout import INFEASIBLE, NOT_SOLVED, OPTIMAL, UNDECIDED, Settings
+from synergrasp.optimisation.ipm.layout import INFEASIBLE, NOT_SOLVED, OPTIMAL, UNDECIDED, Nesting, Settings
 
-__all__ = ["INFEASIBLE", "IPMSettings", "NOT_SOLVED", "OPTIMAL", "SetsResult", "UNDECIDED", "solve_problem", "solve_sets"]
+__all__ = ["INFEASIBLE", "IPMSettings", "NOT_SOLVED", "Nesting", "OPTIMAL", "SetsResult", "UNDECIDED", "solve_problem",
+           "solve_sets"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -55,8 +56,10 @@ class IPMSettings:
         test at `tol`
     nested: the sets of one grasp (`solve_sets`) take the verdicts their nesting implies
         instead of solving them (`ipm.sets.solve_sets`: a subset of an infeasible set is
-        infeasible, a superset of a strictly feasible one strictly feasible, an infeasible
-        set not strictly feasible); False solves every set, to compare the solver with itself
+        infeasible, a superset of a strictly feasible one strictly feasible, a subset of
+        equal rank the same problem, an infeasible set not strictly feasible) and start the
+        basis of a set from its parent's (`ipm.sets.set_bases`); False solves every set from
+        scratch, to compare the solver with itself
     """
 
     tol: float = 1e-8
@@ -130,26 +133,27 @@ def solve_problem(frames: NDArray, E: NDArray, f_p: NDArray, cone: FrictionCone,
     `solve_sets`, with E as the one set's basis; returns its one-row `SetsResult`."""
     e = E.shape[1]
     return _solve(np.ascontiguousarray(E, dtype=float), f_p, frames, np.arange(e)[None, :], np.array([e]),
-                  np.zeros(1), True, np.zeros((1, 1), dtype=bool), cone, strict_cone, f_min, settings, violation_tol)
+                  np.zeros(1), True, Nesting(np.full(1, -1), np.zeros((1, 1), dtype=bool)), cone, strict_cone, f_min, settings, violation_tol)
 
 
 def solve_sets(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_columns: NDArray,
-               thresholds: NDArray, within: NDArray, cone: FrictionCone, strict_cone: FrictionCone | None, f_min: float,
+               thresholds: NDArray, nesting: Nesting, cone: FrictionCone, strict_cone: FrictionCone | None, f_min: float,
                settings: IPMSettings, violation_tol: float) -> SetsResult:
     """Every set of one grasp in one compiled call. F_all: (3m, k) projector @ S, N per
     unit activation; columns: (n_sets, max size) 0-based columns of F_all per set (the first
     n_columns[j] of row j); thresholds: (n_sets,) rank thresholds of the singular values;
-    within: (n_sets, n_sets) bool, set a a subset of set b (`SynergySets.within`; all False
-    unless `settings.nested`: every set solved);
+    nesting: the sets' parents and subsets (`SynergySets.parent`, `SynergySets.within`;
+    ignored unless `settings.nested`: every set solved, its basis from scratch);
     cone: the friction-cone model; strict_cone: that of the strict internal-force test (the
     cone narrowed), None for no strict test."""
-    within = within if settings.nested else np.zeros_like(within)
-    return _solve(np.ascontiguousarray(F_all), f_p, frames, columns, n_columns, thresholds, False, within, cone,
+    if not settings.nested:
+        nesting = Nesting(np.full_like(nesting.parent, -1), np.zeros_like(nesting.within))
+    return _solve(np.ascontiguousarray(F_all), f_p, frames, columns, n_columns, thresholds, False, nesting, cone,
                   strict_cone, f_min, settings, violation_tol)
 
 
 def _solve(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_columns: NDArray,
-           thresholds: NDArray, given: bool, within: NDArray, cone: FrictionCone, strict_cone: FrictionCone | None, f_min: float,
+           thresholds: NDArray, given: bool, nesting: Nesting, cone: FrictionCone, strict_cone: FrictionCone | None, f_min: float,
            settings: IPMSettings, violation_tol: float) -> SetsResult:
     n_sets = columns.shape[0]
     out = SetsResult(code=np.zeros(n_sets, dtype=np.int8), force_norm=np.full(n_sets, np.nan),
@@ -158,7 +162,7 @@ def _solve(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_co
                      strict_code=np.full(n_sets, INFEASIBLE, dtype=np.int8),
                      forces=np.full((n_sets, f_p.size), np.nan), implied=np.zeros(n_sets, dtype=bool))
     data = cone_data(cone, frames)
-    sets.solve_sets(F_all, np.ascontiguousarray(f_p, dtype=float), frames, columns, n_columns, thresholds, given, within, data,
+    sets.solve_sets(F_all, np.ascontiguousarray(f_p, dtype=float), frames, columns, n_columns, thresholds, given, nesting, data,
                     data if strict_cone is None else cone_data(strict_cone, frames), float(f_min),
                     strict_cone is not None, _kernel_settings(settings, violation_tol),
                     _kernel_settings(settings, violation_tol, feasibility=True), out)

@@ -114,8 +114,10 @@ class SynergySets:
     matrix: (n, k) synergies, rad per unit activation; sets: 1-based synergy indices per set.
     Derived once: `columns` (0-based, sorted, per set), `sizes` (synergies per set), `norms`
     (||S_set||_2 per set), `table` (n_sets, largest set) of the columns, padded with 0
-    after each set's size, and `within` (n_sets, n_sets) bool: within[a, b] if set a is a
-    subset of set b (a != b), the nesting whose implied verdicts the kernel takes.
+    after each set's size, `within` (n_sets, n_sets) bool: within[a, b] if set a is a
+    subset of set b (a != b), the nesting whose implied verdicts the kernel takes, and
+    `parent` (n_sets,) the index of the set without its last column (-1: none), whose basis
+    the kernel's starts from.
     """
 
     matrix: NDArray
@@ -125,6 +127,7 @@ class SynergySets:
     norms: NDArray = field(init=False, repr=False)
     table: NDArray = field(init=False, repr=False)
     within: NDArray = field(init=False, repr=False)
+    parent: NDArray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         S = np.asarray(self.matrix, dtype=float)
@@ -149,6 +152,9 @@ class SynergySets:
         members = [set(c.tolist()) for c in columns]
         object.__setattr__(self, "within", np.array([[a is not b and a <= b for b in members] for a in members],
                                                     dtype=bool).reshape(len(members), len(members)))
+        index = {tuple(c.tolist()): j for j, c in reversed(list(enumerate(columns)))}
+        object.__setattr__(self, "parent", np.array([index.get(tuple(c[:-1].tolist()), -1) for c in columns],
+                                                    dtype=np.int64))
 
     def __len__(self) -> int:
         return len(self.columns)

@@ -18,8 +18,8 @@ import numpy as np
 
 from synergrasp.optimisation.ipm.compiled import jit_alloc
 
-__all__ = ["INFEASIBLE", "NOT_SOLVED", "OPTIMAL", "UNDECIDED", "Homogeneous", "PolishWork", "Problem", "Settings",
-           "Work", "polish_workspace", "workspace"]
+__all__ = ["INFEASIBLE", "NOT_SOLVED", "OPTIMAL", "UNDECIDED", "Homogeneous", "Nesting", "PolishWork", "Problem",
+           "Settings", "Work", "polish_workspace", "workspace"]
 
 #: Codes of the kernel's verdicts.
 NOT_SOLVED, OPTIMAL, INFEASIBLE, UNDECIDED = 0, 1, 2, 3
@@ -29,6 +29,10 @@ NOT_SOLVED, OPTIMAL, INFEASIBLE, UNDECIDED = 0, 1, 2, 3
 #: down the calls: numba would compile the iteration once for each literal).
 Settings = namedtuple("Settings", "tol reduced_tol max_iter step_fraction stall_step refine retry_refine polish_from "
                                    "violation_tol feasibility")
+
+#: How the synergy sets of one grasp nest (`sets.solve_sets`): parent (n_sets,) int, the set
+#: without the last column (-1: none); within (n_sets, n_sets) bool, set a a subset of set b.
+Nesting = namedtuple("Nesting", "parent within")
 
 #: One problem as the iteration sees it: contact rows D (m, 3, >= e) applied to E, hv (m, 3)
 #: the rows applied to f_p (N), a = E^T f_p (N), r0 = ||f_p - E a|| (N), mu (1 for a pyramid,

@@ -137,26 +137,37 @@ def range_basis(F_all, cols, s, threshold, U):
     """E_s of one set: an orthonormal basis of the range of F = F_all[:, cols[:s]] from its
     singular vectors whose singular value exceeds `threshold` (the rule of
     `mechanics.internal_force_basis`), written into the leading columns of U; returns their
-    number. One-sided Jacobi (Hestenes): plane rotations of pairs of F's columns until every
-    pair is orthogonal to ~1e-15 relative; the columns are then U Sigma, and their norms the
-    singular values, to high relative accuracy. Sets hold 1 to 15 synergies, so this is a
-    few sweeps of short loops, without LAPACK's copies, workspace query and allocations."""
+    number. One-sided Jacobi (Hestenes, `rotate`) from F's columns, then `kept_directions`."""
     c = F_all.shape[0]
     for q in range(s):
         for k in range(c):
             U[k, q] = F_all[k, cols[q]]
+    rotate(U, 0, s)
+    return kept_directions(U, s, threshold, U)
+
+
+@jit_inline
+def rotate(R, start, s):
+    """One-sided Jacobi (Hestenes) on the first s columns of R (c, >= s), in place: plane
+    rotations of pairs of columns until every pair is orthogonal to ~1e-15 relative; the
+    columns are then U Sigma, their norms the singular values, to high relative accuracy.
+    The first `start` columns are already mutually orthogonal (a subset's rotated columns):
+    the first sweep takes only the pairs with a later column. Sets hold 1 to 15 synergies,
+    so this is a few sweeps of short loops, without LAPACK's copies, workspace query and
+    allocations."""
+    c = R.shape[0]
     tol = 1e-15 * c
     for _ in range(60):
         rotated = False
         for a in range(s - 1):
-            for b in range(a + 1, s):
+            for b in range(max(a + 1, start), s):
                 alpha = 0.0
                 beta = 0.0
                 gamma = 0.0
                 for k in range(c):
-                    alpha += U[k, a] * U[k, a]
-                    beta += U[k, b] * U[k, b]
-                    gamma += U[k, a] * U[k, b]
+                    alpha += R[k, a] * R[k, a]
+                    beta += R[k, b] * R[k, b]
+                    gamma += R[k, a] * R[k, b]
                 if abs(gamma) <= tol * math.sqrt(alpha * beta):
                     continue
                 rotated = True
@@ -165,26 +176,55 @@ def range_basis(F_all, cols, s, threshold, U):
                 cs = 1.0 / math.sqrt(1.0 + t * t)
                 sn = cs * t
                 for k in range(c):
-                    ua, ub = U[k, a], U[k, b]
-                    U[k, a] = cs * ua - sn * ub
-                    U[k, b] = sn * ua + cs * ub
+                    ua, ub = R[k, a], R[k, b]
+                    R[k, a] = cs * ua - sn * ub
+                    R[k, b] = sn * ua + cs * ub
+        start = 0
         if not rotated:
             break
+
+
+@jit_inline
+def kept_directions(R, s, threshold, U):
+    """The rotated columns of R (the first s) whose norm exceeds `threshold`, normalised, into
+    the leading columns of U (R itself allowed); returns their number."""
+    c = R.shape[0]
     rank = 0
     for q in range(s):
         norm = 0.0
         for k in range(c):
-            norm += U[k, q] * U[k, q]
+            norm += R[k, q] * R[k, q]
         norm = math.sqrt(norm)
         if norm > threshold:
             for k in range(c):
-                U[k, rank] = U[k, q] / norm
+                U[k, rank] = R[k, q] / norm
             rank += 1
     return rank
 
 
+@jit_call
+def set_bases(F_all, cols, n_cols, thresholds, parent, order, rotated, bases, e_s):
+    """E_s of every set (`range_basis`) into bases (n_sets, c, >= s), its rank into e_s, in
+    `order` (parents first). A set whose parent (the set without its last column; -1: none)
+    is known starts from the parent's rotated columns, already orthogonal, and the new
+    column (`rotate`): the incremental sets {S1..Sk} cost a few sweeps over k - 1 pairs
+    instead of Jacobi from scratch. rotated (n_sets, c, >= s): the rotated columns."""
+    c = F_all.shape[0]
+    for j in order:
+        s, p, R = n_cols[j], parent[j], rotated[j]
+        start = 0 if p < 0 else s - 1
+        for q in range(start):
+            for k in range(c):
+                R[k, q] = rotated[p, k, q]
+        for q in range(start, s):
+            for k in range(c):
+                R[k, q] = F_all[k, cols[j, q]]
+        rotate(R, start, s)
+        e_s[j] = kept_directions(R, s, thresholds[j], bases[j])
+
+
 @jit_alloc
-def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, within, cone, cone_strict, f_min, strict, opt,
+def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, nesting, cone, cone_strict, f_min, strict, opt,
                opt_strict, out):
     """Every synergy set of one grasp into `out` (`SetsResult`): E_s from the singular vectors
     of F_s = F_all[:, set] whose singular value is above the set's threshold (`range_basis`),
@@ -192,7 +232,9 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, within, cone,
     and, if `strict`, the strict internal-force test (f_p = 0, f_min = 1 N, cone_strict).
     cone, cone_strict: `ConeData` of the same kind; opt, opt_strict: `Settings` of the GFO and
     of the strict test (feasibility only). Sets with e_s = 0 get code NOT_SOLVED.
-    within (n_sets, n_sets) bool: within[a, b] if set a is a subset of set b (a != b); then
+    nesting: `Nesting` of the sets: parent (n_sets,) the index of the set without the last
+    column, -1 for none (`set_bases`), and within (n_sets, n_sets) bool: within[a, b] if
+    set a is a subset of set b (a != b); then
     range(E_a) is in range(E_b), so b infeasible implies a infeasible and a strictly
     feasible implies b strictly feasible; of equal rank the two subspaces are equal, the
     problems the same (a takes b's verdict, ||f|| and forces). A set whose GFO is infeasible
@@ -206,21 +248,22 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, within, cone,
     Q = polish_workspace(cols.shape[1])
     y = np.empty(cols.shape[1])
     bases = np.empty((cols.shape[0], c, cols.shape[1]))
-    order = np.argsort(-n_cols, kind="mergesort")  # supersets before their subsets
-    for j in order:
-        U = bases[j]
-        if given:
-            rank = n_cols[j]
-            for q in range(rank):
+    order = np.argsort(n_cols, kind="mergesort")  # subsets before their supersets
+    if given:
+        for j in order:
+            out.e_s[j] = n_cols[j]
+            for q in range(n_cols[j]):
                 for k in range(c):
-                    U[k, q] = F_all[k, cols[j, q]]
-        else:
-            rank = range_basis(F_all, cols[j], n_cols[j], thresholds[j], U)
-        out.e_s[j] = rank
+                    bases[j, k, q] = F_all[k, cols[j, q]]
+    else:
+        set_bases(F_all, cols, n_cols, thresholds, nesting.parent, order, np.empty_like(bases), bases, out.e_s)
+    order = order[::-1]
+    for j in order:
+        U, rank = bases[j], out.e_s[j]
         if rank == 0:
             out.code[j] = NOT_SOLVED
             continue
-        k = implying(within[j], out.code, INFEASIBLE, out.e_s, rank)
+        k = implying(nesting.within[j], out.code, INFEASIBLE, out.e_s, rank)
         if k >= 0:
             out.implied[j] = True
             out.code[j] = out.code[k]
@@ -239,7 +282,7 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, within, cone,
                     acc += U[k, q] * y[q]
                 out.forces[j, k] = acc
     if strict:
-        strict_tests(bases, within, cone_strict, frames, order[::-1], opt_strict, W, Q, y, out)
+        strict_tests(bases, nesting.within, cone_strict, frames, order[::-1], opt_strict, W, Q, y, out)
 
 
 @jit_call
