@@ -1,7 +1,7 @@
 """The dynamic closure against a reference on the closure benchmark's poses: per pose the
 status and the full synergy set's force-closure verdict, and the CPU per grasp.
 
-    .venv/bin/python tools/closure_agreement.py run OUT.csv [N] [--set KEY=VALUE ...] [--shift-um D]
+    .venv/bin/python tools/closure_agreement.py run OUT.csv [N] [--set KEY=VALUE ...] [--shift-um D] [--engine NAME=VALUE ...]
     .venv/bin/python tools/closure_agreement.py compare REF.csv OTHER.csv ...
     .venv/bin/python tools/closure_agreement.py distribution OTHER.csv COPY.csv COPY.csv ... [--z Z]
 
@@ -13,7 +13,9 @@ n_contacts, force_closure (rank(G) = 6 and the strict internal-force test, the s
 verdict), cpu_ms (the closure alone, ``time.process_time``), steps. ``--set`` overrides a
 configuration key (dotted path, YAML value), e.g. ``closure.dynamic.solver_iterations=49``;
 ``--shift-um D`` moves every placed box by D µm along the palm's x axis: the reference's own
-reproducibility under a change far below any tolerance.
+reproducibility under a change far below any tolerance; ``--engine NAME=VALUE`` sets a
+pybullet engine parameter (``setPhysicsEngineParameter``, e.g. ``solverResidualThreshold=1e-4``)
+on the model's client after the model's own settings: engine variants that are no config key.
 
 ``compare`` prints one markdown row per OTHER: median ms per grasp, % of poses with the
 same status as REF, % with the same verdict, and the counts of grasps and verdicts.
@@ -65,7 +67,7 @@ def study(changes: list[str]) -> dict:
     return validate_config(overlay(defaults(), over))
 
 
-def run(out: str, n_poses: int, changes: list[str], shift_um: float) -> pd.DataFrame:
+def run(out: str, n_poses: int, changes: list[str], shift_um: float, engine: dict | None = None) -> pd.DataFrame:
     config = study(changes)
     hand = load_hand(config["hand"])
     synergies = load_synergies(config["synergies"], joint_names=hand.joint_names)
@@ -76,6 +78,10 @@ def run(out: str, n_poses: int, changes: list[str], shift_um: float) -> pd.DataF
         sim = SimulateParams.from_config(config, name)
         grid = pose_grid(sim.placement)
         closer = closure_model(hand, sim.synergies(hand.joint_names), sim.closure, sim.mechanics, sim.object.mass_kg)
+        if engine:
+            import pybullet
+
+            pybullet.setPhysicsEngineParameter(physicsClientId=closer.client, **engine)
         rows, cpu, steps = [], [], []
         try:
             for pose in np.linspace(0, grid.n_poses - 1, n_poses).round().astype(int):
@@ -164,7 +170,10 @@ if __name__ == "__main__":
     elif args[:1] == ["run"]:
         sets = [args[i + 1] for i, a in enumerate(args) if a == "--set"]
         shift = float(args[args.index("--shift-um") + 1]) if "--shift-um" in args else 0.0
-        rest = [a for i, a in enumerate(args[2:], 2) if not a.startswith("--") and args[i - 1] not in ("--set", "--shift-um")]
-        run(args[1], int(rest[0]) if rest else 60, sets, shift)
+        pairs = (args[i + 1].partition("=") for i, a in enumerate(args) if a == "--engine")
+        engine = {k: int(v) if v.lstrip("-").isdigit() else float(v) for k, _, v in pairs}
+        options = ("--set", "--shift-um", "--engine")
+        rest = [a for i, a in enumerate(args[2:], 2) if not a.startswith("--") and args[i - 1] not in options]
+        run(args[1], int(rest[0]) if rest else 60, sets, shift, engine)
     else:
         raise SystemExit(__doc__)

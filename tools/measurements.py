@@ -188,7 +188,10 @@ def closure_engines(inputs: Path) -> list[str]:
              "study box), the share of poses with the same status and the same full-set force-closure",
              "verdict as main's pybullet model before this work (table made with main's code). Measured",
              "on the shared 2-core machine (load average 9-15): the ms are inflated alike; the two medians",
-             "of 5 were interleaved, the single runs were not.", "",
+             "of 5 were interleaved, the single runs were not, except the engine-parameter rows from \"the",
+             "reference again\" on (load average ~4), each run between two runs of the reference: their",
+             "\"per step\" is CPU per engine step against those neighbours'. \"In distribution\":",
+             "`tools/closure_agreement.py distribution` against the reference and its four moved-box copies.", "",
              "| engine / variant | ms per grasp | same status | same verdict | grasps | force closure | command |",
              "|---|---|---|---|---|---|---|"]
 
