@@ -3,6 +3,7 @@ status and the full synergy set's force-closure verdict, and the CPU per grasp.
 
     .venv/bin/python tools/closure_agreement.py run OUT.csv [N] [--set KEY=VALUE ...] [--shift-um D]
     .venv/bin/python tools/closure_agreement.py compare REF.csv OTHER.csv ...
+    .venv/bin/python tools/closure_agreement.py distribution OTHER.csv COPY.csv COPY.csv ... [--z Z]
 
 ``run`` closes the hand with the dynamic model (the configuration's defaults, the approach
 placement, as ``benchmarks/bench_closure.py``) at N poses per study box (default 60, the
@@ -16,11 +17,19 @@ reproducibility under a change far below any tolerance.
 
 ``compare`` prints one markdown row per OTHER: median ms per grasp, % of poses with the
 same status as REF, % with the same verdict, and the counts of grasps and verdicts.
+
+``distribution`` judges OTHER by the counts the reference's own copies reach (the closure of a
+free box is chaotic: the reference with its box moved by a few µm agrees with itself on only
+91–95 % of the statuses, so pose-by-pose agreement cannot exceed that): per object, OTHER's
+number of ``grasp`` statuses and of force-closure verdicts against the range the COPY tables
+span (e.g. the reference and its copies with the box moved by −1, 1, 2, 5 µm), widened on
+each side by Z (default 1) binomial standard errors; prints one row per object and count.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import sys
 import time
@@ -105,10 +114,53 @@ def compare(reference: str, others: list[str]) -> None:
               f"{(other['status'] == 'grasp').sum()} of {len(other)} | {other['force_closure'].sum()} |")
 
 
+def distribution_agreement(other: pd.DataFrame, copies: list[pd.DataFrame], z: float = 1.0) -> pd.DataFrame:
+    """Per object and count (``grasps``: status ``grasp``; ``force_closure``: the verdict), OTHER's
+    count, the least and greatest count of the COPIES, the band and whether OTHER lies in it.
+
+    The band is [lo − z·se(lo), hi + z·se(hi)] with se(k) = √(n·p(1 − p)) the binomial
+    standard error of a count k of n poses at p = (k + ½)/(n + 1) (so a count of 0 or n has a
+    band too); ``agrees`` is true if OTHER's count lies inside it.
+    """
+    if not copies:
+        raise ValueError("distribution_agreement needs at least one copy of the reference")
+    def counts(table: pd.DataFrame) -> pd.DataFrame:
+        grouped = table.assign(grasps=table["status"] == "grasp").groupby("object", sort=True)
+        return pd.DataFrame({"n": grouped.size(), "grasps": grouped["grasps"].sum(),
+                             "force_closure": grouped["force_closure"].sum()})
+    mine, theirs = counts(other), [counts(c) for c in copies]
+    rows = []
+    for name in mine.index:
+        n = int(mine.at[name, "n"])
+        for column in ("grasps", "force_closure"):
+            values = [int(c.at[name, column]) for c in theirs]
+            lo, hi = min(values), max(values)
+            se = [math.sqrt(n * p * (1 - p)) for p in ((lo + 0.5) / (n + 1), (hi + 0.5) / (n + 1))]
+            low, high = lo - z * se[0], hi + z * se[1]
+            count = int(mine.at[name, column])
+            rows.append({"object": name, "count": column, "n": n, "value": count, "copies_min": lo, "copies_max": hi,
+                         "band_low": low, "band_high": high, "agrees": bool(low <= count <= high)})
+    return pd.DataFrame(rows)
+
+
+def distribution(other: str, copies: list[str], z: float) -> None:
+    table = distribution_agreement(pd.read_csv(other), [pd.read_csv(path) for path in copies], z)
+    print(f"{other} against {len(copies)} copies, band ± {z:g} se: agrees in distribution: {bool(table['agrees'].all())}")
+    print("| object | count | of | value | copies | band | agrees |")
+    print("|---|---|---|---|---|---|---|")
+    for row in table.itertuples():
+        print(f"| {row.object} | {row.count} | {row.n} | {row.value} | {row.copies_min}–{row.copies_max} | "
+              f"{row.band_low:.1f}–{row.band_high:.1f} | {'yes' if row.agrees else 'no'} |")
+
+
 if __name__ == "__main__":
     args = sys.argv[1:]
     if args[:1] == ["compare"]:
         compare(args[1], args[2:])
+    elif args[:1] == ["distribution"] and len(args) > 2:
+        z = float(args[args.index("--z") + 1]) if "--z" in args else 1.0
+        paths = [a for i, a in enumerate(args[1:], 1) if a != "--z" and args[i - 1] != "--z"]
+        distribution(paths[0], paths[1:], z)
     elif args[:1] == ["run"]:
         sets = [args[i + 1] for i, a in enumerate(args) if a == "--set"]
         shift = float(args[args.index("--shift-um") + 1]) if "--shift-um" in args else 0.0
