@@ -133,7 +133,7 @@ def solve_problem(frames: NDArray, E: NDArray, f_p: NDArray, cone: FrictionCone,
     `solve_sets`, with E as the one set's basis; returns its one-row `SetsResult`."""
     e = E.shape[1]
     return _solve(np.ascontiguousarray(E, dtype=float), f_p, frames, np.arange(e)[None, :], np.array([e]),
-                  np.zeros(1), True, Nesting(np.full(1, -1), np.zeros((1, 1), dtype=bool)), cone, strict_cone, f_min, settings, violation_tol)
+                  np.zeros(1), True, Nesting(np.full(1, -1), np.zeros((1, 1), dtype=bool), np.zeros(1, dtype=np.int64)), cone, strict_cone, f_min, settings, violation_tol)
 
 
 def solve_sets(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_columns: NDArray,
@@ -142,12 +142,12 @@ def solve_sets(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, 
     """Every set of one grasp in one compiled call. F_all: (3m, k) projector @ S, N per
     unit activation; columns: (n_sets, max size) 0-based columns of F_all per set (the first
     n_columns[j] of row j); thresholds: (n_sets,) rank thresholds of the singular values;
-    nesting: the sets' parents and subsets (`SynergySets.parent`, `SynergySets.within`;
+    nesting: the sets' parents, subsets and order (`SynergySets.parent`, `.within`, `.order`;
     ignored unless `settings.nested`: every set solved, its basis from scratch);
     cone: the friction-cone model; strict_cone: that of the strict internal-force test (the
     cone narrowed), None for no strict test."""
     if not settings.nested:
-        nesting = Nesting(np.full_like(nesting.parent, -1), np.zeros_like(nesting.within))
+        nesting = Nesting(np.full_like(nesting.parent, -1), np.zeros_like(nesting.within), nesting.order)
     return _solve(np.ascontiguousarray(F_all), f_p, frames, columns, n_columns, thresholds, False, nesting, cone,
                   strict_cone, f_min, settings, violation_tol)
 

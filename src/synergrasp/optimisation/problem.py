@@ -117,7 +117,8 @@ class SynergySets:
     after each set's size, `within` (n_sets, n_sets) bool: within[a, b] if set a is a
     subset of set b (a != b), the nesting whose implied verdicts the kernel takes, and
     `parent` (n_sets,) the index of the set without its last column (-1: none), whose basis
-    the kernel's starts from.
+    the kernel's starts from, and `order` (n_sets,) the sets by size, stable (subsets before
+    their supersets: the kernel's order).
     """
 
     matrix: NDArray
@@ -128,6 +129,7 @@ class SynergySets:
     table: NDArray = field(init=False, repr=False)
     within: NDArray = field(init=False, repr=False)
     parent: NDArray = field(init=False, repr=False)
+    order: NDArray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         S = np.asarray(self.matrix, dtype=float)
@@ -155,6 +157,7 @@ class SynergySets:
         index = {tuple(c.tolist()): j for j, c in reversed(list(enumerate(columns)))}
         object.__setattr__(self, "parent", np.array([index.get(tuple(c[:-1].tolist()), -1) for c in columns],
                                                     dtype=np.int64))
+        object.__setattr__(self, "order", np.argsort(self.sizes, kind="stable").astype(np.int64))
 
     def __len__(self) -> int:
         return len(self.columns)

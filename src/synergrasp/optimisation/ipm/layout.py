@@ -31,8 +31,9 @@ Settings = namedtuple("Settings", "tol reduced_tol max_iter step_fraction stall_
                                    "violation_tol feasibility")
 
 #: How the synergy sets of one grasp nest (`sets.solve_sets`): parent (n_sets,) int, the set
-#: without the last column (-1: none); within (n_sets, n_sets) bool, set a a subset of set b.
-Nesting = namedtuple("Nesting", "parent within")
+#: without the last column (-1: none); within (n_sets, n_sets) bool, set a a subset of set b;
+#: order (n_sets,) int, the sets by size, stable (subsets before their supersets).
+Nesting = namedtuple("Nesting", "parent within order")
 
 #: One problem as the iteration sees it: contact rows D (m, 3, >= e) applied to E, hv (m, 3)
 #: the rows applied to f_p (N), a = E^T f_p (N), r0 = ||f_p - E a|| (N), mu (1 for a pyramid,

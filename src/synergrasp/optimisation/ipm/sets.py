@@ -248,7 +248,7 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, nesting, cone
     Q = polish_workspace(cols.shape[1])
     y = np.empty(cols.shape[1])
     bases = np.empty((cols.shape[0], c, cols.shape[1]))
-    order = np.argsort(n_cols, kind="mergesort")  # subsets before their supersets
+    order = nesting.order  # subsets before their supersets
     if given:
         for j in order:
             out.e_s[j] = n_cols[j]
@@ -269,7 +269,8 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, nesting, cone
             out.code[j] = out.code[k]
             if out.code[k] == OPTIMAL:  # the same subspace: the same problem, the same optimum
                 out.force_norm[j], out.max_violation[j] = out.force_norm[k], out.max_violation[k]
-                out.forces[j, :] = out.forces[k, :]
+                for q in range(c):  # a loop, not a slice copy: that compiles numba's shape-error text
+                    out.forces[j, q] = out.forces[k, q]
             continue
         # E_s is the first `rank` columns of U
         code, out.force_norm[j], out.max_violation[j], out.iterations[j] = solve_one(
@@ -281,8 +282,27 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, nesting, cone
                 for q in range(rank):
                     acc += U[k, q] * y[q]
                 out.forces[j, k] = acc
-    if strict:
-        strict_tests(bases, nesting.within, cone_strict, frames, order[::-1], opt_strict, W, Q, y, out)
+    if not strict:
+        return
+    # The strict test of every set with e_s > 0, subsets before their supersets, on the same
+    # bases: not strictly feasible where the GFO is infeasible, strictly feasible where a
+    # subset is, the verdict of a subset of the same rank, else solved. (In this function,
+    # not one of its own: a compiled function taking the work arrays costs seconds of typing.)
+    cone_rows(frames, cone_strict.mu, rows)
+    zero = np.zeros(c)
+    for j in nesting.order:
+        rank = out.e_s[j]
+        if rank == 0:
+            continue
+        if out.code[j] == INFEASIBLE:
+            out.strict_code[j] = INFEASIBLE
+            continue
+        k = implying(nesting.within[:, j], out.strict_code, OPTIMAL, out.e_s, rank)
+        if k >= 0:
+            out.strict_code[j] = out.strict_code[k]
+        else:
+            out.strict_code[j] = solve_one(build(rows, cone_strict.lin, bases[j], zero, rank, cone_strict.mu, 1.0, W),
+                                           W, Q, opt_strict, y)[0]
 
 
 @jit_call
@@ -297,25 +317,3 @@ def implying(marked, codes, code, e_s, rank):
         if marked[k] and e_s[k] == rank and (codes[k] == OPTIMAL or codes[k] == INFEASIBLE):
             return k
     return -1
-
-
-@jit_alloc
-def strict_tests(bases, within, cone_strict, frames, order, opt_strict, W, Q, y, out):
-    """The strict internal-force test of every set with e_s > 0, in `order` (subsets before
-    their supersets), on the bases of `solve_sets`: not strictly feasible where the GFO is
-    infeasible, strictly feasible where a subset is, a subset's verdict where it has the same
-    rank (`solve_sets`), else solved."""
-    c = bases.shape[1]
-    rows = np.empty((c // 3, 3, 3))
-    cone_rows(frames, cone_strict.mu, rows)
-    zero = np.zeros(c)
-    for j in order:
-        rank = out.e_s[j]
-        if rank == 0:
-            continue
-        if out.code[j] == INFEASIBLE:
-            out.strict_code[j] = INFEASIBLE
-        else:
-            k = implying(within[:, j], out.strict_code, OPTIMAL, out.e_s, rank)
-            out.strict_code[j] = out.strict_code[k] if k >= 0 else solve_one(build(rows, cone_strict.lin, bases[j], zero, rank, cone_strict.mu, 1.0, W),
-                                            W, Q, opt_strict, y)[0]
