@@ -151,13 +151,13 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
     status = _STATUS_OF_CODE[res.code]
     optimal = res.code == ipm_kernel.OPTIMAL
     forces = np.full(n, None, dtype=object)
-    for j in np.flatnonzero(optimal):
+    for j in np.flatnonzero(optimal).tolist():
         forces[j] = res.forces[j]
     sol = GFOSolution(status=status, force_norm=np.where(optimal, res.force_norm, np.nan), forces=forces,
                       e_s=res.e_s.astype(np.int32), iterations=res.iterations,
                       strict_internal=res.strict_code == ipm_kernel.OPTIMAL if strict else None,
                       solver=np.where(res.implied, "implied", "ipm").astype(object), max_violation=np.where(optimal, res.max_violation, np.nan))
-    for j in np.flatnonzero(status == ""):
+    for j in np.flatnonzero((res.code == ipm_kernel.UNDECIDED) | (res.code == ipm_kernel.NOT_SOLVED)):  # status ''
         _fallback(sol, j, g.problem(j), tol, max_iter)
     if strict:
         undecided = (res.strict_code != ipm_kernel.OPTIMAL) & (res.strict_code != ipm_kernel.INFEASIBLE) & (res.e_s > 0)

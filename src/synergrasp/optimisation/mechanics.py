@@ -68,7 +68,7 @@ class Grasp:
         if center.shape != (3,):
             raise ValueError(f"Grasp.center must have shape (3,), got {center.shape}")
         for name, value in (("points", points), ("normals", normals), ("jacobian", jac), ("center", center)):
-            if not np.all(np.isfinite(value)):
+            if not np.isfinite(value).all():
                 raise ValueError(f"Grasp.{name} must be finite")
         object.__setattr__(self, "points", points)
         object.__setattr__(self, "normals", normals)
@@ -87,10 +87,17 @@ def _unit_normals(normals: NDArray, m: int | None, field: str) -> NDArray:
     if n.ndim != 2 or n.shape[1] != 3 or (m is not None and n.shape[0] != m):
         want = f"({m}, 3)" if m is not None else "(m, 3)"
         raise ValueError(f"{field} must have shape {want}, got {n.shape}")
-    norms = np.linalg.norm(n, axis=1)
-    if n.shape[0] and not np.all(np.abs(norms - 1.0) <= _UNIT_TOL):
+    norms = _row_norms(n)
+    if n.shape[0] and not (np.abs(norms - 1.0) <= _UNIT_TOL).all():
         raise ValueError(f"{field} must be unit vectors (|n| = 1 within {_UNIT_TOL}); got norms {norms.min():.6g}..{norms.max():.6g}")
     return n
+
+
+def _row_norms(a: NDArray) -> NDArray:
+    """Euclidean norm of each row of an (m, 3) array: the arithmetic of
+    np.linalg.norm(a, axis=1) (the square root of add.reduce of the squares), without its
+    argument handling, which cost more than the arithmetic for a grasp's few contacts."""
+    return np.sqrt((a * a).sum(axis=1))
 
 
 def _cross_matrices(v: NDArray) -> NDArray:
@@ -180,7 +187,7 @@ def _grasp_rank(G: NDArray, points: NDArray, center: NDArray, rtol: float) -> in
     """
     if G.shape[1] == 0:
         return 0
-    arm = float(np.max(np.linalg.norm(points - center, axis=1)))
+    arm = float(_row_norms(points - center).max())
     scaled = G.copy()
     if arm > 0:
         scaled[3:] /= arm
@@ -238,7 +245,7 @@ def grasp_mechanics(
     it is never an error.
     """
     w = np.asarray(wrench, dtype=float)
-    if w.shape != (6,) or not np.all(np.isfinite(w)):
+    if w.shape != (6,) or not np.isfinite(w).all():
         raise ValueError(f"wrench must be a finite array of shape (6,), got {w.shape}")
     G = grasp_matrix(grasp.points, grasp.center)
     K = contact_stiffness(grasp.jacobian, k_stru, k_ss)
@@ -295,7 +302,8 @@ def internal_force_basis(
 
 
 def _spectral_norm(A: NDArray) -> float:
-    return float(np.linalg.norm(A, 2)) if A.size else 0.0
+    # the largest singular value: np.linalg.norm(A, 2)'s arithmetic, without its dispatch
+    return float(np.linalg.svd(A, compute_uv=False)[0]) if A.size else 0.0
 
 
 def contact_frames(normals: NDArray) -> NDArray:
@@ -310,7 +318,7 @@ def contact_frames(normals: NDArray) -> NDArray:
     axis = np.zeros_like(n)
     axis[np.arange(n.shape[0]), np.argmin(np.abs(n), axis=1)] = 1.0
     t1 = _cross(n, axis)
-    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    t1 /= _row_norms(t1)[:, None]
     t2 = _cross(n, t1)
     return np.stack([n, t1, t2], axis=1)
 

@@ -142,10 +142,11 @@ def read_grasps(table: pd.DataFrame) -> list[Grasp | None]:
     return grasps
 
 
-def mechanics_for(grasp: Grasp, params: GFOParams) -> GraspMechanics:
-    """`grasp_mechanics` with the weight, stiffnesses and rank tolerance of `params`."""
-    return grasp_mechanics(grasp, params.wrench(), params.k_stru_N_per_mm, params.k_ss_Nmm_per_rad,
-                           rank_rtol=params.grasp_rank_rtol)
+def mechanics_for(grasp: Grasp, params: GFOParams, wrench: NDArray | None = None) -> GraspMechanics:
+    """`grasp_mechanics` with the weight, stiffnesses and rank tolerance of `params`
+    (wrench: `params.wrench()`, given by a caller that loops over grasps)."""
+    return grasp_mechanics(grasp, params.wrench() if wrench is None else wrench, params.k_stru_N_per_mm,
+                           params.k_ss_Nmm_per_rad, rank_rtol=params.grasp_rank_rtol)
 
 
 def optimise_grasps(
@@ -186,11 +187,12 @@ def optimise_grasps(
         out["forces"] = np.full(total, None, dtype=object)
     cone = params.cone
     method = FASTEST_METHOD[cone.kind]
+    wrench = params.wrench()
     for p, grasp in enumerate(grasps):
         if grasp is None or grasp.n_contacts == 0:
             continue
         rows = slice(p * n_sets, (p + 1) * n_sets)
-        mech = mechanics_for(grasp, params)
+        mech = mechanics_for(grasp, params, wrench)
         out["rank_G"][rows] = mech.rank_G
         out["n_contacts"][rows] = mech.n_contacts
         if mech.rank_G < 6 or mech.projector is None:
