@@ -11,7 +11,7 @@ from conftest import BAND
 
 from synergrasp.optimisation.cones import CircularCone
 from synergrasp.optimisation.gfo import solve_gfo
-from synergrasp.optimisation.ipm.sets import range_basis, set_bases
+from synergrasp.optimisation.ipm.sets import set_bases
 from synergrasp.optimisation.ipm_kernel import IPMSettings
 from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_basis, object_wrench
 from synergrasp.optimisation.problem import GFOProblem, GraspSets, SynergySets
@@ -299,8 +299,16 @@ def test_bad_settings_name_the_field():
         solve_gfo([], strict_shrink=1.5)
 
 
+def _bases(F_all, table, n_cols, parent):
+    """`set_bases` of the sets in `table` (rows of columns, the first n_cols of each), in order."""
+    n, c = len(n_cols), F_all.shape[0]
+    rotated, bases, e_s = np.zeros((n, c, table.shape[1])), np.full((n, c, table.shape[1]), np.nan), np.zeros(n, dtype=np.int64)
+    set_bases(F_all, table, np.asarray(n_cols), np.full(n, 1e-9), np.asarray(parent), np.arange(n), rotated, bases, e_s)
+    return bases, e_s
+
+
 @pytest.mark.parametrize("seed", range(6))
-def test_range_basis_against_lapack_svd(seed):
+def test_set_basis_against_lapack_svd(seed):
     # F = Q1 diag(sv) Q2^T with singular values from 10 down to 1e-14 (some below the
     # threshold 1e-9), columns picked out of a wider matrix as a synergy set does.
     rng = np.random.default_rng(seed)
@@ -313,11 +321,11 @@ def test_range_basis_against_lapack_svd(seed):
     cols = rng.permutation(s + 3)[:s]
     F_all = rng.normal(size=(c, s + 3))
     F_all[:, cols] = F
-    U = np.full((c, 16), np.nan)
-    rank = range_basis(F_all, cols, s, 1e-9, U)
+    bases, e_s = _bases(F_all, cols[None, :].astype(np.int64), [s], [-1])  # from scratch
+    rank = int(e_s[0])
     lapack = np.linalg.svd(F, compute_uv=False)
     assert rank == int(np.sum(lapack > 1e-9))
-    E = U[:, :rank]
+    E = bases[0, :, :rank]
     np.testing.assert_allclose(E.T @ E, np.eye(rank), atol=1e-13)
     # the kept directions span F up to the dropped singular values
     dropped = lapack[lapack <= 1e-9].max(initial=0.0)
@@ -325,9 +333,7 @@ def test_range_basis_against_lapack_svd(seed):
     # the same set started from its parent's rotated columns (the set without its last column)
     table = np.zeros((2, s), dtype=np.int64)
     table[0, :s - 1], table[1] = cols[:s - 1], cols
-    rotated, bases, e_s = np.zeros((2, c, s)), np.full((2, c, s), np.nan), np.zeros(2, dtype=np.int64)
-    set_bases(F_all, table, np.array([s - 1, s]), np.full(2, 1e-9), np.array([-1, 0]), np.arange(2), rotated, bases,
-              e_s)
+    bases, e_s = _bases(F_all, table, [s - 1, s], [-1, 0])
     E = bases[1, :, :e_s[1]]
     assert e_s[1] == rank
     np.testing.assert_allclose(E.T @ E, np.eye(rank), atol=1e-13)

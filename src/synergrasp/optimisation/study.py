@@ -80,6 +80,10 @@ class GFOParams:
         object.__setattr__(self, "gravity_direction", tuple(float(v) for v in d / norm))
         for name in ("mu", "f_min_N", "k_stru_N_per_mm", "k_ss_Nmm_per_rad", "mass_kg", "g_m_per_s2"):
             object.__setattr__(self, name, float(getattr(self, name)))
+        # once per parameters, not per grasp (the study's loop reads it for every pose)
+        wrench = object_wrench(self.mass_kg, np.asarray(self.gravity_direction), self.g_m_per_s2)
+        wrench.setflags(write=False)
+        object.__setattr__(self, "_wrench", wrench)
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> GFOParams:
@@ -88,8 +92,8 @@ class GFOParams:
                      mass_kg=float(config["objects"][obj]["mass_kg"]))
 
     def wrench(self) -> NDArray:
-        """w_e (6,) the contacts must apply against the weight, N and N·mm."""
-        return object_wrench(self.mass_kg, np.asarray(self.gravity_direction), self.g_m_per_s2)
+        """w_e (6,) the contacts must apply against the weight, N and N·mm (read-only)."""
+        return self._wrench
 
     @property
     def cone(self) -> FrictionCone:
@@ -142,11 +146,10 @@ def read_grasps(table: pd.DataFrame) -> list[Grasp | None]:
     return grasps
 
 
-def mechanics_for(grasp: Grasp, params: GFOParams, wrench: NDArray | None = None) -> GraspMechanics:
-    """`grasp_mechanics` with the weight, stiffnesses and rank tolerance of `params`
-    (wrench: `params.wrench()`, given by a caller that loops over grasps)."""
-    return grasp_mechanics(grasp, params.wrench() if wrench is None else wrench, params.k_stru_N_per_mm,
-                           params.k_ss_Nmm_per_rad, rank_rtol=params.grasp_rank_rtol)
+def mechanics_for(grasp: Grasp, params: GFOParams) -> GraspMechanics:
+    """`grasp_mechanics` with the weight, stiffnesses and rank tolerance of `params`."""
+    return grasp_mechanics(grasp, params.wrench(), params.k_stru_N_per_mm, params.k_ss_Nmm_per_rad,
+                           rank_rtol=params.grasp_rank_rtol)
 
 
 def optimise_grasps(
@@ -187,12 +190,11 @@ def optimise_grasps(
         out["forces"] = np.full(total, None, dtype=object)
     cone = params.cone
     method = FASTEST_METHOD[cone.kind]
-    wrench = params.wrench()
     for p, grasp in enumerate(grasps):
         if grasp is None or grasp.n_contacts == 0:
             continue
         rows = slice(p * n_sets, (p + 1) * n_sets)
-        mech = mechanics_for(grasp, params, wrench)
+        mech = mechanics_for(grasp, params)
         out["rank_G"][rows] = mech.rank_G
         out["n_contacts"][rows] = mech.n_contacts
         if mech.rank_G < 6 or mech.projector is None:

@@ -1,5 +1,5 @@
 """The compiled call per pose: every synergy set of one grasp (`solve_sets`): the set's
-basis by one-sided Jacobi rotations (`range_basis`), its problem built into the pose's work
+basis by one-sided Jacobi rotations (`set_bases`), its problem built into the pose's work
 arrays (`build`), solved (`solve_one`: `hsde` and a refined second attempt) and its forces
 checked, then the strict internal-force test on the same basis."""
 
@@ -21,7 +21,7 @@ from synergrasp.optimisation.ipm.layout import (
     workspace,
 )
 
-__all__ = ["range_basis", "solve_sets"]
+__all__ = ["set_bases", "solve_sets"]
 
 
 @jit_alloc
@@ -132,20 +132,6 @@ def cone_rows(frames, mu, rows):
 
 
 
-@jit_call
-def range_basis(F_all, cols, s, threshold, U):
-    """E_s of one set: an orthonormal basis of the range of F = F_all[:, cols[:s]] from its
-    singular vectors whose singular value exceeds `threshold` (the rule of
-    `mechanics.internal_force_basis`), written into the leading columns of U; returns their
-    number. One-sided Jacobi (Hestenes, `rotate`) from F's columns, then `kept_directions`."""
-    c = F_all.shape[0]
-    for q in range(s):
-        for k in range(c):
-            U[k, q] = F_all[k, cols[q]]
-    rotate(U, 0, s)
-    return kept_directions(U, s, threshold, U)
-
-
 @jit_inline
 def rotate(R, start, s):
     """One-sided Jacobi (Hestenes) on the first s columns of R (c, >= s), in place: plane
@@ -204,8 +190,10 @@ def kept_directions(R, s, threshold, U):
 
 @jit_call
 def set_bases(F_all, cols, n_cols, thresholds, parent, order, rotated, bases, e_s):
-    """E_s of every set (`range_basis`) into bases (n_sets, c, >= s), its rank into e_s, in
-    `order` (parents first). A set whose parent (the set without its last column; -1: none)
+    """E_s of every set into bases (n_sets, c, >= s): an orthonormal basis of the range of
+    F_s = F_all[:, cols[j, :s]] from its singular vectors whose singular value exceeds the set's
+    threshold (the rule of `mechanics.internal_force_basis`), by one-sided Jacobi rotations
+    (`rotate`, `kept_directions`); its rank into e_s; in `order` (parents first). A set whose parent (the set without its last column; -1: none)
     is known starts from the parent's rotated columns, already orthogonal, and the new
     column (`rotate`): the incremental sets {S1..Sk} cost a few sweeps over k - 1 pairs
     instead of Jacobi from scratch. rotated (n_sets, c, >= s): the rotated columns."""
@@ -227,7 +215,7 @@ def set_bases(F_all, cols, n_cols, thresholds, parent, order, rotated, bases, e_
 def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, nesting, cone, cone_strict, f_min, strict, opt,
                opt_strict, out):
     """Every synergy set of one grasp into `out` (`SetsResult`): E_s from the singular vectors
-    of F_s = F_all[:, set] whose singular value is above the set's threshold (`range_basis`),
+    of F_s = F_all[:, set] whose singular value is above the set's threshold (`set_bases`),
     or, if `given`, F_s itself (orthonormal columns), then the GFO, its forces f_p + E_s y (N)
     and, if `strict`, the strict internal-force test (f_p = 0, f_min = 1 N, cone_strict).
     cone, cone_strict: `ConeData` of the same kind; opt, opt_strict: `Settings` of the GFO and
