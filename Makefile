@@ -28,9 +28,11 @@ $(BIN)/.installed: environment.lock pyproject.toml
 
 venv: $(BIN)/.installed
 
-# Compiled solver code is cached per user, named by the kernel sources' hash (any checkout path
-# loads it); build it once here, not in every job.
-WARM_UP = $(BIN)/python -c "from synergrasp.optimisation.gfo import warm_up; warm_up()"
+# Compiled code (the solver's kernel, the closure's queries and steps) is cached per user, named
+# by its sources' hash (any checkout path loads it); build it once here, not in every job, the
+# two groups side by side (one core each).
+WARM_UP = $(BIN)/python -c "from synergrasp.simulation.closure import warm_up; warm_up()" & closure=$$!; \
+	$(BIN)/python -c "from synergrasp.optimisation.gfo import warm_up; warm_up()" && wait $$closure
 
 study: $(BIN)/.installed
 	$(WARM_UP)

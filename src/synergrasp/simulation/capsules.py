@@ -263,7 +263,8 @@ class HandCapsules:
 
     def segments(self, q: NDArray) -> tuple[NDArray, NDArray]:
         """Axis end points (c, 3) and (c, 3) of every capsule in the palm frame at q (rad)."""
-        return _segments(_frames(np.asarray(q, dtype=float), *self.tree), self.frame, self.ends)
+        # a fresh writeable copy: a read-only or strided q (a table's row) would compile another specialisation
+        return _segments(_frames(np.array(q, dtype=float), *self.tree), self.frame, self.ends)
 
     def encloses(self, q: NDArray, point_mm: NDArray) -> bool:
         """Whether ``point_mm`` (palm frame) lies inside the hand at q (rad): within the convex

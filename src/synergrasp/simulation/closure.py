@@ -32,7 +32,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.simulation.shapes import Shape
 
-__all__ = ["SimulateParams", "simulate_object", "closure_model", "place_object"]
+__all__ = ["SimulateParams", "simulate_object", "closure_model", "place_object", "warm_up"]
 
 @dataclass(frozen=True)
 class SimulateParams:
@@ -129,3 +129,23 @@ def simulate_object(hand: Hand, synergies: Synergies, grasped: GraspedObject, pl
         model.close()
         placer.close()
     return contacts_table(rows)
+
+
+def warm_up() -> None:
+    """Compile the kinematic closure's distance queries and steps (numba), or load them from
+    their cache (``synergrasp.simulation.shapes.compiled``: per user, named by the hash of their
+    sources, so any checkout of the same sources loads them). Called once after installation
+    (Makefile), beside the solver's warm-up, so that no workflow job compiles them and parallel
+    jobs do not compile side by side: closes the shipped hand on the default study's first box
+    at one pose, brought to the palm centre."""
+    from dataclasses import replace
+
+    from synergrasp.config import defaults
+    from synergrasp.hand.kinematics import load_hand
+
+    config = defaults()
+    params = SimulateParams.from_config(config, next(iter(config["objects"])))
+    hand = load_hand(params.hand)
+    simulate_object(hand, params.synergies(hand.joint_names), params.object,
+                    replace(params.placement, mode="approach"), replace(params.closure, model="kinematic"), poses=[0])
+

@@ -9,7 +9,6 @@ queried (``HandScene``). mm, rad, palm frame.
 
 from __future__ import annotations
 
-from bisect import bisect_left, bisect_right
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -19,6 +18,7 @@ from numpy.typing import NDArray
 from synergrasp.hand.kinematics import FINGERS
 from synergrasp.hand.synergies import SynergyPath
 from synergrasp.simulation import bullet
+from synergrasp.simulation.closure_steps import MARCH_CROSS, march
 from synergrasp.simulation.contacts import ClosureResult, closure_result
 from synergrasp.simulation.placement import ObjectPose
 from synergrasp.simulation.scene import HandScene
@@ -34,6 +34,8 @@ _LONG_FINGERS = ("index", "middle", "ring", "little")
 #: Distance (mm) within which the hand is queried for the next step size.
 _QUERY_MARGIN_MM = 40.0
 _MAX_REFINE = 40
+#: Placeholder for gaps not yet known (``march`` computes them).
+_NO_GAPS_ARGS = (np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int64))
 
 
 class KinematicClosure:
@@ -61,6 +63,7 @@ class KinematicClosure:
                 self.link_chain_pos[link] = i
         self.reach = self._joint_reach()
         self._profiles: dict[tuple[int, tuple[int, ...]], tuple[list[float], list[float]]] = {}
+        self._profile_arrays: dict[bytes, tuple[NDArray, NDArray, NDArray]] = {}
         self.q_open = self.reference(self.sigma_open)
         self.self_pairs = self._monitored_pairs()
         self.finger_link_mask = np.zeros((len(self.fingers), hand.n_links), dtype=bool)
@@ -155,37 +158,28 @@ class KinematicClosure:
             self._profiles[key] = profile
         return profile
 
-    def advance(self, sigma: float, budget_mm: NDArray, held: NDArray) -> float:
-        """Largest σ' ≤ σ_closed such that no point of finger f travels more than
-        budget_mm[f] on [σ, σ'] (clipped joints do not move; held joints do not move)."""
-        best = self.sigma_closed
-        held_list = held.tolist()
-        for f, (joints, _) in enumerate(self.fingers):
-            moving = tuple(j for j in joints if not held_list[j])
-            if not moving:
-                continue
-            knots, travel = self._travel_profile(f, moving)  # Python lists: scalar work is cheaper
-            i = min(max(bisect_right(knots, sigma), 1), len(knots) - 1)
-            level = travel[i - 1] + (sigma - knots[i - 1]) / (knots[i] - knots[i - 1]) * (travel[i] - travel[i - 1])
-            level += float(budget_mm[f])
-            if level > travel[-1]:
-                continue  # the budget outlasts the closure
-            k = bisect_left(travel, level)  # travel[k-1] < level <= travel[k]
-            t0, t1 = travel[k - 1], travel[k]
-            best = min(best, knots[k - 1] + (level - t0) / (t1 - t0) * (knots[k] - knots[k - 1]))
-        return best
+    def _profiles_of(self, held: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+        """Every finger's travel profile (``_travel_profile``) for the joints that are not
+        ``held``, as the padded arrays ``closure_steps.march`` reads: knots (F, K), travel
+        (F, K) and the number of knots per finger (0: none of its joints moves). Cached per
+        held set."""
+        key = held.tobytes()
+        arrays = self._profile_arrays.get(key)
+        if arrays is None:
+            held_list = held.tolist()
+            rows = []
+            for f, (joints, _) in enumerate(self.fingers):
+                moving = tuple(j for j in joints if not held_list[j])
+                rows.append(self._travel_profile(f, moving) if moving else ([], []))
+            width = max(1, max(len(k) for k, _ in rows))
+            knots, travel = np.zeros((len(rows), width)), np.zeros((len(rows), width))
+            for f, (k, t) in enumerate(rows):
+                knots[f, :len(k)], travel[f, :len(t)] = k, t
+            arrays = self._profile_arrays[key] = (knots, travel, np.array([len(k) for k, _ in rows], dtype=np.int64))
+        return arrays
 
     def posture(self, sigma: float, held: NDArray, q_held: NDArray) -> NDArray:
         return np.where(held, q_held, self.reference(sigma))
-
-    def gaps(self, q: NDArray, moving_links: NDArray, pairs: tuple[tuple[int, int], ...],
-             margin_mm: float) -> _Gaps:
-        """Per moving link: distance to the box and to the monitored hand links (and which),
-        at posture q (mm; +inf for links that do not move and beyond ``margin_mm``)."""
-        d_obj, d_self, partner = self.scene.posture_gaps(q, pairs)
-        d_obj[~moving_links | (d_obj > margin_mm)] = np.inf
-        d_self[~moving_links | (d_self > margin_mm)] = np.inf
-        return _Gaps(q, d_obj, d_self, partner)
 
     def run(self) -> tuple[NDArray, list[str], bool]:
         """Close the hand on the placed box from σ_open to σ_closed. Returns (q, finger_state,
@@ -203,20 +197,24 @@ class KinematicClosure:
         state.touch_object(touching, q)
         sigma = self.sigma_open
         mv, pairs = self._moving(state)
-        known: _Gaps | None = None  # the gaps at σ when known from the previous step or event
+        known: _Gaps | None = None  # the gaps at σ when known from the previous event
+        path = (self.path.mean, self.path.direction, self.path.lower, self.path.upper)
         while sigma < self.sigma_closed and mv.any():
-            now = known if known is not None else self.gaps(self.posture(sigma, state.held, state.q_held),
-                                                           mv, pairs, _QUERY_MARGIN_MM)
-            sigma_next = self.advance(sigma, self._budget(now), state.held)
-            if sigma_next <= sigma:
+            knots, travel, n_knots = self._profiles_of(state.held)
+            now = known if known is not None else _NO_GAPS
+            status, sigma, parts = march(
+                sigma, self.sigma_closed, (now.q, now.d_obj, now.d_self, now.partner), known is not None,
+                state.held, state.q_held, path, self.scene.query_args(), self.scene.pair_args(pairs), mv,
+                self.finger_link_mask, knots, travel, n_knots, p.step_mm, _QUERY_MARGIN_MM, p.tolerance_mm,
+                _MAX_REFINE)
+            if status != MARCH_CROSS:
                 break
-            after = self.gaps(self.posture(sigma_next, state.held, state.q_held), mv, pairs, _QUERY_MARGIN_MM)
-            if after.smallest >= 0.0:
-                sigma, known = sigma_next, after
-                continue
-            sigma, event = self._refine(sigma, now, sigma_next, after, state, mv, pairs)
-            state.touch_object(event.d_obj <= p.contact_distance_mm, event.q)
-            state.touch_hand(event, p.contact_distance_mm)
+            event = _Gaps(*parts)
+            touch = p.contact_distance_mm
+            if not (np.any(event.d_obj <= touch) or np.any(event.d_self <= touch)):
+                event = event.forced_touch(touch)  # the refinement ran out: the closest link touches
+            state.touch_object(event.d_obj <= touch, event.q)
+            state.touch_hand(event, touch)
             # the posture at σ is the event's again (new holds keep its values); a link that
             # still moves keeps all its pairs, so its gaps are those of the event
             mv, pairs = self._moving(state)
@@ -232,41 +230,6 @@ class KinematicClosure:
                 mv[link] = not state.held[joints[i]]
         return mv, tuple(pr for pr in self.self_pairs if mv[pr[0]] or mv[pr[1]])
 
-    def _budget(self, gaps: _Gaps) -> NDArray:
-        """Travel budget (mm) per finger for the next step: max(step_mm, its free distance),
-        at most the query margin; hand gaps count half (both links may move)."""
-        free = np.min(np.where(self.finger_link_mask, np.minimum(gaps.d_obj, 0.5 * gaps.d_self), np.inf), axis=1)
-        return np.maximum(self.params.step_mm, np.minimum(free, _QUERY_MARGIN_MM))
-
-    def _refine(self, sigma: float, now: _Gaps, sigma_next: float, after: _Gaps, state: _HoldState,
-                mv: NDArray, pairs: tuple[tuple[int, int], ...]) -> tuple[float, _Gaps]:
-        """A moving link crosses something in (σ, σ_next]: the last σ before it, where the
-        smallest gap is in [0, tolerance_mm] (Illinois false position, bisection when it
-        stalls), and the gaps there. If nothing is within the contact distance there (the
-        refinement ran out), the closest link is made to touch so the closure progresses."""
-        lo, hi, d_lo, d_hi = sigma, sigma_next, now.smallest, after.smallest
-        side, event = 0, now
-        for _ in range(_MAX_REFINE):
-            mid = 0.5 * (lo + hi)
-            if np.isfinite(d_lo) and (hi - lo) > 1e-12:
-                guess = hi - d_hi * (hi - lo) / (d_hi - d_lo)
-                mid = guess if lo < guess < hi else mid
-            at = self.gaps(self.posture(mid, state.held, state.q_held), mv, pairs, _QUERY_MARGIN_MM)
-            if at.smallest < 0.0:
-                hi, d_hi = mid, at.smallest
-                d_lo = 0.5 * d_lo if side == -1 else d_lo
-                side = -1
-                continue
-            lo, d_lo, event = mid, at.smallest, at
-            if at.smallest <= self.params.tolerance_mm:
-                break
-            d_hi = 0.5 * d_hi if side == +1 else d_hi
-            side = +1
-        touch = self.params.contact_distance_mm
-        if not (np.any(event.d_obj <= touch) or np.any(event.d_self <= touch)):
-            event = event.forced_touch(touch)
-        return (lo if event is not now else sigma), event
-
 
 @dataclass
 class _Gaps:
@@ -277,10 +240,6 @@ class _Gaps:
     d_obj: NDArray
     d_self: NDArray
     partner: NDArray
-
-    @property
-    def smallest(self) -> float:
-        return float(min(self.d_obj.min(), self.d_self.min()))
 
     def masked(self, moving: NDArray) -> _Gaps:
         d_obj, d_self = self.d_obj.copy(), self.d_self.copy()
@@ -297,6 +256,9 @@ class _Gaps:
         else:
             d_self[k] = min(d_self[k], touch_mm)
         return _Gaps(self.q, d_obj, d_self, self.partner)
+
+
+_NO_GAPS = _Gaps(*_NO_GAPS_ARGS)
 
 
 class _HoldState:

@@ -183,11 +183,21 @@ class HandScene:
         """At posture q (rad), in one compiled call: per link the signed distance to the object,
         to the nearest link it is paired with in ``pairs`` and that link (-1 where none), mm.
         (The same numbers as ``object_distance`` and ``self_distance``; the posture is not kept.)"""
-        ends, first, second = self._pair_rows(pairs)
+        return posture_gaps(np.asarray(q, dtype=float), *self.query_args(), *self.pair_args(pairs))
+
+    def query_args(self) -> tuple:
+        """The arguments of ``capsules.posture_gaps`` after q and before the pairs: the hand's
+        frame tree and capsules, the palm's gap to the object (mm) and the placed object."""
         c, placed = self.capsules, self.placed
-        return posture_gaps(np.asarray(q, dtype=float), *self._tree, c.frame, c.ends, c.radius, c.links,
-                            float(self._palm_gap[0]), placed.rotation, placed.center_mm, placed.shape.kernel_code,
-                            placed.shape.kernel_params, first, second, ends, c.palm_rotation, c.palm_centre, c.palm_half, self.hand.n_links)
+        return (*self._tree, c.frame, c.ends, c.radius, c.links, float(self._palm_gap[0]), placed.rotation,
+                placed.center_mm, placed.shape.kernel_code, placed.shape.kernel_params)
+
+    def pair_args(self, pairs: tuple[tuple[int, int], ...]) -> tuple:
+        """The arguments of ``capsules.posture_gaps`` from the pairs on: the monitored pairs'
+        rows, the palm's boxes and the number of links."""
+        ends, first, second = self._pair_rows(pairs)
+        c = self.capsules
+        return first, second, ends, c.palm_rotation, c.palm_centre, c.palm_half, self.hand.n_links
 
     def self_distance(self, pairs: tuple[tuple[int, int], ...], margin_mm: float = np.inf) -> tuple[NDArray, NDArray]:
         """Per link, the distance (mm, negative = overlap; +inf beyond ``margin_mm``) to the

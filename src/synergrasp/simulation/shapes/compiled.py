@@ -18,7 +18,8 @@ __all__ = ["SOURCES", "GROUP", "jit"]
 
 #: The modules whose compiled functions call one another (relative to the package).
 SOURCES = ("simulation/shapes/compiled.py", "simulation/shapes/kernels.py", "simulation/shapes/polytope.py",
-           "simulation/shapes/polytope_axes.py", "simulation/capsules.py")
+           "simulation/shapes/polytope_axes.py", "simulation/capsules.py",
+           "simulation/closure_steps.py")
 
 #: The group; registered before any of its modules defines a function.
 GROUP = register_group("shapes", SOURCES)
