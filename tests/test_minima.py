@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.analysis.minima import FORCE_TIE_RTOL, local_minima, minima_table, preserved
+from synergrasp.analysis.minima import FORCE_TIE_RTOL, local_minima, minima_table, preserved, preserved_counts
 
 
 def ring(forces: dict[float, float], default: float = 5.0):
@@ -132,3 +132,17 @@ def test_minima_table():
     table = minima_table(pd.DataFrame(rows))
     assert table[["set_id", "alpha_deg"]].values.tolist() == [["1", -180.0], ["1", 90.0], ["1-2", -180.0]]
     assert list(table.columns) == ["object", "set_id", "n_synergies", "pose", "alpha_deg", "beta_deg", "force_norm"]
+
+
+def test_preserved_counts_equal_the_per_row_preserved_sums():
+    # 600 random rows (more than one chunk) against the one-row function, α wrapping included
+    rng = np.random.default_rng(7)
+    a, b = rng.choice(np.arange(-180, 180, 5.0), 30), rng.choice(np.arange(-60, 65, 5.0), 30)
+    na, nb = rng.choice(np.arange(-180, 180, 5.0), (600, 25)), rng.choice(np.arange(-60, 65, 5.0), (600, 25))
+    counts = preserved_counts(a, b, na, nb, radius_deg=10.0)
+    expected = [int(preserved(a, b, na[i], nb[i], radius_deg=10.0).sum()) for i in range(600)]
+    assert counts.tolist() == expected
+    assert 0 < counts.min() and counts.max() < 30  # neither trivially none nor all
+    assert preserved_counts(a[:0], b[:0], na, nb).tolist() == [0] * 600
+    with pytest.raises(ValueError, match="next_alpha and next_beta"):
+        preserved_counts(a, b, na[0], nb[0])

@@ -20,7 +20,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp.analysis.bootstrap import PoseResampler
-from synergrasp.analysis.minima import preserved
+from synergrasp.analysis.minima import preserved, preserved_counts
 from synergrasp.ids import incremental_set_id
 
 __all__ = ["identical_force_maps", "allowed_offsets", "null_preserved", "preservation_vs_chance",
@@ -88,24 +88,22 @@ def null_preserved(this: pd.DataFrame, nxt: pd.DataFrame, alphas: NDArray, betas
                    offsets: NDArray, rng: np.random.Generator, draws: int) -> NDArray:
     """(draws,) number of minima of ``this`` preserved by ``nxt`` shifted by random offsets
     (rows of ``offsets``, drawn uniformly). ``this``, ``nxt``: alpha_deg, beta_deg (deg)."""
-    counts = np.zeros(draws, dtype=np.int64)
     if this.empty or nxt.empty or offsets.size == 0:
-        return counts
+        return np.zeros(draws, dtype=np.int64)
     ia = _indices(nxt["alpha_deg"].to_numpy(float), alphas)
     ib = _indices(nxt["beta_deg"].to_numpy(float), betas)
-    a, b = this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float)
-    for d, (da, db) in enumerate(offsets[rng.integers(len(offsets), size=draws)]):
-        shifted_a = alphas[(ia + da) % alphas.size]
-        shifted_b = betas[reflected(ib + db, betas.size)]
-        counts[d] = int(preserved(a, b, shifted_a, shifted_b, radius_deg).sum())
-    return counts
+    shift = offsets[rng.integers(len(offsets), size=draws)]  # (draws, 2) grid steps in α, β
+    shifted_a = alphas[(ia[None, :] + shift[:, :1]) % alphas.size]
+    shifted_b = betas[reflected(ib[None, :] + shift[:, 1:], betas.size)]
+    return preserved_counts(this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float), shifted_a, shifted_b,
+                            radius_deg)
 
 
 def _pairs(table: pd.DataFrame, minima: pd.DataFrame, k_max: int, radius_deg: float,
            periods: dict[str, float], draws: int, rng: np.random.Generator) -> list[dict]:
     """Observed and null preserved counts of every (object, k)."""
     rows = []
-    for obj in sorted(set(table["object"])):
+    for obj in sorted(set(table["object"].unique())):
         own = table[table["object"] == obj]
         alphas, betas = np.sort(own["alpha_deg"].unique()), np.sort(own["beta_deg"].unique())
         offsets = allowed_offsets(alphas, betas, radius_deg, periods.get(obj, 360.0))

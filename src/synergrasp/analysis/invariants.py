@@ -80,7 +80,7 @@ def invariant_checks(table: pd.DataFrame, rates: pd.DataFrame, periods: dict[str
     messages = check_success_rates(rates, tolerance_percent)
     rows = []
     inconsistent = superset_inconsistencies(table)
-    for obj in sorted(set(table["object"])):
+    for obj in sorted(set(table["object"].unique())):
         own = table[table["object"] == obj]
         bad = inconsistent[inconsistent["object"] == obj].sort_values("n_poses", ascending=False)
         named = "; ".join(f"{{{r.set_id}}} succeeds, {{{r.superset_id}}} does not: {r.n_poses} poses"

@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from synergrasp.analysis.verdicts import force_bound
 
-__all__ = ["MinimaParams", "local_minima", "preserved", "minima_table", "MINIMA_COLUMNS", "FORCE_TIE_RTOL"]
+__all__ = ["MinimaParams", "local_minima", "preserved", "preserved_counts", "minima_table", "MINIMA_COLUMNS", "FORCE_TIE_RTOL"]
 
 # Grid angles are multiples of a step; the tolerance makes "within ±radius" inclusive
 # despite rounding in the stored degrees.
@@ -68,10 +68,11 @@ def _as_1d(name: str, values: ArrayLike, n: int | None = None, dtype: type = flo
 
 def _within(alpha_a: NDArray, beta_a: NDArray, alpha_b: NDArray, beta_b: NDArray,
             radius_deg: float, alpha_period_deg: float) -> NDArray[np.bool_]:
-    """(len a, len b) mask: pose b within ±radius of pose a in wrapped α and in β (deg)."""
-    d_alpha = np.abs(alpha_a[:, None] - alpha_b[None, :]) % alpha_period_deg
+    """(..., len a, len b) mask: pose b within ±radius of pose a in wrapped α and in β (deg);
+    leading axes of b (several sets of poses b) broadcast."""
+    d_alpha = np.abs(alpha_a[..., :, None] - alpha_b[..., None, :]) % alpha_period_deg
     d_alpha = np.minimum(d_alpha, alpha_period_deg - d_alpha)
-    d_beta = np.abs(beta_a[:, None] - beta_b[None, :])
+    d_beta = np.abs(beta_a[..., :, None] - beta_b[..., None, :])
     return (d_alpha <= radius_deg + _TOL_DEG) & (d_beta <= radius_deg + _TOL_DEG)
 
 
@@ -143,6 +144,25 @@ def preserved(minima_alpha: ArrayLike, minima_beta: ArrayLike, next_alpha: Array
     if a.size == 0 or na.size == 0:
         return np.zeros(a.shape[0], dtype=bool)
     return _within(a, b, na, nb, radius_deg, alpha_period_deg).any(axis=1)
+
+
+def preserved_counts(minima_alpha: NDArray, minima_beta: NDArray, next_alpha: NDArray, next_beta: NDArray,
+                     radius_deg: float = 10.0, alpha_period_deg: float = 360.0) -> NDArray[np.int64]:
+    """For each row of ``next_alpha``, ``next_beta`` ((d, m'): d sets of minima, deg): how many
+    of the m minima ``minima_alpha``, ``minima_beta`` it preserves (:func:`preserved`, summed);
+    (d,) counts, computed a few hundred rows at a time."""
+    _check_radius(radius_deg, alpha_period_deg)
+    a, b = _as_1d("minima_alpha", minima_alpha), _as_1d("minima_beta", minima_beta, len(minima_alpha))
+    na, nb = np.asarray(next_alpha, dtype=float), np.asarray(next_beta, dtype=float)
+    if na.ndim != 2 or nb.shape != na.shape:
+        raise ValueError(f"next_alpha and next_beta must be equal (d, m') arrays; got {na.shape} and {nb.shape}")
+    counts = np.zeros(na.shape[0], dtype=np.int64)
+    if a.size == 0 or na.shape[1] == 0:
+        return counts
+    for start in range(0, na.shape[0], 250):
+        rows = slice(start, start + 250)
+        counts[rows] = _within(a, b, na[rows], nb[rows], radius_deg, alpha_period_deg).any(axis=-1).sum(axis=-1)
+    return counts
 
 
 def minima_table(table: pd.DataFrame, radius_deg: float = 10.0, alpha_period_deg: float = 360.0) -> pd.DataFrame:

@@ -112,7 +112,7 @@ def _weight_multiples(gfo: pd.DataFrame, full_set_id: str, weights_N: Mapping[st
     definition: rank(G) = 6 and the strict internal-force test, see analysis.verdicts),
     load_feasible, and the optimal ‖f‖₂ under the weight / (m·g) where in force closure."""
     full = gfo[gfo["set_id"].astype(str) == full_set_id]
-    missing = sorted(set(full["object"]) - set(weights_N))
+    missing = sorted(set(full["object"].unique()) - set(weights_N))
     if missing:
         raise ValueError(f"weights_N: no weight for object(s) {missing}; given: {sorted(weights_N)}")
     weight = full["object"].map(weights_N).astype(float)
@@ -181,7 +181,7 @@ def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, equilibrium: pd.Dat
         absent = [c for c in table.names if c not in frame.columns]
         if absent:
             raise ValueError(f"{table.name} table: missing column(s) {absent}")
-    if full_set_id not in set(gfo["set_id"].astype(str)):
+    if full_set_id not in set(gfo["set_id"].astype(str).unique()):
         raise ValueError(f"full_set_id {full_set_id!r} is not in the gfo table")
     work = contacts[["object", "closure_model", "pose", "status", "n_contacts", "contact_link"]].assign(
         pose=contacts["pose"].astype(int), loaded_contacts=_loaded(contacts, load_threshold_N))

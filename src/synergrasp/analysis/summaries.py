@@ -328,7 +328,7 @@ def minimum_preservation(gfo: pd.DataFrame, minima_table: pd.DataFrame, k_max: i
     if not (isinstance(k_max, (int, np.integer)) and k_max >= 2):
         raise ValueError(f"k_max must be an integer >= 2; got {k_max!r}")
     periods = dict(periods_deg or {})
-    objects = sorted(set(gfo["object"]) | set(minima_table["object"]))
+    objects = sorted(set(gfo["object"].unique()) | set(minima_table["object"].unique()))
     counts = ["n_minima", "n_preserved", "n_minima_distinct", "n_preserved_distinct"]
     rows = []
     for obj in objects:
@@ -369,7 +369,7 @@ def full_but_not_first7(table: pd.DataFrame, full_set_id: str, first7_set_id: st
     """
     _require(table, "gfo table", ("object", "pose", "alpha_deg", "beta_deg", "set_id", "status", "success",
                                   "force_norm", "verdict_force_closure", "verdict_load_feasible"))
-    present = set(table["set_id"])
+    present = set(table["set_id"].unique())
     for name, sid in (("full_set_id", full_set_id), ("first7_set_id", first7_set_id)):
         if sid not in present:
             raise ValueError(f"{name} {sid!r} is not in the gfo table; allowed values: {sorted(present)}")
@@ -453,7 +453,7 @@ def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
     table, counts, (chance, pairs), claims = _claims(gfo, minima, k_max, first, settings)
     rates = success_rates(table, full, periods)
     checks = invariant_checks(table, rates, periods, settings.success_rate_tolerance_percent)
-    lost = (full_but_not_first7(table, full, first_n) if first_n in set(table["set_id"]) else None)
+    lost = (full_but_not_first7(table, full, first_n) if first_n in set(table["set_id"].unique()) else None)
     preservation = minimum_preservation(table, minima, k_max, settings.radius_deg, periods)
     preservation = preservation.merge(pairs.astype({"k": "Int64"}), on=["object", "k"], how="left")
     table2 = incrementality_table(rates, table2_k_max)
