@@ -180,20 +180,20 @@ def quality_table(contacts: pd.DataFrame, gfo: pd.DataFrame, grasps: Sequence[Gr
     """One row per pose of ``contacts`` (columns of ``synergrasp.tables.QUALITY``): the quality
     indices of its grasp (``grasps``, one per row; None: no grasp, indices NaN) and the full
     set's verdict and optimal force over the weight from ``gfo``."""
-    full = gfo[gfo["set_id"] == params.full_set_id].set_index("pose")
+    full = gfo[gfo["set_id"] == params.full_set_id]
+    verdicts = {int(pose): (bool(strict and rank == 6), float(force) / params.weight_N)
+                for pose, strict, rank, force in zip(full["pose"].tolist(), full["strict_internal"].tolist(),
+                                                     full["rank_G"].tolist(), full["force_norm"].tolist())}
     rows = []
-    for (_, row), grasp in zip(contacts.iterrows(), grasps):
-        out = {"object": row["object"], "pose": row["pose"], "alpha_deg": row["alpha_deg"],
-               "beta_deg": row["beta_deg"], "n_contacts": int(row["n_contacts"]), "rank_G": 0,
+    for row, grasp in zip(contacts.itertuples(index=False), grasps):
+        out = {"object": row.object, "pose": row.pose, "alpha_deg": row.alpha_deg,
+               "beta_deg": row.beta_deg, "n_contacts": int(row.n_contacts), "rank_G": 0,
                "sigma_min": np.nan, "isotropy": np.nan, "epsilon": np.nan, "manipulability": [np.nan] * 6}
         if grasp is not None:
             q = grasp_quality(grasp, params.mu, params.torque_length_mm, synergies=synergy_matrix)
             out.update(rank_G=q.rank_G, sigma_min=q.sigma_min, isotropy=q.isotropy, epsilon=q.epsilon,
                        manipulability=q.manipulability.tolist())
-        set_row = full.loc[row["pose"]] if row["pose"] in full.index else None
-        out["force_closure"] = bool(set_row is not None and set_row["strict_internal"] and set_row["rank_G"] == 6)
-        out["force_per_weight"] = (float(set_row["force_norm"]) / params.weight_N if set_row is not None
-                                   else np.nan)
+        out["force_closure"], out["force_per_weight"] = verdicts.get(int(row.pose), (False, np.nan))
         out["torque_length_mm"] = params.torque_length_mm
         rows.append(out)
     return pd.DataFrame(rows)
