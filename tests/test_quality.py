@@ -172,3 +172,40 @@ def test_quality_table_rows_for_a_grasp_and_a_pose_without_one(tmp_path):
     assert bool(first["force_closure"]) and first["force_per_weight"] == pytest.approx(2.0)
     assert second["rank_G"] == 0 and np.isnan(second["epsilon"]) and not second["force_closure"]
     assert np.isnan(second["force_per_weight"])
+
+
+def _moved(grasp, delta_mm, links=None):
+    return Grasp(points=grasp.points + delta_mm, normals=grasp.normals,
+                 links=grasp.links if links is None else links, jacobian=grasp.jacobian, center=grasp.center)
+
+
+def test_same_grasp_within_round_off_only():
+    from synergrasp.optimisation.quality import same_grasp
+
+    g = _random_grasp(np.random.default_rng(3), 5)
+    assert same_grasp(g, _moved(g, 1e-12))  # a box's α-period twins differ by about this
+    assert not same_grasp(g, _moved(g, 1e-6))
+    assert not same_grasp(g, _moved(g, 0.0, links=g.links[::-1].copy()))
+
+
+def test_quality_table_computes_one_grasp_once_and_shares_it(monkeypatch):
+    import pandas as pd
+
+    from synergrasp.optimisation import quality
+
+    rng = np.random.default_rng(4)
+    a, b = _random_grasp(rng, 5), _random_grasp(rng, 6)
+    grasps = [a, b, _moved(a, 1e-12), _moved(b, 1e-6)]  # the third is the first; the fourth is not the second
+    calls = []
+    real = quality.grasp_quality
+    monkeypatch.setattr(quality, "grasp_quality", lambda g, *args, **kw: calls.append(g) or real(g, *args, **kw))
+    contacts = pd.DataFrame({"object": "box", "pose": range(4), "alpha_deg": [0.0, 5.0, 90.0, 95.0],
+                             "beta_deg": 0.0, "n_contacts": [5, 6, 5, 6]})
+    gfo = pd.DataFrame({"object": "box", "pose": range(4), "set_id": "1-2", "strict_internal": True, "rank_G": 6,
+                        "force_norm": 9.81})
+    params = quality.QualityParams(hand=None, synergies=None, mu=0.8, full_set_id="1-2", weight_N=9.81,
+                                   torque_length_mm=20.0)
+    table = quality.quality_table(contacts, gfo, grasps, np.zeros((2, 1)), params)
+    assert [id(g) for g in calls] == [id(grasps[0]), id(grasps[1]), id(grasps[3])]
+    assert table["epsilon"].iloc[2] == table["epsilon"].iloc[0] > 0
+    assert table["epsilon"].iloc[3] == pytest.approx(table["epsilon"].iloc[1], rel=1e-3)
