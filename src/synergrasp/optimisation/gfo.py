@@ -145,8 +145,8 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
     thresholds = g.basis_rtol * g.response_norm * S.norms
     strict = shrink is not None
     res = ipm_kernel.solve_sets(P @ S.matrix, g.f_p, contact_frames(g.normals), S.table, S.sizes, thresholds,
-                                ipm_kernel.Nesting(S.parent, S.within, S.order), g.cone, g.cone.narrowed(shrink) if strict else None,
-                                g.f_min, ipm, ALMOST_SOLVED_TOL)
+                                ipm_kernel.Nesting(S.parent, S.within, S.order), g.cone,
+                                g.cone.narrowed(shrink) if strict else None, g.f_min, ipm, ALMOST_SOLVED_TOL)
     n = len(g)
     status = _STATUS_OF_CODE[res.code]
     optimal = res.code == ipm_kernel.OPTIMAL

@@ -132,8 +132,9 @@ def solve_problem(frames: NDArray, E: NDArray, f_p: NDArray, cone: FrictionCone,
     more than violation_tol max(1 N, ||f||) is UNDECIDED. The same compiled call as
     `solve_sets`, with E as the one set's basis; returns its one-row `SetsResult`."""
     e = E.shape[1]
+    alone = Nesting(np.full(1, -1), np.zeros((1, 1), dtype=bool), np.zeros(1, dtype=np.int64))  # one set
     return _solve(np.ascontiguousarray(E, dtype=float), f_p, frames, np.arange(e)[None, :], np.array([e]),
-                  np.zeros(1), True, Nesting(np.full(1, -1), np.zeros((1, 1), dtype=bool), np.zeros(1, dtype=np.int64)), cone, strict_cone, f_min, settings, violation_tol)
+                  np.zeros(1), True, alone, cone, strict_cone, f_min, settings, violation_tol)
 
 
 def solve_sets(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_columns: NDArray,

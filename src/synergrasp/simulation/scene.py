@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from synergrasp.simulation.capsules import HandCapsules, capsule_object, nearest_per_link, pair_gaps, posture_gaps
+from synergrasp.simulation.capsules import HandCapsules, capsule_object, nearest_per_link, pair_gaps
 from synergrasp.simulation.placement import ObjectPose
 from synergrasp.simulation.shapes.box import box_gap, box_samples
 
@@ -179,15 +179,11 @@ class HandScene:
         c = self.capsules
         return pair_gaps(self._p0, self._p1, c.radius, first, second, c.palm_rotation, c.palm_centre, c.palm_half)
 
-    def posture_gaps(self, q: NDArray, pairs: tuple[tuple[int, int], ...]) -> tuple[NDArray, NDArray, NDArray]:
-        """At posture q (rad), in one compiled call: per link the signed distance to the object,
-        to the nearest link it is paired with in ``pairs`` and that link (-1 where none), mm.
-        (The same numbers as ``object_distance`` and ``self_distance``; the posture is not kept.)"""
-        return posture_gaps(np.asarray(q, dtype=float), *self.query_args(), *self.pair_args(pairs))
-
     def query_args(self) -> tuple:
-        """The arguments of ``capsules.posture_gaps`` after q and before the pairs: the hand's
-        frame tree and capsules, the palm's gap to the object (mm) and the placed object."""
+        """The arguments of ``capsules.posture_gaps`` (per link the gaps to the object and to the
+        monitored hand links at a posture q: the kinematic closure's query, made by
+        ``closure_steps.march``) after q and before the pairs: the hand's frame tree and
+        capsules, the palm's gap to the object (mm) and the placed object."""
         c, placed = self.capsules, self.placed
         return (*self._tree, c.frame, c.ends, c.radius, c.links, float(self._palm_gap[0]), placed.rotation,
                 placed.center_mm, placed.shape.kernel_code, placed.shape.kernel_params)
