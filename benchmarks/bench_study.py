@@ -3,8 +3,9 @@
 Reads the optimisation jobs' benchmark files (`<root>/benchmarks/optimise/*.tsv`, column
 cpu_time: CPU seconds of each job, imports and I/O included) and the gfo tables
 (`<root>/objects/*/gfo.parquet`), and prints (pose, set) rows per CPU second, over all rows
-and over the rows that reached the solver (solver not 'none'), and the share of rows the
-Clarabel fallback decided. Nothing is run: it describes the last `make study` (or any root
+and over the rows that reached the solver (solver not 'none'), how many of them were solved
+(poses whose grasps are one share one solve: `mechanics.first_same_grasp` on the contacts
+tables), and the share of rows the Clarabel fallback decided. Nothing is run: it describes the last `make study` (or any root
 given), so run that first. The last two lines are machine-read.
 """
 
@@ -16,6 +17,8 @@ from pathlib import Path
 import pandas as pd
 
 from synergrasp import tables
+from synergrasp.optimisation.mechanics import first_same_grasp
+from synergrasp.optimisation.study import read_grasps
 
 
 def main() -> None:
@@ -30,13 +33,27 @@ def main() -> None:
     solver = pd.concat([tables.read(tables.GFO, f)["solver"] for f in gfo_files], ignore_index=True)
     n, solved = len(solver), int((solver != "none").sum())
     fallback = int((solver == "clarabel_fallback").sum())
+    own = [_solved_here(f) for f in gfo_files]
+    distinct, own_solved = sum(d for d, _ in own), sum(r for _, r in own)
     print(f"{args.root}: {len(gfo_files)} objects, {len(bench)} optimisation jobs, {cpu:.2f} CPU s of jobs")
-    print(f"(pose, set) rows: {n} ({solved} solved, {n - solved} without a solve); "
-          f"{n / cpu:.0f} rows per CPU s, {solved / cpu:.0f} solved per CPU s")
+    print(f"(pose, set) rows: {n} ({solved} decided by a solver, {n - solved} without a solve); "
+          f"{n / cpu:.0f} rows per CPU s, {solved / cpu:.0f} solver-decided rows per CPU s")
+    print(f"grasps solved once for all their poses: {distinct} distinct grasps; {own_solved} (pose, set) problems "
+          f"solved, {own_solved / cpu:.0f} per CPU s")
     print(f"fallback: {fallback} rows, {fallback / n:.4f} of all rows, {fallback / max(solved, 1):.4f} of the solved")
     print(f"study_problems_per_cpu_s: {n / cpu:.0f}  (the last study's optimisation jobs, (pose, set) rows per CPU "
           f"second, imports and I/O included)")
     print(f"study_fallback_share: {fallback / n:.4f}  (share of the last study's rows the Clarabel fallback decided)")
+
+
+def _solved_here(gfo_file: Path) -> tuple[int, int]:
+    """Of one object: its distinct grasps (poses whose grasp is the first of its kind, solved
+    rather than shared) and their rows decided by a solver."""
+    contacts = tables.read(tables.CONTACTS, gfo_file.parent / "contacts.parquet")
+    first = first_same_grasp(read_grasps(contacts))
+    own = set(contacts["pose"].to_numpy()[first == range(len(first))].tolist())
+    gfo = tables.read(tables.GFO, gfo_file)
+    return len(own), int((gfo["pose"].isin(own) & (gfo["solver"] != "none")).sum())
 
 
 if __name__ == "__main__":

@@ -180,7 +180,7 @@ def _moved(grasp, delta_mm, links=None):
 
 
 def test_same_grasp_within_round_off_only():
-    from synergrasp.optimisation.quality import same_grasp
+    from synergrasp.optimisation.mechanics import same_grasp
 
     g = _random_grasp(np.random.default_rng(3), 5)
     assert same_grasp(g, _moved(g, 1e-12))  # a box's α-period twins differ by about this

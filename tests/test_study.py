@@ -18,7 +18,7 @@ from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.ipm_kernel import IPMSettings
 from synergrasp.optimisation.problem import GraspSets, SynergySets
 from grasp_problems import random_grasp, random_synergies
-from synergrasp.optimisation.study import mechanics_for, merge_shards, optimise_grasps, shard_rows
+from synergrasp.optimisation.study import mechanics_for, merge_shards, optimise_grasps, shard_positions
 
 RTOL_NORM = 1e-4
 PARAMS = study_gfo_params(gravity_direction=(0.0, 0.0, -1.0))
@@ -52,13 +52,12 @@ def test_optimise_grasps_matches_clarabel_per_grasp():
 
 
 def test_shards_partition_the_poses_in_order():
-    contacts = pd.DataFrame({"pose": np.arange(10)})
-    parts = [shard_rows(contacts, k, 3)["pose"].tolist() for k in range(3)]
+    parts = [shard_positions(10, k, 3).tolist() for k in range(3)]
     assert parts == [[0, 1, 2, 3], [4, 5, 6], [7, 8, 9]]
     with pytest.raises(ValueError, match="shard must be an int in 0..2"):
-        shard_rows(contacts, 3, 3)
+        shard_positions(10, 3, 3)
     with pytest.raises(ValueError, match="solver.pose_shards"):
-        shard_rows(contacts, 0, 0)
+        shard_positions(10, 0, 0)
 
 
 def test_merge_shards_orders_poses_and_keeps_the_set_order():
@@ -117,3 +116,60 @@ def test_verdicts_implied_by_nested_sets_are_those_of_solving_every_set(cone):
         assert not nested["strict_internal"][infeasible].any()
         assert not nested["iterations"][implied].any()
         assert set(nested["solver"][~implied]) <= {"ipm", "clarabel_fallback"}
+
+
+def _contacts_of(grasps) -> pd.DataFrame:
+    """A contacts table holding the given grasps (None: a pose without a grasp)."""
+    rows = []
+    for pose, g in enumerate(grasps):
+        m = 0 if g is None else g.n_contacts
+        rows.append({"object": "box", "pose": pose, "alpha_deg": 5.0 * pose, "beta_deg": 0.0,
+                     "status": "no_grasp" if g is None else "grasp", "n_contacts": m,
+                     "contact_link": [] if g is None else g.links.tolist(),
+                     "contact_point": [] if g is None else g.points.ravel().tolist(),
+                     "contact_normal": [] if g is None else g.normals.ravel().tolist(),
+                     "jacobian": [] if g is None else g.jacobian.ravel().tolist(),
+                     "object_center": [0.0] * 3 if g is None else g.center.tolist()})
+    return pd.DataFrame(rows)
+
+
+def _twin(grasp, delta_mm=1e-12):
+    return type(grasp)(points=grasp.points + delta_mm, normals=grasp.normals, links=grasp.links,
+                       jacobian=grasp.jacobian, center=grasp.center)
+
+
+def test_first_same_grasp_points_each_grasp_at_the_first_of_its_kind():
+    from synergrasp.optimisation.mechanics import first_same_grasp
+
+    rng = np.random.default_rng(5)
+    a, b = random_grasp(rng, 5), random_grasp(rng, 6)
+    grasps = [a, None, b, _twin(a), _twin(b, 1e-6), _twin(b)]
+    assert first_same_grasp(grasps).tolist() == [0, -1, 2, 0, 4, 2]
+
+
+def test_gfo_table_solves_one_grasp_once_whatever_the_shards(monkeypatch):
+    from synergrasp.optimisation import study
+
+    rng = np.random.default_rng(8)
+    a, b = random_grasp(rng, 6), random_grasp(rng, 7, palm_contacts=1)
+    grasps = [a, b, None, _twin(a), _twin(b), _twin(a, 1e-6)]  # the last is not a's: solved apart
+    sets = SynergySets(random_synergies(rng), tuple(tuple(range(1, k + 1)) for k in (1, 3, 7, 15)))
+    contacts = _contacts_of(grasps)
+    solved = []
+    real = study.optimise_grasps
+    monkeypatch.setattr(study, "optimise_grasps",
+                        lambda gs, *args, **kw: solved.append(sum(g is not None for g in gs)) or real(gs, *args, **kw))
+    whole = study.gfo_table(contacts, sets, PARAMS)
+    assert solved == [3]
+    sharded = merge_shards([study.optimise_shard(contacts, k, 4, sets, PARAMS) for k in range(4)])
+    pd.testing.assert_frame_equal(sharded, whole)  # bit for bit: a twin's rows are its first's in every shard
+    n = len(sets)
+    rows = lambda p: whole.iloc[p * n:(p + 1) * n].drop(columns=["pose", "alpha_deg"]).reset_index(drop=True)  # noqa: E731
+    pd.testing.assert_frame_equal(rows(3), rows(0))
+    pd.testing.assert_frame_equal(rows(4), rows(1))
+    assert set(whole["status"].iloc[2 * n:3 * n]) == {"no_grasp"}
+    # solving every pose on its own decides the same and finds the same forces to round-off
+    alone = optimise_grasps(grasps, sets, PARAMS)
+    np.testing.assert_array_equal(whole["status"].to_numpy(), alone["status"])
+    np.testing.assert_array_equal(whole["strict_internal"].to_numpy(), alone["strict_internal"])
+    np.testing.assert_allclose(whole["force_norm"].to_numpy(), alone["force_norm"], rtol=1e-6)

@@ -9,6 +9,7 @@ components. The wrench reference point is the object centre o.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,10 +21,12 @@ __all__ = [
     "GraspMechanics",
     "contact_frames",
     "contact_stiffness",
+    "first_same_grasp",
     "grasp_matrix",
     "grasp_mechanics",
     "internal_force_basis",
     "object_wrench",
+    "same_grasp",
 ]
 
 #: Relative tolerance of the rank decision on the dimensionless grasp matrix.
@@ -32,6 +35,9 @@ GRASP_RANK_RTOL = 1e-9
 BASIS_RTOL = 1e-9
 #: How far a normal may be from unit length before it is rejected.
 _UNIT_TOL = 1e-6
+#: Two grasps are one when their contact links are equal and their points and centre (mm),
+#: normals and Jacobians (mm/rad) agree to this, entry by entry (``same_grasp``).
+SAME_GRASP_ATOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -79,6 +85,39 @@ class Grasp:
     @property
     def n_contacts(self) -> int:
         return int(self.points.shape[0])
+
+
+def same_grasp(a: Grasp, b: Grasp, atol: float = SAME_GRASP_ATOL) -> bool:
+    """Whether two grasps are one: the same contact links, and points, normals, Jacobian and
+    centre equal to ``atol`` entry by entry (mm, unit normals, mm/rad). A box's poses one
+    α-period apart fill the same region and close to the same grasp up to round-off
+    (1e-12 mm on the study's boxes)."""
+    return bool(np.array_equal(a.links, b.links) and a.jacobian.shape == b.jacobian.shape
+                and all(np.allclose(x, y, rtol=0.0, atol=atol) for x, y in
+                        ((a.points, b.points), (a.normals, b.normals), (a.center, b.center),
+                         (a.jacobian, b.jacobian))))
+
+
+def first_same_grasp(grasps: Sequence[Grasp | None]) -> NDArray:
+    """Per grasp, the index of the first grasp of the sequence that is the same one
+    (``same_grasp``; its own index for the first of its kind), -1 for None.
+
+    Whatever is computed from a grasp alone (its quality, its optimal forces) is computed
+    once, at that first index, and shared: then a pose's result depends on the first grasp
+    of its kind only, not on which other poses a job computes. Candidates are bucketed by
+    links and points rounded to 1e-6 mm; twins that straddle a rounding boundary are kept
+    apart, which only costs a computation."""
+    first = np.full(len(grasps), -1, dtype=np.intp)
+    buckets: dict[tuple, list[int]] = {}
+    for i, grasp in enumerate(grasps):
+        if grasp is None:
+            continue
+        key = (tuple(grasp.links.tolist()), tuple(np.round(grasp.points, 6).ravel().tolist()))
+        bucket = buckets.setdefault(key, [])
+        first[i] = next((j for j in bucket if same_grasp(grasp, grasps[j])), i)  # type: ignore[arg-type]
+        if first[i] == i:
+            bucket.append(i)
+    return first
 
 
 def _unit_normals(normals: NDArray, m: int | None, field: str) -> NDArray:

@@ -37,18 +37,15 @@ import pandas as pd
 from numpy.typing import NDArray
 from scipy.spatial import ConvexHull, QhullError
 
-from synergrasp.optimisation.mechanics import Grasp, contact_frames, grasp_matrix
+from synergrasp.optimisation.mechanics import Grasp, contact_frames, first_same_grasp, grasp_matrix
 
 __all__ = ["GraspQuality", "grasp_quality", "scaled_grasp_matrix", "primitive_wrenches", "ferrari_canny_l1",
-           "synergy_manipulability", "QualityParams", "quality_table", "same_grasp", "QUALITY_EDGES", "RANK_RTOL", "SAME_GRASP_ATOL"]
+           "synergy_manipulability", "QualityParams", "quality_table", "QUALITY_EDGES", "RANK_RTOL"]
 
 #: Edges of the linearised friction cone in ε (GraspIt! uses 8).
 QUALITY_EDGES = 8
 #: Singular values below this fraction of the largest count as zero (rank decisions).
 RANK_RTOL = 1e-9
-#: Two grasps are one when their contact links are equal and their points and centre (mm),
-#: normals and Jacobians (mm/rad) agree to this, entry by entry (``same_grasp``).
-SAME_GRASP_ATOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -178,45 +175,28 @@ class QualityParams:
                    grasped.shape.bounding_radius_mm)
 
 
-def same_grasp(a: Grasp, b: Grasp, atol: float = SAME_GRASP_ATOL) -> bool:
-    """Whether two grasps are one: the same contact links, and points, normals, Jacobian and
-    centre equal to ``atol`` entry by entry (mm, unit normals, mm/rad). A box's poses one
-    α-period apart fill the same region and close to the same grasp up to round-off
-    (1e-12 mm on the study's boxes)."""
-    return bool(np.array_equal(a.links, b.links) and a.jacobian.shape == b.jacobian.shape
-                and all(np.allclose(x, y, rtol=0.0, atol=atol) for x, y in
-                        ((a.points, b.points), (a.normals, b.normals), (a.center, b.center),
-                         (a.jacobian, b.jacobian))))
-
-
-def _grasp_key(grasp: Grasp) -> tuple:
-    """A bucket for grasps that may be one (links and points to 1e-6 mm); ``same_grasp`` decides."""
-    return tuple(grasp.links.tolist()), tuple(np.round(grasp.points, 6).ravel().tolist())
-
-
 def quality_table(contacts: pd.DataFrame, gfo: pd.DataFrame, grasps: Sequence[Grasp | None],
                   synergy_matrix: NDArray, params: QualityParams) -> pd.DataFrame:
     """One row per pose of ``contacts`` (columns of ``synergrasp.tables.QUALITY``): the quality
     indices of its grasp (``grasps``, one per row; None: no grasp, indices NaN) and the full
     set's verdict and optimal force over the weight from ``gfo``. Poses with one grasp
-    (``same_grasp``: a box's poses one α-period apart) share its indices, computed once at the
-    first of them: the ε hull is most of the cost."""
+    (``mechanics.first_same_grasp``: a box's poses one α-period apart) share its indices,
+    computed once at the first of them: the ε hull is most of the cost."""
     full = gfo[gfo["set_id"] == params.full_set_id]
     verdicts = {int(pose): (bool(strict and rank == 6), float(force) / params.weight_N)
                 for pose, strict, rank, force in zip(full["pose"].tolist(), full["strict_internal"].tolist(),
                                                      full["rank_G"].tolist(), full["force_norm"].tolist())}
     rows = []
-    computed: dict[tuple, list[tuple[Grasp, GraspQuality]]] = {}
-    for row, grasp in zip(contacts.itertuples(index=False), grasps):
+    first = first_same_grasp(grasps)
+    computed: dict[int, GraspQuality] = {}
+    for row, grasp, i in zip(contacts.itertuples(index=False), grasps, first):
         out = {"object": row.object, "pose": row.pose, "alpha_deg": row.alpha_deg,
                "beta_deg": row.beta_deg, "n_contacts": int(row.n_contacts), "rank_G": 0,
                "sigma_min": np.nan, "isotropy": np.nan, "epsilon": np.nan, "manipulability": [np.nan] * 6}
         if grasp is not None:
-            bucket = computed.setdefault(_grasp_key(grasp), [])
-            q = next((known for other, known in bucket if same_grasp(grasp, other)), None)
-            if q is None:
-                q = grasp_quality(grasp, params.mu, params.torque_length_mm, synergies=synergy_matrix)
-                bucket.append((grasp, q))
+            if i not in computed:
+                computed[i] = grasp_quality(grasp, params.mu, params.torque_length_mm, synergies=synergy_matrix)
+            q = computed[i]
             out.update(rank_G=q.rank_G, sigma_min=q.sigma_min, isotropy=q.isotropy, epsilon=q.epsilon,
                        manipulability=q.manipulability.tolist())
         out["force_closure"], out["force_per_weight"] = verdicts.get(int(row.pose), (False, np.nan))

@@ -27,13 +27,14 @@ from synergrasp.optimisation.mechanics import (
     GRASP_RANK_RTOL,
     Grasp,
     GraspMechanics,
+    first_same_grasp,
     grasp_mechanics,
     object_wrench,
 )
 from synergrasp.optimisation.problem import DEFAULT_TOL, STRICT_SHRINK, GraspSets, SynergySets
 
 __all__ = ["GFOParams", "OptimiseParams", "gfo_table", "mechanics_for", "merge_shards", "optimise_grasps",
-           "optimise_shard", "read_grasps", "shard_rows"]
+           "optimise_shard", "read_grasps", "shard_positions"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -213,29 +214,44 @@ def optimise_grasps(
     return out
 
 
-def gfo_table(contacts: pd.DataFrame, synergies: SynergySets, params: GFOParams, *, strict: bool = True) -> pd.DataFrame:
-    """The gfo table (columns of `tables.GFO`) of the poses of a contacts table, pose-major,
-    each pose's sets in their given order."""
+def gfo_table(contacts: pd.DataFrame, synergies: SynergySets, params: GFOParams, *, strict: bool = True,
+              rows: Sequence[int] | None = None) -> pd.DataFrame:
+    """The gfo table (columns of `tables.GFO`) of the poses of a contacts table (or of its
+    positional `rows`), pose-major, each pose's sets in their given order.
+
+    Poses with one grasp (`mechanics.first_same_grasp` over the whole table: a box's poses one
+    α-period apart) share one solve, of the first of them: every row of a pose is a function
+    of that grasp alone, the same whichever rows a shard takes."""
+    grasps = read_grasps(contacts)
+    first = first_same_grasp(grasps)
+    picked = np.arange(len(contacts)) if rows is None else np.asarray(rows, dtype=np.intp)
+    solved = np.unique(first[picked][first[picked] >= 0])
+    # one block of n_sets rows per solved grasp, and a last block of no_grasp rows
+    block = np.searchsorted(solved, first[picked])
+    block[first[picked] < 0] = len(solved)
+    out = optimise_grasps([grasps[i] for i in solved] + [None], synergies, params, strict=strict)
     n_sets = len(synergies)
-    table = pd.DataFrame({c: np.repeat(contacts[c].to_numpy(), n_sets) for c in ("object", "pose", "alpha_deg", "beta_deg")})
-    for name, column in optimise_grasps(read_grasps(contacts), synergies, params, strict=strict).items():
-        table[name] = column
+    take = (block[:, None] * n_sets + np.arange(n_sets)).ravel()
+    part = contacts.iloc[picked]
+    table = pd.DataFrame({c: np.repeat(part[c].to_numpy(), n_sets) for c in ("object", "pose", "alpha_deg", "beta_deg")})
+    for name, column in out.items():
+        table[name] = column[take]
     return table
 
 
-def shard_rows(contacts: pd.DataFrame, shard: int, n_shards: int) -> pd.DataFrame:
-    """The poses of shard `shard` of `n_shards`: consecutive rows, sizes differing by at most one."""
+def shard_positions(n_poses: int, shard: int, n_shards: int) -> NDArray:
+    """Positions of shard `shard` of `n_shards` among `n_poses` rows: consecutive, sizes differing by at most one."""
     if not (isinstance(n_shards, (int, np.integer)) and n_shards >= 1):
         raise ValueError(f"n_shards (solver.pose_shards) must be an int >= 1, got {n_shards!r}")
     if not (isinstance(shard, (int, np.integer)) and 0 <= shard < n_shards):
         raise ValueError(f"shard must be an int in 0..{n_shards - 1}, got {shard!r}")
-    return contacts.iloc[np.array_split(np.arange(len(contacts)), n_shards)[shard]]
+    return np.array_split(np.arange(n_poses), n_shards)[shard]
 
 
 def optimise_shard(contacts: pd.DataFrame, shard: int, n_shards: int, synergies: SynergySets,
                    params: GFOParams) -> pd.DataFrame:
     """The gfo table of one shard of an object's contacts table."""
-    return gfo_table(shard_rows(contacts, shard, n_shards), synergies, params)
+    return gfo_table(contacts, synergies, params, rows=shard_positions(len(contacts), shard, n_shards))
 
 
 def merge_shards(shards: Sequence[pd.DataFrame]) -> pd.DataFrame:
