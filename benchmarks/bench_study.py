@@ -17,8 +17,7 @@ from pathlib import Path
 import pandas as pd
 
 from synergrasp import tables
-from synergrasp.optimisation.mechanics import first_same_grasp
-from synergrasp.optimisation.study import read_grasps
+from synergrasp.optimisation.mechanics import first_same_grasp, read_grasps
 
 
 def main() -> None:

@@ -11,7 +11,7 @@ import pytest
 from conftest import study_closure_params, study_placement
 from synergrasp.config import ConfigError, defaults, validate_config
 from synergrasp.simulation.closure import simulate_object
-from synergrasp.optimisation.study import read_grasps
+from synergrasp.optimisation.mechanics import read_grasps
 from synergrasp.simulation.contacts import write_contacts
 from synergrasp.simulation.placement import approach_line, object_pose, palm_centre, pose_grid
 from synergrasp.hand.kinematics import forward_kinematics
@@ -35,7 +35,9 @@ def sample(hand, synergies, grid):
     """A spread of poses of two boxes, plus the same poses turned by α + 180°."""
     base = [grid.index(a, b) for a, b in [(-180, 0), (-90, 30), (-30, -60), (5, 10), (45, 20), (10, -25)]]
     mirrored = [(p + 36 * grid.n_beta) % grid.n_poses for p in base]
-    tables = {box.name: simulate_object(hand, synergies, box, PLACEMENT, PARAMS, poses=base + mirrored)
+    # two runs: within one, a mirrored pose would share its base pose's closure (same region)
+    tables = {box.name: pd.concat([simulate_object(hand, synergies, box, PLACEMENT, PARAMS, poses=poses)
+                                   for poses in (base, mirrored)], ignore_index=True)
               for box in (CUBE, PLATE)}
     return base, mirrored, tables
 
@@ -171,6 +173,29 @@ def test_alpha_plus_180_gives_the_same_grasp(sample):
             np.testing.assert_allclose(a.loc[p, "q"], a.loc[r, "q"], atol=1e-6)
             assert list(a.loc[p, "contact_link"]) == list(a.loc[r, "contact_link"])
             np.testing.assert_allclose(a.loc[p, "contact_point"], a.loc[r, "contact_point"], atol=1e-4)
+
+
+def test_one_region_one_closure_within_a_run(hand, synergies, sample, monkeypatch):
+    """Poses that fill one region share the first one's closure (every contact column equal),
+    each keeping its own pose columns; a region seen once is closed once."""
+    from synergrasp.simulation import kinematic_closure
+
+    base, mirrored, tables = sample
+    calls = []
+    real = kinematic_closure.KinematicClosure.grasp
+    monkeypatch.setattr(kinematic_closure.KinematicClosure, "grasp",
+                        lambda self, placed: calls.append(1) or real(self, placed))
+    both = simulate_object(hand, synergies, PLATE, PLACEMENT, PARAMS, poses=base + mirrored)
+    assert len(calls) == len(base)
+    n = len(base)
+    for col in ("status", "q", "contact_link", "contact_point", "contact_normal", "jacobian", "max_penetration_mm"):
+        assert both[col].iloc[:n].tolist() == both[col].iloc[n:].tolist(), col
+    assert both["pose"].tolist() == base + mirrored
+    assert not np.allclose(np.stack(both["object_rotation"].iloc[:n]), np.stack(both["object_rotation"].iloc[n:]))
+    # the shared rows are the separate closures' to round-off
+    apart = tables["obj2"]
+    np.testing.assert_allclose(np.concatenate(both["contact_point"].tolist()),
+                               np.concatenate(apart["contact_point"].tolist()), atol=1e-9)
 
 
 def test_jacobian_rows_match_finite_differences_of_fk(hand, sample):

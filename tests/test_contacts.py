@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from synergrasp import tables
-from synergrasp.optimisation.study import read_grasps
+from synergrasp.optimisation.mechanics import read_grasps
 from synergrasp.simulation.contacts import load_carrying_contacts
 
 

@@ -85,12 +85,34 @@ def test_s1_push_angles_and_the_outside_count_on_a_hand_made_contact():
     assert np.isnan(angles[3])
     contacts = pd.DataFrame([{"object": "a", "closure_model": "kinematic", "pose": 3, "status": "grasp",
                               "n_contacts": 4, "q": [0.0, 0.0], "jacobian": J.ravel().tolist(),
-                              "contact_normal": normals.ravel().tolist()}])
+                              "contact_normal": normals.ravel().tolist(), "contact_link": [1, 2, 3, 4],
+                              "contact_point": [0.0] * 12, "object_center": [0.0] * 3}])
     row = grasp_equilibrium(contacts, EquilibriumParams(200.0, 1.5, np.array([0.1, 0.0])), synergy).iloc[0]
     assert (row["s1_outside_cone"], row["s1_pushed_contacts"]) == (2, 3)
     # τ = k_ss (q_r − q) = (20, 0) N·mm on the two joints, both moving a contact
     assert row["torque_box_Nmm"] == pytest.approx(20.0)
     assert row["torque_other_Nmm"] == 0.0
+
+
+def test_one_grasp_in_one_posture_is_checked_once(monkeypatch):
+    """Rows with one grasp and one posture (a box's α-period twins) share the first row's
+    checks; the same grasp in another posture is checked on its own."""
+    from synergrasp.optimisation import equilibrium
+
+    rng = np.random.default_rng(7)
+    J, normals = rng.normal(size=(9, 2)), np.tile([1.0, 0.0, 0.0], (3, 1))
+    row = {"object": "a", "closure_model": "kinematic", "status": "grasp", "n_contacts": 3,
+           "jacobian": J.ravel().tolist(), "contact_normal": normals.ravel().tolist(), "contact_link": [1, 2, 3],
+           "contact_point": rng.normal(size=9).tolist(), "object_center": [0.0] * 3}
+    contacts = pd.DataFrame([{**row, "pose": 0, "q": [0.0, 0.0]}, {**row, "pose": 1, "q": [0.0, 1e-13]},
+                             {**row, "pose": 2, "q": [0.0, 0.2]}])
+    calls = []
+    real = equilibrium._one
+    monkeypatch.setattr(equilibrium, "_one", lambda r, *a: calls.append(r.pose) or real(r, *a))
+    out = grasp_equilibrium(contacts, EquilibriumParams(200.0, 1.0, np.array([0.1, 0.3])), np.array([1.0, 0.0]))
+    assert calls == [0, 2]
+    assert out.iloc[0].drop("pose").equals(out.iloc[1].drop("pose"))
+    assert out["torque_box_Nmm"].iloc[2] != out["torque_box_Nmm"].iloc[0]
 
 
 def test_the_residual_agrees_with_an_independent_cvxpy_model():

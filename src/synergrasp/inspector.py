@@ -178,7 +178,8 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import load_synergies
     from synergrasp.optimisation.problem import SynergySets
-    from synergrasp.optimisation.study import OptimiseParams, optimise_grasps, read_grasps
+    from synergrasp.optimisation.mechanics import read_grasps
+    from synergrasp.optimisation.study import OptimiseParams, optimise_grasps
     from synergrasp.simulation.closure import SimulateParams, simulate_object
     from synergrasp.simulation.contacts import ContactsParams, load_carrying_contacts
 
@@ -194,7 +195,7 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     full = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
     chosen = default_sets(full.matrix.shape[1]) if sets is None else [tuple(sorted(set(s))) for s in sets]
     table = simulate_object(hand, sim.synergies(hand.joint_names), sim.object, placement, sim.closure,
-                            poses=[pose], mechanics=sim.mechanics)
+                            poses=[pose], mechanics=sim.mechanics, as_in_grid=True)
     selection = ContactsParams.from_config(cfg, obj)
     if selection.drop_unloaded:
         table = load_carrying_contacts(table, selection.load_threshold_N)

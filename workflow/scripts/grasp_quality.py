@@ -6,7 +6,7 @@ from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
 from synergrasp.optimisation.quality import QualityParams, quality_table
-from synergrasp.optimisation.study import read_grasps
+from synergrasp.optimisation.mechanics import read_grasps
 
 with job_log(snakemake.log[0]):
     params = QualityParams.from_config(snakemake.params.cfg, snakemake.wildcards.object)

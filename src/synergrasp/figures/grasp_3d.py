@@ -257,7 +257,8 @@ def fig2_scenes(hand: Any, synergy_matrix: NDArray, params: Grasps3dParams,
     from synergrasp.analysis.realism import representative_grasps
     from synergrasp.figures.hand_figures import FIG2_GRASPS, object_of
     from synergrasp.optimisation.problem import SynergySets
-    from synergrasp.optimisation.study import optimise_grasps, read_grasps
+    from synergrasp.optimisation.mechanics import read_grasps
+    from synergrasp.optimisation.study import optimise_grasps
 
     sets = SynergySets(np.asarray(synergy_matrix, dtype=float), (params.full_set,))
     name_of_set = set_name(params.full_set)

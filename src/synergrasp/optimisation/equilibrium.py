@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from synergrasp.optimisation.mechanics import contact_frames
+from synergrasp.optimisation.mechanics import SAME_GRASP_ATOL, contact_frames, first_same_grasp, read_grasps
 
 __all__ = ["EquilibriumParams", "torque_residual", "push_angles_deg", "grasp_equilibrium", "EQUILIBRIUM_COLUMNS"]
 
@@ -146,9 +146,17 @@ def grasp_equilibrium(contacts: pd.DataFrame, params: EquilibriumParams, synergy
     ``synergy``: S1 (n,), rad per unit σ. Returns one row per grasp: ``object``,
     ``closure_model``, ``pose`` and :data:`EQUILIBRIUM_COLUMNS` (``torque_residual``
     dimensionless, the torque norms N·mm, ``s1_outside_cone`` and ``s1_pushed_contacts``
-    counts of contacts).
+    counts of contacts). A grasp that is one with an earlier row's (``first_same_grasp``: a
+    box's poses one α-period apart) and ends in the same posture (q to ``SAME_GRASP_ATOL``
+    rad) shares that row's checks, which depend on nothing else.
     """
     grasps = contacts[(contacts["status"] == "grasp") & (contacts["n_contacts"] > 0)]
-    rows = [{"object": r.object, "closure_model": r.closure_model, "pose": int(r.pose), **_one(r, params, synergy)}
-            for r in grasps.itertuples(index=False)]
+    first = first_same_grasp(read_grasps(grasps))
+    checks: list[dict[str, float]] = []
+    for i, r in enumerate(grasps.itertuples(index=False)):
+        j = int(first[i])
+        same = j != i and np.allclose(r.q, grasps["q"].iat[j], rtol=0.0, atol=SAME_GRASP_ATOL)
+        checks.append(checks[j] if same else _one(r, params, synergy))
+    rows = [{"object": r.object, "closure_model": r.closure_model, "pose": int(r.pose), **c}
+            for r, c in zip(grasps.itertuples(index=False), checks)]
     return pd.DataFrame(rows, columns=["object", "closure_model", "pose", *EQUILIBRIUM_COLUMNS])

@@ -26,6 +26,7 @@ __all__ = [
     "grasp_mechanics",
     "internal_force_basis",
     "object_wrench",
+    "read_grasps",
     "same_grasp",
 ]
 
@@ -118,6 +119,33 @@ def first_same_grasp(grasps: Sequence[Grasp | None]) -> NDArray:
         if first[i] == i:
             bucket.append(i)
     return first
+
+
+def read_grasps(table) -> list[Grasp | None]:
+    """One :class:`synergrasp.optimisation.mechanics.Grasp` per row of a contacts table, in row order.
+
+    Rows whose status is not ``grasp`` or that have no contact give ``None``. Reads only
+    numbers: pybullet is not imported.
+    """
+    missing = [c for c in ("status", "n_contacts", "contact_link", "contact_point", "contact_normal",
+                           "jacobian", "object_center") if c not in table.columns]
+    if missing:
+        raise ValueError(f"contacts table: missing column(s) {missing}")
+    grasps: list[Grasp | None] = []
+    for row in table.itertuples(index=False):
+        m = int(row.n_contacts)
+        if row.status != "grasp" or m == 0:
+            grasps.append(None)
+            continue
+        jac = np.asarray(row.jacobian, dtype=float)
+        grasps.append(Grasp(
+            points=np.asarray(row.contact_point, dtype=float).reshape(m, 3),
+            normals=np.asarray(row.contact_normal, dtype=float).reshape(m, 3),
+            links=np.asarray(row.contact_link, dtype=np.int64),
+            jacobian=jac.reshape(3 * m, jac.size // (3 * m)),
+            center=np.asarray(row.object_center, dtype=float),
+        ))
+    return grasps
 
 
 def _unit_normals(normals: NDArray, m: int | None, field: str) -> NDArray:

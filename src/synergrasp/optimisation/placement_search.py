@@ -26,7 +26,8 @@ from numpy.typing import NDArray
 from synergrasp import tables
 from synergrasp.config import build, dataclass_fields, overlay
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.study import GFOParams, optimise_grasps, read_grasps
+from synergrasp.optimisation.mechanics import read_grasps
+from synergrasp.optimisation.study import GFOParams, optimise_grasps
 from synergrasp.simulation.contacts import contacts_row, contacts_table
 from synergrasp.simulation.closure_params import ClosureParams
 from synergrasp.simulation.objects import GraspedObject

@@ -29,12 +29,13 @@ from synergrasp.optimisation.mechanics import (
     GraspMechanics,
     first_same_grasp,
     grasp_mechanics,
+    read_grasps,
     object_wrench,
 )
 from synergrasp.optimisation.problem import DEFAULT_TOL, STRICT_SHRINK, GraspSets, SynergySets
 
 __all__ = ["GFOParams", "OptimiseParams", "gfo_table", "mechanics_for", "merge_shards", "optimise_grasps",
-           "optimise_shard", "read_grasps", "shard_positions"]
+           "optimise_shard", "shard_positions"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -118,33 +119,6 @@ class OptimiseParams:
         """From a configuration or the step's own part of it, for the object ``obj``."""
         return cls(config["synergies"], synergy_sets(config["synergy_sets"]), GFOParams.from_config(config, obj),
                    int(config["solver"]["pose_shards"]))
-
-
-def read_grasps(table: pd.DataFrame) -> list[Grasp | None]:
-    """One :class:`synergrasp.optimisation.mechanics.Grasp` per row of a contacts table, in row order.
-
-    Rows whose status is not ``grasp`` or that have no contact give ``None``. Reads only
-    numbers: pybullet is not imported.
-    """
-    missing = [c for c in ("status", "n_contacts", "contact_link", "contact_point", "contact_normal",
-                           "jacobian", "object_center") if c not in table.columns]
-    if missing:
-        raise ValueError(f"contacts table: missing column(s) {missing}")
-    grasps: list[Grasp | None] = []
-    for row in table.itertuples(index=False):
-        m = int(row.n_contacts)
-        if row.status != "grasp" or m == 0:
-            grasps.append(None)
-            continue
-        jac = np.asarray(row.jacobian, dtype=float)
-        grasps.append(Grasp(
-            points=np.asarray(row.contact_point, dtype=float).reshape(m, 3),
-            normals=np.asarray(row.contact_normal, dtype=float).reshape(m, 3),
-            links=np.asarray(row.contact_link, dtype=np.int64),
-            jacobian=jac.reshape(3 * m, jac.size // (3 * m)),
-            center=np.asarray(row.object_center, dtype=float),
-        ))
-    return grasps
 
 
 def mechanics_for(grasp: Grasp, params: GFOParams) -> GraspMechanics:

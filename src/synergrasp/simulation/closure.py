@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from synergrasp.config import build, dataclass_fields, overlay
 from synergrasp.hand.synergies import Synergies, synergy_values
 from synergrasp.simulation.closure_params import ClosureMechanics, ClosureParams, DynamicParams
-from synergrasp.simulation.contacts import contacts_row, contacts_table
+from synergrasp.simulation.contacts import ClosureResult, contacts_row, contacts_table
 from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.placement import ObjectPose, Placement, approach_line, object_pose, pose_grid
 from synergrasp.simulation.scene import HandScene
@@ -104,12 +104,15 @@ def place_object(scene: HandScene, q_open: NDArray, placement: Placement, shape:
 
 def simulate_object(hand: Hand, synergies: Synergies, grasped: GraspedObject, placement: Placement,
                     closure_params: ClosureParams, poses: Iterable[int] | None = None,
-                    mechanics: ClosureMechanics | None = None) -> pd.DataFrame:
+                    mechanics: ClosureMechanics | None = None, *, as_in_grid: bool = False) -> pd.DataFrame:
     """Close the hand on the object ``grasped`` (name, shape, mass) at every pose of the
     placement's grid (or at ``poses``).
 
     Returns the contacts table (``synergrasp.tables.CONTACTS``, one row per pose, in the
-    order of ``poses``). Deterministic.
+    order of ``poses``). Deterministic. With the kinematic model a pose whose box fills the
+    region of an earlier pose of the run shares that pose's closure (``_RegionResults``);
+    ``as_in_grid=True`` closes each of ``poses`` at the first pose of the whole grid that fills
+    its region, so that its row is the whole grid's run's row bit for bit (the inspector).
     """
     grid = pose_grid(placement)
     pose_list = list(range(grid.n_poses)) if poses is None else [int(v) for v in poses]
@@ -119,16 +122,65 @@ def simulate_object(hand: Hand, synergies: Synergies, grasped: GraspedObject, pl
     shape = grasped.shape
     model = closure_model(hand, synergies, closure_params, mechanics, grasped.mass_kg)
     placer = HandScene(hand)  # the open hand the box is brought to (placement)
+    # the kinematic closure sees only the region the box fills: one region, one closure
+    shared = _RegionResults(shape) if closure_params.model == "kinematic" else None
     try:
         rows = []
         for pose in pose_list:
             a, b = grid.angles_deg(pose)
             placed = place_object(placer, model.q_open, placement, shape, a, b)
-            rows.append(contacts_row(str(grasped.name), pose, a, b, model.grasp(placed), placed))
+            if shared is not None and as_in_grid and shared.get(placed) is None:
+                first = next((other for other in (place_object(placer, model.q_open, placement, shape,
+                                                               *grid.angles_deg(earlier)) for earlier in range(pose))
+                              if shared.same(other, placed)), placed)
+                shared.add(first, model.grasp(first))
+            result = None if shared is None else shared.get(placed)
+            if result is None:
+                result = model.grasp(placed)
+                if shared is not None:
+                    shared.add(placed, result)
+            rows.append(contacts_row(str(grasped.name), pose, a, b, result, placed))
     finally:
         model.close()
         placer.close()
     return contacts_table(rows)
+
+
+#: Unit directions (palm frame) of the rays that tell regions apart in ``_RegionResults``:
+#: none along a palm axis or a diagonal, so that symmetric but distinct regions differ.
+_PROBES = np.array([[1.0, 2.0, 3.0], [-2.0, 1.0, 1.5], [1.5, -1.0, 2.5], [3.0, 1.0, -2.0]])
+_PROBES /= np.linalg.norm(_PROBES, axis=1, keepdims=True)
+
+
+class _RegionResults:
+    """Closure results by the region the placed box fills (``Shape.same_region``: a box's poses
+    one α-period apart): the kinematic closure of the first pose in a region serves every
+    later pose in it. Candidates are bucketed by the centre and the entry distances of four
+    fixed rays aimed at it, rounded to 1e-6 mm (both depend on the region only); twins
+    straddling a rounding boundary are closed apart, at the cost of a closure."""
+
+    def __init__(self, shape: Shape) -> None:
+        self.shape = shape
+        self.buckets: dict[tuple[float, ...], list[tuple[ObjectPose, ClosureResult]]] = {}
+
+    def _key(self, placed: ObjectPose) -> tuple[float, ...]:
+        center, rotation = np.asarray(placed.center_mm, dtype=float), np.asarray(placed.rotation, dtype=float)
+        reach = 2.0 * self.shape.bounding_radius_mm
+        # rays from outside toward the centre, in the shape's own frame (Rᵀ v = v R)
+        t, _, _ = self.shape.ray_hits((reach * _PROBES) @ rotation, -_PROBES @ rotation)
+        return tuple(np.round(np.concatenate([center, t]), 6).tolist())
+
+    def same(self, a: ObjectPose, b: ObjectPose) -> bool:
+        """Whether ``a`` and ``b`` are one region by the rule ``get`` applies."""
+        return self._key(a) == self._key(b) and self.shape.same_region(a.rotation, a.center_mm, b.rotation, b.center_mm)
+
+    def get(self, placed: ObjectPose) -> ClosureResult | None:
+        return next((result for other, result in self.buckets.get(self._key(placed), [])
+                     if self.shape.same_region(other.rotation, other.center_mm, placed.rotation, placed.center_mm)),
+                    None)
+
+    def add(self, placed: ObjectPose, result: ClosureResult) -> None:
+        self.buckets.setdefault(self._key(placed), []).append((placed, result))
 
 
 def warm_up() -> None:
