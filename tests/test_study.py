@@ -18,7 +18,8 @@ from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.ipm_kernel import IPMSettings
 from synergrasp.optimisation.problem import GraspSets, SynergySets
 from grasp_problems import random_grasp, random_synergies
-from synergrasp.optimisation.study import mechanics_for, merge_shards, optimise_grasps, shard_positions
+from synergrasp.optimisation.shards import merge_shards, shard_positions
+from synergrasp.optimisation.study import mechanics_for, optimise_grasps
 
 RTOL_NORM = 1e-4
 PARAMS = study_gfo_params(gravity_direction=(0.0, 0.0, -1.0))

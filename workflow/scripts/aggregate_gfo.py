@@ -2,7 +2,7 @@
 
 from synergrasp import tables
 from synergrasp.job_log import job_log
-from synergrasp.optimisation.study import merge_shards
+from synergrasp.optimisation.shards import merge_shards
 
 with job_log(snakemake.log[0]):
     shards = [tables.read(tables.GFO, path) for path in snakemake.input.shards]

@@ -33,9 +33,9 @@ from synergrasp.optimisation.mechanics import (
     object_wrench,
 )
 from synergrasp.optimisation.problem import DEFAULT_TOL, STRICT_SHRINK, GraspSets, SynergySets
+from synergrasp.optimisation.shards import shard_positions
 
-__all__ = ["GFOParams", "OptimiseParams", "gfo_table", "mechanics_for", "merge_shards", "optimise_grasps",
-           "optimise_shard", "shard_positions"]
+__all__ = ["GFOParams", "OptimiseParams", "gfo_table", "mechanics_for", "optimise_grasps", "optimise_shard"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -213,21 +213,7 @@ def gfo_table(contacts: pd.DataFrame, synergies: SynergySets, params: GFOParams,
     return table
 
 
-def shard_positions(n_poses: int, shard: int, n_shards: int) -> NDArray:
-    """Positions of shard `shard` of `n_shards` among `n_poses` rows: consecutive, sizes differing by at most one."""
-    if not (isinstance(n_shards, (int, np.integer)) and n_shards >= 1):
-        raise ValueError(f"n_shards (solver.pose_shards) must be an int >= 1, got {n_shards!r}")
-    if not (isinstance(shard, (int, np.integer)) and 0 <= shard < n_shards):
-        raise ValueError(f"shard must be an int in 0..{n_shards - 1}, got {shard!r}")
-    return np.array_split(np.arange(n_poses), n_shards)[shard]
-
-
 def optimise_shard(contacts: pd.DataFrame, shard: int, n_shards: int, synergies: SynergySets,
                    params: GFOParams) -> pd.DataFrame:
     """The gfo table of one shard of an object's contacts table."""
     return gfo_table(contacts, synergies, params, rows=shard_positions(len(contacts), shard, n_shards))
-
-
-def merge_shards(shards: Sequence[pd.DataFrame]) -> pd.DataFrame:
-    """One object's gfo table from its shards, in pose order (each pose's sets keep their order)."""
-    return pd.concat(shards, ignore_index=True).sort_values("pose", kind="stable", ignore_index=True)
