@@ -47,8 +47,14 @@ def main() -> None:
 
 def _solved_here(gfo_file: Path) -> tuple[int, int]:
     """Of one object: its distinct grasps (poses whose grasp is the first of its kind, solved
-    rather than shared) and their rows decided by a solver."""
-    contacts = tables.read(tables.CONTACTS, gfo_file.parent / "contacts.parquet")
+    rather than shared) and their rows decided by a solver. Reads the contacts the optimisation
+    read when they are in the object's folder: the load-carrying selection if the run made one,
+    else the closure's table; (0, 0) if neither is there (a step shared from another root)."""
+    folder = gfo_file.parent
+    found = [f for f in (folder / "load_carrying_contacts.parquet", folder / "contacts.parquet") if f.exists()]
+    if not found:
+        return 0, 0
+    contacts = tables.read(tables.CONTACTS, found[0])
     first = first_same_grasp(read_grasps(contacts))
     own = set(contacts["pose"].to_numpy()[first == range(len(first))].tolist())
     gfo = tables.read(tables.GFO, gfo_file)

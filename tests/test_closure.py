@@ -198,6 +198,18 @@ def test_one_region_one_closure_within_a_run(hand, synergies, sample, monkeypatc
                                np.concatenate(apart["contact_point"].tolist()), atol=1e-9)
 
 
+def test_a_pose_alone_as_in_the_grid_is_the_grid_runs_row(hand, synergies, sample):
+    """``as_in_grid``: one pose closed alone gives the row a run over the grid gives it, bit
+    for bit (closed at the grid's first pose of its region, here α = −180°)."""
+    base, mirrored, _ = sample
+    grid_run = simulate_object(hand, synergies, PLATE, PLACEMENT, PARAMS, poses=[base[0], mirrored[0]]).iloc[1]
+    alone = simulate_object(hand, synergies, PLATE, PLACEMENT, PARAMS, poses=[mirrored[0]], as_in_grid=True).iloc[0]
+    plain = simulate_object(hand, synergies, PLATE, PLACEMENT, PARAMS, poses=[mirrored[0]]).iloc[0]
+    for col in ("q", "contact_point", "contact_normal", "jacobian", "object_rotation"):
+        assert list(alone[col]) == list(grid_run[col]), col
+    assert list(plain["contact_point"]) != list(grid_run["contact_point"])  # closed on its own: round-off apart
+
+
 def test_jacobian_rows_match_finite_differences_of_fk(hand, sample):
     _, _, tables = sample
     checked = 0
@@ -225,7 +237,8 @@ def test_jacobian_rows_match_finite_differences_of_fk(hand, sample):
 def empty_hand(hand, synergies):
     """Closures with nothing to grasp (the box 600 mm away)."""
     far = study_placement(mode="fixed", center_mm=(600.0, 0.0, 0.0))
-    return simulate_object(hand, synergies, CUBE, far, PARAMS, poses=[0, 900])
+    return pd.concat([simulate_object(hand, synergies, CUBE, far, PARAMS, poses=[p]) for p in (0, 900)],
+                     ignore_index=True)
 
 
 def test_closing_on_nothing_ends_at_limits_or_blocked_by_the_hand(hand, synergies, empty_hand):

@@ -163,6 +163,23 @@ def test_deterministic_on_rerun_and_whatever_ran_before(hand, synergies):
     assert after.iloc[2]["closure_model"] == "dynamic"
 
 
+def test_twins_are_closed_each_on_their_own(hand, synergies, monkeypatch):
+    """A free box ends differently at poses that fill one region (docs/closure.md): unlike the
+    kinematic model's, the dynamic model's closures are never shared."""
+    from synergrasp.simulation import dynamic_closure
+    from synergrasp.simulation.placement import pose_grid
+
+    params = study_closure_params(model="dynamic", dynamic=study_dynamic_params(time_limit_s=0.2))
+    box, placement = GraspedObject("obj1", Box((30.0, 30.0, 30.0)), 1.0), study_placement()
+    grid = pose_grid(placement)
+    calls = []
+    real = dynamic_closure.DynamicClosure.grasp
+    monkeypatch.setattr(dynamic_closure.DynamicClosure, "grasp", lambda self, placed: calls.append(1) or real(self, placed))
+    table = simulate_object(hand, synergies, box, placement, params, poses=[grid.index(-30.0, 0.0), grid.index(60.0, 0.0)],
+                            mechanics=MECHANICS)
+    assert len(calls) == 2 and list(table["closure_model"]) == ["dynamic", "dynamic"]
+
+
 def test_settled_box_carries_a_near_zero_net_contact_wrench(model, hand):
     """Gravity off: the box at rest between palm, thumb and fingers feels no net wrench from
     its contacts (force within 5 % of the summed contact-force magnitudes; moment about its

@@ -189,21 +189,26 @@ def optimise_grasps(
 
 
 def gfo_table(contacts: pd.DataFrame, synergies: SynergySets, params: GFOParams, *, strict: bool = True,
-              rows: Sequence[int] | None = None) -> pd.DataFrame:
-    """The gfo table (columns of `tables.GFO`) of the poses of a contacts table (or of its
-    positional `rows`), pose-major, each pose's sets in their given order.
+              shard: int = 0, n_shards: int = 1) -> pd.DataFrame:
+    """The gfo table (columns of `tables.GFO`) of the poses of a contacts table, or of shard
+    `shard` of `n_shards` of them, in pose order, each pose's sets in their given order.
 
     Poses with one grasp (`mechanics.first_same_grasp` over the whole table: a box's poses one
-    α-period apart) share one solve, of the first of them: every row of a pose is a function
-    of that grasp alone, the same whichever rows a shard takes."""
+    α-period apart) share one solve, of the first of them, so every row of a pose is a function
+    of that grasp alone, the same for any number of shards. A shard takes an equal share of
+    the distinct grasps (`shards.shard_positions` over them) with every pose that has one of
+    them, and its share of the poses without a grasp (over the table's positions)."""
     grasps = read_grasps(contacts)
     first = first_same_grasp(grasps)
-    picked = np.arange(len(contacts)) if rows is None else np.asarray(rows, dtype=np.intp)
-    solved = np.unique(first[picked][first[picked] >= 0])
+    kinds = np.unique(first[first >= 0])
+    mine = kinds[shard_positions(len(kinds), shard, n_shards)]
+    bare = np.flatnonzero(first < 0)
+    bare = bare[np.isin(bare, shard_positions(len(contacts), shard, n_shards))]
+    picked = np.union1d(np.flatnonzero(np.isin(first, mine)), bare)
     # one block of n_sets rows per solved grasp, and a last block of no_grasp rows
-    block = np.searchsorted(solved, first[picked])
-    block[first[picked] < 0] = len(solved)
-    out = optimise_grasps([grasps[i] for i in solved] + [None], synergies, params, strict=strict)
+    block = np.searchsorted(mine, first[picked])
+    block[first[picked] < 0] = len(mine)
+    out = optimise_grasps([grasps[i] for i in mine] + [None], synergies, params, strict=strict)
     n_sets = len(synergies)
     take = (block[:, None] * n_sets + np.arange(n_sets)).ravel()
     part = contacts.iloc[picked]
@@ -215,5 +220,5 @@ def gfo_table(contacts: pd.DataFrame, synergies: SynergySets, params: GFOParams,
 
 def optimise_shard(contacts: pd.DataFrame, shard: int, n_shards: int, synergies: SynergySets,
                    params: GFOParams) -> pd.DataFrame:
-    """The gfo table of one shard of an object's contacts table."""
-    return gfo_table(contacts, synergies, params, rows=shard_positions(len(contacts), shard, n_shards))
+    """The gfo table of one shard of an object's contacts table (`gfo_table`)."""
+    return gfo_table(contacts, synergies, params, shard=shard, n_shards=n_shards)

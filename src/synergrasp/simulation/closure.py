@@ -180,6 +180,8 @@ class _RegionResults:
                     None)
 
     def add(self, placed: ObjectPose, result: ClosureResult) -> None:
+        if result.settled_pose is not None:  # a box that moved is no longer the region's
+            raise ValueError("a closure that moves the box cannot be shared between poses")
         self.buckets.setdefault(self._key(placed), []).append((placed, result))
 
 

@@ -126,9 +126,11 @@ class Cylinder(Shape):
 
     def same_region(self, rotation_a: NDArray, center_a: NDArray, rotation_b: NDArray, center_b: NDArray) -> bool:
         tol = 1e-9 * max(self.radius_mm, self.height_mm) + 1e-12
-        axes = abs(float(rotation_a[:, 2] @ rotation_b[:, 2]))
+        # the axes' angle θ moves the rim and the end faces by about sin θ times the bounding
+        # radius (1 − cos θ would accept θ up to √(2 tol / R))
+        sine = float(np.linalg.norm(np.cross(rotation_a[:, 2], rotation_b[:, 2])))
         return (float(np.linalg.norm(np.asarray(center_a) - np.asarray(center_b))) <= tol
-                and (1.0 - axes) * self.bounding_radius_mm <= tol)
+                and sine * self.bounding_radius_mm <= tol)
 
     def collision_geometry(self) -> tuple[str, dict[str, Any]]:
         return "cylinder", {"radius_mm": self.radius_mm, "height_mm": self.height_mm}

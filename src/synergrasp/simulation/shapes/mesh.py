@@ -128,6 +128,10 @@ class Mesh(Shape):
         self._params.setflags(write=False)
         object.__setattr__(self, "_every", geometry.vertices)
         object.__setattr__(self, "_hull", self._every[ConvexHull(self._every).vertices])
+        # the parts' vertices and centroids: a turn that maps the vertices onto themselves but
+        # the parts onto other places (two wedges of a bow-tie) moves a centroid
+        object.__setattr__(self, "_landmarks", np.vstack([self._every,
+                                                          [np.mean(part, axis=0) for part in geometry.parts]]))
 
     @property
     def bounding_radius_mm(self) -> float:
@@ -185,11 +189,11 @@ class Mesh(Shape):
         return float(best), point
 
     def same_region(self, rotation_a: NDArray, center_a: NDArray, rotation_b: NDArray, center_b: NDArray) -> bool:
-        # a symmetry maps the parts' vertices onto themselves (none declared: found or not)
+        # a symmetry maps the parts' vertices and centroids onto themselves (none declared: found or not)
         from scipy.spatial import cKDTree
 
         tol = 1e-9 * max(self.geometry.size) + 1e-12
-        a, b = self._every @ rotation_a.T + center_a, self._every @ rotation_b.T + center_b
+        a, b = self._landmarks @ rotation_a.T + center_a, self._landmarks @ rotation_b.T + center_b
         return bool(cKDTree(b).query(a)[0].max() <= tol and cKDTree(a).query(b)[0].max() <= tol)
 
     def collision_geometry(self) -> tuple[str, dict[str, Any]]:
