@@ -129,12 +129,14 @@ def simulate_object(hand: Hand, synergies: Synergies, grasped: GraspedObject, pl
         for pose in pose_list:
             a, b = grid.angles_deg(pose)
             placed = place_object(placer, model.q_open, placement, shape, a, b)
-            if shared is not None and as_in_grid and shared.get(placed) is None:
+            result = None if shared is None else shared.get(placed)
+            if result is None and shared is not None and as_in_grid:  # close where the grid's run closed
                 first = next((other for other in (place_object(placer, model.q_open, placement, shape,
                                                                *grid.angles_deg(earlier)) for earlier in range(pose))
-                              if shared.same(other, placed)), placed)
-                shared.add(first, model.grasp(first))
-            result = None if shared is None else shared.get(placed)
+                              if shared.same(other, placed)), None)
+                if first is not None:
+                    result = model.grasp(first)
+                    shared.add(first, result)
             if result is None:
                 result = model.grasp(placed)
                 if shared is not None:
@@ -170,14 +172,16 @@ class _RegionResults:
         t, _, _ = self.shape.ray_hits((reach * _PROBES) @ rotation, -_PROBES @ rotation)
         return tuple(np.round(np.concatenate([center, t]), 6).tolist())
 
+    def _fill_alike(self, a: ObjectPose, b: ObjectPose) -> bool:
+        return self.shape.same_region(a.rotation, a.center_mm, b.rotation, b.center_mm)
+
     def same(self, a: ObjectPose, b: ObjectPose) -> bool:
         """Whether ``a`` and ``b`` are one region by the rule ``get`` applies."""
-        return self._key(a) == self._key(b) and self.shape.same_region(a.rotation, a.center_mm, b.rotation, b.center_mm)
+        return self._key(a) == self._key(b) and self._fill_alike(a, b)
 
     def get(self, placed: ObjectPose) -> ClosureResult | None:
         return next((result for other, result in self.buckets.get(self._key(placed), [])
-                     if self.shape.same_region(other.rotation, other.center_mm, placed.rotation, placed.center_mm)),
-                    None)
+                     if self._fill_alike(other, placed)), None)
 
     def add(self, placed: ObjectPose, result: ClosureResult) -> None:
         if result.settled_pose is not None:  # a box that moved is no longer the region's
