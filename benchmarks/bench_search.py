@@ -39,7 +39,8 @@ def main(objects: list[str], processes: int = 2) -> None:
         period = alpha_period_deg(sim.placement, sim.object.shape, hand.palm_normal)
         wall, cpu = time.perf_counter(), _cpu_s()
         result = search_object(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo,
-                               full_synergy_set(synergies.matrix, sim.full_set_size), sim.search, period, processes)
+                               full_synergy_set(synergies.matrix, sim.full_set_size), sim.search, period, processes,
+                               opposition=sim.opposition)
         wall, cpu = time.perf_counter() - wall, _cpu_s() - cpu
         n_poses = result.chosen.n_poses
         print(f"{name}: {len(result.ranked)} targets x {n_poses} poses, {processes} processes: wall {wall:.1f} s, "

@@ -12,6 +12,7 @@ import pytest
 
 from synergrasp.config import defaults, overlay
 from synergrasp.optimisation import placement_search
+from synergrasp.simulation.opposition import GRASP_TYPES
 from synergrasp.optimisation.placement_search import (
     SearchStepParams,
     SearchParams,
@@ -28,7 +29,7 @@ REFERENCE = (9.5, -9.0, 52.0)
 
 
 def _score(target, fc, force, contacts):
-    return TargetScore(tuple(float(v) for v in target), 27, float(fc), float(force), float(contacts))
+    return TargetScore(tuple(float(v) for v in target), 27, float(fc), float(fc), float(force), float(contacts))
 
 
 def test_score_is_the_force_closure_share_the_median_force_over_weight_and_contacts():
@@ -40,6 +41,23 @@ def test_score_is_the_force_closure_share_the_median_force_over_weight_and_conta
     assert s.median_force_per_weight == pytest.approx(4.0)  # median of 20, 40, 100 N over 10 N
     assert s.median_contacts == 3.0
     assert s.n_poses == 5 and s.target_mm == (1.0, 2.0, 3.0)
+
+
+def test_score_counts_the_poses_of_the_grasp_type_in_force_closure_and_their_forces_only():
+    fc = np.array([True, True, False, True, False])
+    force = np.array([20.0, 40.0, np.nan, 100.0, 5.0])
+    typed = np.array([True, False, True, True, False])  # pose 2 is of the type but not in force closure
+    s = score_target((0, 0, 0), fc, force, np.array([3, 5, 0, 6, 2]), 10.0, of_type=typed)
+    assert s.typed_percent == pytest.approx(40.0)  # poses 0 and 3
+    assert s.force_closure_percent == pytest.approx(60.0)  # reported, not scored
+    assert s.median_force_per_weight == pytest.approx(6.0)  # median of 20 and 100 N over 10 N
+    none = score_target((0, 0, 0), fc, force, np.array([3, 5, 0, 6, 2]), 10.0, of_type=np.zeros(5, bool))
+    assert none.typed_percent == 0.0 and math.isinf(none.median_force_per_weight)
+    # the tie rules rank by the typed share: 100 % force closure of the wrong type loses
+    ranked = rank_targets([s, replace(none, target_mm=(5.0, 5.0, 5.0))], REFERENCE, 2.0, 0.05)
+    assert ranked[0].target_mm == (0.0, 0.0, 0.0)
+    with pytest.raises(ValueError, match="equal-length"):
+        score_target((0, 0, 0), fc, force, np.zeros(5), 1.0, of_type=np.ones(4, bool))
 
 
 def test_score_without_force_closure_has_infinite_force_and_bad_input_is_refused():
@@ -108,14 +126,27 @@ def _params(**changes):
     return replace(SearchStepParams.from_config(defaults(), "obj1").search, **changes)
 
 
-def test_the_default_region_is_a_20_mm_lattice_of_135_targets_refined_at_10_mm():
+def test_each_grasp_types_default_region_is_a_20_mm_lattice_refined_at_10_mm():
+    cfg = defaults()
+    lattices = {}
+    for kind in GRASP_TYPES:
+        cfg["objects"]["obj1"]["grasp_type"] = kind
+        params = SearchStepParams.from_config(cfg, "obj1").search
+        assert params.spacing_mm <= 10.0 and params.grasp_type == kind
+        lattices[kind] = region_lattice(params, params.coarse_spacing_mm)
+        np.testing.assert_array_equal(np.unique(lattices[kind][:, 1]), [-50, -30, -10, 10, 30])
+    # any: the palm face and the fingers, out to the curling fingers' reach (the first version's region)
+    assert lattices["any"].shape == (135, 3)
+    np.testing.assert_array_equal(np.unique(lattices["any"][:, 0]), [9.5, 29.5, 49.5])
+    # power: the box brought onto the palm face (x = 9.5), centred over the palm
+    assert lattices["power"].shape == (25, 3)
+    np.testing.assert_array_equal(np.unique(lattices["power"][:, 0]), [9.5])
+    np.testing.assert_array_equal(np.unique(lattices["power"][:, 2]), [20, 40, 60, 80, 100])
+    # precision: in front of the fingers, where the thumb's and the fingers' tips meet
+    assert lattices["precision"].shape == (50, 3)
+    np.testing.assert_array_equal(np.unique(lattices["precision"][:, 0]), [19.5, 39.5])
+    np.testing.assert_array_equal(np.unique(lattices["precision"][:, 2]), [60, 80, 100, 120, 140])
     params = _params()
-    assert params.spacing_mm <= 10.0
-    coarse = region_lattice(params, params.coarse_spacing_mm)
-    assert coarse.shape == (135, 3)
-    np.testing.assert_array_equal(np.unique(coarse[:, 0]), [9.5, 29.5, 49.5])
-    np.testing.assert_array_equal(np.unique(coarse[:, 1]), [-50, -30, -10, 10, 30])
-    assert region_lattice(params, params.spacing_mm).shape == (5 * 9 * 17, 3)
     with pytest.raises(ValueError, match="whole multiple"):
         SearchParams(params.region_mm, 15.0, 10.0, 3, 4, 30.0, 15.0, 2.0, 0.05)
 
@@ -136,7 +167,8 @@ def test_scored_poses_are_the_first_alpha_period_on_the_search_steps():
 def _tiny(obj="obj1", **search):
     """The study's search of ``obj`` on a toy region (2 coarse targets, 4 poses, 1 round)."""
     cfg = overlay(defaults(), {"placement": {"search": {
-        "region_mm": {"x": [9.5, 9.5], "y": [-10.0, -10.0], "z": [60.0, 80.0]}, "pose_alpha_step_deg": 60.0,
+        "region_mm": {kind: {"x": [9.5, 9.5], "y": [-10.0, -10.0], "z": [60.0, 80.0]} for kind in GRASP_TYPES},
+        "pose_alpha_step_deg": 60.0,
         "pose_beta_step_deg": 60.0, "refine_top": 1, "max_rounds": 1, **search}}})
     return SearchStepParams.from_config(cfg, obj)
 
@@ -144,7 +176,7 @@ def _tiny(obj="obj1", **search):
 def _run(sim, hand, synergies, processes=1):
     full = placement_search.full_synergy_set(synergies.matrix, sim.full_set_size)
     return search_object(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo, full, sim.search,
-                         period_deg=90.0, processes=processes)
+                         period_deg=90.0, processes=processes, opposition=sim.opposition)
 
 
 def test_the_search_passes_the_solver_the_full_synergy_set_and_nothing_else(hand, synergies, monkeypatch):
@@ -179,9 +211,9 @@ def test_the_search_is_deterministic_for_any_number_of_processes(hand, synergies
 def test_bad_search_settings_are_refused_before_any_job_naming_the_key():
     from synergrasp.config import ConfigError, validate_config
 
-    bad = overlay(defaults(), {"placement": {"search": {"region_mm": {"x": [9.5, 0.0]}}},
+    bad = overlay(defaults(), {"placement": {"search": {"region_mm": {"any": {"x": [9.5, 0.0]}}}},
                                "objects": {"obj1": {"placement": {"search": {"coarse_spacing_mm": 25.0}}}}})
     with pytest.raises(ConfigError) as err:
         validate_config(bad)
-    assert "'placement.search.region_mm.x'" in str(err.value)
+    assert "'placement.search.region_mm.any.x'" in str(err.value)
     assert "'objects.obj1.placement.search.coarse_spacing_mm'" in str(err.value)

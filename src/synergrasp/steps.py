@@ -105,7 +105,8 @@ _PLACEMENT_TARGETS = ("mode", "search_rank", "approach_point_mm", "center_mm")
 _PNG_PDF = ("png", "pdf")
 #: The keys the placement search reads (and the map of its results).
 STEPS_SEARCH_READS = ("hand", "synergies", "grid", "placement", "closure", "mechanics", "synergy_sets.incremental_max",
-                      "objects.{object}.shape", "objects.{object}.mass_kg", "objects.{object}.placement")
+                      "objects.{object}.shape", "objects.{object}.mass_kg", "objects.{object}.placement",
+                      "objects.{object}.grasp_type", "opposition")
 STEPS_SEARCH_NOT_READS = ("closure.model", "closure.dynamic",
                           *(f"{where}.{key}" for where in ("placement", "objects.{object}.placement")
                             for key in _PLACEMENT_TARGETS))

@@ -175,8 +175,11 @@ PLACEMENT = Table("placement", "one row per scored target of one object, best fi
     *_target_columns(),
     Column("round", "int32", "", "search round that scored it (0 = the coarse lattice)"),
     Column("n_poses", "int32", "", "scored poses"),
-    Column("force_closure_percent", "float64", "%", "share of the scored poses in force closure with the full set"),
-    Column("median_force_per_weight", "float64", "", "median optimal force over those poses / weight (inf: none)"),
+    Column("grasp_type", "string", "", "the object's grasp type (power, precision, any) the search scored"),
+    Column("typed_percent", "float64", "%",
+           "the score T: share of the scored poses whose grasp is of the object's grasp type and in force closure with the full set"),
+    Column("force_closure_percent", "float64", "%", "share of the scored poses in force closure with the full set, any opposition"),
+    Column("median_force_per_weight", "float64", "", "median optimal force over the poses counted by T / weight (inf: none)"),
     Column("median_contacts", "float64", "", "median contacts per scored pose"),
     Column("distance_to_chosen_mm", "float64", "mm", "distance to the chosen target"),
 ))

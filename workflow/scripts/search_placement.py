@@ -14,5 +14,5 @@ with job_log(snakemake.log[0]):
     period = alpha_period_deg(sim.placement, sim.object.shape, hand.palm_normal)
     result = search_object(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo,
                            full_synergy_set(synergies.matrix, sim.full_set_size), sim.search, period,
-                           processes=snakemake.threads)
+                           processes=snakemake.threads, opposition=sim.opposition)
     tables.write_csv(tables.PLACEMENT, result.table(sim.distinct_mm), snakemake.output[0])

@@ -1,10 +1,14 @@
 """The placement search: where each box sits best in the hand (docs/placement_search.md).
 
 The objective is pre-registered in docs/placement_search.md, with this module, before any
-search result existed. A target point t (palm frame, mm) is scored on a fixed subset of the
+search result existed (its second version, the grasp type, likewise: that page's "Changes
+since pre-registration"). A target point t (palm frame, mm) is scored on a fixed subset of the
 object's distinct poses (the α-period folded): the box is placed by the placement rule
 (travels along the palm normal toward t, stops at t or at first touch of the open hand), the
-hand closes on it, and the grasp-force optimisation runs with the **full synergy set only**.
+hand closes on it, the grasp's opposition is read from its contacts
+(``synergrasp.simulation.opposition``) and the grasp-force optimisation runs with the **full
+synergy set only**; a pose counts when its grasp is of the object's grasp type and in force
+closure.
 :func:`score_target` turns the per-pose results into a :class:`TargetScore` (a pure
 function), :func:`rank_targets` orders targets by the tie rules; :func:`search_object` runs
 the coarse-to-fine search over the region. Nothing here reads a synergy subset, a claim or
@@ -31,6 +35,7 @@ from synergrasp.optimisation.study import GFOParams, optimise_grasps
 from synergrasp.simulation.contacts import contacts_row, contacts_table
 from synergrasp.simulation.closure_params import ClosureParams
 from synergrasp.simulation.objects import GraspedObject
+from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions, of_grasp_type
 from synergrasp.simulation.placement import Placement, palm_centre, pose_grid
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -48,6 +53,7 @@ class SearchParams:
     """The search's settings (config ``placement.search``; defaults in the schema).
 
     region_mm:          ((x0, x1), (y0, y1), (z0, z1)): the box of target points, palm frame, mm
+                        (the object's grasp type's region, config ``region_mm.<type>``)
     coarse_spacing_mm:  spacing of the first lattice, anchored at (x0, y0, z0)
     spacing_mm:         spacing of the refinement (the final resolution, ≤ 10 mm); divides
                         coarse_spacing_mm
@@ -60,6 +66,8 @@ class SearchParams:
     tie_band_points:    force-closure shares within this many percentage points of the best
                         count as tied
     force_tie_relative: median forces within this relative margin of the lowest count as tied
+    grasp_type:         the object's grasp type (``opposition.GRASP_TYPES``): a scored pose
+                        counts when its grasp's opposition is of this type
     """
 
     region_mm: tuple[tuple[float, float], tuple[float, float], tuple[float, float]]
@@ -71,6 +79,7 @@ class SearchParams:
     pose_beta_step_deg: float
     tie_band_points: float
     force_tie_relative: float
+    grasp_type: str = "any"
 
     def __post_init__(self) -> None:
         region = tuple((float(a), float(b)) for a, b in self.region_mm)
@@ -103,15 +112,17 @@ class SearchStepParams:
     full_set_size: int
     search: SearchParams
     distinct_mm: float
+    opposition: OppositionRule
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> SearchStepParams:
         """From a configuration or the step's own part of it, for the object ``obj``."""
         placement = overlay(config["placement"], config["objects"][obj].get("placement"))
         spec = placement["search"]
-        region = tuple(tuple(spec["region_mm"][axis]) for axis in ("x", "y", "z"))
-        search = build(SearchParams, "placement.search", region_mm=region, **dataclass_fields(
-            SearchParams, {k: v for k, v in spec.items() if k != "region_mm"}))
+        grasp_type = config["objects"][obj]["grasp_type"]
+        region = tuple(tuple(spec["region_mm"][grasp_type][axis]) for axis in ("x", "y", "z"))
+        search = build(SearchParams, "placement.search", region_mm=region, grasp_type=grasp_type,
+                       **dataclass_fields(SearchParams, {k: v for k, v in spec.items() if k != "region_mm"}))
         closure = {**config["closure"], "model": "kinematic"}
         return cls(
             hand=config["hand"], synergies=config["synergies"], object=GraspedObject.from_config(config, obj),
@@ -121,53 +132,60 @@ class SearchStepParams:
             closure=build(ClosureParams, "closure", **{**dataclass_fields(ClosureParams, closure), "dynamic": None}),
             gfo=GFOParams.from_config(config, obj),
             full_set_size=int(config["synergy_sets"]["incremental_max"]), search=search,
-            distinct_mm=float(spec["distinct_mm"]))
+            distinct_mm=float(spec["distinct_mm"]), opposition=OppositionRule.from_config(config))
 
 @dataclass(frozen=True)
 class TargetScore:
     """The objective at one target: what the whole hand does on the scored poses.
 
+    typed_percent:           the score T: share of the scored poses whose grasp is of the
+                             object's grasp type **and** in force closure with the full set, %
     force_closure_percent:   share of the scored poses in force closure (the study's
                              Definition 1: rank(G) = 6 and a strictly internal force) with
-                             the full synergy set, %
-    median_force_per_weight: median optimal contact force ‖f‖₂ under the weight over those
-                             force-closure poses, divided by the weight (inf when none)
+                             the full synergy set, whatever their opposition, % (reported)
+    median_force_per_weight: median optimal contact force ‖f‖₂ under the weight over the
+                             poses that count for T, divided by the weight (inf when none)
     median_contacts:         median number of contacts per scored pose
     """
 
     target_mm: tuple[float, float, float]
     n_poses: int
+    typed_percent: float
     force_closure_percent: float
     median_force_per_weight: float
     median_contacts: float
 
 
 def score_target(target_mm: Sequence[float], force_closure: NDArray, force_N: NDArray, n_contacts: NDArray,
-                 weight_N: float) -> TargetScore:
+                 weight_N: float, of_type: NDArray | None = None) -> TargetScore:
     """The objective of one target from its per-pose results with the full synergy set
     (one entry per scored pose): force closure (bool), optimal force under the weight (N,
-    NaN where none) and the number of contacts. Pure: reads nothing else."""
+    NaN where none), the number of contacts, and whether the grasp's opposition is of the
+    object's grasp type (bool; None: every pose is). Pure: reads nothing else."""
     fc = np.asarray(force_closure, dtype=bool)
     force = np.asarray(force_N, dtype=float)
     contacts = np.asarray(n_contacts, dtype=float)
-    if not (fc.shape == force.shape == contacts.shape and fc.ndim == 1 and fc.size > 0):
-        raise ValueError("force_closure, force_N and n_contacts must be equal-length 1-d arrays of the scored poses")
+    typed = np.ones_like(fc) if of_type is None else np.asarray(of_type, dtype=bool)
+    if not (fc.shape == force.shape == contacts.shape == typed.shape and fc.ndim == 1 and fc.size > 0):
+        raise ValueError("force_closure, force_N, n_contacts and of_type must be equal-length 1-d arrays "
+                         "of the scored poses")
     if not weight_N > 0:
         raise ValueError(f"weight_N must be > 0, got {weight_N}")
-    held = fc & np.isfinite(force)
+    counted = fc & typed
+    held = counted & np.isfinite(force)
     median_force = float(np.median(force[held])) / float(weight_N) if held.any() else math.inf
-    return TargetScore(tuple(float(v) for v in target_mm), int(fc.size), 100.0 * float(fc.mean()),
-                       median_force, float(np.median(contacts)))
+    return TargetScore(tuple(float(v) for v in target_mm), int(fc.size), 100.0 * float(counted.mean()),
+                       100.0 * float(fc.mean()), median_force, float(np.median(contacts)))
 
 
 def _best(scores: Sequence[TargetScore], reference_mm: NDArray, tie_band_points: float,
           force_tie_relative: float) -> TargetScore:
-    """The tie rules: the highest force-closure share, shares within ``tie_band_points`` tied;
-    among them the lowest median force over the weight, forces within ``force_tie_relative``
-    of it tied; then the most median contacts; then the target nearest the reference (the
-    palm centre); then the smallest (x, y, z)."""
-    top = max(s.force_closure_percent for s in scores)
-    tied = [s for s in scores if s.force_closure_percent >= top - tie_band_points - _TOL]
+    """The tie rules: the highest score T (typed force-closure share), shares within
+    ``tie_band_points`` tied; among them the lowest median force over the weight, forces
+    within ``force_tie_relative`` of it tied; then the most median contacts; then the target
+    nearest the reference (the palm centre); then the smallest (x, y, z)."""
+    top = max(s.typed_percent for s in scores)
+    tied = [s for s in scores if s.typed_percent >= top - tie_band_points - _TOL]
     low = min(s.median_force_per_weight for s in tied)
     if math.isfinite(low):
         tied = [s for s in tied if s.median_force_per_weight <= low * (1.0 + force_tie_relative) + _TOL]
@@ -226,10 +244,12 @@ def full_synergy_set(matrix: NDArray, n_full: int) -> SynergySets:
 
 
 class TargetScorer:
-    """Scores targets of one object: placement rule, closure, GFO with the full set only."""
+    """Scores targets of one object: placement rule, closure, the grasps' opposition, GFO with
+    the full set only; a pose counts when its grasp is of ``grasp_type``."""
 
     def __init__(self, hand: Hand, synergies: Synergies, box: Any, placement: Placement,
-                 closure: ClosureParams, gfo: GFOParams, full_set: SynergySets, poses: Sequence[int]) -> None:
+                 closure: ClosureParams, gfo: GFOParams, full_set: SynergySets, poses: Sequence[int],
+                 grasp_type: str = "any", opposition: OppositionRule | None = None) -> None:
         from synergrasp.simulation.closure import closure_model
         from synergrasp.simulation.scene import HandScene
 
@@ -240,6 +260,8 @@ class TargetScorer:
         self.grid = pose_grid(placement)
         self.model = closure_model(hand, synergies, replace(closure, model="kinematic"))
         self.placer = HandScene(hand)
+        self.axes, self.grasp_type = HandAxes.from_hand(hand), grasp_type
+        self.rule = opposition  # None: the scorer only places and closes (contacts)
 
     def close(self) -> None:
         self.model.close()
@@ -262,7 +284,10 @@ class TargetScorer:
         out = optimise_grasps(read_grasps(table), self.full_set, self.gfo)
         fc = np.asarray(out["strict_internal"], dtype=bool) & (np.asarray(out["rank_G"]) == 6)
         weight = self.gfo.mass_kg * self.gfo.g_m_per_s2
-        return score_target(target_mm, fc, out["force_norm"], table["n_contacts"].to_numpy(), weight)
+        if self.rule is None:
+            raise ValueError("TargetScorer: scoring reads the grasps' opposition: give the opposition rule")
+        typed = [of_grasp_type(o, self.grasp_type) for o in contacts_oppositions(table, self.axes, self.rule)]
+        return score_target(target_mm, fc, out["force_norm"], table["n_contacts"].to_numpy(), weight, np.array(typed))
 
 
 def distinct_ranks(ranked: Sequence[TargetScore], distinct_mm: float) -> list[int]:
@@ -288,6 +313,7 @@ class SearchResult:
     object: str
     ranked: tuple[TargetScore, ...]
     rounds: dict[tuple[float, float, float], int]
+    grasp_type: str = "any"
 
     @property
     def chosen(self) -> TargetScore:
@@ -300,7 +326,8 @@ class SearchResult:
         rows = [{"object": self.object, "rank": k + 1, "chosen": k == 0, "distinct_rank": distinct[k],
                  "x_mm": s.target_mm[0],
                  "y_mm": s.target_mm[1], "z_mm": s.target_mm[2], "round": self.rounds[s.target_mm],
-                 "n_poses": s.n_poses, "force_closure_percent": s.force_closure_percent,
+                 "n_poses": s.n_poses, "grasp_type": self.grasp_type, "typed_percent": s.typed_percent,
+                 "force_closure_percent": s.force_closure_percent,
                  "median_force_per_weight": s.median_force_per_weight, "median_contacts": s.median_contacts,
                  "distance_to_chosen_mm": float(np.linalg.norm(np.asarray(s.target_mm) - chosen))}
                 for k, s in enumerate(self.ranked)]
@@ -326,12 +353,13 @@ def _key(point: NDArray) -> tuple[float, float, float]:
 
 def search_object(hand: Hand, synergies: Synergies, box: Any, placement: Placement, closure: ClosureParams,
                   gfo: GFOParams, full_set: SynergySets, params: SearchParams, period_deg: float,
-                  processes: int = 1) -> SearchResult:
+                  processes: int = 1, opposition: OppositionRule | None = None) -> SearchResult:
     """The coarse-to-fine search of one object (docs/placement_search.md): score the coarse
     lattice, then, round by round, the unscored neighbours at ``spacing_mm`` of the best
     ``refine_top`` targets, until they are all scored or ``max_rounds`` is reached.
     Deterministic: the same result for any ``processes``."""
-    args = (hand, synergies, box, placement, closure, gfo, full_set, pose_subset(placement, period_deg, params))
+    args = (hand, synergies, box, placement, closure, gfo, full_set, pose_subset(placement, period_deg, params),
+            params.grasp_type, opposition)
     reference = palm_centre(hand)
     scores: dict[tuple[float, float, float], TargetScore] = {}
     rounds: dict[tuple[float, float, float], int] = {}
@@ -365,5 +393,5 @@ def search_object(hand: Hand, synergies: Synergies, box: Any, placement: Placeme
         else:
             scorer.close()
     ranked = rank_targets(list(scores.values()), reference, params.tie_band_points, params.force_tie_relative)
-    return SearchResult(str(box.name), tuple(ranked), rounds)
+    return SearchResult(str(box.name), tuple(ranked), rounds, params.grasp_type)
 
