@@ -151,19 +151,26 @@ def test_manipulability_of_a_rigid_translation_and_of_a_squeeze():
 
 
 def test_quality_table_rows_for_a_grasp_and_a_pose_without_one(tmp_path):
+    from synergrasp.hand.kinematics import load_hand
+    from synergrasp.simulation.opposition import HandAxes, OppositionRule
+
     import pandas as pd
 
     from synergrasp import tables
     from synergrasp.optimisation.quality import QualityParams, quality_table
 
     g = _cube_face_grasp(15.0)
+    # the palm (link 0) pushes the cube off the palm, the middle fingertip (link 11) back: palm opposition
     contacts = pd.DataFrame({"object": ["cube", "cube"], "pose": [0, 1], "alpha_deg": [0.0, 5.0],
-                             "beta_deg": [0.0, 0.0], "n_contacts": [6, 0]})
+                             "beta_deg": [0.0, 0.0], "n_contacts": [6, 0], "status": ["grasp", "no_contact"],
+                             "contact_link": [[0, 11, 1, 2, 4, 5], []],
+                             "contact_normal": [np.r_[1.0, 0, 0, -1.0, 0, 0, np.zeros(12)], np.zeros(0)]})
     gfo = pd.DataFrame({"object": "cube", "pose": [0, 1], "set_id": "1-2", "strict_internal": [True, False],
                         "rank_G": [6, 0], "force_norm": [19.62, np.nan]})
     params = QualityParams(hand=None, synergies=None, mu=0.8, full_set_id="1-2", weight_N=9.81,
-                           torque_length_mm=15.0 * math.sqrt(3.0))
-    table = quality_table(contacts, gfo, [g, None], np.zeros((2, 2)), params)
+                           torque_length_mm=15.0 * math.sqrt(3.0), opposition=OppositionRule(45.0, 1.0))
+    table = quality_table(contacts, gfo, [g, None], np.zeros((2, 2)), params, HandAxes.from_hand(load_hand()))
+    assert table["opposition"].tolist() == ["palm", "none"]
     tables.write(tables.QUALITY, table, tmp_path / "quality.parquet")  # the contract's columns and types
     table = tables.read(tables.QUALITY, tmp_path / "quality.parquet")
     expected = grasp_quality(g, 0.8, params.torque_length_mm)
@@ -189,6 +196,9 @@ def test_same_grasp_within_round_off_only():
 
 
 def test_quality_table_computes_one_grasp_once_and_shares_it(monkeypatch):
+    from synergrasp.hand.kinematics import load_hand
+    from synergrasp.simulation.opposition import HandAxes, OppositionRule
+
     import pandas as pd
 
     from synergrasp.optimisation import quality
@@ -200,12 +210,13 @@ def test_quality_table_computes_one_grasp_once_and_shares_it(monkeypatch):
     real = quality.grasp_quality
     monkeypatch.setattr(quality, "grasp_quality", lambda g, *args, **kw: calls.append(g) or real(g, *args, **kw))
     contacts = pd.DataFrame({"object": "box", "pose": range(4), "alpha_deg": [0.0, 5.0, 90.0, 95.0],
-                             "beta_deg": 0.0, "n_contacts": [5, 6, 5, 6]})
+                             "beta_deg": 0.0, "n_contacts": [5, 6, 5, 6], "status": "grasp",
+                             "contact_link": [g.links for g in grasps], "contact_normal": [g.normals for g in grasps]})
     gfo = pd.DataFrame({"object": "box", "pose": range(4), "set_id": "1-2", "strict_internal": True, "rank_G": 6,
                         "force_norm": 9.81})
     params = quality.QualityParams(hand=None, synergies=None, mu=0.8, full_set_id="1-2", weight_N=9.81,
-                                   torque_length_mm=20.0)
-    table = quality.quality_table(contacts, gfo, grasps, np.zeros((2, 1)), params)
+                                   torque_length_mm=20.0, opposition=OppositionRule(45.0, 1.0))
+    table = quality.quality_table(contacts, gfo, grasps, np.zeros((2, 1)), params, HandAxes.from_hand(load_hand()))
     assert [id(g) for g in calls] == [id(grasps[0]), id(grasps[1]), id(grasps[3])]
     assert table["epsilon"].iloc[2] == table["epsilon"].iloc[0] > 0
     assert table["epsilon"].iloc[3] == pytest.approx(table["epsilon"].iloc[1], rel=1e-3)

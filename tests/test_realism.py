@@ -8,7 +8,12 @@ import pandas as pd
 import pytest
 
 from synergrasp import tables
-from synergrasp.analysis.realism import NORMAL_FORCE_COLUMN, grasp_realism, link_categories
+from synergrasp.analysis.realism import NORMAL_FORCE_COLUMN, grasp_labels, grasp_realism, link_categories
+from synergrasp.simulation.opposition import HandAxes, OppositionRule
+from synergrasp.simulation.shapes import shape_from_config
+
+_RULE = OppositionRule(45.0, 1.0)
+_BOX = shape_from_config({"box": {"size_mm": [10.0, 20.0, 30.0]}})
 
 # Links of the shipped hand: 0 palm, 3 thumb_distal, 5 index_proximal, 6 index_middle,
 # 7 index_distal, 11 middle_distal, 15 ring_distal, 19 little_distal.
@@ -20,13 +25,14 @@ _POSES = [  # (status, contact links, normal forces N)
 ]
 
 
-def _contacts(obj: str = "a", poses=_POSES) -> pd.DataFrame:
+def _contacts(obj: str = "a", poses=_POSES, normals=None, points=None) -> pd.DataFrame:
     rows = []
     for pose, (status, links, forces) in enumerate(poses):
         m = len(links)
         rows.append({"object": obj, "pose": pose, "alpha_deg": 5.0 * pose, "beta_deg": 0.0, "status": status,
                      "q": [0.0] * 19, "finger_state": [], "n_contacts": m, "contact_link": links,
-                     "contact_point": [0.0] * 3 * m, "contact_normal": [1.0, 0.0, 0.0] * m,
+                     "contact_point": [0.0] * 3 * m if points is None else points[pose],
+                     "contact_normal": [1.0, 0.0, 0.0] * m if normals is None else normals[pose],
                      "jacobian": [0.0] * 57 * m, "object_center": [0.0] * 3, "object_rotation": list(np.eye(3).ravel()),
                      "max_penetration_mm": 0.0, NORMAL_FORCE_COLUMN: forces, "closure_model": "kinematic",
                      "object_translation_mm": [0.0] * 3, "object_rotation_deg": 0.0, "settled": True})
@@ -53,10 +59,11 @@ def _checks(contacts: pd.DataFrame) -> pd.DataFrame:
                          "torque_residual": 0.1 * grasps["pose"], "s1_outside_cone": grasps["pose"]})
 
 
-def _table(hand, contacts=None, gfo=None, load_threshold_N=0.01):
+def _table(hand, contacts=None, gfo=None, load_threshold_N=0.01, grasp_type="power"):
     contacts = _contacts() if contacts is None else contacts
+    labels = grasp_labels(contacts, HandAxes.from_hand(hand), _RULE, {"a": _BOX})
     return grasp_realism(contacts, _gfo() if gfo is None else gfo, _checks(contacts), hand.link_names,
-                         hand.link_finger, "1-2", {"a": 10.0}, load_threshold_N)
+                         hand.link_finger, "1-2", {"a": 10.0}, load_threshold_N, labels, {"a": grasp_type})
 
 
 def test_counts_and_shares_by_hand(hand):
@@ -84,6 +91,27 @@ def test_counts_and_shares_by_hand(hand):
     assert (row["pct_ring"], row["pct_little"]) == (pytest.approx(third), pytest.approx(third))
     assert row["median_torque_residual"] == pytest.approx(0.1)  # 0, 0.1, 0.3
     assert row["pct_s1_outside_cone"] == pytest.approx(2 * third)  # poses 1 and 3
+
+
+def test_opposition_shares_grasp_type_and_edge_contacts_by_hand(hand):
+    """Pose 0: thumb pad against index pad (pad); pose 1: palm pushing out, the middle
+    fingertip pushing back (palm); pose 3: everything pushing off the palm (none)."""
+    x, y = [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]
+    minus = lambda v: [-c for c in v]  # noqa: E731
+    normals = [minus(y) + y, x + x + x + minus(x), [], x * 7]
+    # pose 0 touches the box (centred at the origin, 10 x 20 x 30 mm) at a corner and a face
+    points = [[5.0, 10.0, 15.0, 5.0, 0.0, 0.0], [0.0] * 12, [], [0.0] * 21]
+    contacts = _contacts(normals=normals, points=points)
+    row = _table(hand, contacts).iloc[0]
+    third = 100.0 / 3.0
+    assert (row["pct_palm_opposition"], row["pct_pad_opposition"]) == (pytest.approx(third), pytest.approx(third))
+    assert (row["pct_side_opposition"], row["pct_no_opposition"]) == (0.0, pytest.approx(third))
+    assert row["grasp_type"] == "power" and row["pct_of_grasp_type"] == pytest.approx(third)
+    assert row["pct_of_grasp_type_force_closure"] == pytest.approx(third)  # pose 1 is in force closure
+    assert row["pct_contacts_on_edges"] == pytest.approx(100.0 / 13.0)  # 1 of the 2 + 4 + 7 contacts
+    precise = _table(hand, contacts, grasp_type="precision").iloc[0]
+    assert precise["pct_of_grasp_type"] == pytest.approx(third)
+    assert precise["pct_of_grasp_type_force_closure"] == 0.0  # pose 0's grasp has rank 3
 
 
 def test_the_index_column_and_the_link_shares_on_a_hand_made_table(hand):
@@ -136,12 +164,13 @@ def test_link_categories_of_the_shipped_hand(hand):
 
 
 def test_missing_weight_or_full_set_is_one_clear_error(hand):
+    labels = grasp_labels(_contacts(), HandAxes.from_hand(hand), _RULE, {"a": _BOX})
     with pytest.raises(ValueError, match=r"no weight for object\(s\) \['a'\]"):
         grasp_realism(_contacts(), _gfo(), _checks(_contacts()), hand.link_names, hand.link_finger, "1-2",
-                      {"b": 1.0}, 0.01)
+                      {"b": 1.0}, 0.01, labels, {"a": "any"})
     with pytest.raises(ValueError, match="full_set_id '1-2-3'"):
         grasp_realism(_contacts(), _gfo(), _checks(_contacts()), hand.link_names, hand.link_finger, "1-2-3",
-                      {"a": 1.0}, 0.01)
+                      {"a": 1.0}, 0.01, labels, {"a": "any"})
 
 
 def test_figure_is_written_and_the_same_on_rerun(hand, tmp_path):

@@ -27,8 +27,9 @@ import numpy as np
 import pandas as pd
 
 from synergrasp import tables
-from synergrasp.analysis.realism import grasp_realism
+from synergrasp.analysis.realism import grasp_labels, grasp_realism
 from synergrasp.analysis.realism import RealismParams
+from synergrasp.simulation.opposition import HandAxes
 from synergrasp.config import defaults, validate_config
 from synergrasp.optimisation.study import OptimiseParams
 from synergrasp.simulation.closure import SimulateParams
@@ -96,8 +97,9 @@ def summary(out: Path) -> None:
         start = time.process_time()
         checks = grasp_equilibrium(contacts, checks_params, synergies.columns([1])[:, 0])
         extra.append(checks.assign(cpu_s=time.process_time() - start, all_joints=_all_joints(checks)))
+        labels = grasp_labels(contacts, HandAxes.from_hand(hand), realism.opposition, realism.shapes)
         parts.append(grasp_realism(contacts, gfo, checks, hand.link_names, hand.link_finger, realism.full_set_id,
-                                   realism.weights_N, realism.load_threshold_N))
+                                   realism.weights_N, realism.load_threshold_N, labels, realism.grasp_types))
     table = pd.concat(parts, ignore_index=True)
     more = pd.concat(extra).groupby(["object", "closure_model"]).agg(
         median_residual_all_joints=("all_joints", "median"), checks_cpu_s=("cpu_s", "first"))

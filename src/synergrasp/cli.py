@@ -39,6 +39,11 @@ def _number(value: float, digits: int = 3) -> str:
     return "—" if value is None or (isinstance(value, float) and math.isnan(value)) else f"{value:.{digits}g}"
 
 
+#: The grasp's opposition (docs/opposition.md), in words.
+_OPPOSITION_WORDS = {"palm": "held against the palm: a power grasp", "pad": "between the thumb's and the fingers' pads: "
+                     "a precision grip", "side": "thumb pad against the side of the index: a lateral pinch",
+                     "none": "no two contact groups push against each other"}
+
 #: The optimisation's status under the object's weight, in words.
 _WEIGHT_WORDS = {"force_closure": "feasible", "infeasible": "infeasible", "rank_deficient": "rank(G) < 6",
                  "no_grasp": "no grasp", "numerical_failure": "solver failed"}
@@ -49,13 +54,14 @@ def format_inspection(result: Any) -> str:
     from synergrasp.ids import set_name
 
     lines = [f"{result.object} at alpha = {result.alpha_deg:g} deg, beta = {result.beta_deg:g} deg (pose {result.pose}): "
-             f"{result.closure_status}, {len(result.contacts)} contacts; weight {result.weight_N:.3g} N"]
+             f"{result.closure_status}, {len(result.contacts)} contacts; weight {result.weight_N:.3g} N; "
+             f"opposition: {result.opposition} ({_OPPOSITION_WORDS[result.opposition]})"]
     if len(result.contacts):
-        lines.append(f"  {'link':<14} {'point (mm)':<28} inward normal")
+        lines.append(f"  {'link':<14} {'point (mm)':<28} {'inward normal':<23} face        on")
         for row in result.contacts.itertuples():
             point = ", ".join(f"{v:7.2f}" for v in row.point_mm)
             normal = ", ".join(f"{v:6.3f}" for v in row.normal)
-            lines.append(f"  {row.link_name:<14} ({point})  ({normal})")
+            lines.append(f"  {row.link_name:<14} ({point})  ({normal})  {row.face:<11} {row.feature}")
     q = result.quality
     if q is not None:
         axes = ", ".join(_number(v) for v in q.manipulability if v > 0) or "none"

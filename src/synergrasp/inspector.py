@@ -77,15 +77,17 @@ class GraspInspection:
     object_rotation: tuple[float, ...] = ()
     hand: Any = field(default=None, repr=False, compare=False)
     shape: Any = field(default=None, repr=False, compare=False)
+    opposition: str = "none"  # the grasp's opposition (docs/opposition.md)
 
     def to_dict(self) -> dict[str, Any]:
         """The inspection as plain data (lists and numbers), for ``--json``."""
         q = None if self.quality is None else {**asdict(self.quality),
                                                 "manipulability": self.quality.manipulability.tolist()}
         return {"object": self.object, "pose": self.pose, "alpha_deg": self.alpha_deg, "beta_deg": self.beta_deg,
-                "closure_status": self.closure_status, "weight_N": self.weight_N,
+                "closure_status": self.closure_status, "weight_N": self.weight_N, "opposition": self.opposition,
                 "contacts": [{"link": int(r.link), "link_name": r.link_name, "point_mm": list(r.point_mm),
-                              "normal": list(r.normal)} for r in self.contacts.itertuples()],
+                              "normal": list(r.normal), "face": r.face, "feature": r.feature}
+                             for r in self.contacts.itertuples()],
                 "sets": [asdict(s) for s in self.sets], "quality": q, "q_rad": list(self.q_rad),
                 "object_center_mm": list(self.object_center_mm), "object_rotation": list(self.object_rotation)}
 
@@ -143,13 +145,20 @@ def _pose_index(placement: Any, alpha_deg: float, beta_deg: float) -> tuple[int,
             f"step {a[2]:g}, beta {b[0]:g}..{b[1]:g} step {b[2]:g})") from None
 
 
-def _contacts_frame(hand: Any, row: pd.Series) -> pd.DataFrame:
+def _contacts_frame(hand: Any, row: pd.Series, shape: Any, rule: Any) -> pd.DataFrame:
+    """The contacts of a contacts-table row with the face each pushes on and where it sits
+    (docs/opposition.md)."""
+    from synergrasp.simulation.opposition import HandAxes, face_classes, surface_features
+
     m = int(row["n_contacts"])
     links = np.asarray(row["contact_link"], dtype=np.int64)
     points = np.asarray(row["contact_point"], dtype=float).reshape(m, 3)
     normals = np.asarray(row["contact_normal"], dtype=float).reshape(m, 3)
+    R, c = np.asarray(row["object_rotation"], dtype=float), np.asarray(row["object_center"], dtype=float)
     return pd.DataFrame({"link": links, "link_name": [hand.link_names[k] for k in links],
-                         "point_mm": [tuple(p) for p in points], "normal": [tuple(n) for n in normals]})
+                         "point_mm": [tuple(p) for p in points], "normal": [tuple(n) for n in normals],
+                         "face": face_classes(normals, HandAxes.from_hand(hand)),
+                         "feature": surface_features(points, shape, R, c, rule)})
 
 
 def _searched(placement: Any, path: Path) -> Any:
@@ -182,6 +191,7 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     from synergrasp.optimisation.study import OptimiseParams, optimise_grasps
     from synergrasp.simulation.closure import SimulateParams, simulate_object
     from synergrasp.simulation.contacts import ContactsParams, load_carrying_contacts
+    from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions
 
     cfg = validate_config(config)
     if obj not in cfg["objects"]:
@@ -203,12 +213,14 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     opt = OptimiseParams.from_config(cfg, obj)
     grasp = read_grasps(table)[0]
     weight = float(opt.gfo.mass_kg * opt.gfo.g_m_per_s2)
+    rule = OppositionRule.from_config(cfg)
     drawing = dict(q_rad=_floats(row["q"]), object_center_mm=_floats(row["object_center"]),
-                   object_rotation=_floats(row["object_rotation"]), hand=hand, shape=sim.object.shape)
+                   object_rotation=_floats(row["object_rotation"]), hand=hand, shape=sim.object.shape,
+                   opposition=contacts_oppositions(table.iloc[:1], HandAxes.from_hand(hand), rule)[0])
+    contacts = _contacts_frame(hand, row, sim.object.shape, rule)
     if grasp is None:
         return GraspInspection(obj, pose, float(row["alpha_deg"]), float(row["beta_deg"]), str(row["status"]),
-                               weight, _contacts_frame(hand, row) if int(row["n_contacts"]) else pd.DataFrame(),
-                               **drawing)
+                               weight, contacts if int(row["n_contacts"]) else pd.DataFrame(), **drawing)
     out = optimise_grasps([grasp], SynergySets(full.matrix, tuple(chosen)), opt.gfo, forces=True)
     mu = float(opt.gfo.mu)
     results = tuple(
@@ -219,7 +231,7 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
         for k, s in enumerate(chosen))
     quality = grasp_quality(grasp, mu, sim.object.shape.bounding_radius_mm, synergies=full.matrix)
     return GraspInspection(obj, pose, float(row["alpha_deg"]), float(row["beta_deg"]), str(row["status"]), weight,
-                           _contacts_frame(hand, row), results, quality, **drawing)
+                           contacts, results, quality, **drawing)
 
 
 def _floats(values: Any) -> tuple[float, ...]:
@@ -235,7 +247,8 @@ def _object_in_picture(result: GraspInspection) -> Any:
 def _title(result: GraspInspection) -> str:
     shape = result.shape.label if result.shape.kind in result.shape.label else f"{result.shape.kind} {result.shape.label}"
     return (f"{result.object} ({shape}) at α = {result.alpha_deg:g}°, "
-            f"β = {result.beta_deg:g}° (pose {result.pose}): {result.closure_status}, {len(result.contacts)} contacts")
+            f"β = {result.beta_deg:g}° (pose {result.pose}): {result.closure_status}, {len(result.contacts)} contacts, "
+            f"opposition {result.opposition}")
 
 
 def grasp_picture(result: GraspInspection, png_path: str | Path) -> None:

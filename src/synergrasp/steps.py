@@ -161,7 +161,7 @@ STEPS: dict[str, Step] = {
         rules={"grasp_quality": Cost("pose", 3.0, 300, 6.0e-3, 0.05)},
         outputs={"table": "quality.parquet", **_files(("quality_maps",), "", _PNG_PDF)}, scope="object",
         reads=("hand", "synergies", "mechanics.mu", "mechanics.g_m_per_s2", "synergy_sets.incremental_max",
-               "objects.{object}.shape", "objects.{object}.mass_kg"),
+               "objects.{object}.shape", "objects.{object}.mass_kg", "opposition"),
         upstream=("contacts", "optimise"), params="synergrasp.optimisation.quality:QualityParams"),
     "tables": Step(
         rules={"study_tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
@@ -179,7 +179,8 @@ STEPS: dict[str, Step] = {
                  "png": "figures/grasp_realism.png", "pdf": "figures/grasp_realism.pdf",
                  "graspable_csv": "tables/graspable_objects.csv", "graspable_md": "tables/graspable_objects.md"},
         reads=("hand", "synergies", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2",
-               "mechanics.k_ss_Nmm_per_rad", "mechanics.mu", "closure.model"),
+               "mechanics.k_ss_Nmm_per_rad", "mechanics.mu", "closure.model", "objects.*.shape",
+               "objects.*.grasp_type", "opposition"),
         reads_when=(("closure.model", "dynamic", ("closure.dynamic.load_threshold_N",)),),
         upstream=("contacts", "optimise"), synergy_columns=(1,), params="synergrasp.analysis.realism:RealismParams"),
     "fig1": Step(
@@ -193,7 +194,7 @@ STEPS: dict[str, Step] = {
         rules={"fig2_example_grasps": Cost("none", 4.5, 510)},
         outputs={**_files(("fig2_example_grasps",), "figures", _PNG_PDF), "pages": "figures/grasps_3d"},
         reads=("hand", "synergies", "mechanics", "synergy_sets.incremental_max", "objects.*.shape",
-               "objects.*.mass_kg"),
+               "objects.*.mass_kg", "opposition"),
         upstream=("contacts",), params="synergrasp.figures.grasp_3d:Grasps3dParams"),
     "fig4": Step(
         rules={"fig4_force_maps": Cost("pose_set", 4.3, 257, 5.1e-6, 4.0e-4)},

@@ -129,6 +129,15 @@ def _realism_columns() -> tuple[Column, ...]:
         Column("pct_middle", "float64", "%", "grasps with a contact on a middle-finger link"),
         Column("pct_ring", "float64", "%", "grasps with a contact on a ring-finger link"),
         Column("pct_little", "float64", "%", "grasps with a contact on a little-finger link"),
+        Column("grasp_type", "string", "", "the object's grasp type (objects.<name>.grasp_type; docs/opposition.md)"),
+        Column("pct_palm_opposition", "float64", "%", "grasps in palm opposition (held against the palm: a power grasp)"),
+        Column("pct_pad_opposition", "float64", "%", "grasps in pad opposition (thumb pad against finger pads, no palm contact: a precision grip)"),
+        Column("pct_side_opposition", "float64", "%", "grasps in side opposition (thumb pad against the side of the index: a lateral pinch)"),
+        Column("pct_no_opposition", "float64", "%", "grasps in which no two contact groups push against each other"),
+        Column("pct_of_grasp_type", "float64", "%", "grasps whose opposition is of the object's grasp type"),
+        Column("pct_of_grasp_type_force_closure", "float64", "%",
+               "grasps of the object's grasp type and in force closure with every synergy"),
+        Column("pct_contacts_on_edges", "float64", "%", "contacts (of all simulated grasps) on an edge or a corner of the object"),
         Column("pct_rank6", "float64", "%", "grasps whose grasp matrix G has rank 6"),
         Column("pct_force_closure", "float64", "%",
                "grasps in force closure (rank(G) = 6 and the strict internal-force test) with every synergy"),
@@ -196,6 +205,7 @@ QUALITY = Table("quality", "one row per pose", _pose_columns() + (
     Column("force_closure", "bool", "", "force closure (Definition 1) with the full synergy set"),
     Column("force_per_weight", "float64", "", "optimal contact-force norm with the full set over the weight (NaN: not load-feasible)"),
     Column("torque_length_mm", "float64", "mm", "the length torques are divided by: the object's bounding radius"),
+    Column("opposition", "string", "", "the grasp's opposition: palm, pad, side or none (docs/opposition.md)"),
 ))
 
 #: The study's claims at every scored target of one object's placement search

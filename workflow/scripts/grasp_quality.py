@@ -7,12 +7,14 @@ from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
 from synergrasp.optimisation.quality import QualityParams, quality_table
 from synergrasp.optimisation.mechanics import read_grasps
+from synergrasp.simulation.opposition import HandAxes
 
 with job_log(snakemake.log[0]):
     params = QualityParams.from_config(snakemake.params.cfg, snakemake.wildcards.object)
     contacts = tables.read(tables.CONTACTS, snakemake.input.contacts)
     gfo = tables.read(tables.GFO, snakemake.input.gfo)
-    matrix = load_synergies(params.synergies, joint_names=load_hand(params.hand).joint_names).matrix
-    quality = quality_table(contacts, gfo, read_grasps(contacts), matrix, params)
+    hand = load_hand(params.hand)
+    matrix = load_synergies(params.synergies, joint_names=hand.joint_names).matrix
+    quality = quality_table(contacts, gfo, read_grasps(contacts), matrix, params, HandAxes.from_hand(hand))
     tables.write(tables.QUALITY, quality, snakemake.output.table)
     figure_quality_maps(quality, snakemake.wildcards.object, snakemake.output.png, snakemake.output.pdf)

@@ -6,11 +6,12 @@ import pandas as pd
 
 from synergrasp import tables
 from synergrasp.analysis.graspability import graspable_objects, ungraspable_lines
-from synergrasp.analysis.realism import RealismParams, grasp_realism, link_shares
+from synergrasp.analysis.realism import RealismParams, grasp_labels, grasp_realism, link_shares
 from synergrasp.figures.grasp_realism import figure_grasp_realism
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.job_log import job_log
 from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
+from synergrasp.simulation.opposition import HandAxes
 
 with job_log(snakemake.log[0]) as log:
     params = RealismParams.from_config(snakemake.params.cfg)
@@ -20,8 +21,9 @@ with job_log(snakemake.log[0]) as log:
     gfo = pd.concat([tables.read(tables.GFO, p) for p in snakemake.input.gfo], ignore_index=True)
     checks = grasp_equilibrium(contacts, EquilibriumParams.of(hand, synergies, params.k_ss_Nmm_per_rad, params.mu),
                                synergies.columns([1])[:, 0])
+    labels = grasp_labels(contacts, HandAxes.from_hand(hand), params.opposition, params.shapes)
     table = grasp_realism(contacts, gfo, checks, hand.link_names, hand.link_finger, params.full_set_id,
-                          params.weights_N, params.load_threshold_N)
+                          params.weights_N, params.load_threshold_N, labels, params.grasp_types)
     tables.write_study_table(table, snakemake.output.csv, snakemake.output.md, title="Grasp realism")
     tables.write_study_table(link_shares(contacts, hand.link_names, hand.link_finger), snakemake.output.links_csv,
                              snakemake.output.links_md, title="Which links touch the box (% of simulated grasps)")

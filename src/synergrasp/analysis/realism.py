@@ -21,10 +21,12 @@ import pandas as pd
 from synergrasp.analysis.verdicts import verdict_columns
 from synergrasp.hand.synergies import Synergies, synergy_values
 from synergrasp.ids import incremental_set_id
+from synergrasp.simulation.opposition import (OPPOSITIONS, HandAxes, OppositionRule, contacts_oppositions,
+                                              edge_contacts, of_grasp_type)
 from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 
 __all__ = ["RealismParams", "SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "LONG_FINGERS",
-           "link_categories", "grasp_realism", "link_shares", "representative_grasps"]
+           "link_categories", "grasp_labels", "grasp_realism", "link_shares", "representative_grasps"]
 
 #: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.STATUSES): a
 #: ``no_contact`` closure is a simulated grasp with 0 contacts; any other status is a dropped pose.
@@ -56,6 +58,9 @@ class RealismParams:
     s1: tuple[float, ...]
     k_ss_Nmm_per_rad: float
     mu: float
+    grasp_types: dict[str, str]
+    shapes: dict[str, Any]
+    opposition: OppositionRule
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> RealismParams:
@@ -64,13 +69,18 @@ class RealismParams:
         mechanics = config["mechanics"]
         closure = config["closure"]
         threshold = closure["dynamic"]["load_threshold_N"] if closure["model"] == "dynamic" else None
+        from synergrasp.simulation.shapes import shape_from_config
+
         values = config["synergies"]
         if not isinstance(values, Mapping):
             values = synergy_values(config["hand"], values, (1,))
+        objects = config["objects"]
         return cls(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),
-                   {name: spec["mass_kg"] * mechanics["g_m_per_s2"] for name, spec in config["objects"].items()},
+                   {name: spec["mass_kg"] * mechanics["g_m_per_s2"] for name, spec in objects.items()},
                    threshold, tuple(values["mean_rad"]), tuple(values["S1"]), float(mechanics["k_ss_Nmm_per_rad"]),
-                   float(mechanics["mu"]))
+                   float(mechanics["mu"]), {name: spec["grasp_type"] for name, spec in objects.items()},
+                   {name: shape_from_config(spec["shape"], f"objects.{name}.shape") for name, spec in objects.items()},
+                   OppositionRule.from_config(config))
 
     def synergies(self, joint_names: tuple[str, ...]) -> Synergies:
         """q_m and S1 as a one-synergy :class:`Synergies` of the hand's joints."""
@@ -88,6 +98,20 @@ def link_categories(link_names: Sequence[str], link_finger: Sequence[str]) -> di
                         if f != "palm" and name.rsplit("_", 1)[-1] in _PROXIMAL_OR_MIDDLE)
     return {"thumb": finger("thumb"), "palm": finger("palm"), "proximal_or_middle": phalanx,
             **{name: finger(name) for name in LONG_FINGERS}}
+
+
+def grasp_labels(contacts: pd.DataFrame, axes: HandAxes, rule: OppositionRule,
+                 shapes: Mapping[str, Any]) -> pd.DataFrame:
+    """Per row of the contacts tables: object, closure_model, pose, the grasp's opposition
+    and how many of its contacts sit on an edge or a corner of the object (docs/opposition.md)."""
+    parts = []
+    for obj, rows in contacts.groupby("object", sort=True):
+        parts.append(pd.DataFrame({"object": obj, "closure_model": rows["closure_model"].to_numpy(),
+                                   "pose": rows["pose"].astype(int).to_numpy(),
+                                   "opposition": contacts_oppositions(rows, axes, rule),
+                                   "edge_contacts": edge_contacts(rows, shapes[obj], rule)}))
+    columns = ["object", "closure_model", "pose", "opposition", "edge_contacts"]
+    return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=columns)
 
 
 def _touches(links: pd.Series, category: frozenset[int]) -> pd.Series:
@@ -126,7 +150,7 @@ def _weight_multiples(gfo: pd.DataFrame, full_set_id: str, weights_N: Mapping[st
     return out.reset_index(drop=True)
 
 
-def _one_group(rows: pd.DataFrame, categories: dict[str, frozenset[int]]) -> dict[str, float]:
+def _one_group(rows: pd.DataFrame, categories: dict[str, frozenset[int]], grasp_type: str) -> dict[str, float]:
     simulated = rows["status"].isin(SIMULATED_STATUSES)
     grasps = rows[simulated]
     n = len(grasps)
@@ -142,6 +166,14 @@ def _one_group(rows: pd.DataFrame, categories: dict[str, frozenset[int]]) -> dic
         out[_bin_column(b)] = share(m == b)
     for name, links in categories.items():
         out[f"pct_{name}"] = share(_touches(grasps["contact_link"], links))
+    out["grasp_type"] = grasp_type
+    for opposition in OPPOSITIONS:
+        out[f"pct_{'no' if opposition == 'none' else opposition}_opposition"] = share(grasps["opposition"] == opposition)
+    typed = grasps["opposition"].map(lambda o: of_grasp_type(o, grasp_type))
+    out["pct_of_grasp_type"] = share(typed)
+    out["pct_of_grasp_type_force_closure"] = share(typed & grasps["force_closure"].fillna(False).astype(bool))
+    total = int(grasps["n_contacts"].sum())
+    out["pct_contacts_on_edges"] = 100.0 * float(grasps["edge_contacts"].sum()) / total if total else np.nan
     out["pct_rank6"] = share(grasps["rank_G"] == 6)
     out["pct_force_closure"] = share(grasps["force_closure"].fillna(False).astype(bool))
     out["pct_load_feasible"] = share(grasps["load_feasible"].fillna(False).astype(bool))
@@ -160,7 +192,7 @@ def _bin_column(b: int) -> str:
 
 def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, equilibrium: pd.DataFrame, link_names: Sequence[str],
                   link_finger: Sequence[str], full_set_id: str, weights_N: Mapping[str, float],
-                  load_threshold_N: float | None) -> pd.DataFrame:
+                  load_threshold_N: float | None, labels: pd.DataFrame, grasp_types: Mapping[str, str]) -> pd.DataFrame:
     """The grasp-realism table (columns of :data:`synergrasp.tables.GRASP_REALISM`).
 
     ``contacts``: contacts tables of the objects (CONTACTS contract; rows are grouped by
@@ -171,6 +203,8 @@ def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, equilibrium: pd.Dat
     (``synergrasp.optimisation.equilibrium.grasp_equilibrium``: object, closure_model, pose,
     torque_residual, s1_outside_cone, …); grasps missing from it count as unknown residual and
     no contact pushed outside its cone.
+    ``labels``: each grasp's opposition and edge contacts (:func:`grasp_labels`);
+    ``grasp_types``: each object's grasp type (docs/opposition.md).
     ``link_names`` / ``link_finger``: the hand's links (``Hand.link_names``, ``Hand.link_finger``).
     Shares are percent of the simulated poses (``SIMULATED_STATUSES``); a contact carries load if
     its normal force is at least ``load_threshold_N`` (N; the configuration's
@@ -191,8 +225,10 @@ def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, equilibrium: pd.Dat
     checks = equilibrium[["object", "closure_model", "pose", "torque_residual", "s1_outside_cone"]]
     work = work.merge(checks.astype({"pose": int}), on=["object", "closure_model", "pose"], how="left",
                       validate="one_to_one")
+    work = work.merge(labels.astype({"pose": int}), on=["object", "closure_model", "pose"], how="left",
+                      validate="one_to_one")
     categories = link_categories(link_names, link_finger)
-    rows = [{"object": obj, "closure_model": cm, **_one_group(group, categories)}
+    rows = [{"object": obj, "closure_model": cm, **_one_group(group, categories, grasp_types[obj])}
             for (obj, cm), group in work.groupby(["object", "closure_model"], sort=True)]
     return pd.DataFrame(rows, columns=list(GRASP_REALISM.names))
 

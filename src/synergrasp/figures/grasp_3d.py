@@ -30,6 +30,7 @@ from synergrasp.figures.hand_pictures import BOX, PALM_CAMERA, SKIN, ShapeInPict
 from synergrasp.ids import set_name
 from synergrasp.optimisation.study import GFOParams
 from synergrasp.simulation.objects import GraspedObject
+from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions
 from synergrasp.simulation.shapes.surface import Surface, frame_along, merge_meshes, placed, revolution_mesh
 
 __all__ = ["GraspScene", "Grasps3dParams", "grasp_figure", "grasp_page", "write_grasp_pages", "fig2_scenes",
@@ -238,13 +239,20 @@ class Grasps3dParams:
     full_set: tuple[int, ...]
     objects: tuple[GraspedObject, ...]
     gfo: tuple[GFOParams, ...]
+    opposition: OppositionRule
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> Grasps3dParams:
         names = list(config["objects"])
         return cls(config["hand"], config["synergies"], tuple(range(1, int(config["synergy_sets"]["incremental_max"]) + 1)),
                    tuple(GraspedObject.from_config(config, n, with_mass=False) for n in names),
-                   tuple(GFOParams.from_config(config, n) for n in names))
+                   tuple(GFOParams.from_config(config, n) for n in names), OppositionRule.from_config(config))
+
+    def oppositions(self, hand: Any, tables: Sequence[Any]) -> list[dict[int, str]]:
+        """Per object (``tables[i]``: the contacts table of ``objects[i]``), its grasps'
+        opposition by pose (docs/opposition.md)."""
+        axes = HandAxes.from_hand(hand)
+        return [dict(zip(t["pose"].astype(int), contacts_oppositions(t, axes, self.opposition))) for t in tables]
 
 
 def fig2_scenes(hand: Any, synergy_matrix: NDArray, params: Grasps3dParams,

@@ -214,51 +214,71 @@ def draw_grasp(ax: Any, hand: Any, q: NDArray, shape: ShapeInPicture, touching: 
     return picture
 
 
-def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame, camera: Camera = PALM_CAMERA) -> None:
+#: The two views of one grasp (``figure_grasp_views``): Fig. 2's, and from above the
+#: fingertips with the palm at the bottom and the palm normal up, where the tips and the thumb
+#: are seen on the object side by side.
+GRASP_VIEWS = (("palm side (as Fig. 2)", PALM_CAMERA),
+               ("from above the fingertips (palm below)", Camera(direction=(-0.45, 0.3, -1.0), up=(1.0, 0.0, 0.0))))
+
+
+def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame,
+                   cameras: Sequence[Camera] = (PALM_CAMERA,), oppositions: Mapping[int, str] | None = None) -> None:
     """One row of Fig. 2 on ``axes``: the representative grasps of ``obj`` (a
     ``synergrasp.simulation.objects.GraspedObject``) in its contacts ``table``
-    (``synergrasp.analysis.realism.representative_grasps``, one per axis), drawn in one
-    window with the touching links, the contact points and the touching links in words."""
-    n_grasps = len(axes)
+    (``synergrasp.analysis.realism.representative_grasps``), each drawn from every camera of
+    ``cameras`` (grasp c on ``axes[c * len(cameras) + v]``), one window per camera, with the
+    touching links, the contact points, the touching links in words and, where
+    ``oppositions`` (pose -> class, docs/opposition.md) is given, the grasp's opposition."""
+    k = len(cameras)
+    n_grasps = len(axes) // k
     chosen = representative_grasps(table, n_grasps)
     simulated = int(table["status"].isin(SIMULATED_STATUSES).sum())
     rows = [table[table["pose"] == pose].iloc[0] for pose in chosen["pose"]]
-    row_camera = _fit(camera, hand, [np.asarray(row["q"], dtype=float) for row in rows],
-                      [object_of(row, obj.shape) for row in rows]) if rows else camera
+    fitted = [_fit(camera, hand, [np.asarray(row["q"], dtype=float) for row in rows],
+                   [object_of(row, obj.shape) for row in rows]) if rows else camera for camera in cameras]
     pictures, thumbs = [], []
     axes[0].set_ylabel(f"{obj.name}\n{obj.shape.label}", fontsize=10)
-    for c in range(n_grasps):
-        ax = axes[c]
+    for ax in axes:
         _bare(ax)
+    for c in range(n_grasps):
         if c >= len(chosen):
-            ax.text(0.5, 0.5, "no other contact set" if c else f"no grasp with contacts\n({simulated} simulated)",
-                    ha="center", va="center", transform=ax.transAxes, fontsize=8, color="0.4")
+            axes[c * k].text(0.5, 0.5, "no other contact set" if c else f"no grasp with contacts\n({simulated} simulated)",
+                             ha="center", va="center", transform=axes[c * k].transAxes, fontsize=8, color="0.4")
             continue
         pick, row = chosen.iloc[c], rows[c]
         q = np.asarray(row["q"], dtype=float)
-        picture = draw_grasp(ax, hand, q, object_of(row, obj.shape), pick["pattern"], row["contact_point"],
-                             row_camera)
-        pictures.append(picture)
-        thumbs.append((picture, q))
-        ax.set_title(f"{pick['reason']}: {pick['share_pct']:.0f} % of grasps\n"
-                     f"α = {pick['alpha_deg']:g}°, β = {pick['beta_deg']:g}°, {int(row['n_contacts'])} contacts",
-                     fontsize=8)
-        ax.set_xlabel(_touching_words(hand, pick["pattern"]), fontsize=7, labelpad=2)
-    if pictures:
-        _frame(axes[:len(pictures)], pictures)
-        for ax, (picture, q) in zip(axes, thumbs):
-            _label(ax, "thumb", picture.pixels(_thumb_point(hand, q)[None])[0],
-                   picture.pixels(_palm_point(hand)[None])[0])
+        kind = "" if oppositions is None else f", {oppositions.get(int(pick['pose']), 'none')} opposition"
+        for v, camera in enumerate(fitted):
+            ax = axes[c * k + v]
+            picture = draw_grasp(ax, hand, q, object_of(row, obj.shape), pick["pattern"], row["contact_point"], camera)
+            pictures.append((ax, picture))
+            thumbs.append((ax, picture, q))
+            if v == 0:
+                ax.set_title(f"{pick['reason']}: {pick['share_pct']:.0f} % of grasps\n"
+                             f"α = {pick['alpha_deg']:g}°, β = {pick['beta_deg']:g}°, {int(row['n_contacts'])} contacts"
+                             f"{kind}", fontsize=8)
+                ax.set_xlabel(_touching_words(hand, pick["pattern"]), fontsize=7, labelpad=2)
+            else:
+                ax.set_title("the same grasp from above the fingertips" if k == 2 else f"view {v + 1}", fontsize=8)
+    for v in range(k):
+        mine = [(ax, p) for i, (ax, p) in enumerate(pictures) if i % k == v]
+        if mine:
+            _frame([ax for ax, _ in mine], [p for _, p in mine])
+    for ax, picture, q in thumbs:
+        _label(ax, "thumb", picture.pixels(_thumb_point(hand, q)[None])[0], picture.pixels(_palm_point(hand)[None])[0])
 
 
 def figure_example_grasps(hand: Any, objects: Sequence[Any], tables: Sequence[pd.DataFrame], png_path: str | Path,
-                          pdf_path: str | Path, n_grasps: int = FIG2_GRASPS, camera: Camera = PALM_CAMERA) -> None:
+                          pdf_path: str | Path, n_grasps: int = FIG2_GRASPS,
+                          cameras: Sequence[Camera] = tuple(c for _, c in GRASP_VIEWS),
+                          oppositions: Sequence[Mapping[int, str]] | None = None) -> None:
     """Fig. 2: representative simulated grasps, one row per object, chosen by rule
     (``synergrasp.analysis.realism.representative_grasps``: the most common set of touching
     links, the most common one at the typical contact count, the next most common), each at
-    its pose nearest (α, β) = (0, 0), all in the view of Fig. 1. ``objects`` are
+    its pose nearest (α, β) = (0, 0), each from the palm side (the view of Fig. 1) and from
+    above the fingertips (``GRASP_VIEWS``). ``objects`` are
     ``synergrasp.simulation.objects.GraspedObject``; ``tables[i]`` is the contacts table of
-    ``objects[i]``.
+    ``objects[i]``; ``oppositions[i]`` its grasps' opposition by pose (titles name it).
     Links touching the object are highlighted, contact points are dots (hollow where the
     hand hides them); the object is see-through.
     """
@@ -269,21 +289,14 @@ def figure_example_grasps(hand: Any, objects: Sequence[Any], tables: Sequence[pd
 
     if len(objects) != len(tables):
         raise ValueError(f"objects and tables must have the same length, got {len(objects)} and {len(tables)}")
-    panel = 2.6  # inches
-    fig, axes = plt.subplots(len(objects), n_grasps, figsize=(panel * n_grasps + 0.5, panel * len(objects) + 0.9),
-                             squeeze=False)
+    panel, k = 2.4, len(cameras)  # inches
+    fig, axes = plt.subplots(len(objects), n_grasps * k, figsize=(panel * n_grasps * k + 0.5,
+                                                                   panel * len(objects) + 0.9), squeeze=False)
     for r, (obj, table) in enumerate(zip(objects, tables)):
-        draw_grasp_row(axes[r], hand, obj, table, camera)
+        draw_grasp_row(axes[r], hand, obj, table, cameras, None if oppositions is None else oppositions[r])
     _legend(fig)
     fig.tight_layout(rect=(0, 0.035, 1, 1), h_pad=0.6, w_pad=0.3)
     save_figure(fig, png_path, pdf_path)
-
-
-#: The two views of one grasp (``figure_grasp_views``): Fig. 2's, and from above the
-#: fingertips with the palm at the bottom and the palm normal up, where the tips and the thumb
-#: are seen on the object side by side.
-GRASP_VIEWS = (("palm side (as Fig. 2)", PALM_CAMERA),
-               ("from above the fingertips (palm below)", Camera(direction=(-0.45, 0.3, -1.0), up=(1.0, 0.0, 0.0))))
 
 
 def figure_grasp_views(hand: Any, shape: ShapeInPicture, q: ArrayLike, links: Sequence[int], points_mm: ArrayLike,

@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 from scipy.spatial import ConvexHull, QhullError
 
 from synergrasp.optimisation.mechanics import Grasp, contact_frames, first_same_grasp, grasp_matrix
+from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions
 
 __all__ = ["GraspQuality", "grasp_quality", "scaled_grasp_matrix", "primitive_wrenches", "ferrari_canny_l1",
            "synergy_manipulability", "QualityParams", "quality_table", "QUALITY_EDGES", "RANK_RTOL"]
@@ -162,6 +163,7 @@ class QualityParams:
     full_set_id: str
     weight_N: float
     torque_length_mm: float
+    opposition: OppositionRule
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> QualityParams:
@@ -172,14 +174,15 @@ class QualityParams:
         return cls(config["hand"], config["synergies"], float(config["mechanics"]["mu"]),
                    incremental_set_id(config["synergy_sets"]["incremental_max"]),
                    float(grasped.mass_kg) * float(config["mechanics"]["g_m_per_s2"]),
-                   grasped.shape.bounding_radius_mm)
+                   grasped.shape.bounding_radius_mm, OppositionRule.from_config(config))
 
 
 def quality_table(contacts: pd.DataFrame, gfo: pd.DataFrame, grasps: Sequence[Grasp | None],
-                  synergy_matrix: NDArray, params: QualityParams) -> pd.DataFrame:
+                  synergy_matrix: NDArray, params: QualityParams, axes: HandAxes) -> pd.DataFrame:
     """One row per pose of ``contacts`` (columns of ``synergrasp.tables.QUALITY``): the quality
-    indices of its grasp (``grasps``, one per row; None: no grasp, indices NaN) and the full
-    set's verdict and optimal force over the weight from ``gfo``. Poses with one grasp
+    indices of its grasp (``grasps``, one per row; None: no grasp, indices NaN), the full
+    set's verdict and optimal force over the weight from ``gfo``, and the grasp's opposition
+    (``axes``: the hand's, docs/opposition.md). Poses with one grasp
     (``mechanics.first_same_grasp``: a box's poses one α-period apart) share its indices,
     computed once at the first of them: the ε hull is most of the cost."""
     full = gfo[gfo["set_id"] == params.full_set_id]
@@ -189,7 +192,8 @@ def quality_table(contacts: pd.DataFrame, gfo: pd.DataFrame, grasps: Sequence[Gr
     rows = []
     first = first_same_grasp(grasps)
     computed: dict[int, GraspQuality] = {}
-    for row, grasp, i in zip(contacts.itertuples(index=False), grasps, first):
+    oppositions = contacts_oppositions(contacts, axes, params.opposition)
+    for row, grasp, i, opposition in zip(contacts.itertuples(index=False), grasps, first, oppositions):
         out = {"object": row.object, "pose": row.pose, "alpha_deg": row.alpha_deg,
                "beta_deg": row.beta_deg, "n_contacts": int(row.n_contacts), "rank_G": 0,
                "sigma_min": np.nan, "isotropy": np.nan, "epsilon": np.nan, "manipulability": [np.nan] * 6}
@@ -201,5 +205,6 @@ def quality_table(contacts: pd.DataFrame, gfo: pd.DataFrame, grasps: Sequence[Gr
                        manipulability=q.manipulability.tolist())
         out["force_closure"], out["force_per_weight"] = verdicts.get(int(row.pose), (False, np.nan))
         out["torque_length_mm"] = params.torque_length_mm
+        out["opposition"] = opposition
         rows.append(out)
     return pd.DataFrame(rows)

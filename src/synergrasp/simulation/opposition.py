@@ -39,7 +39,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
 
 __all__ = ["OPPOSITIONS", "GRASP_TYPES", "LINK_KINDS", "FACE_CLASSES", "SURFACE_FEATURES", "OppositionRule",
-           "HandAxes", "classify_grasp", "contacts_oppositions", "of_grasp_type", "face_classes", "surface_features"]
+           "HandAxes", "classify_grasp", "contacts_oppositions", "edge_contacts", "of_grasp_type", "face_classes", "surface_features"]
 
 #: The classes, in the order the rule tries them.
 OPPOSITIONS: tuple[str, ...] = ("palm", "pad", "side", "none")
@@ -163,6 +163,20 @@ def contacts_oppositions(contacts: Any, axes: HandAxes, rule: OppositionRule) ->
     out = []
     for status, links, normals in zip(contacts["status"], contacts["contact_link"], contacts["contact_normal"]):
         out.append(classify_grasp(links, np.asarray(normals), axes, rule) if status == "grasp" else "none")
+    return out
+
+
+def edge_contacts(contacts: Any, shape: Any, rule: OppositionRule) -> list[int]:
+    """Per row of a contacts table, how many of its contacts sit on an edge or a corner of
+    the placed shape (``surface_features``)."""
+    out = []
+    for m, points, rotation, center in zip(contacts["n_contacts"], contacts["contact_point"],
+                                           contacts["object_rotation"], contacts["object_center"]):
+        if int(m) == 0:
+            out.append(0)
+            continue
+        features = surface_features(np.asarray(points), shape, np.asarray(rotation), np.asarray(center), rule)
+        out.append(sum(f != "face" for f in features))
     return out
 
 
