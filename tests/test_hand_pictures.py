@@ -142,7 +142,8 @@ def test_placement_map_is_written_and_the_same_on_rerun(hand, synergies, tmp_pat
     placement = pd.DataFrame({"object": "cube", "rank": range(1, 6), "chosen": [True] + [False] * 4,
                               "distinct_rank": range(1, 6), "x_mm": [t[0] for t in targets],
                               "y_mm": [t[1] for t in targets], "z_mm": [t[2] for t in targets], "round": 0,
-                              "n_poses": 27, "force_closure_percent": [90.0, 80.0, 50.0, 0.0, 90.0],
+                              "n_poses": 27, "grasp_type": "power", "typed_percent": [80.0, 60.0, 0.0, 0.0, 90.0],
+                              "force_closure_percent": [90.0, 80.0, 50.0, 0.0, 90.0],
                               "median_force_per_weight": [1.0, 2.0, 3.0, float("inf"), 1.0],
                               "median_contacts": 4.0, "distance_to_chosen_mm": 0.0})
     for run in ("a", "b"):

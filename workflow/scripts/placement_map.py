@@ -5,9 +5,12 @@ from synergrasp.figures.placement_map import figure_placement_map
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.job_log import job_log
 from synergrasp.optimisation.placement_search import SearchStepParams
+from synergrasp.simulation.opposition import HandAxes, contacts_oppositions
 
 with job_log(snakemake.log[0]):
     sim = SearchStepParams.from_config(snakemake.params.cfg, snakemake.wildcards.object)
-    figure_placement_map(load_hand(sim.hand), sim.object, tables.read_csv(tables.PLACEMENT, snakemake.input.placement),
-                         tables.read(tables.CONTACTS, snakemake.input.contacts), sim.search.spacing_mm,
-                         snakemake.output.png, snakemake.output.pdf)
+    hand = load_hand(sim.hand)
+    contacts = tables.read(tables.CONTACTS, snakemake.input.contacts)
+    oppositions = dict(zip(contacts["pose"], contacts_oppositions(contacts, HandAxes.from_hand(hand), sim.opposition)))
+    figure_placement_map(hand, sim.object, tables.read_csv(tables.PLACEMENT, snakemake.input.placement), contacts,
+                         sim.search.spacing_mm, snakemake.output.png, snakemake.output.pdf, oppositions=oppositions)

@@ -4,13 +4,14 @@ mm, palm frame."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from synergrasp.figures.hand_figures import draw_grasp_row
+from synergrasp.figures.hand_figures import GRASP_VIEWS, draw_grasp_row
 from synergrasp.figures.output import save_figure
 
 __all__ = ["figure_placement_map"]
@@ -32,7 +33,7 @@ def _level_panel(ax: Any, level: pd.DataFrame, spacing_mm: float, outline: tuple
 
     half = spacing_mm / 2.0
     for _, row in level.iterrows():
-        colour = image_colour(row["force_closure_percent"])
+        colour = image_colour(row["typed_percent"])
         ax.add_patch(Rectangle((row["y_mm"] - half, row["z_mm"] - half), spacing_mm, spacing_mm,
                                facecolor=colour, edgecolor="white", linewidth=0.4))
     y0, y1, z0, z1 = outline
@@ -51,20 +52,23 @@ def _level_panel(ax: Any, level: pd.DataFrame, spacing_mm: float, outline: tuple
 
 
 def image_colour(percent: float) -> Any:
-    """The map's colour of a force-closure share (%)."""
+    """The map's colour of a share of scored poses (%)."""
     import matplotlib
 
     return matplotlib.colormaps["viridis"](float(percent) / 100.0)
 
 
 def figure_placement_map(hand: Any, obj: Any, placement: pd.DataFrame, contacts: pd.DataFrame,
-                         spacing_mm: float, png_path: str | Path, pdf_path: str | Path, n_grasps: int = 3) -> None:
+                         spacing_mm: float, png_path: str | Path, pdf_path: str | Path, n_grasps: int = 2,
+                         oppositions: Mapping[int, str] | None = None) -> None:
     """The placement map of ``obj`` (a ``synergrasp.simulation.objects.GraspedObject``): one panel per distance x of the targets from the palm
-    (palm frame, mm): every scored target as a square coloured by its share of scored poses
-    in force closure with the full synergy set, the chosen target a red star, the second and
-    third distinct targets circles; the palm's outline dashed. Below, ``n_grasps``
-    representative grasps of ``contacts`` (the object's closure at the chosen target), as in
-    Fig. 2."""
+    (palm frame, mm): every scored target as a square coloured by the search's score T (the
+    share of scored poses whose grasp is of the object's type and in force closure with the
+    full synergy set), the chosen target a red star, the second and third distinct targets
+    circles; the palm's outline dashed. Below, ``n_grasps`` representative grasps of
+    ``contacts`` (the object's closure at the chosen target) from the palm side and from
+    above the fingertips, as in Fig. 2, titled with their opposition (``oppositions``: pose
+    -> class)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -78,9 +82,10 @@ def figure_placement_map(hand: Any, obj: Any, placement: pd.DataFrame, contacts:
     limits = (placement["y_mm"].min() - half - 2, placement["y_mm"].max() + half + 2,
               placement["z_mm"].min() - half - 2, placement["z_mm"].max() + half + 2)
     outline = _palm_outline(hand)
-    fig = plt.figure(figsize=(max(2.2 * len(levels) + 1.0, 3.4 * n_grasps), 8.8))
+    views = len(GRASP_VIEWS)
+    fig = plt.figure(figsize=(max(2.2 * len(levels) + 1.0, 2.6 * n_grasps * views), 8.8))
     grid = fig.add_gridspec(2, 1, height_ratios=(1.1, 1.0), hspace=0.25)
-    top, bottom = grid[0].subgridspec(1, len(levels)), grid[1].subgridspec(1, n_grasps)
+    top, bottom = grid[0].subgridspec(1, len(levels)), grid[1].subgridspec(1, n_grasps * views)
     for i, x in enumerate(levels):
         ax = fig.add_subplot(top[0, i])
         _level_panel(ax, placement[np.isclose(placement["x_mm"], x)], spacing_mm, outline, limits)
@@ -89,12 +94,13 @@ def figure_placement_map(hand: Any, obj: Any, placement: pd.DataFrame, contacts:
         if i == 0:
             ax.set_ylabel("z (mm, along the fingers)", fontsize=7)
     bar = fig.colorbar(ScalarMappable(Normalize(0, 100), "viridis"), ax=list(fig.axes), fraction=0.02, pad=0.01)
-    bar.set_label("force closure with the full set, % of scored poses", fontsize=7)
+    bar.set_label(f"{chosen['grasp_type']} grasps in force closure (full set), % of scored poses", fontsize=7)
     bar.ax.tick_params(labelsize=7)
-    grasp_axes = [fig.add_subplot(bottom[0, c]) for c in range(n_grasps)]
-    draw_grasp_row(grasp_axes, hand, obj, contacts)
-    fig.suptitle(f"{obj.name}: chosen target ({chosen['x_mm']:g}, {chosen['y_mm']:g}, {chosen['z_mm']:g}) mm, "
-                 f"{chosen['force_closure_percent']:.0f} % force closure, median force "
+    grasp_axes = [fig.add_subplot(bottom[0, c]) for c in range(n_grasps * views)]
+    draw_grasp_row(grasp_axes, hand, obj, contacts, tuple(c for _, c in GRASP_VIEWS), oppositions)
+    fig.suptitle(f"{obj.name} ({chosen['grasp_type']}): chosen target ({chosen['x_mm']:g}, {chosen['y_mm']:g}, "
+                 f"{chosen['z_mm']:g}) mm, {chosen['typed_percent']:.0f} % {chosen['grasp_type']} grasps in force "
+                 f"closure ({chosen['force_closure_percent']:.0f} % force closure of any kind), median force "
                  f"{chosen['median_force_per_weight']:.2g} × weight, {len(placement)} targets scored on "
                  f"{int(chosen['n_poses'])} poses; grasps at it below", fontsize=9)
     save_figure(fig, png_path, pdf_path)
