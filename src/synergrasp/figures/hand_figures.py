@@ -247,7 +247,7 @@ def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame
             continue
         pick, row = chosen.iloc[c], rows[c]
         q = np.asarray(row["q"], dtype=float)
-        kind = "" if oppositions is None else f", {oppositions.get(int(pick['pose']), 'none')} opposition"
+        kind = "" if oppositions is None else f"\n{oppositions.get(int(pick['pose']), 'none')} opposition"
         for v, camera in enumerate(fitted):
             ax = axes[c * k + v]
             picture = draw_grasp(ax, hand, q, object_of(row, obj.shape), pick["pattern"], row["contact_point"], camera)
@@ -259,7 +259,7 @@ def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame
                              f"{kind}", fontsize=8)
                 ax.set_xlabel(_touching_words(hand, pick["pattern"]), fontsize=7, labelpad=2)
             else:
-                ax.set_title("the same grasp from above the fingertips" if k == 2 else f"view {v + 1}", fontsize=8)
+                ax.set_title("the same grasp,\nfrom above the fingertips" if k == 2 else f"view {v + 1}", fontsize=8)
     for v in range(k):
         mine = [(ax, p) for i, (ax, p) in enumerate(pictures) if i % k == v]
         if mine:
