@@ -17,7 +17,7 @@ from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.mechanics import Grasp, internal_force_basis
 from synergrasp.optimisation.problem import GFOProblem
 from synergrasp.optimisation.study import GFOParams, mechanics_for
-from synergrasp.simulation.opposition import HandAxes, OppositionRule
+from synergrasp.simulation.opposition import HandAxes, OppositionRule, classify_grasp
 from synergrasp.simulation.shapes import shape_from_config
 
 X, Y, Z = np.eye(3)
@@ -50,7 +50,7 @@ def strict(grasp, S):
     return bool(solve_gfo([problem], "clarabel", strict_shrink=1e-5).strict_internal[0])
 
 
-def test_a_box_squeezed_between_palm_and_fingers_has_no_blocker(hand):
+def test_a_box_squeezed_between_palm_and_fingers_has_no_blocker(hand, axes):
     # the palm pushes the box off the palm (+x); two fingertips close on it (-x)
     contacts = [("palm", (20, 10, -10), X), ("palm", (20, -10, -10), X),
                 ("middle_distal", (60, 5, 10), -X), ("ring_distal", (60, -5, 10), -X)]
@@ -62,9 +62,10 @@ def test_a_box_squeezed_between_palm_and_fingers_has_no_blocker(hand):
         assert found.blocking.margin > 0.05  # strictly inside every cone: nothing blocks
     assert s1.e_s == 1 and full.e_s == 2
     assert strict(grasp, S) and strict(grasp, S[:, :1])
+    assert classify_grasp(grasp.links, grasp.normals, axes, RULE) == "palm"
 
 
-def test_a_pinch_squeezes_and_a_rigid_motion_reaches_no_internal_force(hand):
+def test_a_pinch_squeezes_and_a_rigid_motion_reaches_no_internal_force(hand, axes):
     contacts = [("thumb_distal", (40, -20, 0), Y), ("index_distal", (40, 20, 8), -Y),
                 ("middle_distal", (40, 20, -8), -Y)]
     grasp = hand_made(hand, contacts, [(0, Y), (1, -Y), (2, -Y)], (40, 0, 0))
@@ -74,6 +75,7 @@ def test_a_pinch_squeezes_and_a_rigid_motion_reaches_no_internal_force(hand):
     # S2 moves every contact the same way: a rigid motion of the box, no internal force
     assert rigid.e_s == 0 and rigid.reason == "no_internal_force" and not rigid.blocking.blockers.any()
     assert not strict(grasp, S[:, 1:])
+    assert classify_grasp(grasp.links, grasp.normals, axes, RULE) == "pad"
 
 
 def one_sided_push(hand):
@@ -94,6 +96,7 @@ def one_sided_push(hand):
 
 def test_a_one_sided_fingertip_push_blocks_s1_at_the_fingertips(hand, axes):
     grasp, S = one_sided_push(hand)
+    assert classify_grasp(grasp.links, grasp.normals, axes, RULE) == "none"
     full, s1 = set_blockers(grasp, S, [tuple(range(2, S.shape[1] + 1)), (1,)], PARAMS)
     assert full.reason == "contacts" and full.blocking.margin > 0 and strict(grasp, S[:, 1:])
     assert s1.e_s == 1 and s1.reason == "contacts" and s1.blocking.margin < 0 and not strict(grasp, S[:, :1])
@@ -199,3 +202,32 @@ def test_sets_examined_and_the_summary_counts_poses():
     assert table.loc[("a", "1"), "pct_face_palm_face"] == 50.0 and table.loc[("a", "1"), "pct_feature_corner"] == 50.0
     assert table.loc[("a", "2"), "pct_no_internal_force"] == 100.0 and table.loc[("a", "2"), "pct_kind_palm"] == 0.0
     assert table.loc[("all", "1"), "n_failing"] == 2 and table.loc[("a", "3"), "n_failing"] == 0
+
+
+def test_the_table_solves_twin_poses_once_and_keeps_its_contract(hand, axes, tmp_path, monkeypatch):
+    from synergrasp import tables
+    from synergrasp.analysis import blockers as module
+
+    grasp, S = one_sided_push(hand)
+    m = grasp.n_contacts
+    row = {"object": "box", "alpha_deg": 0.0, "beta_deg": 0.0, "status": "grasp", "n_contacts": m,
+           "contact_link": grasp.links.tolist(), "contact_point": grasp.points.ravel().tolist(),
+           "contact_normal": grasp.normals.ravel().tolist(), "jacobian": grasp.jacobian.ravel().tolist(),
+           "object_center": grasp.center.tolist(), "object_rotation": np.eye(3).ravel().tolist()}
+    contacts = pd.DataFrame([{**row, "pose": 0}, {**row, "pose": 1, "alpha_deg": 90.0}])
+    full_id = "-".join(str(k) for k in range(2, S.shape[1] + 1))
+    gfo = pd.DataFrame([{"object": "box", "pose": p, "alpha_deg": 90.0 * p, "beta_deg": 0.0, "set_id": sid,
+                         "n_synergies": n, "status": "force_closure", "force_closure": True, "strict_internal": ok,
+                         "rank_G": 6, "force_norm": 1.0} for p in (0, 1)
+                        for sid, n, ok in ((full_id, S.shape[1] - 1, True), ("1", 1, False))])
+    box = shape_from_config({"box": {"size_mm": [60, 60, 60]}}, "test")
+    params = module.BlockersParams(None, None, PARAMS, {"1": (1,)}, full_id, RULE, box)
+    calls = []
+    solve = module.set_blockers
+    monkeypatch.setattr(module, "set_blockers", lambda *a: calls.append(a) or solve(*a))
+    table = module.blockers_table(contacts, gfo, hand.link_names, axes, S, params)
+    assert len(calls) == 1 and list(table["pose"]) == [0, 1] and list(table["alpha_deg"]) == [0.0, 90.0]
+    assert table["blocker_link_name"].tolist() == [["index_distal", "middle_distal"]] * 2
+    tables.write(tables.BLOCKERS, table, tmp_path / "blockers.parquet")
+    back = tables.read(tables.BLOCKERS, tmp_path / "blockers.parquet")
+    assert back["margin"].tolist() == table["margin"].tolist() and back["reason"].tolist() == ["contacts"] * 2
