@@ -45,7 +45,8 @@ def figure_blockers(summary: pd.DataFrame, png_path: str | Path, pdf_path: str |
     objects = [o for o in dict.fromkeys(summary["object"]) if o != "all"] + (["all"] if (summary["object"] == "all").any() else [])
     columns = _columns()
     n = max(len(objects), 1)
-    fig, axes = plt.subplots(n, 1, figsize=(11.5, 0.34 * len(summary) + 1.2 * n + 0.6), squeeze=False)
+    fig, axes = plt.subplots(n, 1, figsize=(11.5, 0.3 * len(summary) + 0.5 * n + 2.4), squeeze=False, sharex=True,
+                             layout="constrained")
     for ax, obj in zip(axes[:, 0], objects):
         part = summary[summary["object"] == obj]
         values = part[[c for c, _ in columns]].to_numpy(dtype=float)
@@ -56,12 +57,13 @@ def figure_blockers(summary: pd.DataFrame, png_path: str | Path, pdf_path: str |
         ax.set_yticks(range(len(part)))
         ax.set_yticklabels([f"{set_name([int(k) for k in s.split('-')])}  (n = {int(c)})"
                             for s, c in zip(part["set_id"], part["n_failing"])], fontsize=7)
-        ax.set_xticks(range(len(columns)))
-        ax.set_xticklabels([label for _, label in columns], fontsize=7, rotation=35, ha="right")
+        ax.set_xticks(range(len(columns)), [label for _, label in columns])
+        # the columns are the same in every panel: named above the first and below the last
+        ax.tick_params(axis="x", labelsize=7, labeltop=ax is axes[0, 0], labelbottom=ax is axes[-1, 0])
+        plt.setp(ax.get_xticklabels(), rotation=35, ha="right" if ax is axes[-1, 0] else "left")
         for edge in (0.5, 0.5 + len(SUMMARY_GROUPS["kind"][1]), 0.5 + len(SUMMARY_GROUPS["kind"][1]) + len(SUMMARY_GROUPS["face"][1])):
             ax.axvline(edge, color="black", linewidth=0.8)
         ax.set_title(f"{obj}: poses where the full set is in force closure and the set is not; "
                      "% with a blocker of each kind", fontsize=8.5, loc="left")
         fig.colorbar(image, ax=ax, fraction=0.02, pad=0.01).ax.tick_params(labelsize=6)
-    fig.tight_layout()
     save_figure(fig, png_path, pdf_path)
