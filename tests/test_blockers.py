@@ -188,8 +188,9 @@ def test_pyramid_t_star_agrees_with_a_linear_programme():
 
 
 def test_sets_examined_and_the_summary_counts_poses():
-    sets = blocker_sets({"hierarchy_first": 3})
+    sets = blocker_sets({"hierarchy_first": 3, "incremental_max": 15})
     assert list(sets) == ["1", "1-2", "1-2-3", "2", "3"]
+    assert list(blocker_sets({"hierarchy_first": 3, "incremental_max": 2})) == ["1", "1-2", "2", "3"]
     rows = pd.DataFrame({"object": ["a", "a", "a"], "set_id": ["1", "1", "2"], "reason": ["contacts", "contacts",
                                                                                         "no_internal_force"],
                          "margin": [-1.0, -0.5, np.nan],

@@ -174,7 +174,7 @@ STEPS: dict[str, Step] = {
     "blockers_table": Step(
         rules={"blockers_summary": Cost("none", 4.0, 300)},
         outputs={"csv": "tables/blockers.csv", "md": "tables/blockers.md", **_files(("blockers",), "figures", _PNG_PDF)},
-        reads=("synergy_sets.hierarchy_first",), upstream=("blockers",)),
+        reads=("synergy_sets.hierarchy_first", "synergy_sets.incremental_max"), upstream=("blockers",)),
     "tables": Step(
         rules={"study_tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
         outputs=_files(TABLES, "tables", ("csv", "md")),

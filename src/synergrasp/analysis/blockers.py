@@ -34,10 +34,12 @@ __all__ = ["BlockersParams", "ContactLabels", "SetBlockers", "blocker_sets", "co
 
 
 def blocker_sets(sets_config: Mapping[str, int]) -> dict[str, tuple[int, ...]]:
-    """The sets examined, by id: {S1..Sk} for k = 1 .. hierarchy_first, then the singles
+    """The sets examined, by id: {S1..Sk} for k = 1 .. hierarchy_first (at most
+    incremental_max: the study solves no larger incremental set), then the singles
     {S2} .. {S_hierarchy_first} ({S1} is the first of both)."""
     first = int(sets_config["hierarchy_first"])
-    out = {incremental_set_id(k): tuple(range(1, k + 1)) for k in range(1, first + 1)}
+    out = {incremental_set_id(k): tuple(range(1, k + 1))
+           for k in range(1, min(first, int(sets_config["incremental_max"])) + 1)}
     out.update({set_id([k]): (k,) for k in range(2, first + 1)})
     return out
 
