@@ -141,3 +141,34 @@ def test_png_draws_the_grasp_from_two_views_with_its_touching_links(tmp_path):
     lit = np.linalg.norm(chroma - np.asarray(TOUCHING) / sum(TOUCHING), axis=2) < 0.03
     half = rgb.shape[1] // 2
     assert lit[:, :half].sum() > 500 and lit[:, half:].sum() > 500
+
+
+def test_the_inspector_names_the_blockers_of_the_blockers_table(small, study_rows):
+    """docs/blockers.md: each failing set's blockers at a pose, as the per-object table has them."""
+    from synergrasp.analysis.blockers import BlockersParams, blockers_table
+    from synergrasp.ids import incremental_set_id
+    from synergrasp.simulation.opposition import HandAxes
+
+    cfg = validate_config(small)
+    obj = "obj1"
+    contacts, gfo = study_rows[obj]
+    full_id = incremental_set_id(15)
+    base = BlockersParams.from_config(cfg, obj)
+    params = BlockersParams(base.hand, base.synergies, base.gfo, {set_id(s): s for s in SETS if set_id(s) != full_id},
+                            full_id, base.rule, base.shape)
+    hand = load_hand(params.hand)
+    table = blockers_table(contacts, gfo, hand.link_names, HandAxes.from_hand(hand),
+                           load_synergies(params.synergies, joint_names=hand.joint_names).matrix, params)
+    assert len(table) and set(table["reason"]) <= {"contacts", "no_internal_force"}
+    row = table[table["reason"] == "contacts"].iloc[0]
+    result = inspect_grasp(small, obj, float(row["alpha_deg"]), float(row["beta_deg"]), SETS)
+    inspected = {s.set_id: s for s in result.sets}
+    for _, expected in table[table["pose"] == row["pose"]].iterrows():
+        s = inspected[expected["set_id"]]
+        assert not s.force_closure and s.blocked_by == expected["reason"]
+        assert [b.contact for b in s.blockers] == list(expected["blocker_contact"])
+        assert [b.link_name for b in s.blockers] == list(expected["blocker_link_name"])
+        assert s.margin == pytest.approx(expected["margin"], abs=1e-9, nan_ok=True)
+    assert inspected[full_id].blocked_by == "" and not inspected[full_id].blockers
+    text = __import__("synergrasp.cli", fromlist=["format_inspection"]).format_inspection(result)
+    assert "what blocks each set not in force closure" in text and str(row["blocker_link_name"][0]) in text

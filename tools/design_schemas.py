@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from synergrasp.tables import CONTACTS, GFO, MINIMA, PLACEMENT, QUALITY, TARGET_CLAIMS, Table
+from synergrasp.tables import BLOCKERS, CONTACTS, GFO, MINIMA, PLACEMENT, QUALITY, TARGET_CLAIMS, Table
 
 DESIGN = Path(__file__).resolve().parents[1] / "docs" / "design.md"
 BEGIN = "<!-- schemas: written by tools/design_schemas.py from src/synergrasp/tables.py; do not edit -->"
@@ -24,6 +24,7 @@ FILES: tuple[tuple[Table, str], ...] = (
     (GFO, "objects/<object>/gfo.parquet"),
     (MINIMA, "objects/<object>/minima.parquet"),
     (QUALITY, "objects/<object>/quality.parquet"),
+    (BLOCKERS, "objects/<object>/blockers.parquet"),
     (PLACEMENT, "objects/<object>/placement.csv"),
     (TARGET_CLAIMS, "objects/<object>/target_claims.parquet"),
 )

@@ -76,7 +76,33 @@ def format_inspection(result: Any) -> str:
                          f"{'yes' if s.force_closure else 'no':<14} {_WEIGHT_WORDS.get(s.status, s.status):<17} "
                          f"{_number(s.force_N, 4):>9} {_number(s.force_N / result.weight_N, 3):>9} {s.e_s:>4} "
                          f"{'—' if math.isnan(s.cone_use) else f'{s.cone_use:.3f}':>9}")
+        lines += _blocker_lines(result.sets)
     return "\n".join(lines)
+
+
+#: Why a set fails when no contact is named (docs/blockers.md).
+_REASON_WORDS = {"no_internal_force": "no internal force (e_s = 0)", "rank_deficient": "rank(G) < 6",
+                 "no_squeeze": "every internal force it reaches has zero total normal force",
+                 "numerical_failure": "the max-margin problem was not solved"}
+
+
+def _blocker_lines(sets: Any) -> list[str]:
+    """What blocks each set not in force closure (docs/blockers.md)."""
+    from synergrasp.ids import set_name
+
+    failing = [s for s in sets if getattr(s, "blocked_by", "")]
+    if not failing:
+        return []
+    lines = ["what blocks each set not in force closure (t*: best least cone margin, per N of total normal force):"]
+    for s in failing:
+        if s.blocked_by != "contacts":
+            lines.append(f"  {set_name(s.synergies):<22} {_REASON_WORDS.get(s.blocked_by, s.blocked_by)}")
+            continue
+        lines.append(f"  {set_name(s.synergies):<22} t* = {s.margin:.3g}")
+        for b in s.blockers:
+            lines.append(f"    contact {b.contact}: {b.link_name} ({b.link_kind}), {b.face} on {'an' if b.feature == 'edge' else 'a'} {b.feature}, "
+                         f"normal force {b.normal_force:+.3g}, {_number(b.angle_outside_deg)} deg outside its cone")
+    return lines
 
 
 def _parser() -> argparse.ArgumentParser:

@@ -20,12 +20,29 @@ import pandas as pd
 from synergrasp.ids import set_id, set_name
 from synergrasp.optimisation.quality import GraspQuality, grasp_quality
 
-__all__ = ["InspectionError", "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp",
+__all__ = ["InspectionError", "BlockingContact", "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp",
            "grasp_picture", "grasp_view"]
 
 
 class InspectionError(ValueError):
     """A bad argument of the inspector (the message names it)."""
+
+
+@dataclass(frozen=True)
+class BlockingContact:
+    """A contact that blocks a failing set (docs/blockers.md): its index among the grasp's
+    contacts, link name and kind, the box face it pushes on, where it sits (face, edge,
+    corner), its cone margin and normal force at the max-margin internal force (N per N of
+    total normal force) and the angle of its force outside the cone (deg)."""
+
+    contact: int
+    link_name: str
+    link_kind: str
+    face: str
+    feature: str
+    margin: float
+    normal_force: float
+    angle_outside_deg: float
 
 
 @dataclass(frozen=True)
@@ -43,6 +60,11 @@ class SetResult:
         every circular cone; NaN unless feasible)
     forces_N: the optimal contact forces on the object, (f_x, f_y, f_z) of each contact in
         turn (3m, N, palm frame; empty unless load-feasible)
+    blocked_by: why a set not in force closure fails (`optimisation.blocking.REASONS`:
+        'contacts', 'no_internal_force', 'rank_deficient', ...; '' for force closure)
+    margin: t*, the largest least cone margin over the set's internal forces, N per N of total
+        normal force (NaN unless blocked_by is 'contacts')
+    blockers: the contacts that block it (docs/blockers.md)
     """
 
     set_id: str
@@ -54,6 +76,9 @@ class SetResult:
     e_s: int
     cone_use: float
     forces_N: tuple[float, ...] = ()
+    blocked_by: str = ""
+    margin: float = float("nan")
+    blockers: tuple[BlockingContact, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -229,9 +254,36 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
                   cone_use(out["forces"][k], grasp.normals, mu) if out["forces"][k] is not None else float("nan"),
                   _floats(out["forces"][k]) if out["forces"][k] is not None else ())
         for k, s in enumerate(chosen))
+    results = _with_blockers(results, grasp, full.matrix, opt.gfo, cfg, hand, sim.object.shape, row)
     quality = grasp_quality(grasp, mu, sim.object.shape.bounding_radius_mm, synergies=full.matrix)
     return GraspInspection(obj, pose, float(row["alpha_deg"]), float(row["beta_deg"]), str(row["status"]), weight,
                            contacts, results, quality, **drawing)
+
+
+def _with_blockers(results: tuple[SetResult, ...], grasp: Any, matrix: np.ndarray, gfo: Any, cfg: Mapping[str, Any],
+                   hand: Any, shape: Any, row: pd.Series) -> tuple[SetResult, ...]:
+    """The sets, each failing one with what blocks it (`analysis.blockers.set_blockers`)."""
+    from dataclasses import replace
+
+    from synergrasp.analysis.blockers import contact_labels, set_blockers
+    from synergrasp.simulation.opposition import HandAxes, OppositionRule
+
+    failing = [k for k, s in enumerate(results) if not s.force_closure]
+    if not failing:
+        return results
+    found = set_blockers(grasp, matrix, [results[k].synergies for k in failing], gfo)
+    rotation = np.asarray(row["object_rotation"], dtype=float).reshape(3, 3)
+    labels = contact_labels(grasp, rotation, shape, hand.link_names, HandAxes.from_hand(hand),
+                            OppositionRule.from_config(cfg))
+    out = list(results)
+    for k, one in zip(failing, found):
+        b = one.blocking
+        at = np.flatnonzero(b.blockers)
+        out[k] = replace(out[k], blocked_by=one.reason, margin=float(b.margin), blockers=tuple(
+            BlockingContact(int(i), labels.names[i], labels.kinds[i], labels.faces[i], labels.features[i],
+                            float(b.contact_margin[i]), float(b.normal_force[i]), float(b.angle_outside_deg[i]))
+            for i in at))
+    return tuple(out)
 
 
 def _floats(values: Any) -> tuple[float, ...]:

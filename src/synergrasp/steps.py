@@ -163,6 +163,18 @@ STEPS: dict[str, Step] = {
         reads=("hand", "synergies", "mechanics.mu", "mechanics.g_m_per_s2", "synergy_sets.incremental_max",
                "objects.{object}.shape", "objects.{object}.mass_kg", "opposition"),
         upstream=("contacts", "optimise"), params="synergrasp.optimisation.quality:QualityParams"),
+    # what blocks each set of the hierarchy table where the full set succeeds (docs/blockers.md):
+    # one small conic problem per distinct failing (grasp, set), ~1.5 ms of CPU per pose
+    "blockers": Step(
+        rules={"blocking_contacts": Cost("pose", 3.0, 300, 1.5e-3, 0.05)},
+        outputs={"blockers": "blockers.parquet"}, scope="object",
+        reads=("hand", "synergies", "mechanics", "synergy_sets", "opposition", "objects.{object}.shape",
+               "objects.{object}.mass_kg"),
+        upstream=("contacts", "optimise"), params="synergrasp.analysis.blockers:BlockersParams"),
+    "blockers_table": Step(
+        rules={"blockers_summary": Cost("none", 4.0, 300)},
+        outputs={"csv": "tables/blockers.csv", "md": "tables/blockers.md", **_files(("blockers",), "figures", _PNG_PDF)},
+        reads=("synergy_sets.hierarchy_first", "synergy_sets.incremental_max"), upstream=("blockers",)),
     "tables": Step(
         rules={"study_tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
         outputs=_files(TABLES, "tables", ("csv", "md")),

@@ -15,7 +15,7 @@ from pathlib import Path
 import pandas as pd
 
 __all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT",
-           "QUALITY", "TARGET_CLAIMS", "write", "read", "write_csv", "read_csv", "empty", "write_study_table"]
+           "QUALITY", "TARGET_CLAIMS", "BLOCKERS", "write", "read", "write_csv", "read_csv", "empty", "write_study_table"]
 
 
 @dataclass(frozen=True)
@@ -226,8 +226,35 @@ TARGET_CLAIMS = Table("target_claims", "one row per (scored target, claim), targ
     Column("reason", "string", "", "why the verdict"),
 ))
 
+#: What blocks each synergy set where the full set succeeds (docs/blockers.md), Parquet
+#: (results/objects/<object>/blockers.parquet). Margins and forces are those of the internal
+#: force with the largest least cone margin, scaled to a total normal force of 1 N.
+BLOCKERS = Table("blockers", "one row per (pose, synergy set) failing Definition 1 where the full set succeeds", _pose_columns() + (
+    Column("set_id", "string", "", "enrolled synergies ({S1..Sk} and {Sk}, k = 1..synergy_sets.hierarchy_first)"),
+    Column("n_synergies", "int32", "", "number of enrolled synergies s"),
+    Column("e_s", "int32", "", "rank of the set's internal-force basis E_s"),
+    Column("rank_G", "int32", "", "rank of the grasp matrix"),
+    Column("n_contacts", "int32", "", "contacts of the grasp"),
+    Column("reason", "string", "", "contacts (the blockers are named), no_internal_force (e_s = 0), rank_deficient, "
+           "no_squeeze (every reachable internal force has zero total normal force), numerical_failure"),
+    Column("margin", "float64", "N/N", "t*: the largest least cone margin mu f_n - |f_t| over the set's internal forces, "
+           "per N of total normal force (<= 0: blocked; NaN unless reason contacts)"),
+    Column("n_blockers", "int32", "", "contacts whose margin is within 1e-6 of t* (the blockers)"),
+    Column("blocker_contact", "list<int32>", "", "index of each blocker among the grasp's contacts"),
+    Column("blocker_link", "list<int32>", "", "hand link of each blocker (Hand.link_names)"),
+    Column("blocker_link_name", "list<string>", "", "its link's name"),
+    Column("blocker_link_kind", "list<string>", "", "its link's kind (opposition.LINK_KINDS: palm, palm_side, finger_middle, finger_pad, thumb_pad, thumb_base)"),
+    Column("blocker_face", "list<string>", "", "the box face it pushes on (opposition.FACE_CLASSES)"),
+    Column("blocker_feature", "list<string>", "", "where it sits: face, edge or corner (opposition.SURFACE_FEATURES)"),
+    Column("blocker_margin", "list<float64>", "N/N", "its cone margin at the optimum, per N of total normal force"),
+    Column("blocker_normal_force", "list<float64>", "N/N", "its normal force n.f at the optimum, per N of total normal force (<= 0: pulls)"),
+    Column("blocker_angle_outside_deg", "list<float64>", "deg", "angle of its force from the inward normal minus atan(mu) (> 0: outside the circular cone; NaN: no force)"),
+    Column("n_outside", "int32", "", "contacts with margin <= 0 at the optimum"),
+    Column("outside_link_kind", "list<string>", "", "link kind of each of them"),
+))
+
 TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, QUALITY,
-                                                TARGET_CLAIMS)}
+                                                TARGET_CLAIMS, BLOCKERS)}
 
 
 def _check(table: Table, frame: pd.DataFrame, where: str) -> None:

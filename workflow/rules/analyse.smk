@@ -177,3 +177,58 @@ rule summarise_target_claims:
         runtime=runtime_min("summarise_target_claims"),
     script:
         "../scripts/summarise_target_claims.py"
+
+
+# What blocks each synergy set where the full set succeeds (docs/blockers.md).
+rule blocking_contacts:
+    input:
+        contacts=step_input("contacts"),
+        gfo=step_input("optimise"),
+        code=code("blocking_contacts"),
+        data=SHIPPED_DATA,
+        user=user_files,
+    output:
+        "{root}/objects/{object}/blockers.parquet",
+    log:
+        "{root}/logs/blocking_contacts/{object}.log",
+    benchmark:
+        "{root}/benchmarks/blocking_contacts/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("blocking_contacts"),
+        runtime=runtime_min("blocking_contacts"),
+    params:
+        cfg=step_cfg("blockers"),
+    script:
+        "../scripts/blocking_contacts.py"
+
+
+rule blockers_summary:
+    input:
+        blockers=step_inputs("blockers"),
+        code=code("blockers_summary"),
+    output:
+        csv=report(
+            "{root}/tables/blockers.csv",
+            caption="../report/blockers_table.rst",
+            category="Tables",
+        ),
+        md="{root}/tables/blockers.md",
+        png=report(
+            "{root}/figures/blockers.png",
+            caption="../report/blockers.rst",
+            category="Figures",
+        ),
+        pdf="{root}/figures/blockers.pdf",
+    log:
+        "{root}/logs/blockers_summary.log",
+    benchmark:
+        "{root}/benchmarks/blockers_summary.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("blockers_summary"),
+        runtime=runtime_min("blockers_summary"),
+    params:
+        cfg=step_cfg("blockers_table"),
+    script:
+        "../scripts/blockers_summary.py"
