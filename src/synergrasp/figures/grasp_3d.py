@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from synergrasp.figures.hand_pictures import BOX, PALM_CAMERA, SKIN, ShapeInPicture, hand_shapes
+from synergrasp.figures.hand_pictures import ABOVE_CAMERA, BOX, PALM_CAMERA, SKIN, ShapeInPicture, hand_shapes
 from synergrasp.ids import set_name
 from synergrasp.optimisation.study import GFOParams
 from synergrasp.simulation.objects import GraspedObject
@@ -179,7 +179,8 @@ def grasp_figure(scene: GraspScene) -> dict[str, Any]:
     arrows = (f"arrows: optimal contact forces of {scene.force_set} on the object, 1 N = {scale:g} mm"
               if forces is not None else f"no arrows: {scene.force_set} is not feasible under the weight"
               if scene.force_set else "no arrows: no set optimised (no grasp)")
-    eye = -np.asarray(PALM_CAMERA.direction) / np.linalg.norm(PALM_CAMERA.direction) * 2.3
+    views = {name: _plotly_camera(camera) for name, camera in (("palm side", PALM_CAMERA),
+                                                                ("from above the fingertips", ABOVE_CAMERA))}
     axis = dict(showbackground=True, backgroundcolor="rgb(235, 238, 243)", gridcolor="white", zerolinecolor="white",
                 linecolor="white", showspikes=False)
     layout = dict(
@@ -187,12 +188,24 @@ def grasp_figure(scene: GraspScene) -> dict[str, Any]:
                         f"and see-through; drag to turn, scroll to zoom</sup>", x=0.01, font=dict(size=15)),
         legend=dict(title=dict(text=f"links touching the object<br><sup>{html.escape(arrows)}</sup>"),
                     bgcolor="rgba(255, 255, 255, 0.8)", font=dict(size=13)),
-        scene=dict(aspectmode="data", camera=dict(eye=dict(x=eye[0], y=eye[1], z=eye[2]), up=dict(x=0, y=0, z=1)),
+        updatemenus=[dict(type="buttons", direction="left", x=0.01, y=0.01, xanchor="left", yanchor="bottom",
+                          buttons=[dict(label=name, method="relayout", args=[{"scene.camera": camera}])
+                                   for name, camera in views.items()])],
+        scene=dict(aspectmode="data", camera=views["palm side"],
                    xaxis=dict(title=dict(text="x: palm normal (mm)"), **axis),
                    yaxis=dict(title=dict(text="y (mm)"), **axis),
                    zaxis=dict(title=dict(text="z: along the fingers (mm)"), **axis)),
         margin=dict(l=0, r=0, t=70, b=0), paper_bgcolor="white")
     return {"data": traces, "layout": layout}
+
+
+def _plotly_camera(camera: Any) -> dict[str, Any]:
+    """A picture's camera (``hand_pictures.Camera``) as plotly's scene camera: looking along
+    its direction at the scene's centre, its up toward the top."""
+    eye = -np.asarray(camera.direction, dtype=float) / np.linalg.norm(camera.direction) * 2.3
+    up = np.asarray(camera.up, dtype=float)
+    return dict(eye=dict(x=float(eye[0]), y=float(eye[1]), z=float(eye[2])),
+                up=dict(x=float(up[0]), y=float(up[1]), z=float(up[2])))
 
 
 def _shape_words(shape: Any) -> str:

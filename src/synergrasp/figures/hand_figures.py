@@ -15,7 +15,7 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from synergrasp.analysis.realism import SIMULATED_STATUSES, representative_grasps
-from synergrasp.figures.hand_pictures import (BOX, PALM_CAMERA, SKIN, TOUCHING, Camera, ShapeInPicture, hand_shapes,
+from synergrasp.figures.hand_pictures import (ABOVE_CAMERA, BOX, PALM_CAMERA, SKIN, TOUCHING, Camera, ShapeInPicture, hand_shapes,
                                               render)
 from synergrasp.figures.output import save_figure
 from synergrasp.hand.synergies import SynergyPath
@@ -218,7 +218,7 @@ def draw_grasp(ax: Any, hand: Any, q: NDArray, shape: ShapeInPicture, touching: 
 #: fingertips with the palm at the bottom and the palm normal up, where the tips and the thumb
 #: are seen on the object side by side.
 GRASP_VIEWS = (("palm side (as Fig. 2)", PALM_CAMERA),
-               ("from above the fingertips (palm below)", Camera(direction=(-0.45, 0.3, -1.0), up=(1.0, 0.0, 0.0))))
+               ("from above the fingertips (palm below)", ABOVE_CAMERA))
 
 
 def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame,

@@ -73,6 +73,9 @@ class Camera:
 #: up with the palm toward the face. Flexing fingers come toward the viewer. The figures fit
 #: its centre and width to what they show (``Camera.fitted``).
 PALM_CAMERA = Camera(direction=(-1.0, 0.32, 0.22), center_mm=(10.0, -2.0, 92.0), width_mm=205.0)
+#: From above the fingertips with the palm at the bottom and the palm normal up: the tips and
+#: the thumb are seen on the object side by side, and which way each pushes it.
+ABOVE_CAMERA = Camera(direction=(-0.45, 0.3, -1.0), up=(1.0, 0.0, 0.0))
 
 @dataclass(frozen=True)
 class ShapeInPicture:
