@@ -334,7 +334,8 @@ def test_a_search_rank_beyond_an_existing_table_is_a_problem(tmp_path):
     assert search_rank_problems(cfg, "obj1", table) == []  # no table yet: the closure judges it
     table.write_text("distinct_rank\n1\n0\n2\n")
     assert search_rank_problems(cfg, "obj1", table) == [
-        f"config error at 'placement.search_rank': 3 exceeds the 2 distinct targets of obj1's placement search ({table})"]
+        "config error at 'placement.search_rank': 3 exceeds the 2 distinct targets of obj1's placement search "
+        f"({table})"]
     table.write_text("distinct_rank\n1\n2\n3\n")
     assert search_rank_problems(cfg, "obj1", table) == []
 
@@ -401,3 +402,26 @@ def test_refuse_prints_the_lines_alone_and_exits_1(capsys):
         refuse(["config error at 'a': b"])
     assert stop.value.code == 1
     assert capsys.readouterr().err == f"{REFUSED}\nconfig error at 'a': b\n"
+
+
+def test_a_killed_runs_backup_of_a_folder_does_not_stop_the_next_backup(tmp_path):
+    """Snakemake copies a kept folder output to .snakemake/backups before its job; a backup
+    left by a killed run made that copy fail. The patched backup replaces it."""
+    import snakemake.persistence
+
+    from synergrasp.preflight import keep_outputs_until_replaced
+
+    keep_outputs_until_replaced(type("Workflow", (), {"rules": []})())
+
+    class Backups(snakemake.persistence.FileBackupMixin):
+        path = tmp_path / ".snakemake"
+
+    pages = tmp_path / "pages"
+    pages.mkdir()
+    (pages / "index.html").write_text("current")
+    backups = Backups()
+    stale = backups._get_backup_path(pages)
+    stale.mkdir(parents=True)
+    (stale / "index.html").write_text("stale")
+    backups.backup_output(pages)
+    assert (stale / "index.html").read_text() == "current"

@@ -438,7 +438,8 @@ def _removed_unknown_objects(base: Mapping[str, Any], changes: Mapping[str, Any]
         return []
     known = base.get("objects") if isinstance(base.get("objects"), Mapping) else defaults()["objects"]
     return [f"config error at 'objects.{key}': null removes an object, but the study has no object {key!r}; "
-            f"objects: {sorted(map(str, known))}" for key, value in objects.items() if value is None and key not in known]
+            f"objects: {sorted(map(str, known))}"
+            for key, value in objects.items() if value is None and key not in known]
 
 
 def scenario_config(config: Mapping[str, Any], name: str) -> dict[str, Any]:
