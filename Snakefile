@@ -78,3 +78,7 @@ rule placement_claims:
 rule sensitivity:
     input:
         SENSITIVITY_FILES,
+
+
+# A failed job keeps the outputs of the run before (synergrasp.preflight).
+keep_outputs_until_replaced(workflow)

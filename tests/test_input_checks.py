@@ -279,3 +279,151 @@ def test_make_report_before_the_study_says_it_must_run_first(tmp_path):
     assert out.stdout.strip() == ("make report: the study has not run yet (no results/tables/claims.csv): "
                                   "run 'make study' first")
     assert not (tmp_path / "results").exists()
+
+
+# --------------------------------------------------------------------------- issue 39: the checks' own arithmetic
+
+
+def test_the_object_names_include_the_defaults_a_scenario_takes_by_null():
+    from synergrasp.config import object_names
+
+    config = {"scenarios": {"a": {"objects": None}, "b": {"objects": {"obj9": {"mass_kg": 1}}}, "c": {"mu": 1},
+                            "gone": None}}
+    assert object_names(config, ["x"]) == {"x", "obj1", "obj2", "obj3", "obj4", "obj9"}
+    assert object_names({"scenarios": {"c": {"mechanics": {"mu": 1.0}}}}, ["x"]) == {"x"}
+
+
+def test_a_scenario_removing_an_object_the_study_lacks_names_it():
+    from synergrasp.config import scenario_config
+
+    config = {"objects": {"obj1": defaults()["objects"]["obj1"]}, "scenarios": {"s": {"objects": {"obj9": None}}}}
+    with pytest.raises(ConfigError, match=r"^scenario 's': config error at 'objects.obj9': null removes an object, "
+                                          r"but the study has no object 'obj9'; objects: \['obj1'\]$"):
+        scenario_config(config, "s")
+    config["scenarios"]["s"] = {"objects": {"obj1": None, "obj2": {"shape": {"sphere": {"radius_mm": 20}},
+                                                                   "mass_kg": 1.0}}}
+    assert list(scenario_config(config, "s")["objects"]) == ["obj2"]
+
+
+def test_the_search_lattice_bounds_the_rank():
+    """The regions at 10 mm: any x 9.5..49.5, y -50..30, z 20..180: 5 x 9 x 17 = 765 points;
+    power x 9.5, z 20..100: 1 x 9 x 9 = 81; precision x 19.5..49.5, z 60..140: 4 x 9 x 9 = 324."""
+    from synergrasp.config import search_lattice_size
+
+    search = defaults()["placement"]["search"]
+    assert [search_lattice_size(search, kind) for kind in ("any", "power", "precision")] == [765, 81, 324]
+    assert not [p for p in _rank(81) if "search_rank" in p]
+    (line,) = [p for p in _rank(82) if "search_rank" in p]  # obj3 and obj4 are power objects
+    assert line.startswith("config error at 'placement.search_rank': 82 exceeds the 81 points of the search "
+                           "lattice of obj3, obj4 (search.region_mm of its grasp type at search.spacing_mm 10 mm)")
+
+
+def _rank(rank: int) -> list[str]:
+    config = defaults()
+    config["placement"]["search_rank"] = rank
+    try:
+        validate_config(config)
+    except ConfigError as err:
+        return str(err).splitlines()
+    return []
+
+
+def test_a_search_rank_beyond_an_existing_table_is_a_problem(tmp_path):
+    from synergrasp.study_checks import search_rank_problems
+
+    cfg = validate_config({**defaults(), "placement": {**defaults()["placement"], "search_rank": 3}})
+    table = tmp_path / "placement.csv"
+    assert search_rank_problems(cfg, "obj1", table) == []  # no table yet: the closure judges it
+    table.write_text("distinct_rank\n1\n0\n2\n")
+    assert search_rank_problems(cfg, "obj1", table) == [
+        "config error at 'placement.search_rank': 3 exceeds the 2 distinct targets of obj1's placement search "
+        f"({table})"]
+    table.write_text("distinct_rank\n1\n2\n3\n")
+    assert search_rank_problems(cfg, "obj1", table) == []
+
+
+@pytest.mark.parametrize("shape, warned", [
+    ({"box": {"size_mm": [30, 30, 30]}}, None),
+    ({"box": {"size_mm": [0.03, 0.03, 0.03]}}, "0.052 mm across"),
+    ({"sphere": {"radius_mm": 600}}, "1.2e+03 mm across"),
+    ({"sphere": {"radius_mm": 0.5}}, None),  # 1 mm across: the limit itself is no warning
+])
+def test_an_object_far_from_a_hands_size_is_warned_naming_the_key(shape, warned):
+    from synergrasp.simulation.objects import object_warnings
+
+    lines = object_warnings({"objects": {"o": {"shape": shape, "mass_kg": 1.0}}})
+    if warned is None:
+        assert lines == []
+    else:
+        assert lines == [f"objects.o.shape: {warned}, far from what a hand grasps (1 to 1000 mm); sizes are in mm"]
+
+
+def test_no_success_under_the_setting_is_one_sentence_with_its_reason():
+    from synergrasp.analysis.summaries import no_success_note
+
+    table = pd.DataFrame({"success": [False, False], "verdict_force_closure": [True, False]})
+    settings = type("S", (), {"success": "force_closure_bounded", "marginal_weight_multiple": 0.001})
+    assert no_success_note(table, settings).startswith(
+        "no grasp succeeds under analyses.success = force_closure_bounded: none of the 1 force-closure (pose, set) "
+        "rows holds the weight within analyses.marginal_weight_multiple = 0.001 times the weight")
+    table.loc[0, "success"] = True
+    assert no_success_note(table, settings) == ""
+
+
+def test_an_output_is_its_old_or_its_complete_new_content(tmp_path):
+    from synergrasp.file_output import replacing, replacing_folder
+
+    path = tmp_path / "t.csv"
+    path.write_text("old")
+    with pytest.raises(RuntimeError), replacing(path) as partial:
+        partial.write_text("half")
+        raise RuntimeError("the disk is full")
+    assert path.read_text() == "old" and sorted(p.name for p in tmp_path.iterdir()) == ["t.csv"]
+    with replacing(path) as partial:
+        assert partial.suffix == ".csv" and partial.parent == tmp_path
+        partial.write_text("new")
+    assert path.read_text() == "new" and sorted(p.name for p in tmp_path.iterdir()) == ["t.csv"]
+    folder = tmp_path / "pages"
+    folder.mkdir()
+    (folder / "gone.html").write_text("old page")
+    with pytest.raises(RuntimeError), replacing_folder(folder) as partial:
+        (partial / "a.html").write_text("half")
+        raise RuntimeError
+    assert [p.name for p in folder.iterdir()] == ["gone.html"]
+    with replacing_folder(folder) as partial:
+        (partial / "a.html").write_text("new page")
+    assert [p.name for p in folder.iterdir()] == ["a.html"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pages", "t.csv"]
+
+
+def test_refuse_prints_the_lines_alone_and_exits_1(capsys):
+    from synergrasp.preflight import REFUSED, refuse
+
+    refuse([])  # nothing to refuse
+    with pytest.raises(SystemExit) as stop:
+        refuse(["config error at 'a': b"])
+    assert stop.value.code == 1
+    assert capsys.readouterr().err == f"{REFUSED}\nconfig error at 'a': b\n"
+
+
+def test_a_killed_runs_backup_of_a_folder_does_not_stop_the_next_backup(tmp_path):
+    """Snakemake copies a kept folder output to .snakemake/backups before its job; a backup
+    left by a killed run made that copy fail. The patched backup replaces it."""
+    import snakemake.persistence
+
+    from synergrasp.preflight import keep_outputs_until_replaced
+
+    keep_outputs_until_replaced(type("Workflow", (), {"rules": []})())
+
+    class Backups(snakemake.persistence.FileBackupMixin):
+        path = tmp_path / ".snakemake"
+
+    pages = tmp_path / "pages"
+    pages.mkdir()
+    (pages / "index.html").write_text("current")
+    backups = Backups()
+    stale = backups._get_backup_path(pages)
+    stale.mkdir(parents=True)
+    (stale / "index.html").write_text("stale")
+    backups.backup_output(pages)
+    assert (stale / "index.html").read_text() == "current"

@@ -229,6 +229,11 @@ def test_study_synergy_sets_are_the_75_distinct_sets():  # synergrasp.ids
 
 
 
+def _path(shown: str) -> str:
+    """A path as a dry run lists it, without Snakemake's flag in parentheses (``(update)``)."""
+    return shown.strip().split(" (")[0]
+
+
 def _dry_run(tmp_path, target, scenarios):
     """``snakemake -n target`` (a target or a list of them) on the small config with
     ``scenarios``: (return code, output, {rule: [output files]} of the jobs it would run)."""
@@ -246,7 +251,7 @@ def _dry_run(tmp_path, target, scenarios):
         if line.startswith(("rule ", "localrule ")):
             rule = line.split()[1].rstrip(":")
         elif line.strip().startswith("output:") and rule:
-            jobs.setdefault(rule, []).extend(p.strip() for p in line.split(":", 1)[1].split(","))
+            jobs.setdefault(rule, []).extend(_path(p) for p in line.split(":", 1)[1].split(","))
     return run.returncode, run.stdout + run.stderr, jobs
 
 
@@ -326,7 +331,7 @@ def test_resources_follow_each_scenarios_own_size(tmp_path):
     requests, output = {}, None
     for line in out.splitlines():
         if line.strip().startswith("output:"):
-            output = line.split(":", 1)[1].split(",")[0].strip()
+            output = _path(line.split(":", 1)[1].split(",")[0])
         elif line.strip().startswith("resources:") and output:
             fields = dict(kv.split("=", 1) for kv in line.split(":", 1)[1].replace(" ", "").split(","))
             if "runtime" in fields:

@@ -3,7 +3,10 @@
     synergrasp grasp obj4 --alpha -30 --beta 0 [--configfile my.yaml] [--sets 1 1-5 1-15] [--json]
                      [--png grasp.png] [--html grasp.html [--forces 1-15]]
 
-Bad arguments end with one line naming the argument and exit status 2.
+Bad input (an argument, a configuration file, the hand or synergy file it names, an output
+path that cannot be written) ends with one line per problem naming the argument, the file or
+the key, and exit status 2, before any work: the configuration goes through the workflow's
+own checks (``synergrasp.study_checks``). Warnings on the configuration are printed too.
 """
 
 from __future__ import annotations
@@ -12,27 +15,13 @@ import argparse
 import json
 import math
 import sys
-from collections.abc import Sequence
+import tempfile
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 __all__ = ["main", "format_inspection"]
-
-
-def _read_overlays(paths: Sequence[str]) -> dict[str, Any]:
-    """The configuration given by ``--configfile`` overlays, in order, on the study's defaults."""
-    import yaml
-
-    from synergrasp.config import overlay
-
-    config: dict[str, Any] = {}
-    for path in paths:
-        try:
-            with open(path, encoding="utf-8") as handle:
-                config = overlay(config, yaml.safe_load(handle) or {})
-        except OSError as err:
-            raise SystemExit(f"synergrasp grasp: --configfile {path}: {err.strerror}") from None
-    return config
 
 
 def _number(value: float, digits: int = 3) -> str:
@@ -126,46 +115,91 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command; 0 on success, 2 on a bad argument (one line on standard error)."""
-    args = _parser().parse_args(argv)
-    from synergrasp.config import ConfigError
-    from synergrasp.hand.kinematics import load_hand
-    from synergrasp.hand.synergies import load_synergies
-    from synergrasp.inspector import InspectionError, inspect_grasp, parse_sets
+def _output_problems(args: argparse.Namespace) -> list[str]:
+    """What keeps ``--png`` / ``--html`` from being written, one line each, before any work."""
+    problems = []
+    for option, path, suffixes in (("--png", args.png, (".png",)), ("--html", args.html, (".html", ".htm"))):
+        if path is None:
+            continue
+        target = Path(path)
+        folder = target.parent
+        if target.suffix.lower() not in suffixes:
+            problems.append(f"{option} {path}: the file name must end in {' or '.join(suffixes)}")
+        elif target.is_dir():
+            problems.append(f"{option} {path}: is a folder; give a file name")
+        elif not folder.is_dir():
+            problems.append(f"{option} {path}: folder '{folder}' is not an existing folder")
+        else:
+            try:  # a file written and removed in that folder: permissions, a read-only disk
+                with tempfile.NamedTemporaryFile(dir=folder, prefix=f".{target.name}."):
+                    pass
+            except OSError as err:
+                problems.append(f"{option} {path}: folder '{folder}' cannot be written ({err.strerror or err})")
+    return problems
 
-    config = _read_overlays(args.configfile)
-    try:
-        sets, forces = None, None
-        if args.sets or args.forces:
-            from synergrasp.config import validate_config
-            from synergrasp.inspector import default_sets
 
-            cfg = validate_config(config)
-            n = load_synergies(cfg["synergies"], joint_names=load_hand(cfg["hand"]).joint_names).matrix.shape[1]
-            sets = parse_sets(args.sets, n) if args.sets else default_sets(n)
-            if args.forces:
-                (forces,) = parse_sets([args.forces], n, "--forces")
-                sets += [forces] if forces not in sets else []
-        result = inspect_grasp(config, args.object, args.alpha, args.beta, sets, args.results)
-    except (InspectionError, ConfigError) as err:
-        print(f"synergrasp grasp: {err}", file=sys.stderr)
-        return 2
+def _grasp(args: argparse.Namespace) -> int:
+    from synergrasp.file_output import replacing
+    from synergrasp.inspector import default_sets, inspect_grasp, parse_sets
+    from synergrasp.study_checks import checked_scenario, read_overlays
+
+    problems = _output_problems(args)
+    if problems:
+        raise ValueError("\n".join(problems))
+    config = read_overlays(args.configfile)
+    cfg, warnings = checked_scenario(config)
+    for warning in warnings:
+        print(f"synergrasp grasp: warning: {warning}", file=sys.stderr)
+    sets, forces = None, None
+    if args.sets or args.forces:
+        from synergrasp.hand.kinematics import load_hand
+        from synergrasp.hand.synergies import load_synergies
+
+        n = load_synergies(cfg["synergies"], joint_names=load_hand(cfg["hand"]).joint_names).matrix.shape[1]
+        sets = parse_sets(args.sets, n) if args.sets else default_sets(n)
+        if args.forces:
+            (forces,) = parse_sets([args.forces], n, "--forces")
+            sets += [forces] if forces not in sets else []
+    result = inspect_grasp(config, args.object, args.alpha, args.beta, sets, args.results)
     print(json.dumps(result.to_dict(), indent=1) if args.json else format_inspection(result))
     if args.png:
         from synergrasp.inspector import grasp_picture
 
-        grasp_picture(result, args.png)
+        with _writing("--png", args.png):
+            grasp_picture(result, args.png)
         if not args.json:
             print(f"picture: {args.png}")
     if args.html:
         from synergrasp.figures.grasp_3d import grasp_page
         from synergrasp.inspector import grasp_view
 
-        Path(args.html).write_text(grasp_page(grasp_view(result, forces)), encoding="utf-8")
+        page = grasp_page(grasp_view(result, forces))
+        with _writing("--html", args.html), replacing(args.html) as partial:
+            partial.write_text(page, encoding="utf-8")
         if not args.json:
             print(f"3-D page: {args.html}")
     return 0
+
+
+@contextmanager
+def _writing(option: str, path: str) -> Iterator[None]:
+    """A failure to write ``path`` (a full disk after the check) as one line naming the option."""
+    try:
+        yield
+    except OSError as err:
+        raise ValueError(f"{option} {path}: cannot be written ({err.strerror or err})") from None
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command; 0 on success, 2 on bad input (one line per problem on standard
+    error, naming the argument, the file or the key; no traceback)."""
+    args = _parser().parse_args(argv)
+    try:
+        return _grasp(args)
+    except ValueError as err:  # ConfigError, InspectionError, file errors: each names what is wrong
+        lines = str(err).splitlines() or [repr(err)]
+    print("\n".join(f"synergrasp {args.command}: {line}" for line in lines), file=sys.stderr)
+    return 2
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -43,6 +43,8 @@ __all__ = [
     "scenario_config",
     "scenario_configs",
     "grid_axis_deg",
+    "search_lattice_size",
+    "object_names",
     "build",
     "dataclass_fields",
 ]
@@ -335,7 +337,33 @@ def _search_problems(config: Mapping[str, Any]) -> list[str]:
                 if hi < lo:
                     problems.append(f"config error at '{where}.search.region_mm.{kind}.{axis}': stop {hi} is below "
                                     f"start {lo}")
-    return problems
+    return problems + _rank_problems(config)
+
+
+def search_lattice_size(search: Mapping[str, Any], grasp_type: str) -> int:
+    """The number of points of the placement search's final lattice for an object of
+    ``grasp_type`` (``search.region_mm.<grasp_type>`` at ``search.spacing_mm``): no search can
+    have more distinct targets."""
+    return math.prod(int(math.floor((hi - lo) / search["spacing_mm"] + 1e-9)) + 1
+                     for lo, hi in search["region_mm"][grasp_type].values())
+
+
+def _rank_problems(config: Mapping[str, Any]) -> list[str]:
+    """A searched placement's rank that no search under the configuration can reach (one
+    line per key and lattice, naming the objects)."""
+    found: dict[tuple[str, int, int, float], list[str]] = {}
+    for name, spec in config["objects"].items():
+        placement = overlay(config["placement"], spec.get("placement"))
+        region = placement["search"]["region_mm"][spec["grasp_type"]]
+        if placement["mode"] != "searched" or any(hi < lo for lo, hi in region.values()):
+            continue
+        n = search_lattice_size(placement["search"], spec["grasp_type"])
+        if placement["search_rank"] > n:
+            where = "placement" if "search_rank" not in (spec.get("placement") or {}) else f"objects.{name}.placement"
+            found.setdefault((where, placement["search_rank"], n, placement["search"]["spacing_mm"]), []).append(name)
+    return [f"config error at '{where}.search_rank': {rank} exceeds the {n} points of the search lattice of "
+            f"{', '.join(names)} (search.region_mm of its grasp type at search.spacing_mm {spacing:g} mm): no search "
+            "has that many distinct targets" for (where, rank, n, spacing), names in found.items()]
 
 
 def _settle_problems(dynamic: Mapping[str, Any]) -> list[str]:
@@ -393,6 +421,31 @@ def scenario_names(config: Mapping[str, Any]) -> list[str]:
     return [DEFAULT_SCENARIO, *(_live_scenarios(config.get("scenarios")) or {})]
 
 
+def object_names(config: Mapping[str, Any], study_objects: Sequence[str]) -> set[str]:
+    """Every object name the study (``study_objects``, checked) or a scenario may have, read
+    from the scenarios' overlays without checking them: the names each gives, and the default
+    objects where a scenario removes ``objects`` (it then takes its default)."""
+    names = set(study_objects)
+    for over in (_live_scenarios(config.get("scenarios")) or {}).values():
+        if not isinstance(over, Mapping) or "objects" not in over:
+            continue
+        objects = over["objects"]
+        names |= set(map(str, defaults()["objects"])) if objects is None else set(map(str, objects or {}))
+    return names
+
+
+def _removed_unknown_objects(base: Mapping[str, Any], changes: Mapping[str, Any]) -> list[str]:
+    """A scenario's ``objects: {<name>: null}`` naming an object the configuration does not
+    have (a typo would otherwise remove nothing, silently)."""
+    objects = changes.get("objects")
+    if not isinstance(objects, Mapping):
+        return []
+    known = base.get("objects") if isinstance(base.get("objects"), Mapping) else defaults()["objects"]
+    return [f"config error at 'objects.{key}': null removes an object, but the study has no object {key!r}; "
+            f"objects: {sorted(map(str, known))}"
+            for key, value in objects.items() if value is None and key not in known]
+
+
 def scenario_config(config: Mapping[str, Any], name: str) -> dict[str, Any]:
     """One scenario's complete, checked configuration: the configuration (without
     ``scenarios``) overlaid with the scenario's mapping (:func:`overlay`), validated like the
@@ -414,7 +467,11 @@ def scenario_config(config: Mapping[str, Any], name: str) -> dict[str, Any]:
     if "scenarios" in changes:
         raise ConfigError(f"scenario '{name}': config error at 'scenarios': a scenario cannot define scenarios")
     try:
-        return validate_config(overlay({k: v for k, v in config.items() if k != "scenarios"}, changes))
+        base = {k: v for k, v in config.items() if k != "scenarios"}
+        problems = _removed_unknown_objects(_drop_nulls(base), changes)
+        if problems:
+            raise ConfigError("\n".join(problems))
+        return validate_config(overlay(base, changes))
     except ConfigError as err:
         raise ConfigError("\n".join(f"scenario '{name}': {line}" for line in str(err).splitlines())) from None
 

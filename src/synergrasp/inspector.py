@@ -204,11 +204,11 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     (1-based synergies; None: :func:`default_sets`), as the study's steps do.
 
     ``config`` is a configuration as read from YAML (an overlay on the defaults); it is
-    checked like the workflow's. With ``placement.mode: searched`` the object's target is read
+    checked by the workflow's own check (``study_checks.checked_scenario``: the schema, every
+    relation, the hand, the synergy table, the objects). With ``placement.mode: searched`` the object's target is read
     from the search's table ``<results>/objects/<obj>/placement.csv``. Raises InspectionError (naming the argument) or
     ``synergrasp.config.ConfigError``; a closure or solver failure is a status in the result.
     """
-    from synergrasp.config import validate_config
     from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import load_synergies
     from synergrasp.optimisation.problem import SynergySets
@@ -217,8 +217,9 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     from synergrasp.simulation.closure import SimulateParams, simulate_object
     from synergrasp.simulation.contacts import ContactsParams, load_carrying_contacts
     from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions
+    from synergrasp.study_checks import checked_scenario
 
-    cfg = validate_config(config)
+    cfg, _ = checked_scenario(config)
     if obj not in cfg["objects"]:
         raise InspectionError(f"object: {obj!r} is not an object of the configuration; objects: {list(cfg['objects'])}")
     sim = SimulateParams.from_config(cfg, obj)

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from synergrasp.file_output import replacing
+
 __all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT",
            "QUALITY", "TARGET_CLAIMS", "BLOCKERS", "write", "read", "write_csv", "read_csv", "empty", "write_study_table"]
 
@@ -276,7 +278,8 @@ def write(table: Table, frame: pd.DataFrame, path: str | Path) -> None:
 
     _check(table, frame, str(path))
     arrow = pa.Table.from_pandas(frame[list(table.names)], schema=table.arrow_schema(), preserve_index=False)
-    pq.write_table(arrow, str(path))
+    with replacing(path) as partial:
+        pq.write_table(arrow, str(partial))
 
 
 def read(table: Table, path: str | Path) -> pd.DataFrame:
@@ -293,7 +296,8 @@ def read(table: Table, path: str | Path) -> pd.DataFrame:
 def write_csv(table: Table, frame: pd.DataFrame, path: str | Path) -> None:
     """Write ``frame`` as CSV (full precision) with exactly the contract's columns and order."""
     _check(table, frame, str(path))
-    frame[list(table.names)].to_csv(path, index=False)
+    with replacing(path) as partial:
+        frame[list(table.names)].to_csv(partial, index=False)
 
 
 def read_csv(table: Table, path: str | Path) -> pd.DataFrame:
@@ -307,9 +311,8 @@ def write_study_table(table: pd.DataFrame, csv_path: str | Path, md_path: str | 
                       title: str | None = None, floatfmt: str = ".4g") -> None:
     """Write one of the study's result tables as CSV (full precision) and as Markdown (for
     reading, numbers to ``floatfmt``, under the heading ``title``)."""
-    table.to_csv(csv_path, index=False)
+    with replacing(csv_path) as partial:
+        table.to_csv(partial, index=False)
     text = table.to_markdown(index=False, floatfmt=floatfmt) if len(table) else "(no rows)"
-    with open(md_path, "w", encoding="utf-8") as handle:
-        if title:
-            handle.write(f"# {title}\n\n")
-        handle.write(text + "\n")
+    with replacing(md_path) as partial:
+        partial.write_text((f"# {title}\n\n" if title else "") + text + "\n", encoding="utf-8")

@@ -10,10 +10,11 @@ from pathlib import Path
 from snakemake.exceptions import WorkflowError
 from snakemake.logging import logger
 
-from synergrasp.config import ConfigError, check_relations, scenario_names, synergy_problems
-from synergrasp.config import scenario_config as checked_scenario_config
-from synergrasp.config import overlay
+from synergrasp.config import object_names, overlay, scenario_names
 from synergrasp.preflight import accept_configured_wildcards, configfile_problems, slurm_problems
+from synergrasp.preflight import keep_outputs_until_replaced, outdate_failed_outputs, refuse
+from synergrasp.study_checks import search_table_or_refuse, searched_objects_or_refuse
+from synergrasp.study_checks import workflow_scenario
 from synergrasp.steps import STEPS, TABLES, step_config, step_hash, upstream_when
 
 ROOT = Path(workflow.basedir)
@@ -21,45 +22,15 @@ SRC = ROOT / "src" / "synergrasp"
 
 
 @functools.cache
-def _hand(path):
-    """The hand of a ``hand:`` value, checked for what the study asks of it (one line per
-    problem naming the file and the field); its warnings printed once."""
-    from synergrasp.hand.checks import check_hand
-
-    hand, problems, warnings = check_hand(path)
-    for warning in warnings:
-        logger.warning(f"Warning: {warning}")
-    return hand, problems
-
-
-@functools.cache
 def scenario(name):
     """The complete configuration of scenario ``name`` (``default``: the configuration
     itself), checked with its hand and synergy files when a target first needs it, before
     any job runs (config/README.md): `figures` reads the default only, `sensitivity` all."""
-    from synergrasp.hand.synergies import load_synergies
-    from synergrasp.simulation.objects import object_problems
-
-    try:
-        cfg = checked_scenario_config(config, name)
-        hand, hand_problems = _hand(cfg["hand"])
-        problems = list(hand_problems)
-        synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
-        problems += check_relations(cfg, synergies.matrix.shape[1])
-        problems += synergy_problems(cfg, synergies.mean, synergies.matrix)
-        problems += object_problems(cfg)
-        if problems:
-            where = "" if name == "default" else f"scenario '{name}': "
-            raise ConfigError("\n".join(where + p for p in problems))
-    except ValueError as err:  # ConfigError, SynergyFileError, hand/YAML file errors
-        raise WorkflowError(f"Invalid input, nothing was run:\n{err}") from None
-    return cfg
+    return workflow_scenario(config, name)
 
 
 # Snakemake read the configuration files itself and kept a repeated key's last value.
-_PROBLEMS = configfile_problems(workflow.configfiles)
-if _PROBLEMS:
-    raise WorkflowError("Invalid input, nothing was run:\n" + "\n".join(_PROBLEMS))
+refuse(configfile_problems(workflow.configfiles))
 
 #: The main configuration (scenario `default`), complete (defaults filled in) and checked.
 STUDY = scenario("default")
@@ -131,7 +102,11 @@ def searched_input(wildcards):
     """Input function: the placement search's table of the job's object, where its placement
     is searched (none otherwise)."""
     name = _ROOT_SCENARIO[wildcards.root]
-    return step_file(name, "search", wildcards.object) if searched(name, wildcards.object) else []
+    if not searched(name, wildcards.object):
+        return []
+    return search_table_or_refuse(
+        scenario(name), wildcards.object, step_file(name, "search", wildcards.object)
+    )
 
 
 def _shown(name, step, obj):
@@ -176,11 +151,15 @@ def step_inputs(step):
 def searched_inputs(step):
     """Input function: the per-object ``step`` output of every object of the job's scenario
     whose placement is searched."""
-    return lambda w: [
-        step_file(_ROOT_SCENARIO[w.root], step, o)
-        for o in scenario_config(w)["objects"]
-        if searched(_ROOT_SCENARIO[w.root], o)
-    ]
+    return lambda w: searched_objects_or_refuse(
+        [
+            step_file(_ROOT_SCENARIO[w.root], step, o)
+            for o in scenario_config(w)["objects"]
+            if searched(_ROOT_SCENARIO[w.root], o)
+        ],
+        "placement_claims",
+        scenario_config(w),
+    )
 
 
 def step_cfg(step):
@@ -197,12 +176,7 @@ def _exactly(values):
 
 #: Every object name the configuration or a scenario's overlay gives (read without checking
 #: the scenarios: a superset of the objects any checked scenario has).
-_OBJECT_NAMES = set(OBJECTS) | {
-    o
-    for over in (config.get("scenarios") or {}).values()
-    if isinstance(over, dict)
-    for o in map(str, over.get("objects") or {})
-}
+_OBJECT_NAMES = object_names(config, OBJECTS)
 # Wildcards match the configured names exactly, so Snakemake's guard against endless
 # recursion may accept a configured name ending in a repeated character (obj_000...0).
 accept_configured_wildcards([*_OBJECT_NAMES, *SCENARIO_ROOT.values()])
@@ -241,6 +215,7 @@ onsuccess:
 
 onerror:
     cancel_scheduler_timers()
+    outdate_failed_outputs(workflow)
 
 
 #: `import synergrasp.x[, ...]` and `from synergrasp.x import a, b` (or a parenthesised list),

@@ -2,6 +2,7 @@
 import subprocess
 import sys
 
+from synergrasp.file_output import replacing
 from synergrasp.figures.rulegraph import canonical_rulegraph, figure_rulegraph
 from synergrasp.job_log import job_log
 
@@ -13,6 +14,6 @@ with job_log(snakemake.log[0]) as log:
     log.write(run.stderr)
     run.check_returncode()
     dot = canonical_rulegraph(run.stdout)
-    with open(snakemake.output.dot, "w") as handle:
-        handle.write(dot)
+    with replacing(snakemake.output.dot) as partial:
+        partial.write_text(dot)
     figure_rulegraph(dot, snakemake.output.png, snakemake.output.pdf)

@@ -4,12 +4,13 @@ import warnings
 import pandas as pd
 
 from synergrasp.analysis.invariants import InvariantWarning
-from synergrasp.analysis.summaries import TablesParams, study_tables
+from synergrasp.analysis.summaries import NoSuccessWarning, TablesParams, study_tables
 from synergrasp.job_log import job_log
 from synergrasp.tables import GFO, MINIMA, read, write_study_table
 
 with job_log(snakemake.log[0]) as log, warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always", InvariantWarning)
+    warnings.simplefilter("always", NoSuccessWarning)
     p = TablesParams.from_config(snakemake.params.cfg)
     gfo = pd.concat([read(GFO, path) for path in snakemake.input.gfo], ignore_index=True)
     minima = pd.concat([read(MINIMA, path) for path in snakemake.input.minima], ignore_index=True)
@@ -18,5 +19,5 @@ with job_log(snakemake.log[0]) as log, warnings.catch_warnings(record=True) as c
         write_study_table(table, snakemake.output[f"{name}_csv"], snakemake.output[f"{name}_md"], title=title)
     for warning in caught:  # the invariant checks on the console, everything in the log
         print(f"{warning.category.__name__}: {warning.message}", file=log)
-        if issubclass(warning.category, InvariantWarning):
+        if issubclass(warning.category, (InvariantWarning, NoSuccessWarning)):
             print(f"WARNING: {warning.message}")

@@ -5,6 +5,7 @@ documented in docs/analyses.md. Pure functions: DataFrames in, DataFrames out.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -41,6 +42,8 @@ __all__ = [
     "set_sort_key",
     "study_tables",
     "study_claims",
+    "NoSuccessWarning",
+    "no_success_note",
 ]
 
 ALL_OBJECTS = "all"
@@ -436,6 +439,29 @@ def study_claims(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
     return _claims(gfo, minima, int(sets_config["incremental_max"]), int(sets_config["hierarchy_first"]), settings)[3]
 
 
+class NoSuccessWarning(UserWarning):
+    """No grasp of any object succeeds under the analyses' success setting (said in the log and
+    in the title of every table that names the success verdict)."""
+
+
+def no_success_note(table: pd.DataFrame, settings: AnalysisSettings) -> str:
+    """'' if some (object, pose, set) row of ``table`` (a gfo table with its verdicts,
+    ``with_verdicts``) succeeds; else one sentence saying that nothing can succeed under
+    ``analyses.success`` and why (the setting, or no force closure at all)."""
+    if table["success"].astype(bool).any():
+        return ""
+    n_fc = int(table["verdict_force_closure"].astype(bool).sum())
+    if settings.success == "force_closure_bounded" and n_fc:
+        why = (f"none of the {n_fc} force-closure (pose, set) rows holds the weight within "
+               f"analyses.marginal_weight_multiple = {settings.marginal_weight_multiple:g} times the weight")
+    elif settings.success == "load_feasible":
+        why = "no optimisation under the weight is feasible"
+    else:
+        why = "no pose of any object is in force closure with any set"
+    return (f"no grasp succeeds under analyses.success = {settings.success}: {why}; every success rate is 0 "
+            "and the rates relative to the full set (Table II) are undefined")
+
+
 def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[str, int], table2_k_max: int,
                  settings: AnalysisSettings) -> dict[str, tuple[str, pd.DataFrame]]:
     """Every study table by name: (title, table).
@@ -459,6 +485,10 @@ def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
     table2 = incrementality_table(rates, table2_k_max)
     rates = with_intervals(rates, counts)
     verdict = f"success = {settings.success}"
+    nothing = no_success_note(table, settings)
+    if nothing:  # on the console, in the log and in the titles naming the verdict
+        warnings.warn(nothing, NoSuccessWarning, stacklevel=2)
+        verdict += f" (WARNING: {nothing})"
     level = f"{100 * settings.bootstrap.level:g} % intervals: block bootstrap over distinct poses"
     return {
         "success_rates": (f"Success rates per distinct pose (every verdict) and forces per object and synergy set, "

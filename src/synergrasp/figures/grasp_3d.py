@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from synergrasp.file_output import replacing_folder
 from synergrasp.figures.hand_pictures import ABOVE_CAMERA, BOX, PALM_CAMERA, SKIN, ShapeInPicture, hand_shapes
 from synergrasp.ids import set_name
 from synergrasp.optimisation.study import GFOParams
@@ -229,16 +230,15 @@ def write_grasp_pages(folder: str | Path, pages: Mapping[str, tuple[str, GraspSc
     all load, and ``index.html`` listing them beside a frame that shows the one chosen."""
     from plotly.offline import get_plotlyjs
 
-    out = Path(folder)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / PLOTLY_JS).write_text(get_plotlyjs(), encoding="utf-8")
-    items = []
-    for name, (text, scene) in pages.items():
-        (out / f"{name}.html").write_text(grasp_page(grasp_figure(scene), PLOTLY_JS), encoding="utf-8")
-        items.append(f'<li><a href="{name}.html" target="view">{html.escape(text)}</a></li>')
-    first = f"{next(iter(pages))}.html" if pages else "about:blank"
-    (out / "index.html").write_text(_INDEX.format(title=html.escape(title), items="\n".join(items), first=first),
-                                    encoding="utf-8")
+    with replacing_folder(folder) as out:
+        (out / PLOTLY_JS).write_text(get_plotlyjs(), encoding="utf-8")
+        items = []
+        for name, (text, scene) in pages.items():
+            (out / f"{name}.html").write_text(grasp_page(grasp_figure(scene), PLOTLY_JS), encoding="utf-8")
+            items.append(f'<li><a href="{name}.html" target="view">{html.escape(text)}</a></li>')
+        first = f"{next(iter(pages))}.html" if pages else "about:blank"
+        (out / "index.html").write_text(_INDEX.format(title=html.escape(title), items="\n".join(items), first=first),
+                                        encoding="utf-8")
 
 
 @dataclass(frozen=True)

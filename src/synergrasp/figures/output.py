@@ -5,6 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from synergrasp.file_output import replacing
+
 __all__ = ["save_figure", "colour_range"]
 
 #: Metadata that would change between runs (dates) or versions (software) are left out.
@@ -20,9 +22,11 @@ def save_figure(fig: Any, png_path: str | Path, pdf_path: str | Path | None, dpi
     import matplotlib.pyplot as plt
 
     extra = {"bbox_inches": "tight"} if tight else {}
-    fig.savefig(png_path, dpi=dpi, metadata=_PNG_METADATA, **extra)
+    with replacing(png_path) as partial:
+        fig.savefig(partial, dpi=dpi, metadata=_PNG_METADATA, **extra)
     if pdf_path is not None:
-        fig.savefig(pdf_path, metadata=_PDF_METADATA, **extra)
+        with replacing(pdf_path) as partial:
+            fig.savefig(partial, metadata=_PDF_METADATA, **extra)
     plt.close(fig)
 
 

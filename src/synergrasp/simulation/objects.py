@@ -11,7 +11,7 @@ from typing import Any
 from synergrasp.config import ConfigError, build
 from synergrasp.simulation.shapes import Shape, ShapeError, shape_from_config
 
-__all__ = ["GraspedObject", "ObjectError", "object_problems"]
+__all__ = ["GraspedObject", "ObjectError", "object_problems", "object_warnings"]
 
 _NAME = re.compile(r"[A-Za-z0-9_]+")
 
@@ -85,3 +85,29 @@ def object_problems(config: Mapping[str, Any]) -> list[str]:
         except ShapeError as err:
             problems.append(f"config error at {err}")
     return problems
+
+
+#: Sizes a hand can close on (mm, across the object: twice its bounding radius); the shipped
+#: hand is about 190 mm long and its fingers close to a few mm. Far outside: a warning.
+GRASPABLE_ACROSS_MM = (1.0, 1000.0)
+
+
+def object_warnings(config: Mapping[str, Any]) -> list[str]:
+    """Objects whose size is far from what a hand grasps (a mesh in metres at ``scale: 1``, or
+    a scale off by 10^6), one line each naming the key; such an object would only show as
+    never graspable. Shapes that cannot be built are :func:`object_problems`'."""
+    warnings = []
+    lo, hi = GRASPABLE_ACROSS_MM
+    for name, spec in config["objects"].items():
+        where = f"objects.{name}.shape"
+        try:
+            across = 2.0 * shape_from_config(spec["shape"], where).bounding_radius_mm
+        except ShapeError:
+            continue
+        if not lo <= across <= hi:
+            kind = next(iter(spec["shape"]))
+            hint = (f"; sizes are in mm: a file in metres needs {where}.mesh.scale: 1000" if kind == "mesh"
+                    else "; sizes are in mm")
+            warnings.append(f"{where}: {across:.3g} mm across, far from what a hand grasps "
+                            f"({lo:g} to {hi:g} mm){hint}")
+    return warnings

@@ -1,0 +1,142 @@
+"""The one check of a study's inputs before any work, for the workflow and for every command of
+the package alike (config/README.md, "Checked before any job runs").
+
+:func:`checked_scenario` is that check: one scenario's configuration (the schema and every
+relation, ``synergrasp.config``), its hand file, its synergy table against the hand, and its
+objects' shapes; besides the problems (errors), the warnings on sizes far from a hand's. The
+workflow asks it through :func:`workflow_scenario` (common.smk), ``synergrasp grasp`` through
+``synergrasp.inspector``; :func:`read_overlays` reads a command's ``--configfile`` files as
+strictly as the workflow reads its own. Checks that need a step's output where it exists
+(:func:`search_rank_problems`) or a target's whole configuration
+(:func:`searched_objects_or_refuse`) are here too. Every problem is one line naming the file or
+the key.
+"""
+
+from __future__ import annotations
+
+import csv
+import functools
+import sys
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from synergrasp.config import ConfigError, check_relations, overlay, scenario_config, synergy_problems
+from synergrasp.preflight import refuse
+from synergrasp.yaml_io import read_yaml
+
+__all__ = ["checked_scenario", "workflow_scenario", "read_overlays", "search_rank_problems",
+           "search_table_or_refuse", "searched_objects_or_refuse"]
+
+
+@functools.cache
+def _hand(path: str | None) -> tuple[Any, tuple[str, ...], tuple[str, ...]]:
+    """The hand of a ``hand:`` value, its problems and its warnings (read once per file)."""
+    from synergrasp.hand.checks import check_hand
+
+    hand, problems, warnings = check_hand(path)
+    return hand, tuple(problems), tuple(warnings)
+
+
+def checked_scenario(config: Mapping[str, Any], name: str = "default") -> tuple[dict[str, Any], list[str]]:
+    """Scenario ``name``'s complete, checked configuration (``default``: the configuration
+    itself) and the warnings on it, each one line naming the file or the key.
+
+    Raises
+    ------
+    ConfigError
+        Every problem, one line each (a scenario's prefixed with its name): the configuration,
+        the hand file, the synergy table, the objects' shapes.
+    """
+    from synergrasp.hand.synergies import load_synergies
+    from synergrasp.simulation.objects import object_problems, object_warnings
+
+    where = "" if name == "default" else f"scenario '{name}': "
+    try:
+        cfg = scenario_config(config, name)
+        hand, problems, warnings = _hand(cfg["hand"])
+        synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
+        problems = [*problems, *check_relations(cfg, synergies.matrix.shape[1]),
+                    *synergy_problems(cfg, synergies.mean, synergies.matrix), *object_problems(cfg)]
+    except ConfigError:
+        raise
+    except ValueError as err:  # SynergyFileError, hand and YAML file errors: one line each, naming the file
+        raise ConfigError("\n".join(where + line for line in str(err).splitlines())) from None
+    if problems:
+        raise ConfigError("\n".join(where + p for p in problems))
+    return cfg, [*warnings, *(where + w for w in object_warnings(cfg))]
+
+
+_WARNED: set[str] = set()
+
+
+def workflow_scenario(config: Mapping[str, Any], name: str) -> dict[str, Any]:
+    """:func:`checked_scenario` for the workflow: each warning printed once per run, a problem
+    stops the run before any job with its lines alone (``preflight.refuse``)."""
+    try:
+        cfg, warnings = checked_scenario(config, name)
+    except ConfigError as err:
+        refuse(str(err).splitlines())
+        raise  # refuse stops the run for any problem
+    for warning in warnings:
+        if warning not in _WARNED:
+            _WARNED.add(warning)
+            print(f"Warning: {warning}", file=sys.stderr)
+    return cfg
+
+
+def read_overlays(paths: Sequence[str | Path], what: str = "config file") -> dict[str, Any]:
+    """The configuration given by overlay files, in order (``config.overlay``), each read as
+    the workflow reads its configuration files (``yaml_io.read_yaml``: a repeated key or
+    invalid YAML is an error naming the file and the line) and required to be a mapping."""
+    config: dict[str, Any] = {}
+    for path in paths:
+        doc = read_yaml(path, what) or {}
+        if not isinstance(doc, Mapping):
+            raise ConfigError(f"{what} '{path}': the top level must be a mapping of keys "
+                              f"(key: value), got a {type(doc).__name__}")
+        config = overlay(config, doc)
+    return config
+
+
+def _distinct_targets(path: Path) -> int | None:
+    """The number of distinct targets of a search's table (rows with a positive
+    ``distinct_rank``); None if the file cannot be read as that table."""
+    try:
+        with open(path, newline="", encoding="utf-8") as handle:
+            return sum(1 for row in csv.DictReader(handle) if float(row["distinct_rank"]) > 0)
+    except (OSError, KeyError, ValueError, TypeError, csv.Error):
+        return None
+
+
+def search_rank_problems(cfg: Mapping[str, Any], obj: str, table: str | Path) -> list[str]:
+    """Object ``obj``'s ``search_rank`` against its search's table ``table`` where that table
+    exists already (the closure would fail after other jobs ran, and the search does not
+    read the rank). A table made in this run is judged by the closure, before it writes."""
+    placement = overlay(cfg["placement"], cfg["objects"][obj].get("placement"))
+    n = _distinct_targets(Path(table)) if Path(table).is_file() else None
+    if placement["mode"] != "searched" or n is None or placement["search_rank"] <= n:
+        return []
+    where = "placement" if "search_rank" not in (cfg["objects"][obj].get("placement") or {}) else \
+        f"objects.{obj}.placement"
+    return [f"config error at '{where}.search_rank': {placement['search_rank']} exceeds the {n} distinct targets of "
+            f"{obj}'s placement search ({table})"]
+
+
+def search_table_or_refuse(cfg: Mapping[str, Any], obj: str, table: str,
+                           stop: Callable[[list[str]], Any] = refuse) -> str:
+    """``table`` (object ``obj``'s search table, an input); its :func:`search_rank_problems`
+    stop the run before any job."""
+    stop(search_rank_problems(cfg, obj, table))
+    return table
+
+
+def searched_objects_or_refuse(files: list[str], target: str, cfg: Mapping[str, Any],
+                               stop: Callable[[list[str]], Any] = refuse) -> list[str]:
+    """``files`` (one per object whose placement is searched); an empty list stops the run:
+    ``target`` needs the placement search's targets and no object of ``cfg`` is searched."""
+    if not files:
+        modes = sorted({overlay(cfg["placement"], s.get("placement"))["mode"] for s in cfg["objects"].values()})
+        stop([f"{target}: no object's placement is searched (placement.mode: {', '.join(modes)}); the claims at the "
+              "placement search's targets need placement.mode: searched (docs/placement_search.md)"])
+    return files
