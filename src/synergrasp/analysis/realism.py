@@ -21,6 +21,7 @@ import pandas as pd
 from synergrasp.analysis.verdicts import verdict_columns
 from synergrasp.hand.synergies import Synergies, synergy_values
 from synergrasp.ids import incremental_set_id
+from synergrasp.resolved import friction_mu, weight_N
 from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 
 __all__ = ["RealismParams", "SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "LONG_FINGERS",
@@ -68,9 +69,9 @@ class RealismParams:
         if not isinstance(values, Mapping):
             values = synergy_values(config["hand"], values, (1,))
         return cls(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),
-                   {name: spec["mass_kg"] * mechanics["g_m_per_s2"] for name, spec in config["objects"].items()},
+                   {name: weight_N(config, name) for name in config["objects"]},
                    threshold, tuple(values["mean_rad"]), tuple(values["S1"]), float(mechanics["k_ss_Nmm_per_rad"]),
-                   float(mechanics["mu"]))
+                   friction_mu(config))
 
     def synergies(self, joint_names: tuple[str, ...]) -> Synergies:
         """q_m and S1 as a one-synergy :class:`Synergies` of the hand's joints."""
