@@ -123,7 +123,7 @@ def test_the_study_targets_and_a_step_not_made_hands_on_its_upstreams_file():
     assert not any("target_claims" in t or "placement_claims" in t for t in targets)  # optional steps
     # the kinematic closure selects no contact: the `contacts` step's input is the closure's table
     assert wiring.step_file("default", "contacts", "obj1") == "results/objects/obj1/contacts.parquet"
-    assert wiring.step_input("search")(_W(root="results", object="obj1")) == ["results/objects/obj1/placement.csv"]
+    assert wiring.step_input("search")(_W(root="results", object="obj1")) == "results/objects/obj1/placement.csv"
 
 
 def test_an_approach_placement_has_no_search_and_no_map():

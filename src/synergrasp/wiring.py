@@ -156,6 +156,7 @@ def imported_modules(path: Path) -> frozenset[str]:
     return frozenset(found)
 
 
+@functools.cache
 def _module_file(src: Path, name: str) -> Path | None:
     """Source file of a synergrasp module or package under ``src``, None for another name."""
     rel = Path(*name.split("."))
@@ -348,13 +349,13 @@ class Wiring:
 
     # ---- input functions of the rules
 
-    def step_input(self, step: str) -> Callable[[Any], list[str]]:
-        """Input function: the job's object's ``step`` output in the job's scenario (none
-        where the scenario does not make it for the object, ``placement_when``)."""
-        def files(w: Any) -> list[str]:
+    def step_input(self, step: str) -> Callable[[Any], str | list[str]]:
+        """Input function: the job's object's ``step`` output in the job's scenario (the path;
+        none, ``[]``, where the scenario does not make it for the object, ``placement_when``)."""
+        def file(w: Any) -> str | list[str]:
             name = self.job_scenario(w)
-            return [self.step_file(name, step, w.object)] if self._for_object(name, step, w.object) else []
-        return files
+            return self.step_file(name, step, w.object) if self._for_object(name, step, w.object) else []
+        return file
 
     def step_inputs(self, step: str) -> Callable[[Any], list[str]]:
         """Input function: every object's ``step`` output in the job's scenario."""

@@ -24,7 +24,7 @@ from synergrasp.analysis.periods import distinct_pose_mask, object_periods
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.config import ConfigError, build
 from synergrasp.ids import incremental_set_id, set_id, set_members, set_order
-from synergrasp.resolved import effective_placement
+from synergrasp.resolved import effective_placement, weight_N
 
 __all__ = [
     "AnalysisSettings",
@@ -99,7 +99,7 @@ class TablesParams:
     def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> TablesParams:
         """From a configuration or the step's own part of it (``obj`` is not read): the
         objects' weights m·g and α-periods (from their boxes, placements and the grid)."""
-        analyses, g = config["analyses"], config["mechanics"]["g_m_per_s2"]
+        analyses = config["analyses"]
         objects = {name: {**spec, "placement": effective_placement(config, name)}
                    for name, spec in config["objects"].items()}
         try:
@@ -115,7 +115,7 @@ class TablesParams:
             rules=build(VerdictRules, "analyses", rate_points=float(analyses["tie_band"]["rate_points"]),
                         force_relative=float(analyses["tie_band"]["force_relative"]),
                         min_distinct_poses=int(analyses["min_distinct_poses"]), headline_view=analyses["headline_view"]),
-            weights_N={name: float(spec["mass_kg"]) * float(g) for name, spec in objects.items()},
+            weights_N={name: weight_N(config, name) for name in objects},
             periods_deg=periods_deg)
         return cls(dict(config["synergy_sets"]), int(analyses["table2_k_max"]), settings)
 
