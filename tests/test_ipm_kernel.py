@@ -12,7 +12,7 @@ from conftest import BAND
 from synergrasp.optimisation.cones import CircularCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.ipm.sets import set_bases
-from synergrasp.optimisation.ipm_kernel import IPMSettings
+from synergrasp.optimisation.ipm.solver import IPMSettings
 from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_basis, object_wrench
 from synergrasp.optimisation.problem import GFOProblem, GraspSets, SynergySets
 from grasp_problems import random_grasp, random_synergies, random_unit_vector

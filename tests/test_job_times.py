@@ -17,16 +17,16 @@ def _bench(path: Path, wall: float, cpu: float) -> None:
 
 
 def test_rules_are_summed_over_the_default_study_and_every_scenario(tmp_path):
-    _bench(tmp_path / "benchmarks" / "optimise" / "obj1_0.tsv", 4.0, 3.0)
-    _bench(tmp_path / "scenarios" / "mu_1_0" / "benchmarks" / "optimise" / "obj1_1.tsv", 2.0, 1.0)
-    _bench(tmp_path / "benchmarks" / "simulate_contacts" / "obj1.tsv", 10.0, 5.0)
-    _bench(tmp_path / "benchmarks" / "fig1_synergy_postures.tsv", 1.0, 2.0)
+    _bench(tmp_path / "benchmarks" / "optimise_shard" / "obj1_0.tsv", 4.0, 3.0)
+    _bench(tmp_path / "scenarios" / "mu_1_0" / "benchmarks" / "optimise_shard" / "obj1_1.tsv", 2.0, 1.0)
+    _bench(tmp_path / "benchmarks" / "simulate" / "obj1.tsv", 10.0, 5.0)
+    _bench(tmp_path / "benchmarks" / "fig1.tsv", 1.0, 2.0)
     table = job_times.job_times(tmp_path)
-    assert table.loc["optimise", "jobs"] == 2 and table.loc["optimise", "wall_s"] == 6.0
-    assert table.loc["simulate_contacts", "cpu_s"] == 5.0 and table.loc["fig1_synergy_postures", "jobs"] == 1
+    assert table.loc["optimise_shard", "jobs"] == 2 and table.loc["optimise_shard", "wall_s"] == 6.0
+    assert table.loc["simulate", "cpu_s"] == 5.0 and table.loc["fig1", "jobs"] == 1
     assert table["cpu_percent"].sum() == pytest.approx(100.0)
-    assert table.loc["optimise", "cpu_percent"] == pytest.approx(100.0 * 4 / 11)  # 4 of 11 CPU seconds
-    assert list(table.index) == ["simulate_contacts", "optimise", "fig1_synergy_postures"]  # largest CPU first
+    assert table.loc["optimise_shard", "cpu_percent"] == pytest.approx(100.0 * 4 / 11)  # 4 of 11 CPU seconds
+    assert list(table.index) == ["simulate", "optimise_shard", "fig1"]  # largest CPU first
 
 
 def _measurements():
@@ -43,15 +43,15 @@ def test_measurements_page_gives_cpu_per_pose_from_the_benchmarks_and_the_tables
     measurements = _measurements()
     results, inputs = tmp_path / "results", tmp_path / "inputs"
     for obj, cpu in (("a", 1.0), ("b", 2.0)):
-        _bench(results / "benchmarks" / "simulate_contacts" / f"{obj}.tsv", 4.0, cpu)
+        _bench(results / "benchmarks" / "simulate" / f"{obj}.tsv", 4.0, cpu)
         (results / "objects" / obj).mkdir(parents=True)
         pd.DataFrame({"pose": range(500)}).to_parquet(results / "objects" / obj / "contacts.parquet")
-    _bench(results / "benchmarks" / "fig1_synergy_postures.tsv", 1.0, 1.0)
+    _bench(results / "benchmarks" / "fig1.tsv", 1.0, 1.0)
     inputs.mkdir()
     measurements.study_jobs(results).to_csv(inputs / "study_jobs.csv", index=False)
     text = measurements.page(inputs)
-    assert "| `simulate_contacts` | 2 | 8.0 | 3.0 | 75 | 1 | 3 ms per pose over 1,000 |" in text
-    assert "| `fig1_synergy_postures` | 1 | 1.0 | 1.0 | 25 | 1 |  |" in text
+    assert "| `simulate` | 2 | 8.0 | 3.0 | 75 | 1 | 3 ms per pose over 1,000 |" in text
+    assert "| `fig1` | 1 | 1.0 | 1.0 | 25 | 1 |  |" in text
     assert "`benchmarks/results/gfo.csv`: not recorded yet" in text  # a benchmark not run yet is said so
 
 

@@ -5,7 +5,7 @@ import pytest
 
 from synergrasp.config import defaults
 from synergrasp.figures.grasp_3d import Grasps3dParams
-from synergrasp.optimisation.study import OptimiseParams
+from synergrasp.optimisation.optimise import OptimiseParams
 from synergrasp.simulation.objects import GraspedObject, ObjectError
 from synergrasp.simulation.shapes import Box, ShapeError, shape_from_config
 
@@ -17,7 +17,7 @@ def test_study_objects_from_the_config_defaults():
     assert objects[3].shape.size_mm == (100.0, 60.0, 100.0)
     np.testing.assert_array_equal(objects[1].shape.half_extents_mm, [15, 30, 30])
     assert all(o.mass_kg is None for o in objects)  # Fig. 2 does not read the masses
-    assert all(OptimiseParams.from_config(defaults(), o.name).gfo.mass_kg == 1.0 for o in objects)
+    assert all(OptimiseParams.from_config(defaults(), o.name).gfo.weight_N == 9.81 for o in objects)
     heavy = GraspedObject("a", Box((1, 2, 3)), 1)
     assert heavy.mass_kg == 1.0 and isinstance(heavy.mass_kg, float)
 

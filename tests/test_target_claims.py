@@ -15,7 +15,7 @@ from synergrasp.config import ConfigError, validate_config
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.ids import synergy_sets
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.study import gfo_table
+from synergrasp.optimisation.optimise import gfo_table
 from synergrasp.simulation.closure import SimulateParams, simulate_object
 from synergrasp.steps import step_config
 

@@ -11,7 +11,7 @@ from conftest import study_gfo_params
 from synergrasp.analysis.verdicts import verdict_columns, with_verdicts
 from synergrasp.optimisation.mechanics import Grasp
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.study import optimise_grasps
+from synergrasp.optimisation.optimise import optimise_grasps
 
 LEVER = 50.0  # mm per rad: a pushing joint moves its contact along the normal
 

@@ -57,7 +57,7 @@ def _refused(run: Path, configfile: Path, *args: str, env=None) -> str:
     out = snakemake(run, "-j2", "figures", *args, configfile=configfile, env=env)
     text = out.stdout + out.stderr
     assert out.returncode != 0, text[-3000:]
-    assert "rule simulate_contacts" not in text and "Select jobs to execute" not in text, text[-3000:]
+    assert "rule simulate" not in text and "Select jobs to execute" not in text, text[-3000:]
     assert _results(run) == before
     return text
 
@@ -120,7 +120,7 @@ def test_an_object_that_can_never_be_grasped_is_said_with_its_reason(run, tmp_pa
     table = pd.read_csv(run / "results" / "tables" / "graspable_objects.csv").set_index("object")
     assert table.loc["obj1", "reason"] == reason
     assert not table.loc["obj1", "graspable"] and table.loc["obj4", "graspable"]
-    assert reason in (run / "results" / "logs" / "grasp_realism.log").read_text()
+    assert reason in (run / "results" / "logs" / "realism.log").read_text()
     assert {p: d for p, d in _results(run).items() if "/objects/obj4/" in p} == obj4
 
 
@@ -210,9 +210,9 @@ def test_a_repeated_key_in_a_hand_file_is_refused_naming_it(run, tmp_path):
 def test_an_unreadable_input_inside_a_job_names_the_file(run):
     gfo = run / "results" / "objects" / "obj1" / "gfo.parquet"
     gfo.write_bytes(b"not a parquet file")
-    out = snakemake(run, "-j1", "results/tables/grasp_realism.csv", "--forcerun", "grasp_realism")
+    out = snakemake(run, "-j1", "results/tables/grasp_realism.csv", "--forcerun", "realism")
     assert out.returncode != 0
-    log = (run / "results" / "logs" / "grasp_realism.log").read_text()
+    log = (run / "results" / "logs" / "realism.log").read_text()
     assert "ValueError: gfo table 'results/objects/obj1/gfo.parquet': cannot be read as Parquet" in log
 
 

@@ -47,7 +47,7 @@ from synergrasp.config import defaults, overlay, validate_config  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
 from synergrasp.optimisation.problem import SynergySets  # noqa: E402
-from synergrasp.optimisation.study import OptimiseParams, gfo_table  # noqa: E402
+from synergrasp.optimisation.optimise import OptimiseParams, gfo_table  # noqa: E402
 from synergrasp.simulation.closure import SimulateParams, closure_model, place_object  # noqa: E402
 from synergrasp.simulation.contacts import ContactsParams, contacts_row, contacts_table, load_carrying_contacts  # noqa: E402
 from synergrasp.simulation.placement import pose_grid  # noqa: E402

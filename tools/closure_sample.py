@@ -31,14 +31,14 @@ from synergrasp.analysis.realism import grasp_labels, grasp_realism
 from synergrasp.analysis.realism import RealismParams
 from synergrasp.simulation.opposition import HandAxes
 from synergrasp.config import defaults, validate_config
-from synergrasp.optimisation.study import OptimiseParams
+from synergrasp.optimisation.optimise import OptimiseParams
 from synergrasp.simulation.closure import SimulateParams
 from synergrasp.simulation.contacts import ContactsParams
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.study import gfo_table
+from synergrasp.optimisation.optimise import gfo_table
 from synergrasp.simulation.closure import simulate_object
 from synergrasp.simulation.contacts import load_carrying_contacts
 from synergrasp.simulation.placement import pose_grid

@@ -11,23 +11,26 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from synergrasp.steps import STEPS
 from synergrasp.tables import BLOCKERS, CONTACTS, GFO, MINIMA, PLACEMENT, QUALITY, TARGET_CLAIMS, Table
 
 DESIGN = Path(__file__).resolve().parents[1] / "docs" / "design.md"
 BEGIN = "<!-- schemas: written by tools/design_schemas.py from src/synergrasp/tables.py; do not edit -->"
 END = "<!-- end of schemas -->"
 
+
+def _object_file(step: str, output: str) -> str:
+    """A per-object step's output under a scenario's root (the registry's path)."""
+    return f"objects/<object>/{STEPS[step].outputs[output]}"
+
+
 #: Each table between steps (Parquet; the placement search's CSV) and the files that hold it,
-#: under a scenario's root.
-FILES: tuple[tuple[Table, str], ...] = (
-    (CONTACTS, "objects/<object>/contacts.parquet"),
-    (GFO, "objects/<object>/gfo.parquet"),
-    (MINIMA, "objects/<object>/minima.parquet"),
-    (QUALITY, "objects/<object>/quality.parquet"),
-    (BLOCKERS, "objects/<object>/blockers.parquet"),
-    (PLACEMENT, "objects/<object>/placement.csv"),
-    (TARGET_CLAIMS, "objects/<object>/target_claims.parquet"),
-)
+#: under a scenario's root: (table, step, output name).
+FILES: tuple[tuple[Table, str], ...] = tuple(
+    (table, _object_file(step, output)) for table, step, output in (
+        (CONTACTS, "simulate", "contacts"), (GFO, "optimise", "gfo"), (MINIMA, "minima", "minima"),
+        (QUALITY, "quality", "table"), (BLOCKERS, "blockers", "blockers"), (PLACEMENT, "search", "placement"),
+        (TARGET_CLAIMS, "target_claims", "claims")))
 
 
 def schema(table: Table) -> str:

@@ -43,10 +43,10 @@ FIGURE_COLUMNS = ("figure", "value", "description", "load_average", "machine", "
 
 #: What one unit of a rule's work is, and the per-object table that counts it.
 UNITS = {
-    "simulate_contacts": ("pose", "contacts.parquet"),
+    "simulate": ("pose", "contacts.parquet"),
+    "optimise_shard": ("(pose, set)", "gfo.parquet"),
     "optimise": ("(pose, set)", "gfo.parquet"),
-    "aggregate_gfo": ("(pose, set)", "gfo.parquet"),
-    "local_minima": ("(pose, set)", "gfo.parquet"),
+    "minima": ("(pose, set)", "gfo.parquet"),
     "fig4": ("(pose, set)", "gfo.parquet"),
 }
 
@@ -73,7 +73,7 @@ SECTIONS = (
     ("Placement search", ("search",),
      "`benchmarks/bench_search.py` (in `make bench`): the default study's search of each object with 2 "
      "processes; the target is at most 30 s wall per object on 2 quiet cores (the study's own searches: "
-     "`search_placement` in the jobs table above)."),
+     "`search` in the jobs table above)."),
     ("Snakemake's own cost", ("scheduler",),
      "`benchmarks/bench_scheduler.py` (in `make bench`): the CPU time of Snakemake's own process (the jobs "
      "excluded) per job, on the small sweep from an empty directory with -j2 and the workflow profile "

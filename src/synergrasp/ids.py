@@ -8,12 +8,23 @@ from __future__ import annotations
 import itertools
 from collections.abc import Mapping, Sequence
 
-__all__ = ["set_id", "set_name", "incremental_set_id", "synergy_sets"]
+__all__ = ["set_id", "set_members", "set_order", "set_name", "incremental_set_id", "synergy_sets"]
 
 
 def set_id(synergies: Sequence[int]) -> str:
     """Canonical id of a synergy set: 1-based indices, sorted, joined by '-' ("1-2-3")."""
     return "-".join(str(i) for i in sorted(set(synergies)))
+
+
+def set_members(set_id: str) -> tuple[int, ...]:
+    """The synergies (1-based) of a set's id: "1-2-3" -> (1, 2, 3)."""
+    return tuple(int(i) for i in str(set_id).split("-"))
+
+
+def set_order(set_id: str) -> tuple[int, tuple[int, ...]]:
+    """Sort key of set ids: by size, then by members ("2" < "1-3" < "1-2-3")."""
+    members = set_members(set_id)
+    return len(members), members
 
 
 def set_name(synergies: Sequence[int]) -> str:

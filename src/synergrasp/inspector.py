@@ -213,7 +213,7 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     from synergrasp.hand.synergies import load_synergies
     from synergrasp.optimisation.problem import SynergySets
     from synergrasp.optimisation.mechanics import read_grasps
-    from synergrasp.optimisation.study import OptimiseParams, optimise_grasps
+    from synergrasp.optimisation.optimise import OptimiseParams, optimise_grasps
     from synergrasp.simulation.closure import SimulateParams, simulate_object
     from synergrasp.simulation.contacts import ContactsParams, load_carrying_contacts
     from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions
@@ -238,7 +238,7 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     row = table.iloc[0]
     opt = OptimiseParams.from_config(cfg, obj)
     grasp = read_grasps(table)[0]
-    weight = float(opt.gfo.mass_kg * opt.gfo.g_m_per_s2)
+    weight = opt.gfo.weight_N
     rule = OppositionRule.from_config(cfg)
     drawing = dict(q_rad=_floats(row["q"]), object_center_mm=_floats(row["object_center"]),
                    object_rotation=_floats(row["object_rotation"]), hand=hand, shape=sim.object.shape,

@@ -1,11 +1,14 @@
 """The steps of the workflow, each declared once (docs/design.md, "Adding a step").
 
-:data:`STEPS` is data only: for every step, its rules and the measured cost of one job of
-each, the files it writes, the configuration keys it reads (and those it reads only when
+:data:`STEPS` is data only: for every step, its rules and the measured cost and threads of
+one job of each, the files it writes (and which of them the report shows), the configuration keys it reads (and those it reads only when
 another key has a given value), the steps whose outputs it reads, and the class whose
-``from_config`` builds its typed parameters. The step hash, ``workflow/rules/common.smk``
-(targets, where a shared output lives), ``workflow/rules/resources.smk`` (threads, memory,
-run time, local rules) and the tests all read it.
+``from_config`` builds its typed parameters. The step hash, ``synergrasp.wiring`` (every
+rule's outputs, log, benchmark, threads and requests, the targets, where a shared output
+lives; ``workflow/rules/*.smk`` only wire them) and the tests all read it. A step's last
+rule, the one that writes its ``outputs``, is named as the step; an earlier rule of it is
+named ``<step>_<what>``; every rule's log and benchmark live in a folder (one file for a
+step run once) named as the rule.
 
 A rule is handed only the part of its scenario's configuration that its step reads
 (:func:`step_config`); so a job reruns only when a key it reads changes, and two scenarios
@@ -24,24 +27,32 @@ import copy
 import hashlib
 import json
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
-from synergrasp.config import overlay
 from synergrasp.hand.synergies import synergy_values
+from synergrasp.resolved import effective_placement
 
-__all__ = ["Cost", "Step", "STEPS", "UNITS", "WORKFLOW_KEYS", "step_keys", "step_config", "step_hash",
-           "upstream_when", "rule_costs"]
+__all__ = ["Cost", "Step", "STEPS", "UNITS", "WORKFLOW_KEYS", "CLOSURE_COST_FACTOR", "SOLVER_COMPILE",
+           "step_keys", "step_config", "step_hash", "upstream_when", "rule_costs", "rule_step", "step_for_object", "step_made"]
 
 #: Units of work a job's cost is counted in (resources.smk counts them for a scenario).
 UNITS = ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose_set")
+#: Closure cost per pose relative to the kinematic closure measured in STEPS, per closure
+#: model (docs/cluster.md); a model not listed is charged ``None``'s factor until measured.
+CLOSURE_COST_FACTOR = {"kinematic": 1.0, "dynamic": 9.0, None: 20.0}
+#: A cold compiled-solver cache (a node whose CPU model has no cached build) compiles the
+#: solver once in a job of a rule with ``Cost.compiles``: about 50 s and 150 MB (s, MB).
+SOLVER_COMPILE = (60.0, 150)
 
 
 @dataclass(frozen=True)
 class Cost:
     """Measured cost of one job of a rule: fixed wall time (s) and memory (MB) of the job
     itself (imports, reading inputs), plus wall time and memory per unit of work (UNITS).
-    ``local``: a job of seconds, run where Snakemake runs rather than submitted."""
+    ``local``: a job of seconds, run where Snakemake runs rather than submitted.
+    ``threads``: the processes (cores) a job uses. ``compiles``: a job may compile the
+    solver (a cold cache on its node, ``SOLVER_COMPILE``)."""
 
     unit: str
     fixed_s: float
@@ -49,6 +60,8 @@ class Cost:
     unit_s: float = 0.0
     unit_mb: float = 0.0
     local: bool = True
+    threads: int = 1
+    compiles: bool = False
 
 
 @dataclass(frozen=True)
@@ -71,8 +84,17 @@ class Step:
     synergy_columns: the synergies (1-based) it reads besides the mean posture; it is handed
                their values instead of the synergy table.
     params:    "module:Class" whose ``from_config`` builds its typed parameters.
-    optional:  made only by its own target (``snakemake -j2 placement_claims``), not by the
-               study's (``figures``, ``scenario_<name>``): a report too costly for every run.
+    optional:  made only by its own target (``snakemake -j2 placement_claims``, ``sensitivity``),
+               not by the study's (``figures``, ``scenario_<name>``).
+    placement_when: made for an object only where its effective placement has these values
+               ((key, value), ...): the search only for a searched placement.
+    made_when: made only where the configuration has these values ((key, value), ...);
+               elsewhere its output is its first upstream step's own (nothing to select).
+    report:    the outputs the report shows: output name -> (caption, category); the caption
+               is ``workflow/report/<caption>.rst``; a step per object is filed by object.
+    folders:   the outputs that are folders (of pages), in the report only when it is an archive.
+    rule_outputs: the files of a rule before the last (kept only until the last has run),
+               under the same folder as ``outputs``: rule -> path (with its own wildcards).
     """
 
     rules: Mapping[str, Cost]
@@ -86,11 +108,17 @@ class Step:
     synergy_columns: tuple[int, ...] = ()
     params: str | None = None
     optional: bool = False
+    placement_when: tuple[tuple[str, Any], ...] = ()
+    made_when: tuple[tuple[str, Any], ...] = ()
+    report: Mapping[str, tuple[str, str]] = field(default_factory=dict)
+    folders: tuple[str, ...] = ()
+    rule_outputs: Mapping[str, str] = field(default_factory=dict)
 
 
-def _files(names: tuple[str, ...], folder: str, exts: tuple[str, ...]) -> dict[str, str]:
-    """Output name ``<name>_<ext>`` -> ``<folder>/<name>.<ext>`` for every name and extension."""
-    return {f"{n}_{e}": f"{folder}/{n}.{e}".lstrip("/") for n in names for e in exts}
+def _files(names: tuple[str, ...], folder: str, exts: tuple[str, ...], named: bool = True) -> dict[str, str]:
+    """Output name ``<name>_<ext>`` (``<ext>`` where not ``named``) -> ``<folder>/<name>.<ext>``
+    for every name and extension."""
+    return {f"{n}_{e}" if named else e: f"{folder}/{n}.{e}".lstrip("/") for n in names for e in exts}
 
 
 #: The study's tables (the ``tables`` step).
@@ -120,12 +148,13 @@ STEPS: dict[str, Step] = {
     # optimisation with the full set {S1..S_incremental_max} only; one job per object with
     # 2 processes: ~30 s of CPU (186-195 targets x 27 poses) plus a cold solver cache's compile
     "search": Step(
-        rules={"search_placement": Cost("none", 80.0, 700, local=False)},
+        rules={"search": Cost("none", 80.0, 700, local=False, threads=2, compiles=True)},
         outputs={"placement": "placement.csv"}, scope="object",
         reads=STEPS_SEARCH_READS, not_reads=STEPS_SEARCH_NOT_READS,
-        params="synergrasp.optimisation.placement_search:SearchStepParams"),
+        params="synergrasp.optimisation.placement_search:SearchStepParams",
+        placement_when=(("mode", "searched"),)),
     "simulate": Step(
-        rules={"simulate_contacts": Cost("closure_pose", 1.5, 178, 4.5e-3, 7.6e-3, local=False)},
+        rules={"simulate": Cost("closure_pose", 1.5, 178, 4.5e-3, 7.6e-3, local=False)},
         outputs={"contacts": "contacts.parquet"}, scope="object",
         reads=("hand", "synergies", "grid", "placement", "closure", "objects.{object}.shape",
                "objects.{object}.placement"),
@@ -137,20 +166,22 @@ STEPS: dict[str, Step] = {
         upstream_when=(("placement.mode", "searched", "search"),), synergy_columns=(1,),
         params="synergrasp.simulation.closure:SimulateParams"),
     "contacts": Step(
-        rules={"select_contacts": Cost("pose", 1.0, 150, 5.0e-4, 7.6e-3)},
+        rules={"contacts": Cost("pose", 1.0, 150, 5.0e-4, 7.6e-3)},
         outputs={"contacts": "load_carrying_contacts.parquet"}, scope="object",
         reads=("closure.model",),
         # only the dynamic model records the load each contact carries
         reads_when=(("closure.model", "dynamic", _CONTACT_SELECTION),),
-        upstream=("simulate",), params="synergrasp.simulation.contacts:ContactsParams"),
+        upstream=("simulate",), params="synergrasp.simulation.contacts:ContactsParams",
+        made_when=(("closure.model", "dynamic"), ("closure.dynamic.unloaded_contacts", "drop"))),
     "optimise": Step(
-        rules={"optimise_shard": Cost("shard_pose_set", 2.2, 271, 6.1e-5, 1.1e-3, local=False),
-               "aggregate_gfo": Cost("pose_set", 0.6, 134, 2.0e-6, 6.0e-4)},
+        rules={"optimise_shard": Cost("shard_pose_set", 2.2, 271, 6.1e-5, 1.1e-3, local=False, compiles=True),
+               "optimise": Cost("pose_set", 0.6, 134, 2.0e-6, 6.0e-4)},
         outputs={"gfo": "gfo.parquet"}, scope="object",
         reads=("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg"),
-        upstream=("contacts",), params="synergrasp.optimisation.study:OptimiseParams"),
+        upstream=("contacts",), params="synergrasp.optimisation.optimise:OptimiseParams",
+        rule_outputs={"optimise_shard": "gfo_shards/{shard}.parquet"}),
     "minima": Step(
-        rules={"local_minima": Cost("pose_set", 0.6, 136, 1.35e-5, 6.0e-4)},
+        rules={"minima": Cost("pose_set", 0.6, 136, 1.35e-5, 6.0e-4)},
         outputs={"minima": "minima.parquet"}, scope="object",
         reads=("analyses.minima_radius_deg", "analyses.success"),
         # force closure within a multiple of the weight: the minima and Fig. 4 read the bound
@@ -158,34 +189,38 @@ STEPS: dict[str, Step] = {
         upstream=("optimise",), params="synergrasp.analysis.minima:MinimaParams"),
     # quality indices of every pose and their maps (docs/quality.md)
     "quality": Step(
-        rules={"grasp_quality": Cost("pose", 3.0, 300, 6.0e-3, 0.05)},
-        outputs={"table": "quality.parquet", **_files(("quality_maps",), "", _PNG_PDF)}, scope="object",
+        rules={"quality": Cost("pose", 3.0, 300, 6.0e-3, 0.05)},
+        outputs={"table": "quality.parquet", "png": "quality_maps.png", "pdf": "quality_maps.pdf"}, scope="object",
         reads=("hand", "synergies", "mechanics.mu", "mechanics.g_m_per_s2", "synergy_sets.incremental_max",
                "objects.{object}.shape", "objects.{object}.mass_kg", "opposition"),
-        upstream=("contacts", "optimise"), params="synergrasp.optimisation.quality:QualityParams"),
+        upstream=("contacts", "optimise"), params="synergrasp.optimisation.quality:QualityParams",
+        report={"png": ("quality_maps", "Quality")}),
     # what blocks each set of the hierarchy table where the full set succeeds (docs/blockers.md):
     # one small conic problem per distinct failing (grasp, set), ~1.5 ms of CPU per pose
     "blockers": Step(
-        rules={"blocking_contacts": Cost("pose", 3.0, 300, 1.5e-3, 0.05)},
+        rules={"blockers": Cost("pose", 3.0, 300, 1.5e-3, 0.05)},
         outputs={"blockers": "blockers.parquet"}, scope="object",
         reads=("hand", "synergies", "mechanics", "synergy_sets", "opposition", "objects.{object}.shape",
                "objects.{object}.mass_kg"),
         upstream=("contacts", "optimise"), params="synergrasp.analysis.blockers:BlockersParams"),
     "blockers_table": Step(
-        rules={"blockers_summary": Cost("none", 4.0, 300)},
-        outputs={"csv": "tables/blockers.csv", "md": "tables/blockers.md", **_files(("blockers",), "figures", _PNG_PDF)},
-        reads=("synergy_sets.hierarchy_first", "synergy_sets.incremental_max"), upstream=("blockers",)),
+        rules={"blockers_table": Cost("none", 4.0, 300)},
+        outputs={"csv": "tables/blockers.csv", "md": "tables/blockers.md",
+                 **_files(("blockers",), "figures", _PNG_PDF, named=False)},
+        reads=("synergy_sets.hierarchy_first", "synergy_sets.incremental_max"), upstream=("blockers",),
+        report={"csv": ("blockers_table", "Tables"), "png": ("blockers", "Figures")}),
     "tables": Step(
-        rules={"study_tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
+        rules={"tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
         outputs=_files(TABLES, "tables", ("csv", "md")),
         reads=("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max", "analyses.success",
                "analyses.marginal_weight_multiple", "analyses.success_rate_tolerance_percent",
                "analyses.null_model", "analyses.headline_view", "analyses.tie_band", "analyses.min_distinct_poses",
                "analyses.bootstrap", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
-        upstream=("optimise", "minima"), params="synergrasp.analysis.summaries:TablesParams"),
+        upstream=("optimise", "minima"), params="synergrasp.analysis.summaries:TablesParams",
+        report={f"{t}_csv": (t, "Tables") for t in TABLES}),
     "realism": Step(
         # with the equilibrium checks of every grasp: ~0.5 ms of CPU per grasp over 75 sets
-        rules={"grasp_realism": Cost("object_pose_set", 4.0, 300, 1.1e-5, 3.0e-4)},
+        rules={"realism": Cost("object_pose_set", 4.0, 300, 1.1e-5, 3.0e-4)},
         outputs={"csv": "tables/grasp_realism.csv", "md": "tables/grasp_realism.md",
                  "links_csv": "tables/grasp_links.csv", "links_md": "tables/grasp_links.md",
                  "png": "figures/grasp_realism.png", "pdf": "figures/grasp_realism.pdf",
@@ -194,63 +229,81 @@ STEPS: dict[str, Step] = {
                "mechanics.k_ss_Nmm_per_rad", "mechanics.mu", "closure.model", "objects.*.shape",
                "objects.*.grasp_type", "opposition"),
         reads_when=(("closure.model", "dynamic", ("closure.dynamic.load_threshold_N",)),),
-        upstream=("contacts", "optimise"), synergy_columns=(1,), params="synergrasp.analysis.realism:RealismParams"),
+        upstream=("contacts", "optimise"), synergy_columns=(1,), params="synergrasp.analysis.realism:RealismParams",
+        report={"csv": ("grasp_realism_table", "Tables"), "png": ("grasp_realism", "Figures"),
+                "graspable_csv": ("graspable_objects", "Tables")}),
     "fig1": Step(
-        rules={"fig1_synergy_postures": Cost("none", 3.0, 565)},
-        outputs=_files(("fig1_synergy_postures",), "figures", _PNG_PDF),
-        reads=("hand", "synergies"), params="synergrasp.figures.hand_figures:Fig1Params"),
+        rules={"fig1": Cost("none", 3.0, 565)},
+        outputs=_files(("fig1_synergy_postures",), "figures", _PNG_PDF, named=False),
+        reads=("hand", "synergies"), params="synergrasp.figures.hand_figures:Fig1Params",
+        report={"png": ("fig1", "Figures")}),
     # Fig. 2 and the same grasps in 3-D with the full set's optimal forces: pages sharing one
     # plotly script (docs/inspector.md); one job, so that the pages' imports (the solver, a
     # dozen optimisations) are not paid by a job of their own
     "fig2": Step(
-        rules={"fig2_example_grasps": Cost("none", 4.5, 510)},
-        outputs={**_files(("fig2_example_grasps",), "figures", _PNG_PDF), "pages": "figures/grasps_3d"},
+        rules={"fig2": Cost("none", 4.5, 510)},
+        outputs={**_files(("fig2_example_grasps",), "figures", _PNG_PDF, named=False), "pages": "figures/grasps_3d"},
         reads=("hand", "synergies", "mechanics", "synergy_sets.incremental_max", "objects.*.shape",
                "objects.*.mass_kg", "opposition"),
-        upstream=("contacts",), params="synergrasp.figures.grasp_3d:Grasps3dParams"),
+        upstream=("contacts",), params="synergrasp.figures.grasp_3d:Grasps3dParams",
+        report={"png": ("fig2", "Figures"), "pages": ("grasps_3d", "Figures")}, folders=("pages",)),
     "fig4": Step(
-        rules={"fig4_force_maps": Cost("pose_set", 4.3, 257, 5.1e-6, 4.0e-4)},
-        outputs=_files(("fig4_force_maps", "fig4_exploded"), "", _PNG_PDF), scope="object",
+        rules={"fig4": Cost("pose_set", 4.3, 257, 5.1e-6, 4.0e-4)},
+        outputs={"maps_png": "fig4_force_maps.png", "maps_pdf": "fig4_force_maps.pdf",
+                 "exploded_png": "fig4_exploded.png", "exploded_pdf": "fig4_exploded.pdf"}, scope="object",
         reads=("analyses.fig4", "analyses.success"),
         reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),), upstream=("optimise", "minima"),
-        params="synergrasp.figures.study_figures:Fig4Params"),
+        params="synergrasp.figures.study_figures:Fig4Params",
+        report={"maps_png": ("fig4_force_maps", "Fig. 4"), "exploded_png": ("fig4_exploded", "Fig. 4")}),
     # the placement map: the search's score over its targets, grasps at the chosen target
     "placement_map": Step(
         rules={"placement_map": Cost("none", 6.0, 400)},
-        outputs=_files(("placement_map",), "", _PNG_PDF), scope="object",
+        outputs=_files(("placement_map",), "", _PNG_PDF, named=False), scope="object",
         reads=STEPS_SEARCH_READS, not_reads=STEPS_SEARCH_NOT_READS, upstream=("search", "contacts"),
-        params="synergrasp.optimisation.placement_search:SearchStepParams"),
+        params="synergrasp.optimisation.placement_search:SearchStepParams",
+        placement_when=(("mode", "searched"), ("search_rank", 1)),
+        report={"png": ("placement_map", "Placement search")}),
     # the study's claims at every scored target of the search (docs/placement_search.md): the
     # closure and every set's optimisation on a 117-pose lattice, ~1 s of CPU per target, 2 processes
     "target_claims": Step(
-        rules={"target_claims": Cost("none", 400.0, 900, local=False)},
+        rules={"target_claims": Cost("none", 400.0, 900, local=False, threads=2)},
         outputs={"claims": "target_claims.parquet"}, scope="object",
         reads=(*STEPS_SEARCH_READS, "synergy_sets", "analyses", "objects.{object}"),
         reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
         not_reads=(*STEPS_SEARCH_NOT_READS, "analyses.fig4"), upstream=("search",),
-        params="synergrasp.analysis.target_claims:TargetClaimsParams", optional=True),
-    "placement_claims": Step(
+        params="synergrasp.analysis.target_claims:TargetClaimsParams", optional=True,
+        placement_when=(("mode", "searched"),)),
+    # their summary: made by the target `placement_claims`
+    "summarise_target_claims": Step(
         rules={"summarise_target_claims": Cost("none", 4.0, 300)},
         outputs={"csv": "tables/placement_claims.csv", "md": "tables/placement_claims.md",
-                 **_files(("placement_claims",), "figures", _PNG_PDF)},
-        upstream=("target_claims",), optional=True),
+                 **_files(("placement_claims",), "figures", _PNG_PDF, named=False)},
+        upstream=("target_claims",), optional=True,
+        report={"csv": ("placement_claims", "Placement search"), "png": ("placement_claims", "Placement search")}),
     "fig5": Step(
-        rules={"fig5_hierarchy": Cost("none", 9.6, 268)},
-        outputs=_files(("fig5a_hierarchy_success", "fig5a_hierarchy_success_pooled", "fig5b_hierarchy_force"),
-                       "figures", _PNG_PDF),
+        rules={"fig5": Cost("none", 9.6, 268)},
+        outputs={"success_png": "figures/fig5a_hierarchy_success.png", "success_pdf": "figures/fig5a_hierarchy_success.pdf",
+                 "pooled_png": "figures/fig5a_hierarchy_success_pooled.png",
+                 "pooled_pdf": "figures/fig5a_hierarchy_success_pooled.pdf",
+                 "force_png": "figures/fig5b_hierarchy_force.png", "force_pdf": "figures/fig5b_hierarchy_force.pdf"},
         reads=("synergy_sets.hierarchy_first", "analyses.success"), upstream=("tables",),
-        params="synergrasp.figures.study_figures:Fig5Params"),
+        params="synergrasp.figures.study_figures:Fig5Params",
+        report={"success_png": ("fig5a", "Figures"), "pooled_png": ("fig5a_pooled", "Figures"),
+                "force_png": ("fig5b", "Figures")}),
     # the workflow's own rule graph: drawn with the shipped configuration, so it reads no key
     "fig3": Step(
-        rules={"fig3_rulegraph": Cost("none", 5.3, 380)},
-        outputs={**_files(("fig3_rulegraph",), "figures", _PNG_PDF), "dot": "figures/fig3_rulegraph.dot"},
-        scope="workflow"),
-    # the sweep's summary across every scenario (docs/sensitivity.md): built by `sensitivity`
+        rules={"fig3": Cost("none", 5.3, 380)},
+        outputs={**_files(("fig3_rulegraph",), "figures", _PNG_PDF, named=False), "dot": "figures/fig3_rulegraph.dot"},
+        scope="workflow", report={"png": ("fig3", "Figures")}),
+    # the sweep's summary across every scenario (docs/sensitivity.md): its rule is the target
     "sensitivity": Step(
-        rules={"sensitivity_summary": Cost("none", 5.0, 300)},
+        rules={"sensitivity": Cost("none", 5.0, 300)},
         outputs={"csv": "sensitivity/claims.csv", "md": "sensitivity/claims.md",
-                 **_files(("claims_grid", "table2_curves"), "sensitivity", _PNG_PDF)},
-        scope="workflow", upstream=("tables", "realism")),
+                 "grid_png": "sensitivity/claims_grid.png", "grid_pdf": "sensitivity/claims_grid.pdf",
+                 "curves_png": "sensitivity/table2_curves.png", "curves_pdf": "sensitivity/table2_curves.pdf"},
+        scope="workflow", upstream=("tables", "realism"), optional=True,
+        report={"csv": ("sensitivity_claims", "Sensitivity"), "grid_png": ("sensitivity_grid", "Sensitivity"),
+                "curves_png": ("sensitivity_table2", "Sensitivity")}),
 }
 #: Keys read by the workflow itself, not by a step.
 WORKFLOW_KEYS: tuple[str, ...] = ("scenarios",)
@@ -261,6 +314,24 @@ _MISSING = object()
 def rule_costs() -> dict[str, Cost]:
     """Every rule of every step, with the cost of one of its jobs."""
     return {rule: cost for step in STEPS.values() for rule, cost in step.rules.items()}
+
+
+def rule_step() -> dict[str, str]:
+    """Every rule of every step -> its step."""
+    return {rule: name for name, step in STEPS.items() for rule in step.rules}
+
+
+def step_for_object(config: Mapping[str, Any], step: str, obj: str) -> bool:
+    """Whether the per-object ``step`` runs for ``obj`` under ``config``: its ``placement_when``
+    holds for the object's effective placement."""
+    placement = effective_placement(config, obj)
+    return all(placement.get(key) == value for key, value in STEPS[step].placement_when)
+
+
+def step_made(config: Mapping[str, Any], step: str) -> bool:
+    """Whether ``step`` makes its own output under ``config`` (its ``made_when`` holds), else
+    its output is its first upstream step's."""
+    return all(_get(config, key) == value for key, value in STEPS[step].made_when)
 
 
 def _get(config: Mapping[str, Any], path: str) -> Any:
@@ -347,6 +418,6 @@ def upstream_when(config: Mapping[str, Any], step: str, obj: str | None = None) 
     effective placement (``upstream_when``): ``search`` for a searched placement."""
     if obj is None or not STEPS[step].upstream_when:
         return ()
-    placement = overlay(config["placement"], config["objects"][obj].get("placement"))
+    placement = effective_placement(config, obj)
     return tuple(up for key, value, up in STEPS[step].upstream_when
                  if placement.get(key.removeprefix("placement.")) == value)

@@ -1,234 +1,167 @@
-# Stage 3: local minima per object and set, success rates, and the study's tables.
+# Stage 3: local minima per object and set, grasp quality, the study's tables, grasp
+# realism, and the claims at every target of the placement search.
 
 
-rule local_minima:
+rule minima:
     input:
-        gfo=step_input("optimise"),
-        code=code("local_minima"),
+        gfo=W.step_input("optimise"),
+        code=W.code("minima"),
     output:
-        "{root}/objects/{object}/minima.parquet",
+        **outputs("minima"),
     log:
-        "{root}/logs/local_minima/{object}.log",
+        log_file("minima"),
     benchmark:
-        "{root}/benchmarks/local_minima/{object}.tsv"
-    threads: 1
+        benchmark_file("minima")
+    threads: threads("minima")
     resources:
-        mem_mb=mem_mb("local_minima"),
-        runtime=runtime_min("local_minima"),
+        **W.resources("minima"),
     params:
-        cfg=step_cfg("minima"),
+        cfg=W.step_cfg("minima"),
     script:
-        "../scripts/local_minima.py"
+        "../scripts/minima.py"
 
 
-rule study_tables:
+rule tables:
     input:
-        gfo=step_inputs("optimise"),
-        minima=step_inputs("minima"),
-        code=code("study_tables"),
+        gfo=W.step_inputs("optimise"),
+        minima=W.step_inputs("minima"),
+        code=W.code("tables"),
     output:
-        **{
-            f"{t}_{ext}": (
-                report(
-                    f"{{root}}/tables/{t}.{ext}",
-                    caption=f"../report/{t}.rst",
-                    category="Tables",
-                )
-                if ext == "csv"
-                else f"{{root}}/tables/{t}.{ext}"
-            )
-            for t in TABLES
-            for ext in ("csv", "md")
-        },
+        **outputs("tables"),
     log:
-        "{root}/logs/study_tables.log",
+        log_file("tables"),
     benchmark:
-        "{root}/benchmarks/study_tables.tsv"
-    threads: 1
+        benchmark_file("tables")
+    threads: threads("tables")
     resources:
-        mem_mb=mem_mb("study_tables"),
-        runtime=runtime_min("study_tables"),
+        **W.resources("tables"),
     params:
-        cfg=step_cfg("tables"),
+        cfg=W.step_cfg("tables"),
     script:
-        "../scripts/study_tables.py"
+        "../scripts/tables.py"
 
 
-rule grasp_realism:
+rule realism:
     input:
-        contacts=step_inputs("contacts"),
-        gfo=step_inputs("optimise"),
-        code=code("grasp_realism"),
+        contacts=W.step_inputs("contacts"),
+        gfo=W.step_inputs("optimise"),
+        code=W.code("realism"),
         data=SHIPPED_DATA,
-        user=user_files,
+        user=W.user_files,
     output:
-        csv=report(
-            "{root}/tables/grasp_realism.csv",
-            caption="../report/grasp_realism_table.rst",
-            category="Tables",
-        ),
-        md="{root}/tables/grasp_realism.md",
-        links_csv="{root}/tables/grasp_links.csv",
-        links_md="{root}/tables/grasp_links.md",
-        png=report(
-            "{root}/figures/grasp_realism.png",
-            caption="../report/grasp_realism.rst",
-            category="Figures",
-        ),
-        pdf="{root}/figures/grasp_realism.pdf",
-        graspable_csv=report(
-            "{root}/tables/graspable_objects.csv",
-            caption="../report/graspable_objects.rst",
-            category="Tables",
-        ),
-        graspable_md="{root}/tables/graspable_objects.md",
+        **outputs("realism"),
     log:
-        "{root}/logs/grasp_realism.log",
+        log_file("realism"),
     benchmark:
-        "{root}/benchmarks/grasp_realism.tsv"
-    threads: 1
+        benchmark_file("realism")
+    threads: threads("realism")
     resources:
-        mem_mb=mem_mb("grasp_realism"),
-        runtime=runtime_min("grasp_realism"),
+        **W.resources("realism"),
     params:
-        cfg=step_cfg("realism"),
+        cfg=W.step_cfg("realism"),
     script:
-        "../scripts/grasp_realism.py"
+        "../scripts/realism.py"
 
 
-rule grasp_quality:
+rule quality:
     input:
-        contacts=step_input("contacts"),
-        gfo=step_input("optimise"),
-        code=code("grasp_quality"),
+        contacts=W.step_input("contacts"),
+        gfo=W.step_input("optimise"),
+        code=W.code("quality"),
         data=SHIPPED_DATA,
-        user=user_files,
+        user=W.user_files,
     output:
-        table="{root}/objects/{object}/quality.parquet",
-        png=report(
-            "{root}/objects/{object}/quality_maps.png",
-            caption="../report/quality_maps.rst",
-            category="Quality",
-            subcategory="{object}",
-        ),
-        pdf="{root}/objects/{object}/quality_maps.pdf",
+        **outputs("quality"),
     log:
-        "{root}/logs/grasp_quality/{object}.log",
+        log_file("quality"),
     benchmark:
-        "{root}/benchmarks/grasp_quality/{object}.tsv"
-    threads: 1
+        benchmark_file("quality")
+    threads: threads("quality")
     resources:
-        mem_mb=mem_mb("grasp_quality"),
-        runtime=runtime_min("grasp_quality"),
+        **W.resources("quality"),
     params:
-        cfg=step_cfg("quality"),
+        cfg=W.step_cfg("quality"),
     script:
-        "../scripts/grasp_quality.py"
+        "../scripts/quality.py"
 
 
 # The study's claims at every target of the placement search (docs/placement_search.md):
 # made by `snakemake -j2 placement_claims` only (~1 s of CPU per target), not by `figures`.
 rule target_claims:
     input:
-        placement=step_input("search"),
-        code=code("target_claims"),
+        placement=W.step_input("search"),
+        code=W.code("target_claims"),
         data=SHIPPED_DATA,
-        user=user_files,
+        user=W.user_files,
     output:
-        "{root}/objects/{object}/target_claims.parquet",
+        **outputs("target_claims"),
     log:
-        "{root}/logs/target_claims/{object}.log",
+        log_file("target_claims"),
     benchmark:
-        "{root}/benchmarks/target_claims/{object}.tsv"
-    threads: 2
+        benchmark_file("target_claims")
+    threads: threads("target_claims")
     resources:
-        mem_mb=mem_mb("target_claims"),
-        runtime=runtime_min("target_claims"),
+        **W.resources("target_claims"),
     params:
-        cfg=step_cfg("target_claims"),
+        cfg=W.step_cfg("target_claims"),
     script:
         "../scripts/target_claims.py"
 
 
 rule summarise_target_claims:
     input:
-        claims=searched_inputs("target_claims"),
-        code=code("summarise_target_claims"),
+        claims=W.step_inputs("target_claims", target="placement_claims"),
+        code=W.code("summarise_target_claims"),
     output:
-        csv=report(
-            "{root}/tables/placement_claims.csv",
-            caption="../report/placement_claims.rst",
-            category="Placement search",
-        ),
-        md="{root}/tables/placement_claims.md",
-        png=report(
-            "{root}/figures/placement_claims.png",
-            caption="../report/placement_claims.rst",
-            category="Placement search",
-        ),
-        pdf="{root}/figures/placement_claims.pdf",
+        **outputs("summarise_target_claims"),
     log:
-        "{root}/logs/summarise_target_claims.log",
+        log_file("summarise_target_claims"),
     benchmark:
-        "{root}/benchmarks/summarise_target_claims.tsv"
-    threads: 1
+        benchmark_file("summarise_target_claims")
+    threads: threads("summarise_target_claims")
     resources:
-        mem_mb=mem_mb("summarise_target_claims"),
-        runtime=runtime_min("summarise_target_claims"),
+        **W.resources("summarise_target_claims"),
     script:
         "../scripts/summarise_target_claims.py"
 
 
 # What blocks each synergy set where the full set succeeds (docs/blockers.md).
-rule blocking_contacts:
+rule blockers:
     input:
-        contacts=step_input("contacts"),
-        gfo=step_input("optimise"),
-        code=code("blocking_contacts"),
+        contacts=W.step_input("contacts"),
+        gfo=W.step_input("optimise"),
+        code=W.code("blockers"),
         data=SHIPPED_DATA,
-        user=user_files,
+        user=W.user_files,
     output:
-        "{root}/objects/{object}/blockers.parquet",
+        **outputs("blockers"),
     log:
-        "{root}/logs/blocking_contacts/{object}.log",
+        log_file("blockers"),
     benchmark:
-        "{root}/benchmarks/blocking_contacts/{object}.tsv"
-    threads: 1
+        benchmark_file("blockers")
+    threads: threads("blockers")
     resources:
-        mem_mb=mem_mb("blocking_contacts"),
-        runtime=runtime_min("blocking_contacts"),
+        **W.resources("blockers"),
     params:
-        cfg=step_cfg("blockers"),
+        cfg=W.step_cfg("blockers"),
     script:
-        "../scripts/blocking_contacts.py"
+        "../scripts/blockers.py"
 
 
-rule blockers_summary:
+rule blockers_table:
     input:
-        blockers=step_inputs("blockers"),
-        code=code("blockers_summary"),
+        blockers=W.step_inputs("blockers"),
+        code=W.code("blockers_table"),
     output:
-        csv=report(
-            "{root}/tables/blockers.csv",
-            caption="../report/blockers_table.rst",
-            category="Tables",
-        ),
-        md="{root}/tables/blockers.md",
-        png=report(
-            "{root}/figures/blockers.png",
-            caption="../report/blockers.rst",
-            category="Figures",
-        ),
-        pdf="{root}/figures/blockers.pdf",
+        **outputs("blockers_table"),
     log:
-        "{root}/logs/blockers_summary.log",
+        log_file("blockers_table"),
     benchmark:
-        "{root}/benchmarks/blockers_summary.tsv"
-    threads: 1
+        benchmark_file("blockers_table")
+    threads: threads("blockers_table")
     resources:
-        mem_mb=mem_mb("blockers_summary"),
-        runtime=runtime_min("blockers_summary"),
+        **W.resources("blockers_table"),
     params:
-        cfg=step_cfg("blockers_table"),
+        cfg=W.step_cfg("blockers_table"),
     script:
-        "../scripts/blockers_summary.py"
+        "../scripts/blockers_table.py"

@@ -1,190 +1,127 @@
 # Stage 4: the study's figures: the hand along the synergies (Fig. 1), example grasps
 # (Fig. 2, and in 3-D in the browser), the workflow's own rule graph (Fig. 3), force maps per
-# object (Fig. 4) and the hierarchy (Fig. 5).
+# object (Fig. 4), the hierarchy (Fig. 5) and the placement search's map.
 
 
-rule fig4_force_maps:
+rule fig4:
     input:
-        gfo=step_input("optimise"),
-        minima=step_input("minima"),
-        code=code("fig4_force_maps"),
+        gfo=W.step_input("optimise"),
+        minima=W.step_input("minima"),
+        code=W.code("fig4"),
     output:
-        maps_png=report(
-            "{root}/objects/{object}/fig4_force_maps.png",
-            caption="../report/fig4_force_maps.rst",
-            category="Fig. 4",
-            subcategory="{object}",
-        ),
-        maps_pdf="{root}/objects/{object}/fig4_force_maps.pdf",
-        exploded_png=report(
-            "{root}/objects/{object}/fig4_exploded.png",
-            caption="../report/fig4_exploded.rst",
-            category="Fig. 4",
-            subcategory="{object}",
-        ),
-        exploded_pdf="{root}/objects/{object}/fig4_exploded.pdf",
+        **outputs("fig4"),
     log:
-        "{root}/logs/fig4/{object}.log",
+        log_file("fig4"),
     benchmark:
-        "{root}/benchmarks/fig4/{object}.tsv"
-    threads: 1
+        benchmark_file("fig4")
+    threads: threads("fig4")
     resources:
-        mem_mb=mem_mb("fig4_force_maps"),
-        runtime=runtime_min("fig4_force_maps"),
+        **W.resources("fig4"),
     params:
-        cfg=step_cfg("fig4"),
+        cfg=W.step_cfg("fig4"),
     script:
-        "../scripts/fig4_force_maps.py"
+        "../scripts/fig4.py"
 
 
-rule fig5_hierarchy:
+rule fig5:
     input:
-        hierarchy=study_input("tables", "tables/hierarchy.csv"),
-        code=code("fig5_hierarchy"),
+        hierarchy=W.study_input("tables", "tables/hierarchy.csv"),
+        code=W.code("fig5"),
     output:
-        success_png=report(
-            "{root}/figures/fig5a_hierarchy_success.png",
-            caption="../report/fig5a.rst",
-            category="Figures",
-        ),
-        success_pdf="{root}/figures/fig5a_hierarchy_success.pdf",
-        pooled_png=report(
-            "{root}/figures/fig5a_hierarchy_success_pooled.png",
-            caption="../report/fig5a_pooled.rst",
-            category="Figures",
-        ),
-        pooled_pdf="{root}/figures/fig5a_hierarchy_success_pooled.pdf",
-        force_png=report(
-            "{root}/figures/fig5b_hierarchy_force.png",
-            caption="../report/fig5b.rst",
-            category="Figures",
-        ),
-        force_pdf="{root}/figures/fig5b_hierarchy_force.pdf",
+        **outputs("fig5"),
     log:
-        "{root}/logs/fig5_hierarchy.log",
+        log_file("fig5"),
     benchmark:
-        "{root}/benchmarks/fig5_hierarchy.tsv"
-    threads: 1
+        benchmark_file("fig5")
+    threads: threads("fig5")
     resources:
-        mem_mb=mem_mb("fig5_hierarchy"),
-        runtime=runtime_min("fig5_hierarchy"),
+        **W.resources("fig5"),
     params:
-        cfg=step_cfg("fig5"),
+        cfg=W.step_cfg("fig5"),
     script:
-        "../scripts/fig5_hierarchy.py"
+        "../scripts/fig5.py"
 
 
-rule fig3_rulegraph:
+rule fig3:
     input:
         rules=[str(p) for p in sorted((ROOT / "workflow" / "rules").glob("*.smk"))],
         snakefile=str(ROOT / "Snakefile"),
-        code=code("fig3_rulegraph"),
+        code=W.code("fig3"),
     output:
-        png=report(
-            "results/figures/fig3_rulegraph.png",
-            caption="../report/fig3.rst",
-            category="Figures",
-        ),
-        pdf="results/figures/fig3_rulegraph.pdf",
-        dot="results/figures/fig3_rulegraph.dot",
+        **outputs("fig3"),
     log:
-        "results/logs/fig3_rulegraph.log",
+        log_file("fig3"),
     benchmark:
-        "results/benchmarks/fig3_rulegraph.tsv"
-    threads: 1
+        benchmark_file("fig3")
+    threads: threads("fig3")
     resources:
-        mem_mb=mem_mb("fig3_rulegraph"),
-        runtime=runtime_min("fig3_rulegraph"),
+        **W.resources("fig3"),
     params:
         # the rule graph does not depend on the configuration's values: drawn with the
         # shipped one, so that neither a config value nor a config file's path reruns it
         configfile=str(ROOT / "config" / "config.yaml"),
     script:
-        "../scripts/fig3_rulegraph.py"
+        "../scripts/fig3.py"
 
 
-rule fig1_synergy_postures:
+rule fig1:
     input:
-        code=code("fig1_synergy_postures"),
+        code=W.code("fig1"),
         data=SHIPPED_DATA,
-        user=user_files,
+        user=W.user_files,
     output:
-        png=report(
-            "{root}/figures/fig1_synergy_postures.png",
-            caption="../report/fig1.rst",
-            category="Figures",
-        ),
-        pdf="{root}/figures/fig1_synergy_postures.pdf",
+        **outputs("fig1"),
     log:
-        "{root}/logs/fig1_synergy_postures.log",
+        log_file("fig1"),
     benchmark:
-        "{root}/benchmarks/fig1_synergy_postures.tsv"
-    threads: 1
+        benchmark_file("fig1")
+    threads: threads("fig1")
     resources:
-        mem_mb=mem_mb("fig1_synergy_postures"),
-        runtime=runtime_min("fig1_synergy_postures"),
+        **W.resources("fig1"),
     params:
-        cfg=step_cfg("fig1"),
+        cfg=W.step_cfg("fig1"),
     script:
-        "../scripts/fig1_synergy_postures.py"
+        "../scripts/fig1.py"
 
 
-rule fig2_example_grasps:
+rule fig2:
     input:
-        contacts=step_inputs("contacts"),
-        code=code("fig2_example_grasps"),
+        contacts=W.step_inputs("contacts"),
+        code=W.code("fig2"),
         data=SHIPPED_DATA,
-        user=user_files,
+        user=W.user_files,
     output:
-        png=report(
-            "{root}/figures/fig2_example_grasps.png",
-            caption="../report/fig2.rst",
-            category="Figures",
-        ),
-        pdf="{root}/figures/fig2_example_grasps.pdf",
-        pages=pages_in_report(
-            "{root}/figures/grasps_3d",
-            caption="../report/grasps_3d.rst",
-            category="Figures",
-        ),
+        **outputs("fig2"),
     log:
-        "{root}/logs/fig2_example_grasps.log",
+        log_file("fig2"),
     benchmark:
-        "{root}/benchmarks/fig2_example_grasps.tsv"
-    threads: 1
+        benchmark_file("fig2")
+    threads: threads("fig2")
     resources:
-        mem_mb=mem_mb("fig2_example_grasps"),
-        runtime=runtime_min("fig2_example_grasps"),
+        **W.resources("fig2"),
     params:
-        cfg=step_cfg("fig2"),
+        cfg=W.step_cfg("fig2"),
     script:
-        "../scripts/fig2_example_grasps.py"
+        "../scripts/fig2.py"
 
 
 rule placement_map:
     input:
-        placement=step_input("search"),
-        contacts=step_input("contacts"),
-        code=code("placement_map"),
+        placement=W.step_input("search"),
+        contacts=W.step_input("contacts"),
+        code=W.code("placement_map"),
         data=SHIPPED_DATA,
-        user=user_files,
+        user=W.user_files,
     output:
-        png=report(
-            "{root}/objects/{object}/placement_map.png",
-            caption="../report/placement_map.rst",
-            category="Placement search",
-            subcategory="{object}",
-        ),
-        pdf="{root}/objects/{object}/placement_map.pdf",
+        **outputs("placement_map"),
     log:
-        "{root}/logs/placement_map/{object}.log",
+        log_file("placement_map"),
     benchmark:
-        "{root}/benchmarks/placement_map/{object}.tsv"
-    threads: 1
+        benchmark_file("placement_map")
+    threads: threads("placement_map")
     resources:
-        mem_mb=mem_mb("placement_map"),
-        runtime=runtime_min("placement_map"),
+        **W.resources("placement_map"),
     params:
-        cfg=step_cfg("search"),
+        cfg=W.step_cfg("search"),
     script:
         "../scripts/placement_map.py"

@@ -4,42 +4,37 @@
 
 rule optimise_shard:
     input:
-        contacts=step_input("contacts"),
-        code=code("optimise_shard"),
+        contacts=W.step_input("contacts"),
+        code=W.code("optimise_shard"),
         data=SHIPPED_DATA,
-        user=user_files,
+        user=W.user_files,
     output:
-        temp("{root}/objects/{object}/gfo_shards/{shard}.parquet"),
+        **outputs("optimise_shard"),
     log:
-        "{root}/logs/optimise/{object}_{shard}.log",
+        log_file("optimise_shard"),
     benchmark:
-        "{root}/benchmarks/optimise/{object}_{shard}.tsv"
-    threads: 1
+        benchmark_file("optimise_shard")
+    threads: threads("optimise_shard")
     resources:
-        mem_mb=mem_mb("optimise_shard"),
-        runtime=runtime_min("optimise_shard"),
+        **W.resources("optimise_shard"),
     params:
-        cfg=step_cfg("optimise"),
+        cfg=W.step_cfg("optimise"),
     script:
         "../scripts/optimise_shard.py"
 
 
-rule aggregate_gfo:
+rule optimise:
     input:
-        shards=lambda w: [
-            f"{w.root}/objects/{w.object}/gfo_shards/{i}.parquet"
-            for i in range(scenario_config(w)["solver"]["pose_shards"])
-        ],
-        code=code("aggregate_gfo"),
+        shards=W.shard_files("optimise_shard"),
+        code=W.code("optimise"),
     output:
-        "{root}/objects/{object}/gfo.parquet",
+        **outputs("optimise"),
     log:
-        "{root}/logs/aggregate_gfo/{object}.log",
+        log_file("optimise"),
     benchmark:
-        "{root}/benchmarks/aggregate_gfo/{object}.tsv"
-    threads: 1
+        benchmark_file("optimise")
+    threads: threads("optimise")
     resources:
-        mem_mb=mem_mb("aggregate_gfo"),
-        runtime=runtime_min("aggregate_gfo"),
+        **W.resources("optimise"),
     script:
-        "../scripts/aggregate_gfo.py"
+        "../scripts/optimise.py"

@@ -1,43 +1,27 @@
-# The sensitivity sweep's summary across every scenario (docs/sensitivity.md).
+# The sensitivity sweep's summary across every scenario (docs/sensitivity.md); its rule is
+# the target `sensitivity`: it pulls each scenario's tables and grasp-realism table and what
+# they need, not each scenario's figures (`scenarios` makes those).
 
 
-rule sensitivity_summary:
+rule sensitivity:
     input:
-        claims=scenario_tables("claims"),
-        table2=scenario_tables("table2_success_rates"),
-        success_rates=scenario_tables("success_rates"),
-        preservation=scenario_tables("minimum_preservation"),
-        realism=scenario_tables("grasp_realism", step="realism"),
-        code=code("sensitivity_summary"),
+        claims=W.scenario_tables("claims"),
+        table2=W.scenario_tables("table2_success_rates"),
+        success_rates=W.scenario_tables("success_rates"),
+        preservation=W.scenario_tables("minimum_preservation"),
+        realism=W.scenario_tables("grasp_realism", step="realism"),
+        code=W.code("sensitivity"),
     output:
-        csv=report(
-            "results/sensitivity/claims.csv",
-            caption="../report/sensitivity_claims.rst",
-            category="Sensitivity",
-        ),
-        md="results/sensitivity/claims.md",
-        grid_png=report(
-            "results/sensitivity/claims_grid.png",
-            caption="../report/sensitivity_grid.rst",
-            category="Sensitivity",
-        ),
-        grid_pdf="results/sensitivity/claims_grid.pdf",
-        curves_png=report(
-            "results/sensitivity/table2_curves.png",
-            caption="../report/sensitivity_table2.rst",
-            category="Sensitivity",
-        ),
-        curves_pdf="results/sensitivity/table2_curves.pdf",
+        **outputs("sensitivity"),
     log:
-        "results/logs/sensitivity_summary.log",
+        log_file("sensitivity"),
     benchmark:
-        "results/benchmarks/sensitivity_summary.tsv"
-    threads: 1
+        benchmark_file("sensitivity")
+    threads: threads("sensitivity")
     resources:
-        mem_mb=mem_mb("sensitivity_summary"),
-        runtime=runtime_min("sensitivity_summary"),
+        **W.resources("sensitivity"),
     params:
         scenarios=list(SCENARIOS),
-        placements=lambda wildcards: [placement_label(s) for s in SCENARIOS],
+        placements=lambda wildcards: [W.placement_label(s) for s in SCENARIOS],
     script:
-        "../scripts/sensitivity_summary.py"
+        "../scripts/sensitivity.py"

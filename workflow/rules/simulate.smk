@@ -1,64 +1,62 @@
-# Stage 1: close the hand on each object at every pose, and select the contacts that count.
+# Stage 1: search each object's placement, close the hand on it at every pose, and select
+# the contacts that count. Outputs, log, benchmark, threads and requests: synergrasp.steps.
 
 
-rule search_placement:
+rule search:
     input:
-        code=code("search_placement"),
+        code=W.code("search"),
         data=SHIPPED_DATA,
-        user=user_files,
+        user=W.user_files,
     output:
-        "{root}/objects/{object}/placement.csv",
+        **outputs("search"),
     log:
-        "{root}/logs/search_placement/{object}.log",
+        log_file("search"),
     benchmark:
-        "{root}/benchmarks/search_placement/{object}.tsv"
-    threads: 2
+        benchmark_file("search")
+    threads: threads("search")
     resources:
-        mem_mb=mem_mb("search_placement"),
-        runtime=runtime_min("search_placement"),
+        **W.resources("search"),
     params:
-        cfg=step_cfg("search"),
+        cfg=W.step_cfg("search"),
     script:
-        "../scripts/search_placement.py"
+        "../scripts/search.py"
 
 
-rule simulate_contacts:
+rule simulate:
     input:
-        code=code("simulate_contacts"),
+        code=W.code("simulate"),
         data=SHIPPED_DATA,
-        user=user_files,
-        search=searched_input,
+        user=W.user_files,
+        search=W.search_input(),
     output:
-        "{root}/objects/{object}/contacts.parquet",
+        **outputs("simulate"),
     log:
-        "{root}/logs/simulate_contacts/{object}.log",
+        log_file("simulate"),
     benchmark:
-        "{root}/benchmarks/simulate_contacts/{object}.tsv"
-    threads: 1
+        benchmark_file("simulate")
+    threads: threads("simulate")
     resources:
-        mem_mb=mem_mb("simulate_contacts"),
-        runtime=runtime_min("simulate_contacts"),
+        **W.resources("simulate"),
     params:
-        cfg=step_cfg("simulate"),
+        cfg=W.step_cfg("simulate"),
     script:
-        "../scripts/simulate_contacts.py"
+        "../scripts/simulate.py"
 
 
-rule select_contacts:
+rule contacts:
     input:
-        contacts=step_input("simulate"),
-        code=code("select_contacts"),
+        contacts=W.step_input("simulate"),
+        code=W.code("contacts"),
     output:
-        "{root}/objects/{object}/load_carrying_contacts.parquet",
+        **outputs("contacts"),
     log:
-        "{root}/logs/select_contacts/{object}.log",
+        log_file("contacts"),
     benchmark:
-        "{root}/benchmarks/select_contacts/{object}.tsv"
-    threads: 1
+        benchmark_file("contacts")
+    threads: threads("contacts")
     resources:
-        mem_mb=mem_mb("select_contacts"),
-        runtime=runtime_min("select_contacts"),
+        **W.resources("contacts"),
     params:
-        cfg=step_cfg("contacts"),
+        cfg=W.step_cfg("contacts"),
     script:
-        "../scripts/select_contacts.py"
+        "../scripts/contacts.py"

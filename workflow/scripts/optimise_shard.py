@@ -4,7 +4,7 @@ from synergrasp import tables
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.study import OptimiseParams, optimise_shard
+from synergrasp.optimisation.optimise import OptimiseParams, optimise_shard
 
 with job_log(snakemake.log[0]):
     opt = OptimiseParams.from_config(snakemake.params.cfg, snakemake.wildcards.object)

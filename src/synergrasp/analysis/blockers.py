@@ -25,7 +25,7 @@ from synergrasp.ids import incremental_set_id, set_id
 from synergrasp.optimisation.blocking import Blocking, blocking_contacts
 from synergrasp.optimisation.mechanics import Grasp, first_same_grasp, internal_force_basis, read_grasps
 from synergrasp.optimisation.problem import GFOProblem
-from synergrasp.optimisation.study import GFOParams, mechanics_for
+from synergrasp.optimisation.optimise import GFOParams, mechanics_for
 from synergrasp.simulation.opposition import (FACE_CLASSES, LINK_KINDS, SURFACE_FEATURES, HandAxes, OppositionRule,
                                               face_classes, surface_features)
 

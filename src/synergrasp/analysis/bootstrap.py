@@ -110,10 +110,6 @@ class PoseResampler:
         out = self._block_weights[obj] @ per_block
         return out[:, 0] if values.ndim == 1 else out
 
-    def on_distinct(self, obj: str, frame: pd.DataFrame, column: str, fill: float = 0.0) -> NDArray:
-        """``frame``'s ``column`` (indexed by pose) at ``obj``'s distinct poses, ``fill`` where absent."""
-        return frame[column].reindex(self._poses[obj]).fillna(fill).to_numpy(float)
-
 
 def weighted_median(values: NDArray, weights: NDArray) -> NDArray:
     """Median of ``values`` (n,) under each row of ``weights`` (r, n) (≥ 0): the mean of the

@@ -19,7 +19,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp.analysis.intervals import VIEWS, StudyCounts, mean_defined
-from synergrasp.ids import incremental_set_id, set_id
+from synergrasp.ids import incremental_set_id, set_id, set_members
 
 __all__ = ["HOLDS", "FAILS", "UNDEFINED", "VerdictRules", "Difference", "interval_verdict", "claims_table",
            "CLAIM_COLUMNS"]
@@ -99,7 +99,7 @@ def _decide(d: Difference, min_poses: int) -> tuple[str, str]:
 
 
 def _label(sid: str) -> str:
-    return "{" + ",".join(f"S{i}" for i in sid.split("-")) + "}"
+    return "{" + ",".join(f"S{i}" for i in set_members(sid)) + "}"
 
 
 def _fmt(values: NDArray, counts: StudyCounts, unit: str = "%") -> str:

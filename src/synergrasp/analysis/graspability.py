@@ -20,7 +20,7 @@ from __future__ import annotations
 import pandas as pd
 
 from synergrasp.analysis.verdicts import verdict_columns
-from synergrasp.ids import set_name
+from synergrasp.ids import set_members, set_name
 from synergrasp.tables import GRASPABLE_OBJECTS
 
 __all__ = ["graspable_objects", "ungraspable_lines"]
@@ -34,7 +34,7 @@ def _counts(statuses: pd.Series) -> str:
 
 
 def _set_name(set_id: str) -> str:
-    return set_name(int(i) for i in set_id.split("-"))
+    return set_name(set_members(set_id))
 
 
 def _reason(rows: pd.DataFrame, n_fc: int, dynamic: bool, full_set_id: str) -> str:

@@ -22,6 +22,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp.analysis.bootstrap import PoseResampler, interval, weighted_median
+from synergrasp.ids import set_order
 
 __all__ = ["VIEWS", "StudyCounts", "mean_defined"]
 
@@ -48,7 +49,7 @@ class StudyCounts:
         self.resampler = resampler
         self.full = full_set_id
         self.sets: list[str] = sorted(table["set_id"].astype(str).unique(),
-                                      key=lambda s: (len(s.split("-")), tuple(int(x) for x in s.split("-"))))
+                                      key=set_order)
         self.objects = resampler.objects
         self._success: dict[str, NDArray] = {}
         self._force: dict[str, NDArray] = {}

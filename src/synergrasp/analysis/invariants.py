@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from synergrasp.analysis.periods import period_violations
+from synergrasp.ids import set_members
 
 __all__ = ["InvariantError", "InvariantWarning", "check_success_rates", "superset_inconsistencies", "invariant_checks"]
 
@@ -57,7 +58,7 @@ def superset_inconsistencies(table: pd.DataFrame, column: str = "success") -> pd
     rows = []
     for obj, own in table.groupby("object", sort=True):
         wide = own.pivot(index="pose", columns="set_id", values=column)
-        members = {s: frozenset(s.split("-")) for s in wide.columns}
+        members = {s: frozenset(set_members(s)) for s in wide.columns}
         values = {s: wide[s].fillna(False).to_numpy(bool) for s in wide.columns}
         for small, small_set in members.items():
             for big, big_set in members.items():

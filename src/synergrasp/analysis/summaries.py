@@ -23,8 +23,9 @@ from synergrasp.analysis.invariants import invariant_checks
 from synergrasp.analysis.minima import preserved
 from synergrasp.analysis.periods import distinct_pose_mask, object_periods
 from synergrasp.analysis.verdicts import with_verdicts
-from synergrasp.config import ConfigError, build, overlay
-from synergrasp.ids import incremental_set_id, set_id
+from synergrasp.config import ConfigError, build
+from synergrasp.ids import incremental_set_id, set_id, set_members, set_order
+from synergrasp.resolved import effective_placement, weight_N
 
 __all__ = [
     "AnalysisSettings",
@@ -51,7 +52,7 @@ ALL_OBJECTS = "all"
 
 def set_sort_key(set_ids: pd.Series) -> pd.Series:
     """Sort key of set ids: by size, then by the synergy indices ("1-2" < "1-10" < "1-2-3")."""
-    return set_ids.map(lambda s: (len(s.split("-")), tuple(int(x) for x in s.split("-"))))
+    return set_ids.map(set_order)
 
 
 def _require(table: pd.DataFrame, name: str, columns: Iterable[str]) -> None:
@@ -101,8 +102,8 @@ class TablesParams:
     def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> TablesParams:
         """From a configuration or the step's own part of it (``obj`` is not read): the
         objects' weights m·g and α-periods (from their boxes, placements and the grid)."""
-        analyses, g = config["analyses"], config["mechanics"]["g_m_per_s2"]
-        objects = {name: {**spec, "placement": overlay(config["placement"], spec.get("placement"))}
+        analyses = config["analyses"]
+        objects = {name: {**spec, "placement": effective_placement(config, name)}
                    for name, spec in config["objects"].items()}
         try:
             periods_deg = object_periods(objects, config["grid"], config["hand"])
@@ -117,7 +118,7 @@ class TablesParams:
             rules=build(VerdictRules, "analyses", rate_points=float(analyses["tie_band"]["rate_points"]),
                         force_relative=float(analyses["tie_band"]["force_relative"]),
                         min_distinct_poses=int(analyses["min_distinct_poses"]), headline_view=analyses["headline_view"]),
-            weights_N={name: float(spec["mass_kg"]) * float(g) for name, spec in objects.items()},
+            weights_N={name: weight_N(config, name) for name in objects},
             periods_deg=periods_deg)
         return cls(dict(config["synergy_sets"]), int(analyses["table2_k_max"]), settings)
 
@@ -164,7 +165,7 @@ def success_rates(table: pd.DataFrame, full_set_id: str, periods_deg: Mapping[st
     """
     _require(table, "gfo table", ("object", "set_id", "n_synergies", "pose", "alpha_deg", "success",
                                   "verdict_force_closure", "verdict_load_feasible", "success_force"))
-    present = sorted(table["set_id"].unique(), key=lambda s: (len(s.split("-")), s))
+    present = sorted(table["set_id"].unique(), key=lambda s: (len(set_members(s)), s))
     if full_set_id not in present:
         raise ValueError(f"full_set_id {full_set_id!r} is not in the gfo table; allowed values: {present}")
     distinct = _distinct_poses(table, periods_deg or {})

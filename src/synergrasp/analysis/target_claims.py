@@ -27,7 +27,7 @@ from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.ids import synergy_sets
 from synergrasp.optimisation.placement_search import SearchStepParams, TargetScorer, full_synergy_set, pose_subset
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.study import gfo_table
+from synergrasp.optimisation.optimise import gfo_table
 
 __all__ = ["TargetClaimsParams", "ClaimsAtTargets", "claims_at_target", "claims_at_targets", "claims_summary"]
 

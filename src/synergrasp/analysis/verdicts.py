@@ -32,6 +32,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from synergrasp.ids import set_members
+from synergrasp.resolved import weight_N
+
 __all__ = ["VERDICTS", "verdict_columns", "with_verdicts", "force_bound"]
 
 #: The success verdicts the tables can use (config ``analyses.success``).
@@ -63,8 +66,8 @@ def force_lower_bound(table: pd.DataFrame, rows: np.ndarray) -> np.ndarray:
     set_ids, forces = table["set_id"].astype(str).to_numpy(), table["force_norm"].to_numpy(float)
     for i in np.flatnonzero(rows):
         here = groups[(table["object"].iat[i], table["pose"].iat[i])]
-        members = frozenset(set_ids[i].split("-"))
-        bigger = np.array([members < frozenset(set_ids[j].split("-")) for j in here], dtype=bool)
+        members = frozenset(set_members(set_ids[i]))
+        bigger = np.array([members < frozenset(set_members(set_ids[j])) for j in here], dtype=bool)
         found = forces[here[bigger]]
         bound[i] = np.nanmax(found) if np.isfinite(found).any() else np.nan
     return bound
@@ -128,5 +131,4 @@ def force_bound(config: Mapping[str, Any], obj: str) -> dict[str, Any]:
     analyses = config["analyses"]
     if analyses["success"] != "force_closure_bounded":
         return {}
-    weight = float(config["objects"][obj]["mass_kg"]) * float(config["mechanics"]["g_m_per_s2"])
-    return {"weight_N": weight, "bound_multiple": float(analyses["marginal_weight_multiple"])}
+    return {"weight_N": weight_N(config, obj), "bound_multiple": float(analyses["marginal_weight_multiple"])}

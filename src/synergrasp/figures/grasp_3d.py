@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 from synergrasp.file_output import replacing_folder
 from synergrasp.figures.hand_pictures import ABOVE_CAMERA, BOX, PALM_CAMERA, SKIN, ShapeInPicture, hand_shapes
 from synergrasp.ids import set_name
-from synergrasp.optimisation.study import GFOParams
+from synergrasp.optimisation.optimise import GFOParams
 from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions
 from synergrasp.simulation.shapes.surface import Surface, frame_along, merge_meshes, placed, revolution_mesh
@@ -279,7 +279,7 @@ def fig2_scenes(hand: Any, synergy_matrix: NDArray, params: Grasps3dParams,
     from synergrasp.figures.hand_figures import FIG2_GRASPS, object_of
     from synergrasp.optimisation.problem import SynergySets
     from synergrasp.optimisation.mechanics import read_grasps
-    from synergrasp.optimisation.study import optimise_grasps
+    from synergrasp.optimisation.optimise import optimise_grasps
 
     sets = SynergySets(np.asarray(synergy_matrix, dtype=float), (params.full_set,))
     name_of_set = set_name(params.full_set)

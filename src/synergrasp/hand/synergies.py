@@ -5,7 +5,7 @@ A synergy file is a CSV with one row per hand joint and the columns ``joint``,
 unit of the synergy coordinate σ). The shipped tables, by name (:data:`SHIPPED_TABLES`),
 ``data/synergies_<name>.csv``, are generated from the human synergies
 (``data/santello_synergies_20dof.csv``) and the mappings ``data/synergy_mapping_<name>.yaml``
-by :func:`map_human_synergies`; regenerate them with ``python -m synergrasp.hand.synergies``.
+by :func:`map_human_synergies`; regenerate them with ``tools/synergy_tables.py``.
 """
 
 from __future__ import annotations
@@ -404,8 +404,3 @@ def write_synergies(synergies: Synergies, path: str | Path) -> None:
     table.insert(0, "joint", list(synergies.joint_names))
     table.to_csv(path, index=False, float_format="%.17g", lineterminator="\n")
 
-
-if __name__ == "__main__":
-    for table in SHIPPED_TABLES:
-        write_synergies(map_human_synergies(load_human_synergies(), load_synergy_mapping(table)), shipped_path(table))
-        print(f"wrote {shipped_path(table)}")

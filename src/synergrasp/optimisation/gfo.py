@@ -4,7 +4,7 @@ In the style of `scipy.optimize.linprog`: the problems (`problem.GFOProblem` or,
 grasp and many synergy sets, `problem.GraspSets`) carry their friction-cone model; the
 method picks the back end; every back end returns one `problem.GFOSolution`.
 
-- "ipm": the compiled interior-point kernel (`ipm_kernel`), circular and pyramid cones; the
+- "ipm": the compiled interior-point kernel (`ipm.solver`), circular and pyramid cones; the
   problems it leaves undecided are solved again by Clarabel and marked 'clarabel_fallback'
   (nothing is dropped).
 - "clarabel": Clarabel per problem (`clarabel_solver`), the exact reference of the study.
@@ -18,9 +18,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from synergrasp.optimisation import clarabel_solver, cvxpy_reference, ipm_kernel, piqp_solver
+from synergrasp.optimisation import clarabel_solver, cvxpy_reference, piqp_solver
+from synergrasp.optimisation.ipm import solver as ipm_solver
 from synergrasp.optimisation.cones import CircularCone
-from synergrasp.optimisation.ipm_kernel import IPMSettings
+from synergrasp.optimisation.ipm.solver import IPMSettings
 from synergrasp.optimisation.mechanics import contact_frames
 from synergrasp.optimisation.problem import (
     ALMOST_SOLVED_TOL,
@@ -120,7 +121,7 @@ def _ipm_one(sol: GFOSolution, k: int, problem: GFOProblem, shrink: float | None
         if shrink is not None:
             sol.strict_internal[k] = _strict_fallback(problem, shrink, tol, max_iter)
         return
-    res = ipm_kernel.solve_problem(contact_frames(problem.normals), problem.E, problem.f_p, problem.cone,
+    res = ipm_solver.solve_problem(contact_frames(problem.normals), problem.E, problem.f_p, problem.cone,
                                    problem.cone.narrowed(shrink) if shrink is not None else None, problem.f_min, ipm,
                                    ALMOST_SOLVED_TOL)
     status, iters = _STATUS_OF_CODE[res.code[0]], int(res.iterations[0])
@@ -134,7 +135,7 @@ def _ipm_one(sol: GFOSolution, k: int, problem: GFOProblem, shrink: float | None
         _fallback(sol, k, problem, tol, max_iter)
     if shrink is not None:
         code = res.strict_code[0]
-        sol.strict_internal[k] = (code == ipm_kernel.OPTIMAL if code in (ipm_kernel.OPTIMAL, ipm_kernel.INFEASIBLE)
+        sol.strict_internal[k] = (code == ipm_solver.OPTIMAL if code in (ipm_solver.OPTIMAL, ipm_solver.INFEASIBLE)
                                   else _strict_fallback(problem, shrink, tol, max_iter))
 
 
@@ -144,23 +145,23 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
     P, S = g.projector, g.synergies
     thresholds = g.basis_rtol * g.response_norm * S.norms
     strict = shrink is not None
-    res = ipm_kernel.solve_sets(P @ S.matrix, g.f_p, contact_frames(g.normals), S.table, S.sizes, thresholds,
-                                ipm_kernel.Nesting(S.parent, S.within, S.order), g.cone,
+    res = ipm_solver.solve_sets(P @ S.matrix, g.f_p, contact_frames(g.normals), S.table, S.sizes, thresholds,
+                                ipm_solver.Nesting(S.parent, S.within, S.order), g.cone,
                                 g.cone.narrowed(shrink) if strict else None, g.f_min, ipm, ALMOST_SOLVED_TOL)
     n = len(g)
     status = _STATUS_OF_CODE[res.code]
-    optimal = res.code == ipm_kernel.OPTIMAL
+    optimal = res.code == ipm_solver.OPTIMAL
     forces = np.full(n, None, dtype=object)
     for j in np.flatnonzero(optimal).tolist():
         forces[j] = res.forces[j]
     sol = GFOSolution(status=status, force_norm=np.where(optimal, res.force_norm, np.nan), forces=forces,
                       e_s=res.e_s.astype(np.int32), iterations=res.iterations,
-                      strict_internal=res.strict_code == ipm_kernel.OPTIMAL if strict else None,
+                      strict_internal=res.strict_code == ipm_solver.OPTIMAL if strict else None,
                       solver=np.where(res.implied, "implied", "ipm").astype(object), max_violation=np.where(optimal, res.max_violation, np.nan))
-    for j in np.flatnonzero((res.code == ipm_kernel.UNDECIDED) | (res.code == ipm_kernel.NOT_SOLVED)):  # status ''
+    for j in np.flatnonzero((res.code == ipm_solver.UNDECIDED) | (res.code == ipm_solver.NOT_SOLVED)):  # status ''
         _fallback(sol, j, g.problem(j), tol, max_iter)
     if strict:
-        undecided = (res.strict_code != ipm_kernel.OPTIMAL) & (res.strict_code != ipm_kernel.INFEASIBLE) & (res.e_s > 0)
+        undecided = (res.strict_code != ipm_solver.OPTIMAL) & (res.strict_code != ipm_solver.INFEASIBLE) & (res.e_s > 0)
         for j in np.flatnonzero(undecided):
             sol.strict_internal[j] = _strict_fallback(g.problem(j), shrink, tol, max_iter)
     return sol
@@ -171,7 +172,7 @@ def warm_up() -> None:
     (`ipm.compiled.cache_dir()`: per user, named by the hash of the kernel's sources, so any
     checkout of the same kernel loads it). Called once after installation (Makefile) so that
     no workflow job pays the compilation (docs/measurements) and parallel jobs do not compile
-    side by side. Both entry points (`ipm_kernel.solve_problem`, `ipm_kernel.solve_sets`)
+    side by side. Both entry points (`ipm_solver.solve_problem`, `ipm_solver.solve_sets`)
     are one compiled function; one pose with the strict test compiles all of it.
     """
     normals = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])

@@ -26,6 +26,7 @@ __all__ = [
     "grasp_mechanics",
     "internal_force_basis",
     "object_wrench",
+    "weight_wrench",
     "read_grasps",
     "same_grasp",
 ]
@@ -209,8 +210,15 @@ def object_wrench(mass_kg: float, gravity_direction: NDArray, g: float = 9.81) -
     norm = np.linalg.norm(d) if d.shape == (3,) else 0.0
     if d.shape != (3,) or not np.isfinite(norm) or norm == 0.0:
         raise ValueError(f"gravity_direction must be a non-zero finite 3-vector, got {gravity_direction!r}")
+    return weight_wrench(mass_kg * g, d)
+
+
+def weight_wrench(weight_N: float, gravity_direction: NDArray) -> NDArray:
+    """Wrench w_e (6,) the contacts must apply against a weight of ``weight_N`` (N) along
+    ``gravity_direction`` (normalised here): [-W ĝ; 0] (N, N·mm)."""
+    d = np.asarray(gravity_direction, dtype=float)
     w = np.zeros(6)
-    w[:3] = -mass_kg * g * d / norm
+    w[:3] = -weight_N * d / np.linalg.norm(d)
     return w
 
 

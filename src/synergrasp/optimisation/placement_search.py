@@ -28,10 +28,11 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp import tables
-from synergrasp.config import build, dataclass_fields, overlay
+from synergrasp.config import build, dataclass_fields
+from synergrasp.resolved import effective_placement
 from synergrasp.optimisation.problem import SynergySets
 from synergrasp.optimisation.mechanics import read_grasps
-from synergrasp.optimisation.study import GFOParams, optimise_grasps
+from synergrasp.optimisation.optimise import GFOParams, optimise_grasps
 from synergrasp.simulation.contacts import contacts_row, contacts_table
 from synergrasp.simulation.closure_params import ClosureParams
 from synergrasp.simulation.objects import GraspedObject
@@ -117,7 +118,7 @@ class SearchStepParams:
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> SearchStepParams:
         """From a configuration or the step's own part of it, for the object ``obj``."""
-        placement = overlay(config["placement"], config["objects"][obj].get("placement"))
+        placement = effective_placement(config, obj)
         spec = placement["search"]
         grasp_type = config["objects"][obj]["grasp_type"]
         region = tuple(tuple(spec["region_mm"][grasp_type][axis]) for axis in ("x", "y", "z"))
@@ -283,7 +284,7 @@ class TargetScorer:
         table = self.contacts(target_mm)
         out = optimise_grasps(read_grasps(table), self.full_set, self.gfo)
         fc = np.asarray(out["strict_internal"], dtype=bool) & (np.asarray(out["rank_G"]) == 6)
-        weight = self.gfo.mass_kg * self.gfo.g_m_per_s2
+        weight = self.gfo.weight_N
         if self.rule is None:
             raise ValueError("TargetScorer: scoring reads the grasps' opposition: give the opposition rule")
         typed = [of_grasp_type(o, self.grasp_type) for o in contacts_oppositions(table, self.axes, self.rule)]

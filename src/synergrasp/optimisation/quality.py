@@ -168,13 +168,13 @@ class QualityParams:
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> QualityParams:
         from synergrasp.ids import incremental_set_id
+        from synergrasp.resolved import friction_mu, weight_N
         from synergrasp.simulation.objects import GraspedObject
 
         grasped = GraspedObject.from_config(config, obj)
-        return cls(config["hand"], config["synergies"], float(config["mechanics"]["mu"]),
+        return cls(config["hand"], config["synergies"], friction_mu(config),
                    incremental_set_id(config["synergy_sets"]["incremental_max"]),
-                   float(grasped.mass_kg) * float(config["mechanics"]["g_m_per_s2"]),
-                   grasped.shape.bounding_radius_mm, OppositionRule.from_config(config))
+                   weight_N(config, obj), grasped.shape.bounding_radius_mm, OppositionRule.from_config(config))
 
 
 def quality_table(contacts: pd.DataFrame, gfo: pd.DataFrame, grasps: Sequence[Grasp | None],

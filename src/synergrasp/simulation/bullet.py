@@ -81,17 +81,6 @@ def disconnect(client: int) -> None:
     pb.disconnect(physicsClientId=client)
 
 
-def load_hand_body(client: int, hand: Hand) -> HandBody:
-    """Load ``hand`` (generated URDF) as a fixed-base body at the origin, posture q = 0."""
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "hand.urdf"
-        write_urdf(hand, path)
-        body = pb.loadURDF(str(path), basePosition=[0, 0, 0], baseOrientation=[0, 0, 0, 1],
-                           useFixedBase=True, flags=pb.URDF_USE_INERTIA_FROM_FILE,
-                           physicsClientId=client)
-    return _hand_body(client, body, hand)
-
-
 def set_posture(client: int, body: HandBody, q: NDArray) -> None:
     """Put the hand at joint angles q (19, rad) instantly (no dynamics)."""
     q = np.asarray(q, dtype=float)
@@ -100,56 +89,6 @@ def set_posture(client: int, body: HandBody, q: NDArray) -> None:
     values = body.joint_scale * q[body.joint_q]
     pb.resetJointStatesMultiDof(body.body, body.joint_indices.tolist(),
                                 [[float(v)] for v in values], physicsClientId=client)
-
-
-def joint_positions(client: int, body: HandBody) -> NDArray[np.float64]:
-    """Current pybullet joint positions of every elementary axis (rad), HandBody order."""
-    states = pb.getJointStates(body.body, body.joint_indices.tolist(), physicsClientId=client)
-    return np.array([s[0] for s in states])
-
-
-def link_frames(client: int, body: HandBody) -> NDArray[np.float64]:
-    """(n_links, 4, 4) hand link frames as pybullet has them, palm frame, mm (single precision)."""
-    states = pb.getLinkStates(body.body, body.link_index[1:].tolist(), computeForwardKinematics=1,
-                              physicsClientId=client)
-    pos = np.array([s[4] for s in states]) / MM
-    x, y, z, w = np.array([s[5] for s in states]).T  # pybullet quaternions (x, y, z, w)
-    out = np.zeros((body.hand.n_links, 4, 4))
-    out[:, 3, 3] = 1.0
-    out[0, :3, :3] = np.eye(3)
-    out[1:, :3, :3] = np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=-1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=-1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=-1),
-    ], axis=1)
-    out[1:, :3, 3] = pos
-    return out
-
-
-def bullet_jacobian(client: int, body: HandBody, q: NDArray, link: int, point_mm: NDArray) -> NDArray[np.float64]:
-    """(3, 19) translational Jacobian of a point of hand link ``link`` from pybullet, mm/rad.
-
-    ``point_mm`` in the palm frame. Independent check of ``hand.point_jacobian``: pybullet's
-    per-axis columns are summed per joint with the half-angle weights.
-    """
-    hand = body.hand
-    if link == 0:
-        return np.zeros((3, hand.n_joints))
-    set_posture(client, body, q)
-    frame = link_frames(client, body)[link]
-    local = frame[:3, :3].T @ (np.asarray(point_mm, dtype=float) - frame[:3, 3])
-    n = pb.getNumJoints(body.body, physicsClientId=client)
-    positions = [0.0] * n
-    values = body.joint_scale * np.asarray(q, dtype=float)[body.joint_q]
-    for j, v in zip(body.joint_indices, values):
-        positions[int(j)] = float(v)
-    lin, _ = pb.calculateJacobian(body.body, int(body.link_index[link]), (local * MM).tolist(),
-                                  positions, [0.0] * n, [0.0] * n, physicsClientId=client)
-    lin = np.array(lin)  # (3, n) m/rad, columns in pybullet joint order
-    jac = np.zeros((3, hand.n_joints))
-    for j, qi, s in zip(body.joint_indices, body.joint_q, body.joint_scale):
-        jac[:, qi] += s * lin[:, j] / MM
-    return jac
 
 
 def collision_shape(client: int, shape: Any) -> int:
@@ -180,17 +119,6 @@ def _exact_surface(client: int, body: int, shape: Any) -> None:
     primitives keep their own surface): contacts lie on the shape's surface."""
     if shape.collision_geometry()[0] == "convex_parts":
         pb.changeDynamics(body, -1, collisionMargin=0.0, physicsClientId=client)
-
-
-def load_object(client: int, shape: Any, center_mm: NDArray, rotation: NDArray | None = None) -> int:
-    """A static body of ``shape`` (``synergrasp.simulation.shapes``) centred at ``center_mm``
-    (palm frame), oriented by the 3 × 3 rotation matrix ``rotation`` (identity if None).
-    Returns its body id."""
-    body = pb.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=collision_shape(client, shape),
-                              physicsClientId=client)
-    _exact_surface(client, body, shape)
-    move_body(client, body, center_mm, rotation)
-    return body
 
 
 def move_body(client: int, body: int, center_mm: NDArray, rotation: NDArray | None = None) -> None:

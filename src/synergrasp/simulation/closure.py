@@ -20,7 +20,8 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from synergrasp.config import build, dataclass_fields, overlay
+from synergrasp.config import build, dataclass_fields
+from synergrasp.resolved import effective_placement
 from synergrasp.hand.synergies import Synergies, synergy_values
 from synergrasp.simulation.closure_params import ClosureMechanics, ClosureParams, DynamicParams
 from synergrasp.simulation.contacts import ClosureResult, contacts_row, contacts_table
@@ -63,7 +64,7 @@ class SimulateParams:
         return cls(
             hand=config["hand"], mean_rad=tuple(values["mean_rad"]), s1=tuple(values["S1"]),
             object=GraspedObject.from_config(config, obj, with_mass=dynamic_model),
-            placement=Placement.from_config(overlay(config["placement"], config["objects"][obj].get("placement")),
+            placement=Placement.from_config(effective_placement(config, obj),
                                             config["grid"]),
             closure=build(ClosureParams, "closure", **{**dataclass_fields(ClosureParams, closure), "dynamic": dynamic}),
             mechanics=build(ClosureMechanics, "mechanics", **dataclass_fields(ClosureMechanics, config["mechanics"]))

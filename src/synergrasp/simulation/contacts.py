@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -30,7 +29,6 @@ __all__ = [
     "closure_result",
     "contacts_row",
     "contacts_table",
-    "write_contacts",
     "ContactsParams",
     "load_carrying_contacts",
 ]
@@ -141,11 +139,6 @@ def contacts_table(rows: list[dict[str, Any]]) -> pd.DataFrame:
     for col in ("pose", "n_contacts"):
         table[col] = table[col].astype(np.int32)
     return table
-
-
-def write_contacts(table: pd.DataFrame, path: str | Path) -> None:
-    """Write a contacts table to Parquet with the exact column types of ``tables.CONTACTS``."""
-    tables.write(tables.CONTACTS, table, path)
 
 
 @dataclass(frozen=True)

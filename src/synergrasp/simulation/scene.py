@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from synergrasp.simulation.capsules import HandCapsules, capsule_object, nearest_per_link, pair_gaps
+from synergrasp.simulation.capsules import HandCapsules, capsule_object, pair_gaps
 from synergrasp.simulation.placement import ObjectPose
 from synergrasp.simulation.shapes.box import box_gap, box_samples
 
@@ -194,17 +194,6 @@ class HandScene:
         ends, first, second = self._pair_rows(pairs)
         c = self.capsules
         return first, second, ends, c.palm_rotation, c.palm_centre, c.palm_half, self.hand.n_links
-
-    def self_distance(self, pairs: tuple[tuple[int, int], ...], margin_mm: float = np.inf) -> tuple[NDArray, NDArray]:
-        """Per link, the distance (mm, negative = overlap; +inf beyond ``margin_mm``) to the
-        nearest link it is paired with in ``pairs`` at the current posture, and that link
-        (-1 where none): two (n_links,) arrays."""
-        if not pairs:
-            return np.full(self.hand.n_links, np.inf), np.full(self.hand.n_links, -1)
-        ends, _, _ = self._pair_rows(pairs)
-        d, partner = nearest_per_link(self.pair_distances(pairs), ends, self.hand.n_links)
-        d[d > margin_mm] = np.inf
-        return d, partner
 
     def object_contacts(self, q: NDArray, contact_distance_mm: float) -> tuple[NDArray, NDArray, NDArray, float]:
         """One contact per hand link within ``contact_distance_mm`` of the object at posture q:

@@ -2,4 +2,4 @@
 (`compiled`), its data layout (`layout`), cone algebra (`cone_algebra`), linear systems
 (`linear_systems`), stopping tests and certificates (`certificates`), the iteration
 (`iteration`) and the compiled call per pose (`sets`). The front door is
-`synergrasp.optimisation.ipm_kernel`."""
+`synergrasp.optimisation.ipm.solver`."""

@@ -27,7 +27,7 @@ __all__ = ["set_bases", "solve_sets"]
 @jit_alloc
 def build(rows, lin, E, fp, e, mu, f_min, W):
     """The problem of cone rows (m, 3, 3) (`cone_rows`), linear rows lin (m, p, 3)
-    (`ipm_kernel.cone_data`: p = 0 for the circular cone, whose Coulomb cones are SOCs; a pyramid's
+    (`ipm.solver.cone_data`: p = 0 for the circular cone, whose Coulomb cones are SOCs; a pyramid's
     [n; -a_1; ...] with the normal bound first, the kernel's nonnegative block in this
     order), basis E (3m, >= e; its first e columns) and f_p (3m,) N, its data written into W."""
     m, p = rows.shape[0], lin.shape[1]

@@ -4,7 +4,6 @@ from synergrasp import tables
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.job_log import job_log
 from synergrasp.simulation.closure import SimulateParams, simulate_object
-from synergrasp.simulation.contacts import write_contacts
 from synergrasp.simulation.placement import searched_placement
 
 with job_log(snakemake.log[0]):
@@ -15,4 +14,4 @@ with job_log(snakemake.log[0]):
         placement = searched_placement(placement, tables.read_csv(tables.PLACEMENT, snakemake.input.search))
     table = simulate_object(hand, sim.synergies(hand.joint_names), sim.object, placement, sim.closure,
                             mechanics=sim.mechanics)
-    write_contacts(table, snakemake.output[0])
+    tables.write(tables.CONTACTS, table, snakemake.output[0])

@@ -15,11 +15,11 @@ from synergrasp.ids import synergy_sets
 from synergrasp import tables
 from synergrasp.optimisation.cones import PyramidCone
 from synergrasp.optimisation.gfo import solve_gfo
-from synergrasp.optimisation.ipm_kernel import IPMSettings
+from synergrasp.optimisation.ipm.solver import IPMSettings
 from synergrasp.optimisation.problem import GraspSets, SynergySets
 from grasp_problems import random_grasp, random_synergies
 from synergrasp.optimisation.shards import merge_shards, shard_positions
-from synergrasp.optimisation.study import mechanics_for, optimise_grasps
+from synergrasp.optimisation.optimise import mechanics_for, optimise_grasps
 
 RTOL_NORM = 1e-4
 PARAMS = study_gfo_params(gravity_direction=(0.0, 0.0, -1.0))
@@ -149,7 +149,7 @@ def test_first_same_grasp_points_each_grasp_at_the_first_of_its_kind():
 
 
 def test_gfo_table_solves_one_grasp_once_whatever_the_shards(monkeypatch):
-    from synergrasp.optimisation import study
+    from synergrasp.optimisation import optimise
 
     rng = np.random.default_rng(8)
     a, b = random_grasp(rng, 6), random_grasp(rng, 7, palm_contacts=1)
@@ -157,12 +157,12 @@ def test_gfo_table_solves_one_grasp_once_whatever_the_shards(monkeypatch):
     sets = SynergySets(random_synergies(rng), tuple(tuple(range(1, k + 1)) for k in (1, 3, 7, 15)))
     contacts = _contacts_of(grasps)
     solved = []
-    real = study.optimise_grasps
-    monkeypatch.setattr(study, "optimise_grasps",
+    real = optimise.optimise_grasps
+    monkeypatch.setattr(optimise, "optimise_grasps",
                         lambda gs, *args, **kw: solved.append(sum(g is not None for g in gs)) or real(gs, *args, **kw))
-    whole = study.gfo_table(contacts, sets, PARAMS)
+    whole = optimise.gfo_table(contacts, sets, PARAMS)
     assert solved == [3]
-    sharded = merge_shards([study.optimise_shard(contacts, k, 4, sets, PARAMS) for k in range(4)])
+    sharded = merge_shards([optimise.optimise_shard(contacts, k, 4, sets, PARAMS) for k in range(4)])
     assert solved == [3, 1, 1, 1, 0]  # the shards split the distinct grasps; the fourth has none left
     # bit for bit (an empty shard leaves the string columns' dtype to pandas' concat)
     pd.testing.assert_frame_equal(sharded, whole, check_exact=True, check_dtype=False)

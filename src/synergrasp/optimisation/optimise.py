@@ -21,7 +21,7 @@ from synergrasp.config import build, dataclass_fields
 from synergrasp.ids import set_id, synergy_sets
 from synergrasp.optimisation.cones import FrictionCone, cone_model
 from synergrasp.optimisation.gfo import FASTEST_METHOD, solve_gfo
-from synergrasp.optimisation.ipm_kernel import IPMSettings
+from synergrasp.optimisation.ipm.solver import IPMSettings
 from synergrasp.optimisation.mechanics import (
     BASIS_RTOL,
     GRASP_RANK_RTOL,
@@ -30,10 +30,11 @@ from synergrasp.optimisation.mechanics import (
     first_same_grasp,
     grasp_mechanics,
     read_grasps,
-    object_wrench,
+    weight_wrench,
 )
 from synergrasp.optimisation.problem import DEFAULT_TOL, STRICT_SHRINK, GraspSets, SynergySets
 from synergrasp.optimisation.shards import shard_positions
+from synergrasp import resolved
 
 __all__ = ["GFOParams", "OptimiseParams", "gfo_table", "mechanics_for", "optimise_grasps", "optimise_shard"]
 
@@ -51,7 +52,7 @@ class GFOParams:
     friction_cone: the friction-cone model, one of cones.CONE_MODELS ('circular', the exact
         Coulomb cone; the pyramids), both solved by the compiled interior-point kernel
     k_stru_N_per_mm: structural contact stiffness, N/mm; k_ss_Nmm_per_rad: joint stiffness, N·mm/rad
-    mass_kg, g_m_per_s2: the object's weight is mass_kg · g_m_per_s2, N
+    weight_N: the object's weight m·g, N (synergrasp.resolved.weight_N)
     basis_rtol: rank tolerance of E_s; grasp_rank_rtol: rank tolerance of G
     strict_shrink: relative narrowing of the cone in the strict internal-force test
     tol: Clarabel feasibility and gap tolerance; max_iter: its iteration cap
@@ -64,8 +65,7 @@ class GFOParams:
     friction_cone: str
     k_stru_N_per_mm: float
     k_ss_Nmm_per_rad: float
-    mass_kg: float
-    g_m_per_s2: float
+    weight_N: float
     basis_rtol: float = BASIS_RTOL
     grasp_rank_rtol: float = GRASP_RANK_RTOL
     strict_shrink: float = STRICT_SHRINK
@@ -80,10 +80,12 @@ class GFOParams:
         if norm == 0.0:
             raise ValueError(f"gravity_direction must be a finite non-zero 3-vector, got {self.gravity_direction!r}")
         object.__setattr__(self, "gravity_direction", tuple(float(v) for v in d / norm))
-        for name in ("mu", "f_min_N", "k_stru_N_per_mm", "k_ss_Nmm_per_rad", "mass_kg", "g_m_per_s2"):
+        for name in ("mu", "f_min_N", "k_stru_N_per_mm", "k_ss_Nmm_per_rad", "weight_N"):
             object.__setattr__(self, name, float(getattr(self, name)))
+        if not np.isfinite(self.weight_N) or self.weight_N < 0:
+            raise ValueError(f"weight_N must be a finite number >= 0, got {self.weight_N}")
         # once per parameters, not per grasp (the study's loop reads it for every pose)
-        wrench = object_wrench(self.mass_kg, np.asarray(self.gravity_direction), self.g_m_per_s2)
+        wrench = weight_wrench(self.weight_N, np.asarray(self.gravity_direction))
         wrench.setflags(write=False)
         object.__setattr__(self, "_wrench", wrench)
 
@@ -91,7 +93,7 @@ class GFOParams:
     def from_config(cls, config: Mapping[str, Any], obj: str) -> GFOParams:
         """The configuration's ``mechanics`` with the weight of the object ``obj``."""
         return build(cls, "mechanics", **dataclass_fields(cls, config["mechanics"]),
-                     mass_kg=float(config["objects"][obj]["mass_kg"]))
+                     weight_N=resolved.weight_N(config, obj))
 
     def wrench(self) -> NDArray:
         """w_e (6,) the contacts must apply against the weight, N and N·mm (read-only)."""

@@ -1,0 +1,175 @@
+"""synergrasp.wiring (what workflow/rules/*.smk wire) and synergrasp.resolved (the derived
+values every step reads), checked without Snakemake: paths and requests against cases written
+out by hand, the import scanner against a package made here."""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+import pytest
+
+from synergrasp.config import defaults, validate_config
+from synergrasp.ids import set_members, set_order
+from synergrasp.resolved import effective_placement, friction_mu, study_object, study_objects, weight_N
+from synergrasp.steps import rule_costs, step_config
+from synergrasp.wiring import RuleFiles, Wiring, cancel_scheduler_timers, code_files, job_size, mem_mb, report_archive, runtime_min
+
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+class _W(dict):
+    """Wildcards as Snakemake hands them: attributes and ``keys``/``get``."""
+
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+
+def test_a_rules_paths_follow_its_step_scope_and_wildcards():
+    fig4, shard, tables, fig3 = (RuleFiles(r) for r in ("fig4", "optimise_shard", "tables", "fig3"))
+    assert fig4.outputs()["maps_png"] == "{root}/objects/{object}/fig4_force_maps.png"
+    assert (fig4.log(), fig4.benchmark()) == ("{root}/logs/fig4/{object}.log", "{root}/benchmarks/fig4/{object}.tsv")
+    assert shard.outputs() == {"out": "{root}/objects/{object}/gfo_shards/{shard}.parquet"}
+    assert shard.log() == "{root}/logs/optimise_shard/{object}_{shard}.log"
+    assert tables.log() == "{root}/logs/tables.log" and fig3.benchmark() == "results/benchmarks/fig3.tsv"
+    assert fig4.report("maps_png") == {"caption": "../report/fig4_force_maps.rst", "category": "Fig. 4",
+                                       "subcategory": "{object}"}
+    assert fig4.report("maps_pdf") is None and tables.report("claims_csv")["category"] == "Tables"
+
+
+def test_snakemake_flags_go_where_the_registry_says():
+    def report(path, **entry):
+        return ("report", path, entry.get("caption"))
+
+    def directory(path):
+        return ("directory", path)
+
+    def temp(path):
+        return ("temp", path)
+
+    html = RuleFiles("fig2").snakemake_outputs(report, directory, temp, archive=False)
+    archive = RuleFiles("fig2").snakemake_outputs(report, directory, temp, archive=True)
+    assert html["pages"] == ("directory", "{root}/figures/grasps_3d")  # the one-file report refuses folders
+    assert archive["pages"][0] == "report" and archive["pages"][1] == ("directory", "{root}/figures/grasps_3d")
+    assert html["png"] == ("report", "{root}/figures/fig2_example_grasps.png", "../report/fig2.rst")
+    assert html["pdf"] == "{root}/figures/fig2_example_grasps.pdf"
+    assert RuleFiles("optimise_shard").snakemake_outputs(report, directory, temp, False) == {
+        "out": ("temp", "{root}/objects/{object}/gfo_shards/{shard}.parquet")}
+
+
+def test_job_size_and_requests_by_hand():
+    cfg = defaults()  # 72 x 25 = 1,800 poses, 75 sets, 4 objects, one shard, kinematic closure
+    assert job_size("simulate", cfg) == 1800 and job_size("optimise", cfg) == 1800 * 75
+    assert job_size("tables", cfg) == 4 * 1800 * 75 and job_size("fig1", cfg) == 0
+    dynamic = {**cfg, "closure": {**cfg["closure"], "model": "dynamic"}}
+    assert job_size("simulate", dynamic) == 1800 * 9.0
+    unknown = {**cfg, "closure": {**cfg["closure"], "model": "new_engine"}}
+    assert job_size("simulate", unknown) == 1800 * 20.0  # charged high until measured
+    # search: (80 s + 60 s compile) x 3 = 7 min; (700 + 150 MB) x 1.5 -> 1,300 MB
+    assert runtime_min("search", cfg) == 7 and mem_mb("search", cfg) == 1300
+    # simulate: (1.5 + 4.5e-3 x 1800) s x 3 = 28.8 s -> 1 min; (178 + 7.6e-3 x 1800) x 1.5 = 287.5 -> 300 MB
+    assert runtime_min("simulate", cfg) == 1 and mem_mb("simulate", cfg) == 300
+    assert rule_costs()["search"].threads == 2 and rule_costs()["simulate"].threads == 1
+
+
+def test_the_import_scanner_follows_lazy_imports_and_packages(tmp_path):
+    pkg = tmp_path / "synergrasp"
+    (pkg / "sub").mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "sub" / "__init__.py").write_text("")
+    (pkg / "sub" / "a.py").write_text("def f():\n    from synergrasp import b  # lazy\n")
+    (pkg / "b.py").write_text("import synergrasp.c, os\n")
+    (pkg / "c.py").write_text("from synergrasp.sub import (\n    a,\n)\n")
+    (pkg / "unused.py").write_text("")
+    script = tmp_path / "script.py"
+    script.write_text("from synergrasp.sub.a import f\n")
+    names = {p.relative_to(tmp_path).as_posix() for p in code_files(script, tmp_path)}
+    assert names == {"synergrasp/__init__.py", "synergrasp/sub/__init__.py", "synergrasp/sub/a.py",
+                     "synergrasp/b.py", "synergrasp/c.py"}
+
+
+@pytest.mark.parametrize("argv, archive", [
+    (["snakemake", "--report", "results/report.zip"], True),
+    (["snakemake", "--report=results/report.zip"], True),
+    (["snakemake", "--report", "results/report.html"], False),
+    (["snakemake", "-j2", "figures"], False),
+])
+def test_report_archive_reads_the_command_line(argv, archive):
+    assert report_archive(argv) is archive
+
+
+def test_scheduler_timers_are_cancelled():
+    timer = threading.Timer(60.0, lambda: None)
+    timer.start()
+    cancel_scheduler_timers()
+    timer.join(5.0)
+    assert not timer.is_alive()
+
+
+def _wiring(**changes):
+    """The wiring of the default configuration with ``changes`` (top-level keys) in this checkout."""
+    return Wiring({**defaults(), **changes}, ROOT, error=RuntimeError, warn=lambda text: None)
+
+
+def test_the_study_targets_and_a_step_not_made_hands_on_its_upstreams_file():
+    wiring = _wiring()
+    targets = wiring.study_targets()
+    assert "results/objects/obj1/placement.csv" in targets  # the default placement is searched
+    assert "results/figures/fig3_rulegraph.png" in targets and "results/sensitivity/claims.csv" not in targets
+    assert not any("target_claims" in t or "placement_claims" in t for t in targets)  # optional steps
+    # the kinematic closure selects no contact: the `contacts` step's input is the closure's table
+    assert wiring.step_file("default", "contacts", "obj1") == "results/objects/obj1/contacts.parquet"
+    assert wiring.step_input("search")(_W(root="results", object="obj1")) == "results/objects/obj1/placement.csv"
+
+
+def test_an_approach_placement_has_no_search_and_no_map():
+    config = defaults()
+    config["placement"]["mode"] = "approach"
+    wiring = _wiring(placement=config["placement"])
+    targets = wiring.object_targets("obj1")
+    assert not any(t.endswith(("placement.csv", "placement_map.png")) for t in targets)
+    assert wiring.step_input("search")(_W(root="results", object="obj1")) == []
+    assert wiring.placement_label("default") == "approach"
+
+
+def test_a_bad_scenario_is_one_error_naming_it():
+    wiring = _wiring(scenarios={"s1": {"mechanics": {"muu": 1.0}}})
+    with pytest.raises(RuntimeError, match="Invalid input, nothing was run:\nscenario 's1': config error at 'mechanics'"):
+        wiring.scenario("s1")
+
+
+# --------------------------------------------------------------------------- synergrasp.resolved
+
+def test_an_objects_placement_is_the_global_one_with_its_override():
+    config = defaults()
+    config["objects"]["obj2"]["placement"] = {"search_rank": 2, "search": {"spacing_mm": 4.0}}
+    config = validate_config(config)
+    placement = effective_placement(config, "obj2")
+    assert placement["search_rank"] == 2 and placement["search"]["spacing_mm"] == 4.0
+    assert placement["search"]["coarse_spacing_mm"] == config["placement"]["search"]["coarse_spacing_mm"]
+    assert placement["mode"] == config["placement"]["mode"]
+    assert effective_placement(config, "obj1") == config["placement"]
+
+
+def test_weight_and_friction_are_stated_once():
+    config = defaults()
+    config["objects"]["obj1"]["mass_kg"] = 0.5
+    config["mechanics"]["g_m_per_s2"] = 9.0
+    assert weight_N(config, "obj1") == 4.5 and friction_mu(config) == 1.5
+    objects = study_objects(config)
+    assert list(objects) == ["obj1", "obj2", "obj3", "obj4"] and objects["obj1"].weight_N == 4.5
+    # a step's own part of the configuration: what it does not read resolves to None
+    part = step_config(config, "fig2")  # shapes and masses, the mechanics; no placement
+    obj = study_object(part, "obj1")
+    assert obj.mass_kg == 0.5 and obj.weight_N == 4.5 and obj.placement is None and obj.shape is not None
+    part = step_config(config, "simulate", "obj1")  # kinematic: no mass
+    assert study_object(part, "obj1").weight_N is None and study_object(part, "obj1").placement is not None
+
+
+def test_set_ids_are_read_in_one_place():
+    assert set_members("1-2-10") == (1, 2, 10)
+    assert sorted(["1-2-3", "10", "2", "1-3", "1-10"], key=set_order) == ["2", "10", "1-3", "1-10", "1-2-3"]

@@ -1,0 +1,22 @@
+"""Regenerate the shipped synergy tables (src/synergrasp/data/synergies_<name>.csv) from the
+human synergies and each mapping (docs/synergies.md); tests/test_synergies.py checks that the
+shipped files equal a fresh mapping.
+
+    .venv/bin/python tools/synergy_tables.py
+"""
+
+from __future__ import annotations
+
+from synergrasp.hand.synergies import (
+    SHIPPED_TABLES,
+    load_human_synergies,
+    load_synergy_mapping,
+    map_human_synergies,
+    shipped_path,
+    write_synergies,
+)
+
+if __name__ == "__main__":
+    for table in SHIPPED_TABLES:
+        write_synergies(map_human_synergies(load_human_synergies(), load_synergy_mapping(table)), shipped_path(table))
+        print(f"wrote {shipped_path(table)}")
