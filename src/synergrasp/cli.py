@@ -2,6 +2,7 @@
 
     synergrasp grasp obj4 --alpha -30 --beta 0 [--configfile my.yaml] [--sets 1 1-5 1-15] [--json]
                      [--png grasp.png] [--html grasp.html [--forces 1-15]]
+    synergrasp synergies fit POSTURES.csv --out synergies.csv [--synergies K] [--png variance.png]
 
 Bad arguments end with one line naming the argument and exit status 2.
 """
@@ -91,12 +92,45 @@ def _parser() -> argparse.ArgumentParser:
                                                       "one set as arrows, as one self-contained page")
     grasp.add_argument("--forces", metavar="SET", help="the set whose forces --html draws (default: the last set "
                                                        "asked, {S1..Sk} of every synergy by default)")
+    synergies = sub.add_parser("synergies", help="synergy tables").add_subparsers(dest="action", required=True)
+    fit = synergies.add_parser("fit", help="fit a synergy table to postures (principal components, docs/synergies.md)")
+    fit.add_argument("postures", help="CSV: one column per joint, one row per posture, rad")
+    fit.add_argument("--out", required=True, help="the synergy table to write (joint, mean_rad, syn1..synK)")
+    fit.add_argument("--synergies", type=int, help="how many synergies to keep (default: all with variance)")
+    fit.add_argument("--png", metavar="PATH", help="write the explained variance per synergy (PNG)")
     return parser
+
+
+def _fit_synergies(args: argparse.Namespace) -> int:
+    """``synergrasp synergies fit``: the table, and the variance explained printed (and drawn)."""
+    from synergrasp.hand.synergies import SynergyFileError, write_synergies
+    from synergrasp.hand.synergy_fit import fit_synergies, read_postures
+
+    try:
+        names, postures = read_postures(args.postures)
+        fit = fit_synergies(names, postures, args.synergies)
+    except (SynergyFileError, ValueError) as err:
+        print(f"synergrasp synergies fit: {err}", file=sys.stderr)
+        return 2
+    write_synergies(fit.synergies, args.out)
+    print(f"{len(postures)} postures of {len(names)} joints: total variance {fit.total_variance_rad2:.6g} rad^2")
+    print(f"{'synergy':<8} {'variance (rad^2)':>17} {'explained':>10} {'cumulative':>11}")
+    for i, (v, e, c) in enumerate(zip(fit.variance_rad2, fit.explained, fit.cumulative), start=1):
+        print(f"S{i:<7} {v:>17.6g} {100 * e:>9.2f}% {100 * c:>10.2f}%")
+    print(f"synergy table: {args.out}")
+    if args.png:
+        from synergrasp.figures.synergy_fit import figure_explained_variance
+
+        figure_explained_variance(fit, args.png)
+        print(f"explained variance: {args.png}")
+    return 0
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command; 0 on success, 2 on a bad argument (one line on standard error)."""
     args = _parser().parse_args(argv)
+    if args.command == "synergies":
+        return _fit_synergies(args)
     from synergrasp.config import ConfigError
     from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import load_synergies
