@@ -405,7 +405,17 @@ def write_synergies(synergies: Synergies, path: str | Path) -> None:
     table.to_csv(path, index=False, float_format="%.17g", lineterminator="\n")
 
 
+def shadow_hand_files() -> tuple[Path, Path, Path]:
+    """(hand description, human-to-hand mapping, synergy table) of the shipped Shadow hand."""
+    folder = _data_file("hands") / "shadow"
+    return folder / "hand.yaml", folder / "synergy_mapping_human.yaml", folder / "synergies.csv"
+
+
 if __name__ == "__main__":
     for table in SHIPPED_TABLES:
         write_synergies(map_human_synergies(load_human_synergies(), load_synergy_mapping(table)), shipped_path(table))
         print(f"wrote {shipped_path(table)}")
+    hand_path, mapping_file, table_path = shadow_hand_files()
+    write_synergies(map_human_synergies(load_human_synergies(), load_synergy_mapping(mapping_file),
+                                        load_hand(hand_path).joint_names), table_path)
+    print(f"wrote {table_path}")
