@@ -227,3 +227,28 @@ def test_shadow_thumb_pinches_along_the_closing_synergy():
     q = path.reference(first)
     index = [hand.joint_names.index(n) for n in ("index_mcp", "index_pip")]
     assert np.all(q[index] < hand.upper[index] - 0.05)
+
+
+def test_search_region_from_the_hands_geometry():
+    """region_mm: hand. The palm-derived bounds by hand: the SoftHand's palm box is x −14.5 … 9.5,
+    y −48 … 30, z 14 … 90; the Shadow's palm boxes (MuJoCo, half-sizes) C_palm0 at x 11 ± 32,
+    z 38 ± 49 and C_palm1 at x −32 ± 11 (MuJoCo x is the project's y), face at 11.1 mm."""
+    from synergrasp.hand.synergies import load_synergies
+    from synergrasp.simulation.placement import hand_region
+
+    soft = load_hand(None)
+    (x0, x1), y, (z0, z1) = hand_region(soft, load_synergies(None))
+    assert (x0, y, z0) == (9.0, (-48.0, 30.0), 14.0) and 50 < x1 < 60 and 180 < z1 < 200
+    shadow = load_hand("shadow_hand")
+    (x0, x1), y, (z0, z1) = hand_region(shadow, load_synergies("shadow_hand", joint_names=shadow.joint_names))
+    assert (x0, y, z0) == (11.0, (-43.0, 43.0), -11.0) and x1 > 60 and z1 == 195.0  # middle tip: 99 + 96 mm
+
+
+def test_config_region_hand_is_accepted():
+    from synergrasp.config import validate_config
+    from synergrasp.optimisation.placement_search import SearchStepParams
+
+    config = validate_config({"hand": "shadow_hand", "synergies": "shadow_hand",
+                              "placement": {"search": {"region_mm": "hand"}}})
+    params = SearchStepParams.from_config(config, "obj1")
+    assert params.search.region_mm[1] == (-43.0, 43.0)

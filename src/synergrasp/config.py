@@ -330,7 +330,7 @@ def _search_problems(config: Mapping[str, Any]) -> list[str]:
         if abs(ratio - round(ratio)) > 1e-9:
             problems.append(f"config error at '{where}.search.coarse_spacing_mm': {search['coarse_spacing_mm']} must be "
                             f"a whole multiple of search.spacing_mm ({search['spacing_mm']})")
-        for axis, (lo, hi) in search["region_mm"].items():
+        for axis, (lo, hi) in (search["region_mm"].items() if search["region_mm"] != "hand" else ()):
             if hi < lo:
                 problems.append(f"config error at '{where}.search.region_mm.{axis}': stop {hi} is below start {lo}")
     return problems

@@ -146,7 +146,8 @@ STEPS: dict[str, Step] = {
         rules={"optimise_shard": Cost("shard_pose_set", 2.2, 271, 6.1e-5, 1.1e-3, local=False),
                "aggregate_gfo": Cost("pose_set", 0.6, 134, 2.0e-6, 6.0e-4)},
         outputs={"gfo": "gfo.parquet"}, scope="object",
-        reads=("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg"),
+        reads=("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg",
+               "hand"),  # the hand's joints order the synergy table's rows
         upstream=("contacts",), params="synergrasp.optimisation.study:OptimiseParams"),
     "minima": Step(
         rules={"local_minima": Cost("pose_set", 0.6, 136, 1.35e-5, 6.0e-4)},

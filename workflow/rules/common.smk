@@ -304,6 +304,7 @@ def user_files(wildcards):
     """Input function: the scenario's own hand/synergy files and the mesh files of its objects
     (the job's object only, for a job per object), so that a change of their content reruns
     what uses them (a shipped synergy table given by name is under SHIPPED_DATA)."""
+    from synergrasp.hand.description import SHIPPED_HANDS
     from synergrasp.hand.synergies import SHIPPED_TABLES
 
     cfg = scenario_config(wildcards)
@@ -314,14 +315,15 @@ def user_files(wildcards):
         for o in objects
         if "mesh" in cfg["objects"][o]["shape"]
     ]
-    return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in SHIPPED_TABLES] + meshes
+    shipped = (*SHIPPED_TABLES, *SHIPPED_HANDS)  # by name: their files are under SHIPPED_DATA
+    return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in shipped] + meshes
 
 
 #: The shipped hand and synergy files. Not the schema: its defaults reach a job through its
 #: params (the step's part of the configuration), so a new key reruns nothing.
 SHIPPED_DATA = sorted(
     str(p)
-    for p in (SRC / "data").glob("*")
+    for p in [*(SRC / "data").glob("*"), *(SRC / "data").glob("hands/*/*")]
     if p.is_file() and p.name not in ("config.schema.yaml", "README.md")
 )
 

@@ -140,9 +140,11 @@ def resolve_synergies(source: str | Path | None) -> Path:
         return shipped_path()
     if str(source) in SHIPPED_TABLES:
         return shipped_path(str(source))
+    if str(source) == "shadow_hand":  # the shipped Shadow hand's table (its hand: shadow_hand)
+        return shadow_hand_files()[2]
     path = Path(source)
     if not path.is_file():
-        raise SynergyFileError(f"synergy file '{source}': is neither a shipped table {list(SHIPPED_TABLES)} "
+        raise SynergyFileError(f"synergy file '{source}': is neither a shipped table {[*SHIPPED_TABLES, 'shadow_hand']} "
                                f"nor an existing CSV file")
     return path
 
