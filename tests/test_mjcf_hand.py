@@ -252,3 +252,15 @@ def test_config_region_hand_is_accepted():
                               "placement": {"search": {"region_mm": "hand"}}})
     params = SearchStepParams.from_config(config, "obj1")
     assert params.search.region_mm[1] == (-43.0, 43.0)
+
+
+def test_hand_show_prints_the_joints_and_draws(tmp_path, capsys):
+    from synergrasp.cli import main
+
+    png = tmp_path / "hand.png"
+    assert main(["hand", "show", "shadow_hand", "--png", str(png), "--count", "2"]) == 0
+    text = capsys.readouterr().out
+    assert "17 joints, 22 links (6 without shape)" in text and "index_pip           0.0    78.8    60.7" in text
+    assert png.stat().st_size > 10_000
+    assert main(["hand", "show", str(tmp_path / "none.yaml")]) == 2
+    assert "none.yaml" in capsys.readouterr().err

@@ -3,6 +3,7 @@
     synergrasp grasp obj4 --alpha -30 --beta 0 [--configfile my.yaml] [--sets 1 1-5 1-15] [--json]
                      [--png grasp.png] [--html grasp.html [--forces 1-15]]
     synergrasp synergies fit POSTURES.csv --out synergies.csv [--synergies K] [--png variance.png]
+    synergrasp hand show [HAND] [--synergies TABLE] [--png hand.png] [--count K]
 
 Bad arguments end with one line naming the argument and exit status 2.
 """
@@ -98,7 +99,43 @@ def _parser() -> argparse.ArgumentParser:
     fit.add_argument("--out", required=True, help="the synergy table to write (joint, mean_rad, syn1..synK)")
     fit.add_argument("--synergies", type=int, help="how many synergies to keep (default: all with variance)")
     fit.add_argument("--png", metavar="PATH", help="write the explained variance per synergy (PNG)")
+    hands = sub.add_parser("hand", help="hands").add_subparsers(dest="action", required=True)
+    show = hands.add_parser("show", help="print a hand's joints; draw it at its mean posture and along each synergy")
+    show.add_argument("hand", nargs="?", help="a hand file or description, or shadow_hand (default: the shipped hand)")
+    show.add_argument("--synergies", help="a synergy table (name or CSV; default: the shipped one, or shadow_hand's)")
+    show.add_argument("--png", metavar="PATH", help="write the hand at q_m + sigma S_k, sigma = -1, 0, +1 (PNG)")
+    show.add_argument("--count", type=int, default=7, help="synergies drawn (default 7)")
     return parser
+
+
+def _show_hand(args: argparse.Namespace) -> int:
+    """``synergrasp hand show``: the joints (limits, mean posture, S1), links and fingertips."""
+    from synergrasp.hand.kinematics import fingertip_positions, load_hand
+    from synergrasp.hand.synergies import load_synergies
+
+    try:
+        hand = load_hand(args.hand)
+        table = args.synergies or ("shadow_hand" if args.hand == "shadow_hand" else None)
+        synergies = load_synergies(table, joint_names=hand.joint_names)
+    except ValueError as err:
+        print(f"synergrasp hand show: {err}", file=sys.stderr)
+        return 2
+    deg = math.degrees
+    print(f"{hand.name} ({hand.source}): {hand.n_joints} joints, {hand.n_links} links "
+          f"({len(hand.shapeless_links)} without shape), {synergies.n_synergies} synergies")
+    print(f"{'joint':<15} {'lower':>7} {'upper':>7} {'mean':>7} {'S1':>8}   (deg; S1 rad per unit sigma)")
+    for j, name in enumerate(hand.joint_names):
+        print(f"{name:<15} {deg(hand.lower[j]):7.1f} {deg(hand.upper[j]):7.1f} {deg(synergies.mean[j]):7.1f} "
+              f"{synergies.matrix[j, 0]:8.3f}")
+    tips = fingertip_positions(hand, synergies.mean)
+    print("fingertips at the mean posture (palm frame, mm): " + "; ".join(
+        f"{hand.link_finger[link]} ({', '.join(f'{v:.1f}' for v in tip)})" for link, tip in zip(hand.fingertip_link, tips)))
+    if args.png:
+        from synergrasp.figures.hand_figures import figure_synergy_postures
+
+        figure_synergy_postures(hand, synergies, args.png, None, n_synergies=min(args.count, synergies.n_synergies))
+        print(f"picture: {args.png}")
+    return 0
 
 
 def _fit_synergies(args: argparse.Namespace) -> int:
@@ -131,6 +168,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     if args.command == "synergies":
         return _fit_synergies(args)
+    if args.command == "hand":
+        return _show_hand(args)
     from synergrasp.config import ConfigError
     from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import load_synergies

@@ -317,7 +317,7 @@ def _finger(m: _Model, node: dict, finger: str, chain: list, joint_frames: dict,
         axis = model.jnt_axis[j] / np.linalg.norm(model.jnt_axis[j])
         coupling = couplings.get(model.joint(j).name)
         sign = -1.0 if entry.get("reverse", False) and coupling is None else 1.0
-        lower, upper = sorted(sign * float(v) for v in model.jnt_range[j])  # a follower: its MuJoCo range
+        lower, upper = sorted(sign * float(v) + 0.0 for v in model.jnt_range[j])  # a follower: its MuJoCo range
         follows, scale = "", sign
         if coupling is not None:
             follows, scale = _coupling(m, coupling, model.joint(j).name, chain[:i], names)
