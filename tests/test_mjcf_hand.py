@@ -264,3 +264,47 @@ def test_hand_show_prints_the_joints_and_draws(tmp_path, capsys):
     assert png.stat().st_size > 10_000
     assert main(["hand", "show", str(tmp_path / "none.yaml")]) == 2
     assert "none.yaml" in capsys.readouterr().err
+
+
+def test_softhand_through_its_own_urdf_equals_the_yaml_hand(tmp_path):
+    """URDF through MuJoCo's compiler: the shipped hand's URDF (write_urdf: metres, 9 digits,
+    a rolling joint as two revolute halves) described with each first half named (scale 0.5:
+    MuJoCo turns it by q/2), the second half coupled to it (ratio 1), the root link fused
+    into MuJoCo's world. Same joints, limits, fingertips and Jacobians as the YAML hand."""
+    import yaml
+
+    from synergrasp.hand.kinematics import fingertip_positions, write_urdf
+
+    soft = load_hand(None)
+    write_urdf(soft, tmp_path / "soft.urdf")
+    fingers, couplings = {}, {}
+    for finger, links in zip(("thumb", "index", "middle", "ring", "little"), soft.finger_links):
+        entries = []
+        for link in links:
+            joint = soft.joint_names[soft.link_parent_joint[link]]
+            if joint.endswith("_abd"):
+                entries.append({"mjcf": joint, "name": joint, "link": soft.link_names[link]})
+            else:
+                entries.append({"mjcf": f"{joint}_a", "name": joint, "link": f"{finger}_{joint}_half", "scale": 0.5})
+                entries.append({"mjcf": f"{joint}_b", "link": soft.link_names[link]})
+                couplings[f"{joint}_b"] = {"follows": f"{joint}_a", "ratio": 1.0}
+        fingers[finger] = {"joints": entries, "tip_mm": soft.fingertip_point[len(fingers)].tolist()}
+    (tmp_path / "hand.yaml").write_text(yaml.safe_dump(
+        {"urdf": "soft.urdf", "palm": "world", "palm_normal": [1, 0, 0], "finger_direction": [0, 0, 1],
+         "couplings": couplings, "fingers": fingers}))
+    read = load_hand(tmp_path / "hand.yaml")
+    assert read.joint_names == soft.joint_names
+    np.testing.assert_allclose(read.lower, soft.lower, atol=1e-9)
+    np.testing.assert_allclose(read.upper, soft.upper, atol=1e-9)
+    worst = 0.0
+    for q in _postures(soft, n=10):
+        tips = fingertip_positions(soft, q)
+        tip_gap = float(np.max(np.abs(fingertip_positions(read, q) - tips)))
+        assert tip_gap < 1e-5, tip_gap  # the URDF's 9 digits, in m
+        for f in range(5):
+            a = point_jacobian(soft, q, int(soft.fingertip_link[f]), tips[f])
+            b = point_jacobian(read, q, int(read.fingertip_link[f]), tips[f])
+            worst = max(worst, float(np.max(np.abs(a - b))))
+    print(f"URDF: Jacobians within {worst:.2g} mm/rad")
+    assert worst < 1e-5
+    assert sum(len(s) for s in read.link_shapes) == sum(len(s) for s in soft.link_shapes) == 20

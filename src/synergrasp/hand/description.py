@@ -33,7 +33,7 @@ def hand_spec(path: str | Path | None) -> tuple[HandSpec, str]:
         source = default_hand_path() if path is None else Path(path)
         where = "the shipped hand" if path is None else f"hand file '{source}'"
     doc = read_hand_file(source)
-    if isinstance(doc, dict) and "mjcf" in doc:  # a hand described by an MJCF model (docs/hand.md)
+    if isinstance(doc, dict) and ("mjcf" in doc or "urdf" in doc):  # a hand described by an MJCF/URDF model
         return mjcf_hand_spec(doc, source, where), where
     try:
         return check_hand_doc(doc), where

@@ -27,10 +27,10 @@ __all__ = ["mjcf_hand_spec", "compile_mjcf", "MM_PER_M"]
 
 MM_PER_M = 1000.0
 
-_KEYS = ("name", "mjcf", "palm", "palm_normal", "finger_direction", "fixed_joints", "couplings",
+_KEYS = ("name", "mjcf", "urdf", "palm", "palm_normal", "finger_direction", "fixed_joints", "couplings",
          "ignore_geoms", "fingers")
-_FINGER_KEYS = ("joints", "tip_site")
-_CHAIN_KEYS = ("mjcf", "name", "link", "reverse")
+_FINGER_KEYS = ("joints", "tip_site", "tip_mm")
+_CHAIN_KEYS = ("mjcf", "name", "link", "reverse", "scale")
 #: MuJoCo's joint and geom type codes (mjtJoint, mjtGeom) and their names in messages.
 _JOINT_TYPES = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
 _GEOM_TYPES = {0: "plane", 1: "hfield", 2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box",
@@ -164,13 +164,16 @@ def mjcf_hand_spec(doc: dict, path: Path, where: str) -> HandSpec:
     unknown = [k for k in doc if k not in _KEYS]
     if unknown:
         raise _Error(f"{where}: unknown key(s) {unknown}; allowed keys: {list(_KEYS)}")
-    xml = Path(path).parent / str(doc["mjcf"])
+    fmt = "urdf" if "urdf" in doc else "mjcf"  # MuJoCo's compiler reads both
+    if "urdf" in doc and "mjcf" in doc:
+        raise _Error(f"{where}: mjcf, urdf: give one model, not both")
+    xml = Path(path).parent / str(doc[fmt])
     if not xml.is_file():
-        raise _Error(f"{where}: mjcf: file '{xml}' does not exist")
+        raise _Error(f"{where}: {fmt}: file '{xml}' does not exist")
     try:
         m = _Model(compile_mjcf(xml), where, xml.name)
     except ValueError as err:  # MuJoCo's compiler error: its first line names the element
-        raise _Error(f"{where}: mjcf: MuJoCo cannot compile '{xml}': {str(err).splitlines()[0]}") from None
+        raise _Error(f"{where}: {fmt}: MuJoCo cannot compile '{xml}': {str(err).splitlines()[0]}") from None
     model = m.model
     palm = m.find("body", doc.get("palm"), "palm")
     fixed = _names(doc, "fixed_joints", where, dict)
@@ -316,8 +319,8 @@ def _finger(m: _Model, node: dict, finger: str, chain: list, joint_frames: dict,
         field = f"fingers.{finger}.joints[{i}]"
         axis = model.jnt_axis[j] / np.linalg.norm(model.jnt_axis[j])
         coupling = couplings.get(model.joint(j).name)
-        sign = -1.0 if entry.get("reverse", False) and coupling is None else 1.0
-        lower, upper = sorted(sign * float(v) + 0.0 for v in model.jnt_range[j])  # a follower: its MuJoCo range
+        sign = _scale(m, entry, field) if coupling is None else 1.0
+        lower, upper = sorted(float(v) / sign + 0.0 for v in model.jnt_range[j])  # a follower: its MuJoCo range
         follows, scale = "", sign
         if coupling is not None:
             follows, scale = _coupling(m, coupling, model.joint(j).name, chain[:i], names)
@@ -332,14 +335,36 @@ def _finger(m: _Model, node: dict, finger: str, chain: list, joint_frames: dict,
                                 tuple(shapes.get(j, ())), scale, follows))
         parent = joint_frames[j]
     joints = _limit_masters(joints)
-    site = m.find("site", node.get("tip_site"), f"fingers.{finger}.tip_site")
     distal = chain[-1][0]
-    tip = np.linalg.inv(joint_frames[distal]) @ body_pose[int(model.site_bodyid[site])] @ np.append(
-        model.site_pos[site] * MM_PER_M, 1.0)
-    if not _descends(model, int(model.site_bodyid[site]), int(model.jnt_bodyid[distal]), strictly=False):
-        raise _Error(f"{m.where}: fingers.{finger}.tip_site: site {node['tip_site']!r} is not on the chain's "
-                     "last body")
+    if "tip_mm" in node:  # a point in the last body's frame (URDF has no sites)
+        point, body = _vector_mm(m, node["tip_mm"], f"fingers.{finger}.tip_mm"), int(model.jnt_bodyid[distal])
+    else:
+        site = m.find("site", node.get("tip_site"), f"fingers.{finger}.tip_site")
+        point, body = model.site_pos[site] * MM_PER_M, int(model.site_bodyid[site])
+        if not _descends(model, body, int(model.jnt_bodyid[distal]), strictly=False):
+            raise _Error(f"{m.where}: fingers.{finger}.tip_site: site {node['tip_site']!r} is not on the chain's "
+                         "last body")
+    tip = np.linalg.inv(joint_frames[distal]) @ body_pose[body] @ np.append(point, 1.0)
     return FingerSpec(finger, tip[:3], tuple(joints))
+
+
+def _vector_mm(m: _Model, value: Any, field: str) -> NDArray[np.float64]:
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        arr = np.zeros(0)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise _Error(f"{m.where}: {field}: must be a list of 3 numbers (mm), got {value!r}")
+    return arr
+
+
+def _scale(m: _Model, entry: dict, field: str) -> float:
+    """The MuJoCo angle per unit of the project's q of a chain entry: ``scale`` (default 1),
+    negated by ``reverse``."""
+    scale = entry.get("scale", 1.0)
+    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not math.isfinite(scale) or scale == 0:
+        raise _Error(f"{m.where}: {field}.scale: must be a non-zero number, got {scale!r}")
+    return -float(scale) if entry.get("reverse", False) else float(scale)
 
 
 def _coupling(m: _Model, coupling: Any, name: str, earlier: list, names: dict) -> tuple[str, float]:
@@ -354,8 +379,7 @@ def _coupling(m: _Model, coupling: Any, name: str, earlier: list, names: dict) -
     ratio = coupling["ratio"]
     if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not math.isfinite(ratio) or ratio == 0:
         raise _Error(f"{m.where}: {field}.ratio: must be a non-zero number, got {ratio!r}")
-    sign = -1.0 if dict(earlier)[master].get("reverse", False) else 1.0
-    return names[master], float(ratio) * sign
+    return names[master], float(ratio) * _scale(m, dict(earlier)[master], field)
 
 
 def _limit_masters(joints: list[JointSpec]) -> list[JointSpec]:
