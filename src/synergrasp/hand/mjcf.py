@@ -235,7 +235,7 @@ def _chains(m: _Model, doc: dict, palm: int) -> dict[str, list[tuple[int, dict]]
             joint = m.find("joint", entry["mjcf"], f"{f}.mjcf")
             _hinge_joint(m, joint, f"{f}.mjcf")
             body = int(m.model.jnt_bodyid[joint])
-            if not _descends(m.model, body, above, strictly=i > 0):
+            if not _descends(m.model, body, above, strictly=True):  # a joint of the palm body moves the palm
                 raise _Error(f"{m.where}: {f}.mjcf: joint {entry['mjcf']!r} (body {m.model.body(body).name!r}) "
                              f"does not continue the chain: not below body {m.model.body(above).name!r} in '{m.xml}'")
             link = entry.get("link")
