@@ -438,3 +438,23 @@ def test_small_sweep_summary_has_one_row_per_scenario(run_j2, tmp_path):
     assert summary["grasp_contacts_median"].str.count("/").eq(1).all()  # two objects
     placement = dict(zip(summary["scenario"], summary["placement"]))
     assert placement["default"] == "approach" and placement["placement_searched"] == "searched, rank 1 (own search)"
+
+
+def test_small_study_on_the_shadow_hand(tmp_path):
+    """config/examples/shadow_hand.yaml over the small config: every step runs on the second
+    shipped hand (read from MJCF, 17 joints) and grasps the box obj4 with its own links."""
+    import pandas as pd
+    import yaml
+
+    from synergrasp.config import overlay
+
+    config = overlay(yaml.safe_load(SMALL.read_text()),
+                     yaml.safe_load((ROOT / "config" / "examples" / "shadow_hand.yaml").read_text()))
+    configfile = tmp_path / "shadow_small.yaml"
+    configfile.write_text(yaml.safe_dump(config))
+    out = snakemake(tmp_path, "-j2", "figures", configfile=configfile)
+    assert out.returncode == 0, out.stderr[-5000:]
+    realism = pd.read_csv(tmp_path / "results" / "tables" / "grasp_realism.csv").set_index("object")
+    assert realism.loc["obj4", "contacts_median"] >= 3 and realism.loc["obj4", "pct_force_closure"] > 0
+    contacts = pd.read_parquet(tmp_path / "results" / "objects" / "obj4" / "contacts.parquet")
+    assert contacts["q"].map(len).eq(17).all()

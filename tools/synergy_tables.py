@@ -7,11 +7,13 @@ shipped files equal a fresh mapping.
 
 from __future__ import annotations
 
+from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import (
     SHIPPED_TABLES,
     load_human_synergies,
     load_synergy_mapping,
     map_human_synergies,
+    shadow_hand_files,
     shipped_path,
     write_synergies,
 )
@@ -20,3 +22,7 @@ if __name__ == "__main__":
     for table in SHIPPED_TABLES:
         write_synergies(map_human_synergies(load_human_synergies(), load_synergy_mapping(table)), shipped_path(table))
         print(f"wrote {shipped_path(table)}")
+    hand_path, mapping_file, table_path = shadow_hand_files()
+    write_synergies(map_human_synergies(load_human_synergies(), load_synergy_mapping(mapping_file),
+                                        load_hand(hand_path).joint_names), table_path)
+    print(f"wrote {table_path}")

@@ -2,6 +2,8 @@
 
     synergrasp grasp obj4 --alpha -30 --beta 0 [--configfile my.yaml] [--sets 1 1-5 1-15] [--json]
                      [--png grasp.png] [--html grasp.html [--forces 1-15]]
+    synergrasp synergies fit POSTURES.csv --out synergies.csv [--synergies K] [--png variance.png]
+    synergrasp hand show [HAND] [--synergies TABLE] [--png hand.png] [--count K]
 
 Bad input (an argument, a configuration file, the hand or synergy file it names, an output
 path that cannot be written) ends with one line per problem naming the argument, the file or
@@ -112,6 +114,18 @@ def _parser() -> argparse.ArgumentParser:
                                                       "one set as arrows, as one self-contained page")
     grasp.add_argument("--forces", metavar="SET", help="the set whose forces --html draws (default: the last set "
                                                        "asked, {S1..Sk} of every synergy by default)")
+    synergies = sub.add_parser("synergies", help="synergy tables").add_subparsers(dest="action", required=True)
+    fit = synergies.add_parser("fit", help="fit a synergy table to postures (principal components, docs/synergies.md)")
+    fit.add_argument("postures", help="CSV: one column per joint, one row per posture, rad")
+    fit.add_argument("--out", required=True, help="the synergy table to write (joint, mean_rad, syn1..synK)")
+    fit.add_argument("--synergies", type=int, help="how many synergies to keep (default: all with variance)")
+    fit.add_argument("--png", metavar="PATH", help="write the explained variance per synergy (PNG)")
+    hands = sub.add_parser("hand", help="hands").add_subparsers(dest="action", required=True)
+    show = hands.add_parser("show", help="print a hand's joints; draw it at its mean posture and along each synergy")
+    show.add_argument("hand", nargs="?", help="a hand file or description, or shadow_hand (default: the shipped hand)")
+    show.add_argument("--synergies", help="a synergy table (name or CSV; default: the shipped one, or shadow_hand's)")
+    show.add_argument("--png", metavar="PATH", help="write the hand at q_m + sigma S_k, sigma = -1, 0, +1 (PNG)")
+    show.add_argument("--count", type=int, default=7, help="synergies drawn (default 7)")
     return parser
 
 
@@ -136,6 +150,63 @@ def _output_problems(args: argparse.Namespace) -> list[str]:
             except OSError as err:
                 problems.append(f"{option} {path}: folder '{folder}' cannot be written ({err.strerror or err})")
     return problems
+
+
+def _show_hand(args: argparse.Namespace) -> int:
+    """``synergrasp hand show``: the joints (limits, mean posture, S1), links and fingertips."""
+    from synergrasp.hand.kinematics import fingertip_positions, load_hand
+    from synergrasp.hand.synergies import load_synergies
+
+    try:
+        hand = load_hand(args.hand)
+        table = args.synergies or ("shadow_hand" if args.hand == "shadow_hand" else None)
+        synergies = load_synergies(table, joint_names=hand.joint_names)
+    except ValueError as err:
+        print(f"synergrasp hand show: {err}", file=sys.stderr)
+        return 2
+    deg = math.degrees
+    print(f"{hand.name} ({hand.source}): {hand.n_joints} joints, {hand.n_links} links "
+          f"({len(hand.shapeless_links)} without shape), {synergies.n_synergies} synergies")
+    print(f"{'joint':<15} {'lower':>7} {'upper':>7} {'mean':>7} {'S1':>8}   (deg; S1 rad per unit sigma)")
+    for j, name in enumerate(hand.joint_names):
+        print(f"{name:<15} {deg(hand.lower[j]):7.1f} {deg(hand.upper[j]):7.1f} {deg(synergies.mean[j]):7.1f} "
+              f"{synergies.matrix[j, 0]:8.3f}")
+    tips = fingertip_positions(hand, synergies.mean)
+    print("fingertips at the mean posture (palm frame, mm): " + "; ".join(
+        f"{hand.link_finger[link]} ({', '.join(f'{v:.1f}' for v in tip)})" for link, tip in zip(hand.fingertip_link, tips)))
+    if args.png:
+        from synergrasp.figures.hand_figures import figure_synergy_postures
+
+        figure_synergy_postures(hand, synergies, args.png, None, n_synergies=min(args.count, synergies.n_synergies))
+        print(f"picture: {args.png}")
+    return 0
+
+
+def _fit_synergies(args: argparse.Namespace) -> int:
+    """``synergrasp synergies fit``: the table, and the variance explained printed (and drawn)."""
+    from synergrasp.hand.synergies import SynergyFileError, write_synergies
+    from synergrasp.hand.synergy_fit import fit_synergies, read_postures
+
+    try:
+        names, postures = read_postures(args.postures)
+        fit = fit_synergies(names, postures, args.synergies)
+    except (SynergyFileError, ValueError) as err:
+        print(f"synergrasp synergies fit: {err}", file=sys.stderr)
+        return 2
+    write_synergies(fit.synergies, args.out)
+    print(f"{len(postures)} postures of {len(names)} joints: total variance {fit.total_variance_rad2:.6g} rad^2")
+    print(f"{'synergy':<8} {'variance (rad^2)':>17} {'explained':>10} {'cumulative':>11}")
+    for i, (v, e, c) in enumerate(zip(fit.variance_rad2, fit.explained, fit.cumulative), start=1):
+        print(f"S{i:<7} {v:>17.6g} {100 * e:>9.2f}% {100 * c:>10.2f}%")
+    print(f"synergy table: {args.out}")
+    if args.png:
+        from synergrasp.figures.synergy_fit import figure_explained_variance
+
+        figure_explained_variance(fit, args.png)
+        print(f"explained variance: {args.png}")
+    return 0
+
+
 
 
 def _grasp(args: argparse.Namespace) -> int:
@@ -194,6 +265,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command; 0 on success, 2 on bad input (one line per problem on standard
     error, naming the argument, the file or the key; no traceback)."""
     args = _parser().parse_args(argv)
+    if args.command == "synergies":
+        return _fit_synergies(args)
+    if args.command == "hand":
+        return _show_hand(args)
     try:
         return _grasp(args)
     except ValueError as err:  # ConfigError, InspectionError, file errors: each names what is wrong

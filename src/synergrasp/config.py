@@ -333,7 +333,7 @@ def _search_problems(config: Mapping[str, Any]) -> list[str]:
             problems.append(f"config error at '{where}.search.coarse_spacing_mm': {search['coarse_spacing_mm']} must be "
                             f"a whole multiple of search.spacing_mm ({search['spacing_mm']})")
         for kind, region in search["region_mm"].items():
-            for axis, (lo, hi) in region.items():
+            for axis, (lo, hi) in (region.items() if region != "hand" else ()):
                 if hi < lo:
                     problems.append(f"config error at '{where}.search.region_mm.{kind}.{axis}': stop {hi} is below "
                                     f"start {lo}")
@@ -344,8 +344,10 @@ def search_lattice_size(search: Mapping[str, Any], grasp_type: str) -> int:
     """The number of points of the placement search's final lattice for an object of
     ``grasp_type`` (``search.region_mm.<grasp_type>`` at ``search.spacing_mm``): no search can
     have more distinct targets."""
-    return math.prod(int(math.floor((hi - lo) / search["spacing_mm"] + 1e-9)) + 1
-                     for lo, hi in search["region_mm"][grasp_type].values())
+    region = search["region_mm"][grasp_type]
+    if region == "hand":  # derived from the hand when the search runs: bounded by a generous box
+        return math.prod(int(math.floor(400.0 / search["spacing_mm"])) + 1 for _ in range(3))
+    return math.prod(int(math.floor((hi - lo) / search["spacing_mm"] + 1e-9)) + 1 for lo, hi in region.values())
 
 
 def _rank_problems(config: Mapping[str, Any]) -> list[str]:
@@ -355,7 +357,7 @@ def _rank_problems(config: Mapping[str, Any]) -> list[str]:
     for name, spec in config["objects"].items():
         placement = overlay(config["placement"], spec.get("placement"))
         region = placement["search"]["region_mm"][spec["grasp_type"]]
-        if placement["mode"] != "searched" or any(hi < lo for lo, hi in region.values()):
+        if placement["mode"] != "searched" or (region != "hand" and any(hi < lo for lo, hi in region.values())):
             continue
         n = search_lattice_size(placement["search"], spec["grasp_type"])
         if placement["search_rank"] > n:

@@ -177,7 +177,8 @@ STEPS: dict[str, Step] = {
         rules={"optimise_shard": Cost("shard_pose_set", 2.2, 271, 6.1e-5, 1.1e-3, local=False, compiles=True),
                "optimise": Cost("pose_set", 0.6, 134, 2.0e-6, 6.0e-4)},
         outputs={"gfo": "gfo.parquet"}, scope="object",
-        reads=("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg"),
+        reads=("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg",
+               "hand"),  # the hand's joints order the synergy table's rows
         upstream=("contacts",), params="synergrasp.optimisation.optimise:OptimiseParams",
         rule_outputs={"optimise_shard": "gfo_shards/{shard}.parquet"}),
     "minima": Step(

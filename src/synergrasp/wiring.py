@@ -390,18 +390,21 @@ class Wiring:
     def user_files(self, wildcards: Any) -> list[str]:
         """Input function: the scenario's own hand/synergy files and the mesh files of its
         objects (the job's object only, for a job per object)."""
+        from synergrasp.hand.description import SHIPPED_HANDS
         from synergrasp.hand.synergies import SHIPPED_TABLES
 
         cfg = self.job_config(wildcards)
         obj = getattr(wildcards, "object", None)
         objects = [obj] if obj in cfg["objects"] else list(cfg["objects"])
         meshes = [cfg["objects"][o]["shape"]["mesh"]["path"] for o in objects if "mesh" in cfg["objects"][o]["shape"]]
-        return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in SHIPPED_TABLES] + meshes
+        shipped = (*SHIPPED_TABLES, *SHIPPED_HANDS)  # by name: their files are under shipped_data()
+        return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in shipped] + meshes
 
     def shipped_data(self) -> list[str]:
         """The shipped hand and synergy files (not the schema: its defaults reach a job
         through its params, so a new key reruns nothing)."""
-        return sorted(str(p) for p in (self.src / "synergrasp" / "data").glob("*")
+        data = self.src / "synergrasp" / "data"
+        return sorted(str(p) for p in [*data.glob("*"), *data.glob("hands/*/*")]
                       if p.is_file() and p.name not in ("config.schema.yaml", "README.md"))
 
     def resources(self, rule: str) -> dict[str, Callable[[Any], int]]:

@@ -1,6 +1,7 @@
 """Grasp-force optimisation of one shard of an object's poses, for every synergy set."""
 
 from synergrasp import tables
+from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
 from synergrasp.optimisation.problem import SynergySets
@@ -8,7 +9,8 @@ from synergrasp.optimisation.optimise import OptimiseParams, optimise_shard
 
 with job_log(snakemake.log[0]):
     opt = OptimiseParams.from_config(snakemake.params.cfg, snakemake.wildcards.object)
-    synergies = SynergySets(load_synergies(opt.synergies).matrix, tuple(opt.sets.values()))
+    table = load_synergies(opt.synergies, joint_names=load_hand(opt.hand).joint_names)
+    synergies = SynergySets(table.matrix, tuple(opt.sets.values()))
     contacts = tables.read(tables.CONTACTS, snakemake.input.contacts)
     gfo = optimise_shard(contacts, int(snakemake.wildcards.shard), opt.pose_shards, synergies, opt.gfo)
     tables.write(tables.GFO, gfo, snakemake.output[0])

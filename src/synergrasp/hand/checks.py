@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from synergrasp.hand.hand_file import FINGERS, hand_spec
+from synergrasp.hand.description import hand_spec
+from synergrasp.hand.hand_file import FINGERS
 from synergrasp.hand.kinematics import Hand, build_hand
 
 __all__ = ["link_field", "closure_shape_problems", "check_hand"]
@@ -28,14 +29,15 @@ def link_field(hand: Hand, link: int) -> str:
 
 def closure_shape_problems(hand: Hand) -> list[str]:
     """Where ``hand``'s shapes are not what the closure collides (one capsule per finger link,
-    a palm of boxes), one line per field (empty: none)."""
+    none for a link that only carries a joint in a hand read from MJCF, a palm of boxes),
+    one line per field (empty: none)."""
     problems = []
     palm = [s.kind for s in hand.link_shapes[0]]
     if not palm or any(kind != "box" for kind in palm):
         problems.append(f"palm.shapes: the closure needs a palm made of one or more boxes, got {palm}")
     for link in range(1, hand.n_links):
         kinds = [s.kind for s in hand.link_shapes[link]]
-        if kinds != ["capsule"]:
+        if kinds != ["capsule"] and not (link in hand.shapeless_links and not kinds):
             problems.append(f"{link_field(hand, link)}: the closure needs exactly one capsule per finger link "
                             f"(link '{hand.link_names[link]}'), got {kinds}")
     return problems

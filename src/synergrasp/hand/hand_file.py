@@ -23,7 +23,7 @@ from synergrasp.hand.geometry import SHAPE_KINDS, Shape, pose_matrix, z_to
 from synergrasp.yaml_io import read_yaml
 
 __all__ = ["FINGERS", "JOINT_NAMES", "PALM_NORMAL", "HandSpec", "FingerSpec", "JointSpec",
-           "default_hand_path", "read_hand_file", "check_hand_doc", "hand_spec"]
+           "default_hand_path", "read_hand_file", "check_hand_doc"]
 
 FINGERS: tuple[str, ...] = ("thumb", "index", "middle", "ring", "little")
 
@@ -58,6 +58,11 @@ class JointSpec:
     upper_rad: float
     link: str
     shapes: tuple[Shape, ...]
+    #: the axis turns by ``scale`` × q (a plain joint; a reversed joint: −1); with ``follows``
+    #: (the name of an earlier joint of its finger) the joint has no coordinate of its own
+    #: and turns by ``scale`` × that joint's q (a coupled joint, e.g. a tendon-coupled distal)
+    scale: float = 1.0
+    follows: str = ""
 
 
 @dataclass(frozen=True)
@@ -77,6 +82,9 @@ class HandSpec:
     palm_shapes: tuple[Shape, ...]
     fingers: tuple[FingerSpec, ...]
     warnings: tuple[str, ...] = ()
+    #: whether a finger link may have no shape (a body that only carries a joint, read from
+    #: MJCF; a YAML hand file gives every link its capsule)
+    shapeless_links: bool = False
 
 
 # --------------------------------------------------------------------------- reading
@@ -260,16 +268,3 @@ def check_hand_doc(doc: Any) -> HandSpec:
         check.warnings.append(f"<top level>: no length of the hand exceeds {max(check.lengths):.3g} mm, far "
                               "from a human hand's dimensions (about 190 mm long); lengths are in mm, not m")
     return HandSpec(str(doc.get("name", "hand")), palm_normal, palm_shapes, tuple(specs), tuple(check.warnings))
-
-
-def hand_spec(path: str | Path | None) -> tuple[HandSpec, str]:
-    """The checked content of the hand file ``path`` (None: the shipped hand) and how
-    messages name it (``hand file '<path>'`` or ``the shipped hand``); ValueError naming
-    the file and the field."""
-    source = default_hand_path() if path is None else Path(path)
-    where = "the shipped hand" if path is None else f"hand file '{source}'"
-    doc = read_hand_file(source)
-    try:
-        return check_hand_doc(doc), where
-    except ValueError as exc:
-        raise ValueError(str(exc).replace("hand file:", f"{where}:", 1)) from None

@@ -37,9 +37,9 @@ from synergrasp.hand.hand_file import (  # noqa: F401  (the file format, re-expo
     HandSpec,
     check_hand_doc,
     default_hand_path,
-    hand_spec,
     read_hand_file,
 )
+from synergrasp.hand.description import hand_spec  # noqa: F401  (re-exported)
 
 FINGERTIP_LINKS: tuple[str, ...] = (
     "thumb_distal", "index_distal", "middle_distal", "ring_distal", "little_distal",
@@ -78,6 +78,7 @@ class Hand:
     ignored_link_pairs: tuple[tuple[int, int], ...]  # self-collision pairs to skip (touching by design)
     palm_normal: NDArray[np.float64]
     source: str = "the shipped hand"      # where the model was read from (for messages)
+    shapeless_links: tuple[int, ...] = ()  # finger links without a shape (a body carrying only a joint)
 
     @property
     def n_joints(self) -> int:
@@ -105,7 +106,7 @@ class Hand:
 
 def load_hand(path: str | Path | None = None) -> Hand:
     """Load a hand model from a YAML file (None: the shipped SoftHand-like model): read and
-    check it (``hand_file.hand_spec``), then build it (:func:`build_hand`).
+    check it (``description.hand_spec``), then build it (:func:`build_hand`).
 
     The file format is documented in docs/hand.md and in the header of data/hand.yaml.
     Raises ValueError naming the file and the offending field.
@@ -145,24 +146,36 @@ def build_hand(spec: HandSpec, source: str = "the shipped hand") -> Hand:
     finger_joints: list[tuple[int, ...]] = []
     finger_links: list[tuple[int, ...]] = []
     ignored: set[tuple[int, int]] = set()
+    shapeless: list[int] = []
     for finger in spec.fingers:
-        parent_frame, parent_link, fj, fl = 0, 0, [], []
+        parent_frame, parent_link, shaped_parent, fj, fl = 0, 0, 0, [], []
         for joint in finger.joints:
             k = len(joint_names)
-            if joint.rolling_gap_mm > 0:
+            if joint.follows:  # a coupled joint: a frame turned by the joint it follows
+                k = joint_names.index(joint.follows)
+                last = tree.frame(joint.link, parent_frame, joint.offset, joint.axis, k, joint.scale, joint.name)
+            elif joint.rolling_gap_mm > 0:
                 first = tree.frame(f"{joint.name}_half", parent_frame, joint.offset, joint.axis, k, 0.5,
                                    f"{joint.name}_a")
                 last = tree.frame(joint.link, first, pose_matrix([joint.rolling_gap_mm, 0.0, 0.0]), joint.axis,
                                   k, 0.5, f"{joint.name}_b")
             else:
-                last = tree.frame(joint.link, parent_frame, joint.offset, joint.axis, k, 1.0, joint.name)
-            joint_names.append(joint.name)
-            lower.append(joint.lower_rad)
-            upper.append(joint.upper_rad)
+                last = tree.frame(joint.link, parent_frame, joint.offset, joint.axis, k, joint.scale, joint.name)
+            if not joint.follows:
+                joint_names.append(joint.name)
+                lower.append(joint.lower_rad)
+                upper.append(joint.upper_rad)
             tree.links.append((joint.link, finger.name, last, parent_link, k, joint.shapes))
             li = len(tree.links) - 1
-            # a link touches its parent at the joint by design (rolling surfaces, knuckle in the palm)
+            # a link touches its parent at the joint by design (rolling surfaces, knuckle in the palm);
+            # past a link without shape, the nearest one with shapes
             ignored.add((parent_link, li))
+            if parent_link in shapeless:
+                ignored.add((shaped_parent, li))
+            if joint.shapes:
+                shaped_parent = li
+            else:
+                shapeless.append(li)
             fj.append(k)
             fl.append(li)
             parent_frame, parent_link = last, li
@@ -182,7 +195,8 @@ def build_hand(spec: HandSpec, source: str = "the shipped hand") -> Hand:
         frame_joint_names=tuple(f[6] for f in frames), finger_joints=tuple(finger_joints),
         finger_links=tuple(finger_links), fingertip_link=np.array([fl[-1] for fl in finger_links]),
         fingertip_point=np.array([f.tip_mm for f in spec.fingers]),
-        ignored_link_pairs=tuple(sorted(ignored)), palm_normal=spec.palm_normal, source=source)
+        ignored_link_pairs=tuple(sorted(ignored)), palm_normal=spec.palm_normal, source=source,
+        shapeless_links=tuple(shapeless) if spec.shapeless_links else ())
 
 
 # --------------------------------------------------------------------------- kinematics

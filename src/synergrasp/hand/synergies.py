@@ -140,9 +140,11 @@ def resolve_synergies(source: str | Path | None) -> Path:
         return shipped_path()
     if str(source) in SHIPPED_TABLES:
         return shipped_path(str(source))
+    if str(source) == "shadow_hand":  # the shipped Shadow hand's table (its hand: shadow_hand)
+        return shadow_hand_files()[2]
     path = Path(source)
     if not path.is_file():
-        raise SynergyFileError(f"synergy file '{source}': is neither a shipped table {list(SHIPPED_TABLES)} "
+        raise SynergyFileError(f"synergy file '{source}': is neither a shipped table {[*SHIPPED_TABLES, 'shadow_hand']} "
                                f"nor an existing CSV file")
     return path
 
@@ -404,3 +406,8 @@ def write_synergies(synergies: Synergies, path: str | Path) -> None:
     table.insert(0, "joint", list(synergies.joint_names))
     table.to_csv(path, index=False, float_format="%.17g", lineterminator="\n")
 
+
+def shadow_hand_files() -> tuple[Path, Path, Path]:
+    """(hand description, human-to-hand mapping, synergy table) of the shipped Shadow hand."""
+    folder = _data_file("hands") / "shadow"
+    return folder / "hand.yaml", folder / "synergy_mapping_human.yaml", folder / "synergies.csv"

@@ -115,12 +115,13 @@ class OptimiseParams:
     sets: dict[str, tuple[int, ...]]
     gfo: GFOParams
     pose_shards: int
+    hand: str | None = None  # the hand file (None: the shipped hand), whose joints order the table's rows
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> OptimiseParams:
         """From a configuration or the step's own part of it, for the object ``obj``."""
         return cls(config["synergies"], synergy_sets(config["synergy_sets"]), GFOParams.from_config(config, obj),
-                   int(config["solver"]["pose_shards"]))
+                   int(config["solver"]["pose_shards"]), config["hand"])
 
 
 def mechanics_for(grasp: Grasp, params: GFOParams) -> GraspMechanics:

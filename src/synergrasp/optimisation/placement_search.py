@@ -37,7 +37,7 @@ from synergrasp.simulation.contacts import contacts_row, contacts_table
 from synergrasp.simulation.closure_params import ClosureParams
 from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions, of_grasp_type
-from synergrasp.simulation.placement import Placement, palm_centre, pose_grid
+from synergrasp.simulation.placement import Placement, hand_region, palm_centre, pose_grid
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
@@ -97,6 +97,15 @@ class SearchParams:
 
 
 
+def _hand_region(hand: str | None, synergies: str | None) -> tuple[tuple[float, float], ...]:
+    """``region_mm: hand``: the region of the hand file and synergy table (``hand_region``)."""
+    from synergrasp.hand.kinematics import load_hand
+    from synergrasp.hand.synergies import load_synergies
+
+    loaded = load_hand(hand)
+    return hand_region(loaded, load_synergies(synergies, joint_names=loaded.joint_names))
+
+
 @dataclass(frozen=True)
 class SearchStepParams:
     """The placement search of one object (the ``search`` step; docs/placement_search.md):
@@ -121,7 +130,10 @@ class SearchStepParams:
         placement = effective_placement(config, obj)
         spec = placement["search"]
         grasp_type = config["objects"][obj]["grasp_type"]
-        region = tuple(tuple(spec["region_mm"][grasp_type][axis]) for axis in ("x", "y", "z"))
+        if spec["region_mm"][grasp_type] == "hand":  # derived from the hand's geometry (docs/placement_search.md)
+            region = _hand_region(config["hand"], config["synergies"])
+        else:
+            region = tuple(tuple(spec["region_mm"][grasp_type][axis]) for axis in ("x", "y", "z"))
         search = build(SearchParams, "placement.search", region_mm=region, grasp_type=grasp_type,
                        **dataclass_fields(SearchParams, {k: v for k, v in spec.items() if k != "region_mm"}))
         closure = {**config["closure"], "model": "kinematic"}

@@ -198,8 +198,9 @@ def self_collision_pairs(hand: Hand, links: tuple[int, ...] | None = None) -> tu
     only pairs with at least one link from that set."""
     ignored = set(hand.ignored_link_pairs)
     keep = None if links is None else set(links)
-    return tuple((i, j) for i in range(hand.n_links) for j in range(i + 1, hand.n_links)
-                 if (i, j) not in ignored and (keep is None or i in keep or j in keep))
+    shaped = [i for i in range(hand.n_links) if i not in hand.shapeless_links]  # a link without shape touches nothing
+    return tuple((i, j) for i in shaped for j in shaped
+                 if i < j and (i, j) not in ignored and (keep is None or i in keep or j in keep))
 
 
 def self_closest_points(client: int, body: HandBody, distance_mm: float,

@@ -242,6 +242,8 @@ class HandCapsules:
             raise ValueError(f"{hand.source}: {problems[0]}")
         links, ends, radius = [], [], []
         for link in range(1, hand.n_links):
+            if not hand.link_shapes[link]:  # a link that only carries a joint (hand.shapeless_links)
+                continue
             shape = hand.link_shapes[link][0]
             axis = 0.5 * shape.length * shape.pose[:3, 2]
             links.append(link)

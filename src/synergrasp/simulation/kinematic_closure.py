@@ -109,7 +109,8 @@ class KinematicClosure:
                         centre = frames[distal] @ shape.pose
                         half = 0.5 * shape.length if shape.kind == "capsule" else 0.5 * float(np.linalg.norm(shape.size))
                         r = max(r, float(np.linalg.norm(centre[:3, 3] - base)) + half + shape.radius)
-                reach[joint] = r + 10.0
+                # a coupled joint moves two links of its chain (hand file: ``follows``): the larger reach
+                reach[joint] = max(reach[joint], r + 10.0)
         return reach
 
     def _monitored_pairs(self) -> tuple[tuple[int, int], ...]:

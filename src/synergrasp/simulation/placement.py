@@ -190,11 +190,9 @@ def object_pose(placement: Placement, shape: Shape, alpha_deg: float, beta_deg: 
     return ObjectPose(np.array(placement.center_mm, dtype=float), R, shape)
 
 
-def palm_centre(hand: Hand) -> NDArray:
-    """The centre of the palm's face (palm frame, mm): the centre of the palm link's
-    collision shapes' bounding box, moved along the palm normal onto their outermost
-    point. The default approach point (docs/closure.md: where a hand takes an object it
-    holds against the palm; a property of the hand alone)."""
+def _palm_points(hand: Hand) -> NDArray:
+    """(p, 3) points spanning the palm link's collision shapes (box corners; a capsule's end
+    points widened by its radius along ±x, ±y, ±z), palm frame, mm."""
     corners = []
     for shape in hand.link_shapes[0]:
         if shape.kind == "box":
@@ -208,10 +206,44 @@ def palm_centre(hand: Hand) -> NDArray:
     if not corners:
         raise ValueError(f"{hand.source}: palm.shapes: the palm has no collision shape; give "
                          "placement.approach_point_mm")
-    pts = np.vstack(corners)
+    return np.vstack(corners)
+
+
+def palm_centre(hand: Hand) -> NDArray:
+    """The centre of the palm's face (palm frame, mm): the centre of the palm link's
+    collision shapes' bounding box, moved along the palm normal onto their outermost
+    point. The default approach point (docs/closure.md: where a hand takes an object it
+    holds against the palm; a property of the hand alone)."""
+    pts = _palm_points(hand)
     n = _unit(hand.palm_normal)
     centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
     return centre + (float(np.max(pts @ n)) - float(centre @ n)) * n
+
+
+def hand_region(hand: Hand, synergies: Any) -> tuple[tuple[float, float], ...]:
+    """The placement search's region for any hand (docs/placement_search.md, ``region_mm:
+    hand``), palm frame (mm), each bound rounded outward to a whole mm: x (the palm normal)
+    from the palm's face to the farthest point the finger links' axes reach along x on the
+    closure path q_r(σ), σ_open … σ_closed (where a box centre can still be met by the
+    closing fingers); y the palm's width; z from the palm's wrist end to the highest
+    fingertip of the open hand q_r(σ_open)."""
+    from synergrasp.hand.kinematics import fingertip_positions
+    from synergrasp.hand.synergies import SynergyPath
+    from synergrasp.simulation.capsules import HandCapsules
+
+    if not np.allclose(hand.palm_normal, (1.0, 0.0, 0.0)):
+        raise ValueError(f"{hand.source}: palm_normal: region_mm 'hand' needs the palm frame of docs/hand.md "
+                         f"(palm normal +x), got {list(hand.palm_normal)}")
+    pts = _palm_points(hand)
+    path = SynergyPath.along(synergies, hand.lower, hand.upper)
+    sigma_open, sigma_closed = path.closure_range(hand.flexion_joints)
+    capsules = HandCapsules.of(hand)
+    reach = max(float(np.max(np.concatenate(capsules.segments(path.reference(s)))[:, 0]))
+                for s in np.linspace(sigma_open, sigma_closed, 201))
+    top = float(np.max(fingertip_positions(hand, path.reference(sigma_open))[:, 2]))
+    bounds = ((float(np.max(pts[:, 0])), reach), (float(np.min(pts[:, 1])), float(np.max(pts[:, 1]))),
+              (float(np.min(pts[:, 2])), top))
+    return tuple((float(math.floor(lo + 1e-9)), float(math.ceil(hi - 1e-9))) for lo, hi in bounds)
 
 
 def placement_target(placement: Placement, hand: Hand) -> NDArray:
