@@ -13,7 +13,7 @@ from __future__ import annotations
 import functools
 import json
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -62,6 +62,22 @@ HUMAN_SYNERGIES = "santello_synergies_20dof.csv"
 
 class SynergyFileError(ValueError):
     """A synergy file (or mapping) is malformed; the message names file, field and what is allowed."""
+
+
+def finite_cells(table: Any, columns: Sequence[str], problem: Callable[[int, str, str], str]) -> NDArray[np.float64]:
+    """(rows, len(columns)) the table's text cells as floats (rad); a cell that is no finite
+    number raises SynergyFileError with ``problem(row, column, text)`` (row 0-based)."""
+    values = np.empty((len(table), len(columns)))
+    for j, col in enumerate(columns):
+        for i, text in enumerate(table[col].tolist()):
+            try:
+                value = float(text)
+            except ValueError:
+                value = math.nan
+            if not math.isfinite(value):
+                raise SynergyFileError(problem(i, col, text))
+            values[i, j] = value
+    return values
 
 
 @dataclass(frozen=True)
@@ -196,17 +212,8 @@ def _read_table(path: str | Path, joint_names: Sequence[str]) -> tuple[list[str]
         raise SynergyFileError(f"{where}: {len(syn_cols)} synergy columns for {len(expected)} joints; "
                                f"at most {len(expected)} are allowed")
 
-    values = np.empty((len(names), 1 + len(syn_cols)))
-    for j, col in enumerate(["mean_rad", *syn_cols]):
-        for i, text in enumerate(table[col].tolist()):
-            try:
-                value = float(text)
-            except ValueError:
-                value = math.nan
-            if not math.isfinite(value):
-                raise SynergyFileError(f"{where}: field '{col}' of joint '{names[i]}' is {text!r}; "
-                                       "a finite number (rad) is required")
-            values[i, j] = value
+    values = finite_cells(table, ["mean_rad", *syn_cols], lambda i, col, text: (
+        f"{where}: field '{col}' of joint '{names[i]}' is {text!r}; a finite number (rad) is required"))
     order = [names.index(n) for n in expected]
     values = values[order]
     return syn_cols, values[:, 0], values[:, 1:]

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from synergrasp.hand.synergies import Synergies, SynergyFileError
+from synergrasp.hand.synergies import Synergies, SynergyFileError, finite_cells
 
 __all__ = ["SynergyFit", "read_postures", "fit_synergies", "orient_columns"]
 
@@ -73,17 +73,9 @@ def read_postures(path: str | Path) -> tuple[tuple[str, ...], NDArray[np.float64
         raise SynergyFileError(f"{where}: joint column(s) {repeated} repeated; one column per joint")
     if len(table) < 2:
         raise SynergyFileError(f"{where}: {len(table)} posture(s); at least 2 rows are needed")
-    values = np.empty(table.shape)
-    for j, col in enumerate(table.columns):
-        for i, text in enumerate(table[col].tolist()):
-            try:
-                value = float(text)
-            except ValueError:
-                value = math.nan
-            if not math.isfinite(value):
-                raise SynergyFileError(f"{where}: row {i + 1}, joint '{names[j]}' is {text!r}; "
-                                       "a finite number (rad) is required")
-            values[i, j] = value
+    values = finite_cells(table, list(table.columns), lambda i, col, text: (
+        f"{where}: row {i + 1}, joint '{names[list(table.columns).index(col)]}' is {text!r}; "
+        "a finite number (rad) is required"))
     return names, values
 
 
