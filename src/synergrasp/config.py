@@ -356,10 +356,11 @@ def _rank_problems(config: Mapping[str, Any]) -> list[str]:
     found: dict[tuple[str, int, int, float], list[str]] = {}
     for name, spec in config["objects"].items():
         placement = overlay(config["placement"], spec.get("placement"))
-        region = placement["search"]["region_mm"][spec["grasp_type"]]
+        kind = config.get("grasp_type") or spec["grasp_type"]  # resolved.grasp_type (config cannot import it)
+        region = placement["search"]["region_mm"][kind]
         if placement["mode"] != "searched" or (region != "hand" and any(hi < lo for lo, hi in region.values())):
             continue
-        n = search_lattice_size(placement["search"], spec["grasp_type"])
+        n = search_lattice_size(placement["search"], kind)
         if placement["search_rank"] > n:
             where = "placement" if "search_rank" not in (spec.get("placement") or {}) else f"objects.{name}.placement"
             found.setdefault((where, placement["search_rank"], n, placement["search"]["spacing_mm"]), []).append(name)

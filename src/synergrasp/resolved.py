@@ -4,7 +4,9 @@ workflow read instead of working them out again from the configuration.
 - an object's effective placement: the global ``placement`` overlaid with the object's own
   ``placement`` (config/README.md);
 - an object's weight: ``mass_kg`` × ``mechanics.g_m_per_s2``, N;
-- the hand–object friction μ (``mechanics.mu``).
+- the hand–object friction μ (``mechanics.mu``);
+- an object's grasp type: the top-level ``grasp_type`` when set (every object's), else the
+  object's own ``grasp_type`` (docs/opposition.md).
 
 A step is handed only the part of the configuration it reads (``synergrasp.steps.step_config``),
 so every value here is resolved from whatever part it is given: a key the part does not hold
@@ -22,7 +24,8 @@ from typing import Any
 
 from synergrasp.config import overlay
 
-__all__ = ["StudyObject", "study_object", "study_objects", "effective_placement", "weight_N", "friction_mu"]
+__all__ = ["StudyObject", "study_object", "study_objects", "effective_placement", "weight_N", "friction_mu",
+           "grasp_type"]
 
 
 def effective_placement(config: Mapping[str, Any], obj: str) -> dict[str, Any]:
@@ -33,6 +36,11 @@ def effective_placement(config: Mapping[str, Any], obj: str) -> dict[str, Any]:
 def weight_N(config: Mapping[str, Any], obj: str) -> float:
     """Object ``obj``'s weight m·g (N) from its ``mass_kg`` and ``mechanics.g_m_per_s2``."""
     return float(config["objects"][obj]["mass_kg"]) * float(config["mechanics"]["g_m_per_s2"])
+
+
+def grasp_type(config: Mapping[str, Any], obj: str) -> str:
+    """Object ``obj``'s grasp type: the top-level ``grasp_type`` when set, else its own."""
+    return str(config.get("grasp_type") or config["objects"][obj]["grasp_type"])
 
 
 def friction_mu(config: Mapping[str, Any]) -> float:

@@ -134,7 +134,7 @@ _PNG_PDF = ("png", "pdf")
 #: The keys the placement search reads (and the map of its results).
 STEPS_SEARCH_READS = ("hand", "synergies", "grid", "placement", "closure", "mechanics", "synergy_sets.incremental_max",
                       "objects.{object}.shape", "objects.{object}.mass_kg", "objects.{object}.placement",
-                      "objects.{object}.grasp_type", "opposition")
+                      "objects.{object}.grasp_type", "grasp_type", "opposition")
 STEPS_SEARCH_NOT_READS = ("closure.model", "closure.dynamic",
                           *(f"{where}.{key}" for where in ("placement", "objects.{object}.placement")
                             for key in _PLACEMENT_TARGETS))
@@ -228,7 +228,7 @@ STEPS: dict[str, Step] = {
                  "graspable_csv": "tables/graspable_objects.csv", "graspable_md": "tables/graspable_objects.md"},
         reads=("hand", "synergies", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2",
                "mechanics.k_ss_Nmm_per_rad", "mechanics.mu", "closure.model", "objects.*.shape",
-               "objects.*.grasp_type", "opposition"),
+               "objects.*.grasp_type", "grasp_type", "opposition"),
         reads_when=(("closure.model", "dynamic", ("closure.dynamic.load_threshold_N",)),),
         upstream=("contacts", "optimise"), synergy_columns=(1,), params="synergrasp.analysis.realism:RealismParams",
         report={"csv": ("grasp_realism_table", "Tables"), "png": ("grasp_realism", "Figures"),

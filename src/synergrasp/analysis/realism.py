@@ -21,7 +21,7 @@ import pandas as pd
 from synergrasp.analysis.verdicts import verdict_columns
 from synergrasp.hand.synergies import Synergies, synergy_values
 from synergrasp.ids import incremental_set_id
-from synergrasp.resolved import friction_mu, weight_N
+from synergrasp.resolved import friction_mu, grasp_type, weight_N
 from synergrasp.simulation.opposition import (OPPOSITIONS, HandAxes, OppositionRule, contacts_oppositions,
                                               edge_contacts, of_grasp_type)
 from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
@@ -79,7 +79,7 @@ class RealismParams:
         return cls(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),
                    {name: weight_N(config, name) for name in objects},
                    threshold, tuple(values["mean_rad"]), tuple(values["S1"]), float(mechanics["k_ss_Nmm_per_rad"]),
-                   friction_mu(config), {name: spec["grasp_type"] for name, spec in objects.items()},
+                   friction_mu(config), {name: grasp_type(config, name) for name in objects},
                    {name: shape_from_config(spec["shape"], f"objects.{name}.shape") for name, spec in objects.items()},
                    OppositionRule.from_config(config))
 

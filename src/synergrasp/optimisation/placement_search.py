@@ -36,6 +36,7 @@ from synergrasp.optimisation.optimise import GFOParams, optimise_grasps
 from synergrasp.simulation.contacts import contacts_row, contacts_table
 from synergrasp.simulation.closure_params import ClosureParams
 from synergrasp.simulation.objects import GraspedObject
+from synergrasp.resolved import grasp_type as resolved_grasp_type
 from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions, of_grasp_type
 from synergrasp.simulation.placement import Placement, hand_region, palm_centre, pose_grid
 
@@ -129,7 +130,7 @@ class SearchStepParams:
         """From a configuration or the step's own part of it, for the object ``obj``."""
         placement = effective_placement(config, obj)
         spec = placement["search"]
-        grasp_type = config["objects"][obj]["grasp_type"]
+        grasp_type = resolved_grasp_type(config, obj)
         if spec["region_mm"][grasp_type] == "hand":  # derived from the hand's geometry (docs/placement_search.md)
             region = _hand_region(config["hand"], config["synergies"])
         else:
