@@ -4,6 +4,7 @@
 #   snakemake -j2 scenario_<name>    one scenario of `scenarios:` (config/README.md); `scenarios`: all
 #   snakemake -j2 sensitivity        the summary across every scenario, and what it reads (docs/sensitivity.md)
 #   snakemake -j2 placement_claims   the claims at every target of the placement search (~15 min)
+#   snakemake -j2 plan               the incremental planner on every object (docs/planner.md)
 #   snakemake --report results/report.html   (or results/report.zip)
 from snakemake.utils import min_version
 
@@ -71,6 +72,12 @@ rule scenarios:
 rule placement_claims:
     input:
         placement_claims_targets(),
+
+
+# The incremental planner against the exhaustive search, every object (docs/planner.md).
+rule plan:
+    input:
+        optional_object_targets("plan"),
 
 
 # The summary across every scenario (docs/sensitivity.md): it pulls each scenario's tables and

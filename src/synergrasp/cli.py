@@ -3,6 +3,8 @@
     synergrasp grasp obj4 --alpha -30 --beta 0 [--configfile my.yaml] [--sets 1 1-5 1-15] [--json]
                      [--png grasp.png] [--html grasp.html [--forces 1-15]]
 
+    synergrasp plan obj4 [--radius 10 20 30] [--configfile my.yaml] [--results results] [--csv plan.csv]
+
 Bad arguments end with one line naming the argument and exit status 2.
 """
 
@@ -91,12 +93,57 @@ def _parser() -> argparse.ArgumentParser:
                                                       "one set as arrows, as one self-contained page")
     grasp.add_argument("--forces", metavar="SET", help="the set whose forces --html draws (default: the last set "
                                                        "asked, {S1..Sk} of every synergy by default)")
+    plan = sub.add_parser("plan", help="the incremental planner on one object, against the study's exhaustive search "
+                                       "(reads <results>/objects/<object>/contacts and gfo tables; docs/planner.md)")
+    plan.add_argument("object", help="an object of the configuration")
+    plan.add_argument("--radius", type=float, nargs="+", help="neighbourhood radii, deg (default: "
+                                                              "analyses.planner_radii_deg)")
+    plan.add_argument("--configfile", nargs="+", default=[], help="overlays on the study's configuration")
+    plan.add_argument("--results", default="results", help="where the study's outputs are")
+    plan.add_argument("--csv", metavar="PATH", help="write the plan table (one row per radius) as CSV")
     return parser
+
+
+def _plan(args: argparse.Namespace) -> int:
+    """``synergrasp plan``: the planner at each radius, one line each."""
+    from dataclasses import replace
+
+    from synergrasp import tables
+    from synergrasp.analysis.plan_study import PlanParams, plan_object
+    from synergrasp.config import ConfigError, validate_config
+    from synergrasp.hand.synergies import load_synergies
+
+    folder = Path(args.results) / "objects" / args.object
+    contacts_path = next((folder / f for f in ("load_carrying_contacts.parquet", "contacts.parquet")
+                          if (folder / f).is_file()), folder / "contacts.parquet")
+    try:
+        cfg = validate_config(_read_overlays(args.configfile))
+        if args.object not in cfg["objects"]:
+            raise ConfigError(f"object {args.object!r} is not in the configuration ({', '.join(cfg['objects'])})")
+        params = PlanParams.from_config(cfg, args.object)
+        params = replace(params, radii_deg=tuple(args.radius)) if args.radius else params
+        contacts = tables.read(tables.CONTACTS, contacts_path)
+        gfo = tables.read(tables.GFO, folder / "gfo.parquet")
+    except (ConfigError, ValueError, FileNotFoundError) as err:
+        print(f"synergrasp plan: {err}", file=sys.stderr)
+        return 2
+    result = plan_object(contacts, gfo, load_synergies(params.synergies).matrix, params)
+    for row in result.table.itertuples():
+        print(f"{row.object} radius {row.radius_deg:g} deg: {row.n_solves} of {row.n_exhaustive_solves} solves "
+              f"({row.solve_share_percent:.1f} %), pose {row.best_pose} (alpha {row.best_alpha_deg:g}, beta "
+              f"{row.best_beta_deg:g}) force {_number(row.best_force_N, 4)} N, exhaustive minimum "
+              f"{_number(row.exhaustive_min_force_N, 4)} N, rank {row.rank} of {row.n_ranked}, regret "
+              f"{_number(row.regret_percent, 3)} %")
+    if args.csv:
+        tables.write_csv(tables.PLAN, result.table, args.csv)
+    return 0
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command; 0 on success, 2 on a bad argument (one line on standard error)."""
     args = _parser().parse_args(argv)
+    if args.command == "plan":
+        return _plan(args)
     from synergrasp.config import ConfigError
     from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import load_synergies

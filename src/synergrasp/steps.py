@@ -162,6 +162,16 @@ STEPS: dict[str, Step] = {
         reads=("hand", "synergies", "mechanics.mu", "mechanics.g_m_per_s2", "synergy_sets.incremental_max",
                "objects.{object}.shape", "objects.{object}.mass_kg"),
         upstream=("contacts", "optimise"), params="synergrasp.optimisation.quality:QualityParams"),
+    # the incremental planner against the exhaustive search (docs/planner.md): {S1} over the
+    # grid, then {S1..Sk} near the previous level's minima, at 3 radii, and the greedy order
+    "plan": Step(
+        rules={"incremental_plan": Cost("pose", 6.0, 300, 8.0e-3, 0.05)},
+        outputs={"plan": "plan.csv", "enrollment": "enrollment.csv", **_files(("plan",), "", _PNG_PDF)},
+        scope="object",
+        reads=("synergies", "mechanics", "synergy_sets.incremental_max", "objects.{object}.mass_kg",
+               "analyses.minima_radius_deg", "analyses.success", "analyses.planner_radii_deg"),
+        reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
+        upstream=("contacts", "optimise"), params="synergrasp.analysis.plan_study:PlanParams", optional=True),
     "tables": Step(
         rules={"study_tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
         outputs=_files(TABLES, "tables", ("csv", "md")),

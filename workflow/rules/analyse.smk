@@ -177,3 +177,31 @@ rule summarise_target_claims:
         runtime=runtime_min("summarise_target_claims"),
     script:
         "../scripts/summarise_target_claims.py"
+
+
+# The incremental planner against the exhaustive search (docs/planner.md): made by
+# `snakemake -j2 plan` (or `synergrasp plan OBJECT`), not by `figures`.
+rule incremental_plan:
+    input:
+        contacts=step_input("contacts"),
+        gfo=step_input("optimise"),
+        code=code("incremental_plan"),
+        data=SHIPPED_DATA,
+        user=user_files,
+    output:
+        plan="{root}/objects/{object}/plan.csv",
+        enrollment="{root}/objects/{object}/enrollment.csv",
+        png="{root}/objects/{object}/plan.png",
+        pdf="{root}/objects/{object}/plan.pdf",
+    log:
+        "{root}/logs/incremental_plan/{object}.log",
+    benchmark:
+        "{root}/benchmarks/incremental_plan/{object}.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("incremental_plan"),
+        runtime=runtime_min("incremental_plan"),
+    params:
+        cfg=step_cfg("plan"),
+    script:
+        "../scripts/incremental_plan.py"

@@ -342,6 +342,15 @@ def object_targets(name, scenario_name="default"):
     return list(files)
 
 
+def optional_object_targets(step, name="default"):
+    """The outputs of the optional per-object ``step`` for every object of scenario ``name``."""
+    return [
+        f"{step_root(name, step, obj)}/objects/{obj}/{rel}"
+        for obj in scenario(name)["objects"]
+        for rel in STEPS[step].outputs.values()
+    ]
+
+
 def study_file(name, step, rel):
     """Where scenario ``name``'s file ``rel`` (one of the step's outputs) lives (wherever shared)."""
     return f"{step_root(name, step)}/{rel}"
