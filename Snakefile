@@ -5,6 +5,7 @@
 #   snakemake -j2 sensitivity        the summary across every scenario, and what it reads (docs/sensitivity.md)
 #   snakemake -j2 placement_claims   the claims at every target of the placement search (~15 min)
 #   snakemake -j2 plan               the incremental planner on every object (docs/planner.md)
+#   snakemake -j2 across_objects     the study across its objects, with the planner (docs/random_objects.md)
 #   snakemake --report results/report.html   (or results/report.zip)
 from snakemake.utils import min_version
 
@@ -78,6 +79,15 @@ rule placement_claims:
 rule plan:
     input:
         optional_object_targets("plan"),
+
+
+# The study across its objects with the planner (docs/random_objects.md), and what it reads.
+rule across_objects:
+    input:
+        [
+            study_file("default", "objects_summary", rel)
+            for rel in STEPS["objects_summary"].outputs.values()
+        ],
 
 
 # The summary across every scenario (docs/sensitivity.md): it pulls each scenario's tables and

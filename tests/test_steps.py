@@ -186,7 +186,7 @@ def _rules():
                 for rule in wf._workflow.rules}
 
 
-TARGET_RULES = ("all", "figures", "scenarios", "sensitivity", "placement_claims", "plan")
+TARGET_RULES = ("all", "figures", "scenarios", "sensitivity", "placement_claims", "plan", "across_objects")
 #: Steps declared (their keys are read) whose rule is still to be written.
 NOT_YET_IN_THE_WORKFLOW = ()
 

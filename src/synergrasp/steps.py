@@ -230,6 +230,16 @@ STEPS: dict[str, Step] = {
         outputs={"csv": "tables/placement_claims.csv", "md": "tables/placement_claims.md",
                  **_files(("placement_claims",), "figures", _PNG_PDF)},
         upstream=("target_claims",), optional=True),
+    # the study across its objects, with the planner (docs/random_objects.md): made by
+    # `snakemake -j2 objects_summary`, not by `figures`
+    "objects_summary": Step(
+        rules={"objects_summary": Cost("none", 5.0, 300)},
+        outputs={"csv": "tables/objects_summary.csv", "md": "tables/objects_summary.md",
+                 "intervals_csv": "tables/objects_intervals.csv", "intervals_md": "tables/objects_intervals.md",
+                 "drawn_csv": "tables/random_objects.csv", "drawn_md": "tables/random_objects.md",
+                 **_files(("objects_summary",), "figures", _PNG_PDF)},
+        reads=("synergy_sets", "analyses.planner_radii_deg", "random_objects"), upstream=("tables", "realism", "plan"),
+        params="synergrasp.analysis.objects_summary:ObjectsSummaryParams", optional=True),
     "fig5": Step(
         rules={"fig5_hierarchy": Cost("none", 9.6, 268)},
         outputs=_files(("fig5a_hierarchy_success", "fig5a_hierarchy_success_pooled", "fig5b_hierarchy_force"),

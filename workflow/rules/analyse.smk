@@ -205,3 +205,42 @@ rule incremental_plan:
         cfg=step_cfg("plan"),
     script:
         "../scripts/incremental_plan.py"
+
+
+def plan_inputs(rel):
+    """Input function: every object's file ``rel`` of the `plan` step in the job's scenario."""
+    return lambda w: [
+        f"{step_root(_ROOT_SCENARIO[w.root], 'plan', o)}/objects/{o}/{rel}"
+        for o in scenario_config(w)["objects"]
+    ]
+
+
+rule objects_summary:
+    input:
+        success_rates=study_input("tables", "tables/success_rates.csv"),
+        preservation=study_input("tables", "tables/minimum_preservation.csv"),
+        graspable=study_input("realism", "tables/graspable_objects.csv"),
+        plans=plan_inputs("plan.csv"),
+        enrollment=plan_inputs("enrollment.csv"),
+        code=code("objects_summary"),
+    output:
+        csv="{root}/tables/objects_summary.csv",
+        md="{root}/tables/objects_summary.md",
+        intervals_csv="{root}/tables/objects_intervals.csv",
+        intervals_md="{root}/tables/objects_intervals.md",
+        drawn_csv="{root}/tables/random_objects.csv",
+        drawn_md="{root}/tables/random_objects.md",
+        png="{root}/figures/objects_summary.png",
+        pdf="{root}/figures/objects_summary.pdf",
+    log:
+        "{root}/logs/objects_summary.log",
+    benchmark:
+        "{root}/benchmarks/objects_summary.tsv"
+    threads: 1
+    resources:
+        mem_mb=mem_mb("objects_summary"),
+        runtime=runtime_min("objects_summary"),
+    params:
+        cfg=step_cfg("objects_summary"),
+    script:
+        "../scripts/objects_summary.py"

@@ -56,6 +56,13 @@ def scenario(name):
     return cfg
 
 
+# Objects drawn from pybullet's random meshes (config/examples/random_objects.yaml): added to
+# `objects` before anything is checked; a mesh left out is listed with its reason by the summary.
+if config.get("random_objects"):
+    from synergrasp.simulation.random_objects import add_random_objects
+
+    add_random_objects(config, ROOT)
+
 # Snakemake read the configuration files itself and kept a repeated key's last value.
 _PROBLEMS = configfile_problems(workflow.configfiles)
 if _PROBLEMS:
