@@ -40,10 +40,13 @@ def figure_objects_summary(rows: pd.DataFrame, radii: Sequence[float], png: str 
     axes[2].hist(ks, bins=np.arange(0.5, top + 1.5), label=["PCA order", "greedy order"])
     axes[2].set(xlabel="k at which success reaches 100 %", title="claims 1, 2")
     axes[2].legend(fontsize=7)
-    axes[3].boxplot([_values(rows, f"solve_share_percent_{r:g}") for r in radii], labels=[f"±{r:g}°" for r in radii])
+    names = [f"±{r:g}°" for r in radii]
+    axes[3].boxplot([_values(rows, f"solve_share_percent_{r:g}") for r in radii])
+    axes[3].set_xticks(range(1, len(names) + 1), names)
     axes[3].set(ylabel="solves used (% of exhaustive)", title="planner: savings")
     regrets = [np.maximum(_values(rows, f"regret_percent_{r:g}"), 1e-3) for r in radii]
-    axes[4].boxplot(regrets, labels=[f"±{r:g}°" for r in radii])
+    axes[4].boxplot(regrets)
+    axes[4].set_xticks(range(1, len(names) + 1), names)
     axes[4].set_yscale("log")
     axes[4].set(ylabel="force regret (%; 0 drawn at 1e-3)", title="planner: regret")
     fig.suptitle(f"{n} objects", fontsize=9)
