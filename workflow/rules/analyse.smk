@@ -207,14 +207,6 @@ rule incremental_plan:
         "../scripts/incremental_plan.py"
 
 
-def plan_inputs(rel):
-    """Input function: every object's file ``rel`` of the `plan` step in the job's scenario."""
-    return lambda w: [
-        f"{step_root(_ROOT_SCENARIO[w.root], 'plan', o)}/objects/{o}/{rel}"
-        for o in scenario_config(w)["objects"]
-    ]
-
-
 rule objects_summary:
     input:
         success_rates=study_input("tables", "tables/success_rates.csv"),

@@ -358,6 +358,14 @@ def optional_object_targets(step, name="default"):
     ]
 
 
+def plan_inputs(rel):
+    """Input function: every object's file ``rel`` of the `plan` step in the job's scenario."""
+    return lambda w: [
+        f"{step_root(_ROOT_SCENARIO[w.root], 'plan', o)}/objects/{o}/{rel}"
+        for o in scenario_config(w)["objects"]
+    ]
+
+
 def study_file(name, step, rel):
     """Where scenario ``name``'s file ``rel`` (one of the step's outputs) lives (wherever shared)."""
     return f"{step_root(name, step)}/{rel}"
