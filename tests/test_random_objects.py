@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.analysis.objects_summary import across_objects, object_rows
+from synergrasp.analysis.objects_summary import across_objects, object_rows, with_left_out
 from synergrasp.simulation import random_objects as ro
 
 BOX = Path(__file__).parent / "data" / "box_30x60x100.obj"  # 30 x 60 x 100 units
@@ -88,3 +88,6 @@ def test_summary_rows_and_intervals_from_hand_made_tables():
     summary = across_objects(pd.concat([rows] * 3, ignore_index=True), ["k_full", "global_min_10"]).set_index("quantity")
     assert summary.loc["k_full", "mean"] == 2 and summary.loc["k_full", "low"] == 2 and summary.loc["k_full", "n_objects"] == 3
     assert summary.loc["global_min_10", "mean"] == 0.0 and summary.loc["global_min_10", "unit"] == "% of objects"
+    both = with_left_out(rows, [("rand_439", "mesh cannot be read: non-manifold")])
+    assert both["object"].tolist() == ["a", "rand_439"] and not both["graspable"].iloc[1]
+    assert both["reason"].iloc[1] == "left out: mesh cannot be read: non-manifold"
