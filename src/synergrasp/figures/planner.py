@@ -1,5 +1,5 @@
 """The incremental planner's figure for one object (docs/planner.md): the full set's force map
-with the poses the planner solved at the last level and the pose it returned, beside the
+with the poses the planner solved at the last level (smallest radius) and the pose it returned, beside the
 success of the greedy and the PCA enrollment orders."""
 
 from __future__ import annotations
@@ -33,11 +33,10 @@ def figure_plan(full: pd.DataFrame, plans: Mapping[float, Plan], plan_table: pd.
                           extent=(alphas[0] - 2.5, alphas[-1] + 2.5, betas[0] - 2.5, betas[-1] + 2.5))
     fig.colorbar(image, ax=ax_map, label="log10 optimal force, full set (N)")
     a, b = full["alpha_deg"].to_numpy(float), full["beta_deg"].to_numpy(float)
-    marks = ("o", "s", "D")
-    for (radius, plan), mark in zip(sorted(plans.items()), marks * 4):
-        last = plan.solved[-1]
-        ax_map.scatter(a[last], b[last], s=6, marker=mark, facecolors="none", edgecolors="w", linewidths=0.4,
-                       label=f"solved at k = n, ±{radius:g}°")
+    radius, plan = min(plans.items())  # the smallest radius: the others' squares cover the map
+    last = plan.solved[-1]
+    ax_map.scatter(a[last], b[last], s=6, marker="o", facecolors="none", edgecolors="w", linewidths=0.5,
+                   label=f"solved at k = n, ±{radius:g}°")
     rows = plan_table.sort_values("radius_deg")
     first = rows.iloc[0]
     if first["best_pose"] >= 0:
