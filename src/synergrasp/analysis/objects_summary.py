@@ -121,7 +121,7 @@ class ObjectsSummaryParams:
     random_objects: dict | None
 
     @classmethod
-    def from_config(cls, config: Mapping[str, Any]) -> ObjectsSummaryParams:
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> ObjectsSummaryParams:
         """From a configuration or the step's own part of it."""
         sets = config["synergy_sets"]
         return cls(int(sets["incremental_max"]), int(sets["hierarchy_first"]),
