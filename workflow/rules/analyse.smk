@@ -234,5 +234,6 @@ rule objects_summary:
         runtime=runtime_min("objects_summary"),
     params:
         cfg=step_cfg("objects_summary"),
+        root=str(ROOT),
     script:
         "../scripts/objects_summary.py"
