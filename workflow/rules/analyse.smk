@@ -214,6 +214,7 @@ rule objects_summary:
         graspable=study_input("realism", "tables/graspable_objects.csv"),
         plans=plan_inputs("plan.csv"),
         enrollment=plan_inputs("enrollment.csv"),
+        manifest=random_objects_manifest,
         code=code("objects_summary"),
     output:
         csv="{root}/tables/objects_summary.csv",
@@ -234,6 +235,5 @@ rule objects_summary:
         runtime=runtime_min("objects_summary"),
     params:
         cfg=step_cfg("objects_summary"),
-        root=str(ROOT),
     script:
         "../scripts/objects_summary.py"

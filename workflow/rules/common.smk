@@ -366,6 +366,12 @@ def plan_inputs(rel):
     ]
 
 
+def random_objects_manifest(wildcards):
+    """Input function: the sha256 manifest of the scenario's random objects (none without them)."""
+    spec = scenario_config(wildcards).get("random_objects")
+    return [str(ROOT / spec["sha256_file"])] if spec else []
+
+
 def study_file(name, step, rel):
     """Where scenario ``name``'s file ``rel`` (one of the step's outputs) lives (wherever shared)."""
     return f"{step_root(name, step)}/{rel}"

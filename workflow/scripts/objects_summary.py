@@ -15,7 +15,8 @@ with job_log(snakemake.log[0]):
     enrollment = pd.concat([tables.read_csv(tables.ENROLLMENT, f) for f in inp.enrollment], ignore_index=True)
     rows = object_rows(pd.read_csv(inp.success_rates), pd.read_csv(inp.preservation), pd.read_csv(inp.graspable),
                        plans, enrollment, p.n_full, p.hierarchy_first)
-    drawn = pd.DataFrame([vars(d) for d in drawn_objects(p.random_objects, snakemake.params.root)] if p.random_objects else [],
+    drawn = pd.DataFrame([vars(d) for d in drawn_objects(p.random_objects, manifest=inp.manifest[0])]
+                         if p.random_objects else [],
                          columns=["name", "index", "path", "scale", "longest_side_mm", "problem"])
     left_out = [(d.name, d.problem) for d in drawn.itertuples() if d.problem]
     tables.write_study_table(with_left_out(rows, left_out), out.csv, out.md, title="The study per object")

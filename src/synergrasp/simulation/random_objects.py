@@ -82,20 +82,20 @@ def _check(path: Path, expected: str | None, longest_mm: float) -> tuple[float, 
     return longest_mm / extent, ""
 
 
-def drawn_objects(spec: Mapping[str, Any], root: str | Path = ".") -> list[DrawnObject]:
-    """Every object the ``random_objects`` block draws, in index order; paths of the
-    manifest relative to ``root`` (the project's root)."""
+def drawn_objects(spec: Mapping[str, Any], root: str | Path = ".", manifest: str | Path | None = None) -> list[DrawnObject]:
+    """Every object the ``random_objects`` block draws, in index order; the manifest
+    ``manifest``, else the block's ``sha256_file`` relative to ``root`` (the project's root)."""
     rng = np.random.default_rng(int(spec["seed"]))
     n = int(spec["n_objects"])
     indices = np.sort(rng.choice(N_MESHES, size=n, replace=False))
     lo, hi = (float(v) for v in spec["longest_side_mm"])
     longest = rng.uniform(lo, hi, size=n)
-    manifest = _manifest(Path(root) / spec["sha256_file"])
+    digests = _manifest(manifest if manifest is not None else Path(root) / spec["sha256_file"])
     base = _data_path()
     out = []
     for index, side in zip(indices.tolist(), longest.tolist()):
         rel = f"random_urdfs/{index:03d}/{index:03d}.obj"
-        scale, problem = _check(base / rel, manifest.get(rel), side)
+        scale, problem = _check(base / rel, digests.get(rel), side)
         out.append(DrawnObject(f"rand_{index:03d}", index, str(base / rel), scale, side, problem))
     return out
 
