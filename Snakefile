@@ -4,6 +4,8 @@
 #   snakemake -j2 scenario_<name>    one scenario of `scenarios:` (config/README.md); `scenarios`: all
 #   snakemake -j2 sensitivity        the summary across every scenario, and what it reads (docs/sensitivity.md)
 #   snakemake -j2 placement_claims   the claims at every target of the placement search (~15 min)
+#   snakemake -j2 plans              the incremental planner on every object (docs/planner.md)
+#   snakemake -j2 across_objects     the study across its objects, with the planner (docs/random_objects.md)
 #   snakemake --report results/report.html   (or results/report.zip)
 from snakemake.utils import min_version
 
@@ -70,6 +72,18 @@ rule scenarios:
 rule placement_claims:
     input:
         W.optional_targets("summarise_target_claims"),
+
+
+# The incremental planner against the exhaustive search, every object (docs/planner.md).
+rule plans:
+    input:
+        W.optional_object_targets("plan"),
+
+
+# The study across its objects with the planner (docs/random_objects.md), and what it reads.
+rule across_objects:
+    input:
+        W.optional_targets("objects_summary"),
 
 
 # A failed job keeps the outputs of the run before (synergrasp.preflight).

@@ -192,7 +192,7 @@ def _rules():
                 for rule in wf._workflow.rules}
 
 
-TARGET_RULES = ("all", "figures", "scenarios", "placement_claims")
+TARGET_RULES = ("all", "figures", "scenarios", "placement_claims", "plans", "across_objects")
 
 
 def test_every_step_has_its_rules_outputs_and_costs_and_every_rule_its_step():

@@ -9,6 +9,8 @@ Bad input (an argument, a configuration file, the hand or synergy file it names,
 path that cannot be written) ends with one line per problem naming the argument, the file or
 the key, and exit status 2, before any work: the configuration goes through the workflow's
 own checks (``synergrasp.study_checks``). Warnings on the configuration are printed too.
+
+    synergrasp plan obj4 [--radius 10 20 30] [--configfile my.yaml] [--results results] [--csv plan.csv]
 """
 
 from __future__ import annotations
@@ -126,6 +128,14 @@ def _parser() -> argparse.ArgumentParser:
     show.add_argument("--synergies", help="a synergy table (name or CSV; default: the shipped one, or shadow_hand's)")
     show.add_argument("--png", metavar="PATH", help="write the hand at q_m + sigma S_k, sigma = -1, 0, +1 (PNG)")
     show.add_argument("--count", type=int, default=7, help="synergies drawn (default 7)")
+    plan = sub.add_parser("plan", help="the incremental planner on one object, against the study's exhaustive search "
+                                       "(reads <results>/objects/<object>/contacts and gfo tables; docs/planner.md)")
+    plan.add_argument("object", help="an object of the configuration")
+    plan.add_argument("--radius", type=float, nargs="+", help="neighbourhood radii, deg (default: "
+                                                              "analyses.planner_radii_deg)")
+    plan.add_argument("--configfile", nargs="+", default=[], help="overlays on the study's configuration")
+    plan.add_argument("--results", default="results", help="where the study's outputs are")
+    plan.add_argument("--csv", metavar="PATH", help="write the plan table (one row per radius) as CSV")
     return parser
 
 
@@ -150,6 +160,42 @@ def _output_problems(args: argparse.Namespace) -> list[str]:
             except OSError as err:
                 problems.append(f"{option} {path}: folder '{folder}' cannot be written ({err.strerror or err})")
     return problems
+
+
+def _plan(args: argparse.Namespace) -> int:
+    """``synergrasp plan``: the planner at each radius, one line each."""
+    from dataclasses import replace
+
+    from synergrasp import tables
+    from synergrasp.analysis.plan_study import PlanParams, plan_object
+    from synergrasp.config import ConfigError
+    from synergrasp.hand.synergies import load_synergies
+    from synergrasp.study_checks import checked_scenario, read_overlays
+
+    folder = Path(args.results) / "objects" / args.object
+    contacts_path = next((folder / f for f in ("load_carrying_contacts.parquet", "contacts.parquet")
+                          if (folder / f).is_file()), folder / "contacts.parquet")
+    try:
+        cfg, _ = checked_scenario(read_overlays(args.configfile))
+        if args.object not in cfg["objects"]:
+            raise ConfigError(f"object {args.object!r} is not in the configuration ({', '.join(cfg['objects'])})")
+        params = PlanParams.from_config(cfg, args.object)
+        params = replace(params, radii_deg=tuple(args.radius)) if args.radius else params
+        contacts = tables.read(tables.CONTACTS, contacts_path)
+        gfo = tables.read(tables.GFO, folder / "gfo.parquet")
+    except (ConfigError, ValueError, FileNotFoundError) as err:
+        print(f"synergrasp plan: {err}", file=sys.stderr)
+        return 2
+    result = plan_object(contacts, gfo, load_synergies(params.synergies).matrix, params)
+    for row in result.table.itertuples():
+        print(f"{row.object} radius {row.radius_deg:g} deg: {row.n_solves} of {row.n_exhaustive_solves} solves "
+              f"({row.solve_share_percent:.1f} %), pose {row.best_pose} (alpha {row.best_alpha_deg:g}, beta "
+              f"{row.best_beta_deg:g}) force {_number(row.best_force_N, 4)} N, exhaustive minimum "
+              f"{_number(row.exhaustive_min_force_N, 4)} N, rank {row.rank} of {row.n_ranked}, regret "
+              f"{_number(row.regret_percent, 3)} %")
+    if args.csv:
+        tables.write_csv(tables.PLAN, result.table, args.csv)
+    return 0
 
 
 def _show_hand(args: argparse.Namespace) -> int:
@@ -265,6 +311,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command; 0 on success, 2 on bad input (one line per problem on standard
     error, naming the argument, the file or the key; no traceback)."""
     args = _parser().parse_args(argv)
+    if args.command == "plan":
+        return _plan(args)
     if args.command == "synergies":
         return _fit_synergies(args)
     if args.command == "hand":

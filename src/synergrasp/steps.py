@@ -210,6 +210,17 @@ STEPS: dict[str, Step] = {
                  **_files(("blockers",), "figures", _PNG_PDF, named=False)},
         reads=("synergy_sets.hierarchy_first", "synergy_sets.incremental_max"), upstream=("blockers",),
         report={"csv": ("blockers_table", "Tables"), "png": ("blockers", "Figures")}),
+    # the incremental planner against the exhaustive search (docs/planner.md): {S1} over the
+    # grid, then {S1..Sk} near the previous level's minima, at 3 radii, and the greedy order:
+    # 7.7-8.3 CPU s, 356-371 MB per box of 1800 poses (default study)
+    "plan": Step(
+        rules={"plan": Cost("pose", 3.0, 300, 3.0e-3, 0.04)},
+        outputs={"plan": "plan.csv", "enrollment": "enrollment.csv", **_files(("plan",), "", _PNG_PDF, named=False)},
+        scope="object",
+        reads=("synergies", "mechanics", "synergy_sets.incremental_max", "objects.{object}.mass_kg",
+               "analyses.minima_radius_deg", "analyses.success", "analyses.planner_radii_deg", "hand"),
+        reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
+        upstream=("contacts", "optimise"), params="synergrasp.analysis.plan_study:PlanParams", optional=True),
     "tables": Step(
         rules={"tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
         outputs=_files(TABLES, "tables", ("csv", "md")),
@@ -281,6 +292,16 @@ STEPS: dict[str, Step] = {
                  **_files(("placement_claims",), "figures", _PNG_PDF, named=False)},
         upstream=("target_claims",), optional=True,
         report={"csv": ("placement_claims", "Placement search"), "png": ("placement_claims", "Placement search")}),
+    # the study across its objects, with the planner (docs/random_objects.md): made by
+    # `snakemake -j2 across_objects`, not by `figures`
+    "objects_summary": Step(
+        rules={"objects_summary": Cost("none", 5.0, 300)},
+        outputs={"csv": "tables/objects_summary.csv", "md": "tables/objects_summary.md",
+                 "intervals_csv": "tables/objects_intervals.csv", "intervals_md": "tables/objects_intervals.md",
+                 "drawn_csv": "tables/random_objects.csv", "drawn_md": "tables/random_objects.md",
+                 **_files(("objects_summary",), "figures", _PNG_PDF, named=False)},
+        reads=("synergy_sets", "analyses.planner_radii_deg", "random_objects"), upstream=("tables", "realism", "plan"),
+        params="synergrasp.analysis.objects_summary:ObjectsSummaryParams", optional=True),
     "fig5": Step(
         rules={"fig5": Cost("none", 9.6, 268)},
         outputs={"success_png": "figures/fig5a_hierarchy_success.png", "success_pdf": "figures/fig5a_hierarchy_success.pdf",

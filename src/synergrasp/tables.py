@@ -16,8 +16,8 @@ import pandas as pd
 
 from synergrasp.file_output import replacing
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT",
-           "QUALITY", "TARGET_CLAIMS", "BLOCKERS", "write", "read", "write_csv", "read_csv", "empty", "write_study_table"]
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT", "PLAN", "ENROLLMENT", "BLOCKERS",
+           "QUALITY", "TARGET_CLAIMS", "write", "read", "write_csv", "read_csv", "empty", "write_study_table"]
 
 
 @dataclass(frozen=True)
@@ -255,8 +255,44 @@ BLOCKERS = Table("blockers", "one row per (pose, synergy set) failing Definition
     Column("outside_link_kind", "list<string>", "", "link kind of each of them"),
 ))
 
+#: The incremental planner on one object (docs/planner.md), CSV (results/objects/<object>/plan.csv).
+PLAN = Table("plan", "one row per neighbourhood radius", (
+    Column("object", "string", "", "object name"),
+    Column("radius_deg", "float64", "deg", "neighbourhood half-width around the previous level's minima (alpha wrapped, beta)"),
+    Column("n_levels", "int32", "", "n: the full set is {S1..Sn}"),
+    Column("n_solves", "int32", "", "(pose, set) problems the planner solved over every level"),
+    Column("n_exhaustive_solves", "int32", "", "(pose, set) problems of the exhaustive search: poses x n"),
+    Column("solve_share_percent", "float64", "%", "100 n_solves / n_exhaustive_solves"),
+    Column("levels_from_minima", "int32", "", "levels whose seeds were local minima (the others: the best success, or none)"),
+    Column("best_pose", "int32", "", "the planner's pose with the full set (-1: none succeeds)"),
+    Column("best_alpha_deg", "float64", "deg", "its alpha"),
+    Column("best_beta_deg", "float64", "deg", "its beta"),
+    Column("best_force_N", "float64", "N", "its optimal force with the full set"),
+    Column("exhaustive_min_force_N", "float64", "N", "least optimal force of the full set over every pose"),
+    Column("exhaustive_best_pose", "int32", "", "the first pose with that force"),
+    Column("is_global_min", "bool", "", "the planner's force equals the exhaustive minimum (within 1e-5 relative)"),
+    Column("rank", "int32", "", "1 + poses whose full-set force is lower (twins share a rank; 0: none found)"),
+    Column("n_ranked", "int32", "", "poses in force closure with the full set"),
+    Column("regret", "float64", "", "best_force_N / exhaustive_min_force_N"),
+    Column("regret_percent", "float64", "%", "100 (regret - 1)"),
+    Column("study_rows_differing", "int32", "", "rows the planner solved whose verdict or force (1e-5 relative) differs from the gfo table's"),
+))
+
+#: Greedy enrollment order against the PCA order, one object (results/objects/<object>/enrollment.csv).
+ENROLLMENT = Table("enrollment", "one row per k", (
+    Column("object", "string", "", "object name"),
+    Column("k", "int32", "", "synergies enrolled"),
+    Column("greedy_added", "int32", "", "the k-th synergy of the greedy order (1-based)"),
+    Column("greedy_set", "string", "", "the greedy set's id"),
+    Column("greedy_n_success", "int32", "", "grid poses where the greedy set succeeds"),
+    Column("greedy_success_rate", "float64", "%", "of the full set's successes"),
+    Column("pca_n_success", "int32", "", "grid poses where {S1..Sk} succeeds"),
+    Column("pca_success_rate", "float64", "%", "of the full set's successes"),
+    Column("full_n_success", "int32", "", "grid poses where the full set succeeds"),
+))
+
 TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, QUALITY,
-                                                TARGET_CLAIMS, BLOCKERS)}
+                                                TARGET_CLAIMS, BLOCKERS, PLAN, ENROLLMENT)}
 
 
 def _check(table: Table, frame: pd.DataFrame, where: str) -> None:

@@ -247,6 +247,10 @@ class Wiring:
                  error: type[Exception] = ValueError, warn: Callable[[str], Any] = print,
                  stop: Callable[[list[str]], Any] = lambda lines: None):
         self.config, self.root, self.error, self.warn, self.stop = config, Path(basedir), error, warn, stop
+        if config.get("random_objects"):  # objects drawn from pybullet's meshes, added before any check
+            from synergrasp.simulation.random_objects import add_random_objects
+
+            add_random_objects(config, self.root)
         self._warned: set[str] = set()
         self.src = self.root / "src"
         self._checked: dict[str, dict[str, Any]] = {}
@@ -443,6 +447,23 @@ class Wiring:
         files += [f for step, spec in STEPS.items() if spec.scope == "workflow" and not spec.optional
                   for f in self.workflow_files(step)]
         return files + [f for obj in self.scenario(name)["objects"] for f in self.object_targets(obj, name)]
+
+    def optional_object_targets(self, step: str, name: str = "default") -> list[str]:
+        """The outputs of the optional per-object ``step`` for every object of scenario ``name``."""
+        return [f"{self.step_root(name, step, obj)}/objects/{obj}/{rel}"
+                for obj in self.scenario(name)["objects"] for rel in STEPS[step].outputs.values()]
+
+    def object_files(self, step: str, output: str) -> Callable[[Any], list[str]]:
+        """Input function: every object's file ``output`` (an output name) of the per-object
+        ``step`` in the job's scenario."""
+        rel = STEPS[step].outputs[output]
+        return lambda w: [f"{self.step_root(self.job_scenario(w), step, o)}/objects/{o}/{rel}"
+                          for o in self.job_config(w)["objects"]]
+
+    def random_objects_manifest(self, wildcards: Any) -> list[str]:
+        """Input function: the sha256 manifest of the scenario's random objects (none without them)."""
+        spec = self.job_config(wildcards).get("random_objects")
+        return [str(self.root / spec["sha256_file"])] if spec else []
 
     def optional_targets(self, step: str, name: str = "default") -> list[str]:
         """The files of the optional per-scenario ``step`` of scenario ``name``."""

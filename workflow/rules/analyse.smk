@@ -165,3 +165,51 @@ rule blockers_table:
         cfg=W.step_cfg("blockers_table"),
     script:
         "../scripts/blockers_table.py"
+
+
+# The incremental planner against the exhaustive search (docs/planner.md): made by
+# `snakemake -j2 plans` (or `synergrasp plan OBJECT`), not by `figures`.
+rule plan:
+    input:
+        contacts=W.step_input("contacts"),
+        gfo=W.step_input("optimise"),
+        code=W.code("plan"),
+        data=SHIPPED_DATA,
+        user=W.user_files,
+    output:
+        **outputs("plan"),
+    log:
+        log_file("plan"),
+    benchmark:
+        benchmark_file("plan")
+    threads: threads("plan")
+    resources:
+        **W.resources("plan"),
+    params:
+        cfg=W.step_cfg("plan"),
+    script:
+        "../scripts/plan.py"
+
+
+rule objects_summary:
+    input:
+        success_rates=W.study_input("tables", "tables/success_rates.csv"),
+        preservation=W.study_input("tables", "tables/minimum_preservation.csv"),
+        graspable=W.study_input("realism", "tables/graspable_objects.csv"),
+        plans=W.object_files("plan", "plan"),
+        enrollment=W.object_files("plan", "enrollment"),
+        manifest=W.random_objects_manifest,
+        code=W.code("objects_summary"),
+    output:
+        **outputs("objects_summary"),
+    log:
+        log_file("objects_summary"),
+    benchmark:
+        benchmark_file("objects_summary")
+    threads: threads("objects_summary")
+    resources:
+        **W.resources("objects_summary"),
+    params:
+        cfg=W.step_cfg("objects_summary"),
+    script:
+        "../scripts/objects_summary.py"

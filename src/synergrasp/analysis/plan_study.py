@@ -1,0 +1,178 @@
+"""The incremental planner on one object of the study (the ``plan`` step, docs/planner.md).
+
+Every solve goes through the study's own front door, `optimise_grasps` (one model: the
+gfo step's), on the object's contacts table; the success verdict and its force are the
+study's (`with_verdicts`, ``analyses.success``). The planner (:mod:`synergrasp.analysis.planner`)
+runs once per radius; the object's exhaustive gfo table is the yardstick, and the rows the
+planner solved are compared with it (``study_rows_differing``: same verdict, force within
+1e-5 relative, else counted).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from synergrasp.analysis.minima import FORCE_TIE_RTOL, MinimaParams
+from synergrasp.analysis.planner import Plan, greedy_order, plan_against_exhaustive, plan_incremental
+from synergrasp.analysis.verdicts import with_verdicts
+from synergrasp.ids import incremental_set_id, set_id
+from synergrasp.optimisation.mechanics import first_same_grasp, read_grasps
+from synergrasp.optimisation.problem import SynergySets
+from synergrasp.optimisation.optimise import GFOParams, optimise_grasps
+
+__all__ = ["PlanParams", "ObjectPlan", "StudySolver", "plan_object"]
+
+
+@dataclass(frozen=True)
+class PlanParams:
+    """The ``plan`` step of one object: the planner's radii (deg), the full set's size n,
+    the synergy file (None: the shipped table), the GFO parameters and the minima's policy
+    (radius, verdict, force bound)."""
+
+    radii_deg: tuple[float, ...]
+    n_levels: int
+    synergies: str | None
+    gfo: GFOParams
+    minima: MinimaParams
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str) -> PlanParams:
+        """From a configuration or the step's own part of it, for the object ``obj``."""
+        return cls(tuple(float(r) for r in config["analyses"]["planner_radii_deg"]),
+                   int(config["synergy_sets"]["incremental_max"]), config["synergies"],
+                   GFOParams.from_config(config, obj), MinimaParams.from_config(config, obj))
+
+
+@dataclass(frozen=True)
+class ObjectPlan:
+    """The planner on one object: ``table`` (tables.PLAN, one row per radius), ``enrollment``
+    (tables.ENROLLMENT, one row per k), the plans by radius (deg), and ``full``: the full
+    set's rows of the judged gfo table, one per pose in the contacts' order (``success``,
+    ``success_force`` in N)."""
+
+    table: pd.DataFrame
+    enrollment: pd.DataFrame
+    plans: dict[float, Plan]
+    full: pd.DataFrame
+
+
+class StudySolver:
+    """Solves synergy sets at poses of one object through `optimise_grasps`, one solve per
+    distinct grasp (the study's sharing of twins), and remembers them: a (grasp, set) is
+    solved once however many radii ask. ``n_problems`` counts the problems handed to the
+    solver."""
+
+    def __init__(self, contacts: pd.DataFrame, matrix: NDArray, params: PlanParams):
+        self.contacts = contacts.reset_index(drop=True)
+        self.grasps = read_grasps(self.contacts)
+        self.first = first_same_grasp(self.grasps)
+        self.matrix, self.params = matrix, params
+        self.memo: dict[tuple[str, int], tuple[bool, float]] = {}
+        self.n_problems = 0
+
+    def verdicts(self, sets: Sequence[tuple[int, ...]], poses: NDArray[np.int64]) -> tuple[NDArray, NDArray]:
+        """(len(sets), len(poses)) success (the study's verdict) and its optimal force (N, NaN
+        elsewhere) of every set at every pose."""
+        ids = [set_id(s) for s in sets]
+        reps = np.unique(self.first[poses][self.first[poses] >= 0])
+        new = [int(g) for g in reps if any((i, int(g)) not in self.memo for i in ids)]
+        if new:
+            self._solve(sets, ids, new)
+        success = np.zeros((len(sets), len(poses)), dtype=bool)
+        force = np.full((len(sets), len(poses)), np.nan)
+        for j, pose in enumerate(poses):
+            g = int(self.first[pose])
+            if g < 0:
+                continue
+            for i, sid in enumerate(ids):
+                success[i, j], force[i, j] = self.memo[sid, g]
+        return success, force
+
+    def _solve(self, sets: Sequence[tuple[int, ...]], ids: list[str], grasps: list[int]) -> None:
+        out = optimise_grasps([self.grasps[g] for g in grasps], SynergySets(self.matrix, tuple(sets)), self.params.gfo)
+        self.n_problems += len(grasps) * len(sets)
+        part = self.contacts.iloc[np.repeat(grasps, len(sets))]
+        frame = pd.DataFrame({"object": part["object"].to_numpy(), "pose": part["pose"].to_numpy()} | out)
+        minima = self.params.minima
+        weights = {str(frame["object"].iat[0]): minima.weight_N} if minima.weight_N is not None and len(frame) else None
+        judged = with_verdicts(frame, minima.success, weights, minima.bound_multiple)
+        for row, g in enumerate(np.repeat(grasps, len(sets))):
+            self.memo[ids[row % len(sets)], int(g)] = (bool(judged["success"].iat[row]),
+                                                       float(judged["success_force"].iat[row]))
+
+    def level(self, k: int, poses: NDArray[np.int64]) -> tuple[NDArray, NDArray]:
+        """The planner's solve: {S1..Sk} at ``poses``."""
+        success, force = self.verdicts([tuple(range(1, k + 1))], poses)
+        return success[0], force[0]
+
+
+def _study_differences(solver: StudySolver, gfo: pd.DataFrame, plans: Sequence[Plan]) -> int:
+    """Rows the planner solved whose verdict differs from the study's, or whose force differs
+    by more than the minima's tie tolerance (relative)."""
+    bad = 0
+    for k in range(1, solver.params.n_levels + 1):
+        poses = np.unique(np.concatenate([p.solved[k - 1] for p in plans]))
+        mine, force = solver.level(k, poses)
+        rows = gfo[gfo["set_id"] == incremental_set_id(k)].set_index("pose")
+        theirs = rows.loc[solver.contacts["pose"].to_numpy()[poses]]
+        same = mine == theirs["success"].to_numpy(bool)
+        ft = theirs["success_force"].to_numpy(float)
+        close = np.where(mine & same, np.abs(force - ft) <= FORCE_TIE_RTOL * np.abs(ft), True)
+        bad += int(np.sum(~(same & close)))
+    return bad
+
+
+def plan_object(contacts: pd.DataFrame, gfo: pd.DataFrame, matrix: NDArray, params: PlanParams) -> ObjectPlan:
+    """The planner at every radius of ``params`` on one object, against the exhaustive search.
+
+    ``gfo``: the object's gfo table (the exhaustive search); ``contacts``: its contacts table,
+    one row per pose in the same pose order; ``matrix``: the synergy matrix (n_joints, K)."""
+    minima = params.minima
+    weights = {str(gfo["object"].iat[0]): minima.weight_N} if minima.weight_N is not None else None
+    judged = with_verdicts(gfo, minima.success, weights, minima.bound_multiple)
+    n = params.n_levels
+    full = judged[judged["set_id"] == incremental_set_id(n)].set_index("pose").loc[contacts["pose"].to_numpy()]
+    solver = StudySolver(contacts, matrix, params)
+    alpha, beta = contacts["alpha_deg"].to_numpy(float), contacts["beta_deg"].to_numpy(float)
+    plans = {r: plan_incremental(alpha, beta, solver.level, n, r, minima.radius_deg, 360.0) for r in params.radii_deg}
+    differing = _study_differences(solver, judged, list(plans.values()))
+    rows = []
+    for r, plan in plans.items():
+        versus = plan_against_exhaustive(plan, full["success"].to_numpy(bool), full["success_force"].to_numpy(float))
+        best = plan.best_pose
+        rows.append({"object": str(contacts["object"].iat[0]), "radius_deg": r, "n_levels": n,
+                     "n_solves": plan.n_solves, "n_exhaustive_solves": len(contacts) * n,
+                     "solve_share_percent": 100.0 * plan.n_solves / (len(contacts) * n),
+                     "levels_from_minima": int(sum(plan.from_minima)),
+                     "best_pose": best, "best_alpha_deg": alpha[best] if best >= 0 else np.nan,
+                     "best_beta_deg": beta[best] if best >= 0 else np.nan, "best_force_N": plan.best_force_N,
+                     **versus, "regret_percent": 100.0 * (versus["regret"] - 1.0),
+                     "study_rows_differing": differing})
+    enrollment = _enrollment(solver, full["success"].to_numpy(bool), judged, contacts, n)
+    return ObjectPlan(pd.DataFrame(rows), enrollment, plans, full.reset_index())
+
+
+def _enrollment(solver: StudySolver, full_success: NDArray, judged: pd.DataFrame, contacts: pd.DataFrame,
+                n: int) -> pd.DataFrame:
+    """Greedy order against the PCA order: successes (grid poses) of each order's first k."""
+    # a set can succeed only where the full set does (nested sets): solve there only
+    where = np.flatnonzero(full_success).astype(np.int64)
+
+    def count(sets: Sequence[tuple[int, ...]]) -> NDArray[np.int64]:
+        return solver.verdicts(sets, where)[0].sum(axis=1) if where.size else np.zeros(len(sets), dtype=np.int64)
+
+    target = int(where.size)
+    order, greedy = greedy_order(count, n, target)
+    pca = [int(judged.loc[judged["set_id"] == incremental_set_id(k), "success"].sum()) for k in range(1, n + 1)]
+    pct = (lambda c: 100.0 * c / target) if target else (lambda c: np.nan)
+    return pd.DataFrame({"object": str(contacts["object"].iat[0]), "k": np.arange(1, n + 1),
+                         "greedy_added": order, "greedy_set": [set_id(order[:k]) for k in range(1, n + 1)],
+                         "greedy_n_success": greedy, "greedy_success_rate": [pct(c) for c in greedy],
+                         "pca_n_success": pca, "pca_success_rate": [pct(c) for c in pca],
+                         "full_n_success": target})

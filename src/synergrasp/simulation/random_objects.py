@@ -1,0 +1,116 @@
+"""Objects drawn from pybullet's 1,000 procedurally generated meshes (docs/random_objects.md).
+
+The configuration's ``random_objects`` block (config/examples/random_objects.yaml) names how
+many objects to draw, a seed, the range of their longest side and their mass. The meshes
+``random_urdfs/NNN/NNN.obj`` are read where the installed ``pybullet_data`` package holds
+them (not copied), each checked against the sha256 of a shipped manifest. The rule:
+
+1. ``numpy.random.default_rng(seed)`` draws ``n_objects`` distinct indices of 0…999 (sorted),
+   then one longest side per object, uniform in ``longest_side_mm`` (mm);
+2. each mesh is scaled (mm per file unit) so that the longest side of its axis-aligned
+   bounding box is that length;
+3. an object whose file is missing, differs from the manifest, cannot be read as a closed
+   mesh or is degenerate (no volume) is left out of ``objects`` with the reason, and the
+   others go on; :func:`drawn_objects` lists every drawn object with its reason.
+
+Objects are named ``rand_NNN`` (NNN the mesh's index).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Mapping, MutableMapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from synergrasp.simulation.shapes.mesh_file import MeshFileError, read_mesh
+
+__all__ = ["DrawnObject", "drawn_objects", "add_random_objects", "N_MESHES"]
+
+#: Meshes in pybullet_data/random_urdfs.
+N_MESHES = 1000
+
+
+@dataclass(frozen=True)
+class DrawnObject:
+    """One drawn mesh: name, index, path, scale (mm per unit; NaN if unread), longest side
+    (mm), and why it is left out ('' if it is studied)."""
+
+    name: str
+    index: int
+    path: str
+    scale: float
+    longest_side_mm: float
+    problem: str
+
+
+def _manifest(path: str | Path) -> dict[str, str]:
+    """``sha256sum`` lines -> {relative path: digest}."""
+    out = {}
+    for line in Path(path).read_text(encoding="utf-8").splitlines():
+        if line.strip():
+            digest, name = line.split(maxsplit=1)
+            out[name.lstrip("*").strip()] = digest
+    return out
+
+
+def _data_path() -> Path:
+    import pybullet_data
+
+    return Path(pybullet_data.getDataPath())
+
+
+def _check(path: Path, expected: str | None, longest_mm: float) -> tuple[float, str]:
+    """(scale, problem) of one mesh file."""
+    if not path.is_file():
+        return float("nan"), f"file missing: {path}"
+    data = path.read_bytes()
+    if expected is None:
+        return float("nan"), "not in the sha256 manifest"
+    if hashlib.sha256(data).hexdigest() != expected:
+        return float("nan"), "sha256 differs from the manifest"
+    try:
+        mesh = read_mesh(path)
+    except MeshFileError as err:
+        return float("nan"), f"mesh cannot be read: {err}"
+    extent = float(np.ptp(mesh.vertices, axis=0).max())
+    if not extent > 0 or not mesh.volume > 1e-9 * extent ** 3:
+        return float("nan"), "degenerate mesh (no extent or no volume)"
+    return longest_mm / extent, ""
+
+
+def drawn_objects(spec: Mapping[str, Any], root: str | Path = ".", manifest: str | Path | None = None) -> list[DrawnObject]:
+    """Every object the ``random_objects`` block draws, in index order; the manifest
+    ``manifest``, else the block's ``sha256_file`` relative to ``root`` (the project's root)."""
+    rng = np.random.default_rng(int(spec["seed"]))
+    n = int(spec["n_objects"])
+    indices = np.sort(rng.choice(N_MESHES, size=n, replace=False))
+    lo, hi = (float(v) for v in spec["longest_side_mm"])
+    longest = rng.uniform(lo, hi, size=n)
+    digests = _manifest(manifest if manifest is not None else Path(root) / spec["sha256_file"])
+    base = _data_path()
+    out = []
+    for index, side in zip(indices.tolist(), longest.tolist()):
+        rel = f"random_urdfs/{index:03d}/{index:03d}.obj"
+        scale, problem = _check(base / rel, digests.get(rel), side)
+        out.append(DrawnObject(f"rand_{index:03d}", index, str(base / rel), scale, side, problem))
+    return out
+
+
+def add_random_objects(config: MutableMapping[str, Any], root: str | Path = ".") -> list[DrawnObject]:
+    """Add the studied objects of ``config["random_objects"]`` (if any) to ``config["objects"]``
+    (a mesh shape, the block's mass); return every drawn object. The block's values must
+    have been given in full (the example file gives every key)."""
+    spec = config.get("random_objects")
+    if not spec:
+        return []
+    drawn = drawn_objects(spec, root)
+    objects = config.setdefault("objects", {})
+    for obj in drawn:
+        if not obj.problem:
+            objects[obj.name] = {"shape": {"mesh": {"path": obj.path, "scale": obj.scale}},
+                                 "mass_kg": float(spec["mass_kg"])}
+    return drawn
