@@ -111,7 +111,7 @@ def test_the_planner_on_the_study_solver_reproduces_the_gfo_table():
     rng = np.random.default_rng(38)
     grasps = [random_grasp(rng, int(rng.integers(4, 10))) for _ in range(12)]
     grasps[5] = None
-    from test_study import _contacts_of
+    from test_optimise import _contacts_of
 
     contacts = _contacts_of(grasps)
     contacts["alpha_deg"] = np.repeat(np.arange(-180.0, 180.0, 90.0), 3)  # 4 x 3 grid
@@ -146,7 +146,7 @@ def test_synergrasp_plan_reads_the_study_s_tables_and_prints_one_line_per_radius
     from synergrasp import tables
     from synergrasp.cli import main
     from synergrasp.hand.synergies import load_synergies
-    from test_study import _contacts_of
+    from test_optimise import _contacts_of
 
     rng = np.random.default_rng(7)
     contacts = _contacts_of([random_grasp(rng, int(rng.integers(4, 10))) for _ in range(6)])
