@@ -82,7 +82,7 @@ def solve_gfo(
         return _ipm_sets(problems, strict_shrink, tol, max_iter, ipm)
     items = as_problems(problems)
     sol = GFOSolution.empty(len(items), strict_shrink is not None)
-    solve = _per_problem(method, tol, max_iter)
+    solve = None if method == "ipm" else _per_problem(method, tol, max_iter)
     for k, problem in enumerate(items):
         sol.e_s[k] = problem.e_s
         if method == "ipm":
@@ -95,11 +95,14 @@ def solve_gfo(
 
 
 def _per_problem(method: str, tol: float, max_iter: int):
-    if method == "clarabel":
-        return lambda p: clarabel_solver.solve(p, tol=tol, max_iter=max_iter)
-    if method == "piqp":
-        return lambda p: piqp_solver.solve(p, tol=tol, max_iter=max_iter)
-    return cvxpy_reference.solve
+    """The one-problem solver of a back end solved problem by problem (every method but the
+    kernel's); a method in METHODS without one here is an error, never a silent cvxpy."""
+    solvers = {"clarabel": lambda p: clarabel_solver.solve(p, tol=tol, max_iter=max_iter),
+               "piqp": lambda p: piqp_solver.solve(p, tol=tol, max_iter=max_iter),
+               "cvxpy": cvxpy_reference.solve}
+    if method not in solvers:
+        raise ValueError(f"method {method!r} has no one-problem solver (gfo._per_problem)")
+    return solvers[method]
 
 
 def _fallback(sol: GFOSolution, k: int, problem: GFOProblem, tol: float, max_iter: int) -> None:
