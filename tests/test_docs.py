@@ -46,3 +46,14 @@ def test_measurements_page_is_what_the_tool_writes_from_the_committed_files():
     linked = {anchor for path in [*ROOT.glob("*.md"), *(ROOT / "docs").glob("*.md")]
               for anchor in re.findall(r"measurements\.md#([a-z0-9-]+)", path.read_text())}
     assert "closure" in anchors and not linked - anchors
+
+
+def test_every_module_of_the_package_is_in_design_md():
+    """docs/design.md's module table names every module of src/synergrasp (a new module is
+    described where a contributor looks for it)."""
+    text = (ROOT / "docs" / "design.md").read_text()
+    package = ROOT / "src" / "synergrasp"
+    modules = ["/".join(p.relative_to(package).with_suffix("").parts) for p in sorted(package.rglob("*.py"))
+               if p.name != "__init__.py"]
+    missing = [m for m in modules if f"| `{m}` |" not in text]
+    assert len(modules) > 50 and missing == []
