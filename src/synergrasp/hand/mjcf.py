@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from synergrasp.hand.geometry import Shape, axis_rotation
+from synergrasp.hand.geometry import Shape, axis_rotation, pose_matrix
 from synergrasp.hand.hand_file import FINGERS, FingerSpec, HandSpec, JointSpec
 
 __all__ = ["mjcf_hand_spec", "compile_mjcf", "MM_PER_M"]
@@ -69,22 +69,21 @@ def compile_mjcf(path: str | Path) -> Any:
     return mujoco.MjModel.from_xml_path(str(path))
 
 
-def _local(model: Any, body: int) -> NDArray[np.float64]:
-    """Pose (4 × 4, mm) of ``body`` in its parent body's frame, joints at zero."""
+def _pose(quat: NDArray, pos_m: NDArray) -> NDArray[np.float64]:
+    """A MuJoCo frame (unit quaternion, position in m) as a 4 × 4 pose, mm."""
     import mujoco
 
-    t = np.eye(4)
     rot = np.zeros(9)
-    mujoco.mju_quat2Mat(rot, model.body_quat[body])
-    t[:3, :3] = rot.reshape(3, 3)
-    t[:3, 3] = model.body_pos[body] * MM_PER_M
-    return t
-
-
-def _translation(v: NDArray) -> NDArray[np.float64]:
+    mujoco.mju_quat2Mat(rot, quat)
     t = np.eye(4)
-    t[:3, 3] = v
+    t[:3, :3] = rot.reshape(3, 3)
+    t[:3, 3] = np.asarray(pos_m) * MM_PER_M
     return t
+
+
+def _local(model: Any, body: int) -> NDArray[np.float64]:
+    """Pose (4 × 4, mm) of ``body`` in its parent body's frame, joints at zero."""
+    return _pose(model.body_quat[body], model.body_pos[body])
 
 
 def _hinge(model: Any, joint: int, angle: float) -> NDArray[np.float64]:
@@ -92,7 +91,7 @@ def _hinge(model: Any, joint: int, angle: float) -> NDArray[np.float64]:
     anchor = model.jnt_pos[joint] * MM_PER_M
     turn = np.eye(4)
     turn[:3, :3] = axis_rotation(model.jnt_axis[joint] / np.linalg.norm(model.jnt_axis[joint]), angle)
-    return _translation(anchor) @ turn @ _translation(-anchor)
+    return pose_matrix(anchor) @ turn @ pose_matrix(-anchor)
 
 
 def _geom_shape(m: _Model, geom: int, pose: NDArray) -> Shape:
@@ -113,14 +112,8 @@ def _geom_shape(m: _Model, geom: int, pose: NDArray) -> Shape:
 
 
 def _geom_pose(model: Any, geom: int) -> NDArray[np.float64]:
-    import mujoco
-
-    t = np.eye(4)
-    rot = np.zeros(9)
-    mujoco.mju_quat2Mat(rot, model.geom_quat[geom])
-    t[:3, :3] = rot.reshape(3, 3)
-    t[:3, 3] = model.geom_pos[geom] * MM_PER_M
-    return t
+    """Pose (4 × 4, mm) of a geom in its body's frame."""
+    return _pose(model.geom_quat[geom], model.geom_pos[geom])
 
 
 def _vector(doc: dict, key: str, where: str, default: list[float]) -> NDArray[np.float64]:
@@ -185,7 +178,7 @@ def mjcf_hand_spec(doc: dict, path: Path, where: str) -> HandSpec:
     owner = _link_owner(m, palm, chains, fixed, couplings)
     frame = _palm_frame(doc, where)
     body_pose = _body_poses(m, palm, fixed, frame)
-    joint_frames = {j: body_pose[model.jnt_bodyid[j]] @ _translation(model.jnt_pos[j] * MM_PER_M)
+    joint_frames = {j: body_pose[model.jnt_bodyid[j]] @ pose_matrix(model.jnt_pos[j] * MM_PER_M)
                     for chain in chains.values() for j, _ in chain}
     shapes: dict[int, list[Shape]] = {-1: []}
     for geom in range(model.ngeom):

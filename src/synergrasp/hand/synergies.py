@@ -64,6 +64,16 @@ class SynergyFileError(ValueError):
     """A synergy file (or mapping) is malformed; the message names file, field and what is allowed."""
 
 
+def read_text_table(path: str | Path, where: str) -> pd.DataFrame:
+    """A CSV file's cells as text; SynergyFileError prefixed ``where`` if it cannot be read."""
+    try:
+        return pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True)
+    except OSError as err:
+        raise SynergyFileError(f"{where}: cannot be read ({err.strerror or err})") from None
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as err:
+        raise SynergyFileError(f"{where}: not a readable CSV table ({err})") from None
+
+
 def finite_cells(table: Any, columns: Sequence[str], problem: Callable[[int, str, str], str]) -> NDArray[np.float64]:
     """(rows, len(columns)) the table's text cells as floats (rad); a cell that is no finite
     number raises SynergyFileError with ``problem(row, column, text)`` (row 0-based)."""
@@ -172,12 +182,7 @@ def _syn_names(k: int) -> list[str]:
 def _read_table(path: str | Path, joint_names: Sequence[str]) -> tuple[list[str], NDArray, NDArray]:
     """Read and validate a synergy CSV; return (syn columns, mean, matrix) in joint_names order."""
     where = f"synergy file '{path}'"
-    try:
-        table = pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True)
-    except OSError as err:
-        raise SynergyFileError(f"{where}: cannot be read ({err.strerror or err})") from None
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as err:
-        raise SynergyFileError(f"{where}: not a readable CSV table ({err})") from None
+    table = read_text_table(path, where)
     columns = [str(c).strip() for c in table.columns]
     table.columns = columns
     for required in ("joint", "mean_rad"):

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from synergrasp.hand.synergies import Synergies, SynergyFileError, finite_cells
+from synergrasp.hand.synergies import Synergies, SynergyFileError, finite_cells, read_text_table
 
 __all__ = ["SynergyFit", "read_postures", "fit_synergies", "orient_columns"]
 
@@ -60,12 +60,7 @@ def read_postures(path: str | Path) -> tuple[tuple[str, ...], NDArray[np.float64
     and the field: unreadable, fewer than two postures, a repeated joint, a value that is
     not a finite number."""
     where = f"postures file '{path}'"
-    try:
-        table = pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True)
-    except OSError as err:
-        raise SynergyFileError(f"{where}: cannot be read ({err.strerror or err})") from None
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as err:
-        raise SynergyFileError(f"{where}: not a readable CSV table ({err})") from None
+    table = read_text_table(path, where)
     with open(path, encoding="utf-8", newline="") as handle:  # pandas renames a repeated column
         names = tuple(c.strip() for c in next(csv.reader(handle)))
     repeated = sorted({n for n in names if names.count(n) > 1})
