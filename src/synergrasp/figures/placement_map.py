@@ -38,7 +38,8 @@ def _level_panel(ax: Any, level: pd.DataFrame, spacing_mm: float, outline: tuple
                                facecolor=colour, edgecolor="white", linewidth=0.4))
     y0, y1, z0, z1 = outline
     ax.add_patch(Rectangle((y0, z0), y1 - y0, z1 - z0, fill=False, edgecolor="0.3", linewidth=1.0, linestyle="--"))
-    ax.text(y0 + 2, z0 + 2, "palm", fontsize=6, color="0.3", va="bottom")
+    ax.text(max(y0, limits[0]) + 2, max(z0, limits[2]) + 2, "palm", fontsize=6, color="0.3", va="bottom",
+            clip_on=True)  # inside the panel where the palm reaches beyond the targets
     for _, row in level[level["distinct_rank"].between(1, 3)].iterrows():
         k = int(row["distinct_rank"])
         ax.plot(row["y_mm"], row["z_mm"], marker="*" if k == 1 else "o", ms=13 if k == 1 else 7,
@@ -99,7 +100,7 @@ def figure_placement_map(hand: Any, obj: Any, placement: pd.DataFrame, contacts:
     grasp_axes = [fig.add_subplot(bottom[0, c]) for c in range(n_grasps * views)]
     draw_grasp_row(grasp_axes, hand, obj, contacts, tuple(c for _, c in GRASP_VIEWS), oppositions)
     fig.suptitle(f"{obj.name} ({chosen['grasp_type']}): chosen target ({chosen['x_mm']:g}, {chosen['y_mm']:g}, "
-                 f"{chosen['z_mm']:g}) mm, {chosen['typed_percent']:.0f} % {chosen['grasp_type']} grasps in force "
+                 f"{chosen['z_mm']:g}) mm,\n{chosen['typed_percent']:.0f} % {chosen['grasp_type']} grasps in force "
                  f"closure ({chosen['force_closure_percent']:.0f} % force closure of any kind), median force "
                  f"{chosen['median_force_per_weight']:.2g} × weight, {len(placement)} targets scored on "
                  f"{int(chosen['n_poses'])} poses; grasps at it below", fontsize=9)
