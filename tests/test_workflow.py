@@ -458,3 +458,26 @@ def test_small_study_on_the_shadow_hand(tmp_path):
     assert realism.loc["obj4", "contacts_median"] >= 3 and realism.loc["obj4", "pct_force_closure"] > 0
     contacts = pd.read_parquet(tmp_path / "results" / "objects" / "obj4" / "contacts.parquet")
     assert contacts["q"].map(len).eq(17).all()
+
+
+def test_random_objects_example_plans_every_drawn_object(tmp_path):
+    """config/examples/random_objects.yaml (n_objects: 3): a dry run of `across_objects`
+    plans the steps of each drawn object that is studied, and the summary across objects."""
+    import yaml
+
+    from synergrasp.config import overlay
+    from synergrasp.simulation.random_objects import drawn_objects
+
+    example = yaml.safe_load((ROOT / "config" / "examples" / "random_objects.yaml").read_text())
+    spec = {**example["random_objects"], "n_objects": 3,
+            "sha256_file": str(ROOT / example["random_objects"]["sha256_file"])}
+    configfile = tmp_path / "three_random.yaml"
+    configfile.write_text(yaml.safe_dump(overlay(overlay(yaml.safe_load(SMALL.read_text()), example),
+                                                 {"random_objects": spec})))
+    out = snakemake(tmp_path, "-n", "across_objects", configfile=configfile)
+    assert out.returncode == 0, out.stderr[-5000:]
+    studied = [o.name for o in drawn_objects(spec, ROOT) if not o.problem]
+    assert studied
+    for name in studied:
+        assert f"object={name}" in out.stdout, name
+    assert "objects_summary" in out.stdout

@@ -11,13 +11,6 @@ from synergrasp.preflight import keep_outputs_until_replaced, outdate_failed_out
 from synergrasp.steps import rule_costs
 from synergrasp.wiring import RuleFiles, Wiring, cancel_scheduler_timers, report_archive
 
-# Objects drawn from pybullet's random meshes (config/examples/random_objects.yaml): added to
-# `objects` before anything is checked; a mesh left out is listed with its reason by the summary.
-if config.get("random_objects"):
-    from synergrasp.simulation.random_objects import add_random_objects
-
-    add_random_objects(config, ROOT)
-
 # Snakemake read the configuration files itself and kept a repeated key's last value.
 refuse(configfile_problems(workflow.configfiles))
 
