@@ -11,7 +11,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.analysis.objects_summary import across_objects, object_rows, with_left_out
+from synergrasp.analysis.graspability import with_left_out
+from synergrasp.analysis.objects_summary import across_objects, object_rows
 from synergrasp.simulation import random_objects as ro
 
 BOX = Path(__file__).parent / "data" / "box_30x60x100.obj"  # 30 x 60 x 100 units
@@ -54,6 +55,8 @@ def test_every_drawn_mesh_is_studied_or_left_out_with_its_reason(tmp_path, monke
     assert edited.problem == "sha256 differs from the manifest"
     assert missing.problem.startswith("file missing")
     assert flat.problem.startswith("mesh cannot be read")
+    assert ro.left_out(spec, [tmp_path / "manifest.sha256"]) == [(d.name, d.problem) for d in (edited, missing, flat)]
+    assert ro.left_out(None, []) == []
     config = {"objects": {"obj1": None}, "random_objects": spec}
     ro.add_random_objects(config, tmp_path)
     assert list(config["objects"]) == ["obj1", "rand_000"]
@@ -88,6 +91,12 @@ def test_summary_rows_and_intervals_from_hand_made_tables():
     summary = across_objects(pd.concat([rows] * 3, ignore_index=True), ["k_full", "global_min_10"]).set_index("quantity")
     assert summary.loc["k_full", "mean"] == 2 and summary.loc["k_full", "low"] == 2 and summary.loc["k_full", "n_objects"] == 3
     assert summary.loc["global_min_10", "mean"] == 0.0 and summary.loc["global_min_10", "unit"] == "% of objects"
-    both = with_left_out(rows, [("rand_439", "mesh cannot be read: non-manifold")])
+    # a mesh left out before the study: a row of the graspable table, then of the summary, with
+    # its reason and no value, so the intervals over objects do not count it
+    both = with_left_out(graspable, [("rand_439", "mesh cannot be read: non-manifold")])
     assert both["object"].tolist() == ["a", "rand_439"] and not both["graspable"].iloc[1]
-    assert both["reason"].iloc[1] == "left out: mesh cannot be read: non-manifold"
+    assert both["reason"].iloc[1] == "left out: mesh cannot be read: non-manifold" and both["poses"].iloc[1] == 0
+    rows = object_rows(rates, preservation, both, plans, enrollment, n_full=3, hierarchy_first=3)
+    assert rows["reason"].iloc[1] == "left out: mesh cannot be read: non-manifold"
+    assert np.isnan(rows["k_full"].iloc[1]) and np.isnan(rows["preserved_percent"].iloc[1])
+    assert across_objects(rows, ["k_full"]).set_index("quantity").loc["k_full", "n_objects"] == 1

@@ -239,7 +239,7 @@ STEPS: dict[str, Step] = {
                  "graspable_csv": "tables/graspable_objects.csv", "graspable_md": "tables/graspable_objects.md"},
         reads=("hand", "synergies", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2",
                "mechanics.k_ss_Nmm_per_rad", "mechanics.mu", "closure.model", "objects.*.shape",
-               "objects.*.grasp_type", "grasp_type", "opposition"),
+               "objects.*.grasp_type", "grasp_type", "opposition", "random_objects"),
         reads_when=(("closure.model", "dynamic", ("closure.dynamic.load_threshold_N",)),),
         upstream=("contacts", "optimise"), synergy_columns=(1,), params="synergrasp.analysis.realism:RealismParams",
         report={"csv": ("grasp_realism_table", "Tables"), "png": ("grasp_realism", "Figures"),

@@ -45,6 +45,7 @@ rule realism:
     input:
         contacts=W.step_inputs("contacts"),
         gfo=W.step_inputs("optimise"),
+        manifest=W.random_objects_manifest,
         code=W.code("realism"),
         data=SHIPPED_DATA,
         user=W.user_files,

@@ -3,7 +3,7 @@
 import pandas as pd
 
 from synergrasp import tables
-from synergrasp.analysis.objects_summary import ObjectsSummaryParams, across_objects, object_rows, with_left_out
+from synergrasp.analysis.objects_summary import ObjectsSummaryParams, across_objects, object_rows
 from synergrasp.figures.objects_summary import figure_objects_summary
 from synergrasp.job_log import job_log
 from synergrasp.simulation.random_objects import drawn_objects
@@ -18,9 +18,8 @@ with job_log(snakemake.log[0]):
     drawn = pd.DataFrame([vars(d) for d in drawn_objects(p.random_objects, manifest=inp.manifest[0])]
                          if p.random_objects else [],
                          columns=["name", "index", "path", "scale", "longest_side_mm", "problem"])
-    left_out = [(d.name, d.problem) for d in drawn.itertuples() if d.problem]
-    tables.write_study_table(with_left_out(rows, left_out), out.csv, out.md, title="The study per object")
+    tables.write_study_table(rows, out.csv, out.md, title="The study per object")
     tables.write_study_table(across_objects(rows, p.quantities()), out.intervals_csv, out.intervals_md,
                              title="Across objects (95 % intervals: bootstrap over objects)")
     tables.write_study_table(drawn, out.drawn_csv, out.drawn_md, title="Drawn meshes (problem: why left out)")
-    figure_objects_summary(rows, p.radii_deg, out.png, out.pdf)
+    figure_objects_summary(rows[~rows["reason"].str.startswith("left out")], p.radii_deg, out.png, out.pdf)

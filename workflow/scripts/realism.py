@@ -5,13 +5,14 @@ graspable-objects table, and one line per object that can never be grasped."""
 import pandas as pd
 
 from synergrasp import tables
-from synergrasp.analysis.graspability import graspable_objects, ungraspable_lines
+from synergrasp.analysis.graspability import graspable_objects, ungraspable_lines, with_left_out
 from synergrasp.analysis.realism import RealismParams, grasp_labels, grasp_realism, link_shares
 from synergrasp.figures.grasp_realism import figure_grasp_realism
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.job_log import job_log
 from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
 from synergrasp.simulation.opposition import HandAxes
+from synergrasp.simulation.random_objects import left_out
 
 with job_log(snakemake.log[0]) as log:
     params = RealismParams.from_config(snakemake.params.cfg)
@@ -28,7 +29,8 @@ with job_log(snakemake.log[0]) as log:
     tables.write_study_table(link_shares(contacts, hand.link_names, hand.link_finger), snakemake.output.links_csv,
                              snakemake.output.links_md, title="Which links touch the box (% of simulated grasps)")
     figure_grasp_realism(table, snakemake.output.png, snakemake.output.pdf)
-    graspable = graspable_objects(contacts, gfo, params.full_set_id)
+    graspable = with_left_out(graspable_objects(contacts, gfo, params.full_set_id),
+                              left_out(params.random_objects, snakemake.input.manifest))
     tables.write_study_table(graspable, snakemake.output.graspable_csv, snakemake.output.graspable_md,
                              title="Graspable objects")
     for line in ungraspable_lines(graspable):  # on the console and in the job's log

@@ -17,13 +17,15 @@ DataFrame (or lines) out.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import pandas as pd
 
 from synergrasp.analysis.verdicts import verdict_columns
 from synergrasp.ids import set_members, set_name
 from synergrasp.tables import GRASPABLE_OBJECTS
 
-__all__ = ["graspable_objects", "ungraspable_lines"]
+__all__ = ["graspable_objects", "with_left_out", "ungraspable_lines"]
 
 #: Statuses of a closure that ran (synergrasp.simulation.contacts.STATUSES).
 _RAN = ("grasp", "no_contact")
@@ -68,6 +70,16 @@ def graspable_objects(contacts: pd.DataFrame, gfo: pd.DataFrame, full_set_id: st
                      "grasps": int(grasps.sum()), "settled": int(group.loc[grasps, "settled"].astype(bool).sum()),
                      "force_closure_full_set": n_fc, "graspable": not reason, "reason": reason})
     return pd.DataFrame(rows, columns=list(GRASPABLE_OBJECTS.names))
+
+
+def with_left_out(table: pd.DataFrame, left_out: Sequence[tuple[str, str]]) -> pd.DataFrame:
+    """A graspable-objects table with one more row per (object, reason) left out before the
+    study (a drawn mesh that cannot be read, is degenerate or differs from its manifest):
+    nothing simulated, not graspable, reason ``left out: <reason>``."""
+    extra = pd.DataFrame([{"object": name, "poses": 0, "simulated": 0, "grasps": 0, "settled": 0,
+                           "force_closure_full_set": 0, "graspable": False, "reason": f"left out: {reason}"}
+                          for name, reason in left_out], columns=list(GRASPABLE_OBJECTS.names))
+    return pd.concat([table, extra], ignore_index=True) if len(extra) else table
 
 
 def ungraspable_lines(table: pd.DataFrame) -> list[str]:

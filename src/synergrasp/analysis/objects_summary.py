@@ -28,7 +28,7 @@ import pandas as pd
 
 from synergrasp.ids import incremental_set_id, set_id
 
-__all__ = ["ObjectsSummaryParams", "object_rows", "with_left_out", "across_objects", "RESAMPLES", "SEED"]
+__all__ = ["ObjectsSummaryParams", "object_rows", "across_objects", "RESAMPLES", "SEED"]
 
 #: Bootstrap over objects: resamples and the seed of numpy.random.default_rng.
 RESAMPLES, SEED = 1000, 2018
@@ -62,14 +62,6 @@ def object_rows(success_rates: pd.DataFrame, preservation: pd.DataFrame, graspab
             row[f"global_min_{r}"] = bool(plan.is_global_min) if plan.best_pose >= 0 else np.nan
         rows.append(row)
     return pd.DataFrame(rows)
-
-
-def with_left_out(rows: pd.DataFrame, left_out: Sequence[tuple[str, str]]) -> pd.DataFrame:
-    """``rows`` with one more row per (object, reason) left out before the study (a mesh that
-    cannot be read, is degenerate or differs from its manifest): not graspable, the reason."""
-    extra = pd.DataFrame([{"object": name, "graspable": False, "reason": f"left out: {reason}"}
-                          for name, reason in left_out], columns=["object", "graspable", "reason"])
-    return pd.concat([rows, extra], ignore_index=True) if len(extra) else rows
 
 
 def _first_full(rates: Sequence[float]) -> float:

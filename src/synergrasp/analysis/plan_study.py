@@ -102,9 +102,9 @@ class StudySolver:
         minima = self.params.minima
         weights = {str(frame["object"].iat[0]): minima.weight_N} if minima.weight_N is not None and len(frame) else None
         judged = with_verdicts(frame, minima.success, weights, minima.bound_multiple)
+        success, force = judged["success"].to_numpy(bool), judged["success_force"].to_numpy(float)
         for row, g in enumerate(np.repeat(grasps, len(sets))):
-            self.memo[ids[row % len(sets)], int(g)] = (bool(judged["success"].iat[row]),
-                                                       float(judged["success_force"].iat[row]))
+            self.memo[ids[row % len(sets)], int(g)] = (bool(success[row]), float(force[row]))
 
     def level(self, k: int, poses: NDArray[np.int64]) -> tuple[NDArray, NDArray]:
         """The planner's solve: {S1..Sk} at ``poses``."""
@@ -161,11 +161,20 @@ def plan_object(contacts: pd.DataFrame, gfo: pd.DataFrame, matrix: NDArray, para
 def _enrollment(solver: StudySolver, full_success: NDArray, judged: pd.DataFrame, contacts: pd.DataFrame,
                 n: int) -> pd.DataFrame:
     """Greedy order against the PCA order: successes (grid poses) of each order's first k."""
-    # a set can succeed only where the full set does (nested sets): solve there only
+    # The sets are nested, so success only grows with a set: a set succeeds only where the full
+    # set does, and every set of a greedy round (the last pick plus one synergy) succeeds
+    # wherever the last pick did. Each round solves only where the last pick failed.
     where = np.flatnonzero(full_success).astype(np.int64)
+    picked = np.zeros(where.size, dtype=bool)  # the last pick's successes on `where`
 
     def count(sets: Sequence[tuple[int, ...]]) -> NDArray[np.int64]:
-        return solver.verdicts(sets, where)[0].sum(axis=1) if where.size else np.zeros(len(sets), dtype=np.int64)
+        nonlocal picked
+        success = np.tile(picked, (len(sets), 1))
+        if (~picked).any():
+            success[:, ~picked] = solver.verdicts(sets, where[~picked])[0]
+        got = success.sum(axis=1)
+        picked = success[int(np.argmax(got))] if len(sets) else picked  # greedy_order picks the first maximum
+        return got
 
     target = int(where.size)
     order, greedy = greedy_order(count, n, target)

@@ -62,6 +62,7 @@ class RealismParams:
     grasp_types: dict[str, str]
     shapes: dict[str, Any]
     opposition: OppositionRule
+    random_objects: dict | None = None  # the drawn meshes' block: those left out join the graspable table
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> RealismParams:
@@ -81,7 +82,7 @@ class RealismParams:
                    threshold, tuple(values["mean_rad"]), tuple(values["S1"]), float(mechanics["k_ss_Nmm_per_rad"]),
                    friction_mu(config), {name: grasp_type(config, name) for name in objects},
                    {name: shape_from_config(spec["shape"], f"objects.{name}.shape") for name, spec in objects.items()},
-                   OppositionRule.from_config(config))
+                   OppositionRule.from_config(config), config.get("random_objects"))
 
     def synergies(self, joint_names: tuple[str, ...]) -> Synergies:
         """q_m and S1 as a one-synergy :class:`Synergies` of the hand's joints."""

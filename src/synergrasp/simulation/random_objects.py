@@ -19,7 +19,7 @@ Objects are named ``rand_NNN`` (NNN the mesh's index).
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Mapping, MutableMapping
+from collections.abc import Mapping, MutableMapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -28,7 +28,7 @@ import numpy as np
 
 from synergrasp.simulation.shapes.mesh_file import MeshFileError, read_mesh
 
-__all__ = ["DrawnObject", "drawn_objects", "add_random_objects", "N_MESHES"]
+__all__ = ["DrawnObject", "drawn_objects", "add_random_objects", "left_out", "N_MESHES"]
 
 #: Meshes in pybullet_data/random_urdfs.
 N_MESHES = 1000
@@ -98,6 +98,14 @@ def drawn_objects(spec: Mapping[str, Any], root: str | Path = ".", manifest: str
         scale, problem = _check(base / rel, digests.get(rel), side)
         out.append(DrawnObject(f"rand_{index:03d}", index, str(base / rel), scale, side, problem))
     return out
+
+
+def left_out(spec: Mapping[str, Any] | None, manifest: Sequence[str | Path]) -> list[tuple[str, str]]:
+    """(name, reason) of every drawn mesh left out of the study (none without a block);
+    ``manifest``: the block's sha256 file, as the workflow's input (zero or one path)."""
+    if not spec:
+        return []
+    return [(d.name, d.problem) for d in drawn_objects(spec, manifest=manifest[0]) if d.problem]
 
 
 def add_random_objects(config: MutableMapping[str, Any], root: str | Path = ".") -> list[DrawnObject]:

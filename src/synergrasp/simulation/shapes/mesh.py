@@ -126,6 +126,7 @@ class Mesh(Shape):
         object.__setattr__(self, "geometry", geometry)
         object.__setattr__(self, "_params", pack_parts(list(zip(geometry.parts, geometry.planes))))
         self._params.setflags(write=False)
+        object.__setattr__(self, "_faces", {})  # (part, plane) -> its face polygon packed (normals_near)
         object.__setattr__(self, "_every", geometry.vertices)
         object.__setattr__(self, "_hull", self._every[ConvexHull(self._every).vertices])
         # the parts' vertices and centroids: a turn that maps the vertices onto themselves but
@@ -164,11 +165,13 @@ class Mesh(Shape):
 
         local = rotation.T @ (np.asarray(point, dtype=float) - center)
         out = []
-        for vertices, planes in zip(self.geometry.parts, self.geometry.planes):
-            for plane in planes[np.abs(planes[:, :3] @ local - planes[:, 3]) <= reach_mm]:  # the planes in reach
-                n, b = plane[:3], plane[3]
-                face = vertices[np.abs(vertices @ n - b) <= 1e-6 * max(self.geometry.size)]
-                face_params = pack_parts([(np.ascontiguousarray(face), np.zeros((0, 4)))])
+        for k, (vertices, planes) in enumerate(zip(self.geometry.parts, self.geometry.planes)):
+            for j in np.flatnonzero(np.abs(planes[:, :3] @ local - planes[:, 3]) <= reach_mm):  # the planes in reach
+                n, b = planes[j, :3], planes[j, 3]
+                face_params = self._faces.get((k, j))
+                if face_params is None:  # the face polygon, packed once per shape
+                    face = vertices[np.abs(vertices @ n - b) <= 1e-6 * max(self.geometry.size)]
+                    face_params = self._faces[k, j] = pack_parts([(np.ascontiguousarray(face), np.zeros((0, 4)))])
                 if convex_distance(face_params, 0, local[None])[0] <= reach_mm:
                     out.append(-(rotation @ n))
         return out
