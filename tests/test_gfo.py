@@ -261,3 +261,13 @@ def test_clarabel_agrees_with_cvxpy_reference(generated):
         print("  in band: index %d delta %+.2e ours %s ref %s |f| %.6g vs %.6g" % row)
     # The band is the only place where they may differ, and even there most agree.
     assert len(disagree_in_band) <= 0.3 * in_band
+
+
+def test_a_back_end_without_a_solver_is_an_error_not_a_silent_cvxpy(monkeypatch):
+    """A method registered in gfo.METHODS but given no one-problem solver (a back end half
+    added, docs/design.md's recipe) is refused before any solve, never sent to another solver."""
+    from synergrasp.optimisation import gfo
+
+    monkeypatch.setitem(gfo.METHODS, "newton", ("circular",))
+    with pytest.raises(ValueError, match="'newton' has no one-problem solver"):
+        solve_gfo_one(np.zeros(6), SQUEEZE, wedge_normals(0.0), MU, 0.1, method="newton")

@@ -52,7 +52,7 @@ UNITS = {
 
 #: The page's sections of figures: title, the files of benchmarks/results/ they show, what they are.
 SECTIONS = (
-    ("The default study", ("study",),
+    ("The default study", ("study", "fresh_clone"),
      "`make bench-study`: `snakemake -j2 figures` from an empty `results/`, the solver kernel compiled "
      "(`make bench-study` refuses a `results/` that is not empty); its jobs, per rule, below."),
     ("Other runs", ("sensitivity", "sensitivity_grasp_type", "dynamic_study", "everyday_objects", "random_objects",
@@ -83,6 +83,11 @@ SECTIONS = (
      "`benchmarks/bench_figure_imports.py` (in `make bench`, after a study): per figure rule, the CPU time of "
      "its script's imports in a fresh interpreter (start-up subtracted, median of 3) against its jobs' CPU time "
      "in the last study's benchmark files."),
+    ("Measured while the software was built", ("closure_history", "dynamic_closure_history", "solver_history",
+                                               "parts_history", "job_resources"),
+     "The figures behind design decisions that the pages of docs/ describe, each measured once when the decision "
+     "was made and recorded by hand (the note names the page; `make bench` does not rerun them): they compare the "
+     "alternatives of their day, not what the software costs today (the sections above)."),
 )
 
 
@@ -225,8 +230,8 @@ def page(inputs: Path = RESULTS) -> str:
         lines += [f"## {title}", "", *textwrap.wrap(intro, 100), ""]
         for name in names:
             lines += _figure_table(inputs, name)
-        if names == ("study",):
-            lines += _jobs_table(inputs)
+            if name == "study":
+                lines += _jobs_table(inputs)
     return "\n".join(lines + closure_engines(inputs))
 
 
