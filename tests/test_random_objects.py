@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 from synergrasp.analysis.graspability import with_left_out
-from synergrasp.analysis.objects_summary import across_objects, object_rows
+from synergrasp.analysis.objects_summary import across_objects, object_rows, planner_budget
 from synergrasp.simulation import random_objects as ro
 
 BOX = Path(__file__).parent / "data" / "box_30x60x100.obj"  # 30 x 60 x 100 units
@@ -100,3 +100,18 @@ def test_summary_rows_and_intervals_from_hand_made_tables():
     assert rows["reason"].iloc[1] == "left out: mesh cannot be read: non-manifold"
     assert np.isnan(rows["k_full"].iloc[1]) and np.isnan(rows["preserved_percent"].iloc[1])
     assert across_objects(rows, ["k_full"]).set_index("quantity").loc["k_full", "n_objects"] == 1
+
+
+def test_planner_budget_counts_objects_within_each_aim():
+    """Four objects at two radii, counted by hand: the aims are <= 20 % of the solves and a
+    regret <= 5 %; an object without a plan (NaN) is not counted."""
+    rows = pd.DataFrame({"solve_share_percent_10": [12.0, 20.0, 35.0, np.nan],
+                         "regret_percent_10": [0.0, 7.5, 1.0, np.nan],
+                         "solve_share_percent_20": [60.0, 70.0, 90.0, np.nan],
+                         "regret_percent_20": [0.0, 5.0, 0.0, np.nan]})
+    budget = planner_budget(rows, [10.0, 20.0, 30.0]).set_index("radius_deg")
+    assert budget.loc[10.0, ["objects", "within_solves", "within_regret", "within_both"]].tolist() == [3, 2, 2, 1]
+    assert not budget.loc[10.0, "every_object_within_regret"]
+    assert budget.loc[20.0, ["objects", "within_solves", "within_regret", "within_both"]].tolist() == [3, 0, 3, 0]
+    assert budget.loc[20.0, "every_object_within_regret"]
+    assert budget.loc[30.0, "objects"] == 0 and not budget.loc[30.0, "every_object_within_regret"]

@@ -299,7 +299,8 @@ STEPS: dict[str, Step] = {
         outputs={"csv": "tables/objects_summary.csv", "md": "tables/objects_summary.md",
                  "intervals_csv": "tables/objects_intervals.csv", "intervals_md": "tables/objects_intervals.md",
                  "drawn_csv": "tables/random_objects.csv", "drawn_md": "tables/random_objects.md",
-                 **_files(("objects_summary",), "figures", _PNG_PDF, named=False)},
+                 **_files(("objects_summary",), "figures", _PNG_PDF, named=False),
+                 **_files(("planner_tradeoff",), "figures", _PNG_PDF)},
         reads=("synergy_sets", "analyses.planner_radii_deg", "random_objects"), upstream=("tables", "realism", "plan"),
         params="synergrasp.analysis.objects_summary:ObjectsSummaryParams", optional=True),
     "fig5": Step(

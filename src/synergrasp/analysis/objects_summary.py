@@ -28,7 +28,11 @@ import pandas as pd
 
 from synergrasp.ids import incremental_set_id, set_id
 
-__all__ = ["ObjectsSummaryParams", "object_rows", "across_objects", "RESAMPLES", "SEED"]
+__all__ = ["ObjectsSummaryParams", "object_rows", "planner_budget", "SOLVE_SHARE_BUDGET", "REGRET_BUDGET", "across_objects", "RESAMPLES", "SEED"]
+
+#: The planner's aims (docs/planner.md): at most this share of the exhaustive solves (%), and a
+#: pose whose force is at most this far above the exhaustive minimum (%).
+SOLVE_SHARE_BUDGET, REGRET_BUDGET = 20.0, 5.0
 
 #: Bootstrap over objects: resamples and the seed of numpy.random.default_rng.
 RESAMPLES, SEED = 1000, 2018
@@ -62,6 +66,23 @@ def object_rows(success_rates: pd.DataFrame, preservation: pd.DataFrame, graspab
             row[f"global_min_{r}"] = bool(plan.is_global_min) if plan.best_pose >= 0 else np.nan
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def planner_budget(rows: pd.DataFrame, radii: Sequence[float]) -> pd.DataFrame:
+    """Per planner radius (deg): the objects with a plan, and how many use at most
+    ``SOLVE_SHARE_BUDGET`` % of the exhaustive solves, find a pose within ``REGRET_BUDGET`` %
+    of the exhaustive minimum's force, and both; ``every_object_within_regret``: the regret aim
+    met on every object with a plan (the rule that chooses the radius, docs/planner.md)."""
+    out = []
+    for r in radii:
+        share, regret = (pd.to_numeric(rows[c], errors="coerce") if c in rows else pd.Series(np.nan, index=rows.index)
+                         for c in (f"solve_share_percent_{r:g}", f"regret_percent_{r:g}"))
+        planned = share.notna() & regret.notna()
+        cheap, close = planned & (share <= SOLVE_SHARE_BUDGET), planned & (regret <= REGRET_BUDGET)
+        out.append({"radius_deg": float(r), "objects": int(planned.sum()), "within_solves": int(cheap.sum()),
+                    "within_regret": int(close.sum()), "within_both": int((cheap & close).sum()),
+                    "every_object_within_regret": bool(planned.any() and close[planned].all())})
+    return pd.DataFrame(out)
 
 
 def _first_full(rates: Sequence[float]) -> float:

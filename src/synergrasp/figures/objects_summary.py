@@ -10,7 +10,7 @@ import pandas as pd
 
 from synergrasp.figures.output import save_figure
 
-__all__ = ["figure_objects_summary"]
+__all__ = ["figure_objects_summary", "figure_planner_tradeoff"]
 
 
 def _values(rows: pd.DataFrame, column: str) -> np.ndarray:
@@ -50,5 +50,39 @@ def figure_objects_summary(rows: pd.DataFrame, radii: Sequence[float], png: str 
     axes[4].set_yscale("log")
     axes[4].set(ylabel="force regret (%; 0 drawn at 1e-3)", title="planner: regret")
     fig.suptitle(f"{n} objects", fontsize=9)
+    fig.tight_layout()
+    save_figure(fig, png, pdf)
+
+
+def figure_planner_tradeoff(rows: pd.DataFrame, radii: Sequence[float], png: str | Path, pdf: str | Path) -> None:
+    """One panel per planner radius: each object's share of the exhaustive solves against its
+    force regret, with the planner's aims (``SOLVE_SHARE_BUDGET``, ``REGRET_BUDGET``) and how
+    many objects meet them (``planner_budget``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from synergrasp.analysis.objects_summary import REGRET_BUDGET, SOLVE_SHARE_BUDGET, planner_budget
+
+    budget = planner_budget(rows, radii).set_index("radius_deg")
+    fig, axes = plt.subplots(1, len(radii), figsize=(4.2 * len(radii), 3.6), sharey=True, squeeze=False)
+    floor = 1e-2  # a regret of 0 (the global minimum found) is drawn on this line of the log axis
+    for ax, r in zip(axes[0], radii):
+        share, regret = (pd.to_numeric(rows[c], errors="coerce") if c in rows else pd.Series(np.nan, index=rows.index)
+                         for c in (f"solve_share_percent_{r:g}", f"regret_percent_{r:g}"))
+        ok = share.notna() & regret.notna()
+        ax.scatter(share[ok], np.maximum(regret[ok], floor), s=12, alpha=0.7)
+        ax.axvline(SOLVE_SHARE_BUDGET, c="k", lw=0.8, ls="--")
+        ax.axhline(REGRET_BUDGET, c="k", lw=0.8, ls="--")
+        ax.set_yscale("log")
+        ax.set_xlim(0, 100)
+        b = budget.loc[float(r)]
+        ax.set_title(f"±{r:g}°: {b['within_both']} of {b['objects']} objects within both aims\n"
+                     f"(solves ≤ {SOLVE_SHARE_BUDGET:g} %: {b['within_solves']}, regret ≤ {REGRET_BUDGET:g} %: "
+                     f"{b['within_regret']})", fontsize=8)
+        ax.set_xlabel("solves used (% of the exhaustive search)")
+    axes[0][0].set_ylabel(f"force regret (%; 0 drawn at {floor:g})")
+    fig.suptitle("The incremental planner per object, by radius", fontsize=9)
     fig.tight_layout()
     save_figure(fig, png, pdf)
