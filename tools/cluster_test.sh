@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The small study on a real SLURM scheduler: start a single-node SLURM on this machine
 # (Debian packages slurmctld/slurmd, installed here when missing), run tests/config/small.yaml
-# through `--workflow-profile profiles/slurm`, then check that every output of a local -j2 run
-# exists and that the tables and per-object Parquet files are byte-identical to it.
+# (`figures`), then 10 of pybullet's random meshes on its grid (`across_objects`), through
+# `--workflow-profile profiles/slurm`; for each, check that every output of a local -j2 run
+# exists and that the tables and per-object Parquet and CSV files are byte-identical to it.
 # The daemons started here are stopped by their pid files on exit.
 #
 #   tools/cluster_test.sh [BIN]      BIN: the venv's bin directory (default .venv/bin)
@@ -100,41 +101,70 @@ $(tail -5 "$STATE/log/slurmctld.log" 2>/dev/null)
 $(tail -5 "$STATE/log/slurmd.log" 2>/dev/null)"
 echo "SLURM up: node $HOST, $CPUS CPUs, $MEM_MB MB, partition $PARTITION ($(( $(date +%s) - started )) s)"
 
-snakemake() {  # snakemake on the small config in working directory $1
-    local dir=$1; shift
+snakemake() {  # snakemake in working directory $1 on config file $2
+    local dir=$1 config=$2; shift 2
     "$BIN/python" -m snakemake -s "$ROOT/Snakefile" --directory "$dir" \
-        --configfile "$SMALL" --replace-workflow-config "$@"
+        --configfile "$config" --replace-workflow-config "$@"
 }
 
-# the SLURM run: the workflow's own cluster profile; partition from the environment as a user
-# would set it; no accounting daemon here, so no account and squeue for job status
-export SBATCH_PARTITION=$PARTITION SBATCH_ACCOUNT=""
-snakemake "$WORK/slurm-run" --workflow-profile "$ROOT/profiles/slurm" --jobs 4 \
-    --slurm-no-account --slurm-status-command squeue --slurm-init-seconds-before-status-checks 1 \
-    figures >"$WORK/slurm-run.log" 2>&1 || { tail -40 "$WORK/slurm-run.log"; fail "the workflow failed under SLURM (log: $WORK/slurm-run.log)"; }
-submitted=$(grep -c "Job .* has been submitted with SLURM jobid" "$WORK/slurm-run.log" || true)
-[ "$submitted" -gt 0 ] || fail "no job was submitted to SLURM (log: $WORK/slurm-run.log)"
-echo "SLURM run done: $submitted jobs through sbatch ($(( $(date +%s) - started )) s)"
+# Run TARGET on CONFIG under SLURM and locally with -j2; every output of the local run must
+# exist after the SLURM run, nothing be left to do, and the tables and per-object Parquet files
+# be byte-identical. Sets SUBMITTED, N_OUTPUTS, COMPARED.
+compare_runs() {
+    local label=$1 config=$2 target=$3
+    local slurm_dir=$WORK/$label-slurm local_dir=$WORK/$label-local
+    # the workflow's own cluster profile; partition from the environment as a user would set it;
+    # no accounting daemon here, so no account and squeue for job status
+    SBATCH_PARTITION=$PARTITION SBATCH_ACCOUNT="" snakemake "$slurm_dir" "$config" \
+        --workflow-profile "$ROOT/profiles/slurm" --jobs 4 \
+        --slurm-no-account --slurm-status-command squeue --slurm-init-seconds-before-status-checks 1 \
+        "$target" >"$slurm_dir.log" 2>&1 || { tail -40 "$slurm_dir.log"; fail "$label: the workflow failed under SLURM (log: $slurm_dir.log)"; }
+    SUBMITTED=$(grep -c "Job .* has been submitted with SLURM jobid" "$slurm_dir.log" || true)
+    [ "$SUBMITTED" -gt 0 ] || fail "$label: no job was submitted to SLURM (log: $slurm_dir.log)"
+    echo "$label: SLURM run done, $SUBMITTED jobs through sbatch ($(( $(date +%s) - started )) s)"
 
-snakemake "$WORK/local-run" -j2 figures >"$WORK/local-run.log" 2>&1 \
-    || { tail -40 "$WORK/local-run.log"; fail "the local -j2 run failed (log: $WORK/local-run.log)"; }
+    snakemake "$local_dir" "$config" -j2 "$target" >"$local_dir.log" 2>&1 \
+        || { tail -40 "$local_dir.log"; fail "$label: the local -j2 run failed (log: $local_dir.log)"; }
 
-# every output of the local run exists after the SLURM run, and nothing is left to do
-outputs() { (cd "$1/results" && find . -type f ! -path './logs/*' ! -path './benchmarks/*' | sort); }
-missing=$(comm -23 <(outputs "$WORK/local-run") <(outputs "$WORK/slurm-run"))
-[ -z "$missing" ] || fail "outputs missing after the SLURM run: $missing"
-snakemake "$WORK/slurm-run" -n figures 2>&1 | grep -q "Nothing to be done" \
-    || fail "after the SLURM run, snakemake -n still finds work to do"
-n_outputs=$(outputs "$WORK/local-run" | wc -l)
+    outputs() { (cd "$1/results" && find . -type f ! -path './logs/*' ! -path './benchmarks/*' | sort); }
+    local missing
+    missing=$(comm -23 <(outputs "$local_dir") <(outputs "$slurm_dir"))
+    [ -z "$missing" ] || fail "$label: outputs missing after the SLURM run: $missing"
+    snakemake "$slurm_dir" "$config" -n "$target" 2>&1 | grep -q "Nothing to be done" \
+        || fail "$label: after the SLURM run, snakemake -n still finds work to do"
+    N_OUTPUTS=$(outputs "$local_dir" | wc -l)
+    COMPARED=0
+    while read -r rel; do
+        cmp -s "$local_dir/results/$rel" "$slurm_dir/results/$rel" \
+            || fail "$label: results/$rel differs between the SLURM run and the local -j2 run"
+        COMPARED=$((COMPARED + 1))
+    done < <(outputs "$local_dir" | grep -E '^\./(tables/.*\.(csv|md)|objects/.*\.(parquet|csv))$')
+    [ "$COMPARED" -gt 0 ] || fail "$label: no tables were compared"
+    echo "$label passed: $SUBMITTED SLURM jobs, $N_OUTPUTS outputs present, $COMPARED tables and" \
+         "per-object files byte-identical to a local -j2 run, $(( $(date +%s) - started )) s in all"
+}
 
-# the tables and the per-object Parquet files, byte for byte
-compared=0
-while read -r rel; do
-    cmp -s "$WORK/local-run/results/$rel" "$WORK/slurm-run/results/$rel" \
-        || fail "results/$rel differs between the SLURM run and the local -j2 run"
-    compared=$((compared + 1))
-done < <(outputs "$WORK/local-run" | grep -E '^\./(tables/.*\.(csv|md)|objects/.*\.parquet)$')
-[ "$compared" -gt 0 ] || fail "no tables were compared"
+# 1. the small study (two boxes)
+compare_runs small "$SMALL" figures
 
-echo "cluster-test passed: $submitted SLURM jobs, $n_outputs outputs present, $compared tables and" \
-     "Parquet files byte-identical to a local -j2 run, $(( $(date +%s) - started )) s in all"
+# 2. the many-object study spread over the cluster: 10 of pybullet's random meshes
+#    (config/examples/random_objects.yaml, n_objects: 10) on the small config's grid and placement
+TEN=$WORK/ten_random_objects.yaml
+"$BIN/python" - "$SMALL" "$ROOT/config/examples/random_objects.yaml" "$TEN" "$ROOT" <<'PY'
+import sys
+from pathlib import Path
+
+import yaml
+
+from synergrasp.config import overlay
+
+small, example, out, root = sys.argv[1:]
+base = yaml.safe_load(Path(small).read_text())
+spec = yaml.safe_load(Path(example).read_text())["random_objects"]
+spec = {**spec, "n_objects": 10, "sha256_file": str(Path(root) / spec["sha256_file"])}
+config = overlay(base, {"objects": {name: None for name in base["objects"]}, "random_objects": spec})
+Path(out).write_text(yaml.safe_dump(config))
+PY
+compare_runs ten_random_objects "$TEN" across_objects
+
+echo "cluster-test passed: the small study and 10 random objects under SLURM, $(( $(date +%s) - started )) s in all"
