@@ -105,8 +105,8 @@ def test_pinch_as_grasp_is_rank_deficient():
     mech = mechanics_for(pinch_grasp(), params)
     assert mech.rank_G == 5 and mech.projector is None
     out = optimise_grasps([pinch_grasp()], SynergySets(np.eye(19), ((2, 5),)), params)
-    assert out["status"][0] == "rank_deficient" and not out["force_closure"][0] and math.isnan(out["force_norm"][0])
-    assert not out["strict_internal"][0] and out["solver"][0] == "none" and out["rank_G"][0] == 5
+    assert out["status"][0] == "rank_deficient" and not out["load_feasible"][0] and math.isnan(out["force_norm"][0])
+    assert not out["force_closure_def1"][0] and out["solver"][0] == "none" and out["rank_G"][0] == 5
 
 
 def test_collinear_contacts_rank_deficient():

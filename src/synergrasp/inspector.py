@@ -250,8 +250,8 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     out = optimise_grasps([grasp], SynergySets(full.matrix, tuple(chosen)), opt.gfo, forces=True)
     mu = float(opt.gfo.mu)
     results = tuple(
-        SetResult(set_id(s), s, str(out["status"][k]), bool(out["strict_internal"][k] and out["rank_G"][k] == 6),
-                  bool(out["force_closure"][k]), float(out["force_norm"][k]), int(out["e_s"][k]),
+        SetResult(set_id(s), s, str(out["status"][k]), bool(out["force_closure_def1"][k]),
+                  bool(out["load_feasible"][k]), float(out["force_norm"][k]), int(out["e_s"][k]),
                   cone_use(out["forces"][k], grasp.normals, mu) if out["forces"][k] is not None else float("nan"),
                   _floats(out["forces"][k]) if out["forces"][k] is not None else ())
         for k, s in enumerate(chosen))
