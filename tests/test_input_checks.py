@@ -319,10 +319,12 @@ def test_the_search_lattice_bounds_the_rank():
 
 
 def _rank(rank: int) -> list[str]:
+    from synergrasp.study_checks import checked_scenario
+
     config = defaults()
     config["placement"]["search_rank"] = rank
     try:
-        validate_config(config)
+        checked_scenario(config)
     except ConfigError as err:
         return str(err).splitlines()
     return []

@@ -13,7 +13,7 @@ from synergrasp.optimisation.cones import CircularCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.ipm.sets import set_bases
 from synergrasp.optimisation.ipm.solver import IPMSettings
-from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_basis, object_wrench
+from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_basis, weight_wrench
 from synergrasp.optimisation.problem import GFOProblem, GraspSets, SynergySets
 from grasp_problems import random_grasp, random_synergies, random_unit_vector
 
@@ -27,7 +27,7 @@ def _study_sized_problems(count: int, seed: int = 11) -> list[GFOProblem]:
     while len(out) < count:
         m = int(rng.integers(3, 21))
         grasp = random_grasp(rng, m, palm_contacts=int(rng.integers(0, 3)))
-        mech = grasp_mechanics(grasp, object_wrench(1.0, random_unit_vector(rng)), 1.0, 200.0)
+        mech = grasp_mechanics(grasp, weight_wrench(9.81, random_unit_vector(rng)), 1.0, 200.0)
         if mech.rank_G < 6:
             continue
         S = random_synergies(rng)
@@ -247,7 +247,7 @@ def test_sets_of_one_grasp_match_the_same_problems_one_by_one():
     sets = SynergySets(S, tuple(tuple(range(1, k + 1)) for k in range(1, 16)) + ((2,), (3, 5), (1, 4, 7)))
     for _ in range(4):
         grasp = random_grasp(rng, int(rng.integers(4, 13)), palm_contacts=1)
-        mech = grasp_mechanics(grasp, object_wrench(1.0, random_unit_vector(rng)), 1.0, 200.0)
+        mech = grasp_mechanics(grasp, weight_wrench(9.81, random_unit_vector(rng)), 1.0, 200.0)
         if mech.rank_G < 6:
             continue
         g = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, 0.1, CircularCone(1.5))

@@ -91,8 +91,9 @@ class GFOParams:
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> GFOParams:
-        """The configuration's ``mechanics`` with the weight of the object ``obj``."""
-        return build(cls, "mechanics", **dataclass_fields(cls, config["mechanics"]),
+        """The configuration's ``mechanics`` with the weight of the object ``obj`` (μ and the
+        weight as resolved, ``synergrasp.resolved``)."""
+        return build(cls, "mechanics", **{**dataclass_fields(cls, config["mechanics"]), "mu": resolved.friction_mu(config)},
                      weight_N=resolved.weight_N(config, obj))
 
     def wrench(self) -> NDArray:
