@@ -177,7 +177,7 @@ def critical_friction(
 
     def feasible(mu: float) -> bool:
         problem = GFOProblem(f_p, E, normals, f_min, replace(cone, mu=mu))
-        return solve_gfo([problem], "clarabel").status[0] == "force_closure"
+        return solve_gfo([problem], "clarabel").status[0] == "feasible"
 
     if feasible(mu_start):
         hi, lo = mu_start, mu_start / 2

@@ -19,7 +19,7 @@ def _study(root: Path, gfo: pd.DataFrame, claims: pd.DataFrame) -> Path:
     return root
 
 
-GFO = pd.DataFrame({"pose": [0, 0, 1], "set_id": ["1", "1-2", "1"], "status": ["infeasible", "force_closure", "no_grasp"],
+GFO = pd.DataFrame({"pose": [0, 0, 1], "set_id": ["1", "1-2", "1"], "status": ["infeasible", "feasible", "no_grasp"],
                     "force_closure_def1": [False, True, False], "force_norm": [np.nan, 12.5, np.nan],
                     "iterations": [9, 14, 0], "solver": ["ipm", "clarabel_fallback", "none"],
                     "normal_force_N": [[np.nan], [1.0, 2.0], []]})  # a list column, NaN in it
@@ -33,7 +33,7 @@ def test_equal_studies_differ_only_in_how_problems_were_decided(tmp_path):
 
 
 def test_a_changed_verdict_a_far_norm_and_a_missing_table_are_reported(tmp_path):
-    other = GFO.assign(status=["force_closure", "force_closure", "no_grasp"], force_norm=[np.nan, 12.5 * 1.001, np.nan],
+    other = GFO.assign(status=["feasible", "feasible", "no_grasp"], force_norm=[np.nan, 12.5 * 1.001, np.nan],
                        force_closure_def1=[True, True, False])
     b = _study(tmp_path / "b", other, CLAIMS.assign(rate_pct=[40.0 + 1e-9]))
     (b / "tables" / "claims.csv").unlink()

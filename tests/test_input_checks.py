@@ -197,7 +197,7 @@ def _contacts(obj: str, statuses: list[str], settled: bool = True, model: str = 
 
 
 def _gfo(obj: str, fc_poses: list[int], n_poses: int, full: str = "1-2-3") -> pd.DataFrame:
-    rows = [{"object": obj, "pose": p, "set_id": s, "status": "force_closure" if p in fc_poses else "infeasible",
+    rows = [{"object": obj, "pose": p, "set_id": s, "status": "feasible" if p in fc_poses else "infeasible",
              "load_feasible": p in fc_poses, "force_closure_def1": p in fc_poses, "rank_G": 6, "force_norm": np.nan}
             for p in range(n_poses) for s in ("1", full)]
     return pd.DataFrame(rows)

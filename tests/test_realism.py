@@ -45,7 +45,7 @@ def _gfo(obj: str = "a") -> pd.DataFrame:
     for pose, (rank, fc, force) in enumerate(full):
         for set_id, values in (("1-2", (rank, fc, force)), ("1", (6, True, 1000.0))):  # "1" must not be read
             rows.append({"object": obj, "pose": pose, "alpha_deg": 5.0 * pose, "beta_deg": 0.0, "set_id": set_id,
-                         "n_synergies": len(set_id.split("-")), "status": "force_closure" if values[1] else "infeasible",
+                         "n_synergies": len(set_id.split("-")), "status": "feasible" if values[1] else "infeasible",
                          "load_feasible": values[1], "force_closure_def1": values[1], "force_norm": values[2], "e_s": 1,
                          "rank_G": values[0], "n_contacts": 0, "iterations": 1, "solver": "ipm"})
     return pd.DataFrame(rows)

@@ -14,7 +14,7 @@ from synergrasp import tables
 def _gfo() -> pd.DataFrame:
     return pd.DataFrame({
         "object": ["box"] * 2, "pose": [0, 0], "alpha_deg": [0.0] * 2, "beta_deg": [0.0] * 2,
-        "set_id": ["1", "1-2"], "n_synergies": [1, 2], "status": ["infeasible", "force_closure"],
+        "set_id": ["1", "1-2"], "n_synergies": [1, 2], "status": ["infeasible", "feasible"],
         "load_feasible": [False, True], "force_closure_def1": [False, False], "force_norm": [float("nan"), 3.0],
         "e_s": [1, 2], "rank_G": [6, 6], "n_contacts": [4, 4], "iterations": [7, 9], "solver": ["ipm"] * 2})
 

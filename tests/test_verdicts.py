@@ -72,7 +72,7 @@ def test_symmetric_tripod_with_friction_is_both(gravity):
 
 
 def test_with_verdicts_picks_the_success_column_and_flags_marginal_grasps():
-    gfo = pd.DataFrame({"object": ["a"] * 4, "set_id": ["1"] * 4, "status": ["force_closure"] * 3 + ["infeasible"],
+    gfo = pd.DataFrame({"object": ["a"] * 4, "set_id": ["1"] * 4, "status": ["feasible"] * 3 + ["infeasible"],
                         "load_feasible": [True, True, True, False], "force_closure_def1": [True, False, False, False],
                         "rank_G": [6, 6, 5, 6], "force_norm": [50.0, 200.0, 3.0, np.nan]})
     fc = with_verdicts(gfo, "force_closure", {"a": 9.81}, 10.0)
@@ -86,7 +86,7 @@ def test_with_verdicts_picks_the_success_column_and_flags_marginal_grasps():
 
 
 def test_force_closure_bounded_is_force_closure_within_the_bound():
-    gfo = pd.DataFrame({"object": ["a"] * 4, "set_id": ["1"] * 4, "status": ["force_closure"] * 4,
+    gfo = pd.DataFrame({"object": ["a"] * 4, "set_id": ["1"] * 4, "status": ["feasible"] * 4,
                         "load_feasible": [True] * 4, "force_closure_def1": [True, True, True, False],
                         "rank_G": [6] * 4, "force_norm": [50.0, 98.1, 98.2, 3.0]})
     bounded = with_verdicts(gfo, "force_closure_bounded", {"a": 9.81}, 10.0)
@@ -103,7 +103,7 @@ def test_force_closure_without_a_force_beyond_the_bound_is_reclassified():
     above 10 x 9.81 N, so set 1 is load-feasible in exact arithmetic and never bounded. At
     pose 1 the superset needs only 50 N: left as it is (an unexplained invariant breach)."""
     gfo = pd.DataFrame({"object": ["a"] * 4, "pose": [0, 0, 1, 1], "set_id": ["1", "1-2", "1", "1-2"],
-                        "status": ["infeasible", "force_closure", "infeasible", "force_closure"],
+                        "status": ["infeasible", "feasible", "infeasible", "feasible"],
                         "load_feasible": [False, True, False, True], "force_closure_def1": [True] * 4,
                         "rank_G": [6] * 4, "force_norm": [np.nan, 500.0, np.nan, 50.0]})
     out = with_verdicts(gfo, "force_closure", {"a": 9.81}, 10.0)

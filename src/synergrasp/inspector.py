@@ -49,11 +49,11 @@ class BlockingContact:
 class SetResult:
     """The optimisation of one synergy set at the inspected pose.
 
-    status: the optimisation under the weight: 'force_closure' (feasible) | 'infeasible' |
+    status: the optimisation under the weight: 'feasible' | 'infeasible' |
         'numerical_failure' | 'rank_deficient' | 'no_grasp'
     force_closure: the study's verdict, Definition 1: rank(G) = 6 and a synergy-reachable
         internal force strictly inside every cone (independent of the weight)
-    load_feasible: the optimisation under the weight is feasible (status 'force_closure')
+    load_feasible: the optimisation under the weight is feasible (status 'feasible')
     force_N: optimal ‖f‖₂ under the object's weight (NaN unless load-feasible)
     e_s: dimension of the synergy-reachable internal forces
     cone_use: largest ‖f_t‖ / (μ f_n) over the contacts of the optimal forces (≤ 1: inside

@@ -90,8 +90,8 @@ CONTACTS = Table("contacts", "one row per pose", _pose_columns() + (
 GFO = Table("gfo", "one row per (pose, synergy set)", _pose_columns() + (
     Column("set_id", "string", "", "enrolled synergies, 1-based, sorted, joined by '-'"),
     Column("n_synergies", "int32", "", "number of enrolled synergies s"),
-    Column("status", "string", "", "force_closure, infeasible, rank_deficient, no_grasp, numerical_failure"),
-    Column("load_feasible", "bool", "", "the grasp-force optimisation under the object's weight is feasible (status force_closure); not Definition 1"),
+    Column("status", "string", "", "the optimisation under the object's weight: feasible, infeasible, rank_deficient, no_grasp, numerical_failure"),
+    Column("load_feasible", "bool", "", "the grasp-force optimisation under the object's weight is feasible (status feasible); not Definition 1"),
     Column("force_closure_def1", "bool", "", "force closure, the study's Definition 1: rank(G) = 6 and Bicchi's strict internal-force test (some E_s y strictly inside every friction cone); independent of the weight"),
     Column("force_norm", "float64", "N", "optimal contact-force norm under the weight (NaN unless load_feasible)"),
     Column("e_s", "int32", "", "rank of the internal-force basis"),

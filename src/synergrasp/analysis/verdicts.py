@@ -10,7 +10,7 @@ Two verdicts are derived from the columns the optimisation writes (docs/analyses
   cone) and the friction coefficient shrunk to μ(1 − 1e-5) (the margin that makes "strictly
   inside" decidable). It is a property of the grasp, independent of the load.
 - ``load_feasible`` — the optimisation under the object's weight is feasible (gfo column
-  ``load_feasible``, i.e. status ``force_closure``): the weight may help through f_p, so a
+  ``load_feasible``, i.e. status ``feasible``): the weight may help through f_p, so a
   box resting in curled fingers passes.
 - ``force_closure_bounded`` — force closure whose optimal force under the weight is at most
   ``marginal_multiple`` times the weight: non-marginal force closure.

@@ -189,7 +189,7 @@ def optimise_grasps(
             out["force_closure_def1"][rows] = sol.strict_internal
         if forces:
             out["forces"][rows] = sol.forces
-    out["load_feasible"] = out["status"] == "force_closure"
+    out["load_feasible"] = out["status"] == "feasible"
     return out
 
 
