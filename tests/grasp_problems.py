@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from synergrasp.optimisation.cones import CircularCone, FrictionCone
 from synergrasp.optimisation.gfo import solve_gfo
-from synergrasp.optimisation.mechanics import Grasp, grasp_mechanics, internal_force_basis, object_wrench
+from synergrasp.optimisation.mechanics import Grasp, grasp_mechanics, internal_force_basis, weight_wrench
 from synergrasp.optimisation.problem import GFOProblem
 
 __all__ = [
@@ -177,7 +177,7 @@ def critical_friction(
 
     def feasible(mu: float) -> bool:
         problem = GFOProblem(f_p, E, normals, f_min, replace(cone, mu=mu))
-        return solve_gfo([problem], "clarabel").status[0] == "force_closure"
+        return solve_gfo([problem], "clarabel").status[0] == "feasible"
 
     if feasible(mu_start):
         hi, lo = mu_start, mu_start / 2
@@ -273,7 +273,7 @@ def _random_instance(rng, contacts, synergies, max_palm, k_stru, k_ss):
         m = int(rng.integers(contacts[0], contacts[1] + 1))
         n_palm = int(rng.integers(0, min(max_palm, m - 1) + 1))
         grasp = random_grasp(rng, m, palm_contacts=n_palm)
-        mech = grasp_mechanics(grasp, object_wrench(1.0, random_unit_vector(rng)), k_stru, k_ss)
+        mech = grasp_mechanics(grasp, weight_wrench(9.81, random_unit_vector(rng)), k_stru, k_ss)
         if mech.rank_G == 6:
             break
     s = int(rng.integers(synergies[0], synergies[1] + 1))

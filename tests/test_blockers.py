@@ -218,7 +218,7 @@ def test_the_table_solves_twin_poses_once_and_keeps_its_contract(hand, axes, tmp
     contacts = pd.DataFrame([{**row, "pose": 0}, {**row, "pose": 1, "alpha_deg": 90.0}])
     full_id = "-".join(str(k) for k in range(2, S.shape[1] + 1))
     gfo = pd.DataFrame([{"object": "box", "pose": p, "alpha_deg": 90.0 * p, "beta_deg": 0.0, "set_id": sid,
-                         "n_synergies": n, "status": "force_closure", "force_closure": True, "strict_internal": ok,
+                         "n_synergies": n, "status": "feasible", "load_feasible": True, "force_closure_def1": ok,
                          "rank_G": 6, "force_norm": 1.0} for p in (0, 1)
                         for sid, n, ok in ((full_id, S.shape[1] - 1, True), ("1", 1, False))])
     box = shape_from_config({"box": {"size_mm": [60, 60, 60]}}, "test")

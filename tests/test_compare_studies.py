@@ -19,8 +19,8 @@ def _study(root: Path, gfo: pd.DataFrame, claims: pd.DataFrame) -> Path:
     return root
 
 
-GFO = pd.DataFrame({"pose": [0, 0, 1], "set_id": ["1", "1-2", "1"], "status": ["infeasible", "force_closure", "no_grasp"],
-                    "strict_internal": [False, True, False], "force_norm": [np.nan, 12.5, np.nan],
+GFO = pd.DataFrame({"pose": [0, 0, 1], "set_id": ["1", "1-2", "1"], "status": ["infeasible", "feasible", "no_grasp"],
+                    "force_closure_def1": [False, True, False], "force_norm": [np.nan, 12.5, np.nan],
                     "iterations": [9, 14, 0], "solver": ["ipm", "clarabel_fallback", "none"],
                     "normal_force_N": [[np.nan], [1.0, 2.0], []]})  # a list column, NaN in it
 CLAIMS = pd.DataFrame({"claim": ["c1"], "holds": [True], "rate_pct": [40.0]})
@@ -33,12 +33,12 @@ def test_equal_studies_differ_only_in_how_problems_were_decided(tmp_path):
 
 
 def test_a_changed_verdict_a_far_norm_and_a_missing_table_are_reported(tmp_path):
-    other = GFO.assign(status=["force_closure", "force_closure", "no_grasp"], force_norm=[np.nan, 12.5 * 1.001, np.nan],
-                       strict_internal=[True, True, False])
+    other = GFO.assign(status=["feasible", "feasible", "no_grasp"], force_norm=[np.nan, 12.5 * 1.001, np.nan],
+                       force_closure_def1=[True, True, False])
     b = _study(tmp_path / "b", other, CLAIMS.assign(rate_pct=[40.0 + 1e-9]))
     (b / "tables" / "claims.csv").unlink()
     result = compare_studies.compare(_study(tmp_path / "a", GFO, CLAIMS), b, 1e-6)
     diffs = result["objects/obj1/gfo.parquet"][1]
-    assert [d.split(":")[0] for d in diffs] == ["status", "strict_internal", "force_norm"]
+    assert [d.split(":")[0] for d in diffs] == ["status", "force_closure_def1", "force_norm"]
     assert "1 rows beyond rtol 1e-06 (largest relative difference 0.001)" in diffs[2]
     assert result["tables/claims.csv"] == (1, ["missing"])

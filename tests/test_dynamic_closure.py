@@ -19,7 +19,7 @@ from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.shapes import Box
 from synergrasp.simulation.placement import ObjectPose, object_pose
 
-MECHANICS = ClosureMechanics(k_ss_Nmm_per_rad=200.0, mu=1.5, gravity_direction=(1.0, 0.0, 0.0), g_m_per_s2=9.81)
+MECHANICS = ClosureMechanics(k_ss_Nmm_per_rad=200.0, mu=1.5, gravity_direction=(1.0, 0.0, 0.0))
 PARAMS = study_closure_params(model="dynamic", dynamic=study_dynamic_params(time_limit_s=3.0))
 CUBE60 = Box((60.0, 60.0, 60.0))
 #: A 60 mm cube against the palm: the palm's surface is at x = 9.5 mm (hand.yaml), the
@@ -29,7 +29,7 @@ AGAINST_PALM = study_placement(center_mm=(9.5 + 30.0 + 0.3, -9.0, 75.0))
 
 @pytest.fixture(scope="module")
 def model(hand, synergies):
-    m = closure_model(hand, synergies, PARAMS, MECHANICS, 1.0)
+    m = closure_model(hand, synergies, PARAMS, MECHANICS, 9.81)
     yield m
     m.close()
 
@@ -126,7 +126,7 @@ def test_at_rest_the_springs_balance_the_contact_forces(hand, synergies):
     residual is reported in docs/dynamic_closure.md)."""
     tight = study_dynamic_params(time_limit_s=6.0, settle_joint_change_rad=0.0015, settle_object_change_mm=0.1)
     params = study_closure_params(model="dynamic", dynamic=tight)
-    model = closure_model(hand, synergies, params, MECHANICS, 1.0)
+    model = closure_model(hand, synergies, params, MECHANICS, 9.81)
     placed = object_pose(AGAINST_PALM, CUBE60, 0.0, 0.0, hand.palm_normal)
     try:
         _check_balance(model, hand, params, model.grasp(placed))
@@ -155,7 +155,7 @@ def _check_balance(model, hand, params, result):
 
 def test_deterministic_on_rerun_and_whatever_ran_before(hand, synergies):
     params = study_closure_params(model="dynamic", dynamic=study_dynamic_params(time_limit_s=0.4))
-    box, placement = GraspedObject("obj1", Box((30.0, 30.0, 30.0)), 1.0), study_placement()
+    box, placement = GraspedObject("obj1", Box((30.0, 30.0, 30.0)), 1.0, 9.81), study_placement()
     alone = simulate_object(hand, synergies, box, placement, params, poses=[300], mechanics=MECHANICS)
     after = simulate_object(hand, synergies, box, placement, params, poses=[0, 150, 300], mechanics=MECHANICS)
     for column in ("status", "q", "contact_link", "contact_point", "contact_normal_force_N", "object_center"):
@@ -170,7 +170,7 @@ def test_twins_are_closed_each_on_their_own(hand, synergies, monkeypatch):
     from synergrasp.simulation.placement import pose_grid
 
     params = study_closure_params(model="dynamic", dynamic=study_dynamic_params(time_limit_s=0.2))
-    box, placement = GraspedObject("obj1", Box((30.0, 30.0, 30.0)), 1.0), study_placement()
+    box, placement = GraspedObject("obj1", Box((30.0, 30.0, 30.0)), 1.0, 9.81), study_placement()
     grid = pose_grid(placement)
     calls = []
     real = dynamic_closure.DynamicClosure.grasp
@@ -198,7 +198,7 @@ def test_settled_box_carries_a_near_zero_net_contact_wrench(model, hand):
 def test_a_box_pushed_out_of_the_hand_is_lost(hand, synergies):
     """obj4 placed 50 mm in front of the palm (fixed placement, centre (90, 5, 112) mm): at α = −180°,
     β = −40° the closing fingers push it away and nothing holds it (no gravity)."""
-    box = GraspedObject("obj4", Box((100.0, 60.0, 100.0)), 1.0)
+    box = GraspedObject("obj4", Box((100.0, 60.0, 100.0)), 1.0, 9.81)
     placement = study_placement(mode="fixed", center_mm=(90.0, 5.0, 112.0), box_axes=(1, 0, 2))
     row = simulate_object(hand, synergies, box, placement, study_closure_params(model="dynamic"), poses=[4],
                           mechanics=MECHANICS).iloc[0]
@@ -237,7 +237,7 @@ def test_thumb_index_pinch_of_a_small_box_settles_with_a_near_zero_net_wrench(ha
     closing = np.zeros(hand.n_joints)
     closing[index] = synergies.matrix[index, 0]
     pinch = Synergies(synergies.joint_names, mean, closing[:, None], ("S1",))
-    model = closure_model(hand, pinch, PARAMS, MECHANICS, 1.0)
+    model = closure_model(hand, pinch, PARAMS, MECHANICS, 9.81)
     try:
         # the box's face on the thumb's pad, toward the index tip where the tips are 25 mm apart
         b, edge = model.bullet, 20.0
@@ -277,7 +277,7 @@ def test_a_held_box_stays_put_and_the_fingers_settle_on_it_in_equilibrium(hand, 
     independent model of the balance) is below 10 % (measured: 2.3 %)."""
     from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
 
-    box = GraspedObject("obj4", Box((100.0, 60.0, 100.0)), 1.0)
+    box = GraspedObject("obj4", Box((100.0, 60.0, 100.0)), 1.0, 9.81)
     placement = study_placement(mode="fixed", center_mm=(90.0, 5.0, 112.0), box_axes=(1, 0, 2))
     params = study_closure_params(model="dynamic", dynamic=study_dynamic_params(object="held"))
     rows = simulate_object(hand, synergies, box, placement, params, poses=[4], mechanics=MECHANICS)

@@ -197,8 +197,8 @@ def _contacts(obj: str, statuses: list[str], settled: bool = True, model: str = 
 
 
 def _gfo(obj: str, fc_poses: list[int], n_poses: int, full: str = "1-2-3") -> pd.DataFrame:
-    rows = [{"object": obj, "pose": p, "set_id": s, "status": "force_closure" if p in fc_poses else "infeasible",
-             "force_closure": p in fc_poses, "strict_internal": p in fc_poses, "rank_G": 6, "force_norm": np.nan}
+    rows = [{"object": obj, "pose": p, "set_id": s, "status": "feasible" if p in fc_poses else "infeasible",
+             "load_feasible": p in fc_poses, "force_closure_def1": p in fc_poses, "rank_G": 6, "force_norm": np.nan}
             for p in range(n_poses) for s in ("1", full)]
     return pd.DataFrame(rows)
 
@@ -319,10 +319,12 @@ def test_the_search_lattice_bounds_the_rank():
 
 
 def _rank(rank: int) -> list[str]:
+    from synergrasp.study_checks import checked_scenario
+
     config = defaults()
     config["placement"]["search_rank"] = rank
     try:
-        validate_config(config)
+        checked_scenario(config)
     except ConfigError as err:
         return str(err).splitlines()
     return []

@@ -13,7 +13,7 @@ from synergrasp.optimisation.cones import CircularCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.ipm.sets import set_bases
 from synergrasp.optimisation.ipm.solver import IPMSettings
-from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_basis, object_wrench
+from synergrasp.optimisation.mechanics import grasp_mechanics, internal_force_basis, weight_wrench
 from synergrasp.optimisation.problem import GFOProblem, GraspSets, SynergySets
 from grasp_problems import random_grasp, random_synergies, random_unit_vector
 
@@ -27,7 +27,7 @@ def _study_sized_problems(count: int, seed: int = 11) -> list[GFOProblem]:
     while len(out) < count:
         m = int(rng.integers(3, 21))
         grasp = random_grasp(rng, m, palm_contacts=int(rng.integers(0, 3)))
-        mech = grasp_mechanics(grasp, object_wrench(1.0, random_unit_vector(rng)), 1.0, 200.0)
+        mech = grasp_mechanics(grasp, weight_wrench(9.81, random_unit_vector(rng)), 1.0, 200.0)
         if mech.rank_G < 6:
             continue
         S = random_synergies(rng)
@@ -48,9 +48,9 @@ def test_5000_study_sized_problems_match_the_exact_solver():
     problems = _study_sized_problems(5000)
     sol = solve_gfo(problems, "ipm")
     ref = solve_gfo(problems, "clarabel")
-    assert {"force_closure", "infeasible"} <= set(ref.status)
+    assert {"feasible", "infeasible"} <= set(ref.status)
     np.testing.assert_array_equal(sol.status, ref.status)
-    fc = ref.force_closure
+    fc = ref.feasible
     np.testing.assert_allclose(sol.force_norm[fc], ref.force_norm[fc], rtol=RTOL_NORM)
     assert np.all(sol.max_violation[fc] <= 1e-6 * np.maximum(1.0, sol.force_norm[fc]))
     for k in np.flatnonzero(fc):  # the optimal forces are unique (least norm over a convex set)
@@ -66,12 +66,12 @@ def _feasible_point_clarabel_missed(problem: GFOProblem, sol, k: int, ref_status
     (checked here, in numpy) and cvxpy (another formulation) finds the same optimum. The
     generated problems' mu* is bisected on Clarabel's verdicts, so near the boundary (forces of
     1e5 N) it can lie above the true critical friction and delta is not the problem's own."""
-    if not (sol.status[k] == "force_closure" and ref_status == "infeasible"):
+    if not (sol.status[k] == "feasible" and ref_status == "infeasible"):
         return False
     forces = sol.forces[k]
     assert problem.cone.violation(forces, problem.normals, problem.f_min) <= 1e-9 * np.linalg.norm(forces)
     cvx = solve_gfo([problem], "cvxpy")
-    assert cvx.status[0] == "force_closure"
+    assert cvx.status[0] == "feasible"
     assert cvx.force_norm[0] == pytest.approx(sol.force_norm[k], rel=RTOL_NORM)
     return True
 
@@ -88,7 +88,7 @@ def test_generated_kinds_match_exact_solver_outside_the_band_and_cvxpy_on_a_subs
             # Only near-boundary problems inside the stated band may differ; they are counted.
             assert p.kind == "near_boundary" and abs(p.delta) <= BAND, (k, p.kind, p.delta, sol.status[k], ref.status[k])
             in_band_differ += 1
-        elif ref.status[k] == "force_closure":
+        elif ref.status[k] == "feasible":
             assert sol.force_norm[k] == pytest.approx(ref.force_norm[k], rel=RTOL_NORM)
     assert {"nominal", "feasible", "infeasible", "near_boundary"} <= {p.kind for p in generated}
     assert in_band_differ <= 0.05 * len(generated)
@@ -98,7 +98,7 @@ def test_generated_kinds_match_exact_solver_outside_the_band_and_cvxpy_on_a_subs
         p = generated[k]
         if sol.status[k] != cvx.status[k]:
             assert p.kind == "near_boundary" and abs(p.delta) <= BAND
-        elif cvx.status[k] == "force_closure":
+        elif cvx.status[k] == "feasible":
             assert sol.force_norm[k] == pytest.approx(cvx.force_norm[k], rel=RTOL_NORM)
 
 
@@ -111,7 +111,7 @@ def test_second_attempt_with_refinement_decides_problems_the_first_leaves_open()
     assert n_once > 0  # the premise: the first attempt leaves some problems open
     assert n_twice < n_once
     np.testing.assert_array_equal(once.status, twice.status)
-    both = twice.force_closure
+    both = twice.feasible
     np.testing.assert_allclose(twice.force_norm[both], once.force_norm[both], rtol=RTOL_NORM)
 
 
@@ -121,7 +121,7 @@ def test_hand_derivable_problem():
     normals = np.array([[1.0, 0, 0], [-1.0, 0, 0]])
     E = np.array([1.0, 0, 0, -1.0, 0, 0])[:, None] / np.sqrt(2)
     sol = solve_gfo([GFOProblem(np.zeros(6), E, normals, 0.5, CircularCone(1.0))])
-    assert sol.status[0] == "force_closure" and sol.solver[0] == "ipm"
+    assert sol.status[0] == "feasible" and sol.solver[0] == "ipm"
     assert sol.force_norm[0] == pytest.approx(np.sqrt(2) * 0.5, rel=1e-7)
     np.testing.assert_allclose(sol.forces[0], [0.5, 0, 0, -0.5, 0, 0], atol=1e-7)
     # An internal force that loads only the first contact leaves n.f = 0 < f_min at the second.
@@ -162,11 +162,11 @@ def test_polish_decides_stalled_problems_as_clarabel_and_cvxpy_do():
     for out in (sol, eager):
         np.testing.assert_array_equal(out.status, ref.status)
         np.testing.assert_array_equal(out.strict_internal, ref.strict_internal)
-        fc = ref.force_closure
+        fc = ref.feasible
         np.testing.assert_allclose(out.force_norm[fc], ref.force_norm[fc], rtol=1e-7)
     polished = stalled[sol.solver[stalled] == "ipm"]
     assert polished.size >= 0.8 * stalled.size
-    assert np.all(sol.status[polished] == "force_closure")  # stalls are at optima
+    assert np.all(sol.status[polished] == "feasible")  # stalls are at optima
     for k in polished:
         # feasible and no worse than Clarabel's point; the forces themselves agree to about the
         # square root of the tolerance (near a degenerate optimum ||f|| is flat along the boundary)
@@ -174,7 +174,7 @@ def test_polish_decides_stalled_problems_as_clarabel_and_cvxpy_do():
         assert sol.force_norm[k] <= ref.force_norm[k] * (1 + 1e-9)
         assert np.linalg.norm(sol.forces[k] - ref.forces[k]) <= 1e-4 * ref.force_norm[k]
     cvx = solve_gfo([problems[k] for k in polished[:20]], "cvxpy")
-    np.testing.assert_array_equal(cvx.status, "force_closure")
+    np.testing.assert_array_equal(cvx.status, "feasible")
     np.testing.assert_allclose(sol.force_norm[polished[:20]], cvx.force_norm, rtol=1e-6)
     assert np.mean(sol.solver == "clarabel_fallback") < 0.2 * np.mean(plain.solver == "clarabel_fallback")
 
@@ -220,12 +220,12 @@ def test_fallback_path_when_the_iteration_cap_is_tiny():
     # Two iterations decide no feasible problem (an optimum needs more); an infeasible one
     # may already be proved by a certificate. What the kernel leaves open is Clarabel's.
     fallback = sol.solver == "clarabel_fallback"
-    assert np.all(fallback[ref.force_closure]) and fallback.sum() >= 10
+    assert np.all(fallback[ref.feasible]) and fallback.sum() >= 10
     assert np.all(sol.status[~fallback] == "infeasible")
     np.testing.assert_array_equal(sol.status, ref.status)
     np.testing.assert_array_equal(sol.strict_internal, ref.strict_internal)
     np.testing.assert_array_equal(sol.iterations[fallback], ref.iterations[fallback])
-    fc = ref.force_closure
+    fc = ref.feasible
     np.testing.assert_allclose(sol.force_norm[fc], ref.force_norm[fc], rtol=1e-12)
 
 
@@ -247,7 +247,7 @@ def test_sets_of_one_grasp_match_the_same_problems_one_by_one():
     sets = SynergySets(S, tuple(tuple(range(1, k + 1)) for k in range(1, 16)) + ((2,), (3, 5), (1, 4, 7)))
     for _ in range(4):
         grasp = random_grasp(rng, int(rng.integers(4, 13)), palm_contacts=1)
-        mech = grasp_mechanics(grasp, object_wrench(1.0, random_unit_vector(rng)), 1.0, 200.0)
+        mech = grasp_mechanics(grasp, weight_wrench(9.81, random_unit_vector(rng)), 1.0, 200.0)
         if mech.rank_G < 6:
             continue
         g = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, 0.1, CircularCone(1.5))
@@ -258,7 +258,7 @@ def test_sets_of_one_grasp_match_the_same_problems_one_by_one():
             np.testing.assert_array_equal(fused.status, ref.status)
             np.testing.assert_array_equal(fused.e_s, ref.e_s)
             np.testing.assert_array_equal(fused.strict_internal, ref.strict_internal)
-            fc = ref.force_closure
+            fc = ref.feasible
             np.testing.assert_allclose(fused.force_norm[fc], ref.force_norm[fc], rtol=RTOL_NORM)
             for j in np.flatnonzero(fc):  # unique optimum; its accuracy is that of the solvers' tolerances
                 assert np.linalg.norm(fused.forces[j] - ref.forces[j]) <= 1e-2 * ref.force_norm[j]
@@ -276,7 +276,7 @@ def test_verdicts_implied_by_nested_sets_are_those_of_a_direct_solve():
     g = GraspSets(np.array([0, 0, 1.0, 0, 0, 1.0]), normals, np.eye(6), 1.0, sets, 0.5, CircularCone(0.5))
     sol = solve_gfo(g, strict_shrink=1e-5)
     direct = solve_gfo([g.problem(j) for j in range(len(g))], strict_shrink=1e-5)
-    assert list(sol.status) == ["infeasible"] * 3 + ["force_closure"] * 3
+    assert list(sol.status) == ["infeasible"] * 3 + ["feasible"] * 3
     assert list(sol.solver) == ["ipm", "implied", "implied", "implied", "ipm", "ipm"]
     assert list(sol.iterations[1:4]) == [0, 0, 0] and list(sol.e_s) == [2, 1, 1, 1, 2, 1]
     assert list(sol.strict_internal) == [False, False, False, True, True, True]

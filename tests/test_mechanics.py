@@ -11,7 +11,7 @@ from synergrasp.optimisation.mechanics import (
     grasp_matrix,
     grasp_mechanics,
     internal_force_basis,
-    object_wrench,
+    weight_wrench,
 )
 from grasp_problems import LINK_CHAINS, random_grasp, random_synergies
 
@@ -43,13 +43,9 @@ def test_grasp_matrix_columns_are_force_and_moment_about_centre():
     np.testing.assert_allclose(G @ f, np.r_[F.sum(0), np.cross(p - o, F).sum(0)], atol=1e-10)
 
 
-def test_object_wrench_opposes_weight():
-    np.testing.assert_allclose(object_wrench(1.0, [0, 0, -1]), [0, 0, W, 0, 0, 0])
-    np.testing.assert_allclose(object_wrench(2.0, [3.0, 0, 0]), [-2 * W, 0, 0, 0, 0, 0])  # normalised
-    with pytest.raises(ValueError, match="gravity_direction"):
-        object_wrench(1.0, [0, 0, 0])
-    with pytest.raises(ValueError, match="mass_kg"):
-        object_wrench(-1.0, [0, 0, 1])
+def test_weight_wrench_opposes_weight():
+    np.testing.assert_allclose(weight_wrench(W, [0, 0, -1]), [0, 0, W, 0, 0, 0])
+    np.testing.assert_allclose(weight_wrench(2 * W, [3.0, 0, 0]), [-2 * W, 0, 0, 0, 0, 0])  # normalised
 
 
 def test_contact_stiffness_is_spd_inverse_compliance(grasp):
@@ -71,7 +67,7 @@ def test_contact_stiffness_is_spd_inverse_compliance(grasp):
 
 
 def test_particular_solution_and_projector(grasp):
-    w = object_wrench(1.0, _unit([0.3, -1.0, -0.2]))
+    w = weight_wrench(W, _unit([0.3, -1.0, -0.2]))
     mech = grasp_mechanics(grasp, w, 1.0, 200.0)
     assert mech.rank_G == 6
     np.testing.assert_allclose(mech.G @ mech.f_p, w, atol=1e-9)
@@ -84,7 +80,7 @@ def test_particular_solution_and_projector(grasp):
 
 
 def test_internal_force_basis_orthonormal_and_spans_fs(grasp):
-    mech = grasp_mechanics(grasp, object_wrench(1.0, [0, 0, -1]), 1.0, 200.0)
+    mech = grasp_mechanics(grasp, weight_wrench(W, [0, 0, -1]), 1.0, 200.0)
     S = random_synergies(np.random.default_rng(3))[:, :5]
     E = internal_force_basis(mech.projector, S, mech.response_norm)
     F = mech.projector @ S
@@ -106,7 +102,7 @@ def test_no_internal_force_when_every_hand_motion_moves_the_object_rigidly():
     center = np.zeros(3)
     twists = rng.normal(size=(6, 19)) * np.r_[np.ones(3), np.full(3, 0.02)][:, None]  # mm/rad, rad/rad
     rigid = Grasp(points, -_unit(points), np.arange(5), grasp_matrix(points, center).T @ twists, center)
-    mech = grasp_mechanics(rigid, object_wrench(1.0, [0, 0, -1]), 1.0, 200.0)
+    mech = grasp_mechanics(rigid, weight_wrench(W, [0, 0, -1]), 1.0, 200.0)
     S = random_synergies(rng)[:, :5]
     assert mech.rank_G == 6
     noise = np.linalg.svd(mech.projector @ S, compute_uv=False)
@@ -117,7 +113,7 @@ def test_no_internal_force_when_every_hand_motion_moves_the_object_rigidly():
 
 def test_internal_force_basis_rank_decision_on_null_synergies(grasp):
     """Synergies that the projector annihilates (and their round-off) give e_s = 0."""
-    mech = grasp_mechanics(grasp, object_wrench(1.0, [0, 0, -1]), 1.0, 200.0)
+    mech = grasp_mechanics(grasp, weight_wrench(W, [0, 0, -1]), 1.0, 200.0)
     _, sv, Vt = np.linalg.svd(mech.projector)
     null = Vt[np.sum(sv > 1e-12 * sv[0]):].T  # joint motions with no internal force
     if null.shape[1] == 0:  # with 6 finger contacts the projector is full column rank
@@ -158,7 +154,7 @@ def test_rank_of_known_grasps(points, rank):
     m = len(p)
     normals = np.tile([0.0, 0.0, 1.0], (m, 1))
     g = Grasp(p, normals, np.arange(1, m + 1), np.zeros((3 * m, 19)), np.zeros(3))
-    mech = grasp_mechanics(g, object_wrench(1.0, [1.0, 0, 0]), 1.0, 200.0)
+    mech = grasp_mechanics(g, weight_wrench(W, [1.0, 0, 0]), 1.0, 200.0)
     assert mech.rank_G == rank
     if rank < 6:
         assert mech.GKR is None and mech.f_p is None and mech.projector is None

@@ -38,16 +38,16 @@ def test_optimise_grasps_matches_clarabel_per_grasp():
         rows = slice(p * n, (p + 1) * n)
         assert list(out["set_id"][rows]) == ["-".join(map(str, s)) for s in sets.sets]
         if grasp is None:
-            assert set(out["status"][rows]) == {"no_grasp"} and not out["force_closure"][rows].any()
+            assert set(out["status"][rows]) == {"no_grasp"} and not out["load_feasible"][rows].any()
             continue
         mech = mechanics_for(grasp, PARAMS)
         ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, PARAMS.f_min_N, PARAMS.cone),
                         "clarabel", strict_shrink=PARAMS.strict_shrink)
         np.testing.assert_array_equal(out["status"][rows], ref.status)
         np.testing.assert_array_equal(out["e_s"][rows], ref.e_s)
-        np.testing.assert_array_equal(out["strict_internal"][rows], ref.strict_internal)
-        np.testing.assert_array_equal(out["force_closure"][rows], ref.status == "force_closure")
-        fc = ref.force_closure
+        np.testing.assert_array_equal(out["force_closure_def1"][rows], ref.strict_internal)
+        np.testing.assert_array_equal(out["load_feasible"][rows], ref.status == "feasible")
+        fc = ref.feasible
         np.testing.assert_allclose(out["force_norm"][rows][fc], ref.force_norm[fc], rtol=RTOL_NORM)
         assert np.isnan(out["force_norm"][rows][~fc]).all()
 
@@ -85,9 +85,9 @@ def test_pyramid_cone_study_runs_through_the_kernel_and_matches_clarabel():
         ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, params.f_min_N, params.cone),
                         "clarabel", strict_shrink=params.strict_shrink)
         np.testing.assert_array_equal(out["status"][rows], ref.status)
-        np.testing.assert_array_equal(out["strict_internal"][rows], ref.strict_internal)
+        np.testing.assert_array_equal(out["force_closure_def1"][rows], ref.strict_internal)
         assert set(out["solver"][rows]) <= {"ipm", "implied", "clarabel_fallback", "direct"}
-        fc = ref.force_closure
+        fc = ref.feasible
         np.testing.assert_allclose(out["force_norm"][rows][fc], ref.force_norm[fc], rtol=RTOL_NORM)
     with pytest.raises(ValueError, match="friction_cone must be one of"):
         study_gfo_params(friction_cone="pyramid6").cone
@@ -106,7 +106,7 @@ def test_verdicts_implied_by_nested_sets_are_those_of_solving_every_set(cone):
         every = optimise_grasps(grasps, sets, params, ipm=IPMSettings(nested=False))
         implied = nested["solver"] == "implied"
         assert implied.sum() > 100 and "implied" not in set(every["solver"])
-        for name in ("status", "strict_internal", "e_s"):
+        for name in ("status", "force_closure_def1", "e_s"):
             np.testing.assert_array_equal(nested[name], every[name])
         # a set of its superset's rank takes the superset's optimum, and a basis starts from
         # its parent's: the same problems on other bases of the same subspaces, equal to the
@@ -114,7 +114,7 @@ def test_verdicts_implied_by_nested_sets_are_those_of_solving_every_set(cone):
         np.testing.assert_allclose(nested["force_norm"], every["force_norm"], rtol=1e-6)
         infeasible = nested["status"] == "infeasible"
         assert (implied & infeasible).sum() > 100 and (implied & ~infeasible).any()
-        assert not nested["strict_internal"][infeasible].any()
+        assert not nested["force_closure_def1"][infeasible].any()
         assert not nested["iterations"][implied].any()
         assert set(nested["solver"][~implied]) <= {"ipm", "clarabel_fallback"}
 
@@ -174,5 +174,5 @@ def test_gfo_table_solves_one_grasp_once_whatever_the_shards(monkeypatch):
     # solving every pose on its own decides the same and finds the same forces to round-off
     alone = optimise_grasps(grasps, sets, PARAMS)
     np.testing.assert_array_equal(whole["status"].to_numpy(), alone["status"])
-    np.testing.assert_array_equal(whole["strict_internal"].to_numpy(), alone["strict_internal"])
+    np.testing.assert_array_equal(whole["force_closure_def1"].to_numpy(), alone["force_closure_def1"])
     np.testing.assert_allclose(whole["force_norm"].to_numpy(), alone["force_norm"], rtol=1e-6)

@@ -129,11 +129,11 @@ def test_the_planner_on_the_study_solver_reproduces_the_gfo_table():
     wide = plan.set_index("radius_deg").loc[200.0]
     assert wide["n_solves"] == 12 * n and wide["solve_share_percent"] == 100.0
     full = gfo[gfo["set_id"] == incremental_set_id(n)]
-    ok = full["force_closure"].to_numpy()
+    ok = full["load_feasible"].to_numpy()
     assert ok.any(), "the random grasps should give some load-feasible pose"
     assert wide["is_global_min"] and wide["best_force_N"] == pytest.approx(full["force_norm"][ok].min(), rel=1e-5)
     assert enrollment["k"].tolist() == list(range(1, n + 1))
-    assert enrollment["pca_n_success"].tolist() == [int(gfo[gfo["set_id"] == incremental_set_id(k)]["force_closure"].sum())
+    assert enrollment["pca_n_success"].tolist() == [int(gfo[gfo["set_id"] == incremental_set_id(k)]["load_feasible"].sum())
                                                     for k in range(1, n + 1)]
     assert enrollment["greedy_n_success"].iloc[-1] == enrollment["full_n_success"].iloc[0] == ok.sum()
     assert enrollment["greedy_n_success"].iloc[0] >= enrollment["pca_n_success"].iloc[0]

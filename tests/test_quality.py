@@ -165,7 +165,7 @@ def test_quality_table_rows_for_a_grasp_and_a_pose_without_one(tmp_path):
                              "beta_deg": [0.0, 0.0], "n_contacts": [6, 0], "status": ["grasp", "no_contact"],
                              "contact_link": [[0, 11, 1, 2, 4, 5], []],
                              "contact_normal": [np.r_[1.0, 0, 0, -1.0, 0, 0, np.zeros(12)], np.zeros(0)]})
-    gfo = pd.DataFrame({"object": "cube", "pose": [0, 1], "set_id": "1-2", "strict_internal": [True, False],
+    gfo = pd.DataFrame({"object": "cube", "pose": [0, 1], "set_id": "1-2", "force_closure_def1": [True, False],
                         "rank_G": [6, 0], "force_norm": [19.62, np.nan]})
     params = QualityParams(hand=None, synergies=None, mu=0.8, full_set_id="1-2", weight_N=9.81,
                            torque_length_mm=15.0 * math.sqrt(3.0), opposition=OppositionRule(45.0, 1.0))
@@ -212,7 +212,7 @@ def test_quality_table_computes_one_grasp_once_and_shares_it(monkeypatch):
     contacts = pd.DataFrame({"object": "box", "pose": range(4), "alpha_deg": [0.0, 5.0, 90.0, 95.0],
                              "beta_deg": 0.0, "n_contacts": [5, 6, 5, 6], "status": "grasp",
                              "contact_link": [g.links for g in grasps], "contact_normal": [g.normals for g in grasps]})
-    gfo = pd.DataFrame({"object": "box", "pose": range(4), "set_id": "1-2", "strict_internal": True, "rank_G": 6,
+    gfo = pd.DataFrame({"object": "box", "pose": range(4), "set_id": "1-2", "force_closure_def1": True, "rank_G": 6,
                         "force_norm": 9.81})
     params = quality.QualityParams(hand=None, synergies=None, mu=0.8, full_set_id="1-2", weight_N=9.81,
                                    torque_length_mm=20.0, opposition=OppositionRule(45.0, 1.0))

@@ -45,8 +45,8 @@ def _gfo(obj: str = "a") -> pd.DataFrame:
     for pose, (rank, fc, force) in enumerate(full):
         for set_id, values in (("1-2", (rank, fc, force)), ("1", (6, True, 1000.0))):  # "1" must not be read
             rows.append({"object": obj, "pose": pose, "alpha_deg": 5.0 * pose, "beta_deg": 0.0, "set_id": set_id,
-                         "n_synergies": len(set_id.split("-")), "status": "force_closure" if values[1] else "infeasible",
-                         "force_closure": values[1], "strict_internal": values[1], "force_norm": values[2], "e_s": 1,
+                         "n_synergies": len(set_id.split("-")), "status": "feasible" if values[1] else "infeasible",
+                         "load_feasible": values[1], "force_closure_def1": values[1], "force_norm": values[2], "e_s": 1,
                          "rank_G": values[0], "n_contacts": 0, "iterations": 1, "solver": "ipm"})
     return pd.DataFrame(rows)
 
@@ -136,7 +136,7 @@ def test_force_closure_is_the_studys_definition_not_load_feasibility(hand):
     """Pose 1 holds its load only with the weight's help (feasible, strict test fails): it is
     load-feasible, not in force closure, and its force does not enter the force median."""
     gfo = _gfo()
-    gfo.loc[(gfo["pose"] == 1) & (gfo["set_id"] == "1-2"), "strict_internal"] = False
+    gfo.loc[(gfo["pose"] == 1) & (gfo["set_id"] == "1-2"), "force_closure_def1"] = False
     row = _table(hand, gfo=gfo).iloc[0]
     assert row["pct_force_closure"] == pytest.approx(100.0 / 3.0)
     assert row["pct_load_feasible"] == pytest.approx(200.0 / 3.0)
@@ -207,7 +207,7 @@ def test_representative_grasps_follow_the_stated_rule(hand):
 
 def test_a_closure_without_contact_is_simulated_not_dropped(hand):
     poses = _POSES + [("no_contact", [], [])]
-    gfo = pd.concat([_gfo(), _gfo().iloc[:2].assign(pose=4, rank_G=0, force_closure=False, force_norm=np.nan)])
+    gfo = pd.concat([_gfo(), _gfo().iloc[:2].assign(pose=4, rank_G=0, load_feasible=False, force_closure_def1=False, force_norm=np.nan)])
     row = _table(hand, _contacts(poses=poses), gfo).iloc[0]
     assert (row["poses"], row["simulated"], row["dropped"]) == (5, 4, 1)
     assert row["pct_m0"] == pytest.approx(25.0)

@@ -27,8 +27,8 @@ def gfo_rows(obj: str, set_id: str, forces: list[float | None], strict: list[boo
     ``strict`` (default: wherever feasible) is the strict internal-force test."""
     strict = strict if strict is not None else [f is not None for f in forces]
     return [dict(object=obj, pose=p, alpha_deg=step_deg * p, beta_deg=0.0, set_id=set_id,
-                 n_synergies=len(set_id.split("-")), status="force_closure" if f is not None else "infeasible",
-                 force_closure=f is not None, strict_internal=s, rank_G=6, force_norm=np.nan if f is None else f)
+                 n_synergies=len(set_id.split("-")), status="feasible" if f is not None else "infeasible",
+                 load_feasible=f is not None, force_closure_def1=s, rank_G=6, force_norm=np.nan if f is None else f)
             for p, (f, s) in enumerate(zip(forces, strict))]
 
 

@@ -49,8 +49,7 @@ def verdicts_of(grasp: Grasp, gravity: tuple[float, float, float]) -> pd.Series:
     synergies[[4, 8, 12], 1] = [1.0, -1.0, 0.0]  # two pushed against each other
     out = optimise_grasps([grasp], SynergySets(synergies, ((1, 2),)), study_gfo_params(gravity_direction=gravity, mu=1.5))
     table = pd.DataFrame(out).assign(object="box")
-    row = pd.concat([table, verdict_columns(table)[["load_feasible"]]], axis=1)
-    return row.assign(force_closure_verdict=verdict_columns(table)["force_closure"]).iloc[0]
+    return table.assign(force_closure_verdict=verdict_columns(table)["force_closure"]).iloc[0]
 
 
 def test_resting_box_is_load_feasible_and_not_force_closure():
@@ -73,11 +72,11 @@ def test_symmetric_tripod_with_friction_is_both(gravity):
 
 
 def test_with_verdicts_picks_the_success_column_and_flags_marginal_grasps():
-    gfo = pd.DataFrame({"object": ["a"] * 4, "set_id": ["1"] * 4, "status": ["force_closure"] * 3 + ["infeasible"],
-                        "force_closure": [True, True, True, False], "strict_internal": [True, False, True, False],
+    gfo = pd.DataFrame({"object": ["a"] * 4, "set_id": ["1"] * 4, "status": ["feasible"] * 3 + ["infeasible"],
+                        "load_feasible": [True, True, True, False], "force_closure_def1": [True, False, False, False],
                         "rank_G": [6, 6, 5, 6], "force_norm": [50.0, 200.0, 3.0, np.nan]})
     fc = with_verdicts(gfo, "force_closure", {"a": 9.81}, 10.0)
-    assert fc["success"].tolist() == [True, False, False, False]  # rank 5 is never force closure
+    assert fc["success"].tolist() == [True, False, False, False]  # rank 5: never Definition 1 (tests/test_gfo.py)
     lf = with_verdicts(gfo, "load_feasible", {"a": 9.81}, 10.0)
     assert lf["success"].tolist() == [True, True, True, False]
     assert lf["marginal"].tolist() == [False, True, False, False]  # 200 N > 98.1 N
@@ -87,8 +86,8 @@ def test_with_verdicts_picks_the_success_column_and_flags_marginal_grasps():
 
 
 def test_force_closure_bounded_is_force_closure_within_the_bound():
-    gfo = pd.DataFrame({"object": ["a"] * 4, "set_id": ["1"] * 4, "status": ["force_closure"] * 4,
-                        "force_closure": [True] * 4, "strict_internal": [True, True, True, False],
+    gfo = pd.DataFrame({"object": ["a"] * 4, "set_id": ["1"] * 4, "status": ["feasible"] * 4,
+                        "load_feasible": [True] * 4, "force_closure_def1": [True, True, True, False],
                         "rank_G": [6] * 4, "force_norm": [50.0, 98.1, 98.2, 3.0]})
     bounded = with_verdicts(gfo, "force_closure_bounded", {"a": 9.81}, 10.0)
     assert bounded["success"].tolist() == [True, True, False, False]  # 98.2 N > 10 x 9.81 N; no strict test
@@ -104,8 +103,8 @@ def test_force_closure_without_a_force_beyond_the_bound_is_reclassified():
     above 10 x 9.81 N, so set 1 is load-feasible in exact arithmetic and never bounded. At
     pose 1 the superset needs only 50 N: left as it is (an unexplained invariant breach)."""
     gfo = pd.DataFrame({"object": ["a"] * 4, "pose": [0, 0, 1, 1], "set_id": ["1", "1-2", "1", "1-2"],
-                        "status": ["infeasible", "force_closure", "infeasible", "force_closure"],
-                        "force_closure": [False, True, False, True], "strict_internal": [True] * 4,
+                        "status": ["infeasible", "feasible", "infeasible", "feasible"],
+                        "load_feasible": [False, True, False, True], "force_closure_def1": [True] * 4,
                         "rank_G": [6] * 4, "force_norm": [np.nan, 500.0, np.nan, 50.0]})
     out = with_verdicts(gfo, "force_closure", {"a": 9.81}, 10.0)
     assert out["force_lower_bound_N"].tolist()[0] == 500.0 and out["force_lower_bound_N"].tolist()[2] == 50.0

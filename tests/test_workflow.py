@@ -138,9 +138,9 @@ def test_tables_have_documented_columns_and_sane_values(run_j2):
     checks = pd.read_csv(tables / "invariant_checks.csv")
     assert (checks.loc[checks["check"] == "alpha_period", "count"] == 0).all()  # results repeat every 90 deg
     gfo = pd.read_parquet(run_j2 / "results" / "objects" / "obj4" / "gfo.parquet")
-    assert set(gfo["status"]) <= {"force_closure", "infeasible", "rank_deficient", "no_grasp", "numerical_failure"}
-    fc = gfo[gfo["force_closure"]]
-    assert (fc["force_norm"] > 0).all() and gfo.loc[~gfo["force_closure"], "force_norm"].isna().all()
+    assert set(gfo["status"]) <= {"feasible", "infeasible", "rank_deficient", "no_grasp", "numerical_failure"}
+    fc = gfo[gfo["load_feasible"]]
+    assert (fc["force_norm"] > 0).all() and gfo.loc[~gfo["load_feasible"], "force_norm"].isna().all()
 
 
 def test_no_pose_is_dropped(run_j2):

@@ -77,7 +77,7 @@ def run(out: str, n_poses: int, changes: list[str], shift_um: float, engine: dic
     for name in config["objects"]:
         sim = SimulateParams.from_config(config, name)
         grid = pose_grid(sim.placement)
-        closer = closure_model(hand, sim.synergies(hand.joint_names), sim.closure, sim.mechanics, sim.object.mass_kg)
+        closer = closure_model(hand, sim.synergies(hand.joint_names), sim.closure, sim.mechanics, sim.object.weight_N)
         if engine:
             import pybullet
 

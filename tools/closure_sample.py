@@ -82,9 +82,8 @@ def summary(out: Path) -> None:
     config = defaults()
     hand = load_hand(config["hand"])
     synergies = load_synergies(config["synergies"], joint_names=hand.joint_names)
-    mech = config["mechanics"]
-    checks_params = EquilibriumParams.of(hand, synergies, mech["k_ss_Nmm_per_rad"], mech["mu"])
     realism = RealismParams.from_config(config)
+    checks_params = EquilibriumParams.of(hand, synergies, realism.k_ss_Nmm_per_rad, realism.mu)
     full = tuple(range(1, config["synergy_sets"]["incremental_max"] + 1))
     parts, extra = [], []
     for label in (m for m in MODELS if (out / m).is_dir()):
@@ -122,8 +121,8 @@ def pictures(out: Path, png: Path, poses: list[int]) -> None:
     config = defaults()
     hand = load_hand(config["hand"])
     synergies = load_synergies(config["synergies"], joint_names=hand.joint_names)
-    mech = config["mechanics"]
-    params = EquilibriumParams.of(hand, synergies, mech["k_ss_Nmm_per_rad"], mech["mu"])
+    realism = RealismParams.from_config(config)
+    params = EquilibriumParams.of(hand, synergies, realism.k_ss_Nmm_per_rad, realism.mu)
     labels = [m for m in MODELS if (out / m).is_dir()]
     names = list(config["objects"])
     fig, axes = plt.subplots(len(names), len(labels), figsize=(2.7 * len(labels), 2.9 * len(names)), squeeze=False)

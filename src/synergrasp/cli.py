@@ -38,7 +38,7 @@ _OPPOSITION_WORDS = {"palm": "held against the palm: a power grasp", "pad": "bet
                      "none": "no two contact groups push against each other"}
 
 #: The optimisation's status under the object's weight, in words.
-_WEIGHT_WORDS = {"force_closure": "feasible", "infeasible": "infeasible", "rank_deficient": "rank(G) < 6",
+_WEIGHT_WORDS = {"feasible": "feasible", "infeasible": "infeasible", "rank_deficient": "rank(G) < 6",
                  "no_grasp": "no grasp", "numerical_failure": "solver failed"}
 
 

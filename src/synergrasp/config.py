@@ -337,7 +337,7 @@ def _search_problems(config: Mapping[str, Any]) -> list[str]:
                 if hi < lo:
                     problems.append(f"config error at '{where}.search.region_mm.{kind}.{axis}': stop {hi} is below "
                                     f"start {lo}")
-    return problems + _rank_problems(config)
+    return problems
 
 
 def search_lattice_size(search: Mapping[str, Any], grasp_type: str) -> int:
@@ -348,25 +348,6 @@ def search_lattice_size(search: Mapping[str, Any], grasp_type: str) -> int:
     if region == "hand":  # derived from the hand when the search runs: bounded by a generous box
         return math.prod(int(math.floor(400.0 / search["spacing_mm"])) + 1 for _ in range(3))
     return math.prod(int(math.floor((hi - lo) / search["spacing_mm"] + 1e-9)) + 1 for lo, hi in region.values())
-
-
-def _rank_problems(config: Mapping[str, Any]) -> list[str]:
-    """A searched placement's rank that no search under the configuration can reach (one
-    line per key and lattice, naming the objects)."""
-    found: dict[tuple[str, int, int, float], list[str]] = {}
-    for name, spec in config["objects"].items():
-        placement = overlay(config["placement"], spec.get("placement"))
-        kind = config.get("grasp_type") or spec["grasp_type"]  # resolved.grasp_type (config cannot import it)
-        region = placement["search"]["region_mm"][kind]
-        if placement["mode"] != "searched" or (region != "hand" and any(hi < lo for lo, hi in region.values())):
-            continue
-        n = search_lattice_size(placement["search"], kind)
-        if placement["search_rank"] > n:
-            where = "placement" if "search_rank" not in (spec.get("placement") or {}) else f"objects.{name}.placement"
-            found.setdefault((where, placement["search_rank"], n, placement["search"]["spacing_mm"]), []).append(name)
-    return [f"config error at '{where}.search_rank': {rank} exceeds the {n} points of the search lattice of "
-            f"{', '.join(names)} (search.region_mm of its grasp type at search.spacing_mm {spacing:g} mm): no search "
-            "has that many distinct targets" for (where, rank, n, spacing), names in found.items()]
 
 
 def _settle_problems(dynamic: Mapping[str, Any]) -> list[str]:

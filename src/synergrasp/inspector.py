@@ -49,11 +49,11 @@ class BlockingContact:
 class SetResult:
     """The optimisation of one synergy set at the inspected pose.
 
-    status: the optimisation under the weight: 'force_closure' (feasible) | 'infeasible' |
+    status: the optimisation under the weight: 'feasible' | 'infeasible' |
         'numerical_failure' | 'rank_deficient' | 'no_grasp'
     force_closure: the study's verdict, Definition 1: rank(G) = 6 and a synergy-reachable
         internal force strictly inside every cone (independent of the weight)
-    load_feasible: the optimisation under the weight is feasible (status 'force_closure')
+    load_feasible: the optimisation under the weight is feasible (status 'feasible')
     force_N: optimal ‖f‖₂ under the object's weight (NaN unless load-feasible)
     e_s: dimension of the synergy-reachable internal forces
     cone_use: largest ‖f_t‖ / (μ f_n) over the contacts of the optimal forces (≤ 1: inside
@@ -250,8 +250,8 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     out = optimise_grasps([grasp], SynergySets(full.matrix, tuple(chosen)), opt.gfo, forces=True)
     mu = float(opt.gfo.mu)
     results = tuple(
-        SetResult(set_id(s), s, str(out["status"][k]), bool(out["strict_internal"][k] and out["rank_G"][k] == 6),
-                  bool(out["force_closure"][k]), float(out["force_norm"][k]), int(out["e_s"][k]),
+        SetResult(set_id(s), s, str(out["status"][k]), bool(out["force_closure_def1"][k]),
+                  bool(out["load_feasible"][k]), float(out["force_norm"][k]), int(out["e_s"][k]),
                   cone_use(out["forces"][k], grasp.normals, mu) if out["forces"][k] is not None else float("nan"),
                   _floats(out["forces"][k]) if out["forces"][k] is not None else ())
         for k, s in enumerate(chosen))

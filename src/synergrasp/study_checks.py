@@ -7,7 +7,8 @@ objects' shapes; besides the problems (errors), the warnings on sizes far from a
 workflow asks it through :func:`workflow_scenario` (common.smk), ``synergrasp grasp`` through
 ``synergrasp.inspector``; :func:`read_overlays` reads a command's ``--configfile`` files as
 strictly as the workflow reads its own. Checks that need a step's output where it exists
-(:func:`search_rank_problems`) or a target's whole configuration
+(:func:`search_rank_problems`), the objects' resolved placements and grasp types
+(:func:`lattice_rank_problems`) or a target's whole configuration
 (:func:`searched_objects_or_refuse`) are here too. Every problem is one line naming the file or
 the key.
 """
@@ -21,11 +22,12 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from synergrasp.config import ConfigError, check_relations, overlay, scenario_config, synergy_problems
+from synergrasp.config import ConfigError, check_relations, overlay, scenario_config, search_lattice_size, synergy_problems
 from synergrasp.preflight import refuse
+from synergrasp.resolved import effective_placement, grasp_type
 from synergrasp.yaml_io import read_yaml
 
-__all__ = ["checked_scenario", "workflow_scenario", "read_overlays", "search_rank_problems",
+__all__ = ["checked_scenario", "workflow_scenario", "read_overlays", "search_rank_problems", "lattice_rank_problems",
            "search_table_or_refuse", "searched_objects_or_refuse"]
 
 
@@ -56,7 +58,7 @@ def checked_scenario(config: Mapping[str, Any], name: str = "default") -> tuple[
         cfg = scenario_config(config, name)
         hand, problems, warnings = _hand(cfg["hand"])
         synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
-        problems = [*problems, *check_relations(cfg, synergies.matrix.shape[1]),
+        problems = [*problems, *check_relations(cfg, synergies.matrix.shape[1]), *lattice_rank_problems(cfg),
                     *synergy_problems(cfg, synergies.mean, synergies.matrix), *object_problems(cfg)]
     except ConfigError:
         raise
@@ -109,16 +111,39 @@ def _distinct_targets(path: Path) -> int | None:
         return None
 
 
+def _rank_key(cfg: Mapping[str, Any], obj: str) -> str:
+    """Where object ``obj``'s ``search_rank`` is set: its own placement or the global one."""
+    return "placement" if "search_rank" not in (cfg["objects"][obj].get("placement") or {}) else \
+        f"objects.{obj}.placement"
+
+
+def lattice_rank_problems(cfg: Mapping[str, Any]) -> list[str]:
+    """A searched placement's rank that no search under the configuration can reach (one
+    line per key and lattice, naming the objects)."""
+    found: dict[tuple[str, int, int, float], list[str]] = {}
+    for name in cfg["objects"]:
+        placement, kind = effective_placement(cfg, name), grasp_type(cfg, name)
+        region = placement["search"]["region_mm"][kind]
+        if placement["mode"] != "searched" or (region != "hand" and any(hi < lo for lo, hi in region.values())):
+            continue
+        n = search_lattice_size(placement["search"], kind)
+        if placement["search_rank"] > n:
+            key = (_rank_key(cfg, name), placement["search_rank"], n, placement["search"]["spacing_mm"])
+            found.setdefault(key, []).append(name)
+    return [f"config error at '{where}.search_rank': {rank} exceeds the {n} points of the search lattice of "
+            f"{', '.join(names)} (search.region_mm of its grasp type at search.spacing_mm {spacing:g} mm): no search "
+            "has that many distinct targets" for (where, rank, n, spacing), names in found.items()]
+
+
 def search_rank_problems(cfg: Mapping[str, Any], obj: str, table: str | Path) -> list[str]:
     """Object ``obj``'s ``search_rank`` against its search's table ``table`` where that table
     exists already (the closure would fail after other jobs ran, and the search does not
     read the rank). A table made in this run is judged by the closure, before it writes."""
-    placement = overlay(cfg["placement"], cfg["objects"][obj].get("placement"))
+    placement = effective_placement(cfg, obj)
     n = _distinct_targets(Path(table)) if Path(table).is_file() else None
     if placement["mode"] != "searched" or n is None or placement["search_rank"] <= n:
         return []
-    where = "placement" if "search_rank" not in (cfg["objects"][obj].get("placement") or {}) else \
-        f"objects.{obj}.placement"
+    where = _rank_key(cfg, obj)
     return [f"config error at '{where}.search_rank': {placement['search_rank']} exceeds the {n} distinct targets of "
             f"{obj}'s placement search ({table})"]
 
@@ -136,7 +161,7 @@ def searched_objects_or_refuse(files: list[str], target: str, cfg: Mapping[str, 
     """``files`` (one per object whose placement is searched); an empty list stops the run:
     ``target`` needs the placement search's targets and no object of ``cfg`` is searched."""
     if not files:
-        modes = sorted({overlay(cfg["placement"], s.get("placement"))["mode"] for s in cfg["objects"].values()})
+        modes = sorted({effective_placement(cfg, name)["mode"] for name in cfg["objects"]})
         stop([f"{target}: no object's placement is searched (placement.mode: {', '.join(modes)}); the claims at the "
               "placement search's targets need placement.mode: searched (docs/placement_search.md)"])
     return files

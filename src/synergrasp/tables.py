@@ -32,11 +32,14 @@ class Column:
 
 @dataclass(frozen=True)
 class Table:
-    """A table's name, one-line description, row key and columns in order."""
+    """A table's name, one-line description, row key and columns in order; ``renamed``: the
+    columns an older version wrote under another name, (old name, new name) each, so that
+    :func:`read` refuses a file of that version instead of reading it under the old meaning."""
 
     name: str
     rows: str
     columns: tuple[Column, ...]
+    renamed: tuple[tuple[str, str], ...] = ()
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -87,16 +90,16 @@ CONTACTS = Table("contacts", "one row per pose", _pose_columns() + (
 GFO = Table("gfo", "one row per (pose, synergy set)", _pose_columns() + (
     Column("set_id", "string", "", "enrolled synergies, 1-based, sorted, joined by '-'"),
     Column("n_synergies", "int32", "", "number of enrolled synergies s"),
-    Column("status", "string", "", "force_closure, infeasible, rank_deficient, no_grasp, numerical_failure"),
-    Column("force_closure", "bool", "", "status == force_closure"),
-    Column("strict_internal", "bool", "", "Bicchi's strict internal-force test"),
-    Column("force_norm", "float64", "N", "optimal contact-force norm (NaN unless force closure)"),
+    Column("status", "string", "", "the optimisation under the object's weight: feasible, infeasible, rank_deficient, no_grasp, numerical_failure"),
+    Column("load_feasible", "bool", "", "the grasp-force optimisation under the object's weight is feasible (status feasible); not Definition 1"),
+    Column("force_closure_def1", "bool", "", "force closure, the study's Definition 1: rank(G) = 6 and Bicchi's strict internal-force test (some E_s y strictly inside every friction cone); independent of the weight"),
+    Column("force_norm", "float64", "N", "optimal contact-force norm under the weight (NaN unless load_feasible)"),
     Column("e_s", "int32", "", "rank of the internal-force basis"),
     Column("rank_G", "int32", "", "rank of the grasp matrix"),
     Column("n_contacts", "int32", "", "number of contacts"),
     Column("iterations", "int32", "", "interior-point iterations of the GFO (0 unless solver ipm or clarabel_fallback)"),
     Column("solver", "string", "", "back end that decided the problem: ipm (compiled interior-point kernel), implied (not solved: range(E_s) lies in that of each superset of its synergies, so infeasible where a superset is, and of a superset of equal rank the same problem, whose verdict and force_norm it takes; 0 iterations, e_s its own rank), clarabel_fallback (the kernel left it undecided), direct (e_s = 0: f = f_p judged without a solver), none (no_grasp, rank_deficient: nothing solved)"),
-))
+), renamed=(("force_closure", "load_feasible"), ("strict_internal", "force_closure_def1")))
 
 MINIMA = Table("minima", "one row per local minimum of (object, synergy set)", (
     Column("object", "string", "", "object name"),
@@ -320,11 +323,17 @@ def write(table: Table, frame: pd.DataFrame, path: str | Path) -> None:
 
 def read(table: Table, path: str | Path) -> pd.DataFrame:
     """Read a Parquet table and check it holds the contract's columns; ValueError naming the
-    table and the file if it cannot be read or lacks a column."""
+    table and the file if it cannot be read, was written by an older version (a column of
+    ``table.renamed`` under its old name: rerun) or lacks a column."""
     try:
         frame = pd.read_parquet(path)
     except (OSError, ValueError) as err:  # pyarrow's read errors are either
         raise ValueError(f"{table.name} table '{path}': cannot be read as Parquet ({err})") from None
+    old = [(was, now) for was, now in table.renamed if was in frame.columns and now not in frame.columns]
+    if old:
+        names = ", ".join(f"'{was}' (now '{now}')" for was, now in old)
+        raise ValueError(f"{table.name} table '{path}': written by an older version of the study (column {names}); "
+                         "delete it (or its results folder) and rerun the study")
     _check(table, frame, str(path))
     return frame
 

@@ -4,12 +4,13 @@ Two verdicts are derived from the columns the optimisation writes (docs/analyses
 
 - ``force_closure`` — the study's Definition 1 (after Bicchi 1995): rank(G) = 6 and the grasp
   is prehensile, i.e. some synergy-reachable internal force E_s·y lies strictly inside every
-  friction cone. The gfo column ``strict_internal`` is that test: the SOCP with f_p = 0,
+  friction cone. The gfo column ``force_closure_def1`` is that verdict: rank(G) = 6 and the
+  strict internal-force test, the SOCP with f_p = 0,
   a normal component of at least 1 N at every contact (a scale only: internal forces form a
   cone) and the friction coefficient shrunk to μ(1 − 1e-5) (the margin that makes "strictly
   inside" decidable). It is a property of the grasp, independent of the load.
 - ``load_feasible`` — the optimisation under the object's weight is feasible (gfo column
-  ``force_closure``, i.e. status ``force_closure``): the weight may help through f_p, so a
+  ``load_feasible``, i.e. status ``feasible``): the weight may help through f_p, so a
   box resting in curled fingers passes.
 - ``force_closure_bounded`` — force closure whose optimal force under the weight is at most
   ``marginal_multiple`` times the weight: non-marginal force closure.
@@ -39,18 +40,18 @@ __all__ = ["VERDICTS", "verdict_columns", "with_verdicts", "force_bound"]
 
 #: The success verdicts the tables can use (config ``analyses.success``).
 VERDICTS: tuple[str, ...] = ("force_closure", "load_feasible", "force_closure_bounded")
-_NEEDED = ("object", "set_id", "status", "force_closure", "strict_internal", "rank_G", "force_norm")
+_NEEDED = ("object", "set_id", "status", "load_feasible", "force_closure_def1", "rank_G", "force_norm")
 
 
 def verdict_columns(gfo: pd.DataFrame) -> pd.DataFrame:
-    """The two verdicts of every gfo row: columns ``force_closure`` (rank(G) = 6 and the
-    strict internal-force test) and ``load_feasible`` (optimisation under the weight
+    """The two verdicts of every gfo row: columns ``force_closure`` (Definition 1: the gfo
+    column ``force_closure_def1``) and ``load_feasible`` (optimisation under the weight
     feasible), index aligned with ``gfo``."""
     missing = [c for c in _NEEDED if c not in gfo.columns]
     if missing:
         raise ValueError(f"gfo table: missing columns {missing}")
-    closure = gfo["strict_internal"].astype(bool) & (gfo["rank_G"].astype(int) == 6)
-    return pd.DataFrame({"force_closure": closure, "load_feasible": gfo["force_closure"].astype(bool)},
+    return pd.DataFrame({"force_closure": gfo["force_closure_def1"].astype(bool),
+                         "load_feasible": gfo["load_feasible"].astype(bool)},
                         index=gfo.index)
 
 

@@ -31,8 +31,8 @@ def solve(problem: GFOProblem, *, tol: float = DEFAULT_TOL, max_iter: int = 200)
     """Solve one problem; e_s = 0 is judged by `judge_direct`.
 
     tol: Clarabel's feasibility, gap and infeasibility tolerances; max_iter: its iteration
-    cap. Status mapping (docs/force_optimisation.md): Solved -> 'force_closure';
-    AlmostSolved -> 'force_closure' if the point violates no constraint by more than
+    cap. Status mapping (docs/force_optimisation.md): Solved -> 'feasible';
+    AlmostSolved -> 'feasible' if the point violates no constraint by more than
     ALMOST_SOLVED_TOL max(1 N, ||f||), else 'numerical_failure'; PrimalInfeasible and
     AlmostPrimalInfeasible -> 'infeasible'; anything else -> 'numerical_failure'.
     A solver failure is a status, never an exception.
@@ -84,7 +84,7 @@ def _verdict(name: str, x: np.ndarray, iterations: int, problem: GFOProblem) -> 
         norm = float(np.linalg.norm(forces))
         viol = problem.cone.violation(forces, problem.normals, problem.f_min)
         if name == "Solved" or viol <= ALMOST_SOLVED_TOL * max(1.0, norm):
-            return Outcome("force_closure", norm, forces, iterations, "clarabel", name, viol)
+            return Outcome("feasible", norm, forces, iterations, "clarabel", name, viol)
         return Outcome("numerical_failure", float("nan"), None, iterations, "clarabel", name, viol)
     if name in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
         return Outcome("infeasible", float("nan"), None, iterations, "clarabel", name)

@@ -20,7 +20,7 @@ _DIRECT_TOL = 1e-8
 
 def solve(problem: GFOProblem, *, solver: str = "CLARABEL") -> Outcome:
     """Solve one problem through cvxpy. Status mapping: optimal and optimal_inaccurate ->
-    'force_closure'; infeasible and infeasible_inaccurate -> 'infeasible'; anything else ->
+    'feasible'; infeasible and infeasible_inaccurate -> 'infeasible'; anything else ->
     'numerical_failure'."""
     import cvxpy as cp
 
@@ -32,7 +32,7 @@ def solve(problem: GFOProblem, *, solver: str = "CLARABEL") -> Outcome:
         fn = np.sum(F * n, axis=1)
         ft = np.sqrt(np.maximum(np.sum(F * F, axis=1) - fn**2, 0.0))
         if np.all(fn >= f_min - _DIRECT_TOL) and np.all(ft <= mu * fn + _DIRECT_TOL):
-            return Outcome("force_closure", float(np.linalg.norm(fp)), fp.copy(), 0, "cvxpy:none", "direct")
+            return Outcome("feasible", float(np.linalg.norm(fp)), fp.copy(), 0, "cvxpy:none", "direct")
         return Outcome("infeasible", float("nan"), None, 0, "cvxpy:none", "direct")
 
     normal_rows = np.zeros((m, 3 * m))
@@ -53,7 +53,7 @@ def solve(problem: GFOProblem, *, solver: str = "CLARABEL") -> Outcome:
     iterations = int(getattr(cvx.solver_stats, "num_iters", 0) or 0)
     if status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
         forces = fp + Em @ y.value
-        return Outcome("force_closure", float(np.linalg.norm(forces)), forces, iterations, name, status,
+        return Outcome("feasible", float(np.linalg.norm(forces)), forces, iterations, name, status,
                        problem.cone.violation(forces, n, f_min))
     if status in (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE):
         return Outcome("infeasible", float("nan"), None, iterations, name, status)

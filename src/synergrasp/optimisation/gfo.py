@@ -48,7 +48,7 @@ METHODS: dict[str, tuple[str, ...]] = {
 FASTEST_METHOD: dict[str, str] = {"circular": "ipm", "pyramid": "ipm"}
 
 #: Verdict of each kernel code; '' marks the problems that go to the Clarabel fallback.
-_STATUS_OF_CODE = np.array(["", "force_closure", "infeasible", ""], dtype=object)
+_STATUS_OF_CODE = np.array(["", "feasible", "infeasible", ""], dtype=object)
 
 
 def solve_gfo(
@@ -90,7 +90,7 @@ def solve_gfo(
             continue
         sol.record(k, solve(problem))
         if strict_shrink is not None:
-            sol.strict_internal[k] = solve(problem.strict_test(strict_shrink)).status == "force_closure"
+            sol.strict_internal[k] = solve(problem.strict_test(strict_shrink)).status == "feasible"
     return sol
 
 
@@ -113,7 +113,7 @@ def _fallback(sol: GFOSolution, k: int, problem: GFOProblem, tol: float, max_ite
 
 
 def _strict_fallback(problem: GFOProblem, shrink: float, tol: float, max_iter: int) -> bool:
-    return clarabel_solver.solve(problem.strict_test(shrink), tol=tol, max_iter=max_iter).status == "force_closure"
+    return clarabel_solver.solve(problem.strict_test(shrink), tol=tol, max_iter=max_iter).status == "feasible"
 
 
 def _ipm_one(sol: GFOSolution, k: int, problem: GFOProblem, shrink: float | None, tol: float, max_iter: int,
@@ -128,7 +128,7 @@ def _ipm_one(sol: GFOSolution, k: int, problem: GFOProblem, shrink: float | None
                                    problem.cone.narrowed(shrink) if shrink is not None else None, problem.f_min, ipm,
                                    ALMOST_SOLVED_TOL)
     status, iters = _STATUS_OF_CODE[res.code[0]], int(res.iterations[0])
-    if status == "force_closure":
+    if status == "feasible":
         forces = res.forces[0]
         sol.record(k, Outcome(status, float(res.force_norm[0]), forces, iters, "ipm", "",
                               problem.cone.violation(forces, problem.normals, problem.f_min)))

@@ -25,7 +25,6 @@ __all__ = [
     "grasp_matrix",
     "grasp_mechanics",
     "internal_force_basis",
-    "object_wrench",
     "weight_wrench",
     "read_grasps",
     "same_grasp",
@@ -196,23 +195,6 @@ def grasp_matrix(points: NDArray, center: NDArray) -> NDArray:
     return blocks.reshape(6, 3 * m)
 
 
-def object_wrench(mass_kg: float, gravity_direction: NDArray, g: float = 9.81) -> NDArray:
-    """Wrench w_e (6,) the contacts must apply to hold the object against its weight.
-
-    Gravity pulls with m g ĝ at the centre (no torque about o), so the contacts must apply
-    w_e = [-m g ĝ; 0] (N, N·mm). `gravity_direction` is normalised; mass in kg, g in m/s².
-    """
-    if not np.isfinite(mass_kg) or mass_kg < 0:
-        raise ValueError(f"mass_kg must be a finite number >= 0, got {mass_kg}")
-    if not np.isfinite(g) or g < 0:
-        raise ValueError(f"g must be a finite number >= 0 (m/s^2), got {g}")
-    d = np.asarray(gravity_direction, dtype=float)
-    norm = np.linalg.norm(d) if d.shape == (3,) else 0.0
-    if d.shape != (3,) or not np.isfinite(norm) or norm == 0.0:
-        raise ValueError(f"gravity_direction must be a non-zero finite 3-vector, got {gravity_direction!r}")
-    return weight_wrench(mass_kg * g, d)
-
-
 def weight_wrench(weight_N: float, gravity_direction: NDArray) -> NDArray:
     """Wrench w_e (6,) the contacts must apply against a weight of ``weight_N`` (N) along
     ``gravity_direction`` (normalised here): [-W ĝ; 0] (N, N·mm)."""
@@ -315,7 +297,7 @@ def grasp_mechanics(
 ) -> GraspMechanics:
     """Compute G, K, G_K^R, f_p and the internal-force projector of a grasp.
 
-    wrench: (6,) w_e the contacts must apply (see `object_wrench`), N and N·mm.
+    wrench: (6,) w_e the contacts must apply (see `weight_wrench`), N and N·mm.
     A grasp with rank(G) < 6 is recorded (rank_G, and None for GKR, f_p and projector);
     it is never an error.
     """

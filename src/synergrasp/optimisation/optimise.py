@@ -91,8 +91,9 @@ class GFOParams:
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> GFOParams:
-        """The configuration's ``mechanics`` with the weight of the object ``obj``."""
-        return build(cls, "mechanics", **dataclass_fields(cls, config["mechanics"]),
+        """The configuration's ``mechanics`` with the weight of the object ``obj`` (μ and the
+        weight as resolved, ``synergrasp.resolved``)."""
+        return build(cls, "mechanics", **{**dataclass_fields(cls, config["mechanics"]), "mu": resolved.friction_mu(config)},
                      weight_N=resolved.weight_N(config, obj))
 
     def wrench(self) -> NDArray:
@@ -145,7 +146,8 @@ def optimise_grasps(
     cone (`gfo.FASTEST_METHOD`: the compiled kernel, with Clarabel for what it leaves
     undecided, for every cone kind). strict=False skips the strict
     test (column all False). Returns columns, one row per (grasp, set), grasp-major:
-    set_id, n_synergies, status, force_closure, strict_internal, force_norm (N), e_s,
+    set_id, n_synergies, status, load_feasible, force_closure_def1 (rank(G) = 6 and the strict
+    test), force_norm (N), e_s,
     rank_G, n_contacts, iterations, solver; with forces=True also ``forces``, each row's optimal
     contact forces (3m,) N (None unless load-feasible; the one-grasp inspector reads them).
     """
@@ -155,8 +157,8 @@ def optimise_grasps(
         "set_id": np.array([set_id(s) for s in synergies.sets] * n_poses, dtype=object),
         "n_synergies": np.tile(synergies.sizes.astype(np.int32), n_poses),
         "status": np.full(total, "no_grasp", dtype=object),
-        "force_closure": np.zeros(total, dtype=bool),
-        "strict_internal": np.zeros(total, dtype=bool),
+        "load_feasible": np.zeros(total, dtype=bool),
+        "force_closure_def1": np.zeros(total, dtype=bool),
         "force_norm": np.full(total, np.nan),
         "e_s": np.zeros(total, dtype=np.int32),
         "rank_G": np.zeros(total, dtype=np.int32),
@@ -183,11 +185,11 @@ def optimise_grasps(
                         max_iter=params.max_iter, ipm=ipm)
         out["status"][rows], out["force_norm"][rows], out["e_s"][rows] = sol.status, sol.force_norm, sol.e_s
         out["iterations"][rows], out["solver"][rows] = sol.iterations, sol.solver
-        if strict:
-            out["strict_internal"][rows] = sol.strict_internal
+        if strict:  # rank(G) = 6 here, so the strict test is Definition 1
+            out["force_closure_def1"][rows] = sol.strict_internal
         if forces:
             out["forces"][rows] = sol.forces
-    out["force_closure"] = out["status"] == "force_closure"
+    out["load_feasible"] = out["status"] == "feasible"
     return out
 
 

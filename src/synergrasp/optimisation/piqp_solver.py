@@ -27,7 +27,7 @@ def solve(problem: GFOProblem, *, tol: float = DEFAULT_TOL, max_iter: int = 200)
     """Solve one problem with a pyramid cone; e_s = 0 is judged directly.
 
     tol: PIQP's absolute and relative tolerances; max_iter: its iteration cap. Status
-    mapping: solved -> 'force_closure' (its forces violate no constraint by more than
+    mapping: solved -> 'feasible' (its forces violate no constraint by more than
     ALMOST_SOLVED_TOL max(1 N, ||f||), else 'numerical_failure'); primal infeasible ->
     'infeasible'; anything else -> 'numerical_failure'.
     """
@@ -50,7 +50,7 @@ def solve(problem: GFOProblem, *, tol: float = DEFAULT_TOL, max_iter: int = 200)
         norm = float(np.linalg.norm(forces))
         viol = problem.cone.violation(forces, problem.normals, problem.f_min)
         if viol <= ALMOST_SOLVED_TOL * max(1.0, norm):
-            return Outcome("force_closure", norm, forces, iterations, "piqp", str(status), viol)
+            return Outcome("feasible", norm, forces, iterations, "piqp", str(status), viol)
         return Outcome("numerical_failure", float("nan"), None, iterations, "piqp", str(status), viol)
     if status == piqp.PIQP_PRIMAL_INFEASIBLE:
         return Outcome("infeasible", float("nan"), None, iterations, "piqp", str(status))

@@ -296,7 +296,7 @@ class TargetScorer:
     def __call__(self, target_mm: Sequence[float]) -> TargetScore:
         table = self.contacts(target_mm)
         out = optimise_grasps(read_grasps(table), self.full_set, self.gfo)
-        fc = np.asarray(out["strict_internal"], dtype=bool) & (np.asarray(out["rank_G"]) == 6)
+        fc = np.asarray(out["force_closure_def1"], dtype=bool)
         weight = self.gfo.weight_N
         if self.rule is None:
             raise ValueError("TargetScorer: scoring reads the grasps' opposition: give the opposition rule")

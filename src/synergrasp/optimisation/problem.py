@@ -40,7 +40,7 @@ __all__ = [
 
 #: Verdicts of one GFO problem (the `status` column of gfo.parquet, minus `rank_deficient`
 #: and `no_grasp`, which the study gives before any solve).
-STATUSES: tuple[str, ...] = ("force_closure", "infeasible", "numerical_failure")
+STATUSES: tuple[str, ...] = ("feasible", "infeasible", "numerical_failure")
 #: Feasibility / gap tolerance of the exact solvers unless told otherwise (Clarabel's default).
 DEFAULT_TOL = 1e-8
 #: A reduced-accuracy optimum is accepted when its worst constraint violation is below
@@ -195,7 +195,7 @@ class GraspSets:
 class Outcome(NamedTuple):
     """What a per-problem back end returns for one problem (a row of `GFOSolution`).
 
-    status: one of STATUSES; force_norm: N (NaN unless force closure); forces: (3m,) N or
+    status: one of STATUSES; force_norm: N (NaN unless feasible); forces: (3m,) N or
     None; iterations; solver: back-end name; solver_status: the solver's own status;
     max_violation: worst constraint violation of `forces`, N (NaN when there are none).
     """
@@ -213,16 +213,17 @@ class Outcome(NamedTuple):
 class GFOSolution:
     """Outcome of `solve_gfo`, one entry per problem, in the caller's order.
 
-    status: 'force_closure' | 'infeasible' | 'numerical_failure'
-    force_norm: optimal ||f||_2, N (NaN unless force closure)
-    forces: each problem's optimal contact forces f_p + E y, (3m,) N (None unless force closure)
+    status: 'feasible' | 'infeasible' | 'numerical_failure' (the problem under its load: for
+        a grasp, load feasibility, not force closure)
+    force_norm: optimal ||f||_2, N (NaN unless feasible)
+    forces: each problem's optimal contact forces f_p + E y, (3m,) N (None unless feasible)
     e_s: rank of each problem's internal-force basis
     iterations: interior-point iterations (those of the solver that decided it; 0 if none ran)
     strict_internal: Bicchi's strict internal-force verdict (None when not asked for)
     solver: back end that decided the problem: 'ipm', 'clarabel', 'cvxpy:<SOLVER>',
         'clarabel_fallback' (the interior-point kernel left it undecided), 'direct' (e_s = 0:
         f = f_p judged without a solver)
-    max_violation: worst constraint violation of `forces`, N (NaN unless force closure)
+    max_violation: worst constraint violation of `forces`, N (NaN unless feasible)
     """
 
     status: NDArray
@@ -250,12 +251,12 @@ class GFOSolution:
         """Store a per-problem outcome in row k (its solver name, or `solver` if given)."""
         self.status[k], self.force_norm[k], self.forces[k] = outcome.status, outcome.force_norm, outcome.forces
         self.iterations[k] = outcome.iterations
-        self.max_violation[k] = outcome.max_violation if outcome.status == "force_closure" else np.nan
+        self.max_violation[k] = outcome.max_violation if outcome.status == "feasible" else np.nan
         self.solver[k] = outcome.solver if solver is None else solver
 
     @property
-    def force_closure(self) -> NDArray:
-        return self.status == "force_closure"
+    def feasible(self) -> NDArray:
+        return self.status == "feasible"
 
 
 def judge_direct(problem: GFOProblem, tol: float = DEFAULT_TOL) -> Outcome:
@@ -265,7 +266,7 @@ def judge_direct(problem: GFOProblem, tol: float = DEFAULT_TOL) -> Outcome:
     viol = problem.cone.violation(fp, problem.normals, problem.f_min)
     norm = float(np.linalg.norm(fp))
     if viol <= tol * max(1.0, norm):
-        return Outcome("force_closure", norm, fp.copy(), 0, "direct", "direct", viol)
+        return Outcome("feasible", norm, fp.copy(), 0, "direct", "direct", viol)
     return Outcome("infeasible", float("nan"), None, 0, "direct", "direct", viol)
 
 

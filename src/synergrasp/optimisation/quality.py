@@ -186,9 +186,9 @@ def quality_table(contacts: pd.DataFrame, gfo: pd.DataFrame, grasps: Sequence[Gr
     (``mechanics.first_same_grasp``: a box's poses one α-period apart) share its indices,
     computed once at the first of them: the ε hull is most of the cost."""
     full = gfo[gfo["set_id"] == params.full_set_id]
-    verdicts = {int(pose): (bool(strict and rank == 6), float(force) / params.weight_N)
-                for pose, strict, rank, force in zip(full["pose"].tolist(), full["strict_internal"].tolist(),
-                                                     full["rank_G"].tolist(), full["force_norm"].tolist())}
+    verdicts = {int(pose): (bool(closure), float(force) / params.weight_N)
+                for pose, closure, force in zip(full["pose"].tolist(), full["force_closure_def1"].tolist(),
+                                                full["force_norm"].tolist())}
     rows = []
     first = first_same_grasp(grasps)
     computed: dict[int, GraspQuality] = {}

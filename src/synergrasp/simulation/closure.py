@@ -21,7 +21,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp.config import build, dataclass_fields
-from synergrasp.resolved import effective_placement
+from synergrasp.resolved import effective_placement, friction_mu
 from synergrasp.hand.synergies import Synergies, synergy_values
 from synergrasp.simulation.closure_params import ClosureMechanics, ClosureParams, DynamicParams
 from synergrasp.simulation.contacts import ClosureResult, contacts_row, contacts_table
@@ -67,7 +67,8 @@ class SimulateParams:
             placement=Placement.from_config(effective_placement(config, obj),
                                             config["grid"]),
             closure=build(ClosureParams, "closure", **{**dataclass_fields(ClosureParams, closure), "dynamic": dynamic}),
-            mechanics=build(ClosureMechanics, "mechanics", **dataclass_fields(ClosureMechanics, config["mechanics"]))
+            mechanics=build(ClosureMechanics, "mechanics", **{**dataclass_fields(ClosureMechanics, config["mechanics"]),
+                                                              "mu": friction_mu(config)})
             if dynamic_model else None)
 
     def synergies(self, joint_names: tuple[str, ...]) -> Synergies:
@@ -75,16 +76,16 @@ class SimulateParams:
         return Synergies(tuple(joint_names), np.array(self.mean_rad), np.array(self.s1)[:, None], ("S1",))
 
 def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams,
-                  mechanics: ClosureMechanics | None = None, mass_kg: float | None = None):
+                  mechanics: ClosureMechanics | None = None, weight_N: float | None = None):
     """The closure model of ``params`` on a new pybullet scene of ``hand``; the dynamic model
-    also needs the :class:`ClosureMechanics` (k_ss, μ, gravity) and the object's mass (kg)."""
+    also needs the :class:`ClosureMechanics` (k_ss, μ, gravity) and the object's weight (N)."""
     if params.model == "dynamic":
         from synergrasp.simulation.dynamic_closure import DynamicClosure
 
-        if mechanics is None or mass_kg is None:
+        if mechanics is None or weight_N is None:
             raise ValueError("closure.model: dynamic needs the mechanics block (k_ss_Nmm_per_rad, mu, gravity) "
-                             "and the object's mass_kg")
-        return DynamicClosure(hand, synergies, params, mechanics, mass_kg)
+                             "and the object's weight (mass_kg, mechanics.g_m_per_s2)")
+        return DynamicClosure(hand, synergies, params, mechanics, weight_N)
     from synergrasp.simulation.kinematic_closure import KinematicClosure
 
     return KinematicClosure(hand, synergies, params)
@@ -121,7 +122,7 @@ def simulate_object(hand: Hand, synergies: Synergies, grasped: GraspedObject, pl
         if not 0 <= v < grid.n_poses:
             raise ValueError(f"poses must be in 0 … {grid.n_poses - 1}, got {v}")
     shape = grasped.shape
-    model = closure_model(hand, synergies, closure_params, mechanics, grasped.mass_kg)
+    model = closure_model(hand, synergies, closure_params, mechanics, grasped.weight_N)
     placer = HandScene(hand)  # the open hand the box is brought to (placement)
     # the kinematic closure sees only the region the box fills: one region, one closure
     shared = _RegionResults(shape) if closure_params.model == "kinematic" else None

@@ -122,15 +122,14 @@ class ClosureParams:
 @dataclass(frozen=True)
 class ClosureMechanics:
     """What the dynamic closure reads of the configuration's ``mechanics``: the joint
-    stiffness k_ss (N·mm/rad), the hand–box friction μ, the direction of gravity (palm frame;
-    normalised where used) and g (m/s²)."""
+    stiffness k_ss (N·mm/rad), the hand–box friction μ and the direction of gravity (palm
+    frame; normalised where used). The box's weight is the object's (``synergrasp.resolved``)."""
 
     k_ss_Nmm_per_rad: float
     mu: float
     gravity_direction: tuple[float, float, float]
-    g_m_per_s2: float
 
     def __post_init__(self) -> None:
-        for name in ("k_ss_Nmm_per_rad", "mu", "g_m_per_s2"):
+        for name in ("k_ss_Nmm_per_rad", "mu"):
             object.__setattr__(self, name, float(getattr(self, name)))
         object.__setattr__(self, "gravity_direction", tuple(float(v) for v in self.gravity_direction))

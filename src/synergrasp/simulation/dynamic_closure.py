@@ -70,11 +70,12 @@ class DynamicClosure:
     ``params`` is the closure's :class:`synergrasp.simulation.closure.ClosureParams` (contact
     distance, penetration tolerance, ``params.dynamic``); the σ path is the kinematic
     model's (``SynergyPath.closure_range``); ``mechanics`` the :class:`ClosureMechanics` (k_ss,
-    μ, gravity direction and g); ``mass_kg`` the box's mass (its weight, if gravity is on).
+    μ, gravity direction); ``weight_N`` the box's weight m·g, N (``synergrasp.resolved``;
+    applied if gravity is on).
     """
 
     def __init__(self, hand: Hand, synergies: Synergies, params: ClosureParams, mechanics: ClosureMechanics,
-                 mass_kg: float = 1.0) -> None:
+                 weight_N: float = 9.81) -> None:
         from synergrasp.simulation import bullet
 
         names = tuple(synergies.joint_names)
@@ -88,7 +89,7 @@ class DynamicClosure:
         self.mu = mechanics.mu
         down = np.asarray(mechanics.gravity_direction, dtype=float)
         # weight of the box, N (palm frame), applied only when params.dynamic.gravity is true
-        self.weight = float(mass_kg) * mechanics.g_m_per_s2 * down / np.linalg.norm(down)
+        self.weight = float(weight_N) * down / np.linalg.norm(down)
         self.path = SynergyPath.along(synergies, hand.lower, hand.upper)
         # the same path as the kinematic model: fully open hand to every S1 joint at a limit
         self.sigma_open, self.sigma_closed = self.path.closure_range(hand.flexion_joints)

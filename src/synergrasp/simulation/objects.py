@@ -9,6 +9,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from synergrasp.config import ConfigError, build
+from synergrasp.resolved import study_object
 from synergrasp.simulation.shapes import Shape, ShapeError, shape_from_config
 
 __all__ = ["GraspedObject", "ObjectError", "object_problems", "object_warnings"]
@@ -29,6 +30,7 @@ class GraspedObject:
     name : usable in file paths ([A-Za-z0-9_]+).
     shape : its geometry (a box, ...), in its own frame, mm.
     mass_kg : mass, kg; None where it is not given (a step that does not read it).
+    weight_N : its weight m·g, N (``synergrasp.resolved``); None likewise.
 
     Built from the configuration by :meth:`from_config`.
     """
@@ -36,6 +38,7 @@ class GraspedObject:
     name: str
     shape: Shape
     mass_kg: float | None = None
+    weight_N: float | None = None
 
     def __post_init__(self) -> None:
         _check_name(self.name)
@@ -46,14 +49,17 @@ class GraspedObject:
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], name: str, with_mass: bool = True) -> GraspedObject:
-        """The object ``name`` of the configuration; without a mass (None) where the step
-        does not read it (``with_mass`` false)."""
+        """The object ``name`` of the configuration; without a mass and a weight (None) where
+        the step does not read them (``with_mass`` false)."""
         spec = config["objects"][name]
         try:
             shape = shape_from_config(spec["shape"], f"objects.{name}.shape")
         except ShapeError as err:
             raise ConfigError(f"config error at {err}") from None
-        return build(cls, f"objects.{name}", name=name, shape=shape, mass_kg=spec["mass_kg"] if with_mass else None)
+        if not with_mass:
+            return build(cls, f"objects.{name}", name=name, shape=shape)
+        resolved = study_object(config, name)
+        return build(cls, f"objects.{name}", name=name, shape=shape, mass_kg=spec["mass_kg"], weight_N=resolved.weight_N)
 
 
 def _check_name(name: Any) -> None:

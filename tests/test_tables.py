@@ -1,0 +1,41 @@
+"""The table contracts' reader: a gfo table of an older version is refused, naming the file
+and the renamed column, instead of being read under the column's old meaning."""
+
+from __future__ import annotations
+
+import re
+
+import pandas as pd
+import pytest
+
+from synergrasp import tables
+
+
+def _gfo() -> pd.DataFrame:
+    return pd.DataFrame({
+        "object": ["box"] * 2, "pose": [0, 0], "alpha_deg": [0.0] * 2, "beta_deg": [0.0] * 2,
+        "set_id": ["1", "1-2"], "n_synergies": [1, 2], "status": ["infeasible", "feasible"],
+        "load_feasible": [False, True], "force_closure_def1": [False, False], "force_norm": [float("nan"), 3.0],
+        "e_s": [1, 2], "rank_G": [6, 6], "n_contacts": [4, 4], "iterations": [7, 9], "solver": ["ipm"] * 2})
+
+
+def test_a_current_gfo_table_reads_back_as_written(tmp_path):
+    tables.write(tables.GFO, _gfo(), tmp_path / "gfo.parquet")
+    read = tables.read(tables.GFO, tmp_path / "gfo.parquet")
+    assert read["load_feasible"].tolist() == [False, True] and read["force_closure_def1"].tolist() == [False, False]
+
+
+def test_an_older_gfo_table_is_refused_naming_the_file_and_the_old_column(tmp_path):
+    """Before the rename, `force_closure` held what is now `load_feasible` (feasible under the
+    weight, not Definition 1): read as it stands it would be taken for the study's verdict."""
+    path = tmp_path / "gfo.parquet"
+    _gfo().rename(columns={"load_feasible": "force_closure", "force_closure_def1": "strict_internal"}).to_parquet(path)
+    expected = (f"gfo table '{path}': written by an older version of the study (column 'force_closure' (now "
+                "'load_feasible'), 'strict_internal' (now 'force_closure_def1')); delete it (or its results folder) "
+                "and rerun the study")
+    with pytest.raises(ValueError, match=f"^{re.escape(expected)}$"):
+        tables.read(tables.GFO, path)
+    # one old column alone is refused too (a table whose other column is current)
+    _gfo().rename(columns={"load_feasible": "force_closure"}).to_parquet(path)
+    with pytest.raises(ValueError, match=re.escape("column 'force_closure' (now 'load_feasible'));")):
+        tables.read(tables.GFO, path)
