@@ -39,7 +39,7 @@ _NO_GAPS_ARGS = (np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0, dtype=np.int
 
 
 class KinematicClosure:
-    """The quasi-static kinematic closure along S1 on one pybullet scene (hand + box)."""
+    """The quasi-static kinematic closure along S1 on one scene of our own (hand capsules + object)."""
 
     def __init__(self, hand: Hand, synergies: Synergies, params: ClosureParams) -> None:
         self.hand = hand
@@ -72,7 +72,7 @@ class KinematicClosure:
         self.long_fingers = {f for f, name in enumerate(FINGERS) if name in _LONG_FINGERS}
 
     def close(self) -> None:
-        """Release the pybullet scene."""
+        """Release the scene."""
         self.scene.close()
 
     def grasp(self, placed: ObjectPose) -> ClosureResult:
