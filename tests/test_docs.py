@@ -59,14 +59,6 @@ def test_every_module_of_the_package_is_in_design_md():
     assert len(modules) > 50 and missing == []
 
 
-#: TEMPORARY: pages (or a page's `## ` sections) being rewritten by the integrator, exempt from
-#: test_docs_state_no_cost_and_no_commit until they land. Empty this list; do not add to it.
-_BEING_REWRITTEN = (
-    ("docs/random_objects.md", None),
-    ("docs/planner.md", None),
-    ("README.md", "## The incremental planner, and many objects"),
-)
-
 #: A number with a short unit of time (µs, ms) or a long one (min, h): always a cost here.
 _COST_TIME = r"[0-9](?:[.,][0-9]+)?\s?(?:µs|us|ms|min|minutes?|h|hours?|CPU ?(?:s|seconds?))\b"
 #: A number of seconds: a cost when words of _COST_WORDS are near it, else a model parameter.
@@ -121,16 +113,13 @@ def test_docs_state_no_cost_and_no_commit():
     - a **commit hash**: 7-40 hex digits with at least one letter and one digit, as a word,
       except in docs/placement_search.md's "## Changes since pre-registration" section (the
       pre-registration commits). Describe the state of the software instead ("before the
-      closure was compiled").
-    Pages in `_BEING_REWRITTEN` are exempt while the integrator rewrites them."""
+      closure was compiled")."""
     import re
 
     found = []
     for path in _markdown_pages():
         name = path.relative_to(ROOT).as_posix()
         for section, number, line, context in _sections(path):
-            if (name, None) in _BEING_REWRITTEN or (name, section) in _BEING_REWRITTEN:
-                continue
             words = re.sub(r"\S*/\S*", "", context)
             if (re.search(_COST_TIME, line) or re.search(_RATE, line)
                     or re.search(_SECONDS, line) and re.search(_COST_WORDS, words, flags=re.I)):

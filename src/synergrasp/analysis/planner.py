@@ -119,8 +119,8 @@ def plan_against_exhaustive(plan: Plan, full_success: ArrayLike, full_force: Arr
     pose. Returns: exhaustive_min_force_N, exhaustive_best_pose, is_global_min (the plan's
     force equal to the minimum within the tie tolerance of the minima), rank (1 + the poses
     whose exhaustive force is lower beyond that tolerance; twins share a rank; 0: no pose),
-    n_ranked (force-closure poses), regret (plan's force / the minimum, at least 1: a ratio below 1
-    is rounding of the same solve; NaN without either).
+    n_ranked (force-closure poses), regret (plan's force / the minimum; exactly 1 for the minimum
+    within the tie tolerance, never below 1; NaN without either).
     """
     fc = np.asarray(full_success, dtype=bool) & np.isfinite(full_force)
     f = np.where(fc, np.asarray(full_force, dtype=float), np.inf)
@@ -131,9 +131,11 @@ def plan_against_exhaustive(plan: Plan, full_success: ArrayLike, full_force: Arr
     mine = plan.best_force_N
     found = plan.best_pose >= 0
     rank = int(np.sum(f < mine * (1.0 - FORCE_TIE_RTOL))) + 1 if found else 0
-    return {"exhaustive_min_force_N": float(f[best]), "exhaustive_best_pose": best,
-            "is_global_min": bool(found and mine <= f[best] * (1.0 + FORCE_TIE_RTOL)),
-            "rank": rank, "n_ranked": int(fc.sum()), "regret": max(float(mine / f[best]), 1.0) if found else float("nan")}
+    is_global = bool(found and mine <= f[best] * (1.0 + FORCE_TIE_RTOL))
+    # the minimum itself (or a twin within the tie tolerance): no regret, not rounding's 1 + 1e-16
+    regret = 1.0 if is_global else (max(float(mine / f[best]), 1.0) if found else float("nan"))
+    return {"exhaustive_min_force_N": float(f[best]), "exhaustive_best_pose": best, "is_global_min": is_global,
+            "rank": rank, "n_ranked": int(fc.sum()), "regret": regret}
 
 
 def greedy_order(count: Callable[[Sequence[tuple[int, ...]]], NDArray[np.int64]], n_synergies: int,
