@@ -15,6 +15,8 @@ Pairs whose two force maps are identical (same success at every pose, forces equ
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
@@ -99,6 +101,18 @@ def null_preserved(this: pd.DataFrame, nxt: pd.DataFrame, alphas: NDArray, betas
                             radius_deg)
 
 
+def _level_pairs(mins: pd.DataFrame, k_max: int,
+                 radius_deg: float) -> Iterator[tuple[int, pd.DataFrame, pd.DataFrame, NDArray]]:
+    """(k, the minima of {S1..Sk}, those of {S1..Sk+1}, which of the first are preserved) for
+    k = 1 … k_max − 1, from one object's minima table."""
+    for k in range(1, k_max):
+        this = mins[mins["set_id"] == incremental_set_id(k)]
+        nxt = mins[mins["set_id"] == incremental_set_id(k + 1)]
+        kept = preserved(this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float),
+                         nxt["alpha_deg"].to_numpy(float), nxt["beta_deg"].to_numpy(float), radius_deg)
+        yield k, this, nxt, kept
+
+
 def _pairs(table: pd.DataFrame, minima: pd.DataFrame, k_max: int, radius_deg: float,
            periods: dict[str, float], draws: int, rng: np.random.Generator) -> list[dict]:
     """Observed and null preserved counts of every (object, k)."""
@@ -107,12 +121,7 @@ def _pairs(table: pd.DataFrame, minima: pd.DataFrame, k_max: int, radius_deg: fl
         own = table[table["object"] == obj]
         alphas, betas = np.sort(own["alpha_deg"].unique()), np.sort(own["beta_deg"].unique())
         offsets = allowed_offsets(alphas, betas, radius_deg, periods.get(obj, 360.0))
-        mins = minima[minima["object"] == obj]
-        for k in range(1, k_max):
-            this = mins[mins["set_id"] == incremental_set_id(k)]
-            nxt = mins[mins["set_id"] == incremental_set_id(k + 1)]
-            kept = preserved(this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float),
-                             nxt["alpha_deg"].to_numpy(float), nxt["beta_deg"].to_numpy(float), radius_deg)
+        for k, this, nxt, kept in _level_pairs(minima[minima["object"] == obj], k_max, radius_deg):
             rows.append({"object": obj, "k": k, "n_minima": len(this), "n_preserved": int(kept.sum()),
                          "identical": identical_force_maps(own, incremental_set_id(k), incremental_set_id(k + 1)),
                          "null": null_preserved(this, nxt, alphas, betas, radius_deg, offsets, rng, draws)})
@@ -172,12 +181,7 @@ def resampled_preservation(minima: pd.DataFrame, k_max: int, radius_deg: float,
         poses = resampler.poses(obj)
         where = {int(p): i for i, p in enumerate(poses)}
         n_min, n_kept = np.zeros(len(poses)), np.zeros(len(poses))
-        mins = minima[minima["object"] == obj]
-        for k in range(1, k_max):
-            this = mins[mins["set_id"] == incremental_set_id(k)]
-            nxt = mins[mins["set_id"] == incremental_set_id(k + 1)]
-            kept = preserved(this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float),
-                             nxt["alpha_deg"].to_numpy(float), nxt["beta_deg"].to_numpy(float), radius_deg)
+        for _, this, _, kept in _level_pairs(minima[minima["object"] == obj], k_max, radius_deg):
             index = np.array([where.get(int(p), -1) for p in this["pose"]], dtype=np.int64)
             here = index >= 0
             np.add.at(n_min, index[here], 1.0)
