@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp.analysis.graspability import with_left_out
+from synergrasp.analysis.graspability import studied, with_left_out
 from synergrasp.analysis.objects_summary import across_objects, object_rows, planner_budget
 from synergrasp.simulation import random_objects as ro
 
@@ -96,6 +96,7 @@ def test_summary_rows_and_intervals_from_hand_made_tables():
     both = with_left_out(graspable, [("rand_439", "mesh cannot be read: non-manifold")])
     assert both["object"].tolist() == ["a", "rand_439"] and not both["graspable"].iloc[1]
     assert both["reason"].iloc[1] == "left out: mesh cannot be read: non-manifold" and both["poses"].iloc[1] == 0
+    assert studied(both)["object"].tolist() == ["a"]
     rows = object_rows(rates, preservation, both, plans, enrollment, n_full=3, hierarchy_first=3)
     assert rows["reason"].iloc[1] == "left out: mesh cannot be read: non-manifold"
     assert np.isnan(rows["k_full"].iloc[1]) and np.isnan(rows["preserved_percent"].iloc[1])

@@ -3,6 +3,7 @@
 import pandas as pd
 
 from synergrasp import tables
+from synergrasp.analysis.graspability import studied
 from synergrasp.analysis.objects_summary import ObjectsSummaryParams, across_objects, object_rows
 from synergrasp.figures.objects_summary import figure_objects_summary, figure_planner_tradeoff
 from synergrasp.job_log import job_log
@@ -22,6 +23,5 @@ with job_log(snakemake.log[0]):
     tables.write_study_table(across_objects(rows, p.quantities()), out.intervals_csv, out.intervals_md,
                              title="Across objects (95 % intervals: bootstrap over objects)")
     tables.write_study_table(drawn, out.drawn_csv, out.drawn_md, title="Drawn meshes (problem: why left out)")
-    studied = rows[~rows["reason"].str.startswith("left out")]
-    figure_objects_summary(studied, p.radii_deg, out.png, out.pdf)
-    figure_planner_tradeoff(studied, p.radii_deg, out.planner_tradeoff_png, out.planner_tradeoff_pdf)
+    figure_objects_summary(studied(rows), p.radii_deg, out.png, out.pdf)
+    figure_planner_tradeoff(studied(rows), p.radii_deg, out.planner_tradeoff_png, out.planner_tradeoff_pdf)

@@ -25,7 +25,10 @@ from synergrasp.analysis.verdicts import verdict_columns
 from synergrasp.ids import set_members, set_name
 from synergrasp.tables import GRASPABLE_OBJECTS
 
-__all__ = ["graspable_objects", "with_left_out", "ungraspable_lines"]
+__all__ = ["graspable_objects", "with_left_out", "studied", "ungraspable_lines", "LEFT_OUT"]
+
+#: How the reason of an object left out before the study begins.
+LEFT_OUT = "left out: "
 
 #: Statuses of a closure that ran (synergrasp.simulation.contacts.STATUSES).
 _RAN = ("grasp", "no_contact")
@@ -77,9 +80,15 @@ def with_left_out(table: pd.DataFrame, left_out: Sequence[tuple[str, str]]) -> p
     study (a drawn mesh that cannot be read, is degenerate or differs from its manifest):
     nothing simulated, not graspable, reason ``left out: <reason>``."""
     extra = pd.DataFrame([{"object": name, "poses": 0, "simulated": 0, "grasps": 0, "settled": 0,
-                           "force_closure_full_set": 0, "graspable": False, "reason": f"left out: {reason}"}
+                           "force_closure_full_set": 0, "graspable": False, "reason": f"{LEFT_OUT}{reason}"}
                           for name, reason in left_out], columns=list(GRASPABLE_OBJECTS.names))
     return pd.concat([table, extra], ignore_index=True) if len(extra) else table
+
+
+def studied(table: pd.DataFrame) -> pd.DataFrame:
+    """The rows of a table with a ``reason`` column (graspable objects, the summary per object)
+    whose object was studied, not left out before the study."""
+    return table[~table["reason"].fillna("").astype(str).str.startswith(LEFT_OUT)]
 
 
 def ungraspable_lines(table: pd.DataFrame) -> list[str]:

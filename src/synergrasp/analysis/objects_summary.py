@@ -28,7 +28,7 @@ import pandas as pd
 
 from synergrasp.ids import incremental_set_id, set_id
 
-__all__ = ["ObjectsSummaryParams", "object_rows", "planner_budget", "SOLVE_SHARE_BUDGET", "REGRET_BUDGET", "across_objects", "RESAMPLES", "SEED"]
+__all__ = ["ObjectsSummaryParams", "object_rows", "planner_budget", "planner_columns", "SOLVE_SHARE_BUDGET", "REGRET_BUDGET", "across_objects", "RESAMPLES", "SEED"]
 
 #: The planner's aims (docs/planner.md): at most this share of the exhaustive solves (%), and a
 #: pose whose force is at most this far above the exhaustive minimum (%).
@@ -68,6 +68,13 @@ def object_rows(success_rates: pd.DataFrame, preservation: pd.DataFrame, graspab
     return pd.DataFrame(rows)
 
 
+def planner_columns(rows: pd.DataFrame, radius_deg: float) -> tuple[pd.Series, pd.Series]:
+    """The planner's share of the exhaustive solves and its force regret (both %) at
+    ``radius_deg``, per row of the summary (NaN where there is no plan or no column)."""
+    return tuple(pd.to_numeric(rows[c], errors="coerce") if c in rows else pd.Series(np.nan, index=rows.index)
+                 for c in (f"solve_share_percent_{radius_deg:g}", f"regret_percent_{radius_deg:g}"))
+
+
 def planner_budget(rows: pd.DataFrame, radii: Sequence[float]) -> pd.DataFrame:
     """Per planner radius (deg): the objects with a plan, and how many use at most
     ``SOLVE_SHARE_BUDGET`` % of the exhaustive solves, find a pose within ``REGRET_BUDGET`` %
@@ -75,8 +82,7 @@ def planner_budget(rows: pd.DataFrame, radii: Sequence[float]) -> pd.DataFrame:
     met on every object with a plan (the rule that chooses the radius, docs/planner.md)."""
     out = []
     for r in radii:
-        share, regret = (pd.to_numeric(rows[c], errors="coerce") if c in rows else pd.Series(np.nan, index=rows.index)
-                         for c in (f"solve_share_percent_{r:g}", f"regret_percent_{r:g}"))
+        share, regret = planner_columns(rows, r)
         planned = share.notna() & regret.notna()
         cheap, close = planned & (share <= SOLVE_SHARE_BUDGET), planned & (regret <= REGRET_BUDGET)
         out.append({"radius_deg": float(r), "objects": int(planned.sum()), "within_solves": int(cheap.sum()),

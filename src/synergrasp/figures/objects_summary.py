@@ -63,14 +63,13 @@ def figure_planner_tradeoff(rows: pd.DataFrame, radii: Sequence[float], png: str
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from synergrasp.analysis.objects_summary import REGRET_BUDGET, SOLVE_SHARE_BUDGET, planner_budget
+    from synergrasp.analysis.objects_summary import REGRET_BUDGET, SOLVE_SHARE_BUDGET, planner_budget, planner_columns
 
     budget = planner_budget(rows, radii).set_index("radius_deg")
     fig, axes = plt.subplots(1, len(radii), figsize=(4.2 * len(radii), 3.6), sharey=True, squeeze=False)
     floor = 1e-2  # a regret of 0 (the global minimum found) is drawn on this line of the log axis
     for ax, r in zip(axes[0], radii):
-        share, regret = (pd.to_numeric(rows[c], errors="coerce") if c in rows else pd.Series(np.nan, index=rows.index)
-                         for c in (f"solve_share_percent_{r:g}", f"regret_percent_{r:g}"))
+        share, regret = planner_columns(rows, r)
         ok = share.notna() & regret.notna()
         ax.scatter(share[ok], np.maximum(regret[ok], floor), s=12, alpha=0.7)
         ax.axvline(SOLVE_SHARE_BUDGET, c="k", lw=0.8, ls="--")
