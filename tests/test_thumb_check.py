@@ -1,4 +1,4 @@
-"""The thumb-opposition check (synergrasp.hand.thumb_check, docs/synergies.md): along S1 the
+"""The thumb-opposition check (synergrasp.simulation.thumb_check, docs/synergies.md): along S1 the
 thumb meets the index or middle fingertip 20 mm in front of the palm face, no thumb link on
 the palm before. Checked on the shipped hands, on the Shadow hand's joint-by-joint mapping
 (a thumb folded onto the palm: it must fail) and against the hands' geometry computed here."""
@@ -9,7 +9,7 @@ import pytest
 from synergrasp.hand.kinematics import fingertip_positions, forward_kinematics, load_hand
 from synergrasp.hand.synergies import (SynergyPath, load_human_synergies, load_synergies, load_synergy_mapping,
                                        map_human_synergies, shadow_hand_files)
-from synergrasp.hand.thumb_check import MIN_FRONT_MM, closing_sigmas, thumb_opposition
+from synergrasp.simulation.thumb_check import MIN_FRONT_MM, closing_sigmas, thumb_opposition
 
 
 def _capsule_gap(hand, q, a, b):

@@ -228,7 +228,7 @@ def _show_hand(args: argparse.Namespace) -> int:
     """``synergrasp hand show``: the joints (limits, mean posture, S1), links and fingertips."""
     from synergrasp.hand.kinematics import fingertip_positions, load_hand
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.hand.thumb_check import closing_sigmas, thumb_opposition
+    from synergrasp.simulation.thumb_check import closing_sigmas, thumb_opposition
 
     problems = _output_problems(argparse.Namespace(png=args.png, closing=args.closing_png))
     try:
@@ -273,7 +273,7 @@ def _map_synergies(args: argparse.Namespace) -> int:
     from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import load_synergies, resolve_synergies, write_synergies
     from synergrasp.hand.synergy_map import map_synergies
-    from synergrasp.hand.thumb_check import thumb_opposition
+    from synergrasp.simulation.thumb_check import thumb_opposition
 
     if args.joint_mapping:
         return _map_joint_by_joint(args)
@@ -328,7 +328,7 @@ def _map_joint_by_joint(args: argparse.Namespace) -> int:
     from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import (load_human_synergies, load_synergy_mapping, map_human_synergies,
                                            write_synergies)
-    from synergrasp.hand.thumb_check import thumb_opposition
+    from synergrasp.simulation.thumb_check import thumb_opposition
 
     problems = _output_problems(args)
     problems += [f"{option}: not used with --joint-mapping (it maps the human table joint by joint)"
