@@ -103,3 +103,20 @@ def test_workflow_checks_and_hand_show_warn(tmp_path, capsys):
     assert main(["hand", "show", "shadow_hand", "--closing-png", str(png)]) == 0
     out = capsys.readouterr().out
     assert "WARNING: thumb opposition: hand 'shadow_hand'" in out and png.stat().st_size > 10_000
+
+
+def test_a_table_whose_s1_opens_a_joint_cannot_be_checked_and_says_why():
+    """S1 with a negative flexion entry does not close the hand: no check, one warning line
+    naming the hand and the reason (the closure's own message), not a traceback."""
+    from synergrasp.hand.synergies import Synergies
+    from synergrasp.simulation.thumb_check import opposition_line, opposition_warnings
+
+    hand = load_hand(None)
+    table = load_synergies(None)
+    matrix = table.matrix.copy()
+    matrix[hand.joint_names.index("index_pip"), 0] = -0.1
+    broken = Synergies(table.joint_names, table.mean, matrix, table.names)
+    (warning,) = opposition_warnings(hand, broken)
+    assert warning.startswith("thumb opposition: hand 'softhand_like': cannot be checked: the closing synergy S1 "
+                              "must have flexion entries >= 0") and "\n" not in warning
+    assert opposition_line(hand, broken) == (f"WARNING: {warning}", [-1.0, 0.0, 1.0])

@@ -228,7 +228,7 @@ def _show_hand(args: argparse.Namespace) -> int:
     """``synergrasp hand show``: the joints (limits, mean posture, S1), links and fingertips."""
     from synergrasp.hand.kinematics import fingertip_positions, load_hand
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.simulation.thumb_check import closing_sigmas, thumb_opposition
+    from synergrasp.simulation.thumb_check import opposition_line
 
     problems = _output_problems(argparse.Namespace(png=args.png, closing=args.closing_png))
     try:
@@ -255,12 +255,12 @@ def _show_hand(args: argparse.Namespace) -> int:
 
         figure_synergy_postures(hand, synergies, args.png, None, n_synergies=min(args.count, synergies.n_synergies))
         print(f"picture: {args.png}")
-    check = thumb_opposition(hand, synergies)
-    print(check.summary())
+    line, sigmas = opposition_line(hand, synergies)
+    print(line)
     if args.closing_png:
         from synergrasp.figures.hand_figures import figure_closing_views
 
-        figure_closing_views(hand, synergies, args.closing_png, None, closing_sigmas(check))
+        figure_closing_views(hand, synergies, args.closing_png, None, sigmas)
         print(f"closing along S1, palm side and thumb side: {args.closing_png}")
     return 0
 
@@ -273,7 +273,7 @@ def _map_synergies(args: argparse.Namespace) -> int:
     from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import load_synergies, resolve_synergies, write_synergies
     from synergrasp.hand.synergy_map import map_synergies
-    from synergrasp.simulation.thumb_check import thumb_opposition
+    from synergrasp.simulation.thumb_check import opposition_line
 
     if args.joint_mapping:
         return _map_joint_by_joint(args)
@@ -312,8 +312,7 @@ def _map_synergies(args: argparse.Namespace) -> int:
           f"max {np.max(mapped.residual_mm):.2f})")
     _print_variance(fit)
     print(f"synergy table: {args.out}" + (f"; mapped postures: {args.postures}" if args.postures else ""))
-    check = thumb_opposition(target, fit.synergies)
-    print(check.summary())
+    print(opposition_line(target, fit.synergies)[0])
     if args.png:
         from synergrasp.figures.synergy_fit import figure_explained_variance
 
@@ -328,7 +327,7 @@ def _map_joint_by_joint(args: argparse.Namespace) -> int:
     from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import (load_human_synergies, load_synergy_mapping, map_human_synergies,
                                            write_synergies)
-    from synergrasp.simulation.thumb_check import thumb_opposition
+    from synergrasp.simulation.thumb_check import opposition_line
 
     problems = _output_problems(args)
     problems += [f"{option}: not used with --joint-mapping (it maps the human table joint by joint)"
@@ -345,7 +344,7 @@ def _map_joint_by_joint(args: argparse.Namespace) -> int:
         return 2
     write_synergies(table, args.out)
     print(f"{target.name}: the human synergies mapped joint by joint ({args.joint_mapping}); synergy table: {args.out}")
-    print(thumb_opposition(target, table).summary())
+    print(opposition_line(target, table)[0])
     return 0
 
 
