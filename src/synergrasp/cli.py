@@ -3,6 +3,9 @@
     synergrasp grasp obj4 --alpha -30 --beta 0 [--configfile my.yaml] [--sets 1 1-5 1-15] [--json]
                      [--png grasp.png] [--html grasp.html [--forces 1-15]]
     synergrasp synergies fit POSTURES.csv --out synergies.csv [--synergies K] [--png variance.png]
+    synergrasp synergies map HAND --out synergies.csv [--table TABLE] [--source SOURCE_HAND] [--synergies K]
+                             [--postures postures.csv] [--png variance.png]
+    synergrasp synergies map HAND --out synergies.csv --joint-mapping MAPPING.yaml
     synergrasp hand show [HAND] [--synergies TABLE] [--png hand.png] [--count K]
 
 Bad input (an argument, a configuration file, the hand or synergy file it names, an output
@@ -122,12 +125,29 @@ def _parser() -> argparse.ArgumentParser:
     fit.add_argument("--out", required=True, help="the synergy table to write (joint, mean_rad, syn1..synK)")
     fit.add_argument("--synergies", type=int, help="how many synergies to keep (default: all with variance)")
     fit.add_argument("--png", metavar="PATH", help="write the explained variance per synergy (PNG)")
+    mapping = synergies.add_parser("map", help="carry a synergy table over to another hand in the object's terms: "
+                                               "fingertips and thumb-to-fingertip vectors retargeted, then principal "
+                                               "components (docs/synergies.md)")
+    mapping.add_argument("hand", help="the target hand: a hand file or description, or a shipped hand (shadow_hand)")
+    mapping.add_argument("--out", required=True, help="the target hand's synergy table to write (CSV)")
+    mapping.add_argument("--table", help="the source hand's synergy table (name or CSV; default: the study's, "
+                                         "softhand_opposed)")
+    mapping.add_argument("--source", help="the source hand (a hand file or description; default: the study's hand)")
+    mapping.add_argument("--synergies", type=int, help="how many synergies to keep (default: as many as the table has)")
+    mapping.add_argument("--postures", metavar="PATH", help="also write the mapped postures (CSV, one column per "
+                                                            "joint: the input of synergies fit)")
+    mapping.add_argument("--png", metavar="PATH", help="write the explained variance per synergy (PNG)")
+    mapping.add_argument("--joint-mapping", metavar="YAML", help="map the human synergies joint by joint with this "
+                                                                 "mapping file instead (for hands whose joints "
+                                                                 "correspond; docs/synergies.md)")
     hands = sub.add_parser("hand", help="hands").add_subparsers(dest="action", required=True)
     show = hands.add_parser("show", help="print a hand's joints; draw it at its mean posture and along each synergy")
     show.add_argument("hand", nargs="?", help="a hand file or description, or shadow_hand (default: the shipped hand)")
     show.add_argument("--synergies", help="a synergy table (name or CSV; default: the shipped one, or shadow_hand's)")
     show.add_argument("--png", metavar="PATH", help="write the hand at q_m + sigma S_k, sigma = -1, 0, +1 (PNG)")
     show.add_argument("--count", type=int, default=7, help="synergies drawn (default 7)")
+    show.add_argument("--closing-png", metavar="PATH", help="write the hand closing along S1 from the palm side and "
+                                                            "from the thumb side (PNG)")
     plan = sub.add_parser("plan", help="the incremental planner on one object, against the study's exhaustive search "
                                        "(reads <results>/objects/<object>/contacts and gfo tables; docs/planner.md)")
     plan.add_argument("object", help="an object of the configuration")
@@ -139,10 +159,16 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: The output options a command may have and the file names each accepts.
+_OUTPUTS = (("--png", "png", (".png",)), ("--html", "html", (".html", ".htm")), ("--out", "out", (".csv",)),
+            ("--postures", "postures", (".csv",)), ("--closing-png", "closing", (".png",)))
+
+
 def _output_problems(args: argparse.Namespace) -> list[str]:
-    """What keeps ``--png`` / ``--html`` from being written, one line each, before any work."""
+    """What keeps an output (``--png``, ``--html``, ``--out``, ``--postures``) from being
+    written, one line each, before any work."""
     problems = []
-    for option, path, suffixes in (("--png", args.png, (".png",)), ("--html", args.html, (".html", ".htm"))):
+    for option, path, suffixes in ((o, getattr(args, a, None), s) for o, a, s in _OUTPUTS):
         if path is None:
             continue
         target = Path(path)
@@ -202,13 +228,17 @@ def _show_hand(args: argparse.Namespace) -> int:
     """``synergrasp hand show``: the joints (limits, mean posture, S1), links and fingertips."""
     from synergrasp.hand.kinematics import fingertip_positions, load_hand
     from synergrasp.hand.synergies import load_synergies
+    from synergrasp.simulation.thumb_check import opposition_line
 
+    problems = _output_problems(argparse.Namespace(png=args.png, closing=args.closing_png))
     try:
         hand = load_hand(args.hand)
         table = args.synergies or ("shadow_hand" if args.hand == "shadow_hand" else None)
         synergies = load_synergies(table, joint_names=hand.joint_names)
     except ValueError as err:
-        print(f"synergrasp hand show: {err}", file=sys.stderr)
+        problems += str(err).splitlines()
+    if problems:
+        print("\n".join(f"synergrasp hand show: {line}" for line in problems), file=sys.stderr)
         return 2
     deg = math.degrees
     print(f"{hand.name} ({hand.source}): {hand.n_joints} joints, {hand.n_links} links "
@@ -225,7 +255,104 @@ def _show_hand(args: argparse.Namespace) -> int:
 
         figure_synergy_postures(hand, synergies, args.png, None, n_synergies=min(args.count, synergies.n_synergies))
         print(f"picture: {args.png}")
+    line, sigmas = opposition_line(hand, synergies)
+    print(line)
+    if args.closing_png:
+        from synergrasp.figures.hand_figures import figure_closing_views
+
+        figure_closing_views(hand, synergies, args.closing_png, None, sigmas)
+        print(f"closing along S1, palm side and thumb side: {args.closing_png}")
     return 0
+
+
+def _map_synergies(args: argparse.Namespace) -> int:
+    """``synergrasp synergies map``: every argument checked, then the mapping, the table
+    written, the variance explained and the thumb-opposition check printed."""
+    import numpy as np
+
+    from synergrasp.hand.kinematics import load_hand
+    from synergrasp.hand.synergies import load_synergies, resolve_synergies, write_synergies
+    from synergrasp.hand.synergy_map import map_synergies
+    from synergrasp.simulation.thumb_check import opposition_line
+
+    if args.joint_mapping:
+        return _map_joint_by_joint(args)
+    problems = _output_problems(args)
+    try:
+        target = load_hand(args.hand)
+        source = load_hand(args.source)
+        table_path = resolve_synergies(args.table)
+        table = load_synergies(table_path, joint_names=source.joint_names)
+    except ValueError as err:
+        problems += str(err).splitlines()
+        target = table_path = None
+    outputs = {option: Path(path) for option, path in (("--out", args.out), ("--postures", args.postures),
+                                                        ("--png", args.png)) if path}
+    for option, path in outputs.items():
+        if table_path is not None and path.resolve() == Path(table_path).resolve():
+            problems.append(f"{option} {path}: is the input table; give another file name")
+    if "--postures" in outputs and outputs["--postures"].resolve() == outputs["--out"].resolve():
+        problems.append(f"--postures {args.postures}: is the --out file; give another file name")
+    k_max = None if target is None else min(table.n_synergies, target.n_joints)
+    if args.synergies is not None and k_max is not None and not 1 <= args.synergies <= k_max:
+        problems.append(f"--synergies {args.synergies}: must be 1 … {k_max} (the table's columns, at most the "
+                        "target's joints)")
+    if problems:
+        print("\n".join(f"synergrasp synergies map: {line}" for line in problems), file=sys.stderr)
+        return 2
+    fit, mapped = map_synergies(source, table, target, args.synergies)
+    write_synergies(fit.synergies, args.out)
+    if args.postures:
+        import pandas as pd
+
+        pd.DataFrame(mapped.target, columns=list(target.joint_names)).to_csv(
+            args.postures, index=False, float_format="%.17g", lineterminator="\n")
+    print(f"{target.name}: {len(mapped.sigma)} postures mapped from {source.name}'s table {table_path} "
+          f"(fingertip and thumb-to-fingertip residual, RMS mm: median {np.median(mapped.residual_mm):.2f}, "
+          f"max {np.max(mapped.residual_mm):.2f})")
+    _print_variance(fit)
+    print(f"synergy table: {args.out}" + (f"; mapped postures: {args.postures}" if args.postures else ""))
+    print(opposition_line(target, fit.synergies)[0])
+    if args.png:
+        from synergrasp.figures.synergy_fit import figure_explained_variance
+
+        figure_explained_variance(fit, args.png)
+        print(f"explained variance: {args.png}")
+    return 0
+
+
+def _map_joint_by_joint(args: argparse.Namespace) -> int:
+    """``synergrasp synergies map --joint-mapping``: the human table mapped joint by joint
+    (``map_human_synergies``), written, and the thumb-opposition check printed."""
+    from synergrasp.hand.kinematics import load_hand
+    from synergrasp.hand.synergies import (load_human_synergies, load_synergy_mapping, map_human_synergies,
+                                           write_synergies)
+    from synergrasp.simulation.thumb_check import opposition_line
+
+    problems = _output_problems(args)
+    problems += [f"{option}: not used with --joint-mapping (it maps the human table joint by joint)"
+                 for option, value in (("--table", args.table), ("--source", args.source), ("--synergies", args.synergies),
+                                       ("--postures", args.postures), ("--png", args.png)) if value is not None]
+    try:
+        target = load_hand(args.hand)
+        table = map_human_synergies(load_human_synergies(), load_synergy_mapping(args.joint_mapping),
+                                    target.joint_names)
+    except (ValueError, KeyError, TypeError) as err:  # a mapping file's missing or malformed field
+        problems.append(f"--joint-mapping {args.joint_mapping}: {err}")
+    if problems:
+        print("\n".join(f"synergrasp synergies map: {line}" for line in problems), file=sys.stderr)
+        return 2
+    write_synergies(table, args.out)
+    print(f"{target.name}: the human synergies mapped joint by joint ({args.joint_mapping}); synergy table: {args.out}")
+    print(opposition_line(target, table)[0])
+    return 0
+
+
+def _print_variance(fit: Any) -> None:
+    """Per synergy: its variance, its share of the total and the cumulated share."""
+    print(f"{'synergy':<8} {'variance (rad^2)':>17} {'explained':>10} {'cumulative':>11}")
+    for i, (v, e, c) in enumerate(zip(fit.variance_rad2, fit.explained, fit.cumulative), start=1):
+        print(f"S{i:<7} {v:>17.6g} {100 * e:>9.2f}% {100 * c:>10.2f}%")
 
 
 def _fit_synergies(args: argparse.Namespace) -> int:
@@ -241,9 +368,7 @@ def _fit_synergies(args: argparse.Namespace) -> int:
         return 2
     write_synergies(fit.synergies, args.out)
     print(f"{len(postures)} postures of {len(names)} joints: total variance {fit.total_variance_rad2:.6g} rad^2")
-    print(f"{'synergy':<8} {'variance (rad^2)':>17} {'explained':>10} {'cumulative':>11}")
-    for i, (v, e, c) in enumerate(zip(fit.variance_rad2, fit.explained, fit.cumulative), start=1):
-        print(f"S{i:<7} {v:>17.6g} {100 * e:>9.2f}% {100 * c:>10.2f}%")
+    _print_variance(fit)
     print(f"synergy table: {args.out}")
     if args.png:
         from synergrasp.figures.synergy_fit import figure_explained_variance
@@ -314,7 +439,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command == "plan":
         return _plan(args)
     if args.command == "synergies":
-        return _fit_synergies(args)
+        return _map_synergies(args) if args.action == "map" else _fit_synergies(args)
     if args.command == "hand":
         return _show_hand(args)
     try:
