@@ -6,9 +6,11 @@
     synergrasp hand show [HAND] [--synergies TABLE] [--png hand.png] [--count K]
 
 Bad input (an argument, a configuration file, the hand or synergy file it names, an output
-path that cannot be written) ends with one line per problem naming the argument, the file or
-the key, and exit status 2, before any work: the configuration goes through the workflow's
-own checks (``synergrasp.study_checks``). Warnings on the configuration are printed too.
+path that cannot be written, a count below 1, a radius that is not a positive number, an
+output that names a file the command reads: symbolic and hard links included) ends with one
+line per problem naming the argument, the file or the key, and exit status 2, before any
+work, for every command: the configuration goes through the workflow's own checks
+(``synergrasp.study_checks``). Warnings on the configuration are printed too.
 
     synergrasp plan obj4 [--radius 10 20 30] [--configfile my.yaml] [--results results] [--csv plan.csv]
 """
@@ -139,18 +141,59 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: Each command's output options: (option, attribute, the suffixes its file name may end in).
+_OUTPUTS: dict[str, tuple[tuple[str, str, tuple[str, ...]], ...]] = {
+    "grasp": (("--png", "png", (".png",)), ("--html", "html", (".html", ".htm"))),
+    "synergies": (("--out", "out", (".csv",)), ("--png", "png", (".png",))),
+    "hand": (("--png", "png", (".png",)),),
+    "plan": (("--csv", "csv", (".csv",)),),
+}
+
+
+def _inputs(args: argparse.Namespace) -> list[tuple[str, str]]:
+    """(how the command names it, path) of every file the command reads that a user names."""
+    named = [("--configfile", path) for path in getattr(args, "configfile", [])]
+    if args.command == "synergies":
+        named.append(("POSTURES", args.postures))
+    if args.command == "hand":
+        from synergrasp.hand.description import SHIPPED_HANDS
+
+        named += [(what, path) for what, path in (("HAND", args.hand), ("--synergies", args.synergies))
+                  if path is not None and path not in SHIPPED_HANDS and Path(path).suffix]
+    if args.command == "plan":
+        folder = Path(args.results) / "objects" / args.object
+        named += [("--results", str(folder / name)) for name in
+                  ("contacts.parquet", "load_carrying_contacts.parquet", "gfo.parquet")]
+    return named
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether two paths name one file: equal once resolved (symbolic links followed), or
+    one file under two names (a hard link)."""
+    try:
+        return a.resolve() == b.resolve() or (a.exists() and b.exists() and a.samefile(b))
+    except OSError:
+        return False
+
+
 def _output_problems(args: argparse.Namespace) -> list[str]:
-    """What keeps ``--png`` / ``--html`` from being written, one line each, before any work."""
+    """What keeps an output option from being written, one line each, before any work: a
+    file name without the option's suffix, a folder, a folder missing or not writable, a
+    file the command reads (its input is never its output)."""
     problems = []
-    for option, path, suffixes in (("--png", args.png, (".png",)), ("--html", args.html, (".html", ".htm"))):
+    for option, attribute, suffixes in _OUTPUTS[args.command]:
+        path = getattr(args, attribute)
         if path is None:
             continue
         target = Path(path)
         folder = target.parent
-        if target.suffix.lower() not in suffixes:
-            problems.append(f"{option} {path}: the file name must end in {' or '.join(suffixes)}")
+        read = next((f"{what} {given}" for what, given in _inputs(args) if _same_file(target, Path(given))), None)
+        if read is not None:
+            problems.append(f"{option} {path}: is the file the command reads ({read}); write to another file")
         elif target.is_dir():
             problems.append(f"{option} {path}: is a folder; give a file name")
+        elif target.suffix.lower() not in suffixes:
+            problems.append(f"{option} {path}: the file name must end in {' or '.join(suffixes)}")
         elif not folder.is_dir():
             problems.append(f"{option} {path}: folder '{folder}' is not an existing folder")
         else:
@@ -159,6 +202,21 @@ def _output_problems(args: argparse.Namespace) -> list[str]:
                     pass
             except OSError as err:
                 problems.append(f"{option} {path}: folder '{folder}' cannot be written ({err.strerror or err})")
+    return problems
+
+
+def _count_problems(args: argparse.Namespace) -> list[str]:
+    """Counts and radii a command cannot use, one line each: a count below 1, a radius that
+    is not a positive finite number (deg)."""
+    problems = []
+    for option, attribute in (("--count", "count"), ("--synergies", "synergies")):
+        value = getattr(args, attribute, None)
+        if isinstance(value, int) and value < 1:
+            problems.append(f"{option} {value}: must be a whole number of at least 1")
+    bad = [r for r in getattr(args, "radius", None) or () if not (math.isfinite(r) and r > 0)]
+    if bad:
+        problems.append(f"--radius {' '.join(f'{r:g}' for r in bad)}: each radius must be a positive finite "
+                        "number of degrees")
     return problems
 
 
@@ -194,7 +252,8 @@ def _plan(args: argparse.Namespace) -> int:
               f"{_number(row.exhaustive_min_force_N, 4)} N, rank {row.rank} of {row.n_ranked}, regret "
               f"{_number(row.regret_percent, 3)} %")
     if args.csv:
-        tables.write_csv(tables.PLAN, result.table, args.csv)
+        with _writing("--csv", args.csv):
+            tables.write_csv(tables.PLAN, result.table, args.csv)
     return 0
 
 
@@ -223,7 +282,8 @@ def _show_hand(args: argparse.Namespace) -> int:
     if args.png:
         from synergrasp.figures.hand_figures import figure_synergy_postures
 
-        figure_synergy_postures(hand, synergies, args.png, None, n_synergies=min(args.count, synergies.n_synergies))
+        with _writing("--png", args.png):
+            figure_synergy_postures(hand, synergies, args.png, None, n_synergies=min(args.count, synergies.n_synergies))
         print(f"picture: {args.png}")
     return 0
 
@@ -239,7 +299,8 @@ def _fit_synergies(args: argparse.Namespace) -> int:
     except (SynergyFileError, ValueError) as err:
         print(f"synergrasp synergies fit: {err}", file=sys.stderr)
         return 2
-    write_synergies(fit.synergies, args.out)
+    with _writing("--out", args.out):
+        write_synergies(fit.synergies, args.out)
     print(f"{len(postures)} postures of {len(names)} joints: total variance {fit.total_variance_rad2:.6g} rad^2")
     print(f"{'synergy':<8} {'variance (rad^2)':>17} {'explained':>10} {'cumulative':>11}")
     for i, (v, e, c) in enumerate(zip(fit.variance_rad2, fit.explained, fit.cumulative), start=1):
@@ -248,7 +309,8 @@ def _fit_synergies(args: argparse.Namespace) -> int:
     if args.png:
         from synergrasp.figures.synergy_fit import figure_explained_variance
 
-        figure_explained_variance(fit, args.png)
+        with _writing("--png", args.png):
+            figure_explained_variance(fit, args.png)
         print(f"explained variance: {args.png}")
     return 0
 
@@ -260,9 +322,6 @@ def _grasp(args: argparse.Namespace) -> int:
     from synergrasp.inspector import default_sets, inspect_grasp, parse_sets
     from synergrasp.study_checks import checked_scenario, read_overlays
 
-    problems = _output_problems(args)
-    if problems:
-        raise ValueError("\n".join(problems))
     config = read_overlays(args.configfile)
     cfg, warnings = checked_scenario(config)
     for warning in warnings:
@@ -298,30 +357,35 @@ def _grasp(args: argparse.Namespace) -> int:
     return 0
 
 
+class _WriteError(ValueError):
+    """An output that could not be written after the work (one line naming the option)."""
+
+
 @contextmanager
 def _writing(option: str, path: str) -> Iterator[None]:
     """A failure to write ``path`` (a full disk after the check) as one line naming the option."""
     try:
         yield
     except OSError as err:
-        raise ValueError(f"{option} {path}: cannot be written ({err.strerror or err})") from None
+        raise _WriteError(f"{option} {path}: cannot be written ({err.strerror or err})") from None
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command; 0 on success, 2 on bad input (one line per problem on standard
-    error, naming the argument, the file or the key; no traceback)."""
+    error, naming the argument, the file or the key; no traceback). The counts and every
+    output path are checked before any work, for every command."""
     args = _parser().parse_args(argv)
-    if args.command == "plan":
-        return _plan(args)
-    if args.command == "synergies":
-        return _fit_synergies(args)
-    if args.command == "hand":
-        return _show_hand(args)
-    try:
-        return _grasp(args)
-    except ValueError as err:  # ConfigError, InspectionError, file errors: each names what is wrong
-        lines = str(err).splitlines() or [repr(err)]
-    print("\n".join(f"synergrasp {args.command}: {line}" for line in lines), file=sys.stderr)
+    command = " ".join(filter(None, (args.command, getattr(args, "action", None))))
+    lines = _count_problems(args) + _output_problems(args)
+    if not lines:
+        run = {"plan": _plan, "synergies": _fit_synergies, "hand": _show_hand, "grasp": _grasp}[args.command]
+        try:
+            return run(args)
+        except ValueError as err:  # grasp: ConfigError, InspectionError, file errors; every command: a write
+            if args.command != "grasp" and not isinstance(err, _WriteError):
+                raise
+            lines = str(err).splitlines() or [repr(err)]
+    print("\n".join(f"synergrasp {command}: {line}" for line in lines), file=sys.stderr)
     return 2
 
 

@@ -66,6 +66,8 @@ class SynergyFileError(ValueError):
 
 def read_text_table(path: str | Path, where: str) -> pd.DataFrame:
     """A CSV file's cells as text; SynergyFileError prefixed ``where`` if it cannot be read."""
+    if Path(path).is_dir():
+        raise SynergyFileError(f"{where}: cannot be read: is a folder; give a file")
     try:
         return pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True)
     except OSError as err:
