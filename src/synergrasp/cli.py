@@ -220,6 +220,18 @@ def _count_problems(args: argparse.Namespace) -> list[str]:
     return problems
 
 
+def _configuration(args: argparse.Namespace) -> dict[str, Any]:
+    """The configuration of ``--configfile`` overlays as the workflow has it: with the objects
+    its ``random_objects`` block draws (manifest relative to the working folder, the project's
+    root), checked before anything is drawn."""
+    from synergrasp.simulation.random_objects import add_random_objects
+    from synergrasp.study_checks import read_overlays
+
+    config = read_overlays(args.configfile)
+    add_random_objects(config, ".")
+    return config
+
+
 def _plan(args: argparse.Namespace) -> int:
     """``synergrasp plan``: the planner at each radius, one line each."""
     from dataclasses import replace
@@ -228,13 +240,13 @@ def _plan(args: argparse.Namespace) -> int:
     from synergrasp.analysis.plan_study import PlanParams, plan_object
     from synergrasp.config import ConfigError
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.study_checks import checked_scenario, read_overlays
+    from synergrasp.study_checks import checked_scenario
 
     folder = Path(args.results) / "objects" / args.object
     contacts_path = next((folder / f for f in ("load_carrying_contacts.parquet", "contacts.parquet")
                           if (folder / f).is_file()), folder / "contacts.parquet")
     try:
-        cfg, _ = checked_scenario(read_overlays(args.configfile))
+        cfg, _ = checked_scenario(_configuration(args))
         if args.object not in cfg["objects"]:
             raise ConfigError(f"object {args.object!r} is not in the configuration ({', '.join(cfg['objects'])})")
         params = PlanParams.from_config(cfg, args.object)
@@ -320,9 +332,9 @@ def _fit_synergies(args: argparse.Namespace) -> int:
 def _grasp(args: argparse.Namespace) -> int:
     from synergrasp.file_output import replacing
     from synergrasp.inspector import default_sets, inspect_grasp, parse_sets
-    from synergrasp.study_checks import checked_scenario, read_overlays
+    from synergrasp.study_checks import checked_scenario
 
-    config = read_overlays(args.configfile)
+    config = _configuration(args)
     cfg, warnings = checked_scenario(config)
     for warning in warnings:
         print(f"synergrasp grasp: warning: {warning}", file=sys.stderr)
