@@ -96,8 +96,8 @@ def test_a_hand_far_from_a_human_hand_is_warned_naming_the_field(run, tmp_path):
     before = _results(run)
     out = snakemake(run, "-n", "figures", configfile=_overlay(tmp_path, hand=str(hand)))
     assert out.returncode == 0, out.stderr[-3000:]
-    _one_line(out.stdout + out.stderr, f"hand file '{hand}': fingers.index.joints[1].offset_mm: 9000 mm is far "
-                                       "from a human hand's dimensions")
+    _one_line(out.stdout + out.stderr, f"hand file '{hand}': fingers.index.joints[1] (index_mcp) offset: 9000 mm "
+                                       "is far from a human hand's dimensions")
     assert _results(run) == before
 
 
