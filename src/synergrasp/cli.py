@@ -246,7 +246,9 @@ def _plan(args: argparse.Namespace) -> int:
     contacts_path = next((folder / f for f in ("load_carrying_contacts.parquet", "contacts.parquet")
                           if (folder / f).is_file()), folder / "contacts.parquet")
     try:
-        cfg, _ = checked_scenario(_configuration(args))
+        cfg, warnings = checked_scenario(_configuration(args))
+        for warning in warnings:
+            print(f"synergrasp plan: warning: {warning}", file=sys.stderr)
         if args.object not in cfg["objects"]:
             raise ConfigError(f"object {args.object!r} is not in the configuration ({', '.join(cfg['objects'])})")
         params = PlanParams.from_config(cfg, args.object)
@@ -271,16 +273,19 @@ def _plan(args: argparse.Namespace) -> int:
 
 def _show_hand(args: argparse.Namespace) -> int:
     """``synergrasp hand show``: the joints (limits, mean posture, S1), links and fingertips."""
-    from synergrasp.hand.kinematics import fingertip_positions, load_hand
+    from synergrasp.hand.checks import check_hand
+    from synergrasp.hand.kinematics import fingertip_positions
     from synergrasp.hand.synergies import load_synergies
 
     try:
-        hand = load_hand(args.hand)
+        hand, _, warnings = check_hand(args.hand)
         table = args.synergies or ("shadow_hand" if args.hand == "shadow_hand" else None)
         synergies = load_synergies(table, joint_names=hand.joint_names)
     except ValueError as err:
         print(f"synergrasp hand show: {err}", file=sys.stderr)
         return 2
+    for warning in warnings:
+        print(f"synergrasp hand show: warning: {warning}", file=sys.stderr)
     deg = math.degrees
     print(f"{hand.name} ({hand.source}): {hand.n_joints} joints, {hand.n_links} links "
           f"({len(hand.shapeless_links)} without shape), {synergies.n_synergies} synergies")

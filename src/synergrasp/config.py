@@ -200,13 +200,16 @@ def _raw_problems(value: Any, path: tuple = ()) -> list[str]:
 def _describe(error: Any) -> str:
     """One line for one jsonschema error, naming the key and what is allowed; for a value that
     matches none of several forms (``oneOf``/``anyOf``), the error of the form it comes
-    closest to: the one whose error lies deepest inside the value (a mapping of the right
-    keys with one wrong entry), then ``jsonschema.exceptions.best_match``."""
+    closest to: a form of the value's kind (not a ``type``/``enum`` mismatch of the whole
+    value) whose error lies deepest inside the value (a mapping with one wrong entry), then
+    ``jsonschema.exceptions.best_match``."""
     if error.validator in ("oneOf", "anyOf") and error.context:
         from jsonschema.exceptions import best_match
 
-        depth = max(len(e.relative_path) for e in error.context)
-        return _describe(best_match(e for e in error.context if len(e.relative_path) == depth))
+        near = [e for e in error.context if e.relative_path or e.validator not in ("type", "enum", "const")]
+        near = near or list(error.context)
+        depth = max(len(e.relative_path) for e in near)
+        return _describe(best_match(e for e in near if len(e.relative_path) == depth))
     where = _key_path(list(error.absolute_path))
     schema = error.schema
     if error.validator == "additionalProperties" and isinstance(error.instance, Mapping):
