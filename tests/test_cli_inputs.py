@@ -222,6 +222,10 @@ COMMANDS = {
                                                                       "number of degrees"),
     "plan csv into a missing folder": (lambda t: ["plan", "obj4", "--csv", str(t / "no/p.csv")],
                                        "--csv {t}/no/p.csv: folder '{t}/no' is not an existing folder"),
+    "plan results a file": (lambda t: ["plan", "obj4", "--results", str(t / "postures.csv")],
+                            "--results {t}/postures.csv: is a file; give the folder of the study's outputs"),
+    "grasp results a file": (lambda t: [*POSE, "--results", str(t / "postures.csv")],
+                             "--results {t}/postures.csv: is a file; give the folder of the study's outputs"),
 }
 
 

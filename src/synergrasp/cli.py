@@ -206,8 +206,8 @@ def _output_problems(args: argparse.Namespace) -> list[str]:
 
 
 def _count_problems(args: argparse.Namespace) -> list[str]:
-    """Counts and radii a command cannot use, one line each: a count below 1, a radius that
-    is not a positive finite number (deg)."""
+    """Counts, radii and folders a command cannot use, one line each: a count below 1, a
+    radius that is not a positive finite number (deg), a file given as ``--results``."""
     problems = []
     for option, attribute in (("--count", "count"), ("--synergies", "synergies")):
         value = getattr(args, attribute, None)
@@ -217,6 +217,9 @@ def _count_problems(args: argparse.Namespace) -> list[str]:
     if bad:
         problems.append(f"--radius {' '.join(f'{r:g}' for r in bad)}: each radius must be a positive finite "
                         "number of degrees")
+    results = getattr(args, "results", None)
+    if results is not None and Path(results).exists() and not Path(results).is_dir():
+        problems.append(f"--results {results}: is a file; give the folder of the study's outputs")
     return problems
 
 

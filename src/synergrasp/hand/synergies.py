@@ -171,6 +171,8 @@ def resolve_synergies(source: str | Path | None) -> Path:
     if str(source) == "shadow_hand":  # the shipped Shadow hand's table (its hand: shadow_hand)
         return shadow_hand_files()[2]
     path = Path(source)
+    if path.is_dir():
+        raise SynergyFileError(f"synergy file '{source}': is a folder; give a synergy CSV file or a shipped table's name")
     if not path.is_file():
         raise SynergyFileError(f"synergy file '{source}': is neither a shipped table {[*SHIPPED_TABLES, 'shadow_hand']} "
                                f"nor an existing CSV file")
