@@ -18,7 +18,8 @@ import yaml
 from synergrasp.hand.checks import check_hand
 from test_mjcf_hand import softhand_urdf
 from test_workflow import ROOT, SMALL, digest, snakemake
-from test_workflow_checks import finished, run  # noqa: F401  (fixtures: a fresh copy of the finished run)
+from test_workflow_checks import _no_frames, finished, run  # noqa: F401  (fixtures: a fresh copy of the finished run)
+from test_workflow_checks import _overlay as _config
 
 pytestmark = pytest.mark.workflow
 
@@ -37,10 +38,6 @@ def _command(run: Path, *args: str) -> subprocess.CompletedProcess:
                           timeout=600)
 
 
-def _no_frames(text: str) -> None:
-    assert "Traceback" not in text and '  File "' not in text and "Exception in" not in text, text[-3000:]
-
-
 def _refused_command(run: Path, args: list[str], prefix: str, *expected: str, files: tuple[Path, ...] = ()) -> None:
     """The command exits 2 with exactly the ``expected`` lines' fragments, one line each, each
     starting with ``prefix``; nothing printed on standard output; nothing changed."""
@@ -53,14 +50,6 @@ def _refused_command(run: Path, args: list[str], prefix: str, *expected: str, fi
     for line, fragment in zip(lines, expected):
         assert fragment in line, out.stderr
     assert _state(run, *files) == before
-
-
-def _config(tmp_path: Path, **changes) -> Path:
-    config = yaml.safe_load(SMALL.read_text())
-    config.update(changes)
-    path = tmp_path / "my.yaml"
-    path.write_text(yaml.safe_dump(config, sort_keys=False))
-    return path
 
 
 def _refused_run(run: Path, configfile: Path, *expected: str) -> None:
