@@ -55,6 +55,8 @@ def _searched(tmp_path: Path, placement_csv: str | None, rank: int = 1) -> list[
 #: (arguments after the pose, or a function of tmp_path giving them; text every line must hold)
 BAD = {
     "unknown object": (lambda t: ["--configfile", str(SMALL)], "object: 'obj9'"),
+    "a drawn object without its block": (lambda t: ["--configfile", str(SMALL)], "objects drawn by random_objects are "
+                                                                                 "objects of a --configfile"),
     "pose off the grid": (["--alpha", "7"], "--alpha/--beta"),
     "pose not a number": (["--alpha", "nan"], "--alpha/--beta"),
     "set beyond the table": (["--sets", "16"], "--sets"),
@@ -123,7 +125,8 @@ def _binary(tmp_path: Path) -> Path:
 def test_bad_input_gives_one_line_per_problem_and_does_no_work(case, tmp_path, capsys, monkeypatch):
     args, text = BAD[case]
     args = args(tmp_path) if callable(args) else ["--configfile", str(SMALL), *args]
-    argv = (["grasp", "obj9", "--alpha", "-30", "--beta", "0"] if case == "unknown object" else POSE) + args
+    obj = {"unknown object": "obj9", "a drawn object without its block": "rand_305"}.get(case, "obj1")
+    argv = ["grasp", obj, *POSE[2:], *args]
     closures = []
     monkeypatch.setattr("synergrasp.simulation.closure.simulate_object", lambda *a, **k: closures.append(a))
     before = sorted(p.name for p in tmp_path.rglob("*"))

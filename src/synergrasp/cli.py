@@ -243,7 +243,7 @@ def _plan(args: argparse.Namespace) -> int:
     from synergrasp.analysis.plan_study import PlanParams, plan_object
     from synergrasp.config import ConfigError
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.study_checks import checked_scenario
+    from synergrasp.study_checks import checked_scenario, unknown_object
 
     folder = Path(args.results) / "objects" / args.object
     contacts_path = next((folder / f for f in ("load_carrying_contacts.parquet", "contacts.parquet")
@@ -252,8 +252,8 @@ def _plan(args: argparse.Namespace) -> int:
         cfg, warnings = checked_scenario(_configuration(args))
         for warning in warnings:
             print(f"synergrasp plan: warning: {warning}", file=sys.stderr)
-        if args.object not in cfg["objects"]:
-            raise ConfigError(f"object {args.object!r} is not in the configuration ({', '.join(cfg['objects'])})")
+        if unknown_object(cfg, args.object):
+            raise ConfigError(unknown_object(cfg, args.object))
         params = PlanParams.from_config(cfg, args.object)
         params = replace(params, radii_deg=tuple(args.radius)) if args.radius else params
         contacts = tables.read(tables.CONTACTS, contacts_path)

@@ -29,7 +29,7 @@ from synergrasp.resolved import effective_placement, grasp_type
 from synergrasp.yaml_io import read_yaml
 
 __all__ = ["checked_scenario", "workflow_scenario", "read_overlays", "search_rank_problems", "lattice_rank_problems",
-           "search_table_or_refuse", "searched_objects_or_refuse", "older_results_problems"]
+           "search_table_or_refuse", "searched_objects_or_refuse", "older_results_problems", "unknown_object"]
 
 
 @functools.cache
@@ -181,3 +181,14 @@ def older_results_problems(results: str | Path = "results") -> list[str]:
             problems += [line for path in sorted(Path(results).rglob(f"{table.name}.parquet"))
                          if (line := tables.older_version(table, path))]
     return problems
+
+
+def unknown_object(cfg: Mapping[str, Any], obj: str) -> str:
+    """The line a command gives for an object ``obj`` that the checked configuration ``cfg``
+    does not have ('' if it has it): its objects, and for a name like a drawn object's
+    (``rand_NNN``) without a ``random_objects`` block, where the drawn objects come from."""
+    if obj in cfg["objects"]:
+        return ""
+    hint = ("; objects drawn by random_objects are objects of a --configfile with that block "
+            "(docs/random_objects.md)") if obj.startswith("rand_") and not cfg.get("random_objects") else ""
+    return f"object: {obj!r} is not an object of the configuration; objects: {list(cfg['objects'])}{hint}"
