@@ -215,6 +215,9 @@ COMMANDS = {
                                   str(t / "v.pdf")], "--png {t}/v.pdf: the file name must end in .png"),
     "fit 0 synergies": (lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out", str(t / "x.csv"),
                                    "--synergies", "0"], "--synergies 0: must be a whole number of at least 1"),
+    "fit more synergies than the postures hold": (
+        lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out", str(t / "x.csv"), "--synergies", "4"],
+        "--synergies 4: at most 3 for 12 postures of 3 joints"),
     "fit postures a folder": (lambda t: ["synergies", "fit", str(t), "--out", str(t / "x.csv")],
                               "postures file '{t}': cannot be read: is a folder; give a file"),
     "hand count 0": (lambda t: ["hand", "show", "--count", "0"], "--count 0: must be a whole number of at least 1"),

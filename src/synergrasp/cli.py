@@ -315,6 +315,10 @@ def _fit_synergies(args: argparse.Namespace) -> int:
 
     try:
         names, postures = read_postures(args.postures)
+        k_max = min(len(names), len(postures) - 1)
+        if args.synergies is not None and args.synergies > k_max:
+            raise ValueError(f"--synergies {args.synergies}: at most {k_max} for {len(postures)} postures of "
+                             f"{len(names)} joints")
         fit = fit_synergies(names, postures, args.synergies)
     except (SynergyFileError, ValueError) as err:
         print(f"synergrasp synergies fit: {err}", file=sys.stderr)
