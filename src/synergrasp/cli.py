@@ -144,18 +144,23 @@ def _parser() -> argparse.ArgumentParser:
 #: Each command's output options: (option, attribute, the suffixes its file name may end in).
 _OUTPUTS: dict[str, tuple[tuple[str, str, tuple[str, ...]], ...]] = {
     "grasp": (("--png", "png", (".png",)), ("--html", "html", (".html", ".htm"))),
-    "synergies": (("--out", "out", (".csv",)), ("--png", "png", (".png",))),
-    "hand": (("--png", "png", (".png",)),),
+    "synergies fit": (("--out", "out", (".csv",)), ("--png", "png", (".png",))),
+    "hand show": (("--png", "png", (".png",)),),
     "plan": (("--csv", "csv", (".csv",)),),
 }
+
+
+def _command(args: argparse.Namespace) -> str:
+    """The command's name as its messages give it (``synergies fit``, ``grasp``)."""
+    return " ".join(filter(None, (args.command, getattr(args, "action", None))))
 
 
 def _inputs(args: argparse.Namespace) -> list[tuple[str, str]]:
     """(how the command names it, path) of every file the command reads that a user names."""
     named = [("--configfile", path) for path in getattr(args, "configfile", [])]
-    if args.command == "synergies":
+    if _command(args) == "synergies fit":
         named.append(("POSTURES", args.postures))
-    if args.command == "hand":
+    if _command(args) == "hand show":
         from synergrasp.hand.description import SHIPPED_HANDS
 
         named += [(what, path) for what, path in (("HAND", args.hand), ("--synergies", args.synergies))
@@ -181,7 +186,7 @@ def _output_problems(args: argparse.Namespace) -> list[str]:
     file name without the option's suffix, a folder, a folder missing or not writable, a
     file the command reads (its input is never its output)."""
     problems = []
-    for option, attribute, suffixes in _OUTPUTS[args.command]:
+    for option, attribute, suffixes in _OUTPUTS.get(_command(args), ()):
         path = getattr(args, attribute)
         if path is None:
             continue
@@ -399,10 +404,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     error, naming the argument, the file or the key; no traceback). The counts and every
     output path are checked before any work, for every command."""
     args = _parser().parse_args(argv)
-    command = " ".join(filter(None, (args.command, getattr(args, "action", None))))
+    command = _command(args)
     lines = _count_problems(args) + _output_problems(args)
     if not lines:
-        run = {"plan": _plan, "synergies": _fit_synergies, "hand": _show_hand, "grasp": _grasp}[args.command]
+        run = {"plan": _plan, "synergies fit": _fit_synergies, "hand show": _show_hand, "grasp": _grasp}[command]
         try:
             return run(args)
         except ValueError as err:  # grasp: ConfigError, InspectionError, file errors; every command: a write
