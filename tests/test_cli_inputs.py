@@ -61,6 +61,8 @@ def _searched(tmp_path: Path, placement_csv: str | None, rank: int = 1) -> list[
 #: (arguments after the pose, or a function of tmp_path giving them; text every line must hold)
 BAD = {
     "unknown object": (lambda t: ["--configfile", str(SMALL)], "object: 'obj9'"),
+    "a drawn object without its block": (lambda t: ["--configfile", str(SMALL)], "objects drawn by random_objects are "
+                                                                                 "objects of a --configfile"),
     "pose off the grid": (["--alpha", "7"], "--alpha/--beta"),
     "pose not a number": (["--alpha", "nan"], "--alpha/--beta"),
     "set beyond the table": (["--sets", "16"], "--sets"),
@@ -129,7 +131,8 @@ def _binary(tmp_path: Path) -> Path:
 def test_bad_input_gives_one_line_per_problem_and_does_no_work(case, tmp_path, capsys, monkeypatch):
     args, text = BAD[case]
     args = args(tmp_path) if callable(args) else ["--configfile", str(SMALL), *args]
-    argv = (["grasp", "obj9", "--alpha", "-30", "--beta", "0"] if case == "unknown object" else POSE) + args
+    obj = {"unknown object": "obj9", "a drawn object without its block": "rand_305"}.get(case, "obj1")
+    argv = ["grasp", obj, *POSE[2:], *args]
     closures = []
     monkeypatch.setattr("synergrasp.simulation.closure.simulate_object", lambda *a, **k: closures.append(a))
     before = sorted(p.name for p in tmp_path.rglob("*"))
@@ -191,3 +194,71 @@ def test_cli_has_one_check_of_the_configuration():
     """The command reads its configuration through the workflow's check, not a second one."""
     source = Path(cli.__file__).read_text() + Path(inspector.__file__).read_text()
     assert "checked_scenario" in source and "validate_config" not in source
+
+
+# --------------------------------------------------------------------------- issue 48: every command, before the work
+
+def _postures_file(tmp_path: Path) -> Path:
+    rng = np.random.default_rng(5)
+    path = tmp_path / "postures.csv"
+    pd.DataFrame(rng.uniform(0, 1, (12, 3)), columns=["a", "b", "c"]).to_csv(path, index=False)
+    return path
+
+
+#: (argv of tmp_path with postures.csv in it, the one line expected after the command's prefix)
+COMMANDS = {
+    "fit over its postures": (lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out", str(t / "postures.csv")],
+                              "--out {t}/postures.csv: is the file the command reads (POSTURES {t}/postures.csv); write to another file"),
+    "fit over a symbolic link to them": (lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out",
+                                                    str(_linked(t, "link.csv", symbolic=True))],
+                                         "--out {t}/link.csv: is the file the command reads (POSTURES {t}/postures.csv); write to another file"),
+    "fit over a hard link to them": (lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out",
+                                                str(_linked(t, "hard.csv", symbolic=False))],
+                                     "--out {t}/hard.csv: is the file the command reads (POSTURES {t}/postures.csv); write to another file"),
+    "fit into a missing folder": (lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out", str(t / "no/x.csv")],
+                                  "--out {t}/no/x.csv: folder '{t}/no' is not an existing folder"),
+    "fit png suffix": (lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out", str(t / "x.csv"), "--png",
+                                  str(t / "v.pdf")], "--png {t}/v.pdf: the file name must end in .png"),
+    "fit 0 synergies": (lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out", str(t / "x.csv"),
+                                   "--synergies", "0"], "--synergies 0: must be a whole number of at least 1"),
+    "fit more synergies than the postures hold": (
+        lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out", str(t / "x.csv"), "--synergies", "4"],
+        "--synergies 4: at most 3 for 12 postures of 3 joints"),
+    "fit postures a folder": (lambda t: ["synergies", "fit", str(t), "--out", str(t / "x.csv")],
+                              "postures file '{t}': cannot be read: is a folder; give a file"),
+    "hand count 0": (lambda t: ["hand", "show", "--count", "0"], "--count 0: must be a whole number of at least 1"),
+    "hand png a folder": (lambda t: ["hand", "show", "--png", str(t)], "--png {t}: is a folder; give a file name"),
+    "plan radius -10": (lambda t: ["plan", "obj4", "--radius", "-10"], "--radius -10: each radius must be a positive "
+                                                                       "finite number of degrees"),
+    "plan radius nan": (lambda t: ["plan", "obj4", "--radius", "nan"], "--radius nan: each radius must be a positive finite "
+                                                                      "number of degrees"),
+    "plan csv into a missing folder": (lambda t: ["plan", "obj4", "--csv", str(t / "no/p.csv")],
+                                       "--csv {t}/no/p.csv: folder '{t}/no' is not an existing folder"),
+    "plan results a file": (lambda t: ["plan", "obj4", "--results", str(t / "postures.csv")],
+                            "--results {t}/postures.csv: is a file; give the folder of the study's outputs"),
+    "grasp results a file": (lambda t: [*POSE, "--results", str(t / "postures.csv")],
+                             "--results {t}/postures.csv: is a file; give the folder of the study's outputs"),
+}
+
+
+def _linked(tmp_path: Path, name: str, symbolic: bool) -> Path:
+    link = tmp_path / name
+    (link.symlink_to if symbolic else link.hardlink_to)(tmp_path / "postures.csv")
+    return link
+
+
+@pytest.mark.parametrize("case", list(COMMANDS), ids=list(COMMANDS))
+def test_every_command_checks_its_arguments_and_outputs_first(case, tmp_path, capsys, monkeypatch):
+    postures = _postures_file(tmp_path)
+    argv = COMMANDS[case][0](tmp_path)
+    expected = COMMANDS[case][1].format(t=tmp_path)
+    for work in ("synergrasp.hand.synergy_fit.fit_synergies", "synergrasp.analysis.plan_study.plan_object",
+                 "synergrasp.hand.checks.check_hand"):
+        monkeypatch.setattr(work, lambda *a, **k: pytest.fail("work done before the arguments were checked"))
+    before = {p: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()}
+    assert main(argv) == 2
+    out = capsys.readouterr()
+    prefix = "synergrasp " + " ".join(argv[:2] if argv[0] in ("synergies", "hand") else argv[:1]) + ": "
+    assert out.err.strip().splitlines() == [prefix + expected] and out.out == ""
+    assert {p: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before
+    assert postures.read_bytes() == before[postures]

@@ -106,6 +106,13 @@ def _broken(path, value, config=SMALL):
         (("solver", "pose_shards"), 85, "'solver.pose_shards': 85 exceeds the 84 poses of the grid; allowed values: 1..84"),
         # defect 7: a fractional number where an integer is expected
         (("solver", "pose_shards"), 2.5, "'solver.pose_shards': 2.5 is not of type 'integer'"),
+        # issue 48, kind 8: a value matching no form of a oneOf names the closest form's error
+        (("placement", "search", "region_mm", "power"), {"x": [0, 10, 20], "y": [0, 10], "z": [0, 10]},
+         "config error at 'placement.search.region_mm.power.x': [0, 10, 20] is too long"),
+        (("placement", "search", "region_mm", "power"), {"x": [0, 10], "y": [0, 10]},
+         "config error at 'placement.search.region_mm.power': 'z' is a required property"),
+        (("placement", "search", "region_mm", "power"), "hands",
+         "config error at 'placement.search.region_mm.power': 'hands' is not allowed; allowed values: ['hand']"),
     ],
 )
 def test_bad_values_name_the_key(path, value, expected):
@@ -212,6 +219,8 @@ def test_a_scenario_set_to_null_by_an_overlay_is_removed():
     ({"default": {"mechanics": {"mu": 1.0}}}, "config error at 'scenarios': name 'default' is not allowed"),
     ({"a b": {}}, "config error at 'scenarios': name 'a b' is not allowed"),
     ({"s1": 3}, "config error at 'scenarios.s1': 3 is not of type 'object'"),
+    ({"s1": {"random_objects": {"n_objects": 3}}},
+     "scenario 's1': config error at 'scenarios.s1.random_objects': a scenario cannot draw objects of its own"),
 ])
 def test_a_bad_scenario_names_the_scenario_and_the_key(scenarios, expected):
     with pytest.raises(ConfigError) as info:

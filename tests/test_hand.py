@@ -278,7 +278,7 @@ def test_load_hand_rejects_malformed_file_naming_the_file_and_field(tmp_path, mu
     assert field in str(info.value)
 
 
-@pytest.mark.parametrize("content, reason", [(None, "No such file"), ("dir", "Is a directory"), (b"", "is empty"),
+@pytest.mark.parametrize("content, reason", [(None, "No such file"), ("dir", "is a folder"), (b"", "is empty"),
                                              (bytes(range(256)), "not a readable YAML file")])
 def test_unreadable_hand_file_gives_one_message_naming_it(tmp_path, content, reason):
     path = tmp_path / "hand.yaml"

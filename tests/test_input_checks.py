@@ -126,8 +126,8 @@ def test_a_link_offset_of_minus_9000_mm_is_warned_naming_the_field(tmp_path):
     path = _write(tmp_path, doc)
     _, problems, warnings = check_hand(path)
     assert problems == []
-    assert warnings == [f"hand file '{path}': fingers.index.joints[1].offset_mm: 9000 mm is far from a human "
-                        "hand's dimensions (a hand is about 190 mm long; lengths are in mm)"]
+    assert warnings == [f"hand file '{path}': fingers.index.joints[1] (index_mcp) offset: 9000 mm is far from a "
+                        "human hand's dimensions (a hand is about 190 mm long); lengths are in mm"]
 
 
 def test_a_hand_file_in_metres_is_warned(tmp_path):

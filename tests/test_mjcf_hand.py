@@ -250,17 +250,25 @@ def test_hand_show_prints_the_joints_and_draws(tmp_path, capsys):
     assert "none.yaml" in capsys.readouterr().err
 
 
-def test_softhand_through_its_own_urdf_equals_the_yaml_hand(tmp_path):
-    """URDF through MuJoCo's compiler: the shipped hand's URDF (write_urdf: metres, 9 digits,
-    a rolling joint as two revolute halves) described with each first half named (scale 0.5:
-    MuJoCo turns it by q/2), the second half coupled to it (ratio 1), the root link fused
-    into MuJoCo's world. Same joints, limits, fingertips and Jacobians as the YAML hand."""
+def softhand_urdf(folder: Path, factor: float = 1.0) -> Path:
+    """A hand description of the shipped hand through its own URDF (``write_urdf``: metres, 9
+    digits, a rolling joint as two revolute halves), written in ``folder``: each first half
+    named (scale 0.5: MuJoCo turns it by q/2), the second half coupled to it (ratio 1), the root
+    link fused into MuJoCo's world; every length of the URDF times ``factor`` (1000: a URDF
+    written in mm). Returns the description's path."""
+    import re
+
     import yaml
 
-    from synergrasp.hand.kinematics import fingertip_positions, write_urdf
+    from synergrasp.hand.kinematics import write_urdf
 
     soft = load_hand(None)
-    write_urdf(soft, tmp_path / "soft.urdf")
+    write_urdf(soft, folder / "soft.urdf")
+    if factor != 1.0:
+        def scaled(m):
+            return f'{m.group(1)}="' + " ".join(f"{float(v) * factor:.9g}" for v in m.group(2).split()) + '"'
+        text = re.sub(r'\b(xyz|size|radius|length)="([^"]*)"', scaled, (folder / "soft.urdf").read_text())
+        (folder / "soft.urdf").write_text(text)
     fingers, couplings = {}, {}
     for finger, links in zip(("thumb", "index", "middle", "ring", "little"), soft.finger_links):
         entries = []
@@ -273,9 +281,20 @@ def test_softhand_through_its_own_urdf_equals_the_yaml_hand(tmp_path):
                 entries.append({"mjcf": f"{joint}_b", "link": soft.link_names[link]})
                 couplings[f"{joint}_b"] = {"follows": f"{joint}_a", "ratio": 1.0}
         fingers[finger] = {"joints": entries, "tip_mm": soft.fingertip_point[len(fingers)].tolist()}
-    (tmp_path / "hand.yaml").write_text(yaml.safe_dump(
+    path = folder / "hand.yaml"
+    path.write_text(yaml.safe_dump(
         {"urdf": "soft.urdf", "palm": "world", "palm_normal": [1, 0, 0], "finger_direction": [0, 0, 1],
          "couplings": couplings, "fingers": fingers}))
+    return path
+
+
+def test_softhand_through_its_own_urdf_equals_the_yaml_hand(tmp_path):
+    """URDF through MuJoCo's compiler: the shipped hand's URDF (softhand_urdf). Same joints,
+    limits, fingertips and Jacobians as the YAML hand."""
+    from synergrasp.hand.kinematics import fingertip_positions
+
+    soft = load_hand(None)
+    softhand_urdf(tmp_path)
     read = load_hand(tmp_path / "hand.yaml")
     assert read.joint_names == soft.joint_names
     np.testing.assert_allclose(read.lower, soft.lower, atol=1e-9)
@@ -292,3 +311,21 @@ def test_softhand_through_its_own_urdf_equals_the_yaml_hand(tmp_path):
     print(f"URDF: Jacobians within {worst:.2g} mm/rad")
     assert worst < 1e-5
     assert sum(len(s) for s in read.link_shapes) == sum(len(s) for s in soft.link_shapes) == 20
+
+
+def test_a_urdf_in_mm_gets_the_size_warning_a_yaml_hand_gets(tmp_path):
+    """One size check for every format (hand_file.size_warnings): the shipped hand's URDF with
+    its lengths in mm is 1000 times a hand, one line naming the unit MuJoCo reads; in m, none."""
+    assert check_hand(softhand_urdf(tmp_path))[1:] == ([], [])
+    path = softhand_urdf(tmp_path, 1000.0)
+    _, problems, warnings = check_hand(path)
+    assert problems == [] and len(warnings) == 1
+    assert warnings[0].startswith(f"hand file '{path}': <top level>: ")
+    assert "lengths exceed 250 mm" in warnings[0] and warnings[0].endswith("lengths are in m, not mm")
+
+
+def test_a_folder_given_as_the_model_says_so(tmp_path):
+    (tmp_path / "hand.yaml").write_text("mjcf: .\npalm: palm\nfingers: {}\n")
+    with pytest.raises(ValueError, match=f"^hand file '{tmp_path / 'hand.yaml'}': mjcf: '{tmp_path}' is a folder; "
+                                         "give the model's file$"):
+        check_hand(tmp_path / "hand.yaml")

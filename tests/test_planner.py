@@ -172,4 +172,4 @@ def test_synergrasp_plan_reads_the_study_s_tables_and_prints_one_line_per_radius
     plan = tables.read_csv(tables.PLAN, tmp_path / "plan.csv")
     assert plan["study_rows_differing"].tolist() == [0, 0] and bool(plan["is_global_min"].iloc[1])
     assert main(["plan", "nothing", "--results", str(tmp_path)]) == 2
-    assert "synergrasp plan: object 'nothing'" in capsys.readouterr().err
+    assert "synergrasp plan: object: 'nothing' is not an object of the configuration" in capsys.readouterr().err

@@ -13,6 +13,7 @@ import pytest
 
 from synergrasp.analysis.graspability import studied, with_left_out
 from synergrasp.analysis.objects_summary import across_objects, object_rows, planner_budget
+from synergrasp.config import ConfigError
 from synergrasp.simulation import random_objects as ro
 
 BOX = Path(__file__).parent / "data" / "box_30x60x100.obj"  # 30 x 60 x 100 units
@@ -116,3 +117,40 @@ def test_planner_budget_counts_objects_within_each_aim():
     assert budget.loc[20.0, ["objects", "within_solves", "within_regret", "within_both"]].tolist() == [3, 0, 3, 0]
     assert budget.loc[20.0, "every_object_within_regret"]
     assert budget.loc[30.0, "objects"] == 0 and not budget.loc[30.0, "every_object_within_regret"]
+
+
+@pytest.mark.parametrize("changes, lines", [
+    ({"n_objects": -1}, ["config error at 'random_objects.n_objects': -1 is less than the minimum of 1"]),
+    ({"n_objects": "three", "seed": -1}, ["config error at 'random_objects.n_objects': 'three' is not of type 'integer'",
+                                          "config error at 'random_objects.seed': -1 is less than the minimum of 0"]),
+    ({"longest_side_mm": [110, 50]}, ["config error at 'random_objects.longest_side_mm': [110, 50] is reversed; give "
+                                      "[shortest, longest] (mm)"]),
+    ({"mass_kg": 0.0}, ["config error at 'random_objects.mass_kg': 0.0 is less than or equal to the minimum of 0"]),
+    ({"seed": None}, ["config error at 'random_objects': 'seed' is a required property"]),
+])
+def test_the_block_is_checked_before_numpy_sees_a_value(tmp_path, monkeypatch, changes, lines):
+    """Every problem of the block, one line each under random_objects.*, and nothing drawn."""
+    _fake_package(tmp_path, monkeypatch)
+    spec = {k: v for k, v in ({"n_objects": 2, "seed": 1, "longest_side_mm": [50.0, 110.0], "mass_kg": 0.1,
+                               "sha256_file": "manifest.sha256"} | changes).items() if v is not None}
+    monkeypatch.setattr(ro, "drawn_objects", lambda *a, **k: pytest.fail("drawn before the block was checked"))
+    config = {"random_objects": spec, "objects": {"obj1": {}}}
+    with pytest.raises(ConfigError) as info:
+        ro.add_random_objects(config, tmp_path)
+    assert str(info.value).splitlines() == lines
+    assert config["objects"] == {"obj1": {}}
+
+
+def test_a_missing_manifest_and_an_object_named_like_a_drawn_one_are_named(tmp_path, monkeypatch):
+    _fake_package(tmp_path, monkeypatch)
+    spec = {"n_objects": 4, "seed": 1, "longest_side_mm": [50.0, 110.0], "mass_kg": 0.1, "sha256_file": "none"}
+    with pytest.raises(ConfigError, match=r"^config error at 'random_objects.sha256_file': '.*none' cannot be read"):
+        ro.add_random_objects({"random_objects": spec}, tmp_path)
+    spec["sha256_file"] = "manifest.sha256"
+    config = {"random_objects": spec, "objects": {"rand_000": {"shape": {"sphere": {"radius_mm": 20}}}, "rand_002": None}}
+    with pytest.raises(ConfigError) as info:
+        ro.add_random_objects(config, tmp_path)
+    # rand_000 is studied and clashes; rand_002 (removed by null, and left out: its file is missing) does not
+    assert str(info.value).splitlines() == [
+        "config error at 'objects.rand_000': an object of the configuration has the name of an object random_objects "
+        "draws (rand_000); rename the object or change random_objects.seed"]

@@ -87,3 +87,40 @@ def test_bad_postures_file_is_one_line_naming_the_file_and_field(tmp_path, capsy
     bad.write_text("a,a\n0.1,0.2\n0.3,0.4\n")
     with pytest.raises(SynergyFileError, match="repeated"):
         read_postures(bad)
+
+
+def _problems(x, names=("a", "b", "c")):
+    from synergrasp.hand.synergy_fit import posture_problems
+
+    return posture_problems(tuple(names), np.asarray(x, dtype=float))
+
+
+def test_postures_a_fit_should_question_are_one_line_each():
+    rng = np.random.default_rng(2)
+    x = rng.uniform(0.0, 1.0, (20, 3))
+    assert _problems(x) == []
+    # identical up to rounding noise: the fit would explain "100 %" with an S1 of noise
+    same = np.tile(x[0], (20, 1)) + 1e-12 * rng.standard_normal((20, 3))
+    assert _problems(same) == ["the 20 postures do not differ (every joint spreads by at most "
+                               f"{np.ptp(same, axis=0).max():.3g} rad): no variance to fit synergies to"]
+    # a CSV saved with its index: a nameless column, or a column counting the rows
+    assert _problems(x, ("", "b", "c"))[0].startswith("column 1 has no joint name")
+    counted = np.column_stack([np.arange(20), x[:, 1:]])
+    assert _problems(counted)[0].startswith("column 1 ('a') counts the rows 0, 1, …, 19")
+    # degrees: most postures beyond a full turn; an outlier: a few, named by row (1-based)
+    assert _problems(np.degrees(x)) == [f"20 of 20 postures have angles beyond 2π (up to {np.degrees(x).max():.4g}); "
+                                        "postures are in rad (is the table in degrees?)"]
+    outlier = x.copy()
+    outlier[[3, 7], 2] = [50.0, -7.0]
+    assert _problems(outlier) == ["row(s) 4, 8 beyond a full turn (row 4, joint 'c' is 50 rad, beyond 2π): an outlier "
+                                  "no joint reaches; remove or correct it"]
+    # 2π itself is a posture a joint may have (inclusive bound)
+    edge = x.copy()
+    edge[0, 0] = 2 * np.pi
+    assert _problems(edge) == []
+
+
+def test_fit_refuses_postures_that_differ_by_rounding_noise_alone():
+    x = np.tile([0.1, 0.2, 0.3], (30, 1)) + 1e-15 * np.arange(30)[:, None]
+    with pytest.raises(ValueError, match="the 30 postures do not differ"):
+        fit_synergies(("a", "b", "c"), x)

@@ -116,10 +116,14 @@ def test_command_checks_its_arguments_before_any_work_and_never_writes_over_its_
     assert main(["synergies", "map", "shadow_hand", "--table", str(table), "--out", str(table),
                  "--png", str(tmp_path / "v.txt"), "--synergies", "40"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == [f"synergrasp synergies map: --png {tmp_path / 'v.txt'}: the file name must end in .png",
-                   f"synergrasp synergies map: --out {table}: is the input table; give another file name",
-                   "synergrasp synergies map: --synergies 40: must be 1 … 15 (the table's columns, at most the "
-                   "target's joints)"]
+    assert err == [f"synergrasp synergies map: --out {table}: is the file the command reads (--table {table}); "
+                   "write to another file",
+                   f"synergrasp synergies map: --png {tmp_path / 'v.txt'}: the file name must end in .png"]
+    # the outputs mended, the count is checked before any mapping
+    assert main(["synergies", "map", "shadow_hand", "--table", str(table), "--out", str(tmp_path / "o.csv"),
+                 "--synergies", "40"]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [
+        "synergrasp synergies map: --synergies 40: must be 1 … 15 (the table's columns, at most the target's joints)"]
     assert table.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["table.csv"]
     assert main(["synergies", "map", str(tmp_path / "none.yaml"), "--out", str(tmp_path / "o.csv")]) == 2
     assert "none.yaml" in capsys.readouterr().err and not (tmp_path / "o.csv").exists()

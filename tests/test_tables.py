@@ -39,3 +39,23 @@ def test_an_older_gfo_table_is_refused_naming_the_file_and_the_old_column(tmp_pa
     _gfo().rename(columns={"load_feasible": "force_closure"}).to_parquet(path)
     with pytest.raises(ValueError, match=re.escape("column 'force_closure' (now 'load_feasible'));")):
         tables.read(tables.GFO, path)
+
+
+def test_an_older_results_folder_is_found_from_the_schemas_with_the_readers_line(tmp_path):
+    """The workflow's check before any job (study_checks.older_results_problems): every gfo
+    table under the folder, scenarios' included, with the line tables.read would give; a
+    current table and an unreadable one (left to the step reading it) give none."""
+    from synergrasp.study_checks import older_results_problems
+
+    old = tmp_path / "results" / "scenarios" / "s" / "objects" / "obj1" / "gfo.parquet"
+    current = tmp_path / "results" / "objects" / "obj1" / "gfo.parquet"
+    broken = tmp_path / "results" / "objects" / "obj2" / "gfo.parquet"
+    for path in (old, current, broken):
+        path.parent.mkdir(parents=True)
+    _gfo().rename(columns={"load_feasible": "force_closure"}).to_parquet(old)
+    tables.write(tables.GFO, _gfo(), current)
+    broken.write_bytes(b"not parquet")
+    with pytest.raises(ValueError) as read:
+        tables.read(tables.GFO, old)
+    assert older_results_problems(tmp_path / "results") == [str(read.value)]
+    assert older_results_problems(tmp_path / "none") == []

@@ -9,9 +9,11 @@
     synergrasp hand show [HAND] [--synergies TABLE] [--png hand.png] [--count K]
 
 Bad input (an argument, a configuration file, the hand or synergy file it names, an output
-path that cannot be written) ends with one line per problem naming the argument, the file or
-the key, and exit status 2, before any work: the configuration goes through the workflow's
-own checks (``synergrasp.study_checks``). Warnings on the configuration are printed too.
+path that cannot be written, a count below 1, a radius that is not a positive number, an
+output that names a file the command reads: symbolic and hard links included) ends with one
+line per problem naming the argument, the file or the key, and exit status 2, before any
+work, for every command: the configuration goes through the workflow's own checks
+(``synergrasp.study_checks``). Warnings on the configuration are printed too.
 
     synergrasp plan obj4 [--radius 10 20 30] [--configfile my.yaml] [--results results] [--csv plan.csv]
 """
@@ -159,24 +161,69 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-#: The output options a command may have and the file names each accepts.
-_OUTPUTS = (("--png", "png", (".png",)), ("--html", "html", (".html", ".htm")), ("--out", "out", (".csv",)),
-            ("--postures", "postures", (".csv",)), ("--closing-png", "closing", (".png",)))
+#: Each command's output options: (option, attribute, the suffixes its file name may end in).
+_OUTPUTS: dict[str, tuple[tuple[str, str, tuple[str, ...]], ...]] = {
+    "grasp": (("--png", "png", (".png",)), ("--html", "html", (".html", ".htm"))),
+    "synergies fit": (("--out", "out", (".csv",)), ("--png", "png", (".png",))),
+    "synergies map": (("--out", "out", (".csv",)), ("--postures", "postures", (".csv",)), ("--png", "png", (".png",))),
+    "hand show": (("--png", "png", (".png",)), ("--closing-png", "closing_png", (".png",))),
+    "plan": (("--csv", "csv", (".csv",)),),
+}
+
+
+def _command(args: argparse.Namespace) -> str:
+    """The command's name as its messages give it (``synergies fit``, ``grasp``)."""
+    return " ".join(filter(None, (args.command, getattr(args, "action", None))))
+
+
+def _inputs(args: argparse.Namespace) -> list[tuple[str, str]]:
+    """(how the command names it, path) of every file the command reads that a user names."""
+    named = [("--configfile", path) for path in getattr(args, "configfile", [])]
+    if _command(args) == "synergies fit":
+        named.append(("POSTURES", args.postures))
+    if _command(args) == "synergies map":
+        named += [(what, path) for what, path in (("HAND", args.hand), ("--table", args.table), ("--source", args.source),
+                                                  ("--joint-mapping", args.joint_mapping))
+                  if path is not None and Path(path).suffix]
+    if _command(args) == "hand show":
+        from synergrasp.hand.description import SHIPPED_HANDS
+
+        named += [(what, path) for what, path in (("HAND", args.hand), ("--synergies", args.synergies))
+                  if path is not None and path not in SHIPPED_HANDS and Path(path).suffix]
+    if args.command == "plan":
+        folder = Path(args.results) / "objects" / args.object
+        named += [("--results", str(folder / name)) for name in
+                  ("contacts.parquet", "load_carrying_contacts.parquet", "gfo.parquet")]
+    return named
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether two paths name one file: equal once resolved (symbolic links followed), or
+    one file under two names (a hard link)."""
+    try:
+        return a.resolve() == b.resolve() or (a.exists() and b.exists() and a.samefile(b))
+    except OSError:
+        return False
 
 
 def _output_problems(args: argparse.Namespace) -> list[str]:
-    """What keeps an output (``--png``, ``--html``, ``--out``, ``--postures``) from being
-    written, one line each, before any work."""
+    """What keeps an output option from being written, one line each, before any work: a
+    file name without the option's suffix, a folder, a folder missing or not writable, a
+    file the command reads (its input is never its output)."""
     problems = []
-    for option, path, suffixes in ((o, getattr(args, a, None), s) for o, a, s in _OUTPUTS):
+    for option, attribute, suffixes in _OUTPUTS.get(_command(args), ()):
+        path = getattr(args, attribute)
         if path is None:
             continue
         target = Path(path)
         folder = target.parent
-        if target.suffix.lower() not in suffixes:
-            problems.append(f"{option} {path}: the file name must end in {' or '.join(suffixes)}")
+        read = next((f"{what} {given}" for what, given in _inputs(args) if _same_file(target, Path(given))), None)
+        if read is not None:
+            problems.append(f"{option} {path}: is the file the command reads ({read}); write to another file")
         elif target.is_dir():
             problems.append(f"{option} {path}: is a folder; give a file name")
+        elif target.suffix.lower() not in suffixes:
+            problems.append(f"{option} {path}: the file name must end in {' or '.join(suffixes)}")
         elif not folder.is_dir():
             problems.append(f"{option} {path}: folder '{folder}' is not an existing folder")
         else:
@@ -188,6 +235,36 @@ def _output_problems(args: argparse.Namespace) -> list[str]:
     return problems
 
 
+def _count_problems(args: argparse.Namespace) -> list[str]:
+    """Counts, radii and folders a command cannot use, one line each: a count below 1, a
+    radius that is not a positive finite number (deg), a file given as ``--results``."""
+    problems = []
+    for option, attribute in (("--count", "count"), ("--synergies", "synergies")):
+        value = getattr(args, attribute, None)
+        if isinstance(value, int) and value < 1:
+            problems.append(f"{option} {value}: must be a whole number of at least 1")
+    bad = [r for r in getattr(args, "radius", None) or () if not (math.isfinite(r) and r > 0)]
+    if bad:
+        problems.append(f"--radius {' '.join(f'{r:g}' for r in bad)}: each radius must be a positive finite "
+                        "number of degrees")
+    results = getattr(args, "results", None)
+    if results is not None and Path(results).exists() and not Path(results).is_dir():
+        problems.append(f"--results {results}: is a file; give the folder of the study's outputs")
+    return problems
+
+
+def _configuration(args: argparse.Namespace) -> dict[str, Any]:
+    """The configuration of ``--configfile`` overlays as the workflow has it: with the objects
+    its ``random_objects`` block draws (manifest relative to the working folder, the project's
+    root), checked before anything is drawn."""
+    from synergrasp.simulation.random_objects import add_random_objects
+    from synergrasp.study_checks import read_overlays
+
+    config = read_overlays(args.configfile)
+    add_random_objects(config, ".")
+    return config
+
+
 def _plan(args: argparse.Namespace) -> int:
     """``synergrasp plan``: the planner at each radius, one line each."""
     from dataclasses import replace
@@ -196,15 +273,17 @@ def _plan(args: argparse.Namespace) -> int:
     from synergrasp.analysis.plan_study import PlanParams, plan_object
     from synergrasp.config import ConfigError
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.study_checks import checked_scenario, read_overlays
+    from synergrasp.study_checks import checked_scenario, unknown_object
 
     folder = Path(args.results) / "objects" / args.object
     contacts_path = next((folder / f for f in ("load_carrying_contacts.parquet", "contacts.parquet")
                           if (folder / f).is_file()), folder / "contacts.parquet")
     try:
-        cfg, _ = checked_scenario(read_overlays(args.configfile))
-        if args.object not in cfg["objects"]:
-            raise ConfigError(f"object {args.object!r} is not in the configuration ({', '.join(cfg['objects'])})")
+        cfg, warnings = checked_scenario(_configuration(args))
+        for warning in warnings:
+            print(f"synergrasp plan: warning: {warning}", file=sys.stderr)
+        if unknown_object(cfg, args.object):
+            raise ConfigError(unknown_object(cfg, args.object))
         params = PlanParams.from_config(cfg, args.object)
         params = replace(params, radii_deg=tuple(args.radius)) if args.radius else params
         contacts = tables.read(tables.CONTACTS, contacts_path)
@@ -220,19 +299,21 @@ def _plan(args: argparse.Namespace) -> int:
               f"{_number(row.exhaustive_min_force_N, 4)} N, rank {row.rank} of {row.n_ranked}, regret "
               f"{_number(row.regret_percent, 3)} %")
     if args.csv:
-        tables.write_csv(tables.PLAN, result.table, args.csv)
+        with _writing("--csv", args.csv):
+            tables.write_csv(tables.PLAN, result.table, args.csv)
     return 0
 
 
 def _show_hand(args: argparse.Namespace) -> int:
     """``synergrasp hand show``: the joints (limits, mean posture, S1), links and fingertips."""
-    from synergrasp.hand.kinematics import fingertip_positions, load_hand
+    from synergrasp.hand.checks import check_hand
+    from synergrasp.hand.kinematics import fingertip_positions
     from synergrasp.hand.synergies import load_synergies
     from synergrasp.simulation.thumb_check import opposition_line
 
-    problems = _output_problems(argparse.Namespace(png=args.png, closing=args.closing_png))
+    problems: list[str] = []
     try:
-        hand = load_hand(args.hand)
+        hand, _, warnings = check_hand(args.hand)
         table = args.synergies or ("shadow_hand" if args.hand == "shadow_hand" else None)
         synergies = load_synergies(table, joint_names=hand.joint_names)
     except ValueError as err:
@@ -240,6 +321,8 @@ def _show_hand(args: argparse.Namespace) -> int:
     if problems:
         print("\n".join(f"synergrasp hand show: {line}" for line in problems), file=sys.stderr)
         return 2
+    for warning in warnings:
+        print(f"synergrasp hand show: warning: {warning}", file=sys.stderr)
     deg = math.degrees
     print(f"{hand.name} ({hand.source}): {hand.n_joints} joints, {hand.n_links} links "
           f"({len(hand.shapeless_links)} without shape), {synergies.n_synergies} synergies")
@@ -253,7 +336,8 @@ def _show_hand(args: argparse.Namespace) -> int:
     if args.png:
         from synergrasp.figures.hand_figures import figure_synergy_postures
 
-        figure_synergy_postures(hand, synergies, args.png, None, n_synergies=min(args.count, synergies.n_synergies))
+        with _writing("--png", args.png):
+            figure_synergy_postures(hand, synergies, args.png, None, n_synergies=min(args.count, synergies.n_synergies))
         print(f"picture: {args.png}")
     line, sigmas = opposition_line(hand, synergies)
     print(line)
@@ -277,7 +361,7 @@ def _map_synergies(args: argparse.Namespace) -> int:
 
     if args.joint_mapping:
         return _map_joint_by_joint(args)
-    problems = _output_problems(args)
+    problems: list[str] = []
     try:
         target = load_hand(args.hand)
         source = load_hand(args.source)
@@ -329,8 +413,7 @@ def _map_joint_by_joint(args: argparse.Namespace) -> int:
                                            write_synergies)
     from synergrasp.simulation.thumb_check import opposition_line
 
-    problems = _output_problems(args)
-    problems += [f"{option}: not used with --joint-mapping (it maps the human table joint by joint)"
+    problems = [f"{option}: not used with --joint-mapping (it maps the human table joint by joint)"
                  for option, value in (("--table", args.table), ("--source", args.source), ("--synergies", args.synergies),
                                        ("--postures", args.postures), ("--png", args.png)) if value is not None]
     try:
@@ -362,18 +445,24 @@ def _fit_synergies(args: argparse.Namespace) -> int:
 
     try:
         names, postures = read_postures(args.postures)
+        k_max = min(len(names), len(postures) - 1)
+        if args.synergies is not None and args.synergies > k_max:
+            raise ValueError(f"--synergies {args.synergies}: at most {k_max} for {len(postures)} postures of "
+                             f"{len(names)} joints")
         fit = fit_synergies(names, postures, args.synergies)
     except (SynergyFileError, ValueError) as err:
         print(f"synergrasp synergies fit: {err}", file=sys.stderr)
         return 2
-    write_synergies(fit.synergies, args.out)
+    with _writing("--out", args.out):
+        write_synergies(fit.synergies, args.out)
     print(f"{len(postures)} postures of {len(names)} joints: total variance {fit.total_variance_rad2:.6g} rad^2")
     _print_variance(fit)
     print(f"synergy table: {args.out}")
     if args.png:
         from synergrasp.figures.synergy_fit import figure_explained_variance
 
-        figure_explained_variance(fit, args.png)
+        with _writing("--png", args.png):
+            figure_explained_variance(fit, args.png)
         print(f"explained variance: {args.png}")
     return 0
 
@@ -383,12 +472,9 @@ def _fit_synergies(args: argparse.Namespace) -> int:
 def _grasp(args: argparse.Namespace) -> int:
     from synergrasp.file_output import replacing
     from synergrasp.inspector import default_sets, inspect_grasp, parse_sets
-    from synergrasp.study_checks import checked_scenario, read_overlays
+    from synergrasp.study_checks import checked_scenario
 
-    problems = _output_problems(args)
-    if problems:
-        raise ValueError("\n".join(problems))
-    config = read_overlays(args.configfile)
+    config = _configuration(args)
     cfg, warnings = checked_scenario(config)
     for warning in warnings:
         print(f"synergrasp grasp: warning: {warning}", file=sys.stderr)
@@ -423,30 +509,36 @@ def _grasp(args: argparse.Namespace) -> int:
     return 0
 
 
+class _WriteError(ValueError):
+    """An output that could not be written after the work (one line naming the option)."""
+
+
 @contextmanager
 def _writing(option: str, path: str) -> Iterator[None]:
     """A failure to write ``path`` (a full disk after the check) as one line naming the option."""
     try:
         yield
     except OSError as err:
-        raise ValueError(f"{option} {path}: cannot be written ({err.strerror or err})") from None
+        raise _WriteError(f"{option} {path}: cannot be written ({err.strerror or err})") from None
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command; 0 on success, 2 on bad input (one line per problem on standard
-    error, naming the argument, the file or the key; no traceback)."""
+    error, naming the argument, the file or the key; no traceback). The counts and every
+    output path are checked before any work, for every command."""
     args = _parser().parse_args(argv)
-    if args.command == "plan":
-        return _plan(args)
-    if args.command == "synergies":
-        return _map_synergies(args) if args.action == "map" else _fit_synergies(args)
-    if args.command == "hand":
-        return _show_hand(args)
-    try:
-        return _grasp(args)
-    except ValueError as err:  # ConfigError, InspectionError, file errors: each names what is wrong
-        lines = str(err).splitlines() or [repr(err)]
-    print("\n".join(f"synergrasp {args.command}: {line}" for line in lines), file=sys.stderr)
+    command = _command(args)
+    lines = _count_problems(args) + _output_problems(args)
+    if not lines:
+        run = {"plan": _plan, "synergies fit": _fit_synergies, "synergies map": _map_synergies, "hand show": _show_hand,
+               "grasp": _grasp}[command]
+        try:
+            return run(args)
+        except ValueError as err:  # grasp: ConfigError, InspectionError, file errors; every command: a write
+            if args.command != "grasp" and not isinstance(err, _WriteError):
+                raise
+            lines = str(err).splitlines() or [repr(err)]
+    print("\n".join(f"synergrasp {command}: {line}" for line in lines), file=sys.stderr)
     return 2
 
 

@@ -37,6 +37,7 @@ __all__ = [
     "defaults",
     "overlay",
     "validate_config",
+    "block_problems",
     "check_relations",
     "synergy_problems",
     "scenario_names",
@@ -197,7 +198,18 @@ def _raw_problems(value: Any, path: tuple = ()) -> list[str]:
 
 
 def _describe(error: Any) -> str:
-    """One line for one jsonschema error, naming the key and what is allowed."""
+    """One line for one jsonschema error, naming the key and what is allowed; for a value that
+    matches none of several forms (``oneOf``/``anyOf``), the error of the form it comes
+    closest to: a form of the value's kind (not a ``type``/``enum`` mismatch of the whole
+    value) whose error lies deepest inside the value (a mapping with one wrong entry), then
+    ``jsonschema.exceptions.best_match``."""
+    if error.validator in ("oneOf", "anyOf") and error.context:
+        from jsonschema.exceptions import best_match
+
+        near = [e for e in error.context if e.relative_path or e.validator not in ("type", "enum", "const")]
+        near = near or list(error.context)
+        depth = max(len(e.relative_path) for e in near)
+        return _describe(best_match(e for e in near if len(e.relative_path) == depth))
     where = _key_path(list(error.absolute_path))
     schema = error.schema
     if error.validator == "additionalProperties" and isinstance(error.instance, Mapping):
@@ -245,6 +257,22 @@ def validate_config(config: Mapping[str, Any], n_synergies: int | None = None) -
     if problems:
         raise ConfigError("\n".join(problems))
     return full
+
+
+def block_problems(key: str, value: Any) -> list[str]:
+    """The schema's problems of one top-level block ``key: value`` alone (no defaults filled,
+    nothing else of the configuration read), one line each naming ``key.<field>``: for a
+    block whose values are used before the whole configuration is checked
+    (``random_objects``)."""
+    from jsonschema import Draft202012Validator
+
+    problems = _raw_problems({key: value})
+    if problems:
+        return problems
+    schema = load_schema()
+    sub = {"$defs": schema.get("$defs", {}), "type": "object", "properties": {key: schema["properties"][key]}}
+    errors = sorted(Draft202012Validator(sub).iter_errors({key: value}), key=lambda e: list(e.absolute_path))
+    return [_describe(e) for e in errors]
 
 
 def grid_axis_deg(axis: Mapping[str, float]) -> list[float]:
@@ -450,6 +478,10 @@ def scenario_config(config: Mapping[str, Any], name: str) -> dict[str, Any]:
     changes = main["scenarios"][name]
     if "scenarios" in changes:
         raise ConfigError(f"scenario '{name}': config error at 'scenarios': a scenario cannot define scenarios")
+    if "random_objects" in changes:
+        raise ConfigError(f"scenario '{name}': config error at 'scenarios.{name}.random_objects': a scenario cannot "
+                          "draw objects of its own; the main configuration's random_objects are every scenario's "
+                          "objects (a scenario may drop some with objects: {rand_NNN: null})")
     try:
         base = {k: v for k, v in config.items() if k != "scenarios"}
         problems = _removed_unknown_objects(_drop_nulls(base), changes)

@@ -217,11 +217,11 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     from synergrasp.simulation.closure import SimulateParams, simulate_object
     from synergrasp.simulation.contacts import ContactsParams, load_carrying_contacts
     from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions
-    from synergrasp.study_checks import checked_scenario
+    from synergrasp.study_checks import checked_scenario, unknown_object
 
     cfg, _ = checked_scenario(config)
-    if obj not in cfg["objects"]:
-        raise InspectionError(f"object: {obj!r} is not an object of the configuration; objects: {list(cfg['objects'])}")
+    if unknown_object(cfg, obj):
+        raise InspectionError(unknown_object(cfg, obj))
     sim = SimulateParams.from_config(cfg, obj)
     pose, _ = _pose_index(sim.placement, alpha_deg, beta_deg)
     placement = sim.placement

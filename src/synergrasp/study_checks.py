@@ -10,7 +10,8 @@ workflow asks it through :func:`workflow_scenario` (common.smk), ``synergrasp gr
 strictly as the workflow reads its own. Checks that need a step's output where it exists
 (:func:`search_rank_problems`), the objects' resolved placements and grasp types
 (:func:`lattice_rank_problems`) or a target's whole configuration
-(:func:`searched_objects_or_refuse`) are here too. Every problem is one line naming the file or
+(:func:`searched_objects_or_refuse`) are here too, and the tables of a results folder an older
+version wrote (:func:`older_results_problems`). Every problem is one line naming the file or
 the key.
 """
 
@@ -29,7 +30,7 @@ from synergrasp.resolved import effective_placement, grasp_type
 from synergrasp.yaml_io import read_yaml
 
 __all__ = ["checked_scenario", "workflow_scenario", "read_overlays", "search_rank_problems", "lattice_rank_problems",
-           "search_table_or_refuse", "searched_objects_or_refuse"]
+           "search_table_or_refuse", "searched_objects_or_refuse", "older_results_problems", "unknown_object"]
 
 
 @functools.cache
@@ -168,3 +169,29 @@ def searched_objects_or_refuse(files: list[str], target: str, cfg: Mapping[str, 
         stop([f"{target}: no object's placement is searched (placement.mode: {', '.join(modes)}); the claims at the "
               "placement search's targets need placement.mode: searched (docs/placement_search.md)"])
     return files
+
+
+def older_results_problems(results: str | Path = "results") -> list[str]:
+    """Every table under ``results`` (scenarios' folders included) written by an older version
+    of the study (``tables.older_version``: a column under its old name), one line each naming
+    the file; read from the files' schemas before any job, so that a run refuses them up
+    front as ``synergrasp plan`` does, not inside the jobs that read them."""
+    from synergrasp import tables
+
+    problems = []
+    for table in tables.TABLES.values():
+        if table.renamed and Path(results).is_dir():
+            problems += [line for path in sorted(Path(results).rglob(f"{table.name}.parquet"))
+                         if (line := tables.older_version(table, path))]
+    return problems
+
+
+def unknown_object(cfg: Mapping[str, Any], obj: str) -> str:
+    """The line a command gives for an object ``obj`` that the checked configuration ``cfg``
+    does not have ('' if it has it): its objects, and for a name like a drawn object's
+    (``rand_NNN``) without a ``random_objects`` block, where the drawn objects come from."""
+    if obj in cfg["objects"]:
+        return ""
+    hint = ("; objects drawn by random_objects are objects of a --configfile with that block "
+            "(docs/random_objects.md)") if obj.startswith("rand_") and not cfg.get("random_objects") else ""
+    return f"object: {obj!r} is not an object of the configuration; objects: {list(cfg['objects'])}{hint}"

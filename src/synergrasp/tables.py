@@ -11,13 +11,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
 from synergrasp.file_output import replacing
 
 __all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT", "PLAN", "ENROLLMENT", "BLOCKERS",
-           "QUALITY", "TARGET_CLAIMS", "write", "read", "write_csv", "read_csv", "empty", "write_study_table"]
+           "QUALITY", "TARGET_CLAIMS", "write", "read", "older_version", "write_csv", "read_csv", "empty",
+           "write_study_table"]
 
 
 @dataclass(frozen=True)
@@ -329,13 +331,35 @@ def read(table: Table, path: str | Path) -> pd.DataFrame:
         frame = pd.read_parquet(path)
     except (OSError, ValueError) as err:  # pyarrow's read errors are either
         raise ValueError(f"{table.name} table '{path}': cannot be read as Parquet ({err})") from None
-    old = [(was, now) for was, now in table.renamed if was in frame.columns and now not in frame.columns]
-    if old:
-        names = ", ".join(f"'{was}' (now '{now}')" for was, now in old)
-        raise ValueError(f"{table.name} table '{path}': written by an older version of the study (column {names}); "
-                         "delete it (or its results folder) and rerun the study")
+    problem = _older(table, path, frame.columns)
+    if problem:
+        raise ValueError(problem)
     _check(table, frame, str(path))
     return frame
+
+
+def _older(table: Table, path: str | Path, columns: Any) -> str:
+    """The line saying that a file of ``table`` with ``columns`` was written by an older
+    version (a column of ``table.renamed`` under its old name); '' if it was not."""
+    old = [(was, now) for was, now in table.renamed if was in columns and now not in columns]
+    if not old:
+        return ""
+    names = ", ".join(f"'{was}' (now '{now}')" for was, now in old)
+    return (f"{table.name} table '{path}': written by an older version of the study (column {names}); "
+            "delete it (or its results folder) and rerun the study")
+
+
+def older_version(table: Table, path: str | Path) -> str:
+    """:func:`read`'s line on a file of ``table`` written by an older version, from the
+    Parquet file's schema alone (no row is read); '' if it was not, or cannot be read (the
+    step reading it says so)."""
+    import pyarrow.parquet as pq
+
+    try:
+        columns = pq.read_schema(str(path)).names
+    except (OSError, ValueError):
+        return ""
+    return _older(table, path, columns)
 
 
 def write_csv(table: Table, frame: pd.DataFrame, path: str | Path) -> None:

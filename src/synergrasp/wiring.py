@@ -247,10 +247,14 @@ class Wiring:
                  error: type[Exception] = ValueError, warn: Callable[[str], Any] = print,
                  stop: Callable[[list[str]], Any] = lambda lines: None):
         self.config, self.root, self.error, self.warn, self.stop = config, Path(basedir), error, warn, stop
-        if config.get("random_objects"):  # objects drawn from pybullet's meshes, added before any check
+        if config.get("random_objects") is not None:  # objects drawn from pybullet's meshes, added before any check
             from synergrasp.simulation.random_objects import add_random_objects
 
-            add_random_objects(config, self.root)
+            try:  # the block is checked before any value of it is used
+                add_random_objects(config, self.root)
+            except ConfigError as err:
+                self.stop(str(err).splitlines())
+                raise self.error(f"Invalid input, nothing was run:\n{err}") from None
         self._warned: set[str] = set()
         self.src = self.root / "src"
         self._checked: dict[str, dict[str, Any]] = {}

@@ -59,6 +59,8 @@ def read_yaml(path: str | Path, what: str = "YAML file") -> Any:
         mapping repeats a key (every repeated key is listed, one line each).
     """
     where = f"{what} '{path}'"
+    if Path(path).is_dir():
+        raise YamlFileError(f"{where}: cannot be read: is a folder; give a file")
     try:
         text = Path(path).read_text(encoding="utf-8")
     except OSError as err:

@@ -14,6 +14,10 @@ from synergrasp.wiring import RuleFiles, Wiring, cancel_scheduler_timers, report
 # Snakemake read the configuration files itself and kept a repeated key's last value.
 refuse(configfile_problems(workflow.configfiles))
 
+# A results folder of an older version (a table with a renamed column) is refused before any job.
+from synergrasp.study_checks import older_results_problems
+refuse(older_results_problems("results"))
+
 #: The study: its scenarios (each checked when a target first needs it) and their files.
 W = Wiring(config, workflow.basedir, error=WorkflowError, warn=logger.warning, stop=refuse)
 ROOT = W.root

@@ -4,9 +4,10 @@ hand file (``synergrasp.hand.hand_file``) or a hand description naming an MJCF m
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
-from synergrasp.hand.hand_file import HandSpec, check_hand_doc, default_hand_path, read_hand_file
+from synergrasp.hand.hand_file import HandSpec, check_hand_doc, default_hand_path, read_hand_file, size_warnings
 from synergrasp.hand.mjcf import mjcf_hand_spec
 
 __all__ = ["hand_spec", "SHIPPED_HANDS", "shipped_hand_path"]
@@ -25,8 +26,9 @@ def hand_spec(path: str | Path | None) -> tuple[HandSpec, str]:
     """The checked content of the hand file ``path`` (None: the shipped hand; a name of
     SHIPPED_HANDS: that hand's description; a file with the
     key ``mjcf``: a hand description read through MuJoCo, ``synergrasp.hand.mjcf``) and how
-    messages name it (``hand file '<path>'`` or ``the shipped hand``); ValueError naming
-    the file and the field."""
+    messages name it (``hand file '<path>'`` or ``the shipped hand``), its ``warnings`` the
+    size warnings of every format (``hand_file.size_warnings``); ValueError naming the file
+    and the field."""
     if path is not None and str(path) in SHIPPED_HANDS:
         source, where = shipped_hand_path(str(path)), f"the shipped hand '{path}'"
     else:
@@ -34,8 +36,10 @@ def hand_spec(path: str | Path | None) -> tuple[HandSpec, str]:
         where = "the shipped hand" if path is None else f"hand file '{source}'"
     doc = read_hand_file(source)
     if isinstance(doc, dict) and ("mjcf" in doc or "urdf" in doc):  # a hand described by an MJCF/URDF model
-        return mjcf_hand_spec(doc, source, where), where
+        spec = mjcf_hand_spec(doc, source, where)
+        return replace(spec, warnings=size_warnings(spec, "m")), where
     try:
-        return check_hand_doc(doc), where
+        spec = check_hand_doc(doc)
     except ValueError as exc:
         raise ValueError(str(exc).replace("hand file:", f"{where}:", 1)) from None
+    return replace(spec, warnings=size_warnings(spec, "mm")), where

@@ -5,7 +5,9 @@
 the file's values in the units of the model (mm, rad, unit axes, 4 × 4 poses), from which
 ``synergrasp.hand.kinematics`` builds the frame tree. Every error names the field
 (``fingers.index.joints[1].limits_deg``); :func:`load_hand` adds the file. Values far from a
-human hand's dimensions are not errors: they are listed in ``HandSpec.warnings``.
+human hand's dimensions are not errors: :func:`size_warnings` lists them, for a hand of any
+format (the front door ``synergrasp.hand.description.hand_spec`` puts them in
+``HandSpec.warnings``).
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from synergrasp.hand.geometry import SHAPE_KINDS, Shape, pose_matrix, z_to
 from synergrasp.yaml_io import read_yaml
 
 __all__ = ["FINGERS", "JOINT_NAMES", "PALM_NORMAL", "HandSpec", "FingerSpec", "JointSpec",
-           "default_hand_path", "read_hand_file", "check_hand_doc"]
+           "default_hand_path", "read_hand_file", "check_hand_doc", "size_warnings"]
 
 FINGERS: tuple[str, ...] = ("thumb", "index", "middle", "ring", "little")
 
@@ -38,11 +40,15 @@ JOINT_NAMES: tuple[str, ...] = (
 PALM_NORMAL: NDArray[np.float64] = np.array([1.0, 0.0, 0.0])
 """Unit vector (palm frame) the palm faces: the side toward which every finger flexes."""
 
-#: A human hand is about 190 mm from wrist crease to fingertip and 85 mm wide; a length in a
-#: hand file above ``_LONGEST_MM`` (more than a whole hand), or a hand whose every length is
-#: below ``_SHORTEST_MM`` (a file in metres?), is far from a hand: warned, not refused.
+#: A human hand is about 190 mm from wrist crease to fingertip and 85 mm wide; a length of a
+#: hand above ``_LONGEST_MM`` (more than a whole hand), a fingertip farther than ``_REACH_MM``
+#: from the palm frame's origin (about two hands), or a hand whose every length is below
+#: ``_SHORTEST_MM`` (a file in the wrong unit?), is far from a hand: warned, not refused.
 _LONGEST_MM = 250.0
+_REACH_MM = 400.0
 _SHORTEST_MM = 5.0
+#: More lengths than this above ``_LONGEST_MM``: one line for the whole hand (a unit mistake).
+_MANY = 3
 
 
 @dataclass(frozen=True)
@@ -125,17 +131,7 @@ class _Checker:
         "box": ("center_mm", "size_mm", "rpy_rad"),
     }
 
-    def __init__(self) -> None:
-        self.warnings: list[str] = []
-        self.lengths: list[float] = []  # every length of the file (mm), for the scale check
-
-    def length(self, field: str, value_mm: float) -> None:
-        self.lengths.append(value_mm)
-        if value_mm > _LONGEST_MM:
-            self.warnings.append(f"{field}: {value_mm:.6g} mm is far from a human hand's dimensions "
-                                 f"(a hand is about 190 mm long; lengths are in mm)")
-
-    def vector(self, node: dict, key: str, field: str, n: int = 3, mm: bool = False) -> NDArray[np.float64]:
+    def vector(self, node: dict, key: str, field: str, n: int = 3) -> NDArray[np.float64]:
         if key not in node:
             raise _err(f"{field}.{key}", f"missing (a list of {n} numbers)")
         value = node[key]
@@ -145,11 +141,9 @@ class _Checker:
             raise _err(f"{field}.{key}", f"must be a list of {n} numbers, got {value!r}") from None
         if arr.shape != (n,) or not np.all(np.isfinite(arr)):
             raise _err(f"{field}.{key}", f"must be a list of {n} finite numbers, got {value!r}")
-        if mm:
-            self.length(f"{field}.{key}", float(np.max(np.abs(arr))))
         return arr
 
-    def number(self, node: dict, key: str, field: str, minimum: float | None = None, mm: bool = False) -> float:
+    def number(self, node: dict, key: str, field: str, minimum: float | None = None) -> float:
         if key not in node:
             raise _err(f"{field}.{key}", "missing (a number)")
         value = node[key]
@@ -157,8 +151,6 @@ class _Checker:
             raise _err(f"{field}.{key}", f"must be a finite number, got {value!r}")
         if minimum is not None and value < minimum:
             raise _err(f"{field}.{key}", f"must be >= {minimum}, got {value!r}")
-        if mm:
-            self.length(f"{field}.{key}", abs(float(value)))
         return float(value)
 
     def mapping(self, node: Any, field: str, kind: str | None = None) -> dict:
@@ -178,18 +170,18 @@ class _Checker:
         f = f"{field}.{kind}"
         spec = self.mapping(node[kind], f, kind)
         if kind == "capsule":
-            a, b = self.vector(spec, "from_mm", f, mm=True), self.vector(spec, "to_mm", f, mm=True)
-            radius = self.number(spec, "radius_mm", f, minimum=1e-6, mm=True)
+            a, b = self.vector(spec, "from_mm", f), self.vector(spec, "to_mm", f)
+            radius = self.number(spec, "radius_mm", f, minimum=1e-6)
             pose = np.eye(4)
             pose[:3, 3] = 0.5 * (a + b)
             length = float(np.linalg.norm(b - a))
             if length > 0:
                 pose[:3, :3] = z_to(b - a)
             return Shape("capsule", pose, radius=radius, length=length)
-        size = self.vector(spec, "size_mm", f, mm=True)
+        size = self.vector(spec, "size_mm", f)
         if np.any(size <= 0):
             raise _err(f"{f}.size_mm", f"must be positive, got {size.tolist()}")
-        center = self.vector(spec, "center_mm", f, mm=True)
+        center = self.vector(spec, "center_mm", f)
         rpy = self.vector(spec, "rpy_rad", f) if "rpy_rad" in spec else np.zeros(3)
         return Shape("box", pose_matrix(center, rpy), size=size)
 
@@ -210,8 +202,8 @@ class _Checker:
         if np.linalg.norm(axis) < 1e-9:
             raise _err(f"{field}.axis", "must be a non-zero vector")
         rpy = self.vector(jnode, "rpy_rad", field) if "rpy_rad" in jnode else np.zeros(3)
-        offset = knuckle @ pose_matrix(self.vector(jnode, "offset_mm", field, mm=True), rpy)
-        gap = (self.number(jnode, "rolling_gap_mm", field, minimum=0.0, mm=True)
+        offset = knuckle @ pose_matrix(self.vector(jnode, "offset_mm", field), rpy)
+        gap = (self.number(jnode, "rolling_gap_mm", field, minimum=0.0)
                if "rolling_gap_mm" in jnode else 0.0)
         lim = jnode.get("limits_deg")
         if (not isinstance(lim, list) or len(lim) != 2
@@ -229,9 +221,9 @@ class _Checker:
         ff = f"fingers.{finger}"
         fnode = self.mapping(node, ff, "finger")
         knuckle = self.mapping(fnode.get("knuckle"), f"{ff}.knuckle", "knuckle")
-        knuckle_pose = pose_matrix(self.vector(knuckle, "xyz_mm", f"{ff}.knuckle", mm=True),
+        knuckle_pose = pose_matrix(self.vector(knuckle, "xyz_mm", f"{ff}.knuckle"),
                                    self.vector(knuckle, "rpy_rad", f"{ff}.knuckle"))
-        tip = self.vector(fnode, "tip_mm", ff, mm=True)
+        tip = self.vector(fnode, "tip_mm", ff)
         joints = fnode.get("joints")
         if not isinstance(joints, list) or not joints:
             raise _err(f"{ff}.joints", "must be a non-empty list of joints")
@@ -264,7 +256,63 @@ def check_hand_doc(doc: Any) -> HandSpec:
     names = tuple(j.name for f in specs for j in f.joints)
     if names != JOINT_NAMES:
         raise _err("fingers", f"joints must be exactly {JOINT_NAMES}, got {names}")
-    if check.lengths and max(check.lengths) < _SHORTEST_MM:
-        check.warnings.append(f"<top level>: no length of the hand exceeds {max(check.lengths):.3g} mm, far "
-                              "from a human hand's dimensions (about 190 mm long); lengths are in mm, not m")
-    return HandSpec(str(doc.get("name", "hand")), palm_normal, palm_shapes, tuple(specs), tuple(check.warnings))
+    return HandSpec(str(doc.get("name", "hand")), palm_normal, palm_shapes, tuple(specs))
+
+
+# --------------------------------------------------------------------------- sizes
+
+
+def _shape_mm(shape: Shape) -> float:
+    """A shape's largest dimension or distance from its link frame's origin (mm)."""
+    extent = 2.0 * shape.radius + shape.length if shape.kind == "capsule" else float(np.max(shape.size))
+    return max(extent, float(np.linalg.norm(shape.pose[:3, 3])))
+
+
+def _lengths(spec: HandSpec) -> list[tuple[str, float]]:
+    """(field, mm) of every length of a hand: its shapes, each joint's offset from the previous
+    joint (the first's from the palm frame) and each fingertip, named by the description's fields."""
+    out = [(f"palm.shapes[{k}]", _shape_mm(shape)) for k, shape in enumerate(spec.palm_shapes)]
+    for finger in spec.fingers:
+        for i, joint in enumerate(finger.joints):
+            field = f"fingers.{finger.name}.joints[{i}]"
+            out.append((f"{field} ({joint.name}) offset", float(np.linalg.norm(joint.offset[:3, 3]))))
+            out += [(f"{field}.shapes[{k}]", _shape_mm(shape)) for k, shape in enumerate(joint.shapes)]
+        out.append((f"fingers.{finger.name} tip", float(np.linalg.norm(finger.tip_mm))))
+    return out
+
+
+def _reach_mm(finger: FingerSpec) -> float:
+    """Distance (mm) of a fingertip from the palm frame's origin with every joint at zero."""
+    pose = np.eye(4)
+    for joint in finger.joints:
+        pose = pose @ joint.offset
+    return float(np.linalg.norm(pose[:3, :3] @ finger.tip_mm + pose[:3, 3]))
+
+
+def size_warnings(spec: HandSpec, unit: str = "mm") -> tuple[str, ...]:
+    """The warnings on a hand's dimensions far from a human hand's (about 190 mm long), one
+    line each naming the field, the same for every format: each length above 250 mm (more
+    than three: one line for the whole hand), else a fingertip farther than 400 mm from the
+    palm frame's origin at the zero posture; or no length above 5 mm. ``unit``: the unit the
+    hand's source gives lengths in (``mm``: a hand file; ``m``: an MJCF or URDF model), named
+    in the advice."""
+    lengths = _lengths(spec)
+    other = {"mm": "m", "m": "mm"}[unit]
+    advice = f"lengths are in {unit}, not {other}"
+    big = [(field, value) for field, value in lengths if value > _LONGEST_MM]
+    far = "far from a human hand's dimensions (a hand is about 190 mm long)"
+    if len(big) > _MANY:
+        field, value = max(big, key=lambda item: item[1])
+        return (f"<top level>: {len(big)} of the hand's {len(lengths)} lengths exceed {_LONGEST_MM:g} mm, up to "
+                f"{value:.6g} mm ({field}), {far}; {advice}",)
+    if big:
+        return tuple(f"{field}: {value:.6g} mm is {far}; lengths are in {unit}" for field, value in big)
+    reach = [(f"fingers.{f.name}", _reach_mm(f)) for f in spec.fingers]
+    field, value = max(reach, key=lambda item: item[1])
+    if value > _REACH_MM:
+        return (f"{field}: the fingertip lies {value:.6g} mm from the palm frame's origin at the zero posture, "
+                f"{far}; {advice}",)
+    longest = max(value for _, value in lengths)
+    if longest < _SHORTEST_MM:
+        return (f"<top level>: no length of the hand exceeds {longest:.3g} mm, {far}; {advice}",)
+    return ()

@@ -161,6 +161,8 @@ def mjcf_hand_spec(doc: dict, path: Path, where: str) -> HandSpec:
     if "urdf" in doc and "mjcf" in doc:
         raise _Error(f"{where}: mjcf, urdf: give one model, not both")
     xml = Path(path).parent / str(doc[fmt])
+    if xml.is_dir():
+        raise _Error(f"{where}: {fmt}: '{xml}' is a folder; give the model's file")
     if not xml.is_file():
         raise _Error(f"{where}: {fmt}: file '{xml}' does not exist")
     try:

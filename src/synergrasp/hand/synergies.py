@@ -66,6 +66,8 @@ class SynergyFileError(ValueError):
 
 def read_text_table(path: str | Path, where: str) -> pd.DataFrame:
     """A CSV file's cells as text; SynergyFileError prefixed ``where`` if it cannot be read."""
+    if Path(path).is_dir():
+        raise SynergyFileError(f"{where}: cannot be read: is a folder; give a file")
     try:
         return pd.read_csv(path, dtype=str, keep_default_na=False, skipinitialspace=True)
     except OSError as err:
@@ -169,6 +171,8 @@ def resolve_synergies(source: str | Path | None) -> Path:
     if str(source) == "shadow_hand":  # the shipped Shadow hand's table (its hand: shadow_hand)
         return shadow_hand_files()[2]
     path = Path(source)
+    if path.is_dir():
+        raise SynergyFileError(f"synergy file '{source}': is a folder; give a synergy CSV file or a shipped table's name")
     if not path.is_file():
         raise SynergyFileError(f"synergy file '{source}': is neither a shipped table {[*SHIPPED_TABLES, 'shadow_hand']} "
                                f"nor an existing CSV file")

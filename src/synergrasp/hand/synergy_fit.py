@@ -21,13 +21,18 @@ from numpy.typing import NDArray
 
 from synergrasp.hand.synergies import Synergies, SynergyFileError, finite_cells, read_text_table
 
-__all__ = ["SynergyFit", "read_postures", "fit_synergies", "orient_columns"]
+__all__ = ["SynergyFit", "read_postures", "posture_problems", "fit_synergies", "orient_columns"]
 
 #: A column whose entries sum to less than this share of its 1-norm has no clear "closing"
 #: direction; its sign is then set by its largest entry (:func:`orient_columns`).
 _SUM_TOLERANCE = 1e-9
 #: A component whose variance is below this share of the first's is not a synergy by default.
 _RANK_TOLERANCE = 1e-12
+#: Postures whose every joint spreads by at most this much (rad) do not differ: what a fit
+#: would find is rounding noise.
+_SAME_POSTURE_RAD = 1e-9
+#: No joint angle of a posture exceeds a full turn (rad); a larger value is in degrees or an outlier.
+_FULL_TURN_RAD = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
@@ -58,7 +63,7 @@ def read_postures(path: str | Path) -> tuple[tuple[str, ...], NDArray[np.float64
     """The joint names (the header) and the postures (m × n, rad) of a postures CSV: one
     column per joint, one row per posture, angles in rad. SynergyFileError naming the file
     and the field: unreadable, fewer than two postures, a repeated joint, a value that is
-    not a finite number."""
+    not a finite number, and every :func:`posture_problems` (one line each)."""
     where = f"postures file '{path}'"
     table = read_text_table(path, where)
     with open(path, encoding="utf-8", newline="") as handle:  # pandas renames a repeated column
@@ -71,7 +76,46 @@ def read_postures(path: str | Path) -> tuple[tuple[str, ...], NDArray[np.float64
     values = finite_cells(table, list(table.columns), lambda i, col, text: (
         f"{where}: row {i + 1}, joint '{names[list(table.columns).index(col)]}' is {text!r}; "
         "a finite number (rad) is required"))
+    problems = posture_problems(names, values)
+    if problems:
+        raise SynergyFileError("\n".join(f"{where}: {p}" for p in problems))
     return names, values
+
+
+def posture_problems(joint_names: tuple[str, ...], postures: NDArray) -> list[str]:
+    """What makes readable postures (m × n, rad) unfit for a synergy fit, one line per kind:
+    a column without a joint name or counting the rows 0, 1, …, m − 1 (a table saved with its
+    row index); postures that do not differ (every joint spreads by at most 1e-9 rad: the
+    fit would be rounding noise); angles beyond a full turn, 2π rad (most postures: a table
+    in degrees; a few: outliers, named by row, 1-based)."""
+    x = np.asarray(postures, dtype=float)
+    m = len(x)
+    problems = []
+    for j, name in enumerate(joint_names):
+        if not name or name.startswith("Unnamed:"):
+            problems.append(f"column {j + 1} has no joint name: a table saved with its row index? "
+                            "(pandas: to_csv(..., index=False)); one named column per joint")
+        elif m >= 3 and np.array_equal(x[:, j], np.arange(m)):
+            problems.append(f"column {j + 1} ('{name}') counts the rows 0, 1, …, {m - 1}: a row index, not "
+                            "a joint angle (pandas: to_csv(..., index=False))")
+    if problems:
+        return problems
+    spread = np.ptp(x, axis=0)
+    if spread.max() <= _SAME_POSTURE_RAD:
+        problems.append(f"the {m} postures do not differ (every joint spreads by at most {spread.max():.3g} rad): "
+                        "no variance to fit synergies to")
+    beyond = np.abs(x) > _FULL_TURN_RAD
+    rows = np.flatnonzero(beyond.any(axis=1))
+    if 2 * len(rows) > m:
+        problems.append(f"{len(rows)} of {m} postures have angles beyond 2π (up to {np.abs(x).max():.4g}); "
+                        "postures are in rad (is the table in degrees?)")
+    elif len(rows):
+        i = int(rows[0])
+        j = int(np.argmax(np.abs(x[i])))
+        shown = ", ".join(str(r + 1) for r in rows[:5]) + (", …" if len(rows) > 5 else "")
+        problems.append(f"row(s) {shown} beyond a full turn (row {i + 1}, joint '{joint_names[j]}' is "
+                        f"{x[i, j]:.4g} rad, beyond 2π): an outlier no joint reaches; remove or correct it")
+    return problems
 
 
 def orient_columns(matrix: NDArray) -> NDArray[np.float64]:
@@ -104,11 +148,13 @@ def fit_synergies(joint_names: tuple[str, ...], postures: NDArray, n_synergies: 
     mean = x.mean(axis=0)
     _, singular, vt = np.linalg.svd(x - mean, full_matrices=False)  # ordered by singular value
     variance = singular ** 2 / (m - 1)
-    if variance[0] <= 0.0:
-        raise ValueError("the postures are all the same: no variance to fit")
+    if np.ptp(x, axis=0).max() <= _SAME_POSTURE_RAD:
+        raise ValueError(f"the {m} postures do not differ (every joint spreads by at most {_SAME_POSTURE_RAD:g} rad): "
+                         "no variance to fit synergies to")
     k = int(np.sum(variance[:k_max] > _RANK_TOLERANCE * variance[0])) if n_synergies is None else int(n_synergies)
     if not 1 <= k <= k_max:
-        raise ValueError(f"n_synergies must be 1 … {k_max} for {m} postures of {n} joints, got {n_synergies}")
+        raise ValueError(f"the number of synergies to keep must be 1 … {k_max} for {m} postures of {n} joints, "
+                         f"got {n_synergies}")
     matrix = orient_columns(vt[:k].T)
     synergies = Synergies(tuple(joint_names), mean, matrix, tuple(f"S{i}" for i in range(1, k + 1)))
     return SynergyFit(synergies, variance[:k], float(np.sum(variance)))

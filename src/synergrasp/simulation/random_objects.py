@@ -26,9 +26,10 @@ from typing import Any
 
 import numpy as np
 
+from synergrasp.config import ConfigError, block_problems
 from synergrasp.simulation.shapes.mesh_file import MeshFileError, read_mesh
 
-__all__ = ["DrawnObject", "drawn_objects", "add_random_objects", "left_out", "N_MESHES"]
+__all__ = ["DrawnObject", "drawn_objects", "random_objects_problems", "add_random_objects", "left_out", "N_MESHES"]
 
 #: Meshes in pybullet_data/random_urdfs.
 N_MESHES = 1000
@@ -108,17 +109,59 @@ def left_out(spec: Mapping[str, Any] | None, manifest: Sequence[str | Path]) -> 
     return [(d.name, d.problem) for d in drawn_objects(spec, manifest=manifest[0]) if d.problem]
 
 
+def random_objects_problems(spec: Any, root: str | Path = ".") -> list[str]:
+    """What keeps a ``random_objects`` block from being drawn, one line each naming
+    ``random_objects.<key>``, before any number of it is used: the schema's checks of the
+    block alone (``config.block_problems``: every key given, whole numbers, ranges), its
+    ``longest_side_mm`` in order, and its manifest a readable ``sha256sum`` file (relative to
+    ``root``)."""
+    problems = block_problems("random_objects", spec)
+    if not isinstance(spec, Mapping) or any("'random_objects'" in p for p in problems):
+        return problems  # not a mapping, or a key missing or unknown
+
+    def fine(key: str) -> bool:
+        return key in spec and not any(f"'random_objects.{key}'" in p for p in problems)
+
+    if fine("longest_side_mm") and spec["longest_side_mm"][1] < spec["longest_side_mm"][0]:
+        problems.append(f"config error at 'random_objects.longest_side_mm': {spec['longest_side_mm']} is reversed; "
+                        "give [shortest, longest] (mm)")
+    if not fine("sha256_file"):
+        return problems
+    manifest = Path(root) / spec["sha256_file"]
+    try:
+        _manifest(manifest)
+    except OSError as err:
+        problems.append(f"config error at 'random_objects.sha256_file': '{manifest}' cannot be read "
+                        f"({'is a folder' if manifest.is_dir() else err.strerror or err}); a sha256sum manifest "
+                        "relative to the project's root is required")
+    except (ValueError, UnicodeDecodeError):
+        problems.append(f"config error at 'random_objects.sha256_file': '{manifest}' is not a sha256sum manifest "
+                        "(lines of '<digest>  <path>')")
+    return problems
+
+
 def add_random_objects(config: MutableMapping[str, Any], root: str | Path = ".") -> list[DrawnObject]:
     """Add the studied objects of ``config["random_objects"]`` (if any) to ``config["objects"]``
-    (a mesh shape, the block's mass); return every drawn object. The block's values must
-    have been given in full (the example file gives every key)."""
+    (a mesh shape, the block's mass); return every drawn object. ConfigError, before anything
+    is drawn or added, with every :func:`random_objects_problems` and every object of the
+    configuration named like a drawn one (one line each, naming both)."""
     spec = config.get("random_objects")
-    if not spec:
+    if spec is None:
         return []
+    problems = random_objects_problems(spec, root)
+    if problems:
+        raise ConfigError("\n".join(problems))
     drawn = drawn_objects(spec, root)
-    objects = config.setdefault("objects", {})
+    objects = config.get("objects")
+    objects = {} if not isinstance(objects, MutableMapping) else objects
+    clashes = [d.name for d in drawn if not d.problem and objects.get(d.name) is not None]
+    if clashes:
+        raise ConfigError("\n".join(
+            f"config error at 'objects.{name}': an object of the configuration has the name of an object "
+            f"random_objects draws ({name}); rename the object or change random_objects.seed" for name in clashes))
     for obj in drawn:
         if not obj.problem:
             objects[obj.name] = {"shape": {"mesh": {"path": obj.path, "scale": obj.scale}},
                                  "mass_kg": float(spec["mass_kg"])}
+    config["objects"] = objects
     return drawn
