@@ -3,6 +3,8 @@
     synergrasp grasp obj4 --alpha -30 --beta 0 [--configfile my.yaml] [--sets 1 1-5 1-15] [--json]
                      [--png grasp.png] [--html grasp.html [--forces 1-15]]
     synergrasp synergies fit POSTURES.csv --out synergies.csv [--synergies K] [--png variance.png]
+    synergrasp synergies map HAND --out synergies.csv [--table TABLE] [--source SOURCE_HAND] [--synergies K]
+                             [--postures postures.csv] [--png variance.png]
     synergrasp hand show [HAND] [--synergies TABLE] [--png hand.png] [--count K]
 
 Bad input (an argument, a configuration file, the hand or synergy file it names, an output
@@ -122,6 +124,18 @@ def _parser() -> argparse.ArgumentParser:
     fit.add_argument("--out", required=True, help="the synergy table to write (joint, mean_rad, syn1..synK)")
     fit.add_argument("--synergies", type=int, help="how many synergies to keep (default: all with variance)")
     fit.add_argument("--png", metavar="PATH", help="write the explained variance per synergy (PNG)")
+    mapping = synergies.add_parser("map", help="carry a synergy table over to another hand in the object's terms: "
+                                               "fingertips and thumb-to-fingertip vectors retargeted, then principal "
+                                               "components (docs/synergies.md)")
+    mapping.add_argument("hand", help="the target hand: a hand file or description, or a shipped hand (shadow_hand)")
+    mapping.add_argument("--out", required=True, help="the target hand's synergy table to write (CSV)")
+    mapping.add_argument("--table", help="the source hand's synergy table (name or CSV; default: the study's, "
+                                         "softhand_opposed)")
+    mapping.add_argument("--source", help="the source hand (a hand file or description; default: the study's hand)")
+    mapping.add_argument("--synergies", type=int, help="how many synergies to keep (default: as many as the table has)")
+    mapping.add_argument("--postures", metavar="PATH", help="also write the mapped postures (CSV, one column per "
+                                                            "joint: the input of synergies fit)")
+    mapping.add_argument("--png", metavar="PATH", help="write the explained variance per synergy (PNG)")
     hands = sub.add_parser("hand", help="hands").add_subparsers(dest="action", required=True)
     show = hands.add_parser("show", help="print a hand's joints; draw it at its mean posture and along each synergy")
     show.add_argument("hand", nargs="?", help="a hand file or description, or shadow_hand (default: the shipped hand)")
@@ -139,10 +153,16 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: The output options a command may have and the file names each accepts.
+_OUTPUTS = (("--png", "png", (".png",)), ("--html", "html", (".html", ".htm")), ("--out", "out", (".csv",)),
+            ("--postures", "postures", (".csv",)))
+
+
 def _output_problems(args: argparse.Namespace) -> list[str]:
-    """What keeps ``--png`` / ``--html`` from being written, one line each, before any work."""
+    """What keeps an output (``--png``, ``--html``, ``--out``, ``--postures``) from being
+    written, one line each, before any work."""
     problems = []
-    for option, path, suffixes in (("--png", args.png, (".png",)), ("--html", args.html, (".html", ".htm"))):
+    for option, path, suffixes in ((o, getattr(args, a, None), s) for o, a, s in _OUTPUTS):
         if path is None:
             continue
         target = Path(path)
@@ -228,6 +248,69 @@ def _show_hand(args: argparse.Namespace) -> int:
     return 0
 
 
+def _map_synergies(args: argparse.Namespace) -> int:
+    """``synergrasp synergies map``: every argument checked, then the mapping, the table
+    written, the variance explained and the thumb-opposition check printed."""
+    import numpy as np
+
+    from synergrasp.hand.kinematics import load_hand
+    from synergrasp.hand.synergies import load_synergies, resolve_synergies, write_synergies
+    from synergrasp.hand.synergy_map import map_synergies
+    from synergrasp.hand.thumb_check import thumb_opposition
+
+    problems = _output_problems(args)
+    try:
+        target = load_hand(args.hand)
+        source = load_hand(args.source)
+        table_path = resolve_synergies(args.table)
+        table = load_synergies(table_path, joint_names=source.joint_names)
+    except ValueError as err:
+        problems += str(err).splitlines()
+        target = table_path = None
+    outputs = {option: Path(path) for option, path in (("--out", args.out), ("--postures", args.postures),
+                                                        ("--png", args.png)) if path}
+    for option, path in outputs.items():
+        if table_path is not None and path.resolve() == Path(table_path).resolve():
+            problems.append(f"{option} {path}: is the input table; give another file name")
+    if "--postures" in outputs and outputs["--postures"].resolve() == outputs["--out"].resolve():
+        problems.append(f"--postures {args.postures}: is the --out file; give another file name")
+    k_max = None if target is None else min(table.n_synergies, target.n_joints)
+    if args.synergies is not None and k_max is not None and not 1 <= args.synergies <= k_max:
+        problems.append(f"--synergies {args.synergies}: must be 1 … {k_max} (the table's columns, at most the "
+                        "target's joints)")
+    if problems:
+        print("\n".join(f"synergrasp synergies map: {line}" for line in problems), file=sys.stderr)
+        return 2
+    fit, mapped = map_synergies(source, table, target, args.synergies)
+    write_synergies(fit.synergies, args.out)
+    if args.postures:
+        import pandas as pd
+
+        pd.DataFrame(mapped.target, columns=list(target.joint_names)).to_csv(
+            args.postures, index=False, float_format="%.17g", lineterminator="\n")
+    print(f"{target.name}: {len(mapped.sigma)} postures mapped from {source.name}'s table {table_path} "
+          f"(fingertip and thumb-to-fingertip residual, RMS mm: median {np.median(mapped.residual_mm):.2f}, "
+          f"max {np.max(mapped.residual_mm):.2f})")
+    _print_variance(fit)
+    print(f"synergy table: {args.out}" + (f"; mapped postures: {args.postures}" if args.postures else ""))
+    check = thumb_opposition(target, fit.synergies)
+    print(check.warning() or f"thumb opposition: along S1 the thumb meets the {check.partner} fingertip at sigma = "
+          f"{check.meet_sigma:.2f}, {check.front_mm:.1f} mm in front of the palm face, the palm untouched")
+    if args.png:
+        from synergrasp.figures.synergy_fit import figure_explained_variance
+
+        figure_explained_variance(fit, args.png)
+        print(f"explained variance: {args.png}")
+    return 0
+
+
+def _print_variance(fit: Any) -> None:
+    """Per synergy: its variance, its share of the total and the cumulated share."""
+    print(f"{'synergy':<8} {'variance (rad^2)':>17} {'explained':>10} {'cumulative':>11}")
+    for i, (v, e, c) in enumerate(zip(fit.variance_rad2, fit.explained, fit.cumulative), start=1):
+        print(f"S{i:<7} {v:>17.6g} {100 * e:>9.2f}% {100 * c:>10.2f}%")
+
+
 def _fit_synergies(args: argparse.Namespace) -> int:
     """``synergrasp synergies fit``: the table, and the variance explained printed (and drawn)."""
     from synergrasp.hand.synergies import SynergyFileError, write_synergies
@@ -241,9 +324,7 @@ def _fit_synergies(args: argparse.Namespace) -> int:
         return 2
     write_synergies(fit.synergies, args.out)
     print(f"{len(postures)} postures of {len(names)} joints: total variance {fit.total_variance_rad2:.6g} rad^2")
-    print(f"{'synergy':<8} {'variance (rad^2)':>17} {'explained':>10} {'cumulative':>11}")
-    for i, (v, e, c) in enumerate(zip(fit.variance_rad2, fit.explained, fit.cumulative), start=1):
-        print(f"S{i:<7} {v:>17.6g} {100 * e:>9.2f}% {100 * c:>10.2f}%")
+    _print_variance(fit)
     print(f"synergy table: {args.out}")
     if args.png:
         from synergrasp.figures.synergy_fit import figure_explained_variance
@@ -314,7 +395,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command == "plan":
         return _plan(args)
     if args.command == "synergies":
-        return _fit_synergies(args)
+        return _map_synergies(args) if args.action == "map" else _fit_synergies(args)
     if args.command == "hand":
         return _show_hand(args)
     try:
