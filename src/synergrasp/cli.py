@@ -138,8 +138,10 @@ def _parser() -> argparse.ArgumentParser:
     mapping.add_argument("--png", metavar="PATH", help="write the explained variance per synergy (PNG)")
     hands = sub.add_parser("hand", help="hands").add_subparsers(dest="action", required=True)
     show = hands.add_parser("show", help="print a hand's joints; draw it at its mean posture and along each synergy")
-    show.add_argument("hand", nargs="?", help="a hand file or description, or shadow_hand (default: the shipped hand)")
-    show.add_argument("--synergies", help="a synergy table (name or CSV; default: the shipped one, or shadow_hand's)")
+    show.add_argument("hand", nargs="?", help="a hand file or description, or a shipped hand: shadow_hand, inspire_hand "
+                                               "(default: the study's hand)")
+    show.add_argument("--synergies", help="a synergy table (name or CSV; default: the shipped one, or a shipped "
+                                            "hand's own)")
     show.add_argument("--png", metavar="PATH", help="write the hand at q_m + sigma S_k, sigma = -1, 0, +1 (PNG)")
     show.add_argument("--count", type=int, default=7, help="synergies drawn (default 7)")
     plan = sub.add_parser("plan", help="the incremental planner on one object, against the study's exhaustive search "
@@ -220,12 +222,13 @@ def _plan(args: argparse.Namespace) -> int:
 
 def _show_hand(args: argparse.Namespace) -> int:
     """``synergrasp hand show``: the joints (limits, mean posture, S1), links and fingertips."""
+    from synergrasp.hand.description import SHIPPED_HANDS
     from synergrasp.hand.kinematics import fingertip_positions, load_hand
     from synergrasp.hand.synergies import load_synergies
 
     try:
         hand = load_hand(args.hand)
-        table = args.synergies or ("shadow_hand" if args.hand == "shadow_hand" else None)
+        table = args.synergies or (args.hand if args.hand in SHIPPED_HANDS else None)
         synergies = load_synergies(table, joint_names=hand.joint_names)
     except ValueError as err:
         print(f"synergrasp hand show: {err}", file=sys.stderr)
