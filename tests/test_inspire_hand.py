@@ -301,3 +301,25 @@ def test_mesh_hand_refused_in_one_line(tmp_path, case, expected):
         check_hand(path)
     message = str(err.value)
     assert "\n" not in message and message.startswith(f"hand file '{path}': ") and expected in message, message
+
+
+def test_provenance_table_names_every_copied_file_with_its_sha256():
+    import hashlib
+    import re
+
+    rows = re.findall(r"^\| `([^`]+)` \| .* \| `([0-9a-f]{64})` \| no \|$", (INSPIRE / "README.md").read_text(), re.M)
+    assert len(rows) == 15  # the XML, 13 meshes, the licence
+    for name, digest in rows:
+        assert hashlib.sha256((INSPIRE / name).read_bytes()).hexdigest() == digest, name
+
+
+def test_shipped_inspire_table_equals_a_fresh_mapping(inspire):
+    """synergies: inspire_hand is `synergies map` of the study's table onto this hand."""
+    from synergrasp.hand.synergies import load_synergies, shipped_hand_table
+    from synergrasp.hand.synergy_map import map_synergies
+
+    hand = inspire[0]
+    fit, _ = map_synergies(load_hand(None), load_synergies(None), hand)
+    shipped = load_synergies(shipped_hand_table("inspire_hand"), joint_names=hand.joint_names)
+    assert shipped.n_synergies == hand.n_joints == 6
+    assert np.array_equal(shipped.mean, fit.synergies.mean) and np.array_equal(shipped.matrix, fit.synergies.matrix)
