@@ -191,40 +191,22 @@ def test_missing_mjcf_file_is_named(tmp_path):
 # --------------------------------------------------------------------------- its synergies
 
 
-def test_shipped_shadow_table_equals_a_fresh_mapping():
-    from synergrasp.hand.synergies import (load_human_synergies, load_synergies, load_synergy_mapping,
-                                           map_human_synergies, shadow_hand_files)
-
-    hand_path, mapping_path, table_path = shadow_hand_files()
-    hand = load_hand(hand_path)
-    fresh = map_human_synergies(load_human_synergies(), load_synergy_mapping(mapping_path), hand.joint_names)
-    shipped = load_synergies(table_path, joint_names=hand.joint_names)
-    assert np.array_equal(shipped.mean, fresh.mean) and np.array_equal(shipped.matrix, fresh.matrix)
-    assert np.all(shipped.mean >= hand.lower) and np.all(shipped.mean <= hand.upper)
-
-
-def test_shadow_thumb_pinches_along_the_closing_synergy():
-    """Along q_r(σ) the thumb's distal capsule reaches the middle's (then the index's) before
-    the index is at its limits: a pinch, as the mapping's comments say."""
+def test_shadow_thumb_meets_the_middle_tip_in_front_of_the_palm():
+    """Along q_r(σ) the thumb's distal capsule reaches the middle finger's while both tips stand
+    well in front of the palm face and before any thumb link touches the palm (a pinch, not
+    the fingertips curling onto a thumb folded in the palm, which the former test accepted:
+    its check, the σ of the meeting alone, passed on the joint-by-joint mapping whose thumb
+    lies on the palm; tests/test_thumb_check.py); the index is still inside its limits there.
+    The table itself: tests/test_synergy_map.py."""
     from synergrasp.hand.synergies import SynergyPath, load_synergies, shadow_hand_files
-    from synergrasp.simulation.capsules import HandCapsules, segment_segment_distance
+    from synergrasp.hand.thumb_check import thumb_opposition
 
     hand_path, _, table_path = shadow_hand_files()
     hand = load_hand(hand_path)
-    path = SynergyPath.along(load_synergies(table_path, joint_names=hand.joint_names), hand.lower, hand.upper)
-    sigma_open, sigma_closed = path.closure_range(hand.flexion_joints)
-    caps = HandCapsules.of(hand)
-    row = {name: list(caps.links).index(hand.link_index(name)) for name in ("thumb_distal", "middle_distal")}
-    first = None
-    for sigma in np.linspace(sigma_open, sigma_closed, 2000):
-        p0, p1 = caps.segments(path.reference(sigma))
-        t, m = row["thumb_distal"], row["middle_distal"]
-        gap = segment_segment_distance(p0[[t]], p1[[t]], p0[[m]], p1[[m]])[0] - caps.radius[t] - caps.radius[m]
-        if gap <= 0:
-            first = sigma
-            break
-    assert first is not None and 0.8 < first < 1.2
-    q = path.reference(first)
+    table = load_synergies(table_path, joint_names=hand.joint_names)
+    check = thumb_opposition(hand, table)
+    assert check.partner == "middle" and check.palm_sigma is None and check.front_mm > 15.0
+    q = SynergyPath.along(table, hand.lower, hand.upper).reference(check.meet_sigma)
     index = [hand.joint_names.index(n) for n in ("index_mcp", "index_pip")]
     assert np.all(q[index] < hand.upper[index] - 0.05)
 
@@ -241,7 +223,9 @@ def test_search_region_from_the_hands_geometry():
     assert (x0, y, z0) == (9.0, (-48.0, 30.0), 14.0) and 50 < x1 < 60 and 180 < z1 < 200
     shadow = load_hand("shadow_hand")
     (x0, x1), y, (z0, z1) = hand_region(shadow, load_synergies("shadow_hand", joint_names=shadow.joint_names))
-    assert (x0, y, z0) == (11.0, (-43.0, 43.0), -11.0) and x1 > 60 and z1 == 195.0  # middle tip: 99 + 96 mm
+    # the open hand of the mapped table spreads the middle finger by its -20 deg limit: its tip at
+    # 96 cos(20 deg) + 99 = 189.2 mm (straight: 99 + 96 = 195 mm)
+    assert (x0, y, z0) == (11.0, (-43.0, 43.0), -11.0) and x1 > 60 and z1 == 190.0
 
 
 def test_config_region_hand_is_accepted():
@@ -260,7 +244,7 @@ def test_hand_show_prints_the_joints_and_draws(tmp_path, capsys):
     png = tmp_path / "hand.png"
     assert main(["hand", "show", "shadow_hand", "--png", str(png), "--count", "2"]) == 0
     text = capsys.readouterr().out
-    assert "17 joints, 22 links (6 without shape)" in text and "index_pip           0.0    78.8    60.7" in text
+    assert "17 joints, 22 links (6 without shape)" in text and "index_pip           0.0    78.8    53.3" in text
     assert png.stat().st_size > 10_000
     assert main(["hand", "show", str(tmp_path / "none.yaml")]) == 2
     assert "none.yaml" in capsys.readouterr().err

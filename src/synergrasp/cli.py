@@ -144,6 +144,8 @@ def _parser() -> argparse.ArgumentParser:
                                             "hand's own)")
     show.add_argument("--png", metavar="PATH", help="write the hand at q_m + sigma S_k, sigma = -1, 0, +1 (PNG)")
     show.add_argument("--count", type=int, default=7, help="synergies drawn (default 7)")
+    show.add_argument("--closing-png", metavar="PATH", help="write the hand closing along S1 from the palm side and "
+                                                            "from the thumb side (PNG)")
     plan = sub.add_parser("plan", help="the incremental planner on one object, against the study's exhaustive search "
                                        "(reads <results>/objects/<object>/contacts and gfo tables; docs/planner.md)")
     plan.add_argument("object", help="an object of the configuration")
@@ -157,7 +159,7 @@ def _parser() -> argparse.ArgumentParser:
 
 #: The output options a command may have and the file names each accepts.
 _OUTPUTS = (("--png", "png", (".png",)), ("--html", "html", (".html", ".htm")), ("--out", "out", (".csv",)),
-            ("--postures", "postures", (".csv",)))
+            ("--postures", "postures", (".csv",)), ("--closing-png", "closing", (".png",)))
 
 
 def _output_problems(args: argparse.Namespace) -> list[str]:
@@ -225,13 +227,17 @@ def _show_hand(args: argparse.Namespace) -> int:
     from synergrasp.hand.description import SHIPPED_HANDS
     from synergrasp.hand.kinematics import fingertip_positions, load_hand
     from synergrasp.hand.synergies import load_synergies
+    from synergrasp.hand.thumb_check import closing_sigmas, thumb_opposition
 
+    problems = _output_problems(argparse.Namespace(png=args.png, closing=args.closing_png))
     try:
         hand = load_hand(args.hand)
         table = args.synergies or (args.hand if args.hand in SHIPPED_HANDS else None)
         synergies = load_synergies(table, joint_names=hand.joint_names)
     except ValueError as err:
-        print(f"synergrasp hand show: {err}", file=sys.stderr)
+        problems += str(err).splitlines()
+    if problems:
+        print("\n".join(f"synergrasp hand show: {line}" for line in problems), file=sys.stderr)
         return 2
     deg = math.degrees
     print(f"{hand.name} ({hand.source}): {hand.n_joints} joints, {hand.n_links} links "
@@ -248,6 +254,13 @@ def _show_hand(args: argparse.Namespace) -> int:
 
         figure_synergy_postures(hand, synergies, args.png, None, n_synergies=min(args.count, synergies.n_synergies))
         print(f"picture: {args.png}")
+    check = thumb_opposition(hand, synergies)
+    print(check.summary())
+    if args.closing_png:
+        from synergrasp.figures.hand_figures import figure_closing_views
+
+        figure_closing_views(hand, synergies, args.closing_png, None, closing_sigmas(check))
+        print(f"closing along S1, palm side and thumb side: {args.closing_png}")
     return 0
 
 
@@ -297,8 +310,7 @@ def _map_synergies(args: argparse.Namespace) -> int:
     _print_variance(fit)
     print(f"synergy table: {args.out}" + (f"; mapped postures: {args.postures}" if args.postures else ""))
     check = thumb_opposition(target, fit.synergies)
-    print(check.warning() or f"thumb opposition: along S1 the thumb meets the {check.partner} fingertip at sigma = "
-          f"{check.meet_sigma:.2f}, {check.front_mm:.1f} mm in front of the palm face, the palm untouched")
+    print(check.summary())
     if args.png:
         from synergrasp.figures.synergy_fit import figure_explained_variance
 

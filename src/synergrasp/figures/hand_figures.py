@@ -20,7 +20,7 @@ from synergrasp.figures.hand_pictures import (ABOVE_CAMERA, BOX, PALM_CAMERA, SK
 from synergrasp.figures.output import save_figure
 from synergrasp.hand.synergies import SynergyPath
 
-__all__ = ["figure_synergy_postures", "figure_example_grasps", "figure_grasp_views", "draw_grasp", "draw_grasp_row",
+__all__ = ["figure_synergy_postures", "figure_closing_views", "THUMB_CAMERA", "figure_example_grasps", "figure_grasp_views", "draw_grasp", "draw_grasp_row",
            "object_of", "PANEL_PX", "GRASP_VIEWS", "FIG2_GRASPS"]
 
 #: Rendered panel size, pixels (width, height).
@@ -163,6 +163,48 @@ def figure_synergy_postures(hand: Any, synergies: Any, png_path: str | Path, pdf
         _label_parts(named[0], hand, named[1], named[2])
     fig.suptitle("Right hand, palm toward the viewer, along each postural synergy (pale: the mean posture)",
                  fontsize=10)
+    fig.tight_layout(rect=(0, 0, 1, 0.99), h_pad=0.3, w_pad=0.3)
+    save_figure(fig, png_path, pdf_path)
+
+
+#: From the thumb's side of a right hand (+y, palm frame), a little from in front of the palm,
+#: fingers up, the palm normal toward the image left: how far in front of the palm face the
+#: thumb meets the fingers.
+THUMB_CAMERA = Camera(direction=(-0.25, -1.0, 0.1))
+
+
+def figure_closing_views(hand: Any, synergies: Any, png_path: str | Path, pdf_path: str | Path | None,
+                         sigmas: Sequence[float]) -> None:
+    """The hand closing along S1, q_r(σ) = clip(q_m + σ·S1) for each σ of ``sigmas`` (columns),
+    seen from the palm side (top row, as Fig. 1) and from the thumb's side (bottom row, the
+    palm normal to the image left: how far in front of the palm the thumb meets the fingers);
+    the mean posture is the pale silhouette behind the others."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    path = SynergyPath.along(synergies, hand.lower, hand.upper)
+    mean = path.reference(0.0)
+    postures = [path.reference(float(sigma)) for sigma in sigmas]
+    panel = 2.35  # inches
+    views = (("palm side", PALM_CAMERA), ("thumb side", THUMB_CAMERA))
+    fig, axes = plt.subplots(len(views), len(sigmas), figsize=(panel * len(sigmas) + 0.4, panel * len(views) + 0.6),
+                             squeeze=False)
+    for r, (name, camera) in enumerate(views):
+        camera = _fit(camera, hand, [*postures, mean])
+        pictures = []
+        for c, (sigma, q) in enumerate(zip(sigmas, postures)):
+            picture = render(hand, q, camera, PANEL_PX, ghost_q=None if sigma == 0 else mean)
+            pictures.append(picture)
+            axes[r, c].imshow(picture.rgb, interpolation="antialiased")
+            _bare(axes[r, c])
+            if r == 0:
+                axes[r, c].set_title(f"σ = {sigma:+.2f}", fontsize=10)
+            if c == 0:
+                axes[r, c].set_ylabel(name, fontsize=11)
+        _frame(axes[r], pictures)
+    fig.suptitle(f"{hand.name}: closing along S1 (pale: the mean posture)", fontsize=10)
     fig.tight_layout(rect=(0, 0, 1, 0.99), h_pad=0.3, w_pad=0.3)
     save_figure(fig, png_path, pdf_path)
 

@@ -28,7 +28,8 @@ import numpy as np
 from synergrasp.hand.kinematics import Hand, fingertip_positions
 from synergrasp.hand.synergies import Synergies, SynergyPath
 
-__all__ = ["MIN_FRONT_MM", "ThumbOpposition", "thumb_opposition", "opposition_warnings"]
+__all__ = ["MIN_FRONT_MM", "ThumbOpposition", "thumb_opposition", "opposition_warnings", "closing_sigmas",
+           "cached_opposition_warnings"]
 
 #: How far in front of the palm face (mm, along the palm normal) the thumb must meet a finger.
 MIN_FRONT_MM = 20.0
@@ -70,13 +71,28 @@ class ThumbOpposition:
         elif self.front_mm < MIN_FRONT_MM:
             why.append(f"the thumb meets the {self.partner} fingertip at sigma = {self.meet_sigma:.2f} only "
                        f"{self.front_mm:.1f} mm in front of the palm face (at least {MIN_FRONT_MM:g} mm needed)")
-        return (f"WARNING thumb opposition: hand '{self.hand}': along S1 " + "; ".join(why)
+        return (f"thumb opposition: hand '{self.hand}': along S1 " + "; ".join(why)
                 + ": the thumb cannot oppose the fingers (docs/synergies.md)")
+
+    def summary(self) -> str:
+        """``WARNING: `` and the warning, or one line saying where the thumb meets a finger."""
+        warning = self.warning()
+        if warning:
+            return f"WARNING: {warning}"
+        return (f"thumb opposition: hand '{self.hand}': along S1 the thumb meets the {self.partner} fingertip at "
+                f"sigma = {self.meet_sigma:.2f}, {self.front_mm:.1f} mm in front of the palm face, the palm untouched")
+
+
+def closing_sigmas(check: ThumbOpposition) -> list[float]:
+    """The σ at which to draw the closing hand: −1, 0, +1 and where the check found the thumb
+    touching the palm and meeting a finger, in order."""
+    found = [s for s in (check.palm_sigma, check.meet_sigma) if s is not None]
+    return sorted({-1.0, 0.0, 1.0, *(round(s, 2) for s in found)})
 
 
 def thumb_opposition(hand: Hand, synergies: Synergies, samples: int = _SAMPLES) -> ThumbOpposition:
-    """Walk the S1 path of ``synergies`` on ``hand`` (module docstring). ValueError if the hand
-    has no thumb chain with a distal capsule."""
+    """Walk the S1 path of ``synergies`` on ``hand`` (module docstring). ValueError if the
+    thumb's, the index's or the middle finger's distal link has no capsule."""
     from synergrasp.simulation.capsules import HandCapsules, pair_gaps
     from synergrasp.simulation.placement import palm_centre
 
@@ -85,6 +101,9 @@ def thumb_opposition(hand: Hand, synergies: Synergies, samples: int = _SAMPLES) 
     caps = HandCapsules.of(hand)
     row = {int(link): i for i, link in enumerate(caps.links)}
     thumb, index, middle = (int(hand.fingertip_link[f]) for f in (0, 1, 2))
+    missing = [hand.link_names[link] for link in (thumb, index, middle) if link not in row]
+    if missing:
+        raise ValueError(f"{hand.source}: the thumb-opposition check needs a capsule on the links {missing}")
     ignored = {tuple(sorted(p)) for p in hand.ignored_link_pairs}
     thumb_links = [link for link in hand.finger_links[0] if link in row and (0, link) not in ignored]
     first = np.array([row[thumb], row[thumb]] + [row[link] for link in thumb_links], dtype=np.int64)
