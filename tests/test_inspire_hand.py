@@ -323,3 +323,17 @@ def test_shipped_inspire_table_equals_a_fresh_mapping(inspire):
     shipped = load_synergies(shipped_hand_table("inspire_hand"), joint_names=hand.joint_names)
     assert shipped.n_synergies == hand.n_joints == 6
     assert np.array_equal(shipped.mean, fit.synergies.mean) and np.array_equal(shipped.matrix, fit.synergies.matrix)
+
+
+def test_inspire_thumb_opposes_along_its_mapped_s1(inspire):
+    """The thumb-opposition check (docs/synergies.md) on the shipped table: the thumb's tip
+    meets the index tip at σ ≈ 0.23, 37.6 mm in front of the palm face, the palm untouched
+    (only thumb_distal may touch the palm: the model excludes the palm's pairs with the
+    thumb's three proximal links)."""
+    from synergrasp.hand.synergies import load_synergies
+    from synergrasp.hand.thumb_check import thumb_opposition
+
+    hand = inspire[0]
+    check = thumb_opposition(hand, load_synergies("inspire_hand", joint_names=hand.joint_names))
+    assert check.opposes and check.partner == "index" and check.palm_sigma is None
+    assert 0.2 < check.meet_sigma < 0.26 and 35.0 < check.front_mm < 40.0
