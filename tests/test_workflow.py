@@ -460,6 +460,29 @@ def test_small_study_on_the_shadow_hand(tmp_path):
     assert contacts["q"].map(len).eq(17).all()
 
 
+def test_small_study_on_the_inspire_hand(tmp_path):
+    """config/examples/inspire_hand.yaml over the small config: every step runs on the third
+    shipped hand (MJCF with fitted collision meshes, 6 joint coordinates, 6 synergies) and
+    grasps obj4 with its own links."""
+    import pandas as pd
+    import yaml
+
+    from synergrasp.config import overlay
+
+    config = overlay(yaml.safe_load(SMALL.read_text()),
+                     yaml.safe_load((ROOT / "config" / "examples" / "inspire_hand.yaml").read_text()))
+    configfile = tmp_path / "inspire_small.yaml"
+    configfile.write_text(yaml.safe_dump(config))
+    out = snakemake(tmp_path, "-j2", "figures", configfile=configfile)
+    assert out.returncode == 0, out.stderr[-5000:]
+    realism = pd.read_csv(tmp_path / "results" / "tables" / "grasp_realism.csv").set_index("object")
+    assert realism.loc["obj4", "contacts_median"] >= 3 and realism.loc["obj4", "pct_force_closure"] > 0
+    contacts = pd.read_parquet(tmp_path / "results" / "objects" / "obj4" / "contacts.parquet")
+    assert contacts["q"].map(len).eq(6).all()
+    table2 = pd.read_csv(tmp_path / "results" / "tables" / "table2_success_rates.csv")
+    assert "6" in table2.columns and "7" not in table2.columns
+
+
 def test_random_objects_example_plans_every_drawn_object(tmp_path):
     """config/examples/random_objects.yaml (n_objects: 3): a dry run of `across_objects`
     plans the steps of each drawn object that is studied, and the summary across objects."""
