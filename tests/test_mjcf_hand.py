@@ -199,7 +199,7 @@ def test_shadow_thumb_meets_the_middle_tip_in_front_of_the_palm():
     lies on the palm; tests/test_thumb_check.py); the index is still inside its limits there.
     The table itself: tests/test_synergy_map.py."""
     from synergrasp.hand.synergies import SynergyPath, load_synergies, shadow_hand_files
-    from synergrasp.hand.thumb_check import thumb_opposition
+    from synergrasp.simulation.thumb_check import thumb_opposition
 
     hand_path, _, table_path = shadow_hand_files()
     hand = load_hand(hand_path)

@@ -123,3 +123,23 @@ def test_command_checks_its_arguments_before_any_work_and_never_writes_over_its_
     assert table.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["table.csv"]
     assert main(["synergies", "map", str(tmp_path / "none.yaml"), "--out", str(tmp_path / "o.csv")]) == 2
     assert "none.yaml" in capsys.readouterr().err and not (tmp_path / "o.csv").exists()
+
+
+def test_joint_by_joint_option_writes_the_mapping_files_table_and_warns(tmp_path, capsys):
+    """--joint-mapping: the human table mapped joint by joint (map_human_synergies); on the
+    Shadow hand's mapping file, the thumb-opposition check's warning (its thumb on the palm)."""
+    from synergrasp.hand.synergies import load_human_synergies, load_synergy_mapping, map_human_synergies
+
+    hand = load_hand("shadow_hand")
+    _, mapping, _ = shadow_hand_files()
+    out = tmp_path / "joint.csv"
+    assert main(["synergies", "map", "shadow_hand", "--joint-mapping", str(mapping), "--out", str(out)]) == 0
+    assert "WARNING: thumb opposition: hand 'shadow_hand'" in capsys.readouterr().out
+    expected = map_human_synergies(load_human_synergies(), load_synergy_mapping(mapping), hand.joint_names)
+    table = load_synergies(out, joint_names=hand.joint_names)
+    np.testing.assert_array_equal(table.matrix, expected.matrix)
+    assert main(["synergies", "map", "shadow_hand", "--joint-mapping", str(mapping), "--out", str(tmp_path / "o.csv"),
+                 "--synergies", "3"]) == 2
+    assert capsys.readouterr().err.strip() == ("synergrasp synergies map: --synergies: not used with --joint-mapping "
+                                               "(it maps the human table joint by joint)")
+    assert not (tmp_path / "o.csv").exists()

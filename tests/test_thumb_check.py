@@ -1,4 +1,4 @@
-"""The thumb-opposition check (synergrasp.hand.thumb_check, docs/synergies.md): along S1 the
+"""The thumb-opposition check (synergrasp.simulation.thumb_check, docs/synergies.md): along S1 the
 thumb meets the index or middle fingertip 20 mm in front of the palm face, no thumb link on
 the palm before. Checked on the shipped hands, on the Shadow hand's joint-by-joint mapping
 (a thumb folded onto the palm: it must fail) and against the hands' geometry computed here."""
@@ -9,7 +9,7 @@ import pytest
 from synergrasp.hand.kinematics import fingertip_positions, forward_kinematics, load_hand
 from synergrasp.hand.synergies import (SynergyPath, load_human_synergies, load_synergies, load_synergy_mapping,
                                        map_human_synergies, shadow_hand_files)
-from synergrasp.hand.thumb_check import MIN_FRONT_MM, closing_sigmas, thumb_opposition
+from synergrasp.simulation.thumb_check import MIN_FRONT_MM, closing_sigmas, thumb_opposition
 
 
 def _capsule_gap(hand, q, a, b):
@@ -103,3 +103,20 @@ def test_workflow_checks_and_hand_show_warn(tmp_path, capsys):
     assert main(["hand", "show", "shadow_hand", "--closing-png", str(png)]) == 0
     out = capsys.readouterr().out
     assert "WARNING: thumb opposition: hand 'shadow_hand'" in out and png.stat().st_size > 10_000
+
+
+def test_a_table_whose_s1_opens_a_joint_cannot_be_checked_and_says_why():
+    """S1 with a negative flexion entry does not close the hand: no check, one warning line
+    naming the hand and the reason (the closure's own message), not a traceback."""
+    from synergrasp.hand.synergies import Synergies
+    from synergrasp.simulation.thumb_check import opposition_line, opposition_warnings
+
+    hand = load_hand(None)
+    table = load_synergies(None)
+    matrix = table.matrix.copy()
+    matrix[hand.joint_names.index("index_pip"), 0] = -0.1
+    broken = Synergies(table.joint_names, table.mean, matrix, table.names)
+    (warning,) = opposition_warnings(hand, broken)
+    assert warning.startswith("thumb opposition: hand 'softhand_like': cannot be checked: the closing synergy S1 "
+                              "must have flexion entries >= 0") and "\n" not in warning
+    assert opposition_line(hand, broken) == (f"WARNING: {warning}", [-1.0, 0.0, 1.0])

@@ -5,6 +5,7 @@
     synergrasp synergies fit POSTURES.csv --out synergies.csv [--synergies K] [--png variance.png]
     synergrasp synergies map HAND --out synergies.csv [--table TABLE] [--source SOURCE_HAND] [--synergies K]
                              [--postures postures.csv] [--png variance.png]
+    synergrasp synergies map HAND --out synergies.csv --joint-mapping MAPPING.yaml
     synergrasp hand show [HAND] [--synergies TABLE] [--png hand.png] [--count K]
 
 Bad input (an argument, a configuration file, the hand or synergy file it names, an output
@@ -136,6 +137,9 @@ def _parser() -> argparse.ArgumentParser:
     mapping.add_argument("--postures", metavar="PATH", help="also write the mapped postures (CSV, one column per "
                                                             "joint: the input of synergies fit)")
     mapping.add_argument("--png", metavar="PATH", help="write the explained variance per synergy (PNG)")
+    mapping.add_argument("--joint-mapping", metavar="YAML", help="map the human synergies joint by joint with this "
+                                                                 "mapping file instead (for hands whose joints "
+                                                                 "correspond; docs/synergies.md)")
     hands = sub.add_parser("hand", help="hands").add_subparsers(dest="action", required=True)
     show = hands.add_parser("show", help="print a hand's joints; draw it at its mean posture and along each synergy")
     show.add_argument("hand", nargs="?", help="a hand file or description, or a shipped hand: shadow_hand, inspire_hand "
@@ -227,7 +231,7 @@ def _show_hand(args: argparse.Namespace) -> int:
     from synergrasp.hand.description import SHIPPED_HANDS
     from synergrasp.hand.kinematics import fingertip_positions, load_hand
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.hand.thumb_check import closing_sigmas, thumb_opposition
+    from synergrasp.simulation.thumb_check import opposition_line
 
     problems = _output_problems(argparse.Namespace(png=args.png, closing=args.closing_png))
     try:
@@ -254,12 +258,12 @@ def _show_hand(args: argparse.Namespace) -> int:
 
         figure_synergy_postures(hand, synergies, args.png, None, n_synergies=min(args.count, synergies.n_synergies))
         print(f"picture: {args.png}")
-    check = thumb_opposition(hand, synergies)
-    print(check.summary())
+    line, sigmas = opposition_line(hand, synergies)
+    print(line)
     if args.closing_png:
         from synergrasp.figures.hand_figures import figure_closing_views
 
-        figure_closing_views(hand, synergies, args.closing_png, None, closing_sigmas(check))
+        figure_closing_views(hand, synergies, args.closing_png, None, sigmas)
         print(f"closing along S1, palm side and thumb side: {args.closing_png}")
     return 0
 
@@ -272,8 +276,10 @@ def _map_synergies(args: argparse.Namespace) -> int:
     from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import load_synergies, resolve_synergies, write_synergies
     from synergrasp.hand.synergy_map import map_synergies
-    from synergrasp.hand.thumb_check import thumb_opposition
+    from synergrasp.simulation.thumb_check import opposition_line
 
+    if args.joint_mapping:
+        return _map_joint_by_joint(args)
     problems = _output_problems(args)
     try:
         target = load_hand(args.hand)
@@ -309,13 +315,39 @@ def _map_synergies(args: argparse.Namespace) -> int:
           f"max {np.max(mapped.residual_mm):.2f})")
     _print_variance(fit)
     print(f"synergy table: {args.out}" + (f"; mapped postures: {args.postures}" if args.postures else ""))
-    check = thumb_opposition(target, fit.synergies)
-    print(check.summary())
+    print(opposition_line(target, fit.synergies)[0])
     if args.png:
         from synergrasp.figures.synergy_fit import figure_explained_variance
 
         figure_explained_variance(fit, args.png)
         print(f"explained variance: {args.png}")
+    return 0
+
+
+def _map_joint_by_joint(args: argparse.Namespace) -> int:
+    """``synergrasp synergies map --joint-mapping``: the human table mapped joint by joint
+    (``map_human_synergies``), written, and the thumb-opposition check printed."""
+    from synergrasp.hand.kinematics import load_hand
+    from synergrasp.hand.synergies import (load_human_synergies, load_synergy_mapping, map_human_synergies,
+                                           write_synergies)
+    from synergrasp.simulation.thumb_check import opposition_line
+
+    problems = _output_problems(args)
+    problems += [f"{option}: not used with --joint-mapping (it maps the human table joint by joint)"
+                 for option, value in (("--table", args.table), ("--source", args.source), ("--synergies", args.synergies),
+                                       ("--postures", args.postures), ("--png", args.png)) if value is not None]
+    try:
+        target = load_hand(args.hand)
+        table = map_human_synergies(load_human_synergies(), load_synergy_mapping(args.joint_mapping),
+                                    target.joint_names)
+    except (ValueError, KeyError, TypeError) as err:  # a mapping file's missing or malformed field
+        problems.append(f"--joint-mapping {args.joint_mapping}: {err}")
+    if problems:
+        print("\n".join(f"synergrasp synergies map: {line}" for line in problems), file=sys.stderr)
+        return 2
+    write_synergies(table, args.out)
+    print(f"{target.name}: the human synergies mapped joint by joint ({args.joint_mapping}); synergy table: {args.out}")
+    print(opposition_line(target, table)[0])
     return 0
 
 

@@ -4,7 +4,7 @@ the package alike (config/README.md, "Checked before any job runs").
 :func:`checked_scenario` is that check: one scenario's configuration (the schema and every
 relation, ``synergrasp.config``), its hand file, its synergy table against the hand, and its
 objects' shapes; besides the problems (errors), the warnings on sizes far from a hand's and on
-a thumb that cannot oppose along S1 (``synergrasp.hand.thumb_check``). The
+a thumb that cannot oppose along S1 (``synergrasp.simulation.thumb_check``). The
 workflow asks it through :func:`workflow_scenario` (common.smk), ``synergrasp grasp`` through
 ``synergrasp.inspector``; :func:`read_overlays` reads a command's ``--configfile`` files as
 strictly as the workflow reads its own. Checks that need a step's output where it exists
@@ -52,7 +52,7 @@ def checked_scenario(config: Mapping[str, Any], name: str = "default") -> tuple[
         the hand file, the synergy table, the objects' shapes.
     """
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.hand.thumb_check import cached_opposition_warnings
+    from synergrasp.simulation.thumb_check import cached_opposition_warnings
     from synergrasp.simulation.objects import object_problems, object_warnings
 
     where = "" if name == "default" else f"scenario '{name}': "

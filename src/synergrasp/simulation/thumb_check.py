@@ -28,8 +28,8 @@ import numpy as np
 from synergrasp.hand.kinematics import Hand, fingertip_positions
 from synergrasp.hand.synergies import Synergies, SynergyPath
 
-__all__ = ["MIN_FRONT_MM", "ThumbOpposition", "thumb_opposition", "opposition_warnings", "closing_sigmas",
-           "cached_opposition_warnings"]
+__all__ = ["MIN_FRONT_MM", "ThumbOpposition", "thumb_opposition", "checked_opposition", "opposition_warnings",
+           "opposition_line", "closing_sigmas", "cached_opposition_warnings"]
 
 #: How far in front of the palm face (mm, along the palm normal) the thumb must meet a finger.
 MIN_FRONT_MM = 20.0
@@ -126,10 +126,30 @@ def thumb_opposition(hand: Hand, synergies: Synergies, samples: int = _SAMPLES) 
     return ThumbOpposition(hand.name, None, "", float("nan"), palm_sigma, palm_link)
 
 
+def checked_opposition(hand: Hand, synergies: Synergies) -> tuple[ThumbOpposition | None, str | None]:
+    """The check (None if it cannot run) and its warning (None if the thumb opposes). A table
+    whose S1 does not close the hand (a negative flexion entry) or a hand without the distal
+    capsules cannot be checked: the warning says why, in one line naming the hand."""
+    try:
+        check = thumb_opposition(hand, synergies)
+    except ValueError as err:
+        return None, f"thumb opposition: hand '{hand.name}': cannot be checked: {err}"
+    return check, check.warning()
+
+
 def opposition_warnings(hand: Hand, synergies: Synergies) -> list[str]:
     """The check's warning for a hand with a thumb, as a list (empty: it opposes)."""
-    warning = thumb_opposition(hand, synergies).warning()
+    warning = checked_opposition(hand, synergies)[1]
     return [] if warning is None else [warning]
+
+
+def opposition_line(hand: Hand, synergies: Synergies) -> tuple[str, list[float]]:
+    """What a command prints of the check (``WARNING: `` and the warning, or where the thumb
+    meets a finger) and the σ at which to draw the closing hand (:func:`closing_sigmas`)."""
+    check, warning = checked_opposition(hand, synergies)
+    if check is None:
+        return f"WARNING: {warning}", [-1.0, 0.0, 1.0]
+    return check.summary(), closing_sigmas(check)
 
 
 @functools.cache
