@@ -331,7 +331,7 @@ def test_inspire_thumb_opposes_along_its_mapped_s1(inspire):
     (only thumb_distal may touch the palm: the model excludes the palm's pairs with the
     thumb's three proximal links)."""
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.hand.thumb_check import thumb_opposition
+    from synergrasp.simulation.thumb_check import thumb_opposition
 
     hand = inspire[0]
     check = thumb_opposition(hand, load_synergies("inspire_hand", joint_names=hand.joint_names))
