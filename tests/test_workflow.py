@@ -440,24 +440,25 @@ def test_small_sweep_summary_has_one_row_per_scenario(run_j2, tmp_path):
     assert placement["default"] == "approach" and placement["placement_searched"] == "searched, rank 1 (own search)"
 
 
-def test_small_study_on_the_shadow_hand(tmp_path):
-    """config/examples/shadow_hand.yaml over the small config: every step runs on the second
-    shipped hand (read from MJCF, 17 joints) and grasps the box obj4 with its own links."""
-    import pandas as pd
-    import yaml
-
+@pytest.mark.parametrize("example, n_joints", [("shadow_hand", 17), ("inspire_hand", 6)])
+def test_small_study_on_a_shipped_hand(tmp_path, example, n_joints):
+    """config/examples/<hand>.yaml over the small config: every step runs on the second
+    (Shadow: MJCF, 17 joints) and the third shipped hand (Inspire: MJCF with fitted collision
+    meshes, 6 joints, 6 synergies) and grasps the box obj4 with its own links."""
     from synergrasp.config import overlay
 
     config = overlay(yaml.safe_load(SMALL.read_text()),
-                     yaml.safe_load((ROOT / "config" / "examples" / "shadow_hand.yaml").read_text()))
-    configfile = tmp_path / "shadow_small.yaml"
+                     yaml.safe_load((ROOT / "config" / "examples" / f"{example}.yaml").read_text()))
+    configfile = tmp_path / f"{example}_small.yaml"
     configfile.write_text(yaml.safe_dump(config))
     out = snakemake(tmp_path, "-j2", "figures", configfile=configfile)
     assert out.returncode == 0, out.stderr[-5000:]
     realism = pd.read_csv(tmp_path / "results" / "tables" / "grasp_realism.csv").set_index("object")
     assert realism.loc["obj4", "contacts_median"] >= 3 and realism.loc["obj4", "pct_force_closure"] > 0
     contacts = pd.read_parquet(tmp_path / "results" / "objects" / "obj4" / "contacts.parquet")
-    assert contacts["q"].map(len).eq(17).all()
+    assert contacts["q"].map(len).eq(n_joints).all()
+    table2 = pd.read_csv(tmp_path / "results" / "tables" / "table2_success_rates.csv")
+    assert list(table2.columns[1:]) == [str(k) for k in range(1, config["analyses"]["table2_k_max"] + 1)]
 
 
 def test_random_objects_example_plans_every_drawn_object(tmp_path):

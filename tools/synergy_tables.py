@@ -1,6 +1,6 @@
 """Regenerate the shipped synergy tables (src/synergrasp/data/synergies_<name>.csv) from the
-human synergies and each mapping, and the Shadow hand's (data/hands/shadow/synergies.csv) by
-``synergies map`` from the study's hand and table (docs/synergies.md); tests/test_synergies.py
+human synergies and each mapping, and the Shadow and Inspire hands' (data/hands/*/synergies.csv)
+by ``synergies map`` from the study's hand and table (docs/synergies.md); tests/test_synergies.py
 and tests/test_synergy_map.py check that the shipped files equal a fresh mapping.
 
     .venv/bin/python tools/synergy_tables.py
@@ -17,6 +17,7 @@ from synergrasp.hand.synergies import (
     load_synergy_mapping,
     map_human_synergies,
     shadow_hand_files,
+    shipped_hand_table,
     shipped_path,
     write_synergies,
 )
@@ -29,3 +30,7 @@ if __name__ == "__main__":
     fit, _ = map_synergies(load_hand(None), load_synergies(None), load_hand(hand_path))
     write_synergies(fit.synergies, table_path)
     print(f"wrote {table_path}")
+    # the Inspire hand's table the same way (docs/hand.md, "The shipped Inspire dexterous hand")
+    fit, _ = map_synergies(load_hand(None), load_synergies(None), load_hand("inspire_hand"))
+    write_synergies(fit.synergies, shipped_hand_table("inspire_hand"))
+    print(f"wrote {shipped_hand_table('inspire_hand')}")

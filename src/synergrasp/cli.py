@@ -144,8 +144,10 @@ def _parser() -> argparse.ArgumentParser:
                                                                  "correspond; docs/synergies.md)")
     hands = sub.add_parser("hand", help="hands").add_subparsers(dest="action", required=True)
     show = hands.add_parser("show", help="print a hand's joints; draw it at its mean posture and along each synergy")
-    show.add_argument("hand", nargs="?", help="a hand file or description, or shadow_hand (default: the shipped hand)")
-    show.add_argument("--synergies", help="a synergy table (name or CSV; default: the shipped one, or shadow_hand's)")
+    show.add_argument("hand", nargs="?", help="a hand file or description, or a shipped hand: shadow_hand, inspire_hand "
+                                               "(default: the study's hand)")
+    show.add_argument("--synergies", help="a synergy table (name or CSV; default: the shipped one, or a shipped "
+                                            "hand's own)")
     show.add_argument("--png", metavar="PATH", help="write the hand at q_m + sigma S_k, sigma = -1, 0, +1 (PNG)")
     show.add_argument("--count", type=int, default=7, help="synergies drawn (default 7)")
     show.add_argument("--closing-png", metavar="PATH", help="write the hand closing along S1 from the palm side and "
@@ -307,6 +309,7 @@ def _plan(args: argparse.Namespace) -> int:
 def _show_hand(args: argparse.Namespace) -> int:
     """``synergrasp hand show``: the joints (limits, mean posture, S1), links and fingertips."""
     from synergrasp.hand.checks import check_hand
+    from synergrasp.hand.description import SHIPPED_HANDS
     from synergrasp.hand.kinematics import fingertip_positions
     from synergrasp.hand.synergies import load_synergies
     from synergrasp.simulation.thumb_check import opposition_line
@@ -314,7 +317,7 @@ def _show_hand(args: argparse.Namespace) -> int:
     problems: list[str] = []
     try:
         hand, _, warnings = check_hand(args.hand)
-        table = args.synergies or ("shadow_hand" if args.hand == "shadow_hand" else None)
+        table = args.synergies or (args.hand if args.hand in SHIPPED_HANDS else None)
         synergies = load_synergies(table, joint_names=hand.joint_names)
     except ValueError as err:
         problems += str(err).splitlines()

@@ -412,7 +412,7 @@ class Wiring:
         """The shipped hand and synergy files (not the schema: its defaults reach a job
         through its params, so a new key reruns nothing)."""
         data = self.src / "synergrasp" / "data"
-        return sorted(str(p) for p in [*data.glob("*"), *data.glob("hands/*/*")]
+        return sorted(str(p) for p in [*data.glob("*"), *data.glob("hands/**/*")]
                       if p.is_file() and p.name not in ("config.schema.yaml", "README.md"))
 
     def resources(self, rule: str) -> dict[str, Callable[[Any], int]]:

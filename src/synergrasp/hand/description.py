@@ -12,14 +12,15 @@ from synergrasp.hand.mjcf import mjcf_hand_spec
 
 __all__ = ["hand_spec", "SHIPPED_HANDS", "shipped_hand_path"]
 
-#: Hands shipped besides the default, by name (a ``hand:`` value): their hand descriptions.
-SHIPPED_HANDS: tuple[str, ...] = ("shadow_hand",)
+#: Hands shipped besides the default, by name (a ``hand:`` value), and their folders under
+#: data/hands/ (each with its hand description, hand.yaml).
+_SHIPPED_FOLDERS: dict[str, str] = {"shadow_hand": "shadow", "inspire_hand": "inspire"}
+SHIPPED_HANDS: tuple[str, ...] = tuple(_SHIPPED_FOLDERS)
 
 
 def shipped_hand_path(name: str) -> Path:
     """The hand description of the shipped hand ``name`` (one of SHIPPED_HANDS)."""
-    folder = {"shadow_hand": "shadow"}[name]
-    return default_hand_path().parent / "hands" / folder / "hand.yaml"
+    return default_hand_path().parent / "hands" / _SHIPPED_FOLDERS[name] / "hand.yaml"
 
 
 def hand_spec(path: str | Path | None) -> tuple[HandSpec, str]:

@@ -91,6 +91,9 @@ class HandSpec:
     #: whether a finger link may have no shape (a body that only carries a joint, read from
     #: MJCF; a YAML hand file gives every link its capsule)
     shapeless_links: bool = False
+    #: pairs of link names that are not self-contacts besides parent/child pairs (an MJCF
+    #: model's contact exclusions)
+    ignored_pairs: tuple[tuple[str, str], ...] = ()
 
 
 # --------------------------------------------------------------------------- reading

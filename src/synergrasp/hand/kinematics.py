@@ -184,6 +184,8 @@ def build_hand(spec: HandSpec, source: str = "the shipped hand") -> Hand:
     # the knuckles sit in the palm: none of them may be tested against it
     ignored.update((0, fl[0]) for fl in finger_links)
     frames, links = tree.frames, tree.links
+    names = [link[0] for link in links]
+    ignored.update(tuple(sorted((names.index(a), names.index(b)))) for a, b in spec.ignored_pairs)
     return Hand(
         name=spec.name, joint_names=tuple(joint_names), lower=np.array(lower), upper=np.array(upper),
         link_names=tuple(link[0] for link in links), link_finger=tuple(link[1] for link in links),

@@ -8,6 +8,10 @@ and the collision geoms to leave out. :func:`mjcf_hand_spec` compiles the model 
 compiler resolved includes, defaults and ``fromto``), checks every name and converts it into
 the project's :class:`HandSpec` (mm, rad, the palm frame of docs/hand.md): a new front door
 to the same hand model. MuJoCo works in metres; every length is multiplied by 1000 here.
+The model's own statements are read too: its joint equalities (``<equality><joint>``, linear
+through zero) are couplings, its contact exclusions (``<contact><exclude>``) pairs of links
+that are not self-contacts, and with ``fit_meshes: true`` each collision mesh becomes the
+capsule or box that holds its convex hull (``synergrasp.hand.mesh_fit``).
 """
 
 from __future__ import annotations
@@ -22,19 +26,21 @@ from numpy.typing import NDArray
 
 from synergrasp.hand.geometry import Shape, axis_rotation, pose_matrix
 from synergrasp.hand.hand_file import FINGERS, FingerSpec, HandSpec, JointSpec
+from synergrasp.hand.mesh_fit import MeshFitError, fit_box, fit_capsule, hull_vertices
 
 __all__ = ["mjcf_hand_spec", "compile_mjcf", "MM_PER_M"]
 
 MM_PER_M = 1000.0
 
 _KEYS = ("name", "mjcf", "urdf", "palm", "palm_normal", "finger_direction", "fixed_joints", "couplings",
-         "ignore_geoms", "fingers")
+         "ignore_geoms", "fit_meshes", "fingers")
 _FINGER_KEYS = ("joints", "tip_site", "tip_mm")
 _CHAIN_KEYS = ("mjcf", "name", "link", "reverse", "scale")
-#: MuJoCo's joint and geom type codes (mjtJoint, mjtGeom) and their names in messages.
+#: MuJoCo's joint, geom and equality type codes (mjtJoint, mjtGeom, mjtEq) and their names in messages.
 _JOINT_TYPES = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
 _GEOM_TYPES = {0: "plane", 1: "hfield", 2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box",
                7: "mesh", 8: "sdf"}
+_EQ_JOINT = 2
 
 
 class _Error(ValueError):
@@ -48,6 +54,7 @@ class _Model:
     model: Any
     where: str   # "hand file '<description>'"
     xml: str     # the MJCF file's name
+    fit_meshes: bool = False  # a collision mesh becomes the capsule or box holding its hull
 
     def find(self, kind: str, name: Any, field: str) -> int:
         """Index of the ``kind`` (body, joint, site, geom) named ``name``; one line naming the
@@ -94,8 +101,9 @@ def _hinge(model: Any, joint: int, angle: float) -> NDArray[np.float64]:
     return pose_matrix(anchor) @ turn @ pose_matrix(-anchor)
 
 
-def _geom_shape(m: _Model, geom: int, pose: NDArray) -> Shape:
-    """The project's shape of a collision geom (``pose``: its pose in the link frame, mm)."""
+def _geom_shape(m: _Model, geom: int, pose: NDArray, palm: bool) -> Shape:
+    """The project's shape of a collision geom (``pose``: its pose in the link frame, mm;
+    ``palm``: the geom is part of the palm, whose frame is the link frame)."""
     model = m.model
     kind = int(model.geom_type[geom])
     size = model.geom_size[geom] * MM_PER_M
@@ -106,9 +114,20 @@ def _geom_shape(m: _Model, geom: int, pose: NDArray) -> Shape:
     if kind == 6:  # box: half-sizes
         return Shape("box", pose, size=2.0 * size)
     label = repr(model.geom(geom).name) if model.geom(geom).name else f"#{geom} (unnamed)"
-    raise _Error(f"{m.where}: geom {label} of body {model.body(model.geom_bodyid[geom]).name!r} in "
-                 f"'{m.xml}': a {_GEOM_TYPES.get(kind, kind)} collision geom is refused (the closure collides "
-                 "capsules, spheres and boxes); give the hand capsules/boxes or list it in ignore_geoms")
+    where = f"{m.where}: geom {label} of body {model.body(model.geom_bodyid[geom]).name!r} in '{m.xml}'"
+    if kind == 7 and m.fit_meshes:  # the capsule (finger link) or box (palm) holding the mesh's hull
+        try:
+            hull = hull_vertices(model, geom)
+            if palm:
+                fitted, edges = fit_box(hull, pose[:3, :3].T)  # the palm frame's axes, in the geom's frame
+                return Shape("box", pose @ fitted, size=edges)
+            fitted, radius, length = fit_capsule(hull)
+        except MeshFitError as err:
+            raise _Error(f"{where}: the mesh is refused: {err}") from None
+        return Shape("capsule", pose @ fitted, radius=radius, length=length)
+    hint = "; or fit_meshes: true" if kind == 7 else ""
+    raise _Error(f"{where}: a {_GEOM_TYPES.get(kind, kind)} collision geom is refused (the closure collides "
+                 f"capsules, spheres and boxes); give the hand capsules/boxes or list it in ignore_geoms{hint}")
 
 
 def _geom_pose(model: Any, geom: int) -> NDArray[np.float64]:
@@ -165,14 +184,17 @@ def mjcf_hand_spec(doc: dict, path: Path, where: str) -> HandSpec:
         raise _Error(f"{where}: {fmt}: '{xml}' is a folder; give the model's file")
     if not xml.is_file():
         raise _Error(f"{where}: {fmt}: file '{xml}' does not exist")
+    fit_meshes = doc.get("fit_meshes", False)
+    if not isinstance(fit_meshes, bool):
+        raise _Error(f"{where}: fit_meshes: must be true or false, got {fit_meshes!r}")
     try:
-        m = _Model(compile_mjcf(xml), where, xml.name)
+        m = _Model(compile_mjcf(xml), where, xml.name, fit_meshes)
     except ValueError as err:  # MuJoCo's compiler error: its first line names the element
         raise _Error(f"{where}: {fmt}: MuJoCo cannot compile '{xml}': {str(err).splitlines()[0]}") from None
     model = m.model
     palm = m.find("body", doc.get("palm"), "palm")
     fixed = _names(doc, "fixed_joints", where, dict)
-    couplings = _names(doc, "couplings", where, dict)
+    couplings = _equality_couplings(m, palm, _names(doc, "couplings", where, dict))
     ignored = {m.find("geom", g, "ignore_geoms") for g in _names(doc, "ignore_geoms", where, list)}
     for name in fixed:
         _hinge_joint(m, m.find("joint", name, f"fixed_joints.{name}"), f"fixed_joints.{name}")
@@ -191,11 +213,50 @@ def mjcf_hand_spec(doc: dict, path: Path, where: str) -> HandSpec:
         link = owner[body]
         base = np.eye(4) if link < 0 else joint_frames[link]
         shapes.setdefault(link, []).append(
-            _geom_shape(m, geom, np.linalg.inv(base) @ body_pose[body] @ _geom_pose(model, geom)))
+            _geom_shape(m, geom, np.linalg.inv(base) @ body_pose[body] @ _geom_pose(model, geom), link < 0))
     fingers = tuple(_finger(m, doc["fingers"][f], f, chains[f], joint_frames, shapes, couplings, body_pose)
                     for f in FINGERS)
     return HandSpec(str(doc.get("name", xml.stem)), np.array([1.0, 0.0, 0.0]), tuple(shapes[-1]), fingers,
-                    (), shapeless_links=True)
+                    (), shapeless_links=True, ignored_pairs=_excluded_pairs(m, owner, chains))
+
+
+def _equality_couplings(m: _Model, palm: int, couplings: dict) -> dict:
+    """The description's ``couplings`` and the model's active joint equalities of joints
+    below the palm, ``joint1 = c1 × joint2`` (polycoef c0 = c2 = c3 = c4 = 0), as entries
+    ``{follows: joint2, ratio: c1}``; a joint coupled by both, or a non-linear equality,
+    refused in one line."""
+    model = m.model
+    out = dict(couplings)
+    for eq in range(model.neq):
+        if int(model.eq_type[eq]) != _EQ_JOINT or not model.eq_active0[eq]:
+            continue
+        joint, master = int(model.eq_obj1id[eq]), int(model.eq_obj2id[eq])
+        if not _descends(model, int(model.jnt_bodyid[joint]), palm, strictly=True):
+            continue  # a joint outside the hand (an arm's)
+        name = model.joint(joint).name
+        coef = [float(c) for c in model.eq_data[eq][:5]]
+        field = f"equality {model.eq(eq).name or f'#{eq}'!r} in '{m.xml}'"
+        if master < 0 or coef[0] != 0.0 or any(c != 0.0 for c in coef[2:]) or coef[1] == 0.0:
+            raise _Error(f"{m.where}: {field}: joint {name!r} is held by polycoef {coef}; only a coupling "
+                         "joint1 = c1 × joint2 (polycoef 0 c1 0 0 0) is read")
+        if name in out:
+            raise _Error(f"{m.where}: couplings.{name}: joint {name!r} is coupled by {field} already")
+        out[name] = {"follows": model.joint(master).name, "ratio": coef[1]}
+    return out
+
+
+def _excluded_pairs(m: _Model, owner: dict[int, int], chains: dict) -> tuple[tuple[str, str], ...]:
+    """The model's contact exclusions (``<contact><exclude body1 body2>``) between bodies of the
+    hand, as pairs of the project's link names (the palm: ``palm``): not self-contacts."""
+    model = m.model
+    link = {j: entry["link"] for chain in chains.values() for j, entry in chain}
+    link[-1] = "palm"
+    pairs = set()
+    for signature in model.exclude_signature[:model.nexclude]:
+        a, b = int(signature) >> 16, int(signature) & 0xFFFF
+        if a in owner and b in owner and owner[a] != owner[b]:
+            pairs.add(tuple(sorted((link[owner[a]], link[owner[b]]))))
+    return tuple(sorted(pairs))
 
 
 def _hinge_joint(m: _Model, joint: int, field: str) -> None:

@@ -23,6 +23,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
+from synergrasp.hand.description import SHIPPED_HANDS, shipped_hand_path
 from synergrasp.hand.kinematics import JOINT_NAMES, load_hand
 from synergrasp.yaml_io import read_yaml
 
@@ -39,6 +40,7 @@ __all__ = [
     "write_synergies",
     "shipped_path",
     "SHIPPED_TABLES",
+    "shipped_hand_table",
     "DEFAULT_TABLE",
 ]
 
@@ -168,13 +170,13 @@ def resolve_synergies(source: str | Path | None) -> Path:
         return shipped_path()
     if str(source) in SHIPPED_TABLES:
         return shipped_path(str(source))
-    if str(source) == "shadow_hand":  # the shipped Shadow hand's table (its hand: shadow_hand)
-        return shadow_hand_files()[2]
+    if str(source) in SHIPPED_HANDS:  # a shipped hand's own table (its hand: the same name)
+        return shipped_hand_table(str(source))
     path = Path(source)
     if path.is_dir():
         raise SynergyFileError(f"synergy file '{source}': is a folder; give a synergy CSV file or a shipped table's name")
     if not path.is_file():
-        raise SynergyFileError(f"synergy file '{source}': is neither a shipped table {[*SHIPPED_TABLES, 'shadow_hand']} "
+        raise SynergyFileError(f"synergy file '{source}': is neither a shipped table {[*SHIPPED_TABLES, *SHIPPED_HANDS]} "
                                f"nor an existing CSV file")
     return path
 
@@ -421,6 +423,12 @@ def write_synergies(synergies: Synergies, path: str | Path) -> None:
     table.insert(0, "mean_rad", synergies.mean)
     table.insert(0, "joint", list(synergies.joint_names))
     table.to_csv(path, index=False, float_format="%.17g", lineterminator="\n")
+
+
+def shipped_hand_table(name: str) -> Path:
+    """The synergy table of the shipped hand ``name`` (one of SHIPPED_HANDS), beside its
+    description: ``synergies.csv``."""
+    return shipped_hand_path(name).parent / "synergies.csv"
 
 
 def shadow_hand_files() -> tuple[Path, Path, Path]:
