@@ -67,9 +67,11 @@ class StudySolver(Oracle):
     """Solves synergy sets at poses of one object through `optimise_grasps`, one solve per
     distinct grasp (the study's sharing of twins), and remembers them: a (grasp, set) is
     solved once however many radii ask. ``n_problems`` counts the problems handed to the
-    solver."""
+    solver; as an :class:`~synergrasp.analysis.planners.Oracle` (``solver(k, poses)``: a
+    planner's solve of {S1..Sk}) it also keeps the planners' cost ledger."""
 
     def __init__(self, contacts: pd.DataFrame, matrix: NDArray, params: PlanParams):
+        super().__init__(len(contacts), params.n_levels)
         self.contacts = contacts.reset_index(drop=True)
         self.grasps = read_grasps(self.contacts)
         self.first = first_same_grasp(self.grasps)
