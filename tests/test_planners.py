@@ -199,3 +199,45 @@ def test_the_solve_times_are_the_benchmark_s():
     with open(ROOT / "benchmarks" / "results" / "set_size.csv", newline="") as f:
         recorded = {row["figure"]: float(row["value"]) for row in csv.DictReader(f)}
     assert SOLVE_COST_BY_SET_SIZE == tuple(recorded[f"solve_cost_k{k}"] for k in range(1, 16))
+
+
+def test_synergrasp_plan_on_demand_closes_only_where_the_planner_asks_and_agrees_with_the_replay(tmp_path, capsys):
+    """A new object (no study tables): the planner closes the hand pose by pose; the same
+    planner replayed on the exhaustive closure and optimisation of every pose ends at the same
+    pose with the same force and the same closures (a grid without twin poses)."""
+    import yaml
+
+    from synergrasp import tables
+    from synergrasp.analysis.plan_new import object_closure
+    from synergrasp.cli import main
+    from synergrasp.hand.synergies import load_synergies
+    from synergrasp.study_checks import checked_scenario, read_overlays
+
+    config = yaml.safe_load((ROOT / "tests" / "config" / "small.yaml").read_text())
+    config["objects"] = {"obj1": config["objects"]["obj1"]}
+    config["grid"] = {"alpha_deg": {"start": -40, "stop": 40, "step": 20}, "beta_deg": {"start": -60, "stop": 60, "step": 20}}
+    config["analyses"]["fig4"]["alpha_slice_deg"] = -20
+    overlay = tmp_path / "new.yaml"
+    overlay.write_text(yaml.safe_dump(config))
+    args = ["plan", "obj1", "--configfile", str(overlay), "--results", str(tmp_path)]
+    for bad, says in ((["--planner", "nope"], "--planner 'nope' is not a candidate"), (["--seed", "-1"], "--seed -1"),
+                      (["--radius", "10"], "--radius"), (["--csv", str(tmp_path / "no" / "x.csv")], "--csv")):
+        assert main(args + bad) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and says in err[0]
+    assert main(args + ["--planner", "descent_5", "--seed", "3", "--csv", str(tmp_path / "plan.csv")]) == 0
+    assert "obj1 on demand, planner descent_5 (seed 3)" in capsys.readouterr().out
+    plan = tables.read_csv(tables.PLAN_ON_DEMAND, tmp_path / "plan.csv").iloc[0]
+    assert plan["n_poses"] == 35 and 0 < plan["closures"] < 35 and np.isnan(plan["regret_percent"])
+    # the exhaustive study of the same object: every pose closed, every level solved
+    cfg, _ = checked_scenario(read_overlays([str(overlay)]))
+    close, grid = object_closure(cfg, "obj1", str(tmp_path))
+    contacts = close(list(range(grid.n_poses)))
+    params = PlanParams.from_config(cfg, "obj1")
+    matrix = load_synergies(None).matrix
+    gfo = gfo_table(contacts, SynergySets(matrix, tuple(tuple(range(1, k + 1)) for k in range(1, 16))), params.gfo)
+    replay = replay_oracle(contacts, gfo, 15, params.minima)()
+    spec = next(s for s in CANDIDATES if s.name == "descent_5")
+    pose, force = run_planner(spec, grid, replay, 15, params.minima.radius_deg, np.random.default_rng(3))
+    assert plan["pose"] == pose and plan["force_N"] == pytest.approx(force, rel=1e-5)
+    assert plan["closures"] == replay.closures and plan["problems"] == replay.problems.sum()

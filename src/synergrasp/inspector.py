@@ -20,7 +20,7 @@ import pandas as pd
 from synergrasp.ids import set_id, set_name
 from synergrasp.optimisation.quality import GraspQuality, grasp_quality
 
-__all__ = ["InspectionError", "BlockingContact", "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp",
+__all__ = ["InspectionError", "searched_target", "BlockingContact", "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp",
            "grasp_picture", "grasp_view"]
 
 
@@ -186,7 +186,7 @@ def _contacts_frame(hand: Any, row: pd.Series, shape: Any, rule: Any) -> pd.Data
                          "feature": surface_features(points, shape, R, c, rule)})
 
 
-def _searched(placement: Any, path: Path) -> Any:
+def searched_target(placement: Any, path: Path) -> Any:
     """The searched placement with the target the object's search chose (its placement.csv)."""
     from synergrasp import tables
     from synergrasp.simulation.placement import searched_placement
@@ -226,7 +226,7 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     pose, _ = _pose_index(sim.placement, alpha_deg, beta_deg)
     placement = sim.placement
     if placement.mode == "searched":
-        placement = _searched(placement, Path(results) / "objects" / obj / "placement.csv")
+        placement = searched_target(placement, Path(results) / "objects" / obj / "placement.csv")
     hand = load_hand(sim.hand)
     full = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
     chosen = default_sets(full.matrix.shape[1]) if sets is None else [tuple(sorted(set(s))) for s in sets]

@@ -16,7 +16,7 @@ import pandas as pd
 
 from synergrasp.file_output import replacing
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT", "PLAN", "ENROLLMENT", "PLANNERS", "PLANNERS_ACROSS", "BLOCKERS",
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT", "PLAN", "ENROLLMENT", "PLANNERS", "PLANNERS_ACROSS", "PLAN_ON_DEMAND", "BLOCKERS",
            "QUALITY", "TARGET_CLAIMS", "write", "read", "write_csv", "read_csv", "empty", "write_study_table"]
 
 
@@ -294,6 +294,23 @@ ENROLLMENT = Table("enrollment", "one row per k", (
     Column("full_n_success", "int32", "", "grid poses where the full set succeeds"),
 ))
 
+#: A plan on demand (``synergrasp plan --on-demand --csv``): the hand closed only where the planner asks.
+PLAN_ON_DEMAND = Table("plan_on_demand", "one row per plan", (
+    Column("object", "string", "", "object name"),
+    Column("planner", "string", "", "the candidate planner (docs/planner.md)"),
+    Column("seed", "int32", "", "numpy.random.default_rng seed of a randomised planner"),
+    Column("pose", "int32", "", "its pose (-1: none succeeds)"),
+    Column("alpha_deg", "float64", "deg", "its alpha"),
+    Column("beta_deg", "float64", "deg", "its beta"),
+    Column("force_N", "float64", "N", "its optimal force with the full set"),
+    Column("closures", "int32", "", "closures run: the poses the planner asked"),
+    Column("n_poses", "int32", "", "the grid's poses (the exhaustive search's closures)"),
+    Column("problems", "int32", "", "(grasp, set) problems solved"),
+    Column("wall_s", "float64", "s", "wall time of the plan: closures and solves"),
+    Column("exhaustive_min_force_N", "float64", "N", "the study's least full-set force over every pose (NaN: no study)"),
+    Column("regret_percent", "float64", "%", "100 (force_N / exhaustive_min_force_N - 1) (NaN: no study)"),
+))
+
 #: Planners compared at equal cost on one scenario's objects (results/tables/planners.csv).
 PLANNERS = Table("planners", "one row per object and candidate planner", (
     Column("object", "string", "", "object name"),
@@ -332,7 +349,7 @@ PLANNERS_ACROSS = Table("planners_across", "one row per candidate planner", (
 
 TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, QUALITY,
                                                 TARGET_CLAIMS, BLOCKERS, PLAN, ENROLLMENT,
-                                                PLANNERS, PLANNERS_ACROSS)}
+                                                PLANNERS, PLANNERS_ACROSS, PLAN_ON_DEMAND)}
 
 
 def _check(table: Table, frame: pd.DataFrame, where: str) -> None:

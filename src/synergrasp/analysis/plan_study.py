@@ -73,6 +73,8 @@ class StudySolver(Oracle):
     def __init__(self, contacts: pd.DataFrame, matrix: NDArray, params: PlanParams):
         super().__init__(len(contacts), params.n_levels)
         self.contacts = contacts.reset_index(drop=True)
+        self.object_name = str(self.contacts["object"].iat[0]) if len(self.contacts) else ""
+        self.pose_ids = self.contacts["pose"].to_numpy(np.int64)
         self.grasps = read_grasps(self.contacts)
         self.first = first_same_grasp(self.grasps)
         self.matrix, self.params = matrix, params
@@ -100,10 +102,9 @@ class StudySolver(Oracle):
     def _solve(self, sets: Sequence[tuple[int, ...]], ids: list[str], grasps: list[int]) -> None:
         out = optimise_grasps([self.grasps[g] for g in grasps], SynergySets(self.matrix, tuple(sets)), self.params.gfo)
         self.n_problems += len(grasps) * len(sets)
-        part = self.contacts.iloc[np.repeat(grasps, len(sets))]
-        frame = pd.DataFrame({"object": part["object"].to_numpy(), "pose": part["pose"].to_numpy()} | out)
+        frame = pd.DataFrame({"object": self.object_name, "pose": self.pose_ids[np.repeat(grasps, len(sets))]} | out)
         minima = self.params.minima
-        weights = {str(frame["object"].iat[0]): minima.weight_N} if minima.weight_N is not None and len(frame) else None
+        weights = {self.object_name: minima.weight_N} if minima.weight_N is not None and len(frame) else None
         judged = with_verdicts(frame, minima.success, weights, minima.bound_multiple)
         success, force = judged["success"].to_numpy(bool), judged["success_force"].to_numpy(float)
         for row, g in enumerate(np.repeat(grasps, len(sets))):
