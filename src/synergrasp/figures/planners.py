@@ -48,8 +48,17 @@ def figure_planners(per_object: pd.DataFrame, across: pd.DataFrame, png: str | P
             chosen = bool(getattr(r, "recommended", False))
             ax_all.scatter(getattr(r, cost), r.meeting_aim_percent, marker=_MARKERS.get(_kind(r.planner), "o"),
                            color=_COLOURS[r.family], s=120 if chosen else 30, edgecolors="k" if chosen else "none")
-            ax_all.annotate(r.planner, (getattr(r, cost), r.meeting_aim_percent), fontsize=6, rotation=30,
-                            xytext=(3, 2), textcoords="offset points")
+        # planners at the same point share one label (every incremental planner closes every pose)
+        spots = across.assign(x=across[cost].round(0), y=across["meeting_aim_percent"].round(1))
+        for (x, y), part in spots.groupby(["x", "y"], sort=False):
+            names = list(part["planner"])
+            text = "\n".join(", ".join(names[i:i + 3]) for i in range(0, len(names), 3))
+            if cost == "closures":  # few distinct costs: labels beside their point, grouped
+                right = x >= 1000
+                ax_all.annotate(text, (x, y), fontsize=5.5, xytext=(-7 if right else 5, 0), textcoords="offset points",
+                                ha="right" if right else "left", va="center")
+            else:  # many close costs at the same share: slanted labels
+                ax_all.annotate(text, (x, y), fontsize=6, rotation=35, xytext=(3, 2), textcoords="offset points")
         ax_all.axhline(OBJECTS_AIM, color="0.4", lw=0.8, ls="--")
         ax_all.set_xscale("log")
         ax_all.set_xlabel(f"{label}, mean over objects")
