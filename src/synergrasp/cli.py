@@ -183,7 +183,12 @@ def _plan(args: argparse.Namespace) -> int:
                           if (folder / f).is_file()), folder / "contacts.parquet")
     on_demand = args.on_demand or not (folder / "gfo.parquet").is_file()
     try:
-        cfg, _ = checked_scenario(read_overlays(args.configfile))
+        config = read_overlays(args.configfile)
+        if config.get("random_objects"):  # pybullet's random objects, drawn as the workflow draws them
+            from synergrasp.simulation.random_objects import add_random_objects
+
+            add_random_objects(config, ".")
+        cfg, _ = checked_scenario(config)
         if args.object not in cfg["objects"]:
             raise ConfigError(f"object {args.object!r} is not in the configuration ({', '.join(cfg['objects'])})")
         params = PlanParams.from_config(cfg, args.object)

@@ -53,7 +53,7 @@ class OnDemandSolver(StudySolver):
         self.matrix, self.params = matrix, params
         self.memo: dict[tuple[str, int], tuple[bool, float]] = {}
         self.n_problems = 0
-        self.close, self.rows = close, []
+        self.close = close
         self.is_closed = np.zeros(n_poses, dtype=bool)
 
     def ask(self, k: int, poses: NDArray[np.int64]) -> tuple[NDArray, NDArray]:
@@ -63,15 +63,10 @@ class OnDemandSolver(StudySolver):
             for pose, grasp in zip(new, read_grasps(table.reset_index(drop=True))):
                 self.grasps[int(pose)] = grasp
             self.is_closed[new] = True
-            self.rows.append(table)
             # the first closed pose of a grasp stays its representative: twins only point to it
             first = np.asarray(first_same_grasp(self.grasps), dtype=np.int64)
             self.first = np.where(self.first >= 0, self.first, first)
         return super().ask(k, poses)
-
-    def closed_contacts(self) -> pd.DataFrame:
-        """The contacts table of every pose closed so far, in the order they were closed."""
-        return pd.concat(self.rows, ignore_index=True) if self.rows else pd.DataFrame()
 
 
 @dataclass(frozen=True)
