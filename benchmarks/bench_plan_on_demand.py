@@ -1,5 +1,6 @@
 """`synergrasp plan --on-demand` on every object of the configuration (the four boxes of the
-default study): the hand closed only where the planner asks, against the study's exhaustive
+default study, or those of ``--configfile`` overlays, e.g. pybullet's random objects): the
+hand closed only where the planner asks, against the study's exhaustive
 minimum (docs/planner.md). Needs a study's results (``--results``: the searched placement's
 target and the gfo tables the regret is read from). Per object the machine-read lines
 (`key: N  (what)`, tools/measurements.py): closures run, their share of the grid, the wall
@@ -13,9 +14,8 @@ import tempfile
 from pathlib import Path
 
 from synergrasp import tables
-from synergrasp.analysis.plan_new import DEFAULT_PLANNER
+from synergrasp.analysis.plan_new import DEFAULT_PLANNER, plan_configuration
 from synergrasp.cli import main as synergrasp
-from synergrasp.config import defaults
 
 
 def main() -> None:
@@ -23,13 +23,15 @@ def main() -> None:
     ap.add_argument("--results", default="results", help="the study's results")
     ap.add_argument("--planner", default=DEFAULT_PLANNER)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--configfile", nargs="+", default=[], help="overlays on the study's configuration")
     args = ap.parse_args()
     rows = []
     with tempfile.TemporaryDirectory() as folder:
-        for obj in defaults()["objects"]:
+        for obj in plan_configuration(args.configfile)["objects"]:
             out = Path(folder) / f"{obj}.csv"
             code = synergrasp(["plan", obj, "--on-demand", "--planner", args.planner, "--seed", str(args.seed),
-                               "--results", args.results, "--csv", str(out)])
+                               "--results", args.results, "--csv", str(out)]
+                               + (["--configfile", *args.configfile] if args.configfile else []))
             if code:
                 raise SystemExit(code)
             rows.append(tables.read_csv(tables.PLAN_ON_DEMAND, out).iloc[0])

@@ -176,19 +176,14 @@ def _plan(args: argparse.Namespace) -> int:
     from synergrasp.analysis.plan_study import PlanParams, plan_object
     from synergrasp.config import ConfigError
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.study_checks import checked_scenario, read_overlays
+    from synergrasp.analysis.plan_new import plan_configuration
 
     folder = Path(args.results) / "objects" / args.object
     contacts_path = next((folder / f for f in ("load_carrying_contacts.parquet", "contacts.parquet")
                           if (folder / f).is_file()), folder / "contacts.parquet")
     on_demand = args.on_demand or not (folder / "gfo.parquet").is_file()
     try:
-        config = read_overlays(args.configfile)
-        if config.get("random_objects"):  # pybullet's random objects, drawn as the workflow draws them
-            from synergrasp.simulation.random_objects import add_random_objects
-
-            add_random_objects(config, ".")
-        cfg, _ = checked_scenario(config)
+        cfg = plan_configuration(args.configfile)  # with pybullet's random objects, as the workflow draws them
         if args.object not in cfg["objects"]:
             raise ConfigError(f"object {args.object!r} is not in the configuration ({', '.join(cfg['objects'])})")
         params = PlanParams.from_config(cfg, args.object)

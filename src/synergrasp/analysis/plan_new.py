@@ -23,7 +23,7 @@ from synergrasp.analysis.plan_study import PlanParams, StudySolver
 from synergrasp.analysis.planners import CANDIDATES, Oracle, PlannerSpec, PoseGrid, run_planner
 from synergrasp.optimisation.mechanics import first_same_grasp, read_grasps
 
-__all__ = ["DEFAULT_PLANNER", "planner_spec", "OnDemandSolver", "OnDemandPlan", "plan_on_demand", "object_closure"]
+__all__ = ["DEFAULT_PLANNER", "planner_spec", "OnDemandSolver", "OnDemandPlan", "plan_on_demand", "object_closure", "plan_configuration"]
 
 #: The rule's choice on the default study's four boxes (tables/planners_across.csv); the
 #: hundred random objects have not yet been compared (docs/planner.md).
@@ -130,3 +130,16 @@ def object_closure(cfg: dict, obj: str, results: str) -> tuple[Callable[[Sequenc
         return load_carrying_contacts(table, selection.load_threshold_N) if selection.drop_unloaded else table
 
     return close, PoseGrid.from_angles(angles[:, 0], angles[:, 1])
+
+
+def plan_configuration(configfiles: Sequence[str]) -> dict:
+    """The checked configuration of ``synergrasp plan`` from its overlay files, pybullet's random
+    objects drawn as the workflow draws them (``random_objects``, paths relative to the working
+    directory: the project's root). Raises ``ConfigError`` naming the file or the key."""
+    from synergrasp.simulation.random_objects import add_random_objects
+    from synergrasp.study_checks import checked_scenario, read_overlays
+
+    config = read_overlays(configfiles)
+    if config.get("random_objects"):
+        add_random_objects(config, ".")
+    return checked_scenario(config)[0]
