@@ -14,7 +14,8 @@ import tempfile
 from pathlib import Path
 
 from synergrasp import tables
-from synergrasp.analysis.plan_new import DEFAULT_PLANNER, plan_configuration
+from synergrasp.analysis.plan_new import DEFAULT_PLANNER
+from synergrasp.study_checks import checked_configuration
 from synergrasp.cli import main as synergrasp
 
 
@@ -27,7 +28,7 @@ def main() -> None:
     args = ap.parse_args()
     rows = []
     with tempfile.TemporaryDirectory() as folder:
-        for obj in plan_configuration(args.configfile)["objects"]:
+        for obj in checked_configuration(args.configfile)["objects"]:
             out = Path(folder) / f"{obj}.csv"
             code = synergrasp(["plan", obj, "--on-demand", "--planner", args.planner, "--seed", str(args.seed),
                                "--results", args.results, "--csv", str(out)]

@@ -208,7 +208,7 @@ def test_synergrasp_plan_on_demand_closes_only_where_the_planner_asks_and_agrees
     import yaml
 
     from synergrasp import tables
-    from synergrasp.analysis.plan_new import object_closure
+    from synergrasp.inspector import object_closure
     from synergrasp.cli import main
     from synergrasp.hand.synergies import load_synergies
     from synergrasp.study_checks import checked_scenario, read_overlays

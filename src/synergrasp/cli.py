@@ -176,14 +176,14 @@ def _plan(args: argparse.Namespace) -> int:
     from synergrasp.analysis.plan_study import PlanParams, plan_object
     from synergrasp.config import ConfigError
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.analysis.plan_new import plan_configuration
+    from synergrasp.study_checks import checked_configuration
 
     folder = Path(args.results) / "objects" / args.object
     contacts_path = next((folder / f for f in ("load_carrying_contacts.parquet", "contacts.parquet")
                           if (folder / f).is_file()), folder / "contacts.parquet")
     on_demand = args.on_demand or not (folder / "gfo.parquet").is_file()
     try:
-        cfg = plan_configuration(args.configfile)  # with pybullet's random objects, as the workflow draws them
+        cfg = checked_configuration(args.configfile)  # with pybullet's random objects, as the workflow draws them
         if args.object not in cfg["objects"]:
             raise ConfigError(f"object {args.object!r} is not in the configuration ({', '.join(cfg['objects'])})")
         params = PlanParams.from_config(cfg, args.object)
@@ -216,7 +216,8 @@ def _plan(args: argparse.Namespace) -> int:
 def _on_demand_inputs(args: argparse.Namespace, cfg: dict) -> tuple[Any, Any, Any]:
     """The planner, ``close(poses)`` and the pose grid of ``synergrasp plan --on-demand``; each
     bad argument a ValueError naming it, before any closure."""
-    from synergrasp.analysis.plan_new import DEFAULT_PLANNER, object_closure, planner_spec
+    from synergrasp.analysis.plan_new import DEFAULT_PLANNER, planner_spec
+    from synergrasp.inspector import object_closure
 
     spec = planner_spec(args.planner or DEFAULT_PLANNER)
     if args.seed < 0:

@@ -27,7 +27,7 @@ from synergrasp.preflight import refuse
 from synergrasp.resolved import effective_placement, grasp_type
 from synergrasp.yaml_io import read_yaml
 
-__all__ = ["checked_scenario", "workflow_scenario", "read_overlays", "search_rank_problems", "lattice_rank_problems",
+__all__ = ["checked_scenario", "checked_configuration", "workflow_scenario", "read_overlays", "search_rank_problems", "lattice_rank_problems",
            "search_table_or_refuse", "searched_objects_or_refuse"]
 
 
@@ -165,3 +165,15 @@ def searched_objects_or_refuse(files: list[str], target: str, cfg: Mapping[str, 
         stop([f"{target}: no object's placement is searched (placement.mode: {', '.join(modes)}); the claims at the "
               "placement search's targets need placement.mode: searched (docs/placement_search.md)"])
     return files
+
+
+def checked_configuration(configfiles: Sequence[str | Path]) -> dict[str, Any]:
+    """The checked configuration of overlay files (``synergrasp plan``), pybullet's random
+    objects drawn as the workflow draws them (``random_objects``, paths relative to the working
+    directory: the project's root). Raises ``ConfigError`` naming the file or the key."""
+    from synergrasp.simulation.random_objects import add_random_objects
+
+    config = read_overlays(configfiles)
+    if config.get("random_objects"):
+        add_random_objects(config, ".")
+    return checked_scenario(config)[0]

@@ -1,9 +1,10 @@
 """A planner for a new object (``synergrasp plan --on-demand``, docs/planner.md): the hand is
 closed only at the poses the planner asks, pose by pose on demand, through the study's
 closure front door (``simulation.closure.simulate_object``, with the ``contacts`` step's
-choice of contacts), and every set is solved through the optimisation front door
-(``optimise_grasps``, via :class:`synergrasp.analysis.plan_study.StudySolver`); so a plan
-costs the planner's closures, not the grid's.
+choice of contacts: ``inspector.object_closure`` makes the ``close`` this module is handed),
+and every set is solved through the optimisation front door (``optimise_grasps``, via
+:class:`synergrasp.analysis.plan_study.StudySolver`); so a plan costs the planner's
+closures, not the grid's.
 
 The default planner, :data:`DEFAULT_PLANNER`, is the one the pre-registered rule selects
 (``analysis.planners.recommended``) on the study's comparison (table ``planners_across``).
@@ -23,7 +24,7 @@ from synergrasp.analysis.plan_study import PlanParams, StudySolver
 from synergrasp.analysis.planners import CANDIDATES, Oracle, PlannerSpec, PoseGrid, run_planner
 from synergrasp.optimisation.mechanics import first_same_grasp, read_grasps
 
-__all__ = ["DEFAULT_PLANNER", "planner_spec", "OnDemandSolver", "OnDemandPlan", "plan_on_demand", "object_closure", "plan_configuration"]
+__all__ = ["DEFAULT_PLANNER", "planner_spec", "OnDemandSolver", "OnDemandPlan", "plan_on_demand"]
 
 #: The rule's choice on the default study's four boxes (tables/planners_across.csv); the
 #: hundred random objects have not yet been compared (docs/planner.md).
@@ -100,46 +101,3 @@ def plan_on_demand(obj: str, grid: PoseGrid, close: Callable[[Sequence[int]], pd
     return OnDemandPlan(obj, spec.name, seed, pose, a, b, force, int(solver.is_closed.sum()), grid.n_poses,
                         int(solver.problems.sum()), wall), solver
 
-
-def object_closure(cfg: dict, obj: str, results: str) -> tuple[Callable[[Sequence[int]], pd.DataFrame], PoseGrid]:
-    """``close(poses)``: the hand closed on ``obj`` at those grid poses with the configuration's
-    hand, first synergy, placement (a searched target read from ``<results>/objects/<obj>/
-    placement.csv``) and closure, the ``contacts`` step's contacts kept; and the pose grid.
-    ``cfg``: a checked configuration. Raises InspectionError (a searched placement without its
-    table)."""
-    from pathlib import Path
-
-    from synergrasp.hand.kinematics import load_hand
-    from synergrasp.inspector import searched_target
-    from synergrasp.simulation.closure import SimulateParams, simulate_object
-    from synergrasp.simulation.contacts import ContactsParams, load_carrying_contacts
-    from synergrasp.simulation.placement import pose_grid
-
-    sim = SimulateParams.from_config(cfg, obj)
-    placement = sim.placement
-    if placement.mode == "searched":
-        placement = searched_target(placement, Path(results) / "objects" / obj / "placement.csv")
-    hand = load_hand(sim.hand)
-    synergies = sim.synergies(hand.joint_names)
-    selection = ContactsParams.from_config(cfg, obj)
-    grid = pose_grid(placement)
-    angles = np.array([grid.angles_deg(p) for p in range(grid.n_poses)])
-
-    def close(poses: Sequence[int]) -> pd.DataFrame:
-        table = simulate_object(hand, synergies, sim.object, placement, sim.closure, poses=poses, mechanics=sim.mechanics)
-        return load_carrying_contacts(table, selection.load_threshold_N) if selection.drop_unloaded else table
-
-    return close, PoseGrid.from_angles(angles[:, 0], angles[:, 1])
-
-
-def plan_configuration(configfiles: Sequence[str]) -> dict:
-    """The checked configuration of ``synergrasp plan`` from its overlay files, pybullet's random
-    objects drawn as the workflow draws them (``random_objects``, paths relative to the working
-    directory: the project's root). Raises ``ConfigError`` naming the file or the key."""
-    from synergrasp.simulation.random_objects import add_random_objects
-    from synergrasp.study_checks import checked_scenario, read_overlays
-
-    config = read_overlays(configfiles)
-    if config.get("random_objects"):
-        add_random_objects(config, ".")
-    return checked_scenario(config)[0]
