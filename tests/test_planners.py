@@ -241,3 +241,19 @@ def test_synergrasp_plan_on_demand_closes_only_where_the_planner_asks_and_agrees
     pose, force = run_planner(spec, grid, replay, 15, params.minima.radius_deg, np.random.default_rng(3))
     assert plan["pose"] == pose and plan["force_N"] == pytest.approx(force, rel=1e-5)
     assert plan["closures"] == replay.closures and plan["problems"] == replay.problems.sum()
+
+
+def test_max_seeds_keeps_the_minima_of_least_force_and_levels_must_increase_to_n():
+    from synergrasp.analysis.planner import plan_incremental
+
+    two = np.minimum(_cone(0, 0, 1.0), _cone(90, 30, 0.5))  # two minima at level 1: B (0.5 N) below A (1 N)
+    levels = [two, two, np.minimum(_cone(0, 0, 0.2), _cone(90, 30, 0.5))]  # the full set's best is at A
+    oracle = _oracle(levels)()
+    plan = plan_incremental(ALPHA, BETA, oracle, 3, 30.0, 30.0, levels=[1, 3], max_seeds=1)
+    assert plan.seeds[0].tolist() == [_pose(90, 30)] and plan.solved[1].size == 9
+    assert plan.best_pose == _pose(90, 30)  # A's valley was never solved with the full set
+    every = plan_incremental(ALPHA, BETA, _oracle(levels)(), 3, 30.0, 30.0, levels=[1, 3])
+    assert sorted(every.seeds[0].tolist()) == sorted([_pose(0, 0), _pose(90, 30)]) and every.best_pose == _pose(0, 0)
+    for bad in ([1, 2], [2, 1, 3], [0, 3]):
+        with pytest.raises(ValueError, match="levels must increase"):
+            plan_incremental(ALPHA, BETA, oracle, 3, 30.0, levels=bad)

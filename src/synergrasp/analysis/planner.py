@@ -42,7 +42,8 @@ class Plan:
     """One run of the planner.
 
     radius_deg: the neighbourhood half-width around each level's seeds, deg.
-    solved: per level k = 1 … n, the pose indices solved with {S1..Sk}.
+    solved: per level solved (k = 1 … n unless the caller skips levels), the pose indices
+        solved with that level's set {S1..Sk}.
     seeds: per level, the pose indices seeding the next level (its minima, else its best
         success; empty: none, the next level covers the grid).
     from_minima: per level, whether the seeds are local minima.
