@@ -81,10 +81,12 @@ bench: $(BIN)/.installed
 	$(RECORD) compile -- $(BIN)/python benchmarks/bench_compile.py
 	$(RECORD) gfo -- $(BIN)/python benchmarks/bench_gfo.py
 	$(RECORD) pyramid -- $(BIN)/python benchmarks/bench_pyramid.py
+	$(RECORD) set_size -- $(BIN)/python benchmarks/bench_set_size.py
 	$(RECORD) closure -- $(BIN)/python benchmarks/bench_closure.py
 	$(RECORD) search -- $(BIN)/python benchmarks/bench_search.py
 	-$(RECORD) study_rate -- $(BIN)/python benchmarks/bench_study.py --root results
 	-$(RECORD) inspector -- $(BIN)/python benchmarks/bench_inspector.py --results results
+	-$(RECORD) plan_on_demand --timed -- $(BIN)/python benchmarks/bench_plan_on_demand.py --results results
 	$(RECORD) scheduler -- $(BIN)/python benchmarks/bench_scheduler.py
 	-$(RECORD) figure_imports -- $(BIN)/python benchmarks/bench_figure_imports.py --root results
 	$(BIN)/python tools/measurements.py

@@ -205,7 +205,7 @@ def test_every_step_has_its_rules_outputs_and_costs_and_every_rule_its_step():
         assert step.outputs, name
         written = rules[list(step.rules)[-1]][0]
         assert sorted(written) == sorted(prefix[step.scope] + rel for rel in step.outputs.values()), name
-        assert all(c.unit in ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose_set")
+        assert all(c.unit in ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose", "object_pose_set")
                    and c.fixed_s > 0 and c.fixed_mb > 0 and c.threads >= 1 for c in step.rules.values()), name
         assert set(step.upstream) <= set(STEPS), name
         assert set(step.report) | set(step.folders) <= set(step.outputs), name

@@ -130,11 +130,16 @@ def test_tables_have_documented_columns_and_sane_values(run_j2):
     share = preservation["preserved_percent"].dropna()
     assert ((share >= 0) & (share <= 100)).all()
     claims = pd.read_csv(tables / "claims.csv")
-    assert claims.loc[claims["headline"], "claim"].tolist() == list(range(1, 8))  # one headline row per claim
+    assert claims.loc[claims["headline"], "claim"].tolist() == list(range(1, 9))  # one headline row per claim
     assert set(claims["verdict"]) <= {"holds", "does not hold", "undefined"}
+    planner, claims = claims[claims["claim"] == 8].iloc[0], claims[claims["claim"] != 8]
     assert claims.loc[claims["verdict"] != "undefined", "reason"].str.startswith("interval").all()
     decided = claims[claims["verdict"] != "undefined"]
     assert (decided["n_distinct_poses"] >= 30).all() and (decided["low"] <= decided["difference"]).all()
+    # claim 8, over objects (docs/planner.md): both objects of the small study behind it, or no incremental planner
+    across = pd.read_csv(tables / "planners_across.csv")
+    assert across["recommended"].sum() == 1 and (across["objects"] == 2).all()
+    assert planner["n_distinct_poses"] == 2 or planner["reason"].startswith("no incremental planner")
     checks = pd.read_csv(tables / "invariant_checks.csv")
     assert (checks.loc[checks["check"] == "alpha_period", "count"] == 0).all()  # results repeat every 90 deg
     gfo = pd.read_parquet(run_j2 / "results" / "objects" / "obj4" / "gfo.parquet")
@@ -269,7 +274,7 @@ def test_code_inputs_hold_every_module_a_job_loads(run_j2):
         script, *files = record.read_text().splitlines()
         loaded.setdefault(script, set()).update(files)
     assert set(loaded) == {"simulate", "optimise_shard", "optimise", "minima", "tables", "fig1", "fig2", "fig3",
-                           "fig4", "fig5", "realism", "quality", "blockers", "blockers_table"}
+                           "fig4", "fig5", "realism", "quality", "blockers", "blockers_table", "planners"}
     for script, files in loaded.items():
         assert files, script
         assert files <= declared[script], (script, sorted(files - declared[script]))

@@ -65,6 +65,17 @@ SECTIONS = (
     ("Grasp-force optimisation", ("gfo", "pyramid", "compile", "study_rate"),
      "`benchmarks/bench_gfo.py`, `bench_pyramid.py`, `bench_compile.py` and `bench_study.py` (in `make bench`; "
      "one core, OMP_NUM_THREADS=1); docs/ipm_solver.md says what made each figure."),
+    ("Planners", ("set_size", "plan_on_demand", "plan_on_demand_random5_random_1200",
+                  "plan_on_demand_random5_straight_m3_r45"),
+     "`benchmarks/bench_set_size.py` (in `make bench`; one core): CPU time of one (grasp, set) problem per size k of "
+     "{S1..Sk}, one call of `optimise_grasps` per set as a planner's level makes it, the grasp's mechanics "
+     "included; its ratios to the full set's weigh the planners' solve time (docs/planner.md). "
+     "`benchmarks/bench_plan_on_demand.py` (in `make bench`, after a study: it reads the searched targets and "
+     "the gfo tables): `synergrasp plan --on-demand` with the default planner on each box, the hand closed "
+     "only where it asks; closures, wall time of the plan and regret against the study's exhaustive minimum; "
+     "also on the first five random objects (`--configfile config/examples/random_objects.yaml "
+     "config/examples/random_objects_5.yaml`, after their study) with the default planner and with the one the "
+     "rule selects on them."),
     ("One grasp in full", ("inspector",),
      "`benchmarks/bench_inspector.py` (in `make bench`, after a study: it reads obj4's searched target): "
      "`synergrasp grasp obj4 --alpha -30 --beta 0` with its 29 default sets, warm, each run in a fresh process "

@@ -16,6 +16,7 @@ work, for every command: the configuration goes through the workflow's own check
 (``synergrasp.study_checks``). Warnings on the configuration are printed too.
 
     synergrasp plan obj4 [--radius 10 20 30] [--configfile my.yaml] [--results results] [--csv plan.csv]
+    synergrasp plan obj4 --on-demand [--planner random_1200] [--seed 0] [--csv plan.csv]
 """
 
 from __future__ import annotations
@@ -159,7 +160,12 @@ def _parser() -> argparse.ArgumentParser:
                                                               "analyses.planner_radii_deg)")
     plan.add_argument("--configfile", nargs="+", default=[], help="overlays on the study's configuration")
     plan.add_argument("--results", default="results", help="where the study's outputs are")
-    plan.add_argument("--csv", metavar="PATH", help="write the plan table (one row per radius) as CSV")
+    plan.add_argument("--csv", metavar="PATH", help="write the plan table (one row per radius; on demand: one row) as CSV")
+    plan.add_argument("--on-demand", action="store_true", help="close the hand only where the planner asks (the "
+                                                               "default for an object without the study's tables)")
+    plan.add_argument("--planner", help="on demand: a candidate planner of docs/planner.md (default: the one the "
+                                        "pre-registered rule selects)")
+    plan.add_argument("--seed", type=int, default=0, help="on demand: seed of a randomised planner (default 0)")
     return parser
 
 
@@ -256,15 +262,11 @@ def _count_problems(args: argparse.Namespace) -> list[str]:
 
 
 def _configuration(args: argparse.Namespace) -> dict[str, Any]:
-    """The configuration of ``--configfile`` overlays as the workflow has it: with the objects
-    its ``random_objects`` block draws (manifest relative to the working folder, the project's
-    root), checked before anything is drawn."""
-    from synergrasp.simulation.random_objects import add_random_objects
-    from synergrasp.study_checks import read_overlays
+    """The configuration of ``--configfile`` overlays as the workflow has it, drawn objects
+    included (``study_checks.overlays_with_drawn_objects``)."""
+    from synergrasp.study_checks import overlays_with_drawn_objects
 
-    config = read_overlays(args.configfile)
-    add_random_objects(config, ".")
-    return config
+    return overlays_with_drawn_objects(args.configfile)
 
 
 def _plan(args: argparse.Namespace) -> int:
@@ -280,6 +282,7 @@ def _plan(args: argparse.Namespace) -> int:
     folder = Path(args.results) / "objects" / args.object
     contacts_path = next((folder / f for f in ("load_carrying_contacts.parquet", "contacts.parquet")
                           if (folder / f).is_file()), folder / "contacts.parquet")
+    on_demand = args.on_demand or not (folder / "gfo.parquet").is_file()
     try:
         cfg, warnings = checked_scenario(_configuration(args))
         for warning in warnings:
@@ -287,12 +290,20 @@ def _plan(args: argparse.Namespace) -> int:
         if unknown_object(cfg, args.object):
             raise ConfigError(unknown_object(cfg, args.object))
         params = PlanParams.from_config(cfg, args.object)
-        params = replace(params, radii_deg=tuple(args.radius)) if args.radius else params
-        contacts = tables.read(tables.CONTACTS, contacts_path)
-        gfo = tables.read(tables.GFO, folder / "gfo.parquet")
+        if on_demand:
+            demand = _on_demand_inputs(args, cfg)
+        elif args.planner is not None or args.seed != 0:
+            raise ValueError("--planner and --seed: only with --on-demand (the study's tables are there: the "
+                             "incremental planner runs on them at each --radius)")
+        if not on_demand:
+            params = replace(params, radii_deg=tuple(args.radius)) if args.radius else params
+            contacts = tables.read(tables.CONTACTS, contacts_path)
+            gfo = tables.read(tables.GFO, folder / "gfo.parquet")
     except (ConfigError, ValueError, FileNotFoundError) as err:
         print(f"synergrasp plan: {err}", file=sys.stderr)
         return 2
+    if on_demand:
+        return _plan_on_demand(args, params, *demand, folder, contacts_path)
     result = plan_object(contacts, gfo, load_synergies(params.synergies).matrix, params)
     for row in result.table.itertuples():
         print(f"{row.object} radius {row.radius_deg:g} deg: {row.n_solves} of {row.n_exhaustive_solves} solves "
@@ -303,6 +314,54 @@ def _plan(args: argparse.Namespace) -> int:
     if args.csv:
         with _writing("--csv", args.csv):
             tables.write_csv(tables.PLAN, result.table, args.csv)
+    return 0
+
+
+def _on_demand_inputs(args: argparse.Namespace, cfg: dict) -> tuple[Any, Any, Any]:
+    """The planner, ``close(poses)`` and the pose grid of ``synergrasp plan --on-demand``; each
+    bad argument a ValueError naming it, before any closure."""
+    from synergrasp.analysis.plan_new import DEFAULT_PLANNER, planner_spec
+    from synergrasp.inspector import object_closure
+
+    spec = planner_spec(args.planner or DEFAULT_PLANNER)
+    if args.seed < 0:
+        raise ValueError(f"--seed {args.seed}: must be >= 0")
+    if args.radius:
+        raise ValueError("--radius: only for the incremental planner on the study's tables (not on demand)")
+    return (spec, *object_closure(cfg, args.object, args.results))
+
+
+def _plan_on_demand(args: argparse.Namespace, params: Any, spec: Any, close: Any, grid: Any, folder: Path,
+                    contacts_path: Path) -> int:
+    """``synergrasp plan --on-demand``: the chosen planner closing the hand only where it asks;
+    against the study's exhaustive minimum where the study's tables are there."""
+    import numpy as np
+    import pandas as pd
+
+    from synergrasp import tables
+    from synergrasp.analysis.plan_new import plan_on_demand
+    from synergrasp.analysis.planner import pose_against_exhaustive
+    from synergrasp.analysis.plan_study import replay_oracle
+    from synergrasp.hand.synergies import load_synergies
+
+    study = (folder / "gfo.parquet").is_file() and contacts_path.is_file()
+    matrix = load_synergies(params.synergies).matrix
+    plan, _ = plan_on_demand(args.object, grid, close, matrix, params, spec, args.seed)
+    least, regret = float("nan"), float("nan")
+    if study:  # the study's exhaustive minimum over the same grid
+        contacts, gfo = tables.read(tables.CONTACTS, contacts_path), tables.read(tables.GFO, folder / "gfo.parquet")
+        full = replay_oracle(contacts, gfo, params.n_levels, params.minima)()
+        order = np.argsort(contacts["pose"].to_numpy())
+        versus = pose_against_exhaustive(plan.pose, plan.force_N, full.success[-1][order], full.force[-1][order])
+        least, regret = versus["exhaustive_min_force_N"], 100.0 * (versus["regret"] - 1.0)
+    print(f"{plan.object} on demand, planner {plan.planner}" + (f" (seed {plan.seed})" if spec.randomised else "")
+          + f": pose {plan.pose} (alpha {plan.alpha_deg:g}, beta {plan.beta_deg:g}) force {_number(plan.force_N, 4)} N; "
+          f"{plan.closures} of {plan.n_poses} closures ({100.0 * plan.closures / plan.n_poses:.1f} %), "
+          f"{plan.problems} problems, {plan.wall_s:.1f} s"
+          + (f"; the study's exhaustive minimum {_number(least, 4)} N, regret {_number(regret, 3)} %" if study else ""))
+    if args.csv:
+        row = vars(plan) | {"exhaustive_min_force_N": least, "regret_percent": regret}
+        tables.write_csv(tables.PLAN_ON_DEMAND, pd.DataFrame([row]), args.csv)
     return 0
 
 

@@ -9,7 +9,7 @@ optimisation stages as the workflow's steps do, from the same configuration.
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -20,7 +20,7 @@ import pandas as pd
 from synergrasp.ids import set_id, set_name
 from synergrasp.optimisation.quality import GraspQuality, grasp_quality
 
-__all__ = ["InspectionError", "BlockingContact", "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp",
+__all__ = ["InspectionError", "searched_target", "object_closure", "BlockingContact", "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp",
            "grasp_picture", "grasp_view"]
 
 
@@ -186,7 +186,7 @@ def _contacts_frame(hand: Any, row: pd.Series, shape: Any, rule: Any) -> pd.Data
                          "feature": surface_features(points, shape, R, c, rule)})
 
 
-def _searched(placement: Any, path: Path) -> Any:
+def searched_target(placement: Any, path: Path) -> Any:
     """The searched placement with the target the object's search chose (its placement.csv)."""
     from synergrasp import tables
     from synergrasp.simulation.placement import searched_placement
@@ -226,7 +226,7 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     pose, _ = _pose_index(sim.placement, alpha_deg, beta_deg)
     placement = sim.placement
     if placement.mode == "searched":
-        placement = _searched(placement, Path(results) / "objects" / obj / "placement.csv")
+        placement = searched_target(placement, Path(results) / "objects" / obj / "placement.csv")
     hand = load_hand(sim.hand)
     full = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
     chosen = default_sets(full.matrix.shape[1]) if sets is None else [tuple(sorted(set(s))) for s in sets]
@@ -332,3 +332,32 @@ def grasp_view(result: GraspInspection, synergies: Sequence[int] | None = None) 
     scene = GraspScene.of(result.hand, result.q_rad, _object_in_picture(result), links, points,
                           chosen.forces_N if chosen is not None else None, name, _title(result))
     return grasp_figure(scene)
+
+
+def object_closure(cfg: Mapping[str, Any], obj: str, results: str | Path) -> tuple[Callable[[Sequence[int]], pd.DataFrame], Any]:
+    """``close(poses)``: the hand closed on ``obj`` at those grid poses with the configuration's
+    hand, first synergy, placement (a searched target read from ``<results>/objects/<obj>/
+    placement.csv``) and closure, the ``contacts`` step's contacts kept; and the pose grid.
+    ``cfg``: a checked configuration. Raises InspectionError (a searched placement without its
+    table). The grid is an ``analysis.planners.PoseGrid`` (synergrasp plan --on-demand)."""
+    from synergrasp.analysis.planners import PoseGrid
+    from synergrasp.hand.kinematics import load_hand
+    from synergrasp.simulation.closure import SimulateParams, simulate_object
+    from synergrasp.simulation.contacts import ContactsParams, load_carrying_contacts
+    from synergrasp.simulation.placement import pose_grid
+
+    sim = SimulateParams.from_config(cfg, obj)
+    placement = sim.placement
+    if placement.mode == "searched":
+        placement = searched_target(placement, Path(results) / "objects" / obj / "placement.csv")
+    hand = load_hand(sim.hand)
+    synergies = sim.synergies(hand.joint_names)
+    selection = ContactsParams.from_config(cfg, obj)
+    grid = pose_grid(placement)
+    angles = np.array([grid.angles_deg(p) for p in range(grid.n_poses)])
+
+    def close(poses: Sequence[int]) -> pd.DataFrame:
+        table = simulate_object(hand, synergies, sim.object, placement, sim.closure, poses=poses, mechanics=sim.mechanics)
+        return load_carrying_contacts(table, selection.load_threshold_N) if selection.drop_unloaded else table
+
+    return close, PoseGrid.from_angles(angles[:, 0], angles[:, 1])

@@ -37,7 +37,7 @@ __all__ = ["Cost", "Step", "STEPS", "UNITS", "WORKFLOW_KEYS", "CLOSURE_COST_FACT
            "step_keys", "step_config", "step_hash", "upstream_when", "rule_costs", "rule_step", "step_for_object", "step_made"]
 
 #: Units of work a job's cost is counted in (resources.smk counts them for a scenario).
-UNITS = ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose_set")
+UNITS = ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose", "object_pose_set")
 #: Closure cost per pose relative to the kinematic closure measured in STEPS, per closure
 #: model (docs/cluster.md); a model not listed is charged ``None``'s factor until measured.
 CLOSURE_COST_FACTOR = {"kinematic": 1.0, "dynamic": 9.0, None: 20.0}
@@ -221,6 +221,19 @@ STEPS: dict[str, Step] = {
                "analyses.minima_radius_deg", "analyses.success", "analyses.planner_radii_deg", "hand"),
         reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
         upstream=("contacts", "optimise"), params="synergrasp.analysis.plan_study:PlanParams", optional=True),
+    # planners compared at equal cost, replayed on every object's gfo table (docs/planner.md):
+    # 28 candidates, the randomised ones over 200 seeds: 8.2 CPU s, 294 MB for the four boxes of
+    # 1800 poses (default study). Before `tables`, whose claims table holds claim 8 from it.
+    "planners": Step(
+        rules={"planners": Cost("object_pose", 3.0, 300, 1.5e-3, 0.0)},
+        outputs={"csv": "tables/planners.csv", "md": "tables/planners.md",
+                 "across_csv": "tables/planners_across.csv", "across_md": "tables/planners_across.md",
+                 **_files(("planners",), "figures", _PNG_PDF, named=False)},
+        reads=("synergy_sets.incremental_max", "analyses.minima_radius_deg", "analyses.success"),
+        reads_when=(("analyses.success", "force_closure_bounded",
+                     ("analyses.marginal_weight_multiple", "objects.*.mass_kg", "mechanics.g_m_per_s2")),),
+        upstream=("contacts", "optimise"), params="synergrasp.analysis.plan_study:PlannersParams",
+        report={"across_csv": ("planners_across", "Tables"), "png": ("planners", "Figures")}),
     "tables": Step(
         rules={"tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
         outputs=_files(TABLES, "tables", ("csv", "md")),
@@ -228,7 +241,7 @@ STEPS: dict[str, Step] = {
                "analyses.marginal_weight_multiple", "analyses.success_rate_tolerance_percent",
                "analyses.null_model", "analyses.headline_view", "analyses.tie_band", "analyses.min_distinct_poses",
                "analyses.bootstrap", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
-        upstream=("optimise", "minima"), params="synergrasp.analysis.summaries:TablesParams",
+        upstream=("optimise", "minima", "planners"), params="synergrasp.analysis.summaries:TablesParams",
         report={f"{t}_csv": (t, "Tables") for t in TABLES}),
     "realism": Step(
         # with the equilibrium checks of every grasp: ~0.5 ms of CPU per grasp over 75 sets

@@ -29,8 +29,9 @@ from synergrasp.preflight import refuse
 from synergrasp.resolved import effective_placement, grasp_type
 from synergrasp.yaml_io import read_yaml
 
-__all__ = ["checked_scenario", "workflow_scenario", "read_overlays", "search_rank_problems", "lattice_rank_problems",
-           "search_table_or_refuse", "searched_objects_or_refuse", "older_results_problems", "unknown_object"]
+__all__ = ["checked_scenario", "checked_configuration", "overlays_with_drawn_objects", "workflow_scenario", "read_overlays", "search_rank_problems",
+           "lattice_rank_problems", "search_table_or_refuse", "searched_objects_or_refuse", "older_results_problems",
+           "unknown_object"]
 
 
 @functools.cache
@@ -195,3 +196,20 @@ def unknown_object(cfg: Mapping[str, Any], obj: str) -> str:
     hint = ("; objects drawn by random_objects are objects of a --configfile with that block "
             "(docs/random_objects.md)") if obj.startswith("rand_") and not cfg.get("random_objects") else ""
     return f"object: {obj!r} is not an object of the configuration; objects: {list(cfg['objects'])}{hint}"
+
+
+def overlays_with_drawn_objects(configfiles: Sequence[str | Path]) -> dict[str, Any]:
+    """The configuration of ``--configfile`` overlays as the workflow has it: with the objects
+    its ``random_objects`` block draws (manifest relative to the working folder, the project's
+    root), the block checked before anything is drawn. Raises ``ConfigError``."""
+    from synergrasp.simulation.random_objects import add_random_objects
+
+    config = read_overlays(configfiles)
+    add_random_objects(config, ".")
+    return config
+
+
+def checked_configuration(configfiles: Sequence[str | Path]) -> dict[str, Any]:
+    """The checked configuration of overlay files, drawn objects included
+    (``overlays_with_drawn_objects``). Raises ``ConfigError`` naming the file or the key."""
+    return checked_scenario(overlays_with_drawn_objects(configfiles))[0]

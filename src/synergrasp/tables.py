@@ -17,9 +17,9 @@ import pandas as pd
 
 from synergrasp.file_output import replacing
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT", "PLAN", "ENROLLMENT", "BLOCKERS",
-           "QUALITY", "TARGET_CLAIMS", "write", "read", "older_version", "write_csv", "read_csv", "empty",
-           "write_study_table"]
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT", "PLAN",
+           "ENROLLMENT", "PLANNERS", "PLANNERS_ACROSS", "PLAN_ON_DEMAND", "BLOCKERS", "QUALITY", "TARGET_CLAIMS", "write",
+           "read", "older_version", "write_csv", "read_csv", "empty", "write_study_table"]
 
 
 @dataclass(frozen=True)
@@ -296,8 +296,62 @@ ENROLLMENT = Table("enrollment", "one row per k", (
     Column("full_n_success", "int32", "", "grid poses where the full set succeeds"),
 ))
 
+#: A plan on demand (``synergrasp plan --on-demand --csv``): the hand closed only where the planner asks.
+PLAN_ON_DEMAND = Table("plan_on_demand", "one row per plan", (
+    Column("object", "string", "", "object name"),
+    Column("planner", "string", "", "the candidate planner (docs/planner.md)"),
+    Column("seed", "int32", "", "numpy.random.default_rng seed of a randomised planner"),
+    Column("pose", "int32", "", "its pose (-1: none succeeds)"),
+    Column("alpha_deg", "float64", "deg", "its alpha"),
+    Column("beta_deg", "float64", "deg", "its beta"),
+    Column("force_N", "float64", "N", "its optimal force with the full set"),
+    Column("closures", "int32", "", "closures run: the poses the planner asked"),
+    Column("n_poses", "int32", "", "the grid's poses (the exhaustive search's closures)"),
+    Column("problems", "int32", "", "(grasp, set) problems solved"),
+    Column("wall_s", "float64", "s", "wall time of the plan: closures and solves"),
+    Column("exhaustive_min_force_N", "float64", "N", "the study's least full-set force over every pose (NaN: no study)"),
+    Column("regret_percent", "float64", "%", "100 (force_N / exhaustive_min_force_N - 1) (NaN: no study)"),
+))
+
+#: Planners compared at equal cost on one scenario's objects (results/tables/planners.csv).
+PLANNERS = Table("planners", "one row per object and candidate planner", (
+    Column("object", "string", "", "object name"),
+    Column("planner", "string", "", "the candidate planner (docs/planner.md)"),
+    Column("family", "string", "", "incremental (solves reduced sets first) or full_set (solves only the full set)"),
+    Column("randomised", "bool", "", "whether it draws poses at random (200 fixed seeds)"),
+    Column("runs", "int32", "", "runs: one per seed, 1 for a deterministic planner"),
+    Column("closures", "float64", "", "distinct poses asked anything (a closure each for a new object), mean over runs"),
+    Column("closure_share_percent", "float64", "%", "100 closures / the grid's poses"),
+    Column("solve_cost", "float64", "full-set solves", "(grasp, set) problems handed to the solver, each weighted by its set size's measured solve time over the full set's, mean over runs"),
+    Column("problems", "float64", "", "(grasp, set) problems handed to the solver, unweighted, mean over runs"),
+    Column("regret_percent_mean", "float64", "%", "100 (its pose's full-set force / the exhaustive minimum - 1), mean over runs (NaN: no force-closure pose)"),
+    Column("regret_percent_max", "float64", "%", "the same, largest over runs"),
+    Column("global_min_probability", "float64", "", "share of runs ending at the exhaustive minimum (within 1e-5 relative)"),
+    Column("within_aim_probability", "float64", "", "share of runs with a regret of at most 5 %"),
+    Column("meets_aim", "bool", "", "within_aim_probability >= 0.95"),
+))
+
+#: The planners across the objects, and the one the pre-registered rule recommends
+#: (results/tables/planners_across.csv).
+PLANNERS_ACROSS = Table("planners_across", "one row per candidate planner", (
+    Column("planner", "string", "", "the candidate planner (docs/planner.md)"),
+    Column("family", "string", "", "incremental (solves reduced sets first) or full_set (solves only the full set)"),
+    Column("randomised", "bool", "", "whether it draws poses at random (200 fixed seeds)"),
+    Column("objects", "int32", "", "objects with a force-closure pose of the full set"),
+    Column("objects_meeting_aim", "int32", "", "objects where it meets the aim (regret <= 5 % with probability >= 0.95)"),
+    Column("meeting_aim_percent", "float64", "%", "100 objects_meeting_aim / objects"),
+    Column("closures", "float64", "", "mean over objects"),
+    Column("closure_share_percent", "float64", "%", "mean over objects"),
+    Column("solve_cost", "float64", "full-set solves", "mean over objects"),
+    Column("regret_percent_mean", "float64", "%", "mean over objects"),
+    Column("regret_percent_max", "float64", "%", "largest over objects and runs"),
+    Column("within_aim_probability", "float64", "", "least over objects"),
+    Column("recommended", "bool", "", "the planner the rule selects: fewest closures among those meeting the aim on >= 95 % of the objects (docs/planner.md)"),
+))
+
 TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, QUALITY,
-                                                TARGET_CLAIMS, BLOCKERS, PLAN, ENROLLMENT)}
+                                                TARGET_CLAIMS, BLOCKERS, PLAN, ENROLLMENT,
+                                                PLANNERS, PLANNERS_ACROSS, PLAN_ON_DEMAND)}
 
 
 def _check(table: Table, frame: pd.DataFrame, where: str) -> None:

@@ -191,6 +191,7 @@ def job_size(rule: str, cfg: Mapping[str, Any]) -> float:
         "closure_pose": n_poses * factor,
         "shard_pose_set": math.ceil(n_poses / cfg["solver"]["pose_shards"]) * n_sets,
         "pose_set": n_poses * n_sets,
+        "object_pose": len(cfg["objects"]) * n_poses,
         "object_pose_set": len(cfg["objects"]) * n_poses * n_sets,
     }[rule_costs()[rule].unit]
 

@@ -21,10 +21,32 @@ rule minima:
         "../scripts/minima.py"
 
 
+# Planners compared at equal cost, replayed on every object's gfo table (docs/planner.md).
+rule planners:
+    input:
+        contacts=W.step_inputs("contacts"),
+        gfo=W.step_inputs("optimise"),
+        code=W.code("planners"),
+    output:
+        **outputs("planners"),
+    log:
+        log_file("planners"),
+    benchmark:
+        benchmark_file("planners")
+    threads: threads("planners")
+    resources:
+        **W.resources("planners"),
+    params:
+        cfg=W.step_cfg("planners"),
+    script:
+        "../scripts/planners.py"
+
+
 rule tables:
     input:
         gfo=W.step_inputs("optimise"),
         minima=W.step_inputs("minima"),
+        planners=W.study_input("planners", "tables/planners.csv"),
         code=W.code("tables"),
     output:
         **outputs("tables"),

@@ -22,7 +22,7 @@ from synergrasp.analysis.intervals import VIEWS, StudyCounts, mean_defined
 from synergrasp.ids import incremental_set_id, set_id, set_members
 
 __all__ = ["HOLDS", "FAILS", "UNDEFINED", "VerdictRules", "Difference", "interval_verdict", "claims_table",
-           "CLAIM_COLUMNS"]
+           "planner_claim", "CLAIM_COLUMNS"]
 
 HOLDS, FAILS, UNDEFINED = "holds", "does not hold", "undefined"
 CLAIM_COLUMNS = ["claim", "view", "headline", "statement", "tested_by", "measured", "difference", "low", "high",
@@ -253,6 +253,8 @@ STATEMENTS = {
     6: ("the best pair (by success rate) contains S1 and S5", "Fig. 5A"),
     7: ("among single synergies, S4, S5 and S1 need the lowest forces (like with like: two sets on the poses "
         "where both succeed)", "Fig. 5B"),
+    8: ("an incremental planner reaches <= 5 % regret at a lower cost (solve time) than the best planner that "
+        "solves only the full set", "planners and planners_across tables, figures/planners.png"),
 }
 
 
@@ -285,3 +287,31 @@ def claims_table(counts: StudyCounts, minima: pd.DataFrame, chance: pd.DataFrame
         rows.append((claim, view, headline, statement.format(first=first), tested_by, text, d.estimate, d.low,
                      d.high, d.unit, d.band, d.n, verdict, reason))
     return pd.DataFrame(rows, columns=CLAIM_COLUMNS)
+
+
+def planner_claim(per_object: pd.DataFrame, rules: VerdictRules) -> pd.DataFrame:
+    """Claim 8, the study's conjecture as a planner (docs/planner.md, written before it ran),
+    one row of :data:`CLAIM_COLUMNS` (view ``across_objects``) from the per-object comparison
+    of the planners (``tables.PLANNERS``). The difference is 100 (C_full − C_inc) / C_full of
+    the two families' chosen planners' solve times, % per object; its band the forces' tie band
+    (relative, as %); no least number of poses applies (the interval is over objects, and
+    ``n_distinct_poses`` holds the number of objects)."""
+    from synergrasp.analysis.planners import OBJECTS_AIM, conjecture
+
+    c = conjecture(per_object)
+    band = 100.0 * rules.force_relative
+    n = int(c.differences.size)
+    if not c.incremental:
+        reason = f"no incremental planner meets the aim on >= {OBJECTS_AIM:g} % of the objects"
+        text = f"{reason}; the best planner solving only the full set: {c.full_set or 'none'}"
+        verdict = FAILS if c.full_set else UNDEFINED
+        d = Difference(np.nan, np.nan, np.nan, band, n, unit="% of the full-set planner's solve time")
+    else:
+        d = Difference(c.mean, c.low, c.high, band, n, unit="% of the full-set planner's solve time")
+        text = (f"{c.incremental} against {c.full_set} over {n} objects: solve time {c.mean:.1f} % lower "
+                f"[{c.low:.1f}, {c.high:.1f}] (negative: higher); closures {c.closures_incremental:.0f} against "
+                f"{c.closures_full_set:.0f} (mean)")
+        verdict, reason = interval_verdict(d, 0)
+    statement, tested_by = STATEMENTS[8]
+    return pd.DataFrame([(8, "across_objects", True, statement, tested_by, text, d.estimate, d.low, d.high, d.unit,
+                          d.band, n, verdict, reason)], columns=CLAIM_COLUMNS)

@@ -20,13 +20,14 @@ from numpy.typing import NDArray
 
 from synergrasp.analysis.minima import FORCE_TIE_RTOL, MinimaParams
 from synergrasp.analysis.planner import Plan, greedy_order, plan_against_exhaustive, plan_incremental
+from synergrasp.analysis.planners import CANDIDATES, Oracle, PlannerSpec, PoseGrid, ReplayOracle, compare_planners
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.ids import incremental_set_id, set_id
 from synergrasp.optimisation.mechanics import first_same_grasp, read_grasps
 from synergrasp.optimisation.problem import SynergySets
 from synergrasp.optimisation.optimise import GFOParams, optimise_grasps
 
-__all__ = ["PlanParams", "ObjectPlan", "StudySolver", "plan_object"]
+__all__ = ["PlanParams", "ObjectPlan", "StudySolver", "plan_object", "PlannersParams", "replay_oracle", "compare_on_study"]
 
 
 @dataclass(frozen=True)
@@ -62,14 +63,18 @@ class ObjectPlan:
     full: pd.DataFrame
 
 
-class StudySolver:
+class StudySolver(Oracle):
     """Solves synergy sets at poses of one object through `optimise_grasps`, one solve per
     distinct grasp (the study's sharing of twins), and remembers them: a (grasp, set) is
     solved once however many radii ask. ``n_problems`` counts the problems handed to the
-    solver."""
+    solver; as an :class:`~synergrasp.analysis.planners.Oracle` (``solver(k, poses)``: a
+    planner's solve of {S1..Sk}) it also keeps the planners' cost ledger."""
 
     def __init__(self, contacts: pd.DataFrame, matrix: NDArray, params: PlanParams):
+        super().__init__(len(contacts), params.n_levels)
         self.contacts = contacts.reset_index(drop=True)
+        self.object_name = str(self.contacts["object"].iat[0]) if len(self.contacts) else ""
+        self.pose_ids = self.contacts["pose"].to_numpy(np.int64)
         self.grasps = read_grasps(self.contacts)
         self.first = first_same_grasp(self.grasps)
         self.matrix, self.params = matrix, params
@@ -97,10 +102,9 @@ class StudySolver:
     def _solve(self, sets: Sequence[tuple[int, ...]], ids: list[str], grasps: list[int]) -> None:
         out = optimise_grasps([self.grasps[g] for g in grasps], SynergySets(self.matrix, tuple(sets)), self.params.gfo)
         self.n_problems += len(grasps) * len(sets)
-        part = self.contacts.iloc[np.repeat(grasps, len(sets))]
-        frame = pd.DataFrame({"object": part["object"].to_numpy(), "pose": part["pose"].to_numpy()} | out)
+        frame = pd.DataFrame({"object": self.object_name, "pose": self.pose_ids[np.repeat(grasps, len(sets))]} | out)
         minima = self.params.minima
-        weights = {str(frame["object"].iat[0]): minima.weight_N} if minima.weight_N is not None and len(frame) else None
+        weights = {self.object_name: minima.weight_N} if minima.weight_N is not None and len(frame) else None
         judged = with_verdicts(frame, minima.success, weights, minima.bound_multiple)
         success, force = judged["success"].to_numpy(bool), judged["success_force"].to_numpy(float)
         for row, g in enumerate(np.repeat(grasps, len(sets))):
@@ -110,6 +114,13 @@ class StudySolver:
         """The planner's solve: {S1..Sk} at ``poses``."""
         success, force = self.verdicts([tuple(range(1, k + 1))], poses)
         return success[0], force[0]
+
+    def ask(self, k: int, poses: NDArray[np.int64]) -> tuple[NDArray, NDArray]:
+        """:meth:`level`, counting the problems it hands the solver under set size k."""
+        before = self.n_problems
+        out = self.level(k, poses)
+        self.problems[k] += self.n_problems - before
+        return out
 
 
 def _study_differences(solver: StudySolver, gfo: pd.DataFrame, plans: Sequence[Plan]) -> int:
@@ -185,3 +196,60 @@ def _enrollment(solver: StudySolver, full_success: NDArray, judged: pd.DataFrame
                          "greedy_n_success": greedy, "greedy_success_rate": [pct(c) for c in greedy],
                          "pca_n_success": pca, "pca_success_rate": [pct(c) for c in pca],
                          "full_n_success": target})
+
+
+@dataclass(frozen=True)
+class PlannersParams:
+    """The ``planners`` step (docs/planner.md): the full set's size n and, per object, the
+    minima's policy (radius, verdict, force bound)."""
+
+    n_levels: int
+    minima: Mapping[str, MinimaParams]
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> PlannersParams:
+        """From a configuration or the step's own part of it; ``objects``: the objects whose
+        minima need a force bound (``analyses.success: force_closure_bounded``), others read
+        none (:func:`minima_for`)."""
+        bounded = config["analyses"]["success"] == "force_closure_bounded"
+        names = list(config["objects"]) if bounded else [""]
+        return cls(int(config["synergy_sets"]["incremental_max"]),
+                   {name: MinimaParams.from_config(config, name) for name in names})
+
+    def minima_for(self, obj: str) -> MinimaParams:
+        """The object's minima policy (the one shared one where no force bound is read)."""
+        return self.minima[obj] if obj in self.minima else self.minima[""]
+
+
+def _judged_levels(contacts: pd.DataFrame, gfo: pd.DataFrame, n: int, minima: MinimaParams) -> tuple[NDArray, NDArray]:
+    """(n, p) the study's verdict and its force (N, NaN elsewhere) of {S1..Sk} (row k − 1) at
+    every pose of ``contacts``, in its order."""
+    weights = {str(gfo["object"].iat[0]): minima.weight_N} if minima.weight_N is not None else None
+    judged = with_verdicts(gfo, minima.success, weights, minima.bound_multiple)
+    order = contacts["pose"].to_numpy()
+    success, force = np.zeros((n, len(order)), dtype=bool), np.full((n, len(order)), np.nan)
+    for k in range(1, n + 1):
+        rows = judged[judged["set_id"] == incremental_set_id(k)].set_index("pose").loc[order]
+        success[k - 1] = rows["success"].to_numpy(bool)
+        force[k - 1] = np.where(success[k - 1], rows["success_force"].to_numpy(float), np.nan)
+    return success, force
+
+
+def replay_oracle(contacts: pd.DataFrame, gfo: pd.DataFrame, n: int, minima: MinimaParams):
+    """A factory of fresh :class:`ReplayOracle` on one object's study tables (the judged
+    verdicts of {S1..Sk}, k = 1 … n, and the distinct grasps of its contacts)."""
+    success, force = _judged_levels(contacts, gfo, n, minima)
+    first = np.asarray(first_same_grasp(read_grasps(contacts.reset_index(drop=True))), dtype=np.int64)
+    return lambda: ReplayOracle(success, force, first)
+
+
+def compare_on_study(contacts: pd.DataFrame, gfo: pd.DataFrame, n: int, minima: MinimaParams,
+                     specs: Sequence[PlannerSpec] = CANDIDATES, **kwargs: Any) -> pd.DataFrame:
+    """Every candidate planner replayed on one object of a study (``planners.compare_planners``'s
+    rows): its contacts table (poses in order) and gfo table."""
+    contacts = contacts.reset_index(drop=True)
+    grid = PoseGrid.from_angles(contacts["alpha_deg"].to_numpy(float), contacts["beta_deg"].to_numpy(float))
+    new = replay_oracle(contacts, gfo, n, minima)
+    full = new()
+    return compare_planners(str(contacts["object"].iat[0]), grid, new, full.success[n - 1], full.force[n - 1], n,
+                            minima.radius_deg, specs, **kwargs)

@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from synergrasp.analysis.minima import FORCE_TIE_RTOL, local_minima, preserved
 
-__all__ = ["LevelSolve", "Plan", "plan_incremental", "plan_against_exhaustive", "greedy_order"]
+__all__ = ["LevelSolve", "Plan", "plan_incremental", "plan_against_exhaustive", "pose_against_exhaustive", "greedy_order"]
 
 #: (k, pose indices) -> (success (p,) bool, optimal force (p,) N, NaN where no success).
 LevelSolve = Callable[[int, NDArray[np.int64]], tuple[NDArray[np.bool_], NDArray[np.float64]]]
@@ -42,7 +42,8 @@ class Plan:
     """One run of the planner.
 
     radius_deg: the neighbourhood half-width around each level's seeds, deg.
-    solved: per level k = 1 … n, the pose indices solved with {S1..Sk}.
+    solved: per level solved (k = 1 … n unless the caller skips levels), the pose indices
+        solved with that level's set {S1..Sk}.
     seeds: per level, the pose indices seeding the next level (its minima, else its best
         success; empty: none, the next level covers the grid).
     from_minima: per level, whether the seeds are local minima.
@@ -73,30 +74,42 @@ def _neighbourhood(alpha: NDArray, beta: NDArray, seeds: NDArray[np.int64], radi
 
 def plan_incremental(alpha_deg: ArrayLike, beta_deg: ArrayLike, solve: LevelSolve, n_levels: int,
                      radius_deg: float, minima_radius_deg: float = 10.0,
-                     alpha_period_deg: float = 360.0) -> Plan:
+                     alpha_period_deg: float = 360.0, levels: Sequence[int] | None = None,
+                     max_seeds: int | None = None) -> Plan:
     """Run the planner over a pose grid (module docstring).
 
     alpha_deg, beta_deg: (p,) the grid's poses, deg; solve: :data:`LevelSolve`;
     n_levels: n, the full set is {S1..Sn}; radius_deg: the seeds' neighbourhood, deg;
-    minima_radius_deg: the study's radius of a local minimum, deg.
+    minima_radius_deg: the study's radius of a local minimum, deg; levels: the set sizes k
+    solved, increasing, ending at n (None: every k = 1 … n; the variants of docs/planner.md skip
+    levels); max_seeds: only the minima of least force, at most this many, seed the next level
+    (None: every minimum). ``Plan.solved`` holds one entry per level solved.
     """
     alpha = np.asarray(alpha_deg, dtype=float)
     beta = np.asarray(beta_deg, dtype=float)
     if n_levels < 1:
         raise ValueError(f"n_levels must be >= 1; got {n_levels}")
+    ks = list(range(1, n_levels + 1)) if levels is None else [int(k) for k in levels]
+    if not ks or ks[-1] != n_levels or any(b <= a for a, b in zip(ks, ks[1:])) or ks[0] < 1:
+        raise ValueError(f"levels must increase from >= 1 to n_levels = {n_levels}; got {ks}")
+    if max_seeds is not None and max_seeds < 1:
+        raise ValueError(f"max_seeds must be >= 1 or None; got {max_seeds}")
     every = np.arange(alpha.size, dtype=np.int64)
     seeds = np.zeros(0, dtype=np.int64)
     solved, seeded, from_minima = [], [], []
     success = force = np.zeros(0)
     todo = every
-    for k in range(1, n_levels + 1):
-        if k > 1:
+    for i, k in enumerate(ks):
+        if i > 0:
             todo = _neighbourhood(alpha, beta, seeds, radius_deg, alpha_period_deg) if seeds.size else every
         success, force = solve(k, todo)
         success = np.asarray(success, dtype=bool) & np.isfinite(force)
         minima = local_minima(alpha[todo], beta[todo], force, success, minima_radius_deg, alpha_period_deg)
         if minima.any():
-            seeds = todo[minima]
+            found = np.flatnonzero(minima)
+            if max_seeds is not None:  # the least forces; a stable sort keeps the lower pose on a tie
+                found = found[np.argsort(force[found], kind="stable")[:max_seeds]]
+            seeds = todo[np.sort(found)]
         elif success.any():
             seeds = todo[[int(np.nanargmin(np.where(success, force, np.nan)))]]
         else:
@@ -122,14 +135,21 @@ def plan_against_exhaustive(plan: Plan, full_success: ArrayLike, full_force: Arr
     n_ranked (force-closure poses), regret (plan's force / the minimum; exactly 1 for the minimum
     within the tie tolerance, never below 1; NaN without either).
     """
+    return pose_against_exhaustive(plan.best_pose, plan.best_force_N, full_success, full_force)
+
+
+def pose_against_exhaustive(best_pose: int, best_force_N: float, full_success: ArrayLike,
+                            full_force: ArrayLike) -> dict[str, float | int | bool]:
+    """How a planner's pose (index, -1: none) and its full-set force (N) compare with the
+    exhaustive search: :func:`plan_against_exhaustive`'s columns."""
     fc = np.asarray(full_success, dtype=bool) & np.isfinite(full_force)
     f = np.where(fc, np.asarray(full_force, dtype=float), np.inf)
     if not fc.any():
         return {"exhaustive_min_force_N": float("nan"), "exhaustive_best_pose": -1, "is_global_min": False,
                 "rank": 0, "n_ranked": 0, "regret": float("nan")}
     best = int(np.argmin(f))
-    mine = plan.best_force_N
-    found = plan.best_pose >= 0
+    mine = best_force_N
+    found = best_pose >= 0
     rank = int(np.sum(f < mine * (1.0 - FORCE_TIE_RTOL))) + 1 if found else 0
     is_global = bool(found and mine <= f[best] * (1.0 + FORCE_TIE_RTOL))
     # the minimum itself (or a twin within the tie tolerance): no regret, not rounding's 1 + 1e-16

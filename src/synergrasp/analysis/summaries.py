@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from synergrasp.analysis.bootstrap import BootstrapSettings, PoseResampler
 from synergrasp.analysis.chance import preservation_vs_chance, resampled_preservation
-from synergrasp.analysis.claims import VerdictRules, claims_table
+from synergrasp.analysis.claims import VerdictRules, claims_table, planner_claim
 from synergrasp.analysis.forces import force_summary
 from synergrasp.analysis.intervals import VIEWS, StudyCounts
 from synergrasp.analysis.invariants import invariant_checks
@@ -464,12 +464,13 @@ def no_success_note(table: pd.DataFrame, settings: AnalysisSettings) -> str:
 
 
 def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[str, int], table2_k_max: int,
-                 settings: AnalysisSettings) -> dict[str, tuple[str, pd.DataFrame]]:
+                 settings: AnalysisSettings, planners: pd.DataFrame | None = None) -> dict[str, tuple[str, pd.DataFrame]]:
     """Every study table by name: (title, table).
 
     ``sets_config`` is the configuration's ``synergy_sets`` (incremental_max,
     hierarchy_first, ...): the full set is {S1..S_incremental_max}, the hierarchy uses the
-    first ``hierarchy_first`` synergies. Raises :class:`InvariantError` when a success
+    first ``hierarchy_first`` synergies. ``planners``: the planners compared per object
+    (``tables.PLANNERS``), whose claim 8 joins the claims (None: the seven only). Raises :class:`InvariantError` when a success
     rate exceeds 100 % beyond the tolerance; warns on the other invariant checks.
     """
     k_max = int(sets_config["incremental_max"])
@@ -478,6 +479,8 @@ def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
     first_n = incremental_set_id(first)
     periods = dict(settings.periods_deg)
     table, counts, (chance, pairs), claims = _claims(gfo, minima, k_max, first, settings)
+    if planners is not None:
+        claims = pd.concat([claims, planner_claim(planners, settings.rules)], ignore_index=True)
     rates = success_rates(table, full, periods)
     checks = invariant_checks(table, rates, periods, settings.success_rate_tolerance_percent)
     lost = (full_but_not_first7(table, full, first_n) if first_n in set(table["set_id"].unique()) else None)
@@ -509,6 +512,6 @@ def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
         "verdict_disagreements": ("Force closure (Definition 1) vs feasibility under the weight",
                                   verdict_disagreements(table)),
         "invariant_checks": ("The pipeline's invariant checks on this run", checks),
-        "claims": (f"The study's claims tested on this run, one row per view (headline first); {level}; "
-                   f"{verdict}", claims),
+        "claims": (f"The study's claims tested on this run, one row per view (headline first); {level}"
+                   + ("; claim 8: bootstrap over objects" if planners is not None else "") + f"; {verdict}", claims),
     }
