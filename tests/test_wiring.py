@@ -4,7 +4,6 @@ out by hand, the import scanner against a package made here."""
 
 from __future__ import annotations
 
-import threading
 from pathlib import Path
 
 import pytest
@@ -13,7 +12,7 @@ from synergrasp.config import defaults, validate_config
 from synergrasp.ids import set_members, set_order
 from synergrasp.resolved import effective_placement, friction_mu, study_object, study_objects, weight_N
 from synergrasp.steps import rule_costs, step_config
-from synergrasp.wiring import RuleFiles, Wiring, cancel_scheduler_timers, code_files, job_size, mem_mb, report_archive, runtime_min
+from synergrasp.wiring import RuleFiles, Wiring, code_files, job_size, mem_mb, report_archive, runtime_min
 
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -100,14 +99,6 @@ def test_the_import_scanner_follows_lazy_imports_and_packages(tmp_path):
 ])
 def test_report_archive_reads_the_command_line(argv, archive):
     assert report_archive(argv) is archive
-
-
-def test_scheduler_timers_are_cancelled():
-    timer = threading.Timer(60.0, lambda: None)
-    timer.start()
-    cancel_scheduler_timers()
-    timer.join(5.0)
-    assert not timer.is_alive()
 
 
 def _wiring(**changes):

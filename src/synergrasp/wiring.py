@@ -18,7 +18,6 @@ from __future__ import annotations
 import functools
 import math
 import re
-import threading
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -38,7 +37,7 @@ from synergrasp.steps import (
 )
 from synergrasp.study_checks import checked_scenario, search_table_or_refuse, searched_objects_or_refuse
 
-__all__ = ["Wiring", "RuleFiles", "code_files", "report_archive", "cancel_scheduler_timers", "job_size",
+__all__ = ["Wiring", "RuleFiles", "code_files", "report_archive", "job_size",
            "runtime_min", "mem_mb", "RUNTIME_MARGIN", "MEMORY_MARGIN"]
 
 #: Requests are the measured cost times a margin (slower nodes, shared file systems),
@@ -220,15 +219,6 @@ def report_archive(argv: Sequence[str]) -> bool:
         if path is not None:
             return path.endswith(".zip")
     return False
-
-
-def cancel_scheduler_timers() -> None:
-    """Cancel the scheduler's pending re-evaluation timers (threading.Timer, not daemon
-    threads) once the run is over, so that Snakemake exits at once instead of a job-rate
-    timespan later (profiles/default/config.yaml). The workflow starts no timer of its own."""
-    for thread in threading.enumerate():
-        if isinstance(thread, threading.Timer):
-            thread.cancel()
 
 
 # --------------------------------------------------------------------------- the study's files
