@@ -36,7 +36,7 @@ from synergrasp.resolved import effective_placement
 __all__ = ["Cost", "Step", "STEPS", "UNITS", "WORKFLOW_KEYS", "CLOSURE_COST_FACTOR", "SOLVER_COMPILE",
            "step_keys", "step_config", "step_hash", "upstream_when", "rule_costs", "rule_step", "step_for_object", "step_made"]
 
-#: Units of work a job's cost is counted in (resources.smk counts them for a scenario).
+#: Units of work a job's cost is counted in (``wiring.job_size`` counts them for a scenario).
 UNITS = ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose_set")
 #: Closure cost per pose relative to the kinematic closure measured in STEPS, per closure
 #: model (docs/cluster.md); a model not listed is charged ``None``'s factor until measured.

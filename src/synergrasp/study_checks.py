@@ -4,8 +4,8 @@ the package alike (config/README.md, "Checked before any job runs").
 :func:`checked_scenario` is that check: one scenario's configuration (the schema and every
 relation, ``synergrasp.config``), its hand file, its synergy table against the hand, and its
 objects' shapes; besides the problems (errors), the warnings on sizes far from a hand's. The
-workflow asks it through :func:`workflow_scenario` (common.smk), ``synergrasp grasp`` through
-``synergrasp.inspector``; :func:`read_overlays` reads a command's ``--configfile`` files as
+workflow asks it through ``synergrasp.wiring.Wiring.scenario`` (common.smk), ``synergrasp grasp``
+through ``synergrasp.inspector``; :func:`read_overlays` reads a command's ``--configfile`` files as
 strictly as the workflow reads its own. Checks that need a step's output where it exists
 (:func:`search_rank_problems`), the objects' resolved placements and grasp types
 (:func:`lattice_rank_problems`) or a target's whole configuration
@@ -27,7 +27,7 @@ from synergrasp.preflight import refuse
 from synergrasp.resolved import effective_placement, grasp_type
 from synergrasp.yaml_io import read_yaml
 
-__all__ = ["checked_scenario", "workflow_scenario", "read_overlays", "search_rank_problems", "lattice_rank_problems",
+__all__ = ["checked_scenario", "read_overlays", "search_rank_problems", "lattice_rank_problems",
            "search_table_or_refuse", "searched_objects_or_refuse"]
 
 
@@ -67,24 +67,6 @@ def checked_scenario(config: Mapping[str, Any], name: str = "default") -> tuple[
     if problems:
         raise ConfigError("\n".join(where + p for p in problems))
     return cfg, [*warnings, *(where + w for w in object_warnings(cfg))]
-
-
-_WARNED: set[str] = set()
-
-
-def workflow_scenario(config: Mapping[str, Any], name: str) -> dict[str, Any]:
-    """:func:`checked_scenario` for the workflow: each warning printed once per run, a problem
-    stops the run before any job with its lines alone (``preflight.refuse``)."""
-    try:
-        cfg, warnings = checked_scenario(config, name)
-    except ConfigError as err:
-        refuse(str(err).splitlines())
-        raise  # refuse stops the run for any problem
-    for warning in warnings:
-        if warning not in _WARNED:
-            _WARNED.add(warning)
-            print(f"Warning: {warning}", file=sys.stderr)
-    return cfg
 
 
 def read_overlays(paths: Sequence[str | Path], what: str = "config file") -> dict[str, Any]:

@@ -36,7 +36,13 @@ from synergrasp.optimisation.problem import DEFAULT_TOL, STRICT_SHRINK, GraspSet
 from synergrasp.optimisation.shards import shard_positions
 from synergrasp import resolved
 
-__all__ = ["GFOParams", "OptimiseParams", "gfo_table", "mechanics_for", "optimise_grasps", "optimise_shard"]
+__all__ = ["GFOParams", "OptimiseParams", "UNSOLVED_STATUSES", "gfo_table", "mechanics_for", "optimise_grasps",
+           "optimise_shard"]
+
+#: The gfo table's statuses of a problem given before any solve: no grasp at the pose, and
+#: rank(G) < 6 (the solved ones are ``problem.STATUSES``).
+UNSOLVED_STATUSES: tuple[str, ...] = ("no_grasp", "rank_deficient")
+NO_GRASP, RANK_DEFICIENT = UNSOLVED_STATUSES
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -156,7 +162,7 @@ def optimise_grasps(
     out = {
         "set_id": np.array([set_id(s) for s in synergies.sets] * n_poses, dtype=object),
         "n_synergies": np.tile(synergies.sizes.astype(np.int32), n_poses),
-        "status": np.full(total, "no_grasp", dtype=object),
+        "status": np.full(total, NO_GRASP, dtype=object),
         "load_feasible": np.zeros(total, dtype=bool),
         "force_closure_def1": np.zeros(total, dtype=bool),
         "force_norm": np.full(total, np.nan),
@@ -178,7 +184,7 @@ def optimise_grasps(
         out["rank_G"][rows] = mech.rank_G
         out["n_contacts"][rows] = mech.n_contacts
         if mech.rank_G < 6 or mech.projector is None:
-            out["status"][rows] = "rank_deficient"
+            out["status"][rows] = RANK_DEFICIENT
             continue
         problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, synergies, params.f_min_N, cone, params.basis_rtol)
         sol = solve_gfo(problems, method, strict_shrink=params.strict_shrink if strict else None, tol=params.tol,
