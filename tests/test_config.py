@@ -1,6 +1,5 @@
 """The one config model: defaults from the schema, the overlay rule, every check before any
 job (one message naming the key) and scenarios."""
-import ast
 import copy
 import math
 from pathlib import Path
@@ -13,7 +12,7 @@ from synergrasp.config import (
     ConfigError,
     defaults,
     overlay,
-    scenario_configs,
+    scenario_config,
     scenario_names,
     validate_config,
 )
@@ -21,6 +20,23 @@ from synergrasp.config import (
 ROOT = Path(__file__).resolve().parents[1]
 STUDY = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 SMALL = yaml.safe_load((ROOT / "tests" / "config" / "small.yaml").read_text())
+
+
+def scenario_configs(config):
+    """Every scenario's complete configuration by name (:func:`scenario_config`), ``default``
+    first; every problem of every scenario in one ConfigError."""
+    out, problems = {}, []
+    for name in scenario_names(validate_config(config)):
+        try:
+            out[name] = scenario_config(config, name)
+        except ConfigError as err:
+            problems += str(err).splitlines()
+    if problems:
+        raise ConfigError("\n".join(problems))
+    return out
+
+
+# --------------------------------------------------------------------------- typed parameters
 
 
 @pytest.mark.parametrize("config", [STUDY, SMALL], ids=["study", "small"])

@@ -157,6 +157,9 @@ _OBJECTS = {"hand", "params", "problem", "problems", "self", "out", "snakemake",
             "rule", "job", "workflow", "wildcards", "W", "palm", "fingers", "cp", "table", "settings", "result",
             "GROUP", "ipm_solver"}
 _FILE_SUFFIXES = (".py", ".smk")
+#: Other files the docs name (outputs, data, pages): not checked.
+_DATA_SUFFIXES = {"md", "yaml", "csv", "toml", "lock", "html", "png", "pdf", "parquet", "js", "json", "rst", "txt", "tsv",
+                  "zip", "dot", "sh", "obj", "stl", "urdf", "xml", "svg", "log", "cfg", "dae"}
 
 
 def _doc_texts():
@@ -231,10 +234,7 @@ def stale_names(text: str, modules: dict[tuple[str, ...], Path], schema: set[tup
                 stale.append(token)
             continue
         parts = tuple(token.split("."))
-        if len(parts) < 2 or "" in parts or "." in token and token.rsplit(".", 1)[1] in {"md", "yaml", "csv", "toml", "lock", "html",
-                                                                           "png", "pdf", "parquet", "js", "json",
-                                                                           "rst", "txt", "tsv", "zip", "dot", "sh", "obj", "stl",
-                                                                           "urdf", "xml", "svg", "log", "cfg", "dae"}:
+        if len(parts) < 2 or "" in parts or parts[-1] in _DATA_SUFFIXES:
             continue
         if parts[0] == "synergrasp":
             parts = parts[1:]

@@ -90,7 +90,8 @@ def test_distinct_poses_count_one_period():
 def test_marginal_grasps_flagged_and_excluded():
     """Weight 1 N, multiple 10: forces 5, 20 and 50 N -> two marginal successes."""
     table = pd.DataFrame(gfo_rows("a", "1", [5.0, 20.0, 50.0]) + gfo_rows("a", "1-2", [5.0, 10.0, 10.0]))
-    r = success_rates(with_verdicts(table, "force_closure", weights_N={"a": 1.0}, marginal_multiple=10.0), "1-2").set_index("set_id")
+    judged = with_verdicts(table, "force_closure", weights_N={"a": 1.0}, marginal_multiple=10.0)
+    r = success_rates(judged, "1-2").set_index("set_id")
     assert r.loc["1", "n_marginal"] == 2 and r.loc["1", "marginal_percent"] == pytest.approx(200 / 3)
     assert r.loc["1", "plain_mean_force_N"] == pytest.approx(25.0)
     assert r.loc["1", "plain_mean_force_non_marginal_N"] == pytest.approx(5.0)

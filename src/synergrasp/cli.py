@@ -93,7 +93,8 @@ def _blocker_lines(sets: Any) -> list[str]:
             continue
         lines.append(f"  {set_name(s.synergies):<22} t* = {s.margin:.3g}")
         for b in s.blockers:
-            lines.append(f"    contact {b.contact}: {b.link_name} ({b.link_kind}), {b.face} on {'an' if b.feature == 'edge' else 'a'} {b.feature}, "
+            article = "an" if b.feature == "edge" else "a"
+            lines.append(f"    contact {b.contact}: {b.link_name} ({b.link_kind}), {b.face} on {article} {b.feature}, "
                          f"normal force {b.normal_force:+.3g}, {_number(b.angle_outside_deg)} deg outside its cone")
     return lines
 

@@ -1,7 +1,8 @@
 """The steps of the workflow, each declared once (docs/design.md, "Adding a step").
 
 :data:`STEPS` is data only: for every step, its rules and the measured cost and threads of
-one job of each, the files it writes (and which of them the report shows), the configuration keys it reads (and those it reads only when
+one job of each, the files it writes (and which of them the report shows), the configuration
+keys it reads (and those it reads only when
 another key has a given value), the steps whose outputs it reads, and the class whose
 ``from_config`` builds its typed parameters. The step hash, ``synergrasp.wiring`` (every
 rule's outputs, log, benchmark, threads and requests, the targets, where a shared output

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import csv
 import functools
-import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any

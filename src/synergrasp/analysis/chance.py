@@ -6,7 +6,8 @@ reflected at the ends of the β range (β is not periodic), and counts the minim
 neighbourhood (the same test as the observed statistic, :func:`synergrasp.analysis.minima.
 preserved`). The shift keeps how many minima there are and how they are spread, and
 destroys where they are. Offsets that leave the map where it was are excluded: α offset
-within the radius of a multiple of the object's α-period *and* β offset within the radius. Each draw gives every pair its own offset; the share is pooled over pairs as the
+within the radius of a multiple of the object's α-period *and* β offset within the radius. Each
+draw gives every pair its own offset; the share is pooled over pairs as the
 observed share is. ``draws`` draws from a generator seeded with ``seed``: deterministic.
 
 Pairs whose two force maps are identical (same success at every pose, forces equal to

@@ -160,7 +160,8 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
     sol = GFOSolution(status=status, force_norm=np.where(optimal, res.force_norm, np.nan), forces=forces,
                       e_s=res.e_s.astype(np.int32), iterations=res.iterations,
                       strict_internal=res.strict_code == ipm_solver.OPTIMAL if strict else None,
-                      solver=np.where(res.implied, "implied", "ipm").astype(object), max_violation=np.where(optimal, res.max_violation, np.nan))
+                      solver=np.where(res.implied, "implied", "ipm").astype(object),
+                      max_violation=np.where(optimal, res.max_violation, np.nan))
     for j in np.flatnonzero((res.code == ipm_solver.UNDECIDED) | (res.code == ipm_solver.NOT_SOLVED)):  # status ''
         _fallback(sol, j, g.problem(j), tol, max_iter)
     if strict:
