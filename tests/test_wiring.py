@@ -164,3 +164,23 @@ def test_weight_and_friction_are_stated_once():
 def test_set_ids_are_read_in_one_place():
     assert set_members("1-2-10") == (1, 2, 10)
     assert sorted(["1-2-3", "10", "2", "1-3", "1-10"], key=set_order) == ["2", "10", "1-3", "1-10", "1-2-3"]
+
+
+@pytest.mark.parametrize("model, unloaded, contacts", [
+    ("kinematic", "keep", "contacts.parquet"),
+    ("dynamic", "keep", "contacts.parquet"),
+    ("dynamic", "drop", "load_carrying_contacts.parquet"),
+])
+def test_the_commands_read_the_files_the_workflow_reads(model, unloaded, contacts):
+    """``synergrasp plan`` and ``synergrasp grasp`` find an object's tables by
+    ``steps.object_file``, the workflow by ``Wiring.step_file``: the same file, whatever
+    else is on disk (the contact selection's table only where the configuration makes it)."""
+    from synergrasp.steps import RESULTS, object_file
+
+    closure = defaults()["closure"]
+    w = _wiring(closure={**closure, "model": model, "dynamic": {**closure["dynamic"], "unloaded_contacts": unloaded}})
+    for obj in w.objects:
+        for step in ("search", "simulate", "contacts", "optimise", "minima"):
+            assert w.step_file("default", step, obj) == object_file(w.study, step, obj).as_posix(), (obj, step)
+        assert object_file(w.study, "contacts", obj) == Path(RESULTS) / "objects" / obj / contacts
+        assert object_file(w.study, "contacts", obj, "elsewhere") == Path("elsewhere") / "objects" / obj / contacts

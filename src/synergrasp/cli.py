@@ -100,6 +100,8 @@ def _blocker_lines(sets: Any) -> list[str]:
 
 
 def _parser() -> argparse.ArgumentParser:
+    from synergrasp.steps import RESULTS
+
     parser = argparse.ArgumentParser(prog="synergrasp", description="synergrasp: one grasp of the study in full")
     sub = parser.add_subparsers(dest="command", required=True)
     grasp = sub.add_parser("grasp", help="close the hand on one object at one pose and optimise its grasp")
@@ -109,7 +111,7 @@ def _parser() -> argparse.ArgumentParser:
     grasp.add_argument("--configfile", nargs="+", default=[], help="overlays on the study's configuration")
     grasp.add_argument("--sets", nargs="+", help="synergy sets: k, a-b (S_a..S_b) or a,b,c (default: each "
                                                  "single synergy and {S1..Sk} for every k)")
-    grasp.add_argument("--results", default="results", help="where the study's outputs are (the searched "
+    grasp.add_argument("--results", default=RESULTS, help="where the study's outputs are (the searched "
                                                             "placement's target: <results>/objects/<object>/placement.csv)")
     grasp.add_argument("--json", action="store_true", help="print the result as JSON")
     grasp.add_argument("--png", metavar="PATH", help="write the grasp drawn as in Fig. 2 from two views (PNG)")
@@ -135,7 +137,7 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--radius", type=float, nargs="+", help="neighbourhood radii, deg (default: "
                                                               "analyses.planner_radii_deg)")
     plan.add_argument("--configfile", nargs="+", default=[], help="overlays on the study's configuration")
-    plan.add_argument("--results", default="results", help="where the study's outputs are")
+    plan.add_argument("--results", default=RESULTS, help="where the study's outputs are")
     plan.add_argument("--csv", metavar="PATH", help="write the plan table (one row per radius) as CSV")
     return parser
 
@@ -171,19 +173,18 @@ def _plan(args: argparse.Namespace) -> int:
     from synergrasp.analysis.plan_study import PlanParams, plan_object
     from synergrasp.config import ConfigError
     from synergrasp.hand.synergies import load_synergies
+    from synergrasp.steps import object_file
     from synergrasp.study_checks import checked_scenario, read_overlays
 
-    folder = Path(args.results) / "objects" / args.object
-    contacts_path = next((folder / f for f in ("load_carrying_contacts.parquet", "contacts.parquet")
-                          if (folder / f).is_file()), folder / "contacts.parquet")
     try:
         cfg, _ = checked_scenario(read_overlays(args.configfile))
         if args.object not in cfg["objects"]:
             raise ConfigError(f"object {args.object!r} is not in the configuration ({', '.join(cfg['objects'])})")
         params = PlanParams.from_config(cfg, args.object)
         params = replace(params, radii_deg=tuple(args.radius)) if args.radius else params
-        contacts = tables.read(tables.CONTACTS, contacts_path)
-        gfo = tables.read(tables.GFO, folder / "gfo.parquet")
+        # the files the workflow's rules read for this configuration, not whichever exists
+        contacts = tables.read(tables.CONTACTS, object_file(cfg, "contacts", args.object, args.results))
+        gfo = tables.read(tables.GFO, object_file(cfg, "optimise", args.object, args.results))
     except (ConfigError, ValueError, FileNotFoundError) as err:
         print(f"synergrasp plan: {err}", file=sys.stderr)
         return 2
