@@ -6,13 +6,12 @@ from pathlib import Path
 
 import pytest
 import yaml
-from conftest import schema_leaf_paths
+from conftest import scenario_configs, schema_leaf_paths
 
 from synergrasp.config import (
     ConfigError,
     defaults,
     overlay,
-    scenario_config,
     scenario_names,
     validate_config,
 )
@@ -20,20 +19,6 @@ from synergrasp.config import (
 ROOT = Path(__file__).resolve().parents[1]
 STUDY = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 SMALL = yaml.safe_load((ROOT / "tests" / "config" / "small.yaml").read_text())
-
-
-def scenario_configs(config):
-    """Every scenario's complete configuration by name (:func:`scenario_config`), ``default``
-    first; every problem of every scenario in one ConfigError."""
-    out, problems = {}, []
-    for name in scenario_names(validate_config(config)):
-        try:
-            out[name] = scenario_config(config, name)
-        except ConfigError as err:
-            problems += str(err).splitlines()
-    if problems:
-        raise ConfigError("\n".join(problems))
-    return out
 
 
 # --------------------------------------------------------------------------- typed parameters

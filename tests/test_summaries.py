@@ -200,6 +200,10 @@ def test_study_tables_names_and_csv_round_trip(gfo, tmp_path):
     assert set(tables) == {"success_rates", "table2_success_rates", "hierarchy", "minimum_preservation",
                            "preservation_vs_chance", "full_not_first7", "verdict_disagreements", "invariant_checks",
                            "claims"}
+    from synergrasp.steps import TABLES
+    from synergrasp.tables import STUDY_TABLES
+
+    assert list(tables) == list(STUDY_TABLES) and TABLES == STUDY_TABLES  # one list: the step's outputs are these
     assert tables["full_not_first7"][1]["pose"].tolist() == [2, 3]
     rates = tables["success_rates"][1]
     views = rates[rates["object"] == "all"].set_index(["set_id", "view"])

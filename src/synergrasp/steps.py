@@ -35,6 +35,7 @@ from typing import Any
 from synergrasp.config import DEFAULT_SCENARIO
 from synergrasp.hand.synergies import synergy_values
 from synergrasp.resolved import effective_placement
+from synergrasp.tables import STUDY_TABLES
 
 __all__ = ["Cost", "Step", "STEPS", "UNITS", "WORKFLOW_KEYS", "CLOSURE_COST_FACTOR", "SOLVER_COMPILE",
            "step_keys", "step_config", "step_hash", "upstream_when", "rule_costs", "rule_step", "step_for_object", "step_made",
@@ -128,9 +129,8 @@ def _files(names: tuple[str, ...], folder: str, exts: tuple[str, ...], named: bo
     return {f"{n}_{e}" if named else e: f"{folder}/{n}.{e}".lstrip("/") for n in names for e in exts}
 
 
-#: The study's tables (the ``tables`` step).
-TABLES = ("success_rates", "table2_success_rates", "hierarchy", "minimum_preservation", "full_not_first7",
-          "verdict_disagreements", "preservation_vs_chance", "invariant_checks", "claims")
+#: The study's tables (the ``tables`` step), named once in ``synergrasp.tables``.
+TABLES = STUDY_TABLES
 #: The keys of the choice of which contacts count (the ``contacts`` step).
 _CONTACT_SELECTION = ("closure.dynamic.unloaded_contacts", "closure.dynamic.load_threshold_N")
 #: The keys of the force bound of ``analyses.success: force_closure_bounded``.

@@ -21,7 +21,8 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from synergrasp.config import ConfigError, check_relations, overlay, scenario_config, search_lattice_size, synergy_problems
+from synergrasp.config import (DEFAULT_SCENARIO, ConfigError, check_relations, overlay, scenario_config,
+                               search_lattice_size, synergy_problems)
 from synergrasp.preflight import refuse
 from synergrasp.resolved import effective_placement, grasp_type
 from synergrasp.yaml_io import read_yaml
@@ -39,7 +40,7 @@ def _hand(path: str | None) -> tuple[Any, tuple[str, ...], tuple[str, ...]]:
     return hand, tuple(problems), tuple(warnings)
 
 
-def checked_scenario(config: Mapping[str, Any], name: str = "default") -> tuple[dict[str, Any], list[str]]:
+def checked_scenario(config: Mapping[str, Any], name: str = DEFAULT_SCENARIO) -> tuple[dict[str, Any], list[str]]:
     """Scenario ``name``'s complete, checked configuration (``default``: the configuration
     itself) and the warnings on it, each one line naming the file or the key.
 
@@ -52,7 +53,7 @@ def checked_scenario(config: Mapping[str, Any], name: str = "default") -> tuple[
     from synergrasp.hand.synergies import load_synergies
     from synergrasp.simulation.objects import object_problems, object_warnings
 
-    where = "" if name == "default" else f"scenario '{name}': "
+    where = "" if name == DEFAULT_SCENARIO else f"scenario '{name}': "
     try:
         cfg = scenario_config(config, name)
         hand, problems, warnings = _hand(cfg["hand"])

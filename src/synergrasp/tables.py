@@ -16,7 +16,7 @@ import pandas as pd
 
 from synergrasp.file_output import replacing
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT", "PLAN", "ENROLLMENT", "BLOCKERS",
+__all__ = ["Column", "Table", "TABLES", "STUDY_TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT", "PLAN", "ENROLLMENT", "BLOCKERS",
            "QUALITY", "TARGET_CLAIMS", "write", "read", "write_csv", "read_csv", "empty", "write_study_table"]
 
 
@@ -294,6 +294,11 @@ ENROLLMENT = Table("enrollment", "one row per k", (
     Column("full_n_success", "int32", "", "grid poses where the full set succeeds"),
 ))
 
+#: The study's tables, in this order (the ``tables`` step's outputs ``tables/<name>.{csv,md}``, made by
+#: ``analysis.summaries.study_tables``): shown to the reader, no contract between steps.
+STUDY_TABLES: tuple[str, ...] = ("success_rates", "table2_success_rates", "hierarchy", "minimum_preservation",
+                                 "full_not_first7", "verdict_disagreements", "preservation_vs_chance",
+                                 "invariant_checks", "claims")
 TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, QUALITY,
                                                 TARGET_CLAIMS, BLOCKERS, PLAN, ENROLLMENT)}
 

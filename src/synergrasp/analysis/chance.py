@@ -24,12 +24,13 @@ from numpy.typing import NDArray
 
 from synergrasp.analysis.bootstrap import PoseResampler
 from synergrasp.analysis.minima import preserved, preserved_counts
-from synergrasp.ids import incremental_set_id
+from synergrasp.ids import ALL_OBJECTS, incremental_set_id
 
 __all__ = ["identical_force_maps", "allowed_offsets", "null_preserved", "preservation_vs_chance",
            "resampled_preservation"]
 
-ALL_OBJECTS = "all"
+#: The ``pairs`` of a row over every pair of consecutive levels (besides ``non_identical``).
+ALL_PAIRS = "all"
 _TOL_DEG = 1e-6
 
 
@@ -162,7 +163,7 @@ def preservation_vs_chance(table: pd.DataFrame, minima: pd.DataFrame, k_max: int
     summary = []
     for obj in [*sorted({r["object"] for r in rows}), ALL_OBJECTS]:
         group = [r for r in rows if obj in (ALL_OBJECTS, r["object"])]
-        summary.append(_summary(obj, "all", group, draws))
+        summary.append(_summary(obj, ALL_PAIRS, group, draws))
         summary.append(_summary(obj, "non_identical", [r for r in group if not r["identical"]], draws))
     pairs = pd.DataFrame([{"object": r["object"], "k": r["k"], "identical_maps": r["identical"]} for r in rows],
                          columns=["object", "k", "identical_maps"])

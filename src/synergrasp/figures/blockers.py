@@ -17,7 +17,7 @@ import pandas as pd
 
 from synergrasp.analysis.blockers import SUMMARY_GROUPS
 from synergrasp.figures.output import save_figure
-from synergrasp.ids import set_name
+from synergrasp.ids import ALL_OBJECTS, set_name
 
 __all__ = ["figure_blockers"]
 
@@ -42,8 +42,8 @@ def figure_blockers(summary: pd.DataFrame, png_path: str | Path, pdf_path: str |
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    objects = [o for o in dict.fromkeys(summary["object"]) if o != "all"]
-    objects += ["all"] if (summary["object"] == "all").any() else []
+    objects = [o for o in dict.fromkeys(summary["object"]) if o != ALL_OBJECTS]
+    objects += [ALL_OBJECTS] if (summary["object"] == ALL_OBJECTS).any() else []
     columns = _columns()
     n = max(len(objects), 1)
     fig, axes = plt.subplots(n, 1, figsize=(11.5, 0.3 * len(summary) + 0.5 * n + 2.4), squeeze=False, sharex=True,

@@ -26,6 +26,7 @@ from synergrasp.optimisation.mechanics import contact_frames
 from synergrasp.optimisation.problem import (
     ALMOST_SOLVED_TOL,
     DEFAULT_TOL,
+    MAX_ITER,
     GFOProblem,
     GFOSolution,
     GraspSets,
@@ -57,7 +58,7 @@ def solve_gfo(
     *,
     strict_shrink: float | None = None,
     tol: float = DEFAULT_TOL,
-    max_iter: int = 200,
+    max_iter: int = MAX_ITER,
     ipm: IPMSettings = IPMSettings(),
 ) -> GFOSolution:
     """Solve GFO problems; one row of the result per problem, in order.

@@ -32,7 +32,7 @@ from synergrasp.optimisation.mechanics import (
     read_grasps,
     weight_wrench,
 )
-from synergrasp.optimisation.problem import DEFAULT_TOL, STRICT_SHRINK, GraspSets, SynergySets
+from synergrasp.optimisation.problem import DEFAULT_TOL, MAX_ITER, STRICT_SHRINK, GraspSets, SynergySets
 from synergrasp.optimisation.shards import shard_positions
 from synergrasp import resolved
 
@@ -76,7 +76,7 @@ class GFOParams:
     grasp_rank_rtol: float = GRASP_RANK_RTOL
     strict_shrink: float = STRICT_SHRINK
     tol: float = DEFAULT_TOL
-    max_iter: int = 200
+    max_iter: int = MAX_ITER
 
     def __post_init__(self) -> None:
         # The configuration is checked by its schema; a direction is normalised here

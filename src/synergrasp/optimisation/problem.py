@@ -27,6 +27,7 @@ from synergrasp.optimisation.mechanics import BASIS_RTOL, _unit_normals, contact
 __all__ = [
     "ALMOST_SOLVED_TOL",
     "DEFAULT_TOL",
+    "MAX_ITER",
     "GFOProblem",
     "GFOSolution",
     "GraspSets",
@@ -43,6 +44,8 @@ __all__ = [
 STATUSES: tuple[str, ...] = ("feasible", "infeasible", "numerical_failure")
 #: Feasibility / gap tolerance of the exact solvers unless told otherwise (Clarabel's default).
 DEFAULT_TOL = 1e-8
+#: Iteration limit of the exact solvers (Clarabel, PIQP) unless told otherwise.
+MAX_ITER = 200
 #: A reduced-accuracy optimum is accepted when its worst constraint violation is below
 #: this, relative to max(1 N, ||f||) (every back end applies the same rule).
 ALMOST_SOLVED_TOL = 1e-6
