@@ -26,6 +26,8 @@ rule tables:
         gfo=W.step_inputs("optimise"),
         minima=W.step_inputs("minima"),
         code=W.code("tables"),
+        data=SHIPPED_DATA,
+        user=W.user_files,
     output:
         **outputs("tables"),
     log:
