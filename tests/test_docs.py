@@ -297,14 +297,14 @@ def test_a_planted_stale_name_is_found():
 
 
 def _status_values() -> set[str]:
-    """Every status and reason value the code writes: the solvers' (`problem.STATUSES`), the
+    """Every status and reason value the code writes: the solvers' (`problem.SOLVER_STATUSES`), the
     gfo table's unsolved ones, the closure's and the blockers' reasons."""
     from synergrasp.optimisation.blocking import REASONS
     from synergrasp.optimisation.optimise import UNSOLVED_STATUSES
-    from synergrasp.optimisation.problem import STATUSES
-    from synergrasp.simulation.contacts import STATUSES as CLOSURE_STATUSES
+    from synergrasp.optimisation.problem import SOLVER_STATUSES
+    from synergrasp.simulation.contacts import CLOSURE_STATUSES
 
-    return {*STATUSES, *UNSOLVED_STATUSES, *CLOSURE_STATUSES, *REASONS}
+    return {*SOLVER_STATUSES, *UNSOLVED_STATUSES, *CLOSURE_STATUSES, *REASONS}
 
 
 def stale_statuses(text: str, known: set[str]) -> list[str]:

@@ -30,7 +30,7 @@ from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 __all__ = ["RealismParams", "SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "LONG_FINGERS",
            "link_categories", "grasp_labels", "grasp_realism", "link_shares", "representative_grasps"]
 
-#: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.STATUSES): a
+#: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.CLOSURE_STATUSES): a
 #: ``no_contact`` closure is a simulated grasp with 0 contacts; any other status is a dropped pose.
 SIMULATED_STATUSES: tuple[str, ...] = ("grasp", "no_contact")
 #: Contact-count bins of the table: 0, 1, …, 5 and "6 or more".

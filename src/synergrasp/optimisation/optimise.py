@@ -40,7 +40,7 @@ __all__ = ["GFOParams", "OptimiseParams", "UNSOLVED_STATUSES", "gfo_table", "mec
            "optimise_shard"]
 
 #: The gfo table's statuses of a problem given before any solve: no grasp at the pose, and
-#: rank(G) < 6 (the solved ones are ``problem.STATUSES``).
+#: rank(G) < 6 (the solved ones are ``problem.SOLVER_STATUSES``).
 UNSOLVED_STATUSES: tuple[str, ...] = ("no_grasp", "rank_deficient")
 NO_GRASP, RANK_DEFICIENT = UNSOLVED_STATUSES
 
