@@ -22,10 +22,12 @@ from synergrasp.analysis.chance import ALL_PAIRS
 from synergrasp.analysis.intervals import VIEWS, StudyCounts, mean_defined
 from synergrasp.ids import ALL_OBJECTS, incremental_set_id, set_id, set_members
 
-__all__ = ["HOLDS", "FAILS", "UNDEFINED", "VerdictRules", "Difference", "interval_verdict", "claims_table",
+__all__ = ["HOLDS", "FAILS", "UNDEFINED", "CLAIM_VERDICTS", "VerdictRules", "Difference", "interval_verdict", "claims_table",
            "CLAIM_COLUMNS"]
 
 HOLDS, FAILS, UNDEFINED = "holds", "does not hold", "undefined"
+#: A claim's verdicts (a success verdict of a grasp is ``verdicts.SUCCESS_VERDICTS``).
+CLAIM_VERDICTS = (HOLDS, FAILS, UNDEFINED)
 CLAIM_COLUMNS = ["claim", "view", "headline", "statement", "tested_by", "measured", "difference", "low", "high",
                  "unit", "tie_band", "n_distinct_poses", "verdict", "reason"]
 #: How a difference d decides a claim: "greater" (holds if d > band), "within_below" (a claim

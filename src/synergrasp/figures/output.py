@@ -11,7 +11,7 @@ from synergrasp.file_output import replacing
 
 __all__ = ["save_figure", "colour_range", "VERDICT_COLOURS"]
 
-#: Fill colour of each verdict of a claim (holds, does not hold, undefined), in every figure.
+#: Fill colour of each verdict of a claim (``claims.CLAIM_VERDICTS``), in every figure.
 VERDICT_COLOURS = {HOLDS: "#9fd89f", FAILS: "#f19c9c", UNDEFINED: "#f3e08a"}
 
 #: Metadata that would change between runs (dates) or versions (software) are left out.
