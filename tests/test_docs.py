@@ -148,7 +148,7 @@ def test_readme_lists_every_page_of_docs():
 #: Names the docs cite that belong to other packages (a module or object of theirs first).
 _OTHER_PACKAGES = {"np", "numpy", "pd", "pandas", "scipy", "pybullet", "mujoco", "plotly", "time", "os", "snakemake",
                    "matplotlib", "numba", "cvxpy", "clarabel", "piqp", "json", "yaml", "re", "math", "shutil",
-                   "threading", "importlib", "subprocess", "pytest", "sys", "pathlib", "warnings"}
+                   "threading", "importlib", "subprocess", "pytest", "sys", "pathlib", "warnings", "jsonschema"}
 #: Variables the docs name the members of (an object, not a module): `hand.point_jacobian` is a
 #: method of a `Hand` called ``hand``, `params.cone` a field of a problem's parameters.
 #: `W.step_input` a method of the `Wiring` common.smk calls ``W``; `palm.shapes` a hand file's field;
