@@ -8,8 +8,12 @@
 #   make test-browser   - the browser tier alone: the 3-D pages in headless Chromium
 #                         (/usr/bin/chromium: apt-get install chromium; CI installs it)
 #   make test-all       - every test, the end-to-end workflow runs and the browser included
-#   make lint           - snakefmt --check, snakemake --lint (conda/container advice aside) and
-#                         the package's layers and no import circle (import-linter, pyproject.toml)
+#   make lint           - ruff check (pyflakes, pycodestyle's errors, 130 characters), snakefmt --check,
+#                         snakemake --lint (conda/container advice aside) and the package's layers and
+#                         no import circle (import-linter, pyproject.toml); ruff format --check too once
+#                         the tree is formatted (the marker file .ruff-formatted)
+#   make format         - ruff format on the Python files, then the marker .ruff-formatted (the
+#                         integrator runs it once after the open branches are merged)
 #   make cluster-test   - the small study on a single-node SLURM started here (root; installs SLURM)
 #   make bench          - the benchmarks, recorded in benchmarks/results/, and docs/measurements.md
 #   make bench-study    - the default study timed from an empty results/, recorded likewise
@@ -18,7 +22,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 CORES  ?= 2
 
-.PHONY: venv study test test-workflow test-browser test-all lint cluster-test bench bench-study lock report clean-venv
+.PHONY: venv study test test-workflow test-browser test-all lint format cluster-test bench bench-study lock report clean-venv
 
 $(BIN)/.installed: environment.lock pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -64,10 +68,17 @@ test-all: $(BIN)/.installed
 	$(WARM_UP)
 	$(call PYTEST,)
 
+# The format is checked only once `make format` has been run on the tree (its marker file).
 lint: $(BIN)/.installed
+	$(BIN)/ruff check .
+	@if [ -e .ruff-formatted ]; then $(BIN)/ruff format --check .; else echo "ruff format --check: skipped, the tree is not formatted yet (make format)"; fi
 	$(BIN)/snakefmt --check Snakefile workflow
 	$(BIN)/python tools/check_lint.py
 	$(BIN)/lint-imports
+
+format: $(BIN)/.installed
+	$(BIN)/ruff format .
+	touch .ruff-formatted
 
 cluster-test: $(BIN)/.installed
 	$(WARM_UP)

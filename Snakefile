@@ -86,5 +86,5 @@ rule across_objects:
         W.optional_targets("objects_summary"),
 
 
-# A failed job keeps the outputs of the run before (synergrasp.preflight).
-keep_outputs_until_replaced(workflow)
+# A failed job keeps the outputs of the run before (synergrasp.snakemake_adapter).
+adapter.keep_outputs_until_replaced(workflow)

@@ -7,7 +7,8 @@ poses: it costs more) the same, then ``closure_dynamic_median_ms: N``; then
 ``closure_median_ms: N`` (kinematic model) over all objects. Last, the kinematic closure on
 each kind of shape (docs/shapes.md) beside a box of the same size, with the study's placement
 and closure settings on the same poses: the median per grasp and its ratio to the box's
-(``closure_shape_median_ms_<kind>: N`` and ``closure_shape_ratio_<kind>: N``; issue 25 asks ≤ 1.5 for the sphere and the cylinder, ≤ 3
+(``closure_shape_median_ms_<kind>: N`` and ``closure_shape_ratio_<kind>: N``; issue 25 asks ≤ 1.5 for the sphere and
+the cylinder, ≤ 3
 for a convex mesh of 1000 faces; a non-convex mesh, the duck of the example study, is
 reported on its own line).
 

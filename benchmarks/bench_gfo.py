@@ -3,7 +3,7 @@ per-problem Clarabel vs cvxpy, all through the front door `solve_gfo`.
 
 Realistic study mix: random grasps with 4-12 contacts (some on the palm) x the 75 synergy
 sets of the study (15 incremental + subsets of 1-3 of S1..S7). The "ipm" figure is the
-study's loop (`study.optimise_grasps`, GFO only): mechanics, bases, rows and solves,
+study's loop (`optimise.optimise_grasps`, GFO only): mechanics, bases, rows and solves,
 measured after one warm-up call that loads the compiled kernel (its one-time cost per
 process is printed separately), median of 5 runs (`--repeats`); also, not machine-read, the
 same loop with every set solved and every basis from scratch (`IPMSettings(nested=False)`). Run on one core with

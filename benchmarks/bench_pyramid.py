@@ -1,7 +1,7 @@
 """Throughput of the pyramid friction cones in the study's loop: the compiled kernel (the
 study's method, `gfo.FASTEST_METHOD["pyramid"] == "ipm"`) against PIQP per problem.
 
-`study.optimise_grasps` with the strict test on the first `--grasps` grasps of
+`optimise.optimise_grasps` with the strict test on the first `--grasps` grasps of
 benchmarks/bench_gfo.py x the 75 study sets, for each pyramid model and the circular cone;
 the PIQP runs set `FASTEST_METHOD["pyramid"]` to "piqp" for their duration. CPU time
 (`time.process_time`), runs of the two methods interleaved, median of `--repeats`. Run on

@@ -12,7 +12,8 @@ import pybullet as pb
 from numpy.typing import NDArray
 
 from synergrasp.hand.kinematics import Hand, write_urdf
-from synergrasp.simulation.bullet import MM, HandBody, _exact_surface, _hand_body, collision_shape, move_body, set_posture
+from synergrasp.simulation.bullet import (MM, HandBody, _exact_surface, _hand_body, _to_hand_links, collision_shape,
+                                          move_body, set_posture)
 
 
 def load_hand_body(client: int, hand: Hand) -> HandBody:
@@ -85,3 +86,19 @@ def load_object(client: int, shape: Any, center_mm: NDArray, rotation: NDArray |
     _exact_surface(client, body, shape)
     move_body(client, body, center_mm, rotation)
     return body
+
+
+def contact_force_vectors(client: int, body_a: int | HandBody, body_b: HandBody) -> tuple[NDArray, NDArray, NDArray]:
+    """Per contact point of the last step between A and the hand B: hand links of A and B
+    (-1 where A is not the hand), the point on B (mm) and the total force B applies to A
+    (normal plus the two friction components, N, palm frame)."""
+    a = body_a.body if isinstance(body_a, HandBody) else body_a
+    pts = pb.getContactPoints(a, body_b.body, physicsClientId=client)
+    links_a = _to_hand_links(body_a, [p[3] for p in pts]) if isinstance(body_a, HandBody) else np.full(len(pts), -1)
+    links = np.stack([links_a, _to_hand_links(body_b, [p[4] for p in pts])], axis=1) if pts else np.zeros((0, 2), np.int64)
+    points = np.array([p[6] for p in pts]).reshape(-1, 3) / MM
+    # pybullet's friction components act on B along its lateral directions: on A, opposite
+    # (checked by the soft-synergy balance at rest, tests/test_dynamic_closure.py)
+    force = np.array([p[9] * np.array(p[7]) - p[10] * np.array(p[11]) - p[12] * np.array(p[13])
+                      for p in pts]).reshape(-1, 3)
+    return links, points, force

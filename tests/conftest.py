@@ -95,3 +95,19 @@ def schema_leaf_paths(node=None, prefix=""):
     if not props:
         return [prefix.rstrip(".")]
     return [p for name, sub in props.items() for p in schema_leaf_paths(sub, f"{prefix}{name}.")]
+
+
+def scenario_configs(config):
+    """Every scenario's complete configuration by name (``config.scenario_config``), ``default``
+    first; every problem of every scenario in one ConfigError."""
+    from synergrasp.config import ConfigError, scenario_config, scenario_names, validate_config
+
+    out, problems = {}, []
+    for name in scenario_names(validate_config(config)):
+        try:
+            out[name] = scenario_config(config, name)
+        except ConfigError as err:
+            problems += str(err).splitlines()
+    if problems:
+        raise ConfigError("\n".join(problems))
+    return out

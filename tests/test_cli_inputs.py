@@ -208,13 +208,16 @@ def _postures_file(tmp_path: Path) -> Path:
 #: (argv of tmp_path with postures.csv in it, the one line expected after the command's prefix)
 COMMANDS = {
     "fit over its postures": (lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out", str(t / "postures.csv")],
-                              "--out {t}/postures.csv: is the file the command reads (POSTURES {t}/postures.csv); write to another file"),
+                              "--out {t}/postures.csv: is the file the command reads (POSTURES {t}/postures.csv); "
+                              "write to another file"),
     "fit over a symbolic link to them": (lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out",
                                                     str(_linked(t, "link.csv", symbolic=True))],
-                                         "--out {t}/link.csv: is the file the command reads (POSTURES {t}/postures.csv); write to another file"),
+                                         "--out {t}/link.csv: is the file the command reads (POSTURES {t}/postures.csv); "
+                                         "write to another file"),
     "fit over a hard link to them": (lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out",
                                                 str(_linked(t, "hard.csv", symbolic=False))],
-                                     "--out {t}/hard.csv: is the file the command reads (POSTURES {t}/postures.csv); write to another file"),
+                                     "--out {t}/hard.csv: is the file the command reads (POSTURES {t}/postures.csv); "
+                                     "write to another file"),
     "fit into a missing folder": (lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out", str(t / "no/x.csv")],
                                   "--out {t}/no/x.csv: folder '{t}/no' is not an existing folder"),
     "fit png suffix": (lambda t: ["synergies", "fit", str(t / "postures.csv"), "--out", str(t / "x.csv"), "--png",

@@ -1,19 +1,17 @@
 """The one config model: defaults from the schema, the overlay rule, every check before any
 job (one message naming the key) and scenarios."""
-import ast
 import copy
 import math
 from pathlib import Path
 
 import pytest
 import yaml
-from conftest import schema_leaf_paths
+from conftest import scenario_configs, schema_leaf_paths
 
 from synergrasp.config import (
     ConfigError,
     defaults,
     overlay,
-    scenario_configs,
     scenario_names,
     validate_config,
 )
@@ -21,6 +19,9 @@ from synergrasp.config import (
 ROOT = Path(__file__).resolve().parents[1]
 STUDY = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 SMALL = yaml.safe_load((ROOT / "tests" / "config" / "small.yaml").read_text())
+
+
+# --------------------------------------------------------------------------- typed parameters
 
 
 @pytest.mark.parametrize("config", [STUDY, SMALL], ids=["study", "small"])

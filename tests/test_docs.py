@@ -141,3 +141,188 @@ def test_readme_lists_every_page_of_docs():
     missing = [name for name in pages if f"docs/{name}" not in section]
     assert len(pages) > 15 and missing == []
     assert re.search(r"\]\(docs/method\.md\)", readme)
+
+
+# --------------------------------------------------------------------------- names the docs cite
+
+#: Names the docs cite that belong to other packages (a module or object of theirs first).
+_OTHER_PACKAGES = {"np", "numpy", "pd", "pandas", "scipy", "pybullet", "mujoco", "plotly", "time", "os", "snakemake",
+                   "matplotlib", "numba", "cvxpy", "clarabel", "piqp", "json", "yaml", "re", "math", "shutil",
+                   "threading", "importlib", "subprocess", "pytest", "sys", "pathlib", "warnings", "jsonschema"}
+#: Variables the docs name the members of (an object, not a module): `hand.point_jacobian` is a
+#: method of a `Hand` called ``hand``, `params.cone` a field of a problem's parameters.
+#: `W.step_input` a method of the `Wiring` common.smk calls ``W``; `palm.shapes` a hand file's field;
+#: `ipm_solver` the name gfo.py imports ``ipm.solver`` as.
+_OBJECTS = {"hand", "params", "problem", "problems", "self", "out", "snakemake", "spec", "cfg", "config", "grasp",
+            "rule", "job", "workflow", "wildcards", "W", "palm", "fingers", "cp", "table", "settings", "result",
+            "GROUP", "ipm_solver"}
+_FILE_SUFFIXES = (".py", ".smk")
+#: Other files the docs name (outputs, data, pages): not checked.
+_DATA_SUFFIXES = {"md", "yaml", "csv", "toml", "lock", "html", "png", "pdf", "parquet", "js", "json", "rst", "txt", "tsv",
+                  "zip", "dot", "sh", "obj", "stl", "urdf", "xml", "svg", "log", "cfg", "dae"}
+
+
+def _doc_texts():
+    pages = [*_markdown_pages(), *(ROOT / "workflow" / "report").glob("*.rst")]
+    return {p.relative_to(ROOT).as_posix(): p.read_text() for p in pages}
+
+
+def _schema_paths() -> set[tuple[str, ...]]:
+    """Every key path of the configuration schema (``placement.search.distinct_mm``), through
+    its `$defs`."""
+    import yaml
+
+    schema = yaml.safe_load((ROOT / "src" / "synergrasp" / "data" / "config.schema.yaml").read_text())
+    paths: set[tuple[str, ...]] = set()
+
+    def walk(node, prefix, depth=0):
+        if not isinstance(node, dict) or depth > 12:
+            return
+        if "$ref" in node:
+            walk(schema["$defs"][node["$ref"].rsplit("/", 1)[1]], prefix, depth + 1)
+        for key in ("properties", "patternProperties"):
+            for name, sub in (node.get(key) or {}).items():
+                here = prefix + ((name,) if key == "properties" else ())
+                paths.add(here)
+                walk(sub, here, depth + 1)
+        for key in ("items", "additionalProperties"):
+            walk(node.get(key), prefix, depth + 1)
+        for key in ("oneOf", "anyOf", "allOf"):
+            for sub in node.get(key) or ():
+                walk(sub, prefix, depth + 1)
+
+    walk(schema, ())
+    return paths
+
+
+def _modules() -> dict[tuple[str, ...], Path]:
+    """The package's modules and packages by dotted parts (``("optimisation", "optimise")``)."""
+    package = ROOT / "src" / "synergrasp"
+    found = {}
+    for path in package.rglob("*.py"):
+        parts = path.relative_to(package).with_suffix("").parts
+        found[parts[:-1] if parts[-1] == "__init__" else parts] = path
+    return found
+
+
+def _defines(path: Path, name: str) -> bool:
+    """Whether module ``path`` defines ``name`` (a function, class, constant or import), or
+    is a package holding a module ``name``."""
+    import re
+
+    if path.name == "__init__.py" and ((path.parent / f"{name}.py").is_file() or (path.parent / name).is_dir()):
+        return True
+    pattern = (rf"^\s*(?:def|class)\s+{name}\b|^\s*{name}\s*[:=]|^\s*from\s+\S+\s+import\s+[^(\n]*\b{name}\b"
+               rf"|^\s+{name},?\s*(?:#.*)?$|\b{name}\s*=\s*|namedtuple\([^)]*\b{name}\b")  # an import block's line
+    return re.search(pattern, path.read_text(), flags=re.M) is not None
+
+
+def stale_names(text: str, modules: dict[tuple[str, ...], Path], schema: set[tuple[str, ...]],
+                files: set[str]) -> list[str]:
+    """The backticked names in ``text`` that name nothing of the code: a ``.py`` or ``.smk`` file
+    no folder of the checkout holds; a dotted name (``optimise.optimise_grasps``,
+    ``synergrasp.wiring.Wiring``, ``Wiring.step_file``) whose leading parts are no module of
+    the package (by its full or any shorter trailing dotted path) or whose first member that
+    module does not define. Configuration keys (a trailing part of a schema path), other
+    packages' names and an object's members (`_OBJECTS`) are left out."""
+    import re
+
+    stale = []
+    for token in re.findall(r"`([A-Za-z_][\w.]*?)(?:\(\))?`", text):
+        if token.endswith(_FILE_SUFFIXES):
+            if token.rsplit("/", 1)[-1] not in files:
+                stale.append(token)
+            continue
+        parts = tuple(token.split("."))
+        if len(parts) < 2 or "" in parts or parts[-1] in _DATA_SUFFIXES:
+            continue
+        if parts[0] == "synergrasp":
+            parts = parts[1:]
+        elif parts[0] in _OTHER_PACKAGES | _OBJECTS:
+            continue
+        if any(parts == path[-len(parts):] for path in schema if len(path) >= len(parts)):
+            continue  # a configuration key
+        if parts[0][:1].isupper():  # Class.member: the class is defined once, the member in it
+            owners = [p for p in modules.values() if re.search(rf"^(?:class {parts[0]}\b|{parts[0]} = )", p.read_text(), re.M)]
+            if not owners or not any(_defines(p, parts[1]) for p in owners):
+                stale.append(token)
+            continue
+        for k in range(len(parts), 0, -1):  # the longest leading parts that are a module
+            owners = [path for key, path in modules.items() if key[-k:] == parts[:k]]
+            if owners:
+                if k < len(parts) and not any(_defines(p, parts[k]) for p in owners):
+                    stale.append(token)
+                break
+        else:
+            stale.append(token)
+    return stale
+
+
+def _file_names() -> set[str]:
+    names = {p.name for folder in ("src", "workflow", "tests", "tools", "benchmarks") for p in (ROOT / folder).rglob("*")}
+    return names | {"Snakefile"}
+
+
+def test_every_module_file_and_name_the_docs_cite_exists():
+    """Every backticked module name, short (`optimise.optimise_grasps`, `gfo.solve_gfo`) or
+    full (`synergrasp.wiring.Wiring`), every class member (`Wiring.step_file`) and every
+    ``.py``/``.smk`` file name the documentation cites exists in the code: a rename that
+    leaves a page behind fails here."""
+    modules, schema, files = _modules(), _schema_paths(), _file_names()
+    found = {name: stale for name, text in _doc_texts().items() if (stale := stale_names(text, modules, schema, files))}
+    assert found == {}
+
+
+def test_every_module_file_and_name_the_code_cites_exists():
+    """Likewise in the code's docstrings and comments (``name``), the rules, the Snakefile and
+    the profiles."""
+    modules, schema, files = _modules(), _schema_paths(), _file_names()
+    sources = [ROOT / "Snakefile", *(ROOT / "workflow").rglob("*.smk"), *(ROOT / "profiles").rglob("*.yaml")]
+    for folder in ("src", "benchmarks", "tools", "workflow"):
+        sources += (ROOT / folder).rglob("*.py")
+    found = {p.relative_to(ROOT).as_posix(): stale for p in sorted(sources)
+             if (stale := stale_names(p.read_text().replace("``", "`"), modules, schema, files))}
+    assert len(sources) > 100 and found == {}
+
+
+def test_a_planted_stale_name_is_found():
+    modules, schema, files = _modules(), _schema_paths(), _file_names()
+    planted = ("the step (`study.py`) runs `study.optimise_grasps`; rules in `resources.smk`; "
+               "`optimise.optimise_grasps`, `gfo.solve_gfo`, `Wiring.step_file`, `placement.search.distinct_mm`, "
+               "`synergrasp.wiring.code_files`, `np.linalg.svd` and `hand.point_jacobian` exist; "
+               "`gfo.solve_everything`, `Wiring.no_such_member` and `synergrasp.studies` do not")
+    assert stale_names(planted, modules, schema, files) == [
+        "study.py", "study.optimise_grasps", "resources.smk", "gfo.solve_everything", "Wiring.no_such_member",
+        "synergrasp.studies"]
+
+
+def _status_values() -> set[str]:
+    """Every status and reason value the code writes: the solvers' (`problem.SOLVER_STATUSES`), the
+    gfo table's unsolved ones, the closure's and the blockers' reasons."""
+    from synergrasp.optimisation.blocking import REASONS
+    from synergrasp.optimisation.optimise import UNSOLVED_STATUSES
+    from synergrasp.optimisation.problem import SOLVER_STATUSES
+    from synergrasp.simulation.contacts import CLOSURE_STATUSES
+
+    return {*SOLVER_STATUSES, *UNSOLVED_STATUSES, *CLOSURE_STATUSES, *REASONS}
+
+
+def stale_statuses(text: str, known: set[str]) -> list[str]:
+    """The backticked values a text gives as a status ("statuses to `a`, `b` or `c`", "status
+    `grasp`") that no status of the code is."""
+    import re
+
+    flat = re.sub(r"\s+", " ", text)
+    found = []
+    for listed in re.findall(r"\bstatus(?:es)?\b(?: (?:to|is|are|of|as|becomes))?:? ((?:`\w+`(?:, | or | and )?)+)",
+                             flat):
+        found += [value for value in re.findall(r"`(\w+)`", listed) if value not in known]
+    return found
+
+
+def test_every_status_the_docs_give_is_one_the_code_writes():
+    known = _status_values()
+    assert stale_statuses("mapping its statuses to `force_closure`, `infeasible` or `numerical_failure`", known) \
+        == ["force_closure"]
+    found = {name: stale for name, text in _doc_texts().items() if (stale := stale_statuses(text, known))}
+    assert found == {}

@@ -8,6 +8,7 @@ import numpy as np
 import pybullet as pb
 import pytest
 
+from bullet_reference import contact_force_vectors
 from conftest import study_closure_params, study_dynamic_params, study_placement
 from synergrasp.config import ConfigError, defaults, validate_config
 from synergrasp.hand.synergies import Synergies, SynergyPath
@@ -43,7 +44,8 @@ def test_settings_name_the_key_and_allowed_values():
     """The dynamic settings are checked once, by the schema and the relations of the config."""
     with pytest.raises(ConfigError, match=r"'closure.model': 'soft' is not allowed; allowed values: \['kinematic', 'dynamic'\]"):
         validate_config({**defaults(), "closure": {**defaults()["closure"], "model": "soft"}})
-    with pytest.raises(ConfigError, match=r"'closure.dynamic.unloaded_contacts': 'ignore' is not allowed; allowed values: \['drop', 'keep'\]"):
+    with pytest.raises(ConfigError,
+                       match=r"'closure.dynamic.unloaded_contacts': 'ignore' is not allowed; allowed values: \['drop', 'keep'\]"):
         validate_config(_with_dynamic(unloaded_contacts="ignore"))
     with pytest.raises(ConfigError, match=r"'closure.dynamic'.*'timestep'"):
         validate_config(_with_dynamic(timestep=0.01))
@@ -108,10 +110,10 @@ def _generalised_contact_forces(model) -> np.ndarray:
                                       [0.0] * n, [0.0] * n, physicsClientId=client)
         total[:] += (np.array(lin)[:, body.joint_indices] * 1e3).T @ force  # mm/rad · N = N·mm
 
-    links, points, forces = b.contact_force_vectors(client, model.box, body)
+    links, points, forces = contact_force_vectors(client, model.box, body)
     for (_, lb), p, f in zip(links, points, forces):
         add(int(lb), p, f)
-    links, points, forces = b.contact_force_vectors(client, body, body)
+    links, points, forces = contact_force_vectors(client, body, body)
     for (la, lb), p, f in zip(links, points, forces):
         add(int(lb), p, f)
         add(int(la), p, -f)
@@ -143,7 +145,7 @@ def _check_balance(model, hand, params, result):
     contact = _generalised_contact_forces(model)
     # fingers pressed against the hand itself are left out: on them the residual reached
     # ~8 N·mm of 18 (docs/dynamic_closure.md); every finger touching only the box is checked
-    links, _, _ = model.bullet.contact_force_vectors(model.client, model.body, model.body)
+    links, _, _ = contact_force_vectors(model.client, model.body, model.body)
     against_hand = {hand.link_finger[int(k)] for k in links.ravel()}
     checked = np.array([hand.joint_names[j].split("_")[0] not in against_hand for j in axis])
     off_limits = checked & (theta > scale * hand.lower[axis] + 0.01) & (theta < scale * hand.upper[axis] - 0.01)
@@ -187,7 +189,7 @@ def test_settled_box_carries_a_near_zero_net_contact_wrench(model, hand):
     placed = object_pose(AGAINST_PALM, CUBE60, 0.0, 0.0, hand.palm_normal)
     result = model.grasp(placed)
     assert result.settled and {0, 3, 7}.issubset(result.links.tolist())  # palm, thumb and index tips
-    _, points, forces = model.bullet.contact_force_vectors(model.client, model.box, model.body)
+    _, points, forces = contact_force_vectors(model.client, model.box, model.body)
     scale = np.linalg.norm(forces, axis=1).sum()
     assert scale > 1.0
     assert np.linalg.norm(forces.sum(axis=0)) <= 0.05 * scale
@@ -257,7 +259,7 @@ def test_thumb_index_pinch_of_a_small_box_settles_with_a_near_zero_net_wrench(ha
         result = model.grasp(placed)
         assert result.status == "grasp" and result.settled
         fingertips = set(hand.finger_links[0]) | set(hand.finger_links[1])
-        links, points, forces = b.contact_force_vectors(model.client, model.box, model.body)
+        links, points, forces = contact_force_vectors(model.client, model.box, model.body)
         assert set(links[:, 1].tolist()) <= fingertips and set(result.links.tolist()) <= fingertips
         assert {hand.link_finger[link] for link in result.links} == {"thumb", "index"}
         scale = np.linalg.norm(forces, axis=1).sum()
@@ -293,7 +295,8 @@ def test_a_held_box_stays_put_and_the_fingers_settle_on_it_in_equilibrium(hand, 
 
 
 def test_the_held_setting_is_a_checked_key():
-    with pytest.raises(ConfigError, match=r"'closure.dynamic.object': 'fixed' is not allowed; allowed values: \['free', 'held'\]"):
+    with pytest.raises(ConfigError,
+                       match=r"'closure.dynamic.object': 'fixed' is not allowed; allowed values: \['free', 'held'\]"):
         validate_config(_with_dynamic(object="fixed"))
     assert SimulateParams.from_config(validate_config(_with_dynamic(object="held")), "obj1").closure.dynamic.held
     assert not SimulateParams.from_config(defaults(), "obj1").closure.dynamic.held

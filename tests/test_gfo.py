@@ -48,7 +48,8 @@ def strict_internal_forces(E, normals, mu, method="clarabel"):
 def optimise_grasp(mech, synergy_subset, params, method="clarabel"):
     """GFO and strict test of one grasp (rank(G) = 6) for the set of all given columns."""
     sets = SynergySets(synergy_subset, (tuple(range(1, synergy_subset.shape[1] + 1)),))
-    problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, params.f_min_N, params.cone, params.basis_rtol)
+    problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, params.f_min_N, params.cone,
+                         params.basis_rtol)
     return row(solve_gfo(problems, method, strict_shrink=params.strict_shrink))
 
 

@@ -19,7 +19,8 @@ from synergrasp.hand.kinematics import (
     default_hand_path,
     fingertip_positions,
     forward_kinematics,
-    hand_from_dict,
+    build_hand,
+    check_hand_doc,
     load_hand,
     matrix_rpy,
     point_jacobian,
@@ -296,7 +297,7 @@ def test_single_axis_rolling_variant():
     for finger in doc["fingers"].values():
         for joint in finger["joints"]:
             joint["rolling_gap_mm"] = 0.0
-    variant = hand_from_dict(doc)
+    variant = build_hand(check_hand_doc(doc))
     assert len(variant.frame_names) == 1 + 19
     assert np.all(variant.frame_scale[1:] == 1.0)
 

@@ -406,26 +406,3 @@ def test_refuse_prints_the_lines_alone_and_exits_1(capsys):
         refuse(["config error at 'a': b"])
     assert stop.value.code == 1
     assert capsys.readouterr().err == f"{REFUSED}\nconfig error at 'a': b\n"
-
-
-def test_a_killed_runs_backup_of_a_folder_does_not_stop_the_next_backup(tmp_path):
-    """Snakemake copies a kept folder output to .snakemake/backups before its job; a backup
-    left by a killed run made that copy fail. The patched backup replaces it."""
-    import snakemake.persistence
-
-    from synergrasp.preflight import keep_outputs_until_replaced
-
-    keep_outputs_until_replaced(type("Workflow", (), {"rules": []})())
-
-    class Backups(snakemake.persistence.FileBackupMixin):
-        path = tmp_path / ".snakemake"
-
-    pages = tmp_path / "pages"
-    pages.mkdir()
-    (pages / "index.html").write_text("current")
-    backups = Backups()
-    stale = backups._get_backup_path(pages)
-    stale.mkdir(parents=True)
-    (stale / "index.html").write_text("stale")
-    backups.backup_output(pages)
-    assert (stale / "index.html").read_text() == "current"

@@ -101,7 +101,8 @@ def test_a_searched_placement_takes_its_target_from_the_search_table(small, tmp_
     folder = tmp_path / "objects" / "obj1"
     folder.mkdir(parents=True)
     row = {"object": "obj1", "rank": 1, "chosen": True, "distinct_rank": 1, "x_mm": target[0], "y_mm": target[1],
-           "z_mm": target[2], "round": 0, "n_poses": 27, "grasp_type": "precision", "typed_percent": 100.0, "force_closure_percent": 100.0,
+           "z_mm": target[2], "round": 0, "n_poses": 27, "grasp_type": "precision", "typed_percent": 100.0,
+           "force_closure_percent": 100.0,
            "median_force_per_weight": 1.0, "median_contacts": 5.0, "distance_to_chosen_mm": 0.0}
     import pandas as pd
 

@@ -207,7 +207,8 @@ def test_representative_grasps_follow_the_stated_rule(hand):
 
 def test_a_closure_without_contact_is_simulated_not_dropped(hand):
     poses = _POSES + [("no_contact", [], [])]
-    gfo = pd.concat([_gfo(), _gfo().iloc[:2].assign(pose=4, rank_G=0, load_feasible=False, force_closure_def1=False, force_norm=np.nan)])
+    unsolved = _gfo().iloc[:2].assign(pose=4, rank_G=0, load_feasible=False, force_closure_def1=False, force_norm=np.nan)
+    gfo = pd.concat([_gfo(), unsolved])
     row = _table(hand, _contacts(poses=poses), gfo).iloc[0]
     assert (row["poses"], row["simulated"], row["dropped"]) == (5, 4, 1)
     assert row["pct_m0"] == pytest.approx(25.0)

@@ -69,7 +69,7 @@ def test_the_shipped_sweep_is_valid_and_changes_one_factor_per_scenario():
 
     import yaml
 
-    from synergrasp.config import scenario_configs
+    from conftest import scenario_configs
 
     root = Path(__file__).resolve().parents[1]
     raw = yaml.safe_load((root / "config" / "config.yaml").read_text())

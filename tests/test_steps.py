@@ -178,18 +178,14 @@ def _imports(path):
 def _rules():
     """Every rule of the workflow (snakemake's own parse): name -> (its output files, its log
     files, its benchmark file or None, its script or None)."""
-    from snakemake.api import SnakemakeApi
-    from snakemake.settings.types import ConfigSettings, OutputSettings, ResourceSettings
+    from synergrasp.snakemake_adapter import workflow_rules
 
     def bare(path):  # wildcards without their constraints: {root,...} -> {root}
         return re.sub(r"\{(\w+),[^{}]*\}", r"{\1}", str(path))
 
-    with SnakemakeApi(OutputSettings(quiet={"all"})) as api:
-        wf = api.workflow(resource_settings=ResourceSettings(), snakefile=ROOT / "Snakefile", workdir=ROOT,
-                          config_settings=ConfigSettings())
-        return {rule.name: ([bare(f) for f in rule.output], [bare(f) for f in rule.log],
-                            bare(rule.benchmark) if rule.benchmark else None, rule.script)
-                for rule in wf._workflow.rules}
+    return {rule.name: ([bare(f) for f in rule.output], [bare(f) for f in rule.log],
+                        bare(rule.benchmark) if rule.benchmark else None, rule.script)
+            for rule in workflow_rules(ROOT / "Snakefile", ROOT)}
 
 
 TARGET_RULES = ("all", "figures", "scenarios", "placement_claims", "plans", "across_objects")

@@ -90,7 +90,8 @@ def test_distinct_poses_count_one_period():
 def test_marginal_grasps_flagged_and_excluded():
     """Weight 1 N, multiple 10: forces 5, 20 and 50 N -> two marginal successes."""
     table = pd.DataFrame(gfo_rows("a", "1", [5.0, 20.0, 50.0]) + gfo_rows("a", "1-2", [5.0, 10.0, 10.0]))
-    r = success_rates(with_verdicts(table, "force_closure", weights_N={"a": 1.0}, marginal_multiple=10.0), "1-2").set_index("set_id")
+    judged = with_verdicts(table, "force_closure", weights_N={"a": 1.0}, marginal_multiple=10.0)
+    r = success_rates(judged, "1-2").set_index("set_id")
     assert r.loc["1", "n_marginal"] == 2 and r.loc["1", "marginal_percent"] == pytest.approx(200 / 3)
     assert r.loc["1", "plain_mean_force_N"] == pytest.approx(25.0)
     assert r.loc["1", "plain_mean_force_non_marginal_N"] == pytest.approx(5.0)
@@ -199,6 +200,10 @@ def test_study_tables_names_and_csv_round_trip(gfo, tmp_path):
     assert set(tables) == {"success_rates", "table2_success_rates", "hierarchy", "minimum_preservation",
                            "preservation_vs_chance", "full_not_first7", "verdict_disagreements", "invariant_checks",
                            "claims"}
+    from synergrasp.steps import TABLES
+    from synergrasp.tables import STUDY_TABLES
+
+    assert list(tables) == list(STUDY_TABLES) and TABLES == STUDY_TABLES  # one list: the step's outputs are these
     assert tables["full_not_first7"][1]["pose"].tolist() == [2, 3]
     rates = tables["success_rates"][1]
     views = rates[rates["object"] == "all"].set_index(["set_id", "view"])

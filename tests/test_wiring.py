@@ -4,7 +4,6 @@ out by hand, the import scanner against a package made here."""
 
 from __future__ import annotations
 
-import threading
 from pathlib import Path
 
 import pytest
@@ -13,7 +12,7 @@ from synergrasp.config import defaults, validate_config
 from synergrasp.ids import set_members, set_order
 from synergrasp.resolved import effective_placement, friction_mu, study_object, study_objects, weight_N
 from synergrasp.steps import rule_costs, step_config
-from synergrasp.wiring import RuleFiles, Wiring, cancel_scheduler_timers, code_files, job_size, mem_mb, report_archive, runtime_min
+from synergrasp.wiring import RuleFiles, Wiring, code_files, job_size, mem_mb, report_archive, runtime_min
 
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -102,14 +101,6 @@ def test_report_archive_reads_the_command_line(argv, archive):
     assert report_archive(argv) is archive
 
 
-def test_scheduler_timers_are_cancelled():
-    timer = threading.Timer(60.0, lambda: None)
-    timer.start()
-    cancel_scheduler_timers()
-    timer.join(5.0)
-    assert not timer.is_alive()
-
-
 def _wiring(**changes):
     """The wiring of the default configuration with ``changes`` (top-level keys) in this checkout."""
     return Wiring({**defaults(), **changes}, ROOT, error=RuntimeError, warn=lambda text: None)
@@ -173,3 +164,23 @@ def test_weight_and_friction_are_stated_once():
 def test_set_ids_are_read_in_one_place():
     assert set_members("1-2-10") == (1, 2, 10)
     assert sorted(["1-2-3", "10", "2", "1-3", "1-10"], key=set_order) == ["2", "10", "1-3", "1-10", "1-2-3"]
+
+
+@pytest.mark.parametrize("model, unloaded, contacts", [
+    ("kinematic", "keep", "contacts.parquet"),
+    ("dynamic", "keep", "contacts.parquet"),
+    ("dynamic", "drop", "load_carrying_contacts.parquet"),
+])
+def test_the_commands_read_the_files_the_workflow_reads(model, unloaded, contacts):
+    """``synergrasp plan`` and ``synergrasp grasp`` find an object's tables by
+    ``steps.object_file``, the workflow by ``Wiring.step_file``: the same file, whatever
+    else is on disk (the contact selection's table only where the configuration makes it)."""
+    from synergrasp.steps import RESULTS, object_file
+
+    closure = defaults()["closure"]
+    w = _wiring(closure={**closure, "model": model, "dynamic": {**closure["dynamic"], "unloaded_contacts": unloaded}})
+    for obj in w.objects:
+        for step in ("search", "simulate", "contacts", "optimise", "minima"):
+            assert w.step_file("default", step, obj) == object_file(w.study, step, obj).as_posix(), (obj, step)
+        assert object_file(w.study, "contacts", obj) == Path(RESULTS) / "objects" / obj / contacts
+        assert object_file(w.study, "contacts", obj, "elsewhere") == Path("elsewhere") / "objects" / obj / contacts

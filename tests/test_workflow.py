@@ -45,9 +45,21 @@ def digest(paths: list[Path]) -> dict[str, str]:
 
 
 # Loaded into every Python process of a run (as sitecustomize): at exit, a workflow script's
-# process writes the synergrasp source files it loaded, relative to the package's parent.
+# process writes the synergrasp source files it loaded, relative to the package's parent
+# (<pid>.txt), and the package's data files it opened (hand, synergy tables: <pid>.data).
 _RECORD_MODULES = """
 import atexit, os, sys
+
+_OPENED = set()
+
+def _opened(event, args):
+    if event == "open" and args and isinstance(args[0], (str, bytes, os.PathLike)):
+        path = os.fsdecode(args[0])
+        if os.sep + "synergrasp" + os.sep + "data" + os.sep in path:
+            _OPENED.add(os.path.realpath(path))
+
+if "/.snakemake/scripts/" in (sys.argv[0] if sys.argv else ""):
+    sys.addaudithook(_opened)
 
 def _record():
     script = os.path.basename(sys.argv[0]) if sys.argv else ""
@@ -56,8 +68,13 @@ def _record():
     base = os.path.dirname(os.path.dirname(sys.modules["synergrasp"].__file__))
     files = sorted(os.path.relpath(m.__file__, base) for name, m in list(sys.modules.items())
                    if name.split(".")[0] == "synergrasp" and getattr(m, "__file__", None))
-    with open(os.path.join(os.environ["SYNERGRASP_RECORD_MODULES"], f"{os.getpid()}.txt"), "w") as out:
-        out.write("\\n".join([script.split(".")[-2]] + files))
+    name = script.split(".")[-2]
+    folder = os.environ["SYNERGRASP_RECORD_MODULES"]
+    with open(os.path.join(folder, f"{os.getpid()}.txt"), "w") as out:
+        out.write("\\n".join([name] + files))
+    data = sorted(os.path.relpath(p, base) for p in _OPENED if os.path.isfile(p))
+    with open(os.path.join(folder, f"{os.getpid()}.data"), "w") as out:
+        out.write("\\n".join([name] + data))
 
 atexit.register(_record)
 """
@@ -278,6 +295,23 @@ def test_code_inputs_hold_every_module_a_job_loads(run_j2):
     for script, files in loaded.items():
         assert files, script
         assert files <= declared[script], (script, sorted(files - declared[script]))
+
+
+def test_every_data_file_a_job_opens_is_an_input_of_its_rule(run_j2):
+    """For every rule, the package's data files its script opened when it ran (the hand file,
+    the synergy tables) are among the rule's inputs, so a change to them reruns the rule: a
+    step's inputs follow from what its code reads, not from a list kept by hand."""
+    declared = declared_code_inputs(run_j2)
+    opened: dict[str, set[str]] = {}
+    for record in (run_j2 / "module_records").glob("*.data"):
+        script, *files = record.read_text().splitlines()
+        opened.setdefault(script, set()).update(files)
+    assert opened["simulate"] and "optimise" in opened  # recorded for every job
+    # the schema reaches a job through its params (its defaults), not as a file (wiring.shipped_data)
+    schema = {"synergrasp/data/config.schema.yaml"}
+    missing = {script: sorted(files - declared[script] - schema) for script, files in opened.items()
+               if files - declared[script] - schema}
+    assert missing == {}
 
 
 def _log_paths(workdir: Path) -> list[str]:

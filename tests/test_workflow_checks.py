@@ -426,7 +426,7 @@ def test_a_scenario_error_is_its_line_alone(run, tmp_path):
 def test_a_corrupted_intermediate_keeps_every_finished_output(run):
     """Kind 7: a corrupted contacts table made Fig. 2 and the 3-D pages rerun, fail and lose
     their outputs. Now every failed job keeps its outputs (Snakemake's `update` flag, set on
-    every output by preflight.keep_outputs_until_replaced), and the next run still redoes them."""
+    every output by snakemake_adapter.keep_outputs_until_replaced), and the next run still redoes them."""
     contacts = run / "results" / "objects" / "obj1" / "contacts.parquet"
     contacts.write_bytes(b"not a parquet file")
     kept = {p: d for p, d in _results(run).items() if "/results/logs/" not in p}

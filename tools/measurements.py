@@ -185,7 +185,8 @@ def _jobs_table(inputs: Path) -> list[str]:
     total_cpu = jobs["cpu_s"].sum()
     lines = [*textwrap.wrap("The jobs' own costs, from their Snakemake `benchmark:` files (`tools/measurements.py jobs "
                             "results`, written to `benchmarks/results/study_jobs.csv`); CPU per unit is over the work of "
-                            "every job of the rule:", 100), "", "| rule | jobs | wall s | CPU s | CPU % | peak MB | CPU per unit |", "|---|---|---|---|---|---|---|"]
+                            "every job of the rule:", 100), "",
+             "| rule | jobs | wall s | CPU s | CPU % | peak MB | CPU per unit |", "|---|---|---|---|---|---|---|"]
     for r in jobs.itertuples(index=False):
         per = f"{1e3 * r.cpu_s / r.units:.3g} ms per {r.unit} over {r.units:,}" if r.units else ""
         lines.append(f"| `{r.rule}` | {r.jobs} | {r.wall_s:.1f} | {r.cpu_s:.1f} | {100 * r.cpu_s / total_cpu:.0f} | "

@@ -99,12 +99,15 @@ def _blocker_lines(sets: Any) -> list[str]:
             continue
         lines.append(f"  {set_name(s.synergies):<22} t* = {s.margin:.3g}")
         for b in s.blockers:
-            lines.append(f"    contact {b.contact}: {b.link_name} ({b.link_kind}), {b.face} on {'an' if b.feature == 'edge' else 'a'} {b.feature}, "
+            article = "an" if b.feature == "edge" else "a"
+            lines.append(f"    contact {b.contact}: {b.link_name} ({b.link_kind}), {b.face} on {article} {b.feature}, "
                          f"normal force {b.normal_force:+.3g}, {_number(b.angle_outside_deg)} deg outside its cone")
     return lines
 
 
 def _parser() -> argparse.ArgumentParser:
+    from synergrasp.steps import RESULTS
+
     parser = argparse.ArgumentParser(prog="synergrasp", description="synergrasp: one grasp of the study in full")
     sub = parser.add_subparsers(dest="command", required=True)
     grasp = sub.add_parser("grasp", help="close the hand on one object at one pose and optimise its grasp")
@@ -114,7 +117,7 @@ def _parser() -> argparse.ArgumentParser:
     grasp.add_argument("--configfile", nargs="+", default=[], help="overlays on the study's configuration")
     grasp.add_argument("--sets", nargs="+", help="synergy sets: k, a-b (S_a..S_b) or a,b,c (default: each "
                                                  "single synergy and {S1..Sk} for every k)")
-    grasp.add_argument("--results", default="results", help="where the study's outputs are (the searched "
+    grasp.add_argument("--results", default=RESULTS, help="where the study's outputs are (the searched "
                                                             "placement's target: <results>/objects/<object>/placement.csv)")
     grasp.add_argument("--json", action="store_true", help="print the result as JSON")
     grasp.add_argument("--png", metavar="PATH", help="write the grasp drawn as in Fig. 2 from two views (PNG)")
@@ -159,7 +162,7 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--radius", type=float, nargs="+", help="neighbourhood radii, deg (default: "
                                                               "analyses.planner_radii_deg)")
     plan.add_argument("--configfile", nargs="+", default=[], help="overlays on the study's configuration")
-    plan.add_argument("--results", default="results", help="where the study's outputs are")
+    plan.add_argument("--results", default=RESULTS, help="where the study's outputs are")
     plan.add_argument("--csv", metavar="PATH", help="write the plan table (one row per radius; on demand: one row) as CSV")
     plan.add_argument("--on-demand", action="store_true", help="close the hand only where the planner asks (the "
                                                                "default for an object without the study's tables)")
@@ -277,12 +280,9 @@ def _plan(args: argparse.Namespace) -> int:
     from synergrasp.analysis.plan_study import PlanParams, plan_object
     from synergrasp.config import ConfigError
     from synergrasp.hand.synergies import load_synergies
+    from synergrasp.steps import object_file
     from synergrasp.study_checks import checked_scenario, unknown_object
 
-    folder = Path(args.results) / "objects" / args.object
-    contacts_path = next((folder / f for f in ("load_carrying_contacts.parquet", "contacts.parquet")
-                          if (folder / f).is_file()), folder / "contacts.parquet")
-    on_demand = args.on_demand or not (folder / "gfo.parquet").is_file()
     try:
         cfg, warnings = checked_scenario(_configuration(args))
         for warning in warnings:
@@ -290,20 +290,24 @@ def _plan(args: argparse.Namespace) -> int:
         if unknown_object(cfg, args.object):
             raise ConfigError(unknown_object(cfg, args.object))
         params = PlanParams.from_config(cfg, args.object)
+        # the files the workflow's rules read for this configuration, not whichever exists
+        contacts_path = Path(object_file(cfg, "contacts", args.object, args.results))
+        gfo_path = Path(object_file(cfg, "optimise", args.object, args.results))
+        on_demand = args.on_demand or not gfo_path.is_file()
         if on_demand:
             demand = _on_demand_inputs(args, cfg)
         elif args.planner is not None or args.seed != 0:
             raise ValueError("--planner and --seed: only with --on-demand (the study's tables are there: the "
                              "incremental planner runs on them at each --radius)")
-        if not on_demand:
+        else:
             params = replace(params, radii_deg=tuple(args.radius)) if args.radius else params
             contacts = tables.read(tables.CONTACTS, contacts_path)
-            gfo = tables.read(tables.GFO, folder / "gfo.parquet")
+            gfo = tables.read(tables.GFO, gfo_path)
     except (ConfigError, ValueError, FileNotFoundError) as err:
         print(f"synergrasp plan: {err}", file=sys.stderr)
         return 2
     if on_demand:
-        return _plan_on_demand(args, params, *demand, folder, contacts_path)
+        return _plan_on_demand(args, params, *demand, contacts_path, gfo_path)
     result = plan_object(contacts, gfo, load_synergies(params.synergies).matrix, params)
     for row in result.table.itertuples():
         print(f"{row.object} radius {row.radius_deg:g} deg: {row.n_solves} of {row.n_exhaustive_solves} solves "
@@ -331,8 +335,8 @@ def _on_demand_inputs(args: argparse.Namespace, cfg: dict) -> tuple[Any, Any, An
     return (spec, *object_closure(cfg, args.object, args.results))
 
 
-def _plan_on_demand(args: argparse.Namespace, params: Any, spec: Any, close: Any, grid: Any, folder: Path,
-                    contacts_path: Path) -> int:
+def _plan_on_demand(args: argparse.Namespace, params: Any, spec: Any, close: Any, grid: Any, contacts_path: Path,
+                    gfo_path: Path) -> int:
     """``synergrasp plan --on-demand``: the chosen planner closing the hand only where it asks;
     against the study's exhaustive minimum where the study's tables are there."""
     import numpy as np
@@ -344,12 +348,12 @@ def _plan_on_demand(args: argparse.Namespace, params: Any, spec: Any, close: Any
     from synergrasp.analysis.plan_study import replay_oracle
     from synergrasp.hand.synergies import load_synergies
 
-    study = (folder / "gfo.parquet").is_file() and contacts_path.is_file()
+    study = gfo_path.is_file() and contacts_path.is_file()
     matrix = load_synergies(params.synergies).matrix
     plan, _ = plan_on_demand(args.object, grid, close, matrix, params, spec, args.seed)
     least, regret = float("nan"), float("nan")
     if study:  # the study's exhaustive minimum over the same grid
-        contacts, gfo = tables.read(tables.CONTACTS, contacts_path), tables.read(tables.GFO, folder / "gfo.parquet")
+        contacts, gfo = tables.read(tables.CONTACTS, contacts_path), tables.read(tables.GFO, gfo_path)
         full = replay_oracle(contacts, gfo, params.n_levels, params.minima)()
         order = np.argsort(contacts["pose"].to_numpy())
         versus = pose_against_exhaustive(plan.pose, plan.force_N, full.success[-1][order], full.force[-1][order])

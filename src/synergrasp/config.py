@@ -42,7 +42,6 @@ __all__ = [
     "synergy_problems",
     "scenario_names",
     "scenario_config",
-    "scenario_configs",
     "grid_axis_deg",
     "search_lattice_size",
     "object_names",
@@ -491,22 +490,6 @@ def scenario_config(config: Mapping[str, Any], name: str) -> dict[str, Any]:
     except ConfigError as err:
         raise ConfigError("\n".join(f"scenario '{name}': {line}" for line in str(err).splitlines())) from None
 
-
-def scenario_configs(config: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
-    """Every scenario's complete configuration by name (:func:`scenario_config`), ``default``
-    first; every problem of every scenario in one ConfigError."""
-    out, problems = {}, []
-    for name in scenario_names(validate_config(config)):
-        try:
-            out[name] = scenario_config(config, name)
-        except ConfigError as err:
-            problems += str(err).splitlines()
-    if problems:
-        raise ConfigError("\n".join(problems))
-    return out
-
-
-# --------------------------------------------------------------------------- typed parameters
 
 def build(cls: Any, where: str, **kwargs: Any) -> Any:
     """``cls(**kwargs)``; a value the class rejects becomes a ConfigError naming the config

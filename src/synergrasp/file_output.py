@@ -2,7 +2,7 @@
 a temporary name beside it and replaces the old one by a rename only once complete. A
 failure (an unreadable input, a full disk, a kill) leaves the previous content, or nothing,
 never a torn file that a later run would read. With the workflow's outputs kept during a
-job (``synergrasp.preflight.keep_outputs_until_replaced``) a failed rerun keeps the finished
+job (``synergrasp.snakemake_adapter.keep_outputs_until_replaced``) a failed rerun keeps the finished
 result. This module imports nothing of the project (lowest layer).
 """
 

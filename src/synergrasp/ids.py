@@ -1,6 +1,7 @@
 """Ids of synergy sets, and the sets of the study (the lowest layer: imports nothing of the package).
 
 An id names a set of synergies by their 1-based indices, sorted and joined by '-' ("1-2-3").
+The study's tables name a row pooled over every object :data:`ALL_OBJECTS`.
 """
 
 from __future__ import annotations
@@ -8,7 +9,10 @@ from __future__ import annotations
 import itertools
 from collections.abc import Mapping, Sequence
 
-__all__ = ["set_id", "set_members", "set_order", "set_name", "incremental_set_id", "synergy_sets"]
+__all__ = ["ALL_OBJECTS", "set_id", "set_members", "set_order", "set_name", "incremental_set_id", "synergy_sets"]
+
+#: The ``object`` of a table's row pooled over every object.
+ALL_OBJECTS = "all"
 
 
 def set_id(synergies: Sequence[int]) -> str:

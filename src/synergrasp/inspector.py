@@ -19,8 +19,10 @@ import pandas as pd
 
 from synergrasp.ids import set_id, set_name
 from synergrasp.optimisation.quality import GraspQuality, grasp_quality
+from synergrasp.steps import RESULTS
 
-__all__ = ["InspectionError", "searched_target", "object_closure", "BlockingContact", "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp",
+__all__ = ["InspectionError", "searched_target", "object_closure", "BlockingContact",
+           "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp",
            "grasp_picture", "grasp_view"]
 
 
@@ -198,7 +200,7 @@ def searched_target(placement: Any, path: Path) -> Any:
 
 
 def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_deg: float,
-                  sets: Sequence[Sequence[int]] | None = None, results: str | Path = "results") -> GraspInspection:
+                  sets: Sequence[Sequence[int]] | None = None, results: str | Path = RESULTS) -> GraspInspection:
     """Close the hand on object ``obj`` at pose (α, β) deg with the configuration's hand,
     synergies, placement and closure, then optimise the grasp for each synergy set in ``sets``
     (1-based synergies; None: :func:`default_sets`), as the study's steps do.
@@ -217,6 +219,7 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     from synergrasp.simulation.closure import SimulateParams, simulate_object
     from synergrasp.simulation.contacts import ContactsParams, load_carrying_contacts
     from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions
+    from synergrasp.steps import object_file
     from synergrasp.study_checks import checked_scenario, unknown_object
 
     cfg, _ = checked_scenario(config)
@@ -226,7 +229,7 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     pose, _ = _pose_index(sim.placement, alpha_deg, beta_deg)
     placement = sim.placement
     if placement.mode == "searched":
-        placement = searched_target(placement, Path(results) / "objects" / obj / "placement.csv")
+        placement = searched_target(placement, object_file(cfg, "search", obj, results))
     hand = load_hand(sim.hand)
     full = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
     chosen = default_sets(full.matrix.shape[1]) if sets is None else [tuple(sorted(set(s))) for s in sets]

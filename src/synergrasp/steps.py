@@ -1,7 +1,8 @@
 """The steps of the workflow, each declared once (docs/design.md, "Adding a step").
 
 :data:`STEPS` is data only: for every step, its rules and the measured cost and threads of
-one job of each, the files it writes (and which of them the report shows), the configuration keys it reads (and those it reads only when
+one job of each, the files it writes (and which of them the report shows), the configuration
+keys it reads (and those it reads only when
 another key has a given value), the steps whose outputs it reads, and the class whose
 ``from_config`` builds its typed parameters. The step hash, ``synergrasp.wiring`` (every
 rule's outputs, log, benchmark, threads and requests, the targets, where a shared output
@@ -28,15 +29,22 @@ import hashlib
 import json
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
+from synergrasp.config import DEFAULT_SCENARIO
 from synergrasp.hand.synergies import synergy_values
 from synergrasp.resolved import effective_placement
+from synergrasp.tables import STUDY_TABLES
 
 __all__ = ["Cost", "Step", "STEPS", "UNITS", "WORKFLOW_KEYS", "CLOSURE_COST_FACTOR", "SOLVER_COMPILE",
-           "step_keys", "step_config", "step_hash", "upstream_when", "rule_costs", "rule_step", "step_for_object", "step_made"]
+           "step_keys", "step_config", "step_hash", "upstream_when", "rule_costs", "rule_step", "step_for_object", "step_made",
+           "RESULTS", "scenario_root", "made_by", "object_file"]
 
-#: Units of work a job's cost is counted in (resources.smk counts them for a scenario).
+#: Where the workflow writes the default scenario's outputs (a scenario's own: ``scenario_root``).
+RESULTS = "results"
+
+#: Units of work a job's cost is counted in (``wiring.job_size`` counts them for a scenario).
 UNITS = ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose", "object_pose_set")
 #: Closure cost per pose relative to the kinematic closure measured in STEPS, per closure
 #: model (docs/cluster.md); a model not listed is charged ``None``'s factor until measured.
@@ -121,9 +129,8 @@ def _files(names: tuple[str, ...], folder: str, exts: tuple[str, ...], named: bo
     return {f"{n}_{e}" if named else e: f"{folder}/{n}.{e}".lstrip("/") for n in names for e in exts}
 
 
-#: The study's tables (the ``tables`` step).
-TABLES = ("success_rates", "table2_success_rates", "hierarchy", "minimum_preservation", "full_not_first7",
-          "verdict_disagreements", "preservation_vs_chance", "invariant_checks", "claims")
+#: The study's tables (the ``tables`` step), named once in ``synergrasp.tables``.
+TABLES = STUDY_TABLES
 #: The keys of the choice of which contacts count (the ``contacts`` step).
 _CONTACT_SELECTION = ("closure.dynamic.unloaded_contacts", "closure.dynamic.load_threshold_N")
 #: The keys of the force bound of ``analyses.success: force_closure_bounded``.
@@ -368,6 +375,29 @@ def step_made(config: Mapping[str, Any], step: str) -> bool:
     """Whether ``step`` makes its own output under ``config`` (its ``made_when`` holds), else
     its output is its first upstream step's."""
     return all(_get(config, key) == value for key, value in STEPS[step].made_when)
+
+
+def made_by(config: Mapping[str, Any], step: str) -> str:
+    """The step whose output stands for ``step``'s under ``config``: ``step`` itself where it
+    makes its own output (:func:`step_made`), else, in turn, its first upstream step."""
+    while not step_made(config, step):
+        step = STEPS[step].upstream[0]
+    return step
+
+
+def scenario_root(name: str) -> str:
+    """The folder of scenario ``name``'s outputs: :data:`RESULTS` for the default scenario,
+    ``results/scenarios/<name>`` for another (config/README.md)."""
+    return RESULTS if name == DEFAULT_SCENARIO else f"{RESULTS}/scenarios/{name}"
+
+
+def object_file(config: Mapping[str, Any], step: str, obj: str, root: str | Path = RESULTS) -> Path:
+    """The one output of the per-object ``step`` for ``obj`` in the outputs under ``root``, the
+    file the workflow's rules read for it under ``config`` (a step not made there hands on its
+    first upstream step's, :func:`made_by`): the one answer for the commands (``synergrasp
+    plan``, ``synergrasp grasp``) and the workflow (``wiring.Wiring.step_file``)."""
+    (rel,) = STEPS[made_by(config, step)].outputs.values()
+    return Path(root) / "objects" / obj / rel
 
 
 def _get(config: Mapping[str, Any], path: str) -> Any:

@@ -5,8 +5,8 @@ the package alike (config/README.md, "Checked before any job runs").
 relation, ``synergrasp.config``), its hand file, its synergy table against the hand, and its
 objects' shapes; besides the problems (errors), the warnings on sizes far from a hand's and on
 a thumb that cannot oppose along S1 (``synergrasp.simulation.thumb_check``). The
-workflow asks it through :func:`workflow_scenario` (common.smk), ``synergrasp grasp`` through
-``synergrasp.inspector``; :func:`read_overlays` reads a command's ``--configfile`` files as
+workflow asks it through ``synergrasp.wiring.Wiring.scenario`` (common.smk), ``synergrasp grasp``
+through ``synergrasp.inspector``; :func:`read_overlays` reads a command's ``--configfile`` files as
 strictly as the workflow reads its own. Checks that need a step's output where it exists
 (:func:`search_rank_problems`), the objects' resolved placements and grasp types
 (:func:`lattice_rank_problems`) or a target's whole configuration
@@ -19,19 +19,19 @@ from __future__ import annotations
 
 import csv
 import functools
-import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from synergrasp.config import ConfigError, check_relations, overlay, scenario_config, search_lattice_size, synergy_problems
+from synergrasp.config import (DEFAULT_SCENARIO, ConfigError, check_relations, overlay, scenario_config,
+                               search_lattice_size, synergy_problems)
 from synergrasp.preflight import refuse
 from synergrasp.resolved import effective_placement, grasp_type
 from synergrasp.yaml_io import read_yaml
 
-__all__ = ["checked_scenario", "checked_configuration", "overlays_with_drawn_objects", "workflow_scenario", "read_overlays", "search_rank_problems",
-           "lattice_rank_problems", "search_table_or_refuse", "searched_objects_or_refuse", "older_results_problems",
-           "unknown_object"]
+__all__ = ["checked_scenario", "checked_configuration", "overlays_with_drawn_objects", "read_overlays",
+           "search_rank_problems", "lattice_rank_problems", "search_table_or_refuse", "searched_objects_or_refuse",
+           "older_results_problems", "unknown_object"]
 
 
 @functools.cache
@@ -43,7 +43,7 @@ def _hand(path: str | None) -> tuple[Any, tuple[str, ...], tuple[str, ...]]:
     return hand, tuple(problems), tuple(warnings)
 
 
-def checked_scenario(config: Mapping[str, Any], name: str = "default") -> tuple[dict[str, Any], list[str]]:
+def checked_scenario(config: Mapping[str, Any], name: str = DEFAULT_SCENARIO) -> tuple[dict[str, Any], list[str]]:
     """Scenario ``name``'s complete, checked configuration (``default``: the configuration
     itself) and the warnings on it, each one line naming the file or the key.
 
@@ -57,7 +57,7 @@ def checked_scenario(config: Mapping[str, Any], name: str = "default") -> tuple[
     from synergrasp.simulation.thumb_check import cached_opposition_warnings
     from synergrasp.simulation.objects import object_problems, object_warnings
 
-    where = "" if name == "default" else f"scenario '{name}': "
+    where = "" if name == DEFAULT_SCENARIO else f"scenario '{name}': "
     try:
         cfg = scenario_config(config, name)
         hand, problems, warnings = _hand(cfg["hand"])
@@ -72,24 +72,6 @@ def checked_scenario(config: Mapping[str, Any], name: str = "default") -> tuple[
         raise ConfigError("\n".join(where + p for p in problems))
     thumb = cached_opposition_warnings(cfg["hand"], cfg["synergies"])
     return cfg, [*warnings, *(where + w for w in (*thumb, *object_warnings(cfg)))]
-
-
-_WARNED: set[str] = set()
-
-
-def workflow_scenario(config: Mapping[str, Any], name: str) -> dict[str, Any]:
-    """:func:`checked_scenario` for the workflow: each warning printed once per run, a problem
-    stops the run before any job with its lines alone (``preflight.refuse``)."""
-    try:
-        cfg, warnings = checked_scenario(config, name)
-    except ConfigError as err:
-        refuse(str(err).splitlines())
-        raise  # refuse stops the run for any problem
-    for warning in warnings:
-        if warning not in _WARNED:
-            _WARNED.add(warning)
-            print(f"Warning: {warning}", file=sys.stderr)
-    return cfg
 
 
 def read_overlays(paths: Sequence[str | Path], what: str = "config file") -> dict[str, Any]:

@@ -17,9 +17,9 @@ import pandas as pd
 
 from synergrasp.file_output import replacing
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT", "PLAN",
-           "ENROLLMENT", "PLANNERS", "PLANNERS_ACROSS", "PLAN_ON_DEMAND", "BLOCKERS", "QUALITY", "TARGET_CLAIMS", "write",
-           "read", "older_version", "write_csv", "read_csv", "empty", "write_study_table"]
+__all__ = ["Column", "Table", "TABLES", "STUDY_TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS",
+           "PLACEMENT", "PLAN", "ENROLLMENT", "PLANNERS", "PLANNERS_ACROSS", "PLAN_ON_DEMAND", "BLOCKERS", "QUALITY",
+           "TARGET_CLAIMS", "write", "read", "older_version", "write_csv", "read_csv", "empty", "write_study_table"]
 
 
 @dataclass(frozen=True)
@@ -349,6 +349,11 @@ PLANNERS_ACROSS = Table("planners_across", "one row per candidate planner", (
     Column("recommended", "bool", "", "the planner the rule selects: fewest closures among those meeting the aim on >= 95 % of the objects (docs/planner.md)"),
 ))
 
+#: The study's tables, in this order (the ``tables`` step's outputs ``tables/<name>.{csv,md}``, made by
+#: ``analysis.summaries.study_tables``): shown to the reader, no contract between steps.
+STUDY_TABLES: tuple[str, ...] = ("success_rates", "table2_success_rates", "hierarchy", "minimum_preservation",
+                                 "full_not_first7", "verdict_disagreements", "preservation_vs_chance",
+                                 "invariant_checks", "claims")
 TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, QUALITY,
                                                 TARGET_CLAIMS, BLOCKERS, PLAN, ENROLLMENT,
                                                 PLANNERS, PLANNERS_ACROSS, PLAN_ON_DEMAND)}

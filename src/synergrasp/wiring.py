@@ -18,33 +18,34 @@ from __future__ import annotations
 import functools
 import math
 import re
-import threading
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from synergrasp.config import ConfigError, grid_axis_deg, object_names, scenario_names
+from synergrasp.config import DEFAULT_SCENARIO, ConfigError, grid_axis_deg, object_names, scenario_names
 from synergrasp.ids import synergy_sets
 from synergrasp.steps import (
     CLOSURE_COST_FACTOR,
+    RESULTS,
     SOLVER_COMPILE,
     STEPS,
+    made_by,
     rule_costs,
     rule_step,
+    scenario_root,
     step_config,
     step_hash,
     step_for_object,
-    step_made,
 )
 from synergrasp.study_checks import checked_scenario, search_table_or_refuse, searched_objects_or_refuse
 
-__all__ = ["Wiring", "RuleFiles", "code_files", "report_archive", "cancel_scheduler_timers", "job_size",
+__all__ = ["Wiring", "RuleFiles", "code_files", "report_archive", "job_size",
            "runtime_min", "mem_mb", "RUNTIME_MARGIN", "MEMORY_MARGIN"]
 
 #: Requests are the measured cost times a margin (slower nodes, shared file systems),
 #: rounded up to whole minutes and to 100 MB (docs/cluster.md).
 RUNTIME_MARGIN, MEMORY_MARGIN = 3.0, 1.5
-_PREFIX = {"object": "{root}/objects/{object}/", "scenario": "{root}/", "workflow": "results/"}
+_PREFIX = {"object": "{root}/objects/{object}/", "scenario": "{root}/", "workflow": f"{RESULTS}/"}
 _WILDCARD = re.compile(r"\{(\w+)\}")
 
 
@@ -77,7 +78,7 @@ class RuleFiles:
         return names
 
     def _under(self, kind: str, ext: str) -> str:
-        root = "results" if self.spec.scope == "workflow" else "{root}"
+        root = RESULTS if self.spec.scope == "workflow" else "{root}"
         wildcards = self._wildcards()
         if not wildcards:
             return f"{root}/{kind}/{self.rule}.{ext}"
@@ -223,15 +224,6 @@ def report_archive(argv: Sequence[str]) -> bool:
     return False
 
 
-def cancel_scheduler_timers() -> None:
-    """Cancel the scheduler's pending re-evaluation timers (threading.Timer, not daemon
-    threads) once the run is over, so that Snakemake exits at once instead of a job-rate
-    timespan later (profiles/default/config.yaml). The workflow starts no timer of its own."""
-    for thread in threading.enumerate():
-        if isinstance(thread, threading.Timer):
-            thread.cancel()
-
-
 # --------------------------------------------------------------------------- the study's files
 
 class Wiring:
@@ -264,10 +256,10 @@ class Wiring:
         self._roots: dict[tuple, str] = {}
         #: The scenarios' names, default first, and their roots.
         self.scenarios = scenario_names(config)
-        self.scenario_root = {n: "results" if n == "default" else f"results/scenarios/{n}" for n in self.scenarios}
+        self.scenario_root = {n: scenario_root(n) for n in self.scenarios}
         self._root_scenario = {root: name for name, root in self.scenario_root.items()}
         #: The main configuration (scenario ``default``), complete and checked.
-        self.study = self.scenario("default")
+        self.study = self.scenario(DEFAULT_SCENARIO)
         self.objects = list(self.study["objects"])
 
     # ---- configurations
@@ -292,7 +284,7 @@ class Wiring:
 
     def job_scenario(self, wildcards: Any) -> str:
         """The scenario whose root a job's ``{root}`` names (the default outside any root)."""
-        return self._root_scenario[wildcards.root] if "root" in wildcards.keys() else "default"
+        return self._root_scenario[wildcards.root] if "root" in wildcards.keys() else DEFAULT_SCENARIO
 
     def job_config(self, wildcards: Any) -> dict[str, Any]:
         """The complete configuration of a job's scenario."""
@@ -327,10 +319,9 @@ class Wiring:
     def step_file(self, name: str, step: str, obj: str) -> str:
         """Where scenario ``name``'s one output of the per-object ``step`` for ``obj`` lives
         (a step not made there, ``made_when``, hands on its first upstream step's)."""
-        if not step_made(self.scenario(name), step):
-            return self.step_file(name, STEPS[step].upstream[0], obj)
-        (rel,) = STEPS[step].outputs.values()
-        return f"{self.step_root(name, step, obj)}/objects/{obj}/{rel}"
+        made = made_by(self.scenario(name), step)
+        (rel,) = STEPS[made].outputs.values()
+        return f"{self.step_root(name, made, obj)}/objects/{obj}/{rel}"
 
     def study_file(self, name: str, step: str, rel: str) -> str:
         """Where scenario ``name``'s file ``rel`` (one of the step's outputs) lives."""
@@ -427,7 +418,7 @@ class Wiring:
         """Whether scenario ``name`` runs the per-object ``step`` for ``obj`` (``placement_when``)."""
         return step_for_object(self.scenario(name), step, obj)
 
-    def object_targets(self, obj: str, name: str = "default") -> list[str]:
+    def object_targets(self, obj: str, name: str = DEFAULT_SCENARIO) -> list[str]:
         """One object's outputs in a scenario: every per-object step's (wherever shared)."""
         files: dict[str, None] = {}
         for step, spec in STEPS.items():
@@ -442,9 +433,9 @@ class Wiring:
 
     def workflow_files(self, step: str) -> list[str]:
         """The files of a step run once for the whole workflow (under results/)."""
-        return [f"results/{rel}" for rel in STEPS[step].outputs.values()]
+        return [f"{RESULTS}/{rel}" for rel in STEPS[step].outputs.values()]
 
-    def study_targets(self, name: str = "default") -> list[str]:
+    def study_targets(self, name: str = DEFAULT_SCENARIO) -> list[str]:
         """Every output of one scenario's study, each where it is made (Fig. 3, the rule
         graph, is the same for all; the sweep's summary is `sensitivity`'s)."""
         files = [self.study_file(name, step, rel) for step, spec in STEPS.items()
@@ -453,7 +444,7 @@ class Wiring:
                   for f in self.workflow_files(step)]
         return files + [f for obj in self.scenario(name)["objects"] for f in self.object_targets(obj, name)]
 
-    def optional_object_targets(self, step: str, name: str = "default") -> list[str]:
+    def optional_object_targets(self, step: str, name: str = DEFAULT_SCENARIO) -> list[str]:
         """The outputs of the optional per-object ``step`` for every object of scenario ``name``."""
         return [f"{self.step_root(name, step, obj)}/objects/{obj}/{rel}"
                 for obj in self.scenario(name)["objects"] for rel in STEPS[step].outputs.values()]
@@ -470,7 +461,7 @@ class Wiring:
         spec = self.job_config(wildcards).get("random_objects")
         return [str(self.root / spec["sha256_file"])] if spec else []
 
-    def optional_targets(self, step: str, name: str = "default") -> list[str]:
+    def optional_targets(self, step: str, name: str = DEFAULT_SCENARIO) -> list[str]:
         """The files of the optional per-scenario ``step`` of scenario ``name``."""
         return [self.study_file(name, step, rel) for rel in STEPS[step].outputs.values()]
 

@@ -48,6 +48,8 @@ rule tables:
         minima=W.step_inputs("minima"),
         planners=W.study_input("planners", "tables/planners.csv"),
         code=W.code("tables"),
+        data=SHIPPED_DATA,
+        user=W.user_files,
     output:
         **outputs("tables"),
     log:

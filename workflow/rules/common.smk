@@ -1,18 +1,23 @@
 # Shared wiring: the configuration checked before any job runs, and what every rule is made
 # of (outputs, log, benchmark, threads, requests, inputs, targets), all answered by
 # synergrasp.wiring from the step registry (synergrasp.steps.STEPS). No logic lives here.
+# Snakemake's internals are used through synergrasp.snakemake_adapter alone.
 import sys
 
 from snakemake.exceptions import WorkflowError
 from snakemake.logging import logger
 
-from synergrasp.preflight import accept_configured_wildcards, configfile_problems, slurm_problems
-from synergrasp.preflight import keep_outputs_until_replaced, outdate_failed_outputs, refuse
+from synergrasp import snakemake_adapter as adapter
+
+# The adapter was written for one Snakemake release series: any other stops here, one line.
+adapter.check_version()
+
+from synergrasp.preflight import configfile_problems, refuse, slurm_problems
 from synergrasp.steps import rule_costs
-from synergrasp.wiring import RuleFiles, Wiring, cancel_scheduler_timers, report_archive
+from synergrasp.wiring import RuleFiles, Wiring, report_archive
 
 # Snakemake read the configuration files itself and kept a repeated key's last value.
-refuse(configfile_problems(workflow.configfiles))
+refuse(configfile_problems(adapter.config_files(workflow)))
 
 # A results folder of an older version (a table with a renamed column) is refused before any job.
 from synergrasp.study_checks import older_results_problems
@@ -46,7 +51,7 @@ def threads(rule):
 
 # Wildcards match the configured names exactly, so Snakemake's guard against endless
 # recursion may accept a configured name ending in a repeated character (obj_000...0).
-accept_configured_wildcards([*W.object_names(), *W.scenario_root.values()])
+adapter.accept_configured_wildcards([*W.object_names(), *W.scenario_root.values()])
 
 
 wildcard_constraints:
@@ -57,14 +62,14 @@ wildcard_constraints:
 
 # Jobs of a few seconds and a few hundred MB run where Snakemake runs: submitting them
 # would cost more queue time than they take (Cost.local).
-workflow.localrules(*(rule for rule, cost in rule_costs().items() if cost.local))
+adapter.run_locally(workflow, [rule for rule, cost in rule_costs().items() if cost.local])
 
 
 onstart:
     # A cluster profile on a machine or shell that cannot submit: one line, before any job.
-    if workflow.executor_plugin.name == "slurm":
-        _raw = {k: r.raw for k, r in workflow.resource_settings.default_resources.items()}
-        _problems = slurm_problems(workflow.executor_settings, _raw)
+    _slurm = adapter.slurm_settings(workflow)
+    if _slurm is not None:
+        _problems = slurm_problems(*_slurm)
         if _problems:
             raise WorkflowError(
                 "The SLURM profile cannot submit from this shell, nothing was run: "
@@ -73,9 +78,9 @@ onstart:
 
 
 onsuccess:
-    cancel_scheduler_timers()
+    adapter.cancel_scheduler_timers()
 
 
 onerror:
-    cancel_scheduler_timers()
-    outdate_failed_outputs(workflow)
+    adapter.cancel_scheduler_timers()
+    adapter.outdate_failed_outputs(workflow)

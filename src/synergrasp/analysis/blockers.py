@@ -21,7 +21,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp.analysis.verdicts import verdict_columns
-from synergrasp.ids import incremental_set_id, set_id
+from synergrasp.ids import ALL_OBJECTS, incremental_set_id, set_id
 from synergrasp.optimisation.blocking import Blocking, blocking_contacts
 from synergrasp.optimisation.mechanics import Grasp, first_same_grasp, internal_force_basis, read_grasps
 from synergrasp.optimisation.problem import GFOProblem
@@ -184,8 +184,8 @@ def blockers_summary(blockers: pd.DataFrame, sets: Mapping[str, Any]) -> pd.Data
     (a pose with several blockers counts in several columns)."""
     rows = []
     objects = sorted(blockers["object"].unique()) if len(blockers) else []
-    for obj in objects + ["all"]:
-        part = blockers if obj == "all" else blockers[blockers["object"] == obj]
+    for obj in objects + [ALL_OBJECTS]:
+        part = blockers if obj == ALL_OBJECTS else blockers[blockers["object"] == obj]
         for sid in sets:
             here = part[part["set_id"] == sid]
             n = len(here)

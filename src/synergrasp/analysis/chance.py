@@ -6,7 +6,8 @@ reflected at the ends of the β range (β is not periodic), and counts the minim
 neighbourhood (the same test as the observed statistic, :func:`synergrasp.analysis.minima.
 preserved`). The shift keeps how many minima there are and how they are spread, and
 destroys where they are. Offsets that leave the map where it was are excluded: α offset
-within the radius of a multiple of the object's α-period *and* β offset within the radius. Each draw gives every pair its own offset; the share is pooled over pairs as the
+within the radius of a multiple of the object's α-period *and* β offset within the radius. Each
+draw gives every pair its own offset; the share is pooled over pairs as the
 observed share is. ``draws`` draws from a generator seeded with ``seed``: deterministic.
 
 Pairs whose two force maps are identical (same success at every pose, forces equal to
@@ -23,12 +24,13 @@ from numpy.typing import NDArray
 
 from synergrasp.analysis.bootstrap import PoseResampler
 from synergrasp.analysis.minima import preserved, preserved_counts
-from synergrasp.ids import incremental_set_id
+from synergrasp.ids import ALL_OBJECTS, incremental_set_id
 
 __all__ = ["identical_force_maps", "allowed_offsets", "null_preserved", "preservation_vs_chance",
            "resampled_preservation"]
 
-ALL_OBJECTS = "all"
+#: The ``pairs`` of a row over every pair of consecutive levels (besides ``non_identical``).
+ALL_PAIRS = "all"
 _TOL_DEG = 1e-6
 
 
@@ -161,7 +163,7 @@ def preservation_vs_chance(table: pd.DataFrame, minima: pd.DataFrame, k_max: int
     summary = []
     for obj in [*sorted({r["object"] for r in rows}), ALL_OBJECTS]:
         group = [r for r in rows if obj in (ALL_OBJECTS, r["object"])]
-        summary.append(_summary(obj, "all", group, draws))
+        summary.append(_summary(obj, ALL_PAIRS, group, draws))
         summary.append(_summary(obj, "non_identical", [r for r in group if not r["identical"]], draws))
     pairs = pd.DataFrame([{"object": r["object"], "k": r["k"], "identical_maps": r["identical"]} for r in rows],
                          columns=["object", "k", "identical_maps"])

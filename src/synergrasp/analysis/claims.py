@@ -18,13 +18,16 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from synergrasp.analysis.chance import ALL_PAIRS
 from synergrasp.analysis.intervals import VIEWS, StudyCounts, mean_defined
-from synergrasp.ids import incremental_set_id, set_id, set_members
+from synergrasp.ids import ALL_OBJECTS, incremental_set_id, set_id, set_members
 
-__all__ = ["HOLDS", "FAILS", "UNDEFINED", "VerdictRules", "Difference", "interval_verdict", "claims_table",
+__all__ = ["HOLDS", "FAILS", "UNDEFINED", "CLAIM_VERDICTS", "VerdictRules", "Difference", "interval_verdict", "claims_table",
            "planner_claim", "CLAIM_COLUMNS"]
 
 HOLDS, FAILS, UNDEFINED = "holds", "does not hold", "undefined"
+#: A claim's verdicts (a success verdict of a grasp is ``verdicts.SUCCESS_VERDICTS``).
+CLAIM_VERDICTS = (HOLDS, FAILS, UNDEFINED)
 CLAIM_COLUMNS = ["claim", "view", "headline", "statement", "tested_by", "measured", "difference", "low", "high",
                  "unit", "tie_band", "n_distinct_poses", "verdict", "reason"]
 #: How a difference d decides a claim: "greater" (holds if d > band), "within_below" (a claim
@@ -175,11 +178,11 @@ def _claim3(minima: pd.DataFrame, chance: pd.DataFrame, view: str, rules: Verdic
     with np.errstate(invalid="ignore", divide="ignore"):
         if view == "pooled":
             share = 100.0 * np.sum(np.vstack(rows["n_preserved"]), axis=0) / np.sum(np.vstack(rows["n_minima"]), axis=0)
-            null_high = float(high.get(("all", "all"), np.nan))
+            null_high = float(high.get((ALL_OBJECTS, ALL_PAIRS), np.nan))
         else:
             share = mean_defined(np.vstack([100.0 * p / np.where(m > 0, m, np.nan)
                                             for p, m in zip(rows["n_preserved"], rows["n_minima"])]))
-            null_high = float(np.mean([high.get((o, "all"), np.nan) for o in rows["object"]]))
+            null_high = float(np.mean([high.get((o, ALL_PAIRS), np.nan) for o in rows["object"]]))
     n = int(sum(m[0] for m in rows["n_minima"]))
     text = (f"{_fmt(share, counts)} of {n} distinct minima preserved; null model's 97.5 percentile "
             f"{null_high:.1f} %")

@@ -30,7 +30,7 @@ __all__ = ["graspable_objects", "with_left_out", "studied", "ungraspable_lines",
 #: How the reason of an object left out before the study begins.
 LEFT_OUT = "left out: "
 
-#: Statuses of a closure that ran (synergrasp.simulation.contacts.STATUSES).
+#: Statuses of a closure that ran (synergrasp.simulation.contacts.CLOSURE_STATUSES).
 _RAN = ("grasp", "no_contact")
 
 

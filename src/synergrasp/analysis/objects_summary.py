@@ -28,7 +28,8 @@ import pandas as pd
 
 from synergrasp.ids import incremental_set_id, set_id
 
-__all__ = ["ObjectsSummaryParams", "object_rows", "planner_budget", "planner_columns", "SOLVE_SHARE_BUDGET", "REGRET_BUDGET", "across_objects", "RESAMPLES", "SEED"]
+__all__ = ["ObjectsSummaryParams", "object_rows", "planner_budget", "planner_columns", "SOLVE_SHARE_BUDGET", "REGRET_BUDGET",
+           "across_objects", "RESAMPLES", "SEED"]
 
 #: The planner's aims (docs/planner.md): at most this share of the exhaustive solves (%), and a
 #: pose whose force is at most this far above the exhaustive minimum (%).

@@ -5,7 +5,8 @@ poses simulated and dropped, the distribution of contacts per grasp, the share o
 that touch with the thumb, the palm, a proximal or middle phalanx, the share whose grasp
 matrix has full rank 6, and the median optimal force with every synergy enrolled as a
 multiple of the object's weight (‖f‖₂ / (m·g), dimensionless); where the closure model
-records per-contact normal forces (the dynamic one), how many contacts per grasp carry load. Columns: :data:`synergrasp.tables.GRASP_REALISM`. Pure functions: DataFrames
+records per-contact normal forces (the dynamic one), how many contacts per grasp carry load.
+Columns: :data:`synergrasp.tables.GRASP_REALISM`. Pure functions: DataFrames
 in, a DataFrame out.
 """
 
@@ -29,7 +30,7 @@ from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 __all__ = ["RealismParams", "SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "LONG_FINGERS",
            "link_categories", "grasp_labels", "grasp_realism", "link_shares", "representative_grasps"]
 
-#: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.STATUSES): a
+#: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.CLOSURE_STATUSES): a
 #: ``no_contact`` closure is a simulated grasp with 0 contacts; any other status is a dropped pose.
 SIMULATED_STATUSES: tuple[str, ...] = ("grasp", "no_contact")
 #: Contact-count bins of the table: 0, 1, …, 5 and "6 or more".
@@ -157,7 +158,9 @@ def _one_group(rows: pd.DataFrame, categories: dict[str, frozenset[int]], grasp_
     grasps = rows[simulated]
     n = len(grasps)
     m = grasps["n_contacts"].astype(int).clip(upper=CONTACT_BINS[-1])
-    share = (lambda mask: 100.0 * float(mask.sum()) / n if n else np.nan)
+    def share(mask: pd.Series) -> float:  # % of the simulated grasps
+        return 100.0 * float(mask.sum()) / n if n else np.nan
+
     dropped = rows.loc[~simulated, "status"].value_counts().sort_index()
     out: dict[str, float] = {
         "poses": len(rows), "simulated": n, "dropped": int((~simulated).sum()),
@@ -200,7 +203,8 @@ def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, equilibrium: pd.Dat
     ``contacts``: contacts tables of the objects (CONTACTS contract; rows are grouped by
     ``closure_model``, loads read from ``contact_normal_force_N``, N).
     ``gfo``: their optimisation results (joined on ``closure_model`` too when it has that
-    column); rank(G), force closure and ‖f‖₂ are taken from the full set ``full_set_id`` (e.g. ``"1-2-…-15"``). ``weights_N``: m·g per object, N.
+    column); rank(G), force closure and ‖f‖₂ are taken from the full set ``full_set_id`` (e.g.
+    ``"1-2-…-15"``). ``weights_N``: m·g per object, N.
     ``equilibrium``: the per-grasp equilibrium checks of the same contacts
     (``synergrasp.optimisation.equilibrium.grasp_equilibrium``: object, closure_model, pose,
     torque_residual, s1_outside_cone, …); grasps missing from it count as unknown residual and

@@ -14,6 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from synergrasp.analysis.chance import ALL_PAIRS
+from synergrasp.ids import ALL_OBJECTS
+
 __all__ = ["ScenarioTables", "scenario_row", "sensitivity_table", "table2_long",
            "TABLE2_ROWS", "SINGLE_SYNERGIES", "REALISM_COLUMNS"]
 
@@ -79,7 +82,7 @@ def _interval(claim: pd.Series) -> str:
 def _preservation_share(preservation: pd.DataFrame) -> float:
     """Share (%) of local minima preserved over all objects and pairs; NaN if none."""
     if "pairs" in preservation.columns:
-        row = preservation[(preservation["object"] == "all") & (preservation["pairs"] == "all")]
+        row = preservation[(preservation["object"] == ALL_OBJECTS) & (preservation["pairs"] == ALL_PAIRS)]
         if len(row):
             return float(row["preserved_percent"].iloc[0])
     total = preservation["n_minima"].sum() if "n_minima" in preservation.columns else 0

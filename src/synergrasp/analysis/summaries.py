@@ -24,8 +24,9 @@ from synergrasp.analysis.minima import preserved
 from synergrasp.analysis.periods import distinct_pose_mask, object_periods
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.config import ConfigError, build
-from synergrasp.ids import incremental_set_id, set_id, set_members, set_order
+from synergrasp.ids import ALL_OBJECTS, incremental_set_id, set_id, set_members, set_order
 from synergrasp.resolved import effective_placement, weight_N
+from synergrasp.tables import STUDY_TABLES
 
 __all__ = [
     "AnalysisSettings",
@@ -47,7 +48,6 @@ __all__ = [
     "no_success_note",
 ]
 
-ALL_OBJECTS = "all"
 
 
 def set_sort_key(set_ids: pd.Series) -> pd.Series:
@@ -465,7 +465,7 @@ def no_success_note(table: pd.DataFrame, settings: AnalysisSettings) -> str:
 
 def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[str, int], table2_k_max: int,
                  settings: AnalysisSettings, planners: pd.DataFrame | None = None) -> dict[str, tuple[str, pd.DataFrame]]:
-    """Every study table by name: (title, table).
+    """Every study table by name (``tables.STUDY_TABLES``, in that order): (title, table).
 
     ``sets_config`` is the configuration's ``synergy_sets`` (incremental_max,
     hierarchy_first, ...): the full set is {S1..S_incremental_max}, the hierarchy uses the
@@ -494,7 +494,7 @@ def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
         warnings.warn(nothing, NoSuccessWarning, stacklevel=2)
         verdict += f" (WARNING: {nothing})"
     level = f"{100 * settings.bootstrap.level:g} % intervals: block bootstrap over distinct poses"
-    return {
+    entries = {
         "success_rates": (f"Success rates per distinct pose (every verdict) and forces per object and synergy set, "
                           f"and averaged over objects in both views; {level}; {verdict}", rates),
         "table2_success_rates": (f"Table II: success rate (%, per distinct pose) with {{S1..Sk}}, "
@@ -515,3 +515,4 @@ def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
         "claims": (f"The study's claims tested on this run, one row per view (headline first); {level}"
                    + ("; claim 8: bootstrap over objects" if planners is not None else "") + f"; {verdict}", claims),
     }
+    return {name: entries[name] for name in STUDY_TABLES}

@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 from synergrasp import tables
-from synergrasp.analysis.claims import FAILS, HOLDS, UNDEFINED
+from synergrasp.analysis.claims import CLAIM_VERDICTS, FAILS, HOLDS, UNDEFINED
 from synergrasp.analysis.minima import MinimaParams, minima_table
 from synergrasp.analysis.summaries import TablesParams, study_claims
 from synergrasp.analysis.verdicts import with_verdicts
@@ -31,7 +31,6 @@ from synergrasp.optimisation.optimise import gfo_table
 
 __all__ = ["TargetClaimsParams", "ClaimsAtTargets", "claims_at_target", "claims_at_targets", "claims_summary"]
 
-VERDICTS = (HOLDS, FAILS, UNDEFINED)
 
 
 @dataclass(frozen=True)
@@ -154,7 +153,7 @@ def claims_summary(per_target: pd.DataFrame) -> pd.DataFrame:
     not hold and is undefined, and the verdict at the chosen target (rank 1)."""
     rows = []
     for (obj, claim), group in per_target.groupby(["object", "claim"], sort=True):
-        shares = {v: 100.0 * float(np.mean(group["verdict"] == v)) for v in VERDICTS}
+        shares = {v: 100.0 * float(np.mean(group["verdict"] == v)) for v in CLAIM_VERDICTS}
         chosen = group.loc[group["rank"] == 1, "verdict"]
         rows.append({"object": obj, "claim": int(claim), "n_targets": len(group),
                      "holds_percent": shares[HOLDS], "does_not_hold_percent": shares[FAILS],

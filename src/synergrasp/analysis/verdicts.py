@@ -36,10 +36,10 @@ import pandas as pd
 from synergrasp.ids import set_members
 from synergrasp.resolved import weight_N
 
-__all__ = ["VERDICTS", "verdict_columns", "with_verdicts", "force_bound"]
+__all__ = ["SUCCESS_VERDICTS", "verdict_columns", "with_verdicts", "force_bound"]
 
 #: The success verdicts the tables can use (config ``analyses.success``).
-VERDICTS: tuple[str, ...] = ("force_closure", "load_feasible", "force_closure_bounded")
+SUCCESS_VERDICTS: tuple[str, ...] = ("force_closure", "load_feasible", "force_closure_bounded")
 _NEEDED = ("object", "set_id", "status", "load_feasible", "force_closure_def1", "rank_G", "force_norm")
 
 
@@ -96,14 +96,14 @@ def with_verdicts(gfo: pd.DataFrame, success: str,
 
     Parameters
     ----------
-    success : one of :data:`VERDICTS` (config ``analyses.success``); ``force_closure_bounded``
+    success : one of :data:`SUCCESS_VERDICTS` (config ``analyses.success``); ``force_closure_bounded``
         needs ``weights_N`` for every object and a finite ``marginal_multiple``.
     weights_N : object name → weight m·g of the object, N.
     marginal_multiple : a success is marginal above this multiple of the weight
         (config ``analyses.marginal_weight_multiple``; none is marginal by default).
     """
-    if success not in VERDICTS:
-        raise ValueError(f"success must be one of {list(VERDICTS)}, got {success!r}")
+    if success not in SUCCESS_VERDICTS:
+        raise ValueError(f"success must be one of {list(SUCCESS_VERDICTS)}, got {success!r}")
     verdicts = verdict_columns(gfo)
     out = gfo.copy()
     out["verdict_force_closure"] = verdicts["force_closure"]

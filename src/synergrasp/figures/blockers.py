@@ -17,7 +17,7 @@ import pandas as pd
 
 from synergrasp.analysis.blockers import SUMMARY_GROUPS
 from synergrasp.figures.output import save_figure
-from synergrasp.ids import set_name
+from synergrasp.ids import ALL_OBJECTS, set_name
 
 __all__ = ["figure_blockers"]
 
@@ -42,7 +42,8 @@ def figure_blockers(summary: pd.DataFrame, png_path: str | Path, pdf_path: str |
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    objects = [o for o in dict.fromkeys(summary["object"]) if o != "all"] + (["all"] if (summary["object"] == "all").any() else [])
+    objects = [o for o in dict.fromkeys(summary["object"]) if o != ALL_OBJECTS]
+    objects += [ALL_OBJECTS] if (summary["object"] == ALL_OBJECTS).any() else []
     columns = _columns()
     n = max(len(objects), 1)
     fig, axes = plt.subplots(n, 1, figsize=(11.5, 0.3 * len(summary) + 0.5 * n + 2.4), squeeze=False, sharex=True,
@@ -61,7 +62,8 @@ def figure_blockers(summary: pd.DataFrame, png_path: str | Path, pdf_path: str |
         # the columns are the same in every panel: named above the first and below the last
         ax.tick_params(axis="x", labelsize=7, labeltop=ax is axes[0, 0], labelbottom=ax is axes[-1, 0])
         plt.setp(ax.get_xticklabels(), rotation=35, ha="right" if ax is axes[-1, 0] else "left")
-        for edge in (0.5, 0.5 + len(SUMMARY_GROUPS["kind"][1]), 0.5 + len(SUMMARY_GROUPS["kind"][1]) + len(SUMMARY_GROUPS["face"][1])):
+        n_kinds, n_faces = len(SUMMARY_GROUPS["kind"][1]), len(SUMMARY_GROUPS["face"][1])
+        for edge in (0.5, 0.5 + n_kinds, 0.5 + n_kinds + n_faces):
             ax.axvline(edge, color="black", linewidth=0.8)
         ax.set_title(f"{obj}: poses where the full set is in force closure and the set is not; "
                      "% with a blocker of each kind", fontsize=8.5, loc="left")

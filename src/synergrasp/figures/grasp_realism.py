@@ -44,9 +44,9 @@ def _contacts_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
         width = table[column].fillna(0.0).to_numpy(dtype=float)
         ax.barh(y, width, left=left, color=colour, edgecolor="white", linewidth=0.5,
                 label=f"{b}+" if b == CONTACT_BINS[-1] else str(b))
-        for yi, (l, w) in enumerate(zip(left, width)):
+        for yi, (start, w) in enumerate(zip(left, width)):
             if w >= 8.0:
-                ax.text(l + w / 2, yi, f"{w:.0f}", ha="center", va="center", fontsize=7,
+                ax.text(start + w / 2, yi, f"{w:.0f}", ha="center", va="center", fontsize=7,
                         color="white" if b < 4 else "black")
         left += width
     ax.set_yticks(y, labels)

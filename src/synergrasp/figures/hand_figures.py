@@ -20,7 +20,8 @@ from synergrasp.figures.hand_pictures import (ABOVE_CAMERA, BOX, PALM_CAMERA, SK
 from synergrasp.figures.output import save_figure
 from synergrasp.hand.synergies import SynergyPath
 
-__all__ = ["figure_synergy_postures", "figure_closing_views", "THUMB_CAMERA", "figure_example_grasps", "figure_grasp_views", "draw_grasp", "draw_grasp_row",
+__all__ = ["figure_synergy_postures", "figure_closing_views", "THUMB_CAMERA",
+           "figure_example_grasps", "figure_grasp_views", "draw_grasp", "draw_grasp_row",
            "object_of", "PANEL_PX", "GRASP_VIEWS", "FIG2_GRASPS"]
 
 #: Rendered panel size, pixels (width, height).

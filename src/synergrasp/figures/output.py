@@ -1,13 +1,18 @@
-"""Writing figures to files with the same bytes on every run."""
+"""Writing figures to files with the same bytes on every run, and what every figure shares:
+the colour of each verdict of the study's claims."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Any
 
+from synergrasp.analysis.claims import FAILS, HOLDS, UNDEFINED
 from synergrasp.file_output import replacing
 
-__all__ = ["save_figure", "colour_range"]
+__all__ = ["save_figure", "colour_range", "VERDICT_COLOURS"]
+
+#: Fill colour of each verdict of a claim (``claims.CLAIM_VERDICTS``), in every figure.
+VERDICT_COLOURS = {HOLDS: "#9fd89f", FAILS: "#f19c9c", UNDEFINED: "#f3e08a"}
 
 #: Metadata that would change between runs (dates) or versions (software) are left out.
 _PNG_METADATA = {"Software": None}

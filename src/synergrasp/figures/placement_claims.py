@@ -9,13 +9,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from synergrasp.figures.output import save_figure
+from synergrasp.analysis.claims import FAILS, HOLDS, UNDEFINED
+from synergrasp.figures.output import VERDICT_COLOURS, save_figure
 
-__all__ = ["figure_placement_claims", "VERDICT_COLOURS"]
+__all__ = ["figure_placement_claims"]
 
-#: Colours of the three verdicts (holds, does not hold, undefined).
-VERDICT_COLOURS = {"holds": "#1a7f37", "does not hold": "#c2000b", "undefined": "0.75"}
-_MARK = {"holds": "Y", "does not hold": "n", "undefined": "?"}
+_MARK = {HOLDS: "Y", FAILS: "n", UNDEFINED: "?"}
 
 
 def figure_placement_claims(summary: pd.DataFrame, png_path: str | Path, pdf_path: str | Path) -> None:
@@ -31,19 +30,18 @@ def figure_placement_claims(summary: pd.DataFrame, png_path: str | Path, pdf_pat
     objects = list(dict.fromkeys(summary["object"]))
     fig, axes = plt.subplots(1, max(len(objects), 1), figsize=(2.9 * max(len(objects), 1) + 0.8, 3.6),
                              sharey=True, squeeze=False)
-    columns = {"holds": "holds_percent", "does not hold": "does_not_hold_percent", "undefined": "undefined_percent"}
+    columns = {HOLDS: "holds_percent", FAILS: "does_not_hold_percent", UNDEFINED: "undefined_percent"}
     for ax, obj in zip(axes[0], objects):
         rows = summary[summary["object"] == obj].sort_values("claim")
         y = np.arange(len(rows))
         left = np.zeros(len(rows))
         for verdict, column in columns.items():
             width = rows[column].to_numpy(float)
-            ax.barh(y, width, left=left, color=VERDICT_COLOURS[verdict], edgecolor="white", linewidth=0.5,
+            ax.barh(y, width, left=left, color=VERDICT_COLOURS[verdict], edgecolor="0.5", linewidth=0.5,
                     label=verdict)
             left += width
         for yi, at_chosen in zip(y, rows["at_chosen_target"]):
-            ax.text(102, yi, _MARK.get(at_chosen, ""), va="center", fontsize=8, fontweight="bold",
-                    color="0.35" if at_chosen == "undefined" else VERDICT_COLOURS.get(at_chosen, "black"))
+            ax.text(102, yi, _MARK.get(at_chosen, ""), va="center", fontsize=8, fontweight="bold", color="black")
         ax.set_yticks(y, [f"claim {int(c)}" for c in rows["claim"]], fontsize=7)
         ax.set_xlim(0, 110)
         ax.set_xticks([0, 25, 50, 75, 100])

@@ -62,7 +62,8 @@ def image_colour(percent: float) -> Any:
 def figure_placement_map(hand: Any, obj: Any, placement: pd.DataFrame, contacts: pd.DataFrame,
                          spacing_mm: float, png_path: str | Path, pdf_path: str | Path, n_grasps: int = 2,
                          oppositions: Mapping[int, str] | None = None) -> None:
-    """The placement map of ``obj`` (a ``synergrasp.simulation.objects.GraspedObject``): one panel per distance x of the targets from the palm
+    """The placement map of ``obj`` (a ``synergrasp.simulation.objects.GraspedObject``): one panel per
+    distance x of the targets from the palm
     (palm frame, mm): every scored target as a square coloured by the search's score T (the
     share of scored poses whose grasp is of the object's type and in force closure with the
     full synergy set), the chosen target a red star, the second and third distinct targets

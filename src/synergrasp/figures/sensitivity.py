@@ -12,13 +12,13 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from synergrasp.analysis.claims import FAILS, HOLDS, UNDEFINED  # noqa: E402
-from synergrasp.figures.output import save_figure  # noqa: E402
+from synergrasp.analysis.claims import UNDEFINED  # noqa: E402
+from synergrasp.config import DEFAULT_SCENARIO  # noqa: E402
+from synergrasp.figures.output import VERDICT_COLOURS, save_figure  # noqa: E402
 
-__all__ = ["figure_claims_grid", "figure_table2_curves", "VERDICT_COLOURS"]
+__all__ = ["figure_claims_grid", "figure_table2_curves"]
 
-#: Cell colour per verdict; a claim a scenario did not produce is grey.
-VERDICT_COLOURS = {HOLDS: "#9fd89f", FAILS: "#f19c9c", UNDEFINED: "#f3e08a"}
+#: Cell colour of a claim a scenario did not produce (a verdict's: VERDICT_COLOURS).
 _MISSING = "#dddddd"
 
 
@@ -89,7 +89,7 @@ def figure_table2_curves(table2: pd.DataFrame, png: str | Path, pdf: str | Path,
     for ax, obj in zip(axes[0], objects):
         for colour, name in zip(colours, scenarios):
             curve = data[(data["object"] == obj) & (data["scenario"] == name)].sort_values("k")
-            default = name == "default"
+            default = name == DEFAULT_SCENARIO
             ax.plot(curve["k"], curve["success_rate"], marker=".", label=name,
                     color="black" if default else colour, lw=2.2 if default else 1.0,
                     zorder=3 if default else 2)

@@ -14,7 +14,6 @@ axis of the joint that moves it.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -112,11 +111,6 @@ def load_hand(path: str | Path | None = None) -> Hand:
     Raises ValueError naming the file and the offending field.
     """
     return build_hand(*hand_spec(path))
-
-
-def hand_from_dict(doc: Any) -> Hand:
-    """Build a Hand from the parsed content of a hand file (see ``load_hand``)."""
-    return build_hand(check_hand_doc(doc))
 
 
 class _Tree:

@@ -16,7 +16,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp.hand.synergies import Synergies, SynergyFileError, finite_cells, read_text_table

@@ -32,7 +32,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from synergrasp.optimisation.mechanics import contact_frames
-from synergrasp.optimisation.problem import DEFAULT_TOL, GFOProblem
+from synergrasp.optimisation.problem import DEFAULT_TOL, MAX_ITER, GFOProblem
 
 __all__ = ["ACTIVE_TOL", "REASONS", "Blocking", "blocking_contacts", "contact_margins"]
 
@@ -84,7 +84,7 @@ def contact_margins(forces: NDArray, problem: GFOProblem) -> NDArray:
 
 
 def blocking_contacts(problem: GFOProblem, *, tol: float = ACTIVE_TOL, solver_tol: float = DEFAULT_TOL,
-                      max_iter: int = 200) -> Blocking:
+                      max_iter: int = MAX_ITER) -> Blocking:
     """The blockers of one (grasp, set): its basis E, normals and cone (f_p and f_min are not
     used: the question is about internal forces alone). e_s = 0 gives ``no_internal_force``."""
     m, e = problem.n_contacts, problem.e_s

@@ -18,6 +18,7 @@ from synergrasp.optimisation.mechanics import contact_frames
 from synergrasp.optimisation.problem import (
     ALMOST_SOLVED_TOL,
     DEFAULT_TOL,
+    MAX_ITER,
     GFOProblem,
     Outcome,
     judge_direct,
@@ -27,7 +28,7 @@ from synergrasp.optimisation.problem import (
 __all__ = ["solve"]
 
 
-def solve(problem: GFOProblem, *, tol: float = DEFAULT_TOL, max_iter: int = 200) -> Outcome:
+def solve(problem: GFOProblem, *, tol: float = DEFAULT_TOL, max_iter: int = MAX_ITER) -> Outcome:
     """Solve one problem; e_s = 0 is judged by `judge_direct`.
 
     tol: Clarabel's feasibility, gap and infeasibility tolerances; max_iter: its iteration

@@ -26,6 +26,7 @@ from synergrasp.optimisation.mechanics import contact_frames
 from synergrasp.optimisation.problem import (
     ALMOST_SOLVED_TOL,
     DEFAULT_TOL,
+    MAX_ITER,
     GFOProblem,
     GFOSolution,
     GraspSets,
@@ -57,7 +58,7 @@ def solve_gfo(
     *,
     strict_shrink: float | None = None,
     tol: float = DEFAULT_TOL,
-    max_iter: int = 200,
+    max_iter: int = MAX_ITER,
     ipm: IPMSettings = IPMSettings(),
 ) -> GFOSolution:
     """Solve GFO problems; one row of the result per problem, in order.
@@ -160,7 +161,8 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
     sol = GFOSolution(status=status, force_norm=np.where(optimal, res.force_norm, np.nan), forces=forces,
                       e_s=res.e_s.astype(np.int32), iterations=res.iterations,
                       strict_internal=res.strict_code == ipm_solver.OPTIMAL if strict else None,
-                      solver=np.where(res.implied, "implied", "ipm").astype(object), max_violation=np.where(optimal, res.max_violation, np.nan))
+                      solver=np.where(res.implied, "implied", "ipm").astype(object),
+                      max_violation=np.where(optimal, res.max_violation, np.nan))
     for j in np.flatnonzero((res.code == ipm_solver.UNDECIDED) | (res.code == ipm_solver.NOT_SOLVED)):  # status ''
         _fallback(sol, j, g.problem(j), tol, max_iter)
     if strict:

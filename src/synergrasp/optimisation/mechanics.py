@@ -156,7 +156,8 @@ def _unit_normals(normals: NDArray, m: int | None, field: str) -> NDArray:
         raise ValueError(f"{field} must have shape {want}, got {n.shape}")
     norms = _row_norms(n)
     if n.shape[0] and not (np.abs(norms - 1.0) <= _UNIT_TOL).all():
-        raise ValueError(f"{field} must be unit vectors (|n| = 1 within {_UNIT_TOL}); got norms {norms.min():.6g}..{norms.max():.6g}")
+        raise ValueError(f"{field} must be unit vectors (|n| = 1 within {_UNIT_TOL}); "
+                         f"got norms {norms.min():.6g}..{norms.max():.6g}")
     return n
 
 

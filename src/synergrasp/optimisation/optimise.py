@@ -32,11 +32,17 @@ from synergrasp.optimisation.mechanics import (
     read_grasps,
     weight_wrench,
 )
-from synergrasp.optimisation.problem import DEFAULT_TOL, STRICT_SHRINK, GraspSets, SynergySets
+from synergrasp.optimisation.problem import DEFAULT_TOL, MAX_ITER, STRICT_SHRINK, GraspSets, SynergySets
 from synergrasp.optimisation.shards import shard_positions
 from synergrasp import resolved
 
-__all__ = ["GFOParams", "OptimiseParams", "gfo_table", "mechanics_for", "optimise_grasps", "optimise_shard"]
+__all__ = ["GFOParams", "OptimiseParams", "UNSOLVED_STATUSES", "gfo_table", "mechanics_for", "optimise_grasps",
+           "optimise_shard"]
+
+#: The gfo table's statuses of a problem given before any solve: no grasp at the pose, and
+#: rank(G) < 6 (the solved ones are ``problem.SOLVER_STATUSES``).
+UNSOLVED_STATUSES: tuple[str, ...] = ("no_grasp", "rank_deficient")
+NO_GRASP, RANK_DEFICIENT = UNSOLVED_STATUSES
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -70,7 +76,7 @@ class GFOParams:
     grasp_rank_rtol: float = GRASP_RANK_RTOL
     strict_shrink: float = STRICT_SHRINK
     tol: float = DEFAULT_TOL
-    max_iter: int = 200
+    max_iter: int = MAX_ITER
 
     def __post_init__(self) -> None:
         # The configuration is checked by its schema; a direction is normalised here
@@ -156,7 +162,7 @@ def optimise_grasps(
     out = {
         "set_id": np.array([set_id(s) for s in synergies.sets] * n_poses, dtype=object),
         "n_synergies": np.tile(synergies.sizes.astype(np.int32), n_poses),
-        "status": np.full(total, "no_grasp", dtype=object),
+        "status": np.full(total, NO_GRASP, dtype=object),
         "load_feasible": np.zeros(total, dtype=bool),
         "force_closure_def1": np.zeros(total, dtype=bool),
         "force_norm": np.full(total, np.nan),
@@ -178,9 +184,10 @@ def optimise_grasps(
         out["rank_G"][rows] = mech.rank_G
         out["n_contacts"][rows] = mech.n_contacts
         if mech.rank_G < 6 or mech.projector is None:
-            out["status"][rows] = "rank_deficient"
+            out["status"][rows] = RANK_DEFICIENT
             continue
-        problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, synergies, params.f_min_N, cone, params.basis_rtol)
+        problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, synergies, params.f_min_N, cone,
+                             params.basis_rtol)
         sol = solve_gfo(problems, method, strict_shrink=params.strict_shrink if strict else None, tol=params.tol,
                         max_iter=params.max_iter, ipm=ipm)
         out["status"][rows], out["force_norm"][rows], out["e_s"][rows] = sol.status, sol.force_norm, sol.e_s

@@ -14,6 +14,7 @@ import piqp
 from synergrasp.optimisation.problem import (
     ALMOST_SOLVED_TOL,
     DEFAULT_TOL,
+    MAX_ITER,
     GFOProblem,
     Outcome,
     judge_direct,
@@ -23,7 +24,7 @@ from synergrasp.optimisation.problem import (
 __all__ = ["solve"]
 
 
-def solve(problem: GFOProblem, *, tol: float = DEFAULT_TOL, max_iter: int = 200) -> Outcome:
+def solve(problem: GFOProblem, *, tol: float = DEFAULT_TOL, max_iter: int = MAX_ITER) -> Outcome:
     """Solve one problem with a pyramid cone; e_s = 0 is judged directly.
 
     tol: PIQP's absolute and relative tolerances; max_iter: its iteration cap. Status

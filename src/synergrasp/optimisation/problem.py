@@ -27,11 +27,12 @@ from synergrasp.optimisation.mechanics import BASIS_RTOL, _unit_normals, contact
 __all__ = [
     "ALMOST_SOLVED_TOL",
     "DEFAULT_TOL",
+    "MAX_ITER",
     "GFOProblem",
     "GFOSolution",
     "GraspSets",
     "Outcome",
-    "STATUSES",
+    "SOLVER_STATUSES",
     "STRICT_SHRINK",
     "SynergySets",
     "judge_direct",
@@ -40,9 +41,11 @@ __all__ = [
 
 #: Verdicts of one GFO problem (the `status` column of gfo.parquet, minus `rank_deficient`
 #: and `no_grasp`, which the study gives before any solve).
-STATUSES: tuple[str, ...] = ("feasible", "infeasible", "numerical_failure")
+SOLVER_STATUSES: tuple[str, ...] = ("feasible", "infeasible", "numerical_failure")
 #: Feasibility / gap tolerance of the exact solvers unless told otherwise (Clarabel's default).
 DEFAULT_TOL = 1e-8
+#: Iteration limit of the exact solvers (Clarabel, PIQP) unless told otherwise.
+MAX_ITER = 200
 #: A reduced-accuracy optimum is accepted when its worst constraint violation is below
 #: this, relative to max(1 N, ||f||) (every back end applies the same rule).
 ALMOST_SOLVED_TOL = 1e-6
@@ -195,7 +198,7 @@ class GraspSets:
 class Outcome(NamedTuple):
     """What a per-problem back end returns for one problem (a row of `GFOSolution`).
 
-    status: one of STATUSES; force_norm: N (NaN unless feasible); forces: (3m,) N or
+    status: one of SOLVER_STATUSES; force_norm: N (NaN unless feasible); forces: (3m,) N or
     None; iterations; solver: back-end name; solver_status: the solver's own status;
     max_violation: worst constraint violation of `forces`, N (NaN when there are none).
     """

@@ -51,8 +51,8 @@ def _smallest(d_obj: NDArray, d_self: NDArray) -> float:
 @jit
 def _advance(sigma: float, sigma_closed: float, budget: NDArray, knots: NDArray, travel: NDArray,
              n_knots: NDArray) -> float:
-    """Largest σ' ≤ σ_closed such that no finger f travels more than budget[f] mm on [σ, σ']
-    (``KinematicClosure.advance``): knots[f, :n_knots[f]] and travel[f, :n_knots[f]] its
+    """Largest σ' ≤ σ_closed such that no finger f travels more than budget[f] mm on [σ, σ']:
+    knots[f, :n_knots[f]] and travel[f, :n_knots[f]] its
     piecewise linear travel bound for its moving joints (n_knots[f] = 0: nothing moves)."""
     best = sigma_closed
     for f in range(n_knots.shape[0]):
@@ -81,7 +81,7 @@ def _advance(sigma: float, sigma_closed: float, budget: NDArray, knots: NDArray,
 @jit
 def _budget(d_obj: NDArray, d_self: NDArray, finger_links: NDArray, step_mm: float, margin_mm: float) -> NDArray:
     """Travel budget (mm) per finger: max(step_mm, min(its free distance, margin_mm)); hand
-    gaps count half (``KinematicClosure._budget``)."""
+    gaps count half."""
     out = np.empty(finger_links.shape[0])
     for f in range(finger_links.shape[0]):
         free = np.inf

@@ -23,7 +23,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
 
 __all__ = [
-    "STATUSES",
+    "CLOSURE_STATUSES",
     "FINGER_STATES",
     "ClosureResult",
     "closure_result",
@@ -33,7 +33,7 @@ __all__ = [
     "load_carrying_contacts",
 ]
 
-STATUSES: tuple[str, ...] = ("grasp", "intersects_open_hand", "no_contact", "caged", "lost")
+CLOSURE_STATUSES: tuple[str, ...] = ("grasp", "intersects_open_hand", "no_contact", "caged", "lost")
 """``grasp``: the closure ran and at least one link touches the box; ``intersects_open_hand``:
 the box overlaps the open hand (only the ``fixed`` placement can give it); ``no_contact``:
 the closure ran, nothing touches the box (or, once the unloaded contacts are dropped, nothing
@@ -51,7 +51,7 @@ another part of the hand), ``limit`` (followed the reference to the end of the c
 class ClosureResult:
     """The outcome of one closure, palm frame.
 
-    status:        one of STATUSES
+    status:        one of CLOSURE_STATUSES
     q:             (19,) final joint angles, rad
     finger_state:  per finger thumb…little, one of FINGER_STATES (empty if the box
                    intersects the open hand)

@@ -75,7 +75,7 @@ class DynamicClosure:
     """
 
     def __init__(self, hand: Hand, synergies: Synergies, params: ClosureParams, mechanics: ClosureMechanics,
-                 weight_N: float = 9.81) -> None:
+                 weight_N: float) -> None:
         from synergrasp.simulation import bullet
 
         names = tuple(synergies.joint_names)

@@ -147,7 +147,6 @@ class KinematicClosure:
         key = (f, moving)
         profile = self._profiles.get(key)
         if profile is None:
-            p = self.params
             idx = list(moving)
             lo, hi = self.active_lo[idx], self.active_hi[idx]
             rate = np.abs(self.s1[idx]) * self.reach[idx]  # mm per unit σ while active

@@ -39,7 +39,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
 
 __all__ = ["OPPOSITIONS", "GRASP_TYPES", "LINK_KINDS", "FACE_CLASSES", "SURFACE_FEATURES", "OppositionRule",
-           "HandAxes", "classify_grasp", "contacts_oppositions", "edge_contacts", "of_grasp_type", "face_classes", "surface_features"]
+           "HandAxes", "classify_grasp", "contacts_oppositions", "edge_contacts", "of_grasp_type", "face_classes",
+           "surface_features"]
 
 #: The classes, in the order the rule tries them.
 OPPOSITIONS: tuple[str, ...] = ("palm", "pad", "side", "none")

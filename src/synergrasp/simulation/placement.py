@@ -22,8 +22,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.simulation.shapes import Shape
 
-__all__ = ["palm_centre", "approach_line", "placement_target", "searched_placement", "FINGER_AXIS", "MODES", "Placement", "PoseGrid",
-           "ObjectPose", "pose_grid", "object_pose"]
+__all__ = ["palm_centre", "approach_line", "placement_target", "searched_placement", "FINGER_AXIS", "MODES", "Placement",
+           "PoseGrid", "ObjectPose", "pose_grid", "object_pose"]
 
 #: The placement modes: presets of one rule, which differ only in where the target comes from.
 MODES: tuple[str, ...] = ("approach", "fixed", "searched")

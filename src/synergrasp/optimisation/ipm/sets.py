@@ -193,7 +193,8 @@ def set_bases(F_all, cols, n_cols, thresholds, parent, order, rotated, bases, e_
     """E_s of every set into bases (n_sets, c, >= s): an orthonormal basis of the range of
     F_s = F_all[:, cols[j, :s]] from its singular vectors whose singular value exceeds the set's
     threshold (the rule of `mechanics.internal_force_basis`), by one-sided Jacobi rotations
-    (`rotate`, `kept_directions`); its rank into e_s; in `order` (parents first). A set whose parent (the set without its last column; -1: none)
+    (`rotate`, `kept_directions`); its rank into e_s; in `order` (parents first). A set whose
+    parent (the set without its last column; -1: none)
     is known starts from the parent's rotated columns, already orthogonal, and the new
     column (`rotate`): the incremental sets {S1..Sk} cost a few sweeps over k - 1 pairs
     instead of Jacobi from scratch. rotated (n_sets, c, >= s): the rotated columns."""
