@@ -52,7 +52,7 @@ UNITS = {
 
 #: The page's sections of figures: title, the files of benchmarks/results/ they show, what they are.
 SECTIONS = (
-    ("The default study", ("study", "fresh_clone"),
+    ("The default study", ("study", "fresh_clone", "fresh_venv"),
      "`make bench-study`: `snakemake -j2 figures` from an empty `results/`, the solver kernel compiled "
      "(`make bench-study` refuses a `results/` that is not empty); its jobs, per rule, below."),
     ("Other runs", ("sensitivity", "sensitivity_grasp_type", "dynamic_study", "everyday_objects", "random_objects",
