@@ -24,10 +24,16 @@ CORES  ?= 2
 
 .PHONY: venv study test test-workflow test-browser test-all lint format cluster-test bench bench-study lock report clean-venv
 
-$(BIN)/.installed: environment.lock pyproject.toml
+# The installer is uv (tools/uv.lock.txt, installed by pip with --require-hashes): it installs the
+# same hash-checked files as pip would, side by side (docs/measurements.md, fresh_clone). Every
+# file is checked against its hash, so every index the lock names is considered for a version
+# (unsafe-best-match; uv's default would stop at the first index that has the name).
+UV = $(BIN)/uv pip install --quiet --python $(BIN)/python --no-deps
+$(BIN)/.installed: environment.lock pyproject.toml tools/uv.lock.txt
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --require-hashes --no-deps -r environment.lock
-	$(BIN)/python -m pip install --quiet --no-deps --no-build-isolation -e .
+	$(BIN)/python -m pip install --quiet --require-hashes --no-deps -r tools/uv.lock.txt
+	$(UV) --require-hashes --index-strategy unsafe-best-match -r environment.lock
+	$(UV) --no-build-isolation -e .
 	touch $@
 
 venv: $(BIN)/.installed

@@ -164,12 +164,40 @@ def test_a_non_convex_mesh_is_decomposed_once_per_file_content(tmp_path, monkeyp
     again = _l_shape(tmp_path, "copy.obj", 60.0)  # same content, another name: from the cache
     assert Mesh(str(again), 2.0).geometry.parts[0] == pytest.approx(2.0 * first.geometry.parts[0])
     assert len(calls) == 1
-    Mesh(str(_l_shape(tmp_path, "longer.obj", 70.0)), 1.0)  # new content: decomposed
+    longer = Mesh(str(_l_shape(tmp_path, "longer.obj", 70.0)), 1.0)  # new content: decomposed on first use
+    assert longer.across_mm > 0 and len(calls) == 1  # building the shape (the configuration's checks) does not
+    assert not longer.geometry.convex
     assert len(calls) == 2
     # the parts cover the L: points inside it are inside the union, its notch is not filled
     inside = np.array([[10.0, 10.0, 10.0], [50.0, 10.0, 10.0], [10.0, 50.0, 10.0]]) - _centroid(first)
     assert (first.gap(inside, np.eye(3), np.zeros(3)) == 0.0).all()
     assert first.gap(np.array([[45.0, 45.0, 10.0]]) - _centroid(first), np.eye(3), np.zeros(3))[0] > 15.0
+
+
+@pytest.mark.parametrize("concave", [True, False])
+def test_the_parts_file_of_the_workflow_gives_the_parts_made_on_first_use(tmp_path, monkeypatch, concave):
+    """The rule mesh_parts writes a file (write_parts) from which the shape reads exactly the
+    parts it would make itself (V-HACD's for the L, the hull of a box), decomposing nothing."""
+    import pybullet
+
+    from synergrasp.simulation.shapes.convex_parts import write_parts
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    path = str(_l_shape(tmp_path, "l.obj", 60.0) if concave else BOX_OBJ)
+    made = Mesh(path, 1.5).geometry
+    write_parts(read_mesh(path), tmp_path / "parts.obj")
+    monkeypatch.setattr(pybullet, "vhacd", lambda *a, **k: pytest.fail("decomposed although the parts are given"))
+    read = Mesh(path, 1.5, parts=str(tmp_path / "parts.obj")).geometry
+    assert len(read.parts) == len(made.parts) == (len(read.parts) if concave else 1) and (len(read.parts) > 1) == concave
+    assert all(np.array_equal(a, b) for a, b in zip(read.parts, made.parts))
+    assert all(np.array_equal(a, b) for a, b in zip(read.planes, made.planes))
+    assert read.convex == made.convex == (not concave) and np.array_equal(read.region, made.region)
+
+
+def test_a_missing_parts_file_is_named_when_the_parts_are_first_needed(tmp_path):
+    mesh = Mesh(str(BOX_OBJ), 1.0, parts=str(tmp_path / "none.obj"))  # the checks read the mesh file only
+    with pytest.raises(ShapeError, match="parts: .*none.obj.* cannot be read.*mesh_parts"):
+        mesh.bounding_radius_mm
 
 
 def _centroid(mesh: Mesh) -> np.ndarray:

@@ -4,6 +4,8 @@ out by hand, the import scanner against a package made here."""
 
 from __future__ import annotations
 
+import re
+import types
 from pathlib import Path
 
 import pytest
@@ -184,3 +186,22 @@ def test_the_commands_read_the_files_the_workflow_reads(model, unloaded, contact
             assert w.step_file("default", step, obj) == object_file(w.study, step, obj).as_posix(), (obj, step)
         assert object_file(w.study, "contacts", obj) == Path(RESULTS) / "objects" / obj / contacts
         assert object_file(w.study, "contacts", obj, "elsewhere") == Path("elsewhere") / "objects" / obj / contacts
+
+
+def test_a_mesh_object_reads_its_parts_from_a_job_named_by_the_files_content(tmp_path):
+    """The workflow names each mesh's parts file by the content's hash (two files with the same
+    bytes share one job) and makes it in the rule mesh_parts; the checks decompose nothing."""
+    import shutil
+
+    box = ROOT / "tests" / "data" / "box_30x60x100.obj"
+    shutil.copy(box, tmp_path / "copy.obj")
+    objects = {name: {"shape": {"mesh": {"path": str(path), "scale": 1.0}}, "mass_kg": 0.2}
+               for name, path in (("a", box), ("b", tmp_path / "copy.obj"))}
+    wiring = _wiring(objects=objects)
+    parts = {name: wiring.study["objects"][name]["shape"]["mesh"]["parts"] for name in objects}
+    assert parts["a"] == parts["b"] and re.fullmatch(r"results/meshes/[0-9a-f]{24}\.obj", parts["a"])
+    key = parts["a"].removeprefix("results/meshes/").removesuffix(".obj")
+    assert wiring.mesh_file(types.SimpleNamespace(mesh=key)) in (str(box), str(tmp_path / "copy.obj"))
+    jobs = types.SimpleNamespace(object="a", keys=lambda: ["object"])
+    assert parts["a"] in wiring.user_files(jobs) and str(box) in wiring.user_files(jobs)
+    assert RuleFiles("mesh_parts").log() == "results/logs/mesh_parts/{mesh}.log"

@@ -502,7 +502,12 @@ def test_small_study_on_a_shipped_hand(tmp_path, example, n_joints):
 
 def test_random_objects_example_plans_every_drawn_object(tmp_path):
     """config/examples/random_objects.yaml (n_objects: 3): a dry run of `across_objects`
-    plans the steps of each drawn object that is studied, and the summary across objects."""
+    plans the steps of each drawn object that is studied, their meshes' convex parts as jobs,
+    and the summary across objects; on a machine that has never seen the meshes it makes no
+    parts (an empty cache stays empty)."""
+    import os
+    import re
+
     import yaml
 
     from synergrasp.config import overlay
@@ -514,10 +519,14 @@ def test_random_objects_example_plans_every_drawn_object(tmp_path):
     configfile = tmp_path / "three_random.yaml"
     configfile.write_text(yaml.safe_dump(overlay(overlay(yaml.safe_load(SMALL.read_text()), example),
                                                  {"random_objects": spec})))
-    out = snakemake(tmp_path, "-n", "across_objects", configfile=configfile)
+    cache = tmp_path / "cache"
+    out = snakemake(tmp_path, "-n", "across_objects", configfile=configfile,
+                    env={**os.environ, "XDG_CACHE_HOME": str(cache)})
     assert out.returncode == 0, out.stderr[-5000:]
     studied = [o.name for o in drawn_objects(spec, ROOT) if not o.problem]
     assert studied
     for name in studied:
         assert f"object={name}" in out.stdout, name
     assert "objects_summary" in out.stdout
+    assert re.search(rf"^mesh_parts\s+{len(studied)}$", out.stdout, re.MULTILINE), out.stdout[-3000:]
+    assert not (cache / "synergrasp-meshes").exists() and not (tmp_path / "results" / "meshes").exists()

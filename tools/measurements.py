@@ -52,11 +52,11 @@ UNITS = {
 
 #: The page's sections of figures: title, the files of benchmarks/results/ they show, what they are.
 SECTIONS = (
-    ("The default study", ("study", "fresh_clone"),
+    ("The default study", ("study", "fresh_clone", "fresh_venv"),
      "`make bench-study`: `snakemake -j2 figures` from an empty `results/`, the solver kernel compiled "
      "(`make bench-study` refuses a `results/` that is not empty); its jobs, per rule, below."),
     ("Other runs", ("sensitivity", "sensitivity_grasp_type", "dynamic_study", "everyday_objects", "random_objects",
-                    "shadow_hand", "inspire_hand", "cluster_test"),
+                    "shadow_hand", "inspire_hand", "cluster_test", "dry_run", "cluster_thousand", "tables_memory"),
      "Whole runs besides the default study; `tools/measurements.py record NAME --timed -- COMMAND` records one "
      "(a workflow from an empty `results/`)."),
     ("Closure", ("closure",),

@@ -151,6 +151,14 @@ STEPS_SEARCH_NOT_READS = ("closure.model", "closure.dynamic",
 #: 2-core x86_64 machine running two jobs at a time; the slope is between the two sizes
 #: (docs/cluster.md).
 STEPS: dict[str, Step] = {
+    # a mesh's convex parts (docs/shapes.md): its hull, or V-HACD's decomposition of a concave
+    # mesh, one file per mesh named by its content and the decomposition's parameters
+    # (``convex_parts.parts_key``), shared by every object and scenario with that file; made
+    # for the objects' meshes that a job reads (Wiring.user_files), never while the DAG is built
+    "mesh_parts": Step(
+        # a job: 3.4 s of CPU and 122-126 MB on two of the random meshes (their benchmark files)
+        rules={"mesh_parts": Cost("none", 10.0, 160, local=False)},
+        outputs={"obj": "meshes/{mesh}.obj"}, scope="workflow", optional=True),
     # the placement search (docs/placement_search.md): the kinematic closure and the
     # optimisation with the full set {S1..S_incremental_max} only; one job per object with
     # 2 processes: ~30 s of CPU (186-195 targets x 27 poses) plus a cold solver cache's compile
@@ -367,6 +375,8 @@ def rule_step() -> dict[str, str]:
 def step_for_object(config: Mapping[str, Any], step: str, obj: str) -> bool:
     """Whether the per-object ``step`` runs for ``obj`` under ``config``: its ``placement_when``
     holds for the object's effective placement."""
+    if not STEPS[step].placement_when:  # most steps: no placement to resolve (a copy per call)
+        return True
     placement = effective_placement(config, obj)
     return all(placement.get(key) == value for key, value in STEPS[step].placement_when)
 

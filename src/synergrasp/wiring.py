@@ -16,6 +16,7 @@ Layer: above the step registry (it checks a scenario's hand, synergy and object 
 from __future__ import annotations
 
 import functools
+import hashlib
 import math
 import re
 from collections.abc import Callable, Mapping, Sequence
@@ -254,6 +255,10 @@ class Wiring:
         self._hands: dict[str, Any] = {}
         self._hashes: dict[str, dict] = {}
         self._roots: dict[tuple, str] = {}
+        self._for: dict[tuple[str, str, str], bool] = {}
+        self._requests: dict[tuple[str, str], dict[str, int]] = {}
+        #: Mesh files by the name of their parts file (``mesh_parts``'s wildcard ``mesh``).
+        self.meshes: dict[str, str] = {}
         #: The scenarios' names, default first, and their roots.
         self.scenarios = scenario_names(config)
         self.scenario_root = {n: scenario_root(n) for n in self.scenarios}
@@ -279,8 +284,27 @@ class Wiring:
             if warning not in self._warned:
                 self._warned.add(warning)
                 self.warn(f"Warning: {warning}")
+        self._name_parts(cfg)
         self._checked[name] = cfg
         return cfg
+
+    def _name_parts(self, cfg: dict[str, Any]) -> None:
+        """Give every mesh object of a checked configuration its ``parts``: the file the rule
+        ``mesh_parts`` makes, ``results/meshes/<key>.obj`` (``convex_parts.parts_key`` of the
+        file's bytes), unless the configuration names one."""
+        from synergrasp.simulation.shapes.convex_parts import parts_key
+
+        for spec in cfg["objects"].values():
+            mesh = spec["shape"].get("mesh")
+            if mesh is None or mesh.get("parts"):
+                continue
+            key = parts_key(hashlib.sha256(Path(mesh["path"]).read_bytes()).hexdigest())
+            self.meshes.setdefault(key, mesh["path"])
+            mesh["parts"] = RuleFiles("mesh_parts").outputs()["obj"].format(mesh=key)
+
+    def mesh_file(self, wildcards: Any) -> str:
+        """Input function of ``mesh_parts``: the mesh file whose parts file the job makes."""
+        return self.meshes[wildcards.mesh]
 
     def job_scenario(self, wildcards: Any) -> str:
         """The scenario whose root a job's ``{root}`` names (the default outside any root)."""
@@ -389,14 +413,16 @@ class Wiring:
 
     def user_files(self, wildcards: Any) -> list[str]:
         """Input function: the scenario's own hand/synergy files and the mesh files of its
-        objects (the job's object only, for a job per object)."""
+        objects with their convex parts (``mesh_parts``; the job's object only, for a job per
+        object)."""
         from synergrasp.hand.description import SHIPPED_HANDS
         from synergrasp.hand.synergies import SHIPPED_TABLES
 
         cfg = self.job_config(wildcards)
         obj = getattr(wildcards, "object", None)
         objects = [obj] if obj in cfg["objects"] else list(cfg["objects"])
-        meshes = [cfg["objects"][o]["shape"]["mesh"]["path"] for o in objects if "mesh" in cfg["objects"][o]["shape"]]
+        meshes = [file for o in objects if "mesh" in cfg["objects"][o]["shape"]
+                  for file in (cfg["objects"][o]["shape"]["mesh"]["path"], cfg["objects"][o]["shape"]["mesh"]["parts"])]
         shipped = (*SHIPPED_TABLES, *SHIPPED_HANDS)  # by name: their files are under shipped_data()
         return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in shipped] + meshes
 
@@ -409,14 +435,25 @@ class Wiring:
 
     def resources(self, rule: str) -> dict[str, Callable[[Any], int]]:
         """A rule's ``resources``: memory and run time of one job in its scenario."""
-        return {"mem_mb": lambda w: mem_mb(rule, self.job_config(w)),
-                "runtime": lambda w: runtime_min(rule, self.job_config(w))}
+        return {"mem_mb": lambda w: self._request(rule, w)["mem_mb"],
+                "runtime": lambda w: self._request(rule, w)["runtime"]}
+
+    def _request(self, rule: str, wildcards: Any) -> dict[str, int]:
+        """The requests of a job of ``rule``, computed once per scenario (the same for every job)."""
+        key = (rule, self.job_scenario(wildcards))
+        if key not in self._requests:
+            cfg = self.scenario(key[1])
+            self._requests[key] = {"mem_mb": mem_mb(rule, cfg), "runtime": runtime_min(rule, cfg)}
+        return self._requests[key]
 
     # ---- targets
 
     def _for_object(self, name: str, step: str, obj: str) -> bool:
         """Whether scenario ``name`` runs the per-object ``step`` for ``obj`` (``placement_when``)."""
-        return step_for_object(self.scenario(name), step, obj)
+        key = (name, step, obj)
+        if key not in self._for:
+            self._for[key] = step_for_object(self.scenario(name), step, obj)
+        return self._for[key]
 
     def object_targets(self, obj: str, name: str = DEFAULT_SCENARIO) -> list[str]:
         """One object's outputs in a scenario: every per-object step's (wherever shared)."""

@@ -2,6 +2,25 @@
 # the contacts that count. Outputs, log, benchmark, threads and requests: synergrasp.steps.
 
 
+# A mesh's convex parts, one job per mesh file (named by its content and the decomposition's
+# parameters), before any job that builds its shape (W.user_files).
+rule mesh_parts:
+    input:
+        code=W.code("mesh_parts"),
+        mesh=W.mesh_file,
+    output:
+        **outputs("mesh_parts"),
+    log:
+        log_file("mesh_parts"),
+    benchmark:
+        benchmark_file("mesh_parts")
+    threads: threads("mesh_parts")
+    resources:
+        **W.resources("mesh_parts"),
+    script:
+        "../scripts/mesh_parts.py"
+
+
 rule search:
     input:
         code=W.code("search"),

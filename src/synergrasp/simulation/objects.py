@@ -107,7 +107,7 @@ def object_warnings(config: Mapping[str, Any]) -> list[str]:
     for name, spec in config["objects"].items():
         where = f"objects.{name}.shape"
         try:
-            across = 2.0 * shape_from_config(spec["shape"], where).bounding_radius_mm
+            across = shape_from_config(spec["shape"], where).across_mm
         except ShapeError:
             continue
         if not lo <= across <= hi:

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from synergrasp.config import ConfigError, block_problems
-from synergrasp.simulation.shapes.mesh_file import MeshFileError, read_mesh
+from synergrasp.simulation.shapes.mesh_file import MeshFileError, checked_mesh
 
 __all__ = ["DrawnObject", "drawn_objects", "random_objects_problems", "add_random_objects", "left_out", "N_MESHES"]
 
@@ -74,7 +74,7 @@ def _check(path: Path, expected: str | None, longest_mm: float) -> tuple[float, 
     if hashlib.sha256(data).hexdigest() != expected:
         return float("nan"), "sha256 differs from the manifest"
     try:
-        mesh = read_mesh(path)
+        mesh = checked_mesh(path)
     except MeshFileError as err:
         return float("nan"), f"mesh cannot be read: {err}"
     extent = float(np.ptp(mesh.vertices, axis=0).max())

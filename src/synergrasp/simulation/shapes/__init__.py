@@ -81,6 +81,12 @@ class Shape(ABC):
         """Radius of the smallest sphere about its centre that holds it, mm."""
 
     @property
+    def across_mm(self) -> float:
+        """Its size across for the configuration's checks, mm: twice ``bounding_radius_mm``; a
+        mesh's from its file alone (its convex parts are made by a job, not by the checks)."""
+        return 2.0 * self.bounding_radius_mm
+
+    @property
     @abstractmethod
     def label(self) -> str:
         """Its sizes in words, for figures ("30 × 30 × 30 mm")."""

@@ -2,14 +2,18 @@
 
 The decomposition is V-HACD's as pybullet ships it (``pybullet.vhacd``, no package beyond
 the engine the study already uses), with pybullet's parameters, written down here. It is
-deterministic (the same parts for the same file on every run) and takes seconds, so it is
-cached per file content: ``$XDG_CACHE_HOME/synergrasp-meshes/<hash>.obj`` (``~/.cache``
-without it), the hash of the file's bytes, these parameters and pybullet's version. The
-physics engine reads the parts from a file too (``bullet_file``), cached the same way.
+deterministic (the same parts for the same file on every run) and takes seconds. Its file is
+named by :func:`parts_key`, the hash of the mesh file's bytes, these parameters and pybullet's
+version: the workflow makes it in a job of its own (rule ``mesh_parts``,
+``results/meshes/<key>.obj``, :func:`write_parts`) and hands its path to the shape (the mesh's
+``parts``); outside the workflow it is made on first use and cached per user,
+``$XDG_CACHE_HOME/synergrasp-meshes/<key>.obj`` (``~/.cache`` without it). The physics engine
+reads the parts from a file too (``bullet_file``), cached per user likewise.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import sys
@@ -24,7 +28,8 @@ from scipy.spatial import ConvexHull, QhullError
 
 from synergrasp.simulation.shapes.mesh_file import TriangleMesh
 
-__all__ = ["convex_parts", "is_convex", "cache_dir", "bullet_file", "VHACD_PARAMETERS", "CONVEX_RTOL"]
+__all__ = ["convex_parts", "is_convex", "cache_dir", "bullet_file", "parts_key", "write_parts", "read_parts",
+           "VHACD_PARAMETERS", "CONVEX_RTOL"]
 
 #: A mesh whose volume is this close to its hull's (relatively) is convex: its hull is it.
 CONVEX_RTOL = 1e-6
@@ -45,18 +50,43 @@ def is_convex(mesh: TriangleMesh) -> bool:
     return mesh.volume >= (1.0 - CONVEX_RTOL) * ConvexHull(mesh.vertices).volume
 
 
+def parts_key(digest: str) -> str:
+    """The name of a mesh's parts file (24 hex digits) from ``digest``, the sha256 of the mesh
+    file's bytes: the hash of it, :data:`VHACD_PARAMETERS` and pybullet's version."""
+    version = _pybullet_version()
+    return hashlib.sha256(f"{digest} {sorted(VHACD_PARAMETERS.items())} pybullet {version}".encode()).hexdigest()[:24]
+
+
+@functools.cache
+def _pybullet_version() -> str:
+    return metadata.version("pybullet")
+
+
 def convex_parts(mesh: TriangleMesh, digest: str) -> list[NDArray]:
     """Vertices (k, 3) of each convex part, in the file's units: the hull's vertices of a
-    convex mesh, else the parts of its decomposition (cached under ``digest``, the sha256 of
-    the file's bytes)."""
+    convex mesh, else the parts of its decomposition (cached per user under
+    :func:`parts_key` of ``digest``, the sha256 of the file's bytes)."""
     if is_convex(mesh):
         return [mesh.vertices[ConvexHull(mesh.vertices).vertices]]
-    version = metadata.version("pybullet")
-    key = hashlib.sha256(f"{digest} {sorted(VHACD_PARAMETERS.items())} pybullet {version}".encode()).hexdigest()[:24]
-    cached = cache_dir() / f"{key}.obj"
+    cached = cache_dir() / f"{parts_key(digest)}.obj"
     if not cached.is_file():
         _decompose(mesh, cached)
-    return _read_parts(cached)
+    return read_parts(cached)
+
+
+def write_parts(mesh: TriangleMesh, out: Path) -> None:
+    """Write the convex parts of ``mesh`` to the OBJ file ``out`` (one object per part, in the
+    file's units), read back by :func:`read_parts` as :func:`convex_parts` gives them: a convex
+    mesh's hull (its vertices in the mesh's order), else V-HACD's decomposition."""
+    out = Path(out)
+    if not is_convex(mesh):
+        _decompose(mesh, out)
+        return
+    hull = ConvexHull(mesh.vertices)
+    rank = np.full(len(mesh.vertices), -1)
+    rank[hull.vertices] = np.arange(len(hull.vertices))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    _write_obj(out, [mesh.vertices[hull.vertices]], [rank[hull.simplices]])
 
 
 def _decompose(mesh: TriangleMesh, out: Path) -> None:
@@ -68,7 +98,7 @@ def _decompose(mesh: TriangleMesh, out: Path) -> None:
         _write_obj(source, [mesh.vertices], [mesh.triangles])
         with _quiet():  # V-HACD prints its progress on the process's standard output
             pybullet.vhacd(str(source), str(parts), str(log), **VHACD_PARAMETERS)
-        if not parts.is_file() or not _read_parts(parts):
+        if not parts.is_file() or not read_parts(parts):
             raise RuntimeError(f"the convex decomposition wrote no parts (its log: {log.read_text()[-500:]!r})")
         os.replace(parts, out)  # atomic: a concurrent job reads the whole file or none
 
@@ -91,7 +121,7 @@ class _quiet:
             os.close(saved)
 
 
-def _read_parts(path: Path) -> list[NDArray]:
+def read_parts(path: Path) -> list[NDArray]:
     """The vertices of each object (``o``) of an OBJ file with at least 4 not in one plane."""
     parts: list[list[list[float]]] = []
     for line in path.read_text().splitlines():

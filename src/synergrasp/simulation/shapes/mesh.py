@@ -1,7 +1,13 @@
 """A mesh from an OBJ or STL file: its hull if it is convex, else its convex parts (mm).
 
 ``path``: the file, absolute or relative to the working directory (the project's root for
-the workflow, which runs there); ``scale``: mm per unit of the file. The own frame is the
+the workflow, which runs there); ``scale``: mm per unit of the file; ``parts``: the file of its
+convex parts (``convex_parts.write_parts``), which the workflow makes in a job of its own
+(rule ``mesh_parts``, ``results/meshes/``) and names here; without it the parts are made on
+first use and cached per user (``convex_parts.convex_parts``). Building a ``Mesh`` reads and
+checks the file only (a closed manifold bounding a volume): its parts and everything made
+from them are made when a query first needs them, so that checking a configuration does no
+decomposition (docs/shapes.md). The own frame is the
 file's axes with the origin moved to the centroid of the solid the mesh bounds (its centre
 of mass at uniform density). The object *is* the convex parts (``convex_parts``): every
 query, the physics engine and the pictures use them. Every query is exact for them
@@ -22,7 +28,7 @@ from numpy.typing import NDArray
 
 from synergrasp.simulation.shapes import Shape, ShapeError, positive_length
 from synergrasp.simulation.shapes.box import box_edges
-from synergrasp.simulation.shapes.mesh_file import MeshFileError, read_mesh
+from synergrasp.simulation.shapes.mesh_file import MeshFileError, checked_mesh
 
 # scipy's sparse graphs and hulls and the compiled polytope queries are imported where a mesh
 # uses them: the shapes package is imported by every Snakemake start (the configuration's
@@ -53,16 +59,24 @@ class MeshGeometry:
 
 
 @functools.lru_cache(maxsize=32)
-def _geometry(path: str, stamp: tuple[int, int], scale: float) -> MeshGeometry:
+def _geometry(path: str, stamp: tuple[int, int], scale: float, parts: str) -> MeshGeometry:
     """The geometry of the file at ``path`` (``stamp``: its change time and size, so that an
-    edited file is read again) scaled to mm."""
+    edited file is read again) scaled to mm; its convex parts read from the file ``parts``, or
+    made (and cached per user) where it is ''."""
     from scipy.spatial import ConvexHull
 
-    from synergrasp.simulation.shapes.convex_parts import convex_parts, is_convex
+    from synergrasp.simulation.shapes.convex_parts import convex_parts, is_convex, read_parts
 
     del stamp
-    mesh = read_mesh(path)
-    file_parts = convex_parts(mesh, hashlib.sha256(Path(path).read_bytes()).hexdigest())
+    mesh = checked_mesh(path)
+    if parts:
+        try:
+            file_parts = read_parts(Path(parts))
+        except OSError as err:
+            raise ShapeError(f"parts: {parts!r} cannot be read ({err.strerror or err}); the workflow's rule "
+                             "mesh_parts makes it") from None
+    else:
+        file_parts = convex_parts(mesh, hashlib.sha256(Path(path).read_bytes()).hexdigest())
     parts, planes, regions, first = [], [], [], 0
     for part in file_parts:
         vertices = np.ascontiguousarray((part - mesh.centroid) * scale)
@@ -97,46 +111,75 @@ def _regions(hull: Any, face_of: NDArray, n_faces: int) -> NDArray:
 
 @dataclass(frozen=True)
 class Mesh(Shape):
-    """A mesh read from ``path`` (OBJ or STL), ``scale`` mm per unit of the file."""
+    """A mesh read from ``path`` (OBJ or STL), ``scale`` mm per unit of the file, its convex
+    parts read from ``parts`` where given (module docstring)."""
 
     path: str
     scale: float
+    parts: str = ""
 
     kind: ClassVar[str] = "mesh"
     kernel_code: ClassVar[int] = 3
 
     def __post_init__(self) -> None:
-        from scipy.spatial import ConvexHull
-
-        from synergrasp.simulation.shapes.polytope import pack_parts
-
         scale = positive_length("scale", self.scale, "a finite positive number of mm per unit of the file")
         if not isinstance(self.path, str) or not self.path:
             raise ShapeError(f"path: {self.path!r} is not allowed; the path of an OBJ or STL file is required")
+        if not isinstance(self.parts, str):
+            raise ShapeError(f"parts: {self.parts!r} is not allowed; the path of the mesh's convex parts is required")
         file = Path(self.path)
         try:
             stat = file.stat()
-            geometry = _geometry(str(file.resolve()), (stat.st_mtime_ns, stat.st_size), scale)
+            key = (str(file.resolve()), (stat.st_mtime_ns, stat.st_size))
+            mesh = checked_mesh(file)
         except FileNotFoundError:
             raise ShapeError(f"path: {self.path!r} does not exist (relative paths are read from the "
                              f"working directory, {Path.cwd()})") from None
         except (MeshFileError, OSError) as err:
             raise ShapeError(f"path: {err}") from None
         object.__setattr__(self, "scale", scale)
-        object.__setattr__(self, "geometry", geometry)
-        object.__setattr__(self, "_params", pack_parts(list(zip(geometry.parts, geometry.planes))))
-        self._params.setflags(write=False)
+        object.__setattr__(self, "_file", key)
+        object.__setattr__(self, "_file_radius_mm", scale * float(np.linalg.norm(mesh.vertices - mesh.centroid,
+                                                                                 axis=1).max()))
         object.__setattr__(self, "_faces", {})  # (part, plane) -> its face polygon packed (normals_near)
-        object.__setattr__(self, "_every", geometry.vertices)
-        object.__setattr__(self, "_hull", self._every[ConvexHull(self._every).vertices])
+
+    @functools.cached_property
+    def geometry(self) -> MeshGeometry:
+        """Its convex parts in mm and what is made of them (made on first use)."""
+        return _geometry(*self._file, self.scale, self.parts)
+
+    @functools.cached_property
+    def _params(self) -> NDArray:
+        from synergrasp.simulation.shapes.polytope import pack_parts
+
+        params = pack_parts(list(zip(self.geometry.parts, self.geometry.planes)))
+        params.setflags(write=False)
+        return params
+
+    @functools.cached_property
+    def _every(self) -> NDArray:
+        return self.geometry.vertices
+
+    @functools.cached_property
+    def _hull(self) -> NDArray:
+        from scipy.spatial import ConvexHull
+
+        return self._every[ConvexHull(self._every).vertices]
+
+    @functools.cached_property
+    def _landmarks(self) -> NDArray:
         # the parts' vertices and centroids: a turn that maps the vertices onto themselves but
         # the parts onto other places (two wedges of a bow-tie) moves a centroid
-        object.__setattr__(self, "_landmarks", np.vstack([self._every,
-                                                          [np.mean(part, axis=0) for part in geometry.parts]]))
+        return np.vstack([self._every, [np.mean(part, axis=0) for part in self.geometry.parts]])
 
     @property
     def bounding_radius_mm(self) -> float:
         return float(np.linalg.norm(self._every, axis=1).max())
+
+    @property
+    def across_mm(self) -> float:
+        # the file's vertices about its centroid: no decomposition needed (the parts' differ a little)
+        return 2.0 * self._file_radius_mm
 
     @property
     def label(self) -> str:

@@ -10,6 +10,7 @@ file's; the caller scales them.
 
 from __future__ import annotations
 
+import functools
 import re
 import struct
 from dataclasses import dataclass
@@ -18,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["MeshFileError", "TriangleMesh", "read_mesh", "MESH_SUFFIXES"]
+__all__ = ["MeshFileError", "TriangleMesh", "read_mesh", "checked_mesh", "MESH_SUFFIXES"]
 
 #: File name endings read (case-insensitive).
 MESH_SUFFIXES = (".obj", ".stl")
@@ -40,6 +41,23 @@ class TriangleMesh:
     triangles: NDArray[np.int64]
     volume: float
     centroid: NDArray[np.float64]
+
+
+def checked_mesh(path: str | Path) -> TriangleMesh:
+    """:func:`read_mesh`, read once per process for a file unchanged since (its change time
+    and size): the configuration's checks and the shapes read the same files."""
+    path = Path(path)
+    try:
+        stat = path.stat()
+    except OSError:
+        return read_mesh(path)  # says why it cannot be read
+    return _read_once(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=None)
+def _read_once(path: str, mtime_ns: int, size: int) -> TriangleMesh:
+    del mtime_ns, size
+    return read_mesh(path)
 
 
 def read_mesh(path: str | Path) -> TriangleMesh:
