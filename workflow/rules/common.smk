@@ -13,15 +13,15 @@ from synergrasp import snakemake_adapter as adapter
 adapter.check_version()
 
 from synergrasp.preflight import configfile_problems, refuse, slurm_problems
-from synergrasp.steps import rule_costs
+from synergrasp.steps import RESULTS, rule_costs
+from synergrasp.study_checks import older_results_problems
 from synergrasp.wiring import RuleFiles, Wiring, report_archive
 
 # Snakemake read the configuration files itself and kept a repeated key's last value.
 refuse(configfile_problems(adapter.config_files(workflow)))
 
 # A results folder of an older version (a table with a renamed column) is refused before any job.
-from synergrasp.study_checks import older_results_problems
-refuse(older_results_problems("results"))
+refuse(older_results_problems(RESULTS))
 
 #: The study: its scenarios (each checked when a target first needs it) and their files.
 W = Wiring(config, workflow.basedir, error=WorkflowError, warn=logger.warning, stop=refuse)
