@@ -100,6 +100,7 @@ def _bad_files(tmp_path: Path) -> dict[str, tuple[Path, str]]:
         "empty": (tmp_path / "empty.obj", "holds no triangles"),
         "not an STL": (tmp_path / "text.stl", "is neither a binary STL"),
         "wrong extension": (tmp_path / "box.ply", "is not an OBJ or STL file"),
+        "a folder": (tmp_path, "is a folder; give an OBJ or STL file"),
         "open": (_write_obj(tmp_path / "open.obj", box, _triangles()[:-1]), "is not closed: 3 edges belong to one"),
         "non-manifold": (_write_obj(tmp_path / "pair.obj", np.unique(two, axis=0), edge_pair),
                          "is non-manifold: 1 edges are shared by more than two triangles"),
@@ -110,7 +111,7 @@ def _bad_files(tmp_path: Path) -> dict[str, tuple[Path, str]]:
     }
 
 
-@pytest.mark.parametrize("case", ["missing", "empty", "not an STL", "wrong extension", "open", "non-manifold",
+@pytest.mark.parametrize("case", ["missing", "empty", "not an STL", "wrong extension", "a folder", "open", "non-manifold",
                                   "inconsistent", "flat"])
 def test_a_bad_mesh_file_is_one_error_naming_the_key(tmp_path, case):
     path, problem = _bad_files(tmp_path)[case]

@@ -63,6 +63,8 @@ def _read_once(path: str, mtime_ns: int, size: int) -> TriangleMesh:
 def read_mesh(path: str | Path) -> TriangleMesh:
     """The closed triangle mesh of an OBJ or STL file; MeshFileError saying why not."""
     path = Path(path)
+    if path.is_dir():
+        raise MeshFileError(f"{str(path)!r} is a folder; give an OBJ or STL file")
     if path.suffix.lower() not in MESH_SUFFIXES:
         raise MeshFileError(f"{str(path)!r} is not an OBJ or STL file (the name must end in .obj or .stl)")
     try:
