@@ -92,14 +92,25 @@ def test_generated_kinds_match_exact_solver_outside_the_band_and_cvxpy_on_a_subs
             assert sol.force_norm[k] == pytest.approx(ref.force_norm[k], rel=RTOL_NORM)
     assert {"nominal", "feasible", "infeasible", "near_boundary"} <= {p.kind for p in generated}
     assert in_band_differ <= 0.05 * len(generated)
-    # cvxpy (a different formulation and canonicalisation; solved once for test_gfo too) on a subset
+    # cvxpy (a different formulation and canonicalisation; solved once for test_gfo too) on a subset.
+    # Inside the band the optimal norm is as ill-conditioned as the verdict: the feasible set
+    # shrinks toward a point, and forces within the solvers' feasibility tolerance (1e-6 ||f||)
+    # may lie well below the exact optimum (problems 228 and 273 under OpenBLAS's Haswell kernel:
+    # 0.24 % and 0.42 % below cvxpy's 'optimal', with violations of 0.05 N on 2.5e5 N against
+    # cvxpy's 3e-6 N). There our norm may be lower, never higher, than the reference's; counted.
     cvx = generated_cvxpy
+    in_band_lower = 0
     for k in range(0, len(generated), 3):
         p = generated[k]
+        in_band = p.kind == "near_boundary" and abs(p.delta) <= BAND
         if sol.status[k] != cvx.status[k]:
-            assert p.kind == "near_boundary" and abs(p.delta) <= BAND
+            assert in_band
+        elif cvx.status[k] == "feasible" and in_band and sol.force_norm[k] < cvx.force_norm[k] * (1 - RTOL_NORM):
+            assert sol.max_violation[k] <= 1e-6 * sol.force_norm[k], (k, sol.max_violation[k])
+            in_band_lower += 1
         elif cvx.status[k] == "feasible":
-            assert sol.force_norm[k] == pytest.approx(cvx.force_norm[k], rel=RTOL_NORM)
+            assert sol.force_norm[k] == pytest.approx(cvx.force_norm[k], rel=RTOL_NORM), (k, p.kind, p.delta)
+    assert in_band_lower <= 0.05 * len(range(0, len(generated), 3))
 
 
 def test_second_attempt_with_refinement_decides_problems_the_first_leaves_open():

@@ -3,6 +3,7 @@ circular cone on generated problems, PIQP against Clarabel on the same pyramid, 
 compiled interior-point kernel against both."""
 
 import math
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -76,15 +77,40 @@ def generated(generated_problems):
     }
 
 
+def _verified_feasible(solution) -> np.ndarray:
+    """Problems for which `solution` holds forces that violate no constraint by more than
+    1e-6 max(1 N, ||f||): a feasible point is a certificate of feasibility."""
+    return solution.feasible & (solution.max_violation <= 1e-6 * np.maximum(1.0, solution.force_norm))
+
+
 def test_inscribed_pyramids_inside_the_circular_cone_inside_the_circumscribed(generated):
     """Inscribed 4 in inscribed 8 in the circle in circumscribed 8: a problem feasible for a
-    smaller cone is feasible for every larger one, at no larger optimal force."""
-    chain = [generated[(4, True)], generated[(8, True)], generated["circular"], generated[(8, False)]]
-    for small, large in zip(chain, chain[1:]):
+    smaller cone is feasible for every larger one, at no larger optimal force.
+
+    A pyramid's 'infeasible' from PIQP is contradicted when Clarabel, on the same pyramid,
+    finds a verified feasible point (`_verified_feasible`); such a problem counts as feasible
+    for the larger cone here, and PIQP's wrong verdicts are counted (at most one of the 150:
+    generated problem 130 under OpenBLAS's Haswell kernel, whose circumscribed pyramid PIQP
+    calls primal infeasible though Clarabel's forces of 8.7e4 N violate it by 5e-8 N)."""
+    names = [(4, True), (8, True), "circular", (8, False)]
+    chain = [generated[name] for name in names]
+    wrong_piqp = 0
+    for (small, large), large_name in zip(zip(chain, chain[1:]), names[1:]):
         ok = small.feasible
-        assert np.all(large.feasible[ok] | (large.status[ok] == "numerical_failure"))
+        large_feasible = large.feasible.copy()
+        if large_name != "circular":
+            contradicted = (large.status == "infeasible") & _verified_feasible(
+                generated["clarabel_pyramids"][large_name])
+            wrong_piqp += int(np.sum(contradicted & ok))
+            large_feasible |= contradicted
+        assert np.all(large_feasible[ok] | (large.status[ok] == "numerical_failure")), np.flatnonzero(
+            ok & ~large_feasible & (large.status != "numerical_failure"))
         both = ok & large.feasible
         assert np.all(large.force_norm[both] <= small.force_norm[both] * (1 + 1e-6))
+    if wrong_piqp:
+        warnings.warn(f"WARNING: PIQP called {wrong_piqp} circumscribed or inscribed pyramid(s) infeasible that "
+                      "Clarabel solves with a verified feasible point")
+    assert wrong_piqp <= 1
     counts = [int(s.feasible.sum()) for s in chain]
     assert counts == sorted(counts) and counts[0] < counts[-1]
 
