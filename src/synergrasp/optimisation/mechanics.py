@@ -9,6 +9,7 @@ components. The wrench reference point is the object centre o.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -269,6 +270,8 @@ class GraspMechanics:
     KJ:         (c, n) K J, N/rad (the contact-force response to joint motion)
     response_norm: ||K J||_2, N/rad: the scale of the rank decision of E_s
                 (`internal_force_basis`)
+    frames:     (m, 3, 3) the contact frames of the normals (`contact_frames`), computed
+                when first read
     """
 
     G: NDArray
@@ -286,6 +289,10 @@ class GraspMechanics:
     @property
     def n_contacts(self) -> int:
         return int(self.normals.shape[0])
+
+    @functools.cached_property
+    def frames(self) -> NDArray:
+        return contact_frames(self.normals)
 
 
 def grasp_mechanics(

@@ -127,7 +127,9 @@ class Mesh(Shape):
         object.__setattr__(self, "_params", pack_parts(list(zip(geometry.parts, geometry.planes))))
         self._params.setflags(write=False)
         object.__setattr__(self, "_faces", {})  # (part, plane) -> its face polygon packed (normals_near)
+        object.__setattr__(self, "_corners", {})  # a box's (pose, half extents) -> its corners (box_gap)
         object.__setattr__(self, "_every", geometry.vertices)
+        object.__setattr__(self, "_radius", float(np.linalg.norm(self._every, axis=1).max()))
         object.__setattr__(self, "_hull", self._every[ConvexHull(self._every).vertices])
         # the parts' vertices and centroids: a turn that maps the vertices onto themselves but
         # the parts onto other places (two wedges of a bow-tie) moves a centroid
@@ -136,7 +138,7 @@ class Mesh(Shape):
 
     @property
     def bounding_radius_mm(self) -> float:
-        return float(np.linalg.norm(self._every, axis=1).max())
+        return self._radius
 
     @property
     def label(self) -> str:
@@ -177,19 +179,17 @@ class Mesh(Shape):
         return out
 
     def box_gap(self, rotation: NDArray, center: NDArray, box_pose: NDArray, box_half: NDArray) -> tuple[float, NDArray]:
-        from synergrasp.simulation.shapes.polytope import convex_distance
-        from synergrasp.simulation.shapes.polytope_axes import part_box_overlap
+        from synergrasp.simulation.shapes.polytope_axes import parts_box_gap
 
-        corners = np.unique(np.vstack(box_edges(box_pose, box_half)), axis=0)
+        key = (box_pose.tobytes(), np.asarray(box_half).tobytes())
+        corners = self._corners.get(key)
+        if corners is None:  # the box's corners, once per box (the palm's boxes do not move)
+            corners = self._corners[key] = np.unique(np.vstack(box_edges(box_pose, box_half)), axis=0)
         local = np.ascontiguousarray((corners - center) @ rotation)
-        best, point = np.inf, np.asarray(center, dtype=float).copy()
-        for k in range(len(self.geometry.parts)):
-            d, a, b, touching = convex_distance(self._params, k, local)
-            if touching:
-                d = part_box_overlap(self._params, k, local, np.ascontiguousarray(box_pose[:3, :3].T @ rotation))
-            if d < best:
-                best, point = d, rotation @ (0.5 * (a + b)) + center
-        return float(best), point
+        best, a, b = parts_box_gap(self._params, local, np.ascontiguousarray(box_pose[:3, :3].T @ rotation))
+        if not best < np.inf:
+            return float(best), np.asarray(center, dtype=float).copy()
+        return float(best), rotation @ (0.5 * (a + b)) + center
 
     def same_region(self, rotation_a: NDArray, center_a: NDArray, rotation_b: NDArray, center_b: NDArray) -> bool:
         # a symmetry maps the parts' vertices and centroids onto themselves (none declared: found or not)
@@ -209,9 +209,11 @@ class Mesh(Shape):
         d = np.broadcast_to(np.asarray(direction, dtype=float), o.shape).reshape(-1, 3)
         flat = np.ascontiguousarray(o.reshape(-1, 3))
         t, normal, face = np.full(len(flat), np.inf), np.zeros((len(flat), 3)), np.full(len(flat), -1, np.int64)
-        for u in np.unique(d, axis=0):  # one direction (a picture's) in practice
-            rows = np.flatnonzero((d == u).all(axis=1))
-            t[rows], normal[rows], face[rows] = ray_parts(flat[rows], np.ascontiguousarray(u), self._params,
+        groups: dict[bytes, list[int]] = {}  # rows by direction: one (a picture's) or a few (closure's probes)
+        for i, u in enumerate(d):
+            groups.setdefault(u.tobytes(), []).append(i)
+        for rows in groups.values():
+            t[rows], normal[rows], face[rows] = ray_parts(flat[rows], np.ascontiguousarray(d[rows[0]]), self._params,
                                                           self.geometry.region)
         return t.reshape(o.shape[:-1]), normal.reshape(o.shape), face.reshape(o.shape[:-1])
 
