@@ -186,8 +186,8 @@ def optimise_grasps(
         if mech.rank_G < 6 or mech.projector is None:
             out["status"][rows] = "rank_deficient"
             continue
-        problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, synergies, params.f_min_N, cone,
-                             params.basis_rtol, mech.frames)
+        problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, synergies, params.f_min_N,
+                             cone, params.basis_rtol, mech.frames)
         sol = solve_gfo(problems, method, strict_shrink=params.strict_shrink if strict else None, tol=params.tol,
                         max_iter=params.max_iter, ipm=ipm)
         out["status"][rows], out["force_norm"][rows], out["e_s"][rows] = sol.status, sol.force_norm, sol.e_s
