@@ -76,3 +76,44 @@ def test_the_hand_encloses_its_palm_not_points_far_in_front_or_beside_it():
     assert caps.encloses(open_q, palm)
     assert not caps.encloses(open_q, palm + [60.0 + caps.palm_half[0][0], 0.0, 0.0])
     assert not caps.encloses(open_q, palm + [0.0, -100.0 - caps.palm_half[0][1], 0.0])
+
+
+def test_posture_gaps_skips_only_distances_the_closure_masks(hand, synergies):
+    """The closure's per-posture query leaves +inf for a link that does not move and for one
+    surely beyond the query margin (its axis farther from the object's centre than the margin,
+    both radii and the object's bounding ball); every other distance is the scene's own, to
+    the last bit. Checked at postures along S1 and object poses near and far from the hand."""
+    from pathlib import Path
+
+    from scipy.spatial.transform import Rotation
+
+    from synergrasp.hand.synergies import SynergyPath
+    from synergrasp.simulation.capsules import posture_gaps
+    from synergrasp.simulation.placement import ObjectPose
+    from synergrasp.simulation.scene import HandScene
+    from synergrasp.simulation.shapes import Mesh
+
+    mesh = Mesh(str(Path(__file__).parent / "data" / "box_30x60x100.obj"), 0.5)
+    scene = HandScene(hand)
+    path = SynergyPath.along(synergies, hand.lower, hand.upper)
+    pairs = ((1, 2),)
+    rng = np.random.default_rng(3)
+    margin, skipped, kept = 40.0, 0, 0
+    for sigma in np.linspace(*path.closure_range(hand.flexion_joints), 4):
+        q = np.array(path.reference(sigma), dtype=float)
+        for centre in ([60.0, 0.0, 80.0], [45.0, 20.0, 120.0], [150.0, 0.0, 60.0], [30.0, -40.0, 40.0]):
+            scene.set_posture(q)
+            scene.place_object(ObjectPose(np.array(centre), Rotation.random(random_state=rng).as_matrix(), mesh))
+            every = scene.object_distance()  # every link's distance, nothing skipped
+            moving = rng.random(hand.n_links) < 0.7
+            d_obj, _, _ = posture_gaps(q, *scene.query_args(), *scene.pair_args(pairs), moving, margin)
+            for link in scene.capsules.links:
+                if not moving[link]:
+                    assert d_obj[link] == np.inf
+                elif d_obj[link] == np.inf:  # skipped by the bound: surely beyond the margin
+                    assert every[link] > margin
+                    skipped += 1
+                else:
+                    assert d_obj[link] == every[link]
+                    kept += 1
+    assert skipped > 0 and kept > 0  # both branches ran

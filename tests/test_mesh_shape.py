@@ -323,3 +323,36 @@ def test_fig2_draws_a_mesh(hand, synergies, tmp_path, monkeypatch):
         figure_example_grasps(hand, [duck], [table], tmp_path / f"f{run}.png", tmp_path / f"f{run}.pdf", n_grasps=2)
     first = (tmp_path / "fa.png").read_bytes()
     assert len(first) > 10_000 and first == (tmp_path / "fb.png").read_bytes()
+
+
+def test_a_meshs_gap_to_a_box_is_the_least_over_its_parts(tmp_path, monkeypatch):
+    """One compiled call over the parts (``polytope_axes.parts_box_gap``) is the part-by-part
+    least of the GJK distance, or minus the overlap where they touch, to the last bit; the
+    palm's box apart, overlapping and touching."""
+    from synergrasp.simulation.shapes.box import box_edges
+    from synergrasp.simulation.shapes.polytope import convex_distance
+    from synergrasp.simulation.shapes.polytope_axes import part_box_overlap
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    mesh = Mesh(str(_l_shape(tmp_path, "l.obj", 60.0)), 1.0)
+    assert len(mesh.geometry.parts) >= 2
+    rng = np.random.default_rng(11)
+    half = np.array([6.0, 25.0, 15.0])
+    outcomes = set()
+    for _ in range(60):
+        R = Rotation.random(random_state=rng).as_matrix()
+        box = np.eye(4)
+        box[:3, :3], box[:3, 3] = Rotation.random(random_state=rng).as_matrix(), rng.uniform(-45, 45, 3)
+        corners = np.unique(np.vstack(box_edges(box, half)), axis=0)
+        local = np.ascontiguousarray(corners @ R)  # the mesh at the origin, turned by R
+        best, point = np.inf, np.zeros(3)
+        for k in range(len(mesh.geometry.parts)):
+            d, a, b, touching = convex_distance(mesh._params, k, local)
+            if touching:
+                d = part_box_overlap(mesh._params, k, local, np.ascontiguousarray(box[:3, :3].T @ R))
+            if d < best:
+                best, point = d, R @ (0.5 * (a + b))
+        got, at = mesh.box_gap(R, np.zeros(3), box, half)
+        assert got == best and np.array_equal(at, point)
+        outcomes.add(bool(got > 0))
+    assert outcomes == {True, False}

@@ -176,3 +176,23 @@ def test_gfo_table_solves_one_grasp_once_whatever_the_shards(monkeypatch):
     np.testing.assert_array_equal(whole["status"].to_numpy(), alone["status"])
     np.testing.assert_array_equal(whole["force_closure_def1"].to_numpy(), alone["force_closure_def1"])
     np.testing.assert_allclose(whole["force_norm"].to_numpy(), alone["force_norm"], rtol=1e-6)
+
+
+def test_mechanics_kept_by_the_caller_give_the_same_results_bit_for_bit():
+    """The planner keeps each grasp's mechanics (and contact frames) across the sets it solves
+    in turn: a solve with them is the solve without them, to the last bit; a list of the
+    wrong length is refused."""
+    rng = np.random.default_rng(5)
+    grasps = [random_grasp(rng, int(rng.integers(3, 10)), palm_contacts=int(rng.integers(0, 2))) for _ in range(4)]
+    grasps.insert(1, None)
+    kept = [None if g is None else mechanics_for(g, PARAMS) for g in grasps]
+    synergies = random_synergies(rng)
+    for sets in (((1,),), ((1, 2, 3),), ((1, 2), (1, 2, 3, 4, 5))):  # one set at a time, as the planner asks
+        chosen = SynergySets(synergies, sets)
+        fresh = optimise_grasps(grasps, chosen, PARAMS)
+        again = optimise_grasps(grasps, chosen, PARAMS, mechanics=kept)
+        assert fresh.keys() == again.keys()
+        for name in fresh:
+            np.testing.assert_array_equal(again[name], fresh[name], err_msg=name)
+    with pytest.raises(ValueError, match="mechanics: one per grasp"):
+        optimise_grasps(grasps, SynergySets(synergies, ((1,),)), PARAMS, mechanics=kept[:2])

@@ -86,6 +86,13 @@ SECTIONS = (
      "`benchmarks/bench_search.py` (in `make bench`): the default study's search of each object with 2 "
      "processes; the target is at most 30 s wall per object on 2 quiet cores (the study's own searches: "
      "`search` in the jobs table above)."),
+    ("One random object", ("object_cost",),
+     "`benchmarks/bench_object.py` (not in `make bench`: a few minutes): three random mesh objects of "
+     "`config/examples/random_objects.yaml` (`n_objects: 3`, seed 2018) each through the placement search (one "
+     "process), the closure at its target, the optimisation of every (pose, set) and the planner, in one process: "
+     "CPU s per step (`time.process_time`); it prints a digest of each step's table, the same before and after a "
+     "change that keeps the results (docs/random_objects.md). Before the closure's query and the planner's solver "
+     "were made cheaper: `object_cost_history.csv` below."),
     ("Snakemake's own cost", ("scheduler",),
      "`benchmarks/bench_scheduler.py` (in `make bench`): the CPU time of Snakemake's own process (the jobs "
      "excluded) per job, on the small sweep from an empty directory with -j2 and the workflow profile "
@@ -95,7 +102,7 @@ SECTIONS = (
      "its script's imports in a fresh interpreter (start-up subtracted, median of 3) against its jobs' CPU time "
      "in the last study's benchmark files."),
     ("Measured while the software was built", ("closure_history", "dynamic_closure_history", "solver_history",
-                                               "parts_history", "job_resources"),
+                                               "parts_history", "object_cost_history", "job_resources"),
      "The figures behind design decisions that the pages of docs/ describe, each measured once when the decision "
      "was made and recorded by hand (the note names the page; `make bench` does not rerun them): they compare the "
      "alternatives of their day, not what the software costs today (the sections above)."),

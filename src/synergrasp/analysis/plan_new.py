@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from synergrasp.analysis.plan_study import PlanParams, StudySolver
 from synergrasp.analysis.planners import CANDIDATES, Oracle, PlannerSpec, PoseGrid, run_planner
-from synergrasp.optimisation.mechanics import first_same_grasp, read_grasps
+from synergrasp.optimisation.mechanics import GraspMechanics, first_same_grasp, read_grasps
 
 __all__ = ["DEFAULT_PLANNER", "planner_spec", "OnDemandSolver", "OnDemandPlan", "plan_on_demand"]
 
@@ -53,6 +53,7 @@ class OnDemandSolver(StudySolver):
         self.first = np.full(n_poses, -1, dtype=np.int64)
         self.matrix, self.params = matrix, params
         self.memo: dict[tuple[str, int], tuple[bool, float]] = {}
+        self.mechanics: dict[int, GraspMechanics] = {}
         self.n_problems = 0
         self.close = close
         self.is_closed = np.zeros(n_poses, dtype=bool)

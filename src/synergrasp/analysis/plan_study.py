@@ -23,9 +23,9 @@ from synergrasp.analysis.planner import Plan, greedy_order, plan_against_exhaust
 from synergrasp.analysis.planners import CANDIDATES, Oracle, PlannerSpec, PoseGrid, ReplayOracle, compare_planners
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.ids import incremental_set_id, set_id
-from synergrasp.optimisation.mechanics import first_same_grasp, read_grasps
+from synergrasp.optimisation.mechanics import GraspMechanics, first_same_grasp, read_grasps
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.optimise import GFOParams, optimise_grasps
+from synergrasp.optimisation.optimise import GFOParams, mechanics_for, optimise_grasps
 
 __all__ = ["PlanParams", "ObjectPlan", "StudySolver", "plan_object", "PlannersParams", "replay_oracle", "compare_on_study"]
 
@@ -66,9 +66,10 @@ class ObjectPlan:
 class StudySolver(Oracle):
     """Solves synergy sets at poses of one object through `optimise_grasps`, one solve per
     distinct grasp (the study's sharing of twins), and remembers them: a (grasp, set) is
-    solved once however many radii ask. ``n_problems`` counts the problems handed to the
-    solver; as an :class:`~synergrasp.analysis.planners.Oracle` (``solver(k, poses)``: a
-    planner's solve of {S1..Sk}) it also keeps the planners' cost ledger."""
+    solved once however many radii ask, and a grasp's mechanics (what does not depend on
+    the set) are computed once however many sets it is solved for. ``n_problems`` counts the
+    problems handed to the solver; as an :class:`~synergrasp.analysis.planners.Oracle`
+    (``solver(k, poses)``: a planner's solve of {S1..Sk}) it also keeps the planners' cost ledger."""
 
     def __init__(self, contacts: pd.DataFrame, matrix: NDArray, params: PlanParams):
         super().__init__(len(contacts), params.n_levels)
@@ -79,6 +80,7 @@ class StudySolver(Oracle):
         self.first = first_same_grasp(self.grasps)
         self.matrix, self.params = matrix, params
         self.memo: dict[tuple[str, int], tuple[bool, float]] = {}
+        self.mechanics: dict[int, GraspMechanics] = {}
         self.n_problems = 0
 
     def verdicts(self, sets: Sequence[tuple[int, ...]], poses: NDArray[np.int64]) -> tuple[NDArray, NDArray]:
@@ -100,7 +102,11 @@ class StudySolver(Oracle):
         return success, force
 
     def _solve(self, sets: Sequence[tuple[int, ...]], ids: list[str], grasps: list[int]) -> None:
-        out = optimise_grasps([self.grasps[g] for g in grasps], SynergySets(self.matrix, tuple(sets)), self.params.gfo)
+        for g in grasps:
+            if g not in self.mechanics:
+                self.mechanics[g] = mechanics_for(self.grasps[g], self.params.gfo)
+        out = optimise_grasps([self.grasps[g] for g in grasps], SynergySets(self.matrix, tuple(sets)), self.params.gfo,
+                              mechanics=[self.mechanics[g] for g in grasps])
         self.n_problems += len(grasps) * len(sets)
         frame = pd.DataFrame({"object": self.object_name, "pose": self.pose_ids[np.repeat(grasps, len(sets))]} | out)
         minima = self.params.minima

@@ -149,7 +149,8 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
     P, S = g.projector, g.synergies
     thresholds = g.basis_rtol * g.response_norm * S.norms
     strict = shrink is not None
-    res = ipm_solver.solve_sets(P @ S.matrix, g.f_p, contact_frames(g.normals), S.table, S.sizes, thresholds,
+    frames = contact_frames(g.normals) if g.frames is None else g.frames
+    res = ipm_solver.solve_sets(P @ S.matrix, g.f_p, frames, S.table, S.sizes, thresholds,
                                 ipm_solver.Nesting(S.parent, S.within, S.order), g.cone,
                                 g.cone.narrowed(shrink) if strict else None, g.f_min, ipm, ALMOST_SOLVED_TOL)
     n = len(g)

@@ -9,12 +9,15 @@ components. The wrench reference point is the object centre o.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import LinAlgError, lapack
 from numpy.typing import NDArray
+
+from synergrasp.hand.kinematics import cross_rows
 
 __all__ = [
     "Grasp",
@@ -132,18 +135,20 @@ def read_grasps(table) -> list[Grasp | None]:
     if missing:
         raise ValueError(f"contacts table: missing column(s) {missing}")
     grasps: list[Grasp | None] = []
-    for row in table.itertuples(index=False):
-        m = int(row.n_contacts)
-        if row.status != "grasp" or m == 0:
+    columns = (table[c] for c in ("status", "n_contacts", "contact_point", "contact_normal", "contact_link",
+                                  "jacobian", "object_center"))
+    for status, n_contacts, points, normals, links, jacobian, center in zip(*columns):
+        m = int(n_contacts)
+        if status != "grasp" or m == 0:
             grasps.append(None)
             continue
-        jac = np.asarray(row.jacobian, dtype=float)
+        jac = np.asarray(jacobian, dtype=float)
         grasps.append(Grasp(
-            points=np.asarray(row.contact_point, dtype=float).reshape(m, 3),
-            normals=np.asarray(row.contact_normal, dtype=float).reshape(m, 3),
-            links=np.asarray(row.contact_link, dtype=np.int64),
+            points=np.asarray(points, dtype=float).reshape(m, 3),
+            normals=np.asarray(normals, dtype=float).reshape(m, 3),
+            links=np.asarray(links, dtype=np.int64),
             jacobian=jac.reshape(3 * m, jac.size // (3 * m)),
-            center=np.asarray(row.object_center, dtype=float),
+            center=np.asarray(center, dtype=float),
         ))
     return grasps
 
@@ -270,6 +275,8 @@ class GraspMechanics:
     KJ:         (c, n) K J, N/rad (the contact-force response to joint motion)
     response_norm: ||K J||_2, N/rad: the scale of the rank decision of E_s
                 (`internal_force_basis`)
+    frames:     (m, 3, 3) the contact frames of the normals (`contact_frames`), computed
+                when first read
     """
 
     G: NDArray
@@ -287,6 +294,10 @@ class GraspMechanics:
     @property
     def n_contacts(self) -> int:
         return int(self.normals.shape[0])
+
+    @functools.cached_property
+    def frames(self) -> NDArray:
+        return contact_frames(self.normals)
 
 
 def grasp_mechanics(
@@ -375,17 +386,8 @@ def contact_frames(normals: NDArray) -> NDArray:
     n = _unit_normals(normals, None, "normals")
     axis = np.zeros_like(n)
     axis[np.arange(n.shape[0]), np.argmin(np.abs(n), axis=1)] = 1.0
-    t1 = _cross(n, axis)
+    t1 = cross_rows(n, axis)
     t1 /= _row_norms(t1)[:, None]
-    t2 = _cross(n, t1)
+    t2 = cross_rows(n, t1)
     return np.stack([n, t1, t2], axis=1)
 
-
-def _cross(a: NDArray, b: NDArray) -> NDArray:
-    """Row-wise a x b of (m, 3) arrays: the products and differences of np.cross, without
-    its axis handling (which cost more than the arithmetic for a grasp's few contacts)."""
-    out = np.empty_like(a)
-    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
-    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
-    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    return out

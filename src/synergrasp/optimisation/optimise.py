@@ -145,6 +145,7 @@ def optimise_grasps(
     strict: bool = True,
     forces: bool = False,
     ipm: IPMSettings = IPMSettings(),
+    mechanics: Sequence[GraspMechanics | None] | None = None,
 ) -> dict[str, NDArray]:
     """GFO verdict, optimal force and strict internal-force test of every (grasp, set).
 
@@ -156,8 +157,13 @@ def optimise_grasps(
     test), force_norm (N), e_s,
     rank_G, n_contacts, iterations, solver; with forces=True also ``forces``, each row's optimal
     contact forces (3m,) N (None unless load-feasible; the one-grasp inspector reads them).
+    mechanics: each grasp's ``mechanics_for(grasp, params)`` (None where the grasp is None),
+    when the caller keeps them (a caller that solves one grasp for many sets in turn, the
+    planner); by default computed here.
     """
     n_sets, n_poses = len(synergies), len(grasps)
+    if mechanics is not None and len(mechanics) != n_poses:
+        raise ValueError(f"mechanics: one per grasp ({n_poses}), got {len(mechanics)}")
     total = n_sets * n_poses
     out = {
         "set_id": np.array([set_id(s) for s in synergies.sets] * n_poses, dtype=object),
@@ -180,14 +186,14 @@ def optimise_grasps(
         if grasp is None or grasp.n_contacts == 0:
             continue
         rows = slice(p * n_sets, (p + 1) * n_sets)
-        mech = mechanics_for(grasp, params)
+        mech = mechanics_for(grasp, params) if mechanics is None else mechanics[p]
         out["rank_G"][rows] = mech.rank_G
         out["n_contacts"][rows] = mech.n_contacts
         if mech.rank_G < 6 or mech.projector is None:
             out["status"][rows] = RANK_DEFICIENT
             continue
-        problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, synergies, params.f_min_N, cone,
-                             params.basis_rtol)
+        problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, synergies, params.f_min_N,
+                             cone, params.basis_rtol, mech.frames)
         sol = solve_gfo(problems, method, strict_shrink=params.strict_shrink if strict else None, tol=params.tol,
                         max_iter=params.max_iter, ipm=ipm)
         out["status"][rows], out["force_norm"][rows], out["e_s"][rows] = sol.status, sol.force_norm, sol.e_s

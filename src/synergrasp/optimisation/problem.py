@@ -173,7 +173,9 @@ class GraspSets:
     f_p: (c,) particular forces, N; normals: (m, 3); projector: (c, n) internal-force
     projector (I - G_K^R G) K J, N/rad; response_norm: ||K J||_2, N/rad; synergies: the
     sets; f_min: N; cone: friction model; basis_rtol: rank rule of E_s (singular values of
-    projector S_set above basis_rtol ||K J||_2 ||S_set||_2, as `mechanics.internal_force_basis`).
+    projector S_set above basis_rtol ||K J||_2 ||S_set||_2, as `mechanics.internal_force_basis`);
+    frames: the contact frames of the normals (`mechanics.contact_frames`) when the caller
+    has them (`GraspMechanics.frames`), None: computed by the solver.
     """
 
     f_p: NDArray
@@ -184,6 +186,7 @@ class GraspSets:
     f_min: float
     cone: FrictionCone
     basis_rtol: float = BASIS_RTOL
+    frames: NDArray | None = None
 
     def __len__(self) -> int:
         return len(self.synergies)

@@ -192,22 +192,50 @@ def nearest_per_link(gaps: NDArray, ends: NDArray, n_links: int) -> tuple[NDArra
     return d, partner
 
 
+#: Slack (mm) of the bound below which a capsule's distance to the object is computed
+#: (``_beyond``): far above the bound's round-off (~1e-13 mm), so a skipped capsule is surely
+#: beyond the margin.
+_BOUND_SLACK_MM = 1e-6
+
+
+@jit
+def _beyond(p0: NDArray, p1: NDArray, radius: float, centre: NDArray, bound_mm: float, margin_mm: float) -> bool:
+    """Whether the capsule p0–p1 (palm frame) of ``radius`` is surely farther than
+    ``margin_mm`` from an object held in the ball of radius ``bound_mm`` about ``centre``:
+    its axis's distance to the centre, less both radii, exceeds the margin (a lower bound of
+    the signed distance; inside, it is at most 0)."""
+    dx, dy, dz = p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]
+    wx, wy, wz = centre[0] - p0[0], centre[1] - p0[1], centre[2] - p0[2]
+    dd = dx * dx + dy * dy + dz * dz
+    t = 0.0 if dd <= _EPS else min(max((wx * dx + wy * dy + wz * dz) / dd, 0.0), 1.0)
+    ex, ey, ez = wx - t * dx, wy - t * dy, wz - t * dz
+    return np.sqrt(ex * ex + ey * ey + ez * ez) - bound_mm - radius > margin_mm + _BOUND_SLACK_MM
+
+
 @jit
 def posture_gaps(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: NDArray, scale: NDArray,
                  cap_frame: NDArray, ends: NDArray, radius: NDArray, cap_link: NDArray, palm_gap: float,
-                 object_rotation: NDArray, object_centre: NDArray, code: int, params: NDArray, first: NDArray,
-                 second: NDArray,
+                 object_rotation: NDArray, object_centre: NDArray, code: int, params: NDArray, bound_mm: float,
+                 first: NDArray, second: NDArray,
                  pair_ends: NDArray, palm_rotation: NDArray, palm_centre: NDArray, palm_half: NDArray,
-                 n_links: int) -> tuple[NDArray, NDArray, NDArray]:
+                 n_links: int, moving_links: NDArray, margin_mm: float) -> tuple[NDArray, NDArray, NDArray]:
     """Everything the closure asks at one posture q (rad), in one call: per link the signed
     distance to the object (the palm's, ``palm_gap``, does not change with q), the distance to
-    the nearest link it is paired with and that link (mm; see ``pair_gaps``)."""
+    the nearest link it is paired with and that link (mm; see ``pair_gaps``).
+
+    Only what the closure reads is computed: a link that does not move (``moving_links``
+    False) or that is surely farther than ``margin_mm`` from the object (``_beyond``, the
+    object in the ball of radius ``bound_mm`` about its centre) gets +inf, as the closure's
+    mask would give it; every other distance is ``capsule_object``'s to the last bit."""
     p0, p1 = _segments(_frames(q, parent, offset, axis, joint, scale), cap_frame, ends)
     d_obj = np.full(n_links, np.inf)
     d_obj[0] = palm_gap
-    dist, _ = capsule_object(p0, p1, radius, object_rotation, object_centre, code, params)
+    work = np.empty((3, WORK))
     for i in range(cap_link.shape[0]):
-        d_obj[cap_link[i]] = dist[i]
+        if not moving_links[cap_link[i]] or _beyond(p0[i], p1[i], radius[i], object_centre, bound_mm, margin_mm):
+            continue
+        d, _ = _capsule_to_object(p0[i], p1[i], object_rotation, object_centre, code, params, work)
+        d_obj[cap_link[i]] = d - radius[i]
     gaps = pair_gaps(p0, p1, radius, first, second, palm_rotation, palm_centre, palm_half)
     d_self, partner = nearest_per_link(gaps, pair_ends, n_links)
     return d_obj, d_self, partner

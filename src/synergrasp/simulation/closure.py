@@ -166,13 +166,18 @@ class _RegionResults:
     def __init__(self, shape: Shape) -> None:
         self.shape = shape
         self.buckets: dict[tuple[float, ...], list[tuple[ObjectPose, ClosureResult]]] = {}
+        self._last: tuple[ObjectPose, tuple[float, ...]] | None = None  # the last pose keyed (get, then add)
 
     def _key(self, placed: ObjectPose) -> tuple[float, ...]:
+        if self._last is not None and self._last[0] is placed:
+            return self._last[1]
         center, rotation = np.asarray(placed.center_mm, dtype=float), np.asarray(placed.rotation, dtype=float)
         reach = 2.0 * self.shape.bounding_radius_mm
         # rays from outside toward the centre, in the shape's own frame (Rᵀ v = v R)
         t, _, _ = self.shape.ray_hits((reach * _PROBES) @ rotation, -_PROBES @ rotation)
-        return tuple(np.round(np.concatenate([center, t]), 6).tolist())
+        key = tuple(np.round(np.concatenate([center, t]), 6).tolist())
+        self._last = (placed, key)
+        return key
 
     def _fill_alike(self, a: ObjectPose, b: ObjectPose) -> bool:
         return self.shape.same_region(a.rotation, a.center_mm, b.rotation, b.center_mm)

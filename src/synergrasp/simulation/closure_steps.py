@@ -99,12 +99,12 @@ def _gaps(sigma: float, held: NDArray, q_held: NDArray, path: tuple, scene: tupl
     ``margin_mm`` (+inf for the others; ``KinematicClosure.gaps``)."""
     mean, direction, lower, upper = path
     (parent, offset, axis, joint, scale, cap_frame, ends, radius, cap_link, palm_gap, rotation, centre, code,
-     params) = scene
+     params, bound) = scene
     first, second, pair_ends, palm_rotation, palm_centre, palm_half, n_links = pair_rows
     q = _posture(sigma, held, q_held, mean, direction, lower, upper)
     d_obj, d_self, partner = posture_gaps(q, parent, offset, axis, joint, scale, cap_frame, ends, radius, cap_link,
-                                          palm_gap, rotation, centre, code, params, first, second, pair_ends,
-                                          palm_rotation, palm_centre, palm_half, n_links)
+                                          palm_gap, rotation, centre, code, params, bound, first, second, pair_ends,
+                                          palm_rotation, palm_centre, palm_half, n_links, moving_links, margin_mm)
     _masked(d_obj, moving_links, margin_mm)
     _masked(d_self, moving_links, margin_mm)
     return q, d_obj, d_self, partner

@@ -66,6 +66,7 @@ class KinematicClosure:
         self._profile_arrays: dict[bytes, tuple[NDArray, NDArray, NDArray]] = {}
         self.q_open = self.reference(self.sigma_open)
         self.self_pairs = self._monitored_pairs()
+        self._chain: tuple[NDArray, NDArray, NDArray] | None = None  # made by the first ``_moving``
         self.finger_link_mask = np.zeros((len(self.fingers), hand.n_links), dtype=bool)
         for f, (_, links) in enumerate(self.fingers):
             self.finger_link_mask[f, list(links)] = True
@@ -224,11 +225,16 @@ class KinematicClosure:
 
     def _moving(self, state: _HoldState) -> tuple[NDArray, tuple[tuple[int, int], ...]]:
         """Links that still move (their own joint is not held) and the monitored pairs with one."""
+        if self._chain is None:  # each finger link with its own joint, and the pairs' ends, as arrays
+            links = [link for _, chain in self.fingers for link in chain]
+            joints = [joints[i] for joints, chain in self.fingers for i in range(len(chain))]
+            ends = np.asarray(self.self_pairs, dtype=np.int64).reshape(-1, 2)
+            self._chain = (np.asarray(links, dtype=np.int64), np.asarray(joints, dtype=np.int64), ends)
+        links, joints, ends = self._chain
         mv = np.zeros(self.hand.n_links, dtype=bool)
-        for joints, links in self.fingers:
-            for i, link in enumerate(links):
-                mv[link] = not state.held[joints[i]]
-        return mv, tuple(pr for pr in self.self_pairs if mv[pr[0]] or mv[pr[1]])
+        mv[links] = ~state.held[joints]
+        keep = (mv[ends[:, 0]] | mv[ends[:, 1]]).tolist()
+        return mv, tuple(pr for pr, k in zip(self.self_pairs, keep) if k)
 
 
 @dataclass

@@ -36,6 +36,7 @@ class HandScene:
         self._row[self.capsules.links] = np.arange(len(self.capsules.links))
         self._tree = self.capsules.tree
         self._pair_cache: dict[tuple[tuple[int, int], ...], tuple[NDArray, NDArray, NDArray]] = {}
+        self._boxes: list[tuple[NDArray, NDArray]] | None = None
         self.placed: ObjectPose | None = None
         self._palm_gap = (np.inf, np.zeros(3))  # palm–object distance (mm) and a closest point
         self.set_posture(np.clip(np.zeros(hand.n_joints), hand.lower, hand.upper))
@@ -64,12 +65,16 @@ class HandScene:
         self._palm_gap = best
 
     def _palm_boxes(self) -> list[tuple[NDArray, NDArray]]:
-        poses = []
-        for rotation, centre, half in zip(self.capsules.palm_rotation, self.capsules.palm_centre, self.capsules.palm_half):
-            pose = np.eye(4)
-            pose[:3, :3], pose[:3, 3] = rotation, centre
-            poses.append((pose, half))
-        return poses
+        """The palm's boxes: (4 × 4 pose, half extents mm) each, made once per scene."""
+        if self._boxes is None:
+            self._boxes = []
+            for rotation, centre, half in zip(self.capsules.palm_rotation, self.capsules.palm_centre,
+                                              self.capsules.palm_half):
+                pose = np.eye(4)
+                pose[:3, :3], pose[:3, 3] = rotation, centre
+                pose.setflags(write=False)
+                self._boxes.append((pose, half))
+        return self._boxes
 
     def _palm_patch_centre(self, contact_distance_mm: float) -> NDArray:
         """The middle of the palm–object contact patch: the mean of the sample points (of a
@@ -183,10 +188,12 @@ class HandScene:
         """The arguments of ``capsules.posture_gaps`` (per link the gaps to the object and to the
         monitored hand links at a posture q: the kinematic closure's query, made by
         ``closure_steps.march``) after q and before the pairs: the hand's frame tree and
-        capsules, the palm's gap to the object (mm) and the placed object."""
+        capsules, the palm's gap to the object (mm) and the placed object with the radius of a
+        ball about its centre that holds it (mm)."""
         c, placed = self.capsules, self.placed
         return (*self._tree, c.frame, c.ends, c.radius, c.links, float(self._palm_gap[0]), placed.rotation,
-                placed.center_mm, placed.shape.kernel_code, placed.shape.kernel_params)
+                placed.center_mm, placed.shape.kernel_code, placed.shape.kernel_params,
+                float(placed.shape.bounding_radius_mm))
 
     def pair_args(self, pairs: tuple[tuple[int, int], ...]) -> tuple:
         """The arguments of ``capsules.posture_gaps`` from the pairs on: the monitored pairs'

@@ -142,6 +142,7 @@ class Mesh(Shape):
         object.__setattr__(self, "_file_radius_mm", scale * float(np.linalg.norm(mesh.vertices - mesh.centroid,
                                                                                  axis=1).max()))
         object.__setattr__(self, "_faces", {})  # (part, plane) -> its face polygon packed (normals_near)
+        object.__setattr__(self, "_corners", {})  # a box's (pose, half extents) -> its corners (box_gap)
 
     @functools.cached_property
     def geometry(self) -> MeshGeometry:
@@ -161,6 +162,10 @@ class Mesh(Shape):
         return self.geometry.vertices
 
     @functools.cached_property
+    def _radius(self) -> float:
+        return float(np.linalg.norm(self._every, axis=1).max())
+
+    @functools.cached_property
     def _hull(self) -> NDArray:
         from scipy.spatial import ConvexHull
 
@@ -174,7 +179,7 @@ class Mesh(Shape):
 
     @property
     def bounding_radius_mm(self) -> float:
-        return float(np.linalg.norm(self._every, axis=1).max())
+        return self._radius
 
     @property
     def across_mm(self) -> float:
@@ -220,19 +225,17 @@ class Mesh(Shape):
         return out
 
     def box_gap(self, rotation: NDArray, center: NDArray, box_pose: NDArray, box_half: NDArray) -> tuple[float, NDArray]:
-        from synergrasp.simulation.shapes.polytope import convex_distance
-        from synergrasp.simulation.shapes.polytope_axes import part_box_overlap
+        from synergrasp.simulation.shapes.polytope_axes import parts_box_gap
 
-        corners = np.unique(np.vstack(box_edges(box_pose, box_half)), axis=0)
+        key = (box_pose.tobytes(), np.asarray(box_half).tobytes())
+        corners = self._corners.get(key)
+        if corners is None:  # the box's corners, once per box (the palm's boxes do not move)
+            corners = self._corners[key] = np.unique(np.vstack(box_edges(box_pose, box_half)), axis=0)
         local = np.ascontiguousarray((corners - center) @ rotation)
-        best, point = np.inf, np.asarray(center, dtype=float).copy()
-        for k in range(len(self.geometry.parts)):
-            d, a, b, touching = convex_distance(self._params, k, local)
-            if touching:
-                d = part_box_overlap(self._params, k, local, np.ascontiguousarray(box_pose[:3, :3].T @ rotation))
-            if d < best:
-                best, point = d, rotation @ (0.5 * (a + b)) + center
-        return float(best), point
+        best, a, b = parts_box_gap(self._params, local, np.ascontiguousarray(box_pose[:3, :3].T @ rotation))
+        if not best < np.inf:
+            return float(best), np.asarray(center, dtype=float).copy()
+        return float(best), rotation @ (0.5 * (a + b)) + center
 
     def same_region(self, rotation_a: NDArray, center_a: NDArray, rotation_b: NDArray, center_b: NDArray) -> bool:
         # a symmetry maps the parts' vertices and centroids onto themselves (none declared: found or not)
@@ -252,9 +255,11 @@ class Mesh(Shape):
         d = np.broadcast_to(np.asarray(direction, dtype=float), o.shape).reshape(-1, 3)
         flat = np.ascontiguousarray(o.reshape(-1, 3))
         t, normal, face = np.full(len(flat), np.inf), np.zeros((len(flat), 3)), np.full(len(flat), -1, np.int64)
-        for u in np.unique(d, axis=0):  # one direction (a picture's) in practice
-            rows = np.flatnonzero((d == u).all(axis=1))
-            t[rows], normal[rows], face[rows] = ray_parts(flat[rows], np.ascontiguousarray(u), self._params,
+        groups: dict[bytes, list[int]] = {}  # rows by direction: one (a picture's) or a few (closure's probes)
+        for i, u in enumerate(d):
+            groups.setdefault(u.tobytes(), []).append(i)
+        for rows in groups.values():
+            t[rows], normal[rows], face[rows] = ray_parts(flat[rows], np.ascontiguousarray(d[rows[0]]), self._params,
                                                           self.geometry.region)
         return t.reshape(o.shape[:-1]), normal.reshape(o.shape), face.reshape(o.shape[:-1])
 

@@ -9,9 +9,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from synergrasp.simulation.shapes.compiled import jit
-from synergrasp.simulation.shapes.polytope import _HEADER, _d3, _part, _support
+from synergrasp.simulation.shapes.polytope import _HEADER, _d3, _part, _support, convex_distance
 
-__all__ = ["part_box_overlap", "ray_parts"]
+__all__ = ["part_box_overlap", "parts_box_gap", "ray_parts"]
 
 
 @jit
@@ -80,6 +80,23 @@ def part_box_overlap(params: NDArray, part: int, corners: NDArray, box_axes: NDA
                 if x * x + y * y + z * z > 1e-18 * length * length:
                     best = max(best, _separation(params, part, corners, i, x, y, z))
     return min(best, 0.0)
+
+
+@jit
+def parts_box_gap(params: NDArray, corners: NDArray, box_axes: NDArray) -> tuple[float, NDArray, NDArray]:
+    """Signed distance (mm) between the union of parts and a box (``corners`` (8, 3),
+    ``box_axes`` (3, 3) rows, own frame): the least over the parts of the GJK distance
+    (``convex_distance``), or of minus the penetration depth where they touch
+    (``part_box_overlap``); with the closest points of the nearest part and of the box
+    (the first such part; zeros if there is none)."""
+    best, a, b = np.inf, np.zeros(3), np.zeros(3)
+    for k in range(int(params[0])):
+        d, pa, pb, touching = convex_distance(params, k, corners)
+        if touching:
+            d = part_box_overlap(params, k, corners, box_axes)
+        if d < best:
+            best, a, b = d, pa, pb
+    return best, a, b
 
 
 @jit
