@@ -16,7 +16,7 @@ import pandas as pd
 
 from synergrasp.file_output import replacing
 
-__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT", "PLAN", "ENROLLMENT", "BLOCKERS",
+__all__ = ["Column", "Table", "TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS", "PLACEMENT", "HAND_REACH", "PLAN", "ENROLLMENT", "BLOCKERS",
            "QUALITY", "TARGET_CLAIMS", "write", "read", "write_csv", "read_csv", "empty", "write_study_table"]
 
 
@@ -198,6 +198,18 @@ PLACEMENT = Table("placement", "one row per scored target of one object, best fi
     Column("distance_to_chosen_mm", "float64", "mm", "distance to the chosen target"),
 ))
 
+#: What grasps the hand can make (docs/hand_reach.md, ``synergrasp.simulation.reach``): one
+#: row per finger of the hand. Written as CSV and Markdown (results/tables/hand_reach).
+HAND_REACH = Table("hand_reach", "one row per finger", (
+    Column("finger", "string", "", "thumb, index, middle, ring, little"),
+    Column("reach_s1_mm", "float64", "mm", "farthest point along the palm normal of the finger's link surfaces on the free S1 closure path, palm frame"),
+    Column("reach_any_mm", "float64", "mm", "the same over a lattice of every posture within the finger's joint limits"),
+    Column("reach_s1_over_palm_mm", "float64", "mm", "reach_s1_mm less the palm face's position along the normal"),
+    Column("reach_any_over_palm_mm", "float64", "mm", "reach_any_mm less the palm face's position along the normal"),
+    Column("press_mm", "float64", "mm", "d_max of the finger: the thickest slab lying on the palm that one of its links presses toward the palm when the hand closes along S1 with soft adaptation (0: none)"),
+    Column("aperture_mm", "float64", "mm", "largest gap between the thumb's pad and this finger's pad on the free S1 path (NaN for the thumb)"),
+))
+
 #: Quality indices of every pose of one object (docs/quality.md), Parquet
 #: (results/objects/<object>/quality.parquet).
 QUALITY = Table("quality", "one row per pose", _pose_columns() + (
@@ -294,7 +306,7 @@ ENROLLMENT = Table("enrollment", "one row per k", (
     Column("full_n_success", "int32", "", "grid poses where the full set succeeds"),
 ))
 
-TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, QUALITY,
+TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, HAND_REACH, QUALITY,
                                                 TARGET_CLAIMS, BLOCKERS, PLAN, ENROLLMENT)}
 
 
