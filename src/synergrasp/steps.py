@@ -134,7 +134,7 @@ _PNG_PDF = ("png", "pdf")
 #: The keys the placement search reads (and the map of its results).
 STEPS_SEARCH_READS = ("hand", "synergies", "grid", "placement", "closure", "mechanics", "synergy_sets.incremental_max",
                       "objects.{object}.shape", "objects.{object}.mass_kg", "objects.{object}.placement",
-                      "objects.{object}.grasp_type", "grasp_type", "opposition")
+                      "objects.{object}.grasp_type", "grasp_type", "opposition", "hand_reach")
 STEPS_SEARCH_NOT_READS = ("closure.model", "closure.dynamic",
                           *(f"{where}.{key}" for where in ("placement", "objects.{object}.placement")
                             for key in _PLACEMENT_TARGETS))

@@ -196,6 +196,10 @@ PLACEMENT = Table("placement", "one row per scored target of one object, best fi
     Column("median_force_per_weight", "float64", "", "median optimal force over the poses counted by T / weight (inf: none)"),
     Column("median_contacts", "float64", "", "median contacts per scored pose"),
     Column("distance_to_chosen_mm", "float64", "mm", "distance to the chosen target"),
+    Column("stated_type", "string", "", "the object's stated grasp type with its shape class (power-circular, precision-prismatic, ..., any)"),
+    Column("effective_type", "string", "", "the grasp type the chosen target was searched for (version 3's fallback chain)"),
+    Column("type_reason", "string", "", "why the effective type differs from the stated one (each fallback with its numbers), or that the stated type was kept"),
+    Column("region_mm", "string", "mm", "the region of targets at the end of the search, grown where the chosen target lay on its boundary"),
 ))
 
 #: What grasps the hand can make (docs/hand_reach.md, ``synergrasp.simulation.reach``): one
