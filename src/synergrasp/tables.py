@@ -177,6 +177,9 @@ GRASPABLE_OBJECTS = Table("graspable_objects", "one row per object", (
     Column("graspable", "bool", "", "some pose reaches force closure with the full set"),
     Column("reason", "string", "", "why no pose does: every pose dropped, nothing touched, no pose settled, "
            "no force closure with the full set (empty when graspable)"),
+    Column("stated_type", "string", "", "the object's stated grasp type (with its shape class where the placement search read it)"),
+    Column("effective_type", "string", "", "the grasp type its grasps are counted as (the search's effective type, version 3; the stated type without a search)"),
+    Column("type_reason", "string", "", "why the effective type differs from the stated one (the search's reason)"),
 ))
 
 #: The placement search of one object (docs/placement_search.md), written as CSV

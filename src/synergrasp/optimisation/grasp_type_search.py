@@ -28,7 +28,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.simulation.reach import HandReach
     from synergrasp.simulation.shapes import Shape
 
-__all__ = ["FallbackParams", "NEXT_TYPE", "type_label", "search_with_fallback", "search_object_types",
+__all__ = ["FallbackParams", "NEXT_TYPE", "type_label", "type_family", "search_with_fallback", "search_object_types",
            "fallback_line", "KEPT"]
 
 #: The fallback chain: the next grasp type tried when one is infeasible or scores no target.
@@ -68,6 +68,12 @@ class FallbackParams:
 def type_label(grasp_type: str, klass: str) -> str:
     """The grasp type with the object's shape class (``power-circular``); ``any`` has none."""
     return grasp_type if grasp_type == "any" else f"{grasp_type}-{klass}"
+
+
+def type_family(label: str) -> str:
+    """The grasp type of a label (``precision-circular`` -> ``precision``; ``any`` -> ``any``):
+    what the opposition rule counts (``opposition.GRASP_TYPES``)."""
+    return label.split("-", 1)[0]
 
 
 def search_with_fallback(stated: str, shape: Shape, reach: HandReach, fallback: FallbackParams,

@@ -12,8 +12,12 @@ Per finger (``hand_reach``):
 - ``reach_any_mm``: the same over every posture within the finger's joint limits (a lattice
   of ``posture_steps`` values per joint, the limits included);
 - ``press_mm`` (d_max of the finger): the largest thickness d of a slab lying on the palm
-  (the palm face's extent across and along the palm, d thick along the palm normal, brought
-  onto the open hand by the placement rule) such that, when the hand closes on it along S1
+  (across the palm from its little-finger edge: the palm's whole width, and as wide as it
+  lies on the palm face itself, shortened in ``length_step_mm`` steps where a link stands
+  out of the face; along the palm
+  from its wrist end to a far end tried at the palm's end and every ``length_step_mm``
+  nearer the wrist; d thick along the palm normal, brought onto the open hand by the
+  placement rule) such that, when the hand closes on it along S1
   with the study's kinematic closure (soft adaptation: a blocked link holds its chain, the
   distal joints go on flexing), one of the finger's links touches it pushing it toward the
   palm (the object's inward normal within ``angle_deg`` of −p, the palm rule's clause of
@@ -62,6 +66,8 @@ class ReachParams:
 
     posture_steps: values per joint of the lattice over the joint limits (reach in any posture)
     step_mm:       thickness step of the slab scan for d_max (mm)
+    length_step_mm: the slab's far end (toward the fingers) is tried at the palm's end and
+                   every this many mm nearer the wrist (mm)
     angle_deg:     a push counts as toward the palm within this angle of −p (deg; the
                    opposition rule's angle)
     """
@@ -69,18 +75,21 @@ class ReachParams:
     posture_steps: int
     step_mm: float
     angle_deg: float
+    length_step_mm: float = 10.0
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any]) -> ReachParams:
         """From a configuration or a step's part of it (``hand_reach``, ``opposition.angle_deg``)."""
         spec = config["hand_reach"]
-        return cls(int(spec["posture_steps"]), float(spec["step_mm"]), float(config["opposition"]["angle_deg"]))
+        return cls(int(spec["posture_steps"]), float(spec["step_mm"]), float(config["opposition"]["angle_deg"]),
+                   float(spec["length_step_mm"]))
 
     def __post_init__(self) -> None:
         if int(self.posture_steps) < 2:
             raise ValueError(f"hand_reach.posture_steps must be >= 2, got {self.posture_steps!r}")
-        if not float(self.step_mm) > 0:
-            raise ValueError(f"hand_reach.step_mm must be > 0, got {self.step_mm!r}")
+        for name in ("step_mm", "length_step_mm"):
+            if not float(getattr(self, name)) > 0:
+                raise ValueError(f"hand_reach.{name} must be > 0, got {getattr(self, name)!r}")
 
 
 @dataclass(frozen=True)
@@ -185,25 +194,40 @@ def _slab_press(hand: Hand, synergies: Synergies, closure: ClosureParams, params
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     centre = palm_centre(hand)
     out = np.zeros(len(hand.finger_links))
+    n_steps = int(math.floor(ceiling_mm / params.step_mm))
+    face = float(np.max(pts @ normal))
+
+    def placed_slab(d: float, y_end: float, z_end: float):
+        slab = Box((d, y_end - float(lo[1]), z_end - float(lo[2])))
+        point = np.array([centre[0], 0.5 * (y_end + float(lo[1])), 0.5 * (z_end + float(lo[2]))]) + 0.5 * d * normal
+        return model.scene.bring_object(slab, np.eye(3), point, normal, model.q_open, 0.0, stop_at_point=True)
+
+    # the palm's whole width, and the widest slab from the palm's little-finger edge that lies on
+    # the palm face itself (not on a link standing out of it, as the SoftHand's thumb knuckle does)
+    y_end = float(hi[1])
+    while (placed_slab(params.step_mm, y_end, float(hi[2])).center_mm @ normal - 0.5 * params.step_mm > face + 0.5
+           and y_end - params.length_step_mm > float(lo[1])):
+        y_end -= params.length_step_mm
+    # the slab's far end (toward the fingers): the palm's end, then every length_step_mm nearer the wrist
+    ends = [float(hi[2]) - k * params.length_step_mm
+            for k in range(int(math.floor((hi[2] - lo[2]) / params.length_step_mm)))]
     try:
-        n_steps = int(math.floor(ceiling_mm / params.step_mm))
-        for k in range(n_steps, 0, -1):  # thickest first: a finger's first success is its d_max
-            d = k * params.step_mm
-            if np.all(out > 0):
-                break
-            # the palm face's extent across and along the palm, d thick along the normal
-            size = (d, float(hi[1] - lo[1]), float(hi[2] - lo[2]))
-            slab = Box(size)
-            placed = model.scene.bring_object(slab, np.eye(3), centre + 0.5 * d * normal, normal, model.q_open,
-                                              0.0, stop_at_point=True)
-            result = model.grasp(placed)
-            if result.status != "grasp":
-                continue
-            toward_palm = np.asarray(result.normals).reshape(-1, 3) @ normal <= -cos + 1e-12
-            for link in np.asarray(result.links)[toward_palm]:
-                f = link_finger[int(link)]
-                if f >= 0 and out[f] == 0:
-                    out[f] = d
+        for y_end, end in itertools.product(sorted({float(hi[1]), y_end}, reverse=True), ends):
+            found = np.zeros(len(hand.finger_links))
+            for k in range(n_steps, 0, -1):  # thickest first: a finger's first success is its d_max
+                d = k * params.step_mm
+                if np.all((found > 0) | (out >= d)):
+                    break
+                # from the palm's wrist end to ``end``, d thick along the normal
+                result = model.grasp(placed_slab(d, y_end, end))
+                if result.status != "grasp":
+                    continue
+                toward_palm = np.asarray(result.normals).reshape(-1, 3) @ normal <= -cos + 1e-12
+                for link in np.asarray(result.links)[toward_palm]:
+                    f = link_finger[int(link)]
+                    if f >= 0 and found[f] == 0:
+                        found[f] = d
+            out = np.maximum(out, found)
     finally:
         model.close()
     return out
