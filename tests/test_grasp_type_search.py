@@ -165,3 +165,16 @@ def test_bad_fallback_settings_are_refused_naming_the_key():
     with pytest.raises(ConfigError) as err:
         validate_config(bad)
     assert "'placement.search.fallback.min_typed_percent'" in str(err.value)
+
+
+def test_the_graspable_table_reads_each_searched_objects_stated_and_effective_type():
+    from synergrasp.analysis.graspability import fallback_lines, grasp_types_of
+
+    searched = search_with_fallback("power", CUBE60, _reach(), ON, _Searches(precision=[64.0]), _palm_centre)
+    types = grasp_types_of({"obj1": "precision", "obj3": "power"}, [searched.table(10.0)])
+    assert types["obj1"] == ("precision", "precision", "")  # not searched: the configured type
+    stated, effective, reason = types["obj3"]
+    assert (stated, effective) == ("power-circular", "precision-circular") and "infeasible" in reason
+    table = pd.DataFrame([{"object": o, "stated_type": t[0], "effective_type": t[1], "type_reason": t[2]}
+                          for o, t in types.items()])
+    assert fallback_lines(table) == [f"obj3: stated grasp type power-circular, effective precision-circular ({reason})"]

@@ -102,3 +102,15 @@ def test_precision_gate_reads_the_aperture(shipped_reach):
     wide = Box((reach.aperture_mm + 1.0, 300.0, 300.0))
     ok, reason = feasible_types(wide, reach)["precision"]
     assert not ok and "> aperture" in reason
+
+
+def test_the_reach_of_the_shadow_hand():
+    """Every shipped hand: the Shadow hand (MJCF) gets a reach table of its five fingers, a
+    d_max below the 60 mm boxes and an aperture above them."""
+    hand = load_hand("shadow_hand")
+    params = _params()
+    reach = hand_reach(hand, load_synergies("shadow_hand", joint_names=hand.joint_names), params.closure, params.reach)
+    assert list(reach.table["finger"]) == ["thumb", "index", "middle", "ring", "little"]
+    assert (reach.table["reach_s1_mm"] > reach.palm_face_mm).all()
+    assert 0 < reach.d_max_mm < 60.0 < reach.aperture_mm
+    assert not feasible_types(_obj("obj3"), reach)["power"][0]

@@ -8,7 +8,6 @@ palm) up; y is not drawn. mm.
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -42,7 +41,7 @@ def figure_hand_reach(hand: Hand, path: np.ndarray, reach: HandReach, objects: M
 
     from synergrasp.simulation.capsules import HandCapsules
     from synergrasp.simulation.placement import _palm_points
-    from synergrasp.simulation.reach import object_extents
+    from synergrasp.simulation.reach import finger_postures, object_extents
 
     capsules = HandCapsules.of(hand)
     palm = _palm_points(hand)
@@ -59,11 +58,8 @@ def figure_hand_reach(hand: Hand, path: np.ndarray, reach: HandReach, objects: M
     for ax, finger, chain in zip(axes, names, hand.finger_links):
         row = reach.table[reach.table["finger"] == finger].iloc[0]
         rows = np.flatnonzero(np.isin(capsules.links, list(chain)))
-        joints = list(hand.finger_joints[names.index(finger)])
-        q = path[0].copy()
         cloud = []
-        for combo in itertools.product(*[np.linspace(hand.lower[j], hand.upper[j], posture_steps) for j in joints]):
-            q[joints] = combo
+        for q in finger_postures(hand, path[0], names.index(finger), posture_steps):
             p0, p1 = capsules.segments(q)
             cloud.append(np.concatenate([p0[rows], p1[rows]]))
         cloud = np.concatenate(cloud)

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -53,7 +53,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.simulation.closure_params import ClosureParams
     from synergrasp.simulation.shapes import Shape
 
-__all__ = ["ReachParams", "HandReachStepParams", "HandReach", "hand_reach", "object_extents", "shape_class", "feasible_types",
+__all__ = ["ReachParams", "HandReachStepParams", "HandReach", "hand_reach", "finger_postures", "object_extents", "shape_class", "feasible_types",
            "path_postures", "palm_face_mm"]
 
 #: Samples of the free closure path σ_open … σ_closed (as ``placement.hand_region``).
@@ -161,17 +161,21 @@ def _surface_reach(capsules, q: NDArray, rows: NDArray, normal: NDArray) -> floa
     return float(np.max(ends + np.concatenate([capsules.radius[rows]] * 2)))
 
 
+def finger_postures(hand: Hand, q0: NDArray, finger: int, steps: int) -> Iterator[NDArray]:
+    """The postures of a lattice over one finger's joint limits (``steps`` values per joint,
+    the limits included), the other joints at ``q0`` (rad); one array, changed in place."""
+    joints = list(hand.finger_joints[finger])
+    values = [np.linspace(hand.lower[j], hand.upper[j], steps) for j in joints]
+    q = np.array(q0, dtype=float)
+    for combo in itertools.product(*values):
+        q[joints] = combo
+        yield q
+
+
 def _any_posture_reach(hand: Hand, capsules, q0: NDArray, finger: int, rows: NDArray, normal: NDArray,
                        steps: int) -> float:
     """Largest surface reach of one finger over a lattice of its joints' limits."""
-    joints = list(hand.finger_joints[finger])
-    values = [np.linspace(hand.lower[j], hand.upper[j], steps) for j in joints]
-    q = q0.copy()
-    best = -math.inf
-    for combo in itertools.product(*values):
-        q[joints] = combo
-        best = max(best, _surface_reach(capsules, q, rows, normal))
-    return best
+    return max(_surface_reach(capsules, q, rows, normal) for q in finger_postures(hand, q0, finger, steps))
 
 
 def _slab_press(hand: Hand, synergies: Synergies, closure: ClosureParams, params: ReachParams,
