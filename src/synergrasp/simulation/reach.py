@@ -206,16 +206,16 @@ def _slab_press(hand: Hand, synergies: Synergies, closure: ClosureParams, params
         point = np.array([centre[0], 0.5 * (y_end + float(lo[1])), 0.5 * (z_end + float(lo[2]))]) + 0.5 * d * normal
         return model.scene.bring_object(slab, np.eye(3), point, normal, model.q_open, 0.0, stop_at_point=True)
 
-    # the palm's whole width, and the widest slab from the palm's little-finger edge that lies on
-    # the palm face itself (not on a link standing out of it, as the SoftHand's thumb knuckle does)
-    y_end = float(hi[1])
-    while (placed_slab(params.step_mm, y_end, float(hi[2])).center_mm @ normal - 0.5 * params.step_mm > face + 0.5
-           and y_end - params.length_step_mm > float(lo[1])):
-        y_end -= params.length_step_mm
     # the slab's far end (toward the fingers): the palm's end, then every length_step_mm nearer the wrist
     ends = [float(hi[2]) - k * params.length_step_mm
             for k in range(int(math.floor((hi[2] - lo[2]) / params.length_step_mm)))]
     try:
+        # the palm's whole width, and the widest slab from the palm's little-finger edge that lies on
+        # the palm face itself (not on a link standing out of it, as the SoftHand's thumb knuckle does)
+        y_end = float(hi[1])
+        while (placed_slab(params.step_mm, y_end, float(hi[2])).center_mm @ normal - 0.5 * params.step_mm > face + 0.5
+               and y_end - params.length_step_mm > float(lo[1])):
+            y_end -= params.length_step_mm
         for y_end, end in itertools.product(sorted({float(hi[1]), y_end}, reverse=True), ends):
             found = np.zeros(len(hand.finger_links))
             for k in range(n_steps, 0, -1):  # thickest first: a finger's first success is its d_max
