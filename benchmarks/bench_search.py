@@ -1,5 +1,6 @@
 """Benchmark of the placement search (docs/placement_search.md): the default study's search
-of each object (or of the objects named on the command line), with 2 processes; prints the
+(version 3: the hand's reach for the gate, then the search of each grasp type the fallback
+chain reaches) of each object (or of the objects named on the command line), with 2 processes; prints the
 wall time, the CPU time of the search's processes, the number of targets scored and the
 machine's load average (the targets: at most 30 s wall per object on 2 quiet cores); the
 lines `search_wall_s_<object>: N` and `search_cpu_s_<object>: N` are machine-read.
@@ -21,7 +22,8 @@ from synergrasp.config import defaults  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
 from synergrasp.optimisation.gfo import warm_up  # noqa: E402
-from synergrasp.optimisation.placement_search import SearchStepParams, full_synergy_set, search_object  # noqa: E402
+from synergrasp.optimisation.grasp_type_search import search_object_types  # noqa: E402
+from synergrasp.optimisation.placement_search import SearchStepParams  # noqa: E402
 
 
 def _cpu_s() -> float:
@@ -38,9 +40,7 @@ def main(objects: list[str], processes: int = 2) -> None:
         synergies = load_synergies(sim.synergies, joint_names=hand.joint_names)
         period = alpha_period_deg(sim.placement, sim.object.shape, hand.palm_normal)
         wall, cpu = time.perf_counter(), _cpu_s()
-        result = search_object(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo,
-                               full_synergy_set(synergies.matrix, sim.full_set_size), sim.search, period, processes,
-                               opposition=sim.opposition)
+        result = search_object_types(hand, synergies, sim, period, processes)  # the gate and the chain too
         wall, cpu = time.perf_counter() - wall, _cpu_s() - cpu
         n_poses = result.chosen.n_poses
         print(f"{name}: {len(result.ranked)} targets x {n_poses} poses, {processes} processes: wall {wall:.1f} s, "

@@ -291,7 +291,8 @@ def test_code_inputs_hold_every_module_a_job_loads(run_j2):
         script, *files = record.read_text().splitlines()
         loaded.setdefault(script, set()).update(files)
     assert set(loaded) == {"simulate", "optimise_shard", "optimise", "minima", "tables", "fig1", "fig2", "fig3",
-                           "fig4", "fig5", "realism", "quality", "blockers", "blockers_table", "planners"}
+                           "fig4", "fig5", "realism", "quality", "blockers", "blockers_table", "planners",
+                           "hand_reach"}
     for script, files in loaded.items():
         assert files, script
         assert files <= declared[script], (script, sorted(files - declared[script]))

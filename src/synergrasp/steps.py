@@ -141,7 +141,7 @@ _PNG_PDF = ("png", "pdf")
 #: The keys the placement search reads (and the map of its results).
 STEPS_SEARCH_READS = ("hand", "synergies", "grid", "placement", "closure", "mechanics", "synergy_sets.incremental_max",
                       "objects.{object}.shape", "objects.{object}.mass_kg", "objects.{object}.placement",
-                      "objects.{object}.grasp_type", "grasp_type", "opposition")
+                      "objects.{object}.grasp_type", "grasp_type", "opposition", "hand_reach")
 STEPS_SEARCH_NOT_READS = ("closure.model", "closure.dynamic",
                           *(f"{where}.{key}" for where in ("placement", "objects.{object}.placement")
                             for key in _PLACEMENT_TARGETS))
@@ -277,6 +277,16 @@ STEPS: dict[str, Step] = {
         outputs=_files(("fig1_synergy_postures",), "figures", _PNG_PDF, named=False),
         reads=("hand", "synergies"), params="synergrasp.figures.hand_figures:Fig1Params",
         report={"png": ("fig1", "Figures")}),
+    # what grasps the hand can make (docs/hand_reach.md): per finger the reach along S1 and in
+    # any posture, d_max (~60 kinematic closures on slabs lying on the palm) and the aperture
+    "hand_reach": Step(
+        rules={"hand_reach": Cost("none", 8.0, 300)},
+        outputs={"csv": "tables/hand_reach.csv", "md": "tables/hand_reach.md",
+                 **_files(("hand_reach",), "figures", _PNG_PDF, named=False)},
+        reads=("hand", "synergies", "closure", "opposition.angle_deg", "hand_reach", "objects.*.shape"),
+        not_reads=("closure.model", "closure.dynamic"),
+        params="synergrasp.simulation.reach:HandReachStepParams",
+        report={"csv": ("hand_reach_table", "Tables"), "png": ("hand_reach", "Figures")}),
     # Fig. 2 and the same grasps in 3-D with the full set's optimal forces: pages sharing one
     # plotly script (docs/inspector.md); one job, so that the pages' imports (the solver, a
     # dozen optimisations) are not paid by a job of their own

@@ -18,8 +18,9 @@ import pandas as pd
 from synergrasp.file_output import replacing
 
 __all__ = ["Column", "Table", "TABLES", "STUDY_TABLES", "CONTACTS", "GFO", "MINIMA", "GRASP_REALISM", "GRASPABLE_OBJECTS",
-           "PLACEMENT", "PLAN", "ENROLLMENT", "PLANNERS", "PLANNERS_ACROSS", "PLAN_ON_DEMAND", "BLOCKERS", "QUALITY",
-           "TARGET_CLAIMS", "write", "read", "older_version", "write_csv", "read_csv", "empty", "write_study_table"]
+           "PLACEMENT", "HAND_REACH", "PLAN", "ENROLLMENT", "PLANNERS", "PLANNERS_ACROSS", "PLAN_ON_DEMAND", "BLOCKERS",
+           "QUALITY", "TARGET_CLAIMS", "write", "read", "older_version", "write_csv", "read_csv", "empty",
+           "write_study_table"]
 
 
 @dataclass(frozen=True)
@@ -179,6 +180,9 @@ GRASPABLE_OBJECTS = Table("graspable_objects", "one row per object", (
     Column("graspable", "bool", "", "some pose reaches force closure with the full set"),
     Column("reason", "string", "", "why no pose does: every pose dropped, nothing touched, no pose settled, "
            "no force closure with the full set (empty when graspable)"),
+    Column("stated_type", "string", "", "the object's stated grasp type (with its shape class where the placement search read it)"),
+    Column("effective_type", "string", "", "the grasp type its grasps are counted as (the search's effective type, version 3; the stated type without a search)"),
+    Column("type_reason", "string", "", "why the effective type differs from the stated one (the search's reason)"),
 ))
 
 #: The placement search of one object (docs/placement_search.md), written as CSV
@@ -198,6 +202,22 @@ PLACEMENT = Table("placement", "one row per scored target of one object, best fi
     Column("median_force_per_weight", "float64", "", "median optimal force over the poses counted by T / weight (inf: none)"),
     Column("median_contacts", "float64", "", "median contacts per scored pose"),
     Column("distance_to_chosen_mm", "float64", "mm", "distance to the chosen target"),
+    Column("stated_type", "string", "", "the object's stated grasp type with its shape class (power-circular, precision-prismatic, ..., any)"),
+    Column("effective_type", "string", "", "the grasp type the chosen target was searched for (version 3's fallback chain)"),
+    Column("type_reason", "string", "", "why the effective type differs from the stated one (each fallback with its numbers), or that the stated type was kept"),
+    Column("region_mm", "string", "mm", "the region of targets at the end of the search, grown where the chosen target lay on its boundary"),
+))
+
+#: What grasps the hand can make (docs/hand_reach.md, ``synergrasp.simulation.reach``): one
+#: row per finger of the hand. Written as CSV and Markdown (results/tables/hand_reach).
+HAND_REACH = Table("hand_reach", "one row per finger", (
+    Column("finger", "string", "", "thumb, index, middle, ring, little"),
+    Column("reach_s1_mm", "float64", "mm", "farthest point along the palm normal of the finger's link surfaces on the free S1 closure path, palm frame"),
+    Column("reach_any_mm", "float64", "mm", "the same over a lattice of every posture within the finger's joint limits"),
+    Column("reach_s1_over_palm_mm", "float64", "mm", "reach_s1_mm less the palm face's position along the normal"),
+    Column("reach_any_over_palm_mm", "float64", "mm", "reach_any_mm less the palm face's position along the normal"),
+    Column("press_mm", "float64", "mm", "d_max of the finger: the thickest slab lying on the palm that one of its links presses toward the palm when the hand closes along S1 with soft adaptation (0: none)"),
+    Column("aperture_mm", "float64", "mm", "largest gap between the thumb's pad and this finger's pad on the free S1 path (NaN for the thumb)"),
 ))
 
 #: Quality indices of every pose of one object (docs/quality.md), Parquet
@@ -354,8 +374,8 @@ PLANNERS_ACROSS = Table("planners_across", "one row per candidate planner", (
 STUDY_TABLES: tuple[str, ...] = ("success_rates", "table2_success_rates", "hierarchy", "minimum_preservation",
                                  "full_not_first7", "verdict_disagreements", "preservation_vs_chance",
                                  "invariant_checks", "claims")
-TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, QUALITY,
-                                                TARGET_CLAIMS, BLOCKERS, PLAN, ENROLLMENT,
+TABLES: dict[str, Table] = {t.name: t for t in (CONTACTS, GFO, MINIMA, GRASP_REALISM, GRASPABLE_OBJECTS, PLACEMENT, HAND_REACH,
+                                                QUALITY, TARGET_CLAIMS, BLOCKERS, PLAN, ENROLLMENT,
                                                 PLANNERS, PLANNERS_ACROSS, PLAN_ON_DEMAND)}
 
 

@@ -69,6 +69,7 @@ rule realism:
     input:
         contacts=W.step_inputs("contacts"),
         gfo=W.step_inputs("optimise"),
+        placements=W.step_inputs("search"),
         manifest=W.random_objects_manifest,
         code=W.code("realism"),
         data=SHIPPED_DATA,

@@ -84,6 +84,26 @@ rule fig1:
         "../scripts/fig1.py"
 
 
+rule hand_reach:
+    input:
+        code=W.code("hand_reach"),
+        data=SHIPPED_DATA,
+        user=W.user_files,
+    output:
+        **outputs("hand_reach"),
+    log:
+        log_file("hand_reach"),
+    benchmark:
+        benchmark_file("hand_reach")
+    threads: threads("hand_reach")
+    resources:
+        **W.resources("hand_reach"),
+    params:
+        cfg=W.step_cfg("hand_reach"),
+    script:
+        "../scripts/hand_reach.py"
+
+
 rule fig2:
     input:
         contacts=W.step_inputs("contacts"),

@@ -1,18 +1,22 @@
-"""The placement search of one object (docs/placement_search.md); write its placement.csv."""
+"""The placement search of one object (docs/placement_search.md, version 3: the grasp types
+this hand can make, with the fallback chain); write its placement.csv."""
 
 from synergrasp import tables
 from synergrasp.analysis.periods import alpha_period_deg
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
-from synergrasp.optimisation.placement_search import SearchStepParams, full_synergy_set, search_object
+from synergrasp.optimisation.grasp_type_search import fallback_line, search_object_types
+from synergrasp.optimisation.placement_search import SearchStepParams
 
-with job_log(snakemake.log[0]):
+with job_log(snakemake.log[0]) as log:
     sim = SearchStepParams.from_config(snakemake.params.cfg, snakemake.wildcards.object)
     hand = load_hand(sim.hand)
     synergies = load_synergies(sim.synergies, joint_names=hand.joint_names)
     period = alpha_period_deg(sim.placement, sim.object.shape, hand.palm_normal)
-    result = search_object(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo,
-                           full_synergy_set(synergies.matrix, sim.full_set_size), sim.search, period,
-                           processes=snakemake.threads, opposition=sim.opposition)
+    result = search_object_types(hand, synergies, sim, period, processes=snakemake.threads)
     tables.write_csv(tables.PLACEMENT, result.table(sim.distinct_mm), snakemake.output[0])
+    line = fallback_line(result)
+    if line:  # on the console and in the job's log
+        print(f"WARNING: {line}")
+        print(f"WARNING: {line}", file=log)

@@ -17,7 +17,7 @@ DataFrame (or lines) out.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import pandas as pd
 
@@ -25,7 +25,8 @@ from synergrasp.analysis.verdicts import verdict_columns
 from synergrasp.ids import set_members, set_name
 from synergrasp.tables import GRASPABLE_OBJECTS
 
-__all__ = ["graspable_objects", "with_left_out", "studied", "ungraspable_lines", "LEFT_OUT"]
+__all__ = ["graspable_objects", "with_left_out", "studied", "ungraspable_lines", "grasp_types_of", "fallback_lines",
+           "LEFT_OUT"]
 
 #: How the reason of an object left out before the study begins.
 LEFT_OUT = "left out: "
@@ -57,10 +58,32 @@ def _reason(rows: pd.DataFrame, n_fc: int, dynamic: bool, full_set_id: str) -> s
     return f"no force closure with the full set {_set_name(full_set_id)} at any of the {int(grasps.sum())} grasps"
 
 
-def graspable_objects(contacts: pd.DataFrame, gfo: pd.DataFrame, full_set_id: str) -> pd.DataFrame:
+def grasp_types_of(grasp_types: Mapping[str, str], placements: Sequence[pd.DataFrame]) -> dict[str, tuple[str, str, str]]:
+    """Per object (stated, effective, reason): the chosen row of its placement-search table
+    (``tables.PLACEMENT``; version 3 of docs/placement_search.md) where its placement was
+    searched, else its configured grasp type ``grasp_types[object]`` both stated and effective."""
+    out = {name: (kind, kind, "") for name, kind in grasp_types.items()}
+    for table in placements:
+        row = table[table["chosen"].astype(bool)].iloc[0]
+        reason = "" if pd.isna(row["type_reason"]) else str(row["type_reason"])
+        out[str(row["object"])] = (str(row["stated_type"]), str(row["effective_type"]), reason)
+    return out
+
+
+def fallback_lines(table: pd.DataFrame) -> list[str]:
+    """One line per object of a graspable-objects table whose effective grasp type is not its
+    stated one (version 3's fallback), with the reason."""
+    return [f"{row.object}: stated grasp type {row.stated_type}, effective {row.effective_type} ({row.type_reason})"
+            for row in table.itertuples() if row.stated_type != row.effective_type]
+
+
+def graspable_objects(contacts: pd.DataFrame, gfo: pd.DataFrame, full_set_id: str,
+                      types: Mapping[str, tuple[str, str, str]] | None = None) -> pd.DataFrame:
     """One row per object of ``contacts`` (contacts tables of every object): poses, closures
     that ran, touching grasps, grasps that settled, force-closure poses with the full set
-    ``full_set_id`` (from ``gfo``), whether any pose is graspable and, if none is, why."""
+    ``full_set_id`` (from ``gfo``), whether any pose is graspable and, if none is, why; its
+    stated and effective grasp type and the reason they differ (``types``: :func:`grasp_types_of`)."""
+    types = types or {}
     full = gfo[gfo["set_id"].astype(str) == full_set_id]
     fc = full.loc[verdict_columns(full)["force_closure"], "object"].value_counts() if len(full) else pd.Series()
     rows = []
@@ -71,7 +94,8 @@ def graspable_objects(contacts: pd.DataFrame, gfo: pd.DataFrame, full_set_id: st
         reason = _reason(group, n_fc, dynamic, full_set_id)
         rows.append({"object": obj, "poses": len(group), "simulated": int(group["status"].isin(_RAN).sum()),
                      "grasps": int(grasps.sum()), "settled": int(group.loc[grasps, "settled"].astype(bool).sum()),
-                     "force_closure_full_set": n_fc, "graspable": not reason, "reason": reason})
+                     "force_closure_full_set": n_fc, "graspable": not reason, "reason": reason,
+                     **dict(zip(("stated_type", "effective_type", "type_reason"), types.get(obj, ("", "", ""))))})
     return pd.DataFrame(rows, columns=list(GRASPABLE_OBJECTS.names))
 
 
@@ -80,7 +104,8 @@ def with_left_out(table: pd.DataFrame, left_out: Sequence[tuple[str, str]]) -> p
     study (a drawn mesh that cannot be read, is degenerate or differs from its manifest):
     nothing simulated, not graspable, reason ``left out: <reason>``."""
     extra = pd.DataFrame([{"object": name, "poses": 0, "simulated": 0, "grasps": 0, "settled": 0,
-                           "force_closure_full_set": 0, "graspable": False, "reason": f"{LEFT_OUT}{reason}"}
+                           "force_closure_full_set": 0, "graspable": False, "reason": f"{LEFT_OUT}{reason}",
+                           "stated_type": "", "effective_type": "", "type_reason": ""}
                           for name, reason in left_out], columns=list(GRASPABLE_OBJECTS.names))
     return pd.concat([table, extra], ignore_index=True) if len(extra) else table
 

@@ -31,6 +31,7 @@ from synergrasp import tables
 from synergrasp.config import build, dataclass_fields
 from synergrasp.resolved import effective_placement
 from synergrasp.optimisation.problem import SynergySets
+from synergrasp.optimisation.grasp_type_search import FallbackParams
 from synergrasp.optimisation.mechanics import read_grasps
 from synergrasp.optimisation.optimise import GFOParams, optimise_grasps
 from synergrasp.simulation.contacts import contacts_row, contacts_table
@@ -39,13 +40,14 @@ from synergrasp.simulation.objects import GraspedObject
 from synergrasp.resolved import grasp_type as resolved_grasp_type
 from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions, of_grasp_type
 from synergrasp.simulation.placement import Placement, hand_region, palm_centre, pose_grid
+from synergrasp.simulation.reach import ReachParams
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
 
 __all__ = ["SearchStepParams", "SearchParams", "TargetScore", "SearchResult", "score_target", "rank_targets", "pose_subset",
-           "full_synergy_set", "TargetScorer", "search_object", "region_lattice", "distinct_ranks"]
+           "full_synergy_set", "TargetScorer", "search_object", "region_lattice", "distinct_ranks", "grown_region"]
 
 _TOL = 1e-6
 
@@ -70,6 +72,10 @@ class SearchParams:
     force_tie_relative: median forces within this relative margin of the lowest count as tied
     grasp_type:         the object's grasp type (``opposition.GRASP_TYPES``): a scored pose
                         counts when its grasp's opposition is of this type
+    grow_region:        version 3: when the chosen target lies on the region's boundary, the
+                        region grows one ``spacing_mm`` step in that direction, within the
+                        hand's reach (``search_object``'s ``bound_mm``), and the refinement
+                        goes on, until the chosen target is inside or the reach stops it
     """
 
     region_mm: tuple[tuple[float, float], tuple[float, float], tuple[float, float]]
@@ -82,6 +88,7 @@ class SearchParams:
     tie_band_points: float
     force_tie_relative: float
     grasp_type: str = "any"
+    grow_region: bool = False
 
     def __post_init__(self) -> None:
         region = tuple((float(a), float(b)) for a, b in self.region_mm)
@@ -124,6 +131,16 @@ class SearchStepParams:
     search: SearchParams
     distinct_mm: float
     opposition: OppositionRule
+    regions: Mapping[str, tuple[tuple[float, float], ...]] | None = None
+    fallback: FallbackParams | None = None
+    reach: ReachParams | None = None
+
+    def params_of(self, grasp_type: str) -> SearchParams:
+        """The search's settings for one grasp type: its region (version 3 searches the types
+        of the fallback chain, each over its own region)."""
+        if grasp_type == self.search.grasp_type or self.regions is None:
+            return replace(self.search, grasp_type=grasp_type)
+        return replace(self.search, grasp_type=grasp_type, region_mm=self.regions[grasp_type])
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> SearchStepParams:
@@ -131,12 +148,15 @@ class SearchStepParams:
         placement = effective_placement(config, obj)
         spec = placement["search"]
         grasp_type = resolved_grasp_type(config, obj)
-        if spec["region_mm"][grasp_type] == "hand":  # derived from the hand's geometry (docs/placement_search.md)
-            region = _hand_region(config["hand"], config["synergies"])
-        else:
-            region = tuple(tuple(spec["region_mm"][grasp_type][axis]) for axis in ("x", "y", "z"))
-        search = build(SearchParams, "placement.search", region_mm=region, grasp_type=grasp_type,
+        regions = {}
+        for kind, value in spec["region_mm"].items():
+            if value == "hand":  # derived from the hand's geometry (docs/placement_search.md)
+                regions[kind] = _hand_region(config["hand"], config["synergies"])
+            else:
+                regions[kind] = tuple(tuple(value[axis]) for axis in ("x", "y", "z"))
+        search = build(SearchParams, "placement.search", region_mm=regions[grasp_type], grasp_type=grasp_type,
                        **dataclass_fields(SearchParams, {k: v for k, v in spec.items() if k != "region_mm"}))
+        fallback = build(FallbackParams, "placement.search.fallback", **spec["fallback"])
         closure = {**config["closure"], "model": "kinematic"}
         return cls(
             hand=config["hand"], synergies=config["synergies"], object=GraspedObject.from_config(config, obj),
@@ -146,7 +166,8 @@ class SearchStepParams:
             closure=build(ClosureParams, "closure", **{**dataclass_fields(ClosureParams, closure), "dynamic": None}),
             gfo=GFOParams.from_config(config, obj),
             full_set_size=int(config["synergy_sets"]["incremental_max"]), search=search,
-            distinct_mm=float(spec["distinct_mm"]), opposition=OppositionRule.from_config(config))
+            distinct_mm=float(spec["distinct_mm"]), opposition=OppositionRule.from_config(config),
+            regions=regions, fallback=fallback, reach=ReachParams.from_config(config))
 
 @dataclass(frozen=True)
 class TargetScore:
@@ -328,6 +349,10 @@ class SearchResult:
     ranked: tuple[TargetScore, ...]
     rounds: dict[tuple[float, float, float], int]
     grasp_type: str = "any"
+    region_mm: tuple[tuple[float, float], ...] = ()
+    stated_type: str = ""
+    effective_type: str = ""
+    type_reason: str = ""
 
     @property
     def chosen(self) -> TargetScore:
@@ -337,13 +362,17 @@ class SearchResult:
         """The placement table (``tables.PLACEMENT``), best first."""
         chosen = np.asarray(self.chosen.target_mm)
         distinct = distinct_ranks(self.ranked, distinct_mm)
+        region = "; ".join(f"{axis} {lo:g} … {hi:g}" for axis, (lo, hi) in zip("xyz", self.region_mm))
         rows = [{"object": self.object, "rank": k + 1, "chosen": k == 0, "distinct_rank": distinct[k],
                  "x_mm": s.target_mm[0],
                  "y_mm": s.target_mm[1], "z_mm": s.target_mm[2], "round": self.rounds[s.target_mm],
                  "n_poses": s.n_poses, "grasp_type": self.grasp_type, "typed_percent": s.typed_percent,
                  "force_closure_percent": s.force_closure_percent,
                  "median_force_per_weight": s.median_force_per_weight, "median_contacts": s.median_contacts,
-                 "distance_to_chosen_mm": float(np.linalg.norm(np.asarray(s.target_mm) - chosen))}
+                 "distance_to_chosen_mm": float(np.linalg.norm(np.asarray(s.target_mm) - chosen)),
+                 "stated_type": self.stated_type or self.grasp_type,
+                 "effective_type": self.effective_type or self.grasp_type, "type_reason": self.type_reason,
+                 "region_mm": region}
                 for k, s in enumerate(self.ranked)]
         return pd.DataFrame(rows, columns=list(tables.PLACEMENT.names))
 
@@ -365,12 +394,34 @@ def _key(point: NDArray) -> tuple[float, float, float]:
     return tuple(float(round(v, 6)) for v in point)
 
 
+def grown_region(region_mm: Sequence[tuple[float, float]], target_mm: Sequence[float], step_mm: float,
+                 bound_mm: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
+    """Version 3's region growth (docs/placement_search.md): on every axis where the target
+    lies on the region's lower or upper bound, that bound moves one ``step_mm`` outward,
+    unless it would pass ``bound_mm`` (the hand's reach, ``placement.hand_region``); an axis
+    the region pins to one value (the power region's x, the palm face) never grows. The same
+    region when nothing grows."""
+    out = []
+    for (lo, hi), v, (b_lo, b_hi) in zip(region_mm, target_mm, bound_mm):
+        if hi - lo > _TOL:
+            if abs(v - hi) <= _TOL and hi + step_mm <= b_hi + _TOL:
+                hi = hi + step_mm
+            if abs(v - lo) <= _TOL and lo - step_mm >= b_lo - _TOL:
+                lo = lo - step_mm
+        out.append((float(lo), float(hi)))
+    return tuple(out)
+
+
 def search_object(hand: Hand, synergies: Synergies, box: Any, placement: Placement, closure: ClosureParams,
                   gfo: GFOParams, full_set: SynergySets, params: SearchParams, period_deg: float,
-                  processes: int = 1, opposition: OppositionRule | None = None) -> SearchResult:
+                  processes: int = 1, opposition: OppositionRule | None = None,
+                  bound_mm: Sequence[tuple[float, float]] | None = None) -> SearchResult:
     """The coarse-to-fine search of one object (docs/placement_search.md): score the coarse
     lattice, then, round by round, the unscored neighbours at ``spacing_mm`` of the best
-    ``refine_top`` targets, until they are all scored or ``max_rounds`` is reached.
+    ``refine_top`` targets, until they are all scored or ``max_rounds`` is reached. With
+    ``params.grow_region`` and the hand's reach ``bound_mm``, a chosen target (T > 0) on the
+    region's boundary grows the region (:func:`grown_region`) and the refinement goes on with
+    a fresh round budget, until the target is inside or nothing can grow.
     Deterministic: the same result for any ``processes``."""
     args = (hand, synergies, box, placement, closure, gfo, full_set, pose_subset(placement, period_deg, params),
             params.grasp_type, opposition)
@@ -387,19 +438,33 @@ def search_object(hand: Hand, synergies: Synergies, box: Any, placement: Placeme
         scorer = TargetScorer(*args)
         score_many = lambda targets: [scorer(t) for t in targets]  # noqa: E731
     steps = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if any(d)], dtype=float)
+    def neighbours(region: SearchParams) -> list[tuple[float, float, float]]:
+        ranked = rank_targets(list(scores.values()), reference, params.tie_band_points, params.force_tie_relative)
+        near = {_key(np.asarray(s.target_mm) + params.spacing_mm * d) for s in ranked[:params.refine_top] for d in steps}
+        return sorted(t for t in near if t not in scores and _in_region(np.asarray(t), region))
+
+    grow = params.grow_region and bound_mm is not None
+    k = 0
     try:
         todo = [_key(p) for p in region_lattice(params, params.coarse_spacing_mm)]
-        for k in range(params.max_rounds + 1):
-            for target, score in zip(todo, score_many(todo)):
-                scores[target], rounds[target] = score, k
-            if k == params.max_rounds:
+        while True:
+            for budget in range(params.max_rounds + 1):
+                for target, score in zip(todo, score_many(todo)):
+                    scores[target], rounds[target] = score, k
+                k += 1
+                todo = neighbours(params) if budget < params.max_rounds else []
+                if not todo:
+                    break
+            if not grow:
                 break
-            ranked = rank_targets(list(scores.values()), reference, params.tie_band_points, params.force_tie_relative)
-            near = {_key(np.asarray(s.target_mm) + params.spacing_mm * d)
-                    for s in ranked[:params.refine_top] for d in steps}
-            todo = sorted(t for t in near if t not in scores and _in_region(np.asarray(t), params))
-            if not todo:
+            best = rank_targets(list(scores.values()), reference, params.tie_band_points, params.force_tie_relative)[0]
+            if not best.typed_percent > 0:
+                break  # nothing chosen (version 3 falls back): no region to decide
+            region = grown_region(params.region_mm, best.target_mm, params.spacing_mm, bound_mm)
+            if region == params.region_mm:
                 break
+            params = replace(params, region_mm=region)
+            todo = neighbours(params)
     finally:
         if pool is not None:
             pool.close()
@@ -407,5 +472,5 @@ def search_object(hand: Hand, synergies: Synergies, box: Any, placement: Placeme
         else:
             scorer.close()
     ranked = rank_targets(list(scores.values()), reference, params.tie_band_points, params.force_tie_relative)
-    return SearchResult(str(box.name), tuple(ranked), rounds, params.grasp_type)
+    return SearchResult(str(box.name), tuple(ranked), rounds, params.grasp_type, params.region_mm)
 
