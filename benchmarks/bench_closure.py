@@ -36,22 +36,37 @@ from synergrasp.simulation.shapes import Box, Cylinder, Mesh, Sphere  # noqa: E4
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The shapes timed against the box: (name, shape, placement.box_axes, key of its ratio line).
-SHAPES = (("box 60 mm", Box((60.0, 60.0, 60.0)), (0, 1, 2), "box"),
-          ("sphere r 30 mm", Sphere(30.0), (0, 1, 2), "sphere"),
-          ("cylinder r 30 x 120 mm, axis along the fingers", Cylinder(30.0, 120.0), (0, 1, 2), "cylinder"),
-          ("cylinder r 30 x 120 mm, axis along the palm normal", Cylinder(30.0, 120.0), (2, 0, 1), "cylinder"),
-          ("convex mesh of 1000 faces, 60 mm (tests/data/rounded_cube_1000.stl)",
-           Mesh(str(ROOT / "tests" / "data" / "rounded_cube_1000.stl"), 1.0), (0, 1, 2), "mesh_convex_1000"),
-          ("non-convex mesh: the duck, 83 x 77 x 58 mm, 5 convex parts (config/examples/meshes/duck.obj)",
-           Mesh(str(ROOT / "config" / "examples" / "meshes" / "duck.obj"), 50.0), (0, 1, 2), "mesh_nonconvex_duck"))
+SHAPES = (
+    ("box 60 mm", Box((60.0, 60.0, 60.0)), (0, 1, 2), "box"),
+    ("sphere r 30 mm", Sphere(30.0), (0, 1, 2), "sphere"),
+    ("cylinder r 30 x 120 mm, axis along the fingers", Cylinder(30.0, 120.0), (0, 1, 2), "cylinder"),
+    ("cylinder r 30 x 120 mm, axis along the palm normal", Cylinder(30.0, 120.0), (2, 0, 1), "cylinder"),
+    (
+        "convex mesh of 1000 faces, 60 mm (tests/data/rounded_cube_1000.stl)",
+        Mesh(str(ROOT / "tests" / "data" / "rounded_cube_1000.stl"), 1.0),
+        (0, 1, 2),
+        "mesh_convex_1000",
+    ),
+    (
+        "non-convex mesh: the duck, 83 x 77 x 58 mm, 5 convex parts (config/examples/meshes/duck.obj)",
+        Mesh(str(ROOT / "config" / "examples" / "meshes" / "duck.obj"), 50.0),
+        (0, 1, 2),
+        "mesh_nonconvex_duck",
+    ),
+)
 
 
 def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_median_ms") -> None:
     """The study's boxes and closure settings (the configuration's defaults), each box placed
     by the approach preset (the palm centre; a searched target needs the search's output),
     closed by ``model``."""
-    study = validate_config({**defaults(), "closure": {**defaults()["closure"], "model": model},
-                             "placement": {**defaults()["placement"], "mode": "approach"}})
+    study = validate_config(
+        {
+            **defaults(),
+            "closure": {**defaults()["closure"], "model": model},
+            "placement": {**defaults()["placement"], "mode": "approach"},
+        }
+    )
     hand = load_hand()
     synergies = load_synergies(None, joint_names=hand.joint_names)
     first = SimulateParams.from_config(study, next(iter(study["objects"])))
@@ -80,18 +95,21 @@ def main(n_poses: int = 300, model: str = "kinematic", key: str = "closure_media
             all_times.extend(t)
             status, n_status = np.unique(statuses, return_counts=True)
             m, n_m = np.unique(counts, return_counts=True)
-            print(f"{obj.name} {obj.shape.kind} {obj.shape.label} {placement.mode} axes {placement.box_axes}: "
-                  f"{len(poses)} poses, median {np.median(t):.2f} ms, "
-                  f"p90 {np.percentile(t, 90):.2f} ms per grasp "
-                  f"(placement median {1e3 * np.median(placing):.2f} ms)")
+            print(
+                f"{obj.name} {obj.shape.kind} {obj.shape.label} {placement.mode} axes {placement.box_axes}: "
+                f"{len(poses)} poses, median {np.median(t):.2f} ms, "
+                f"p90 {np.percentile(t, 90):.2f} ms per grasp "
+                f"(placement median {1e3 * np.median(placing):.2f} ms)"
+            )
             print(f"  status: {dict(zip(status.tolist(), n_status.tolist()))}")
             print(f"  contacts m: {dict(zip(m.tolist(), n_m.tolist()))}")
             print(f"  poses with >= 2 fingers in contact: {two_fingers} / {len(poses)}")
     finally:
         closer.close()
         placer.close()
-    print(f"{key}: {np.median(all_times):.2f}  ({model} closure, median CPU ms per grasp over "
-          f"{len(poses)} poses of each study box)")
+    print(
+        f"{key}: {np.median(all_times):.2f}  ({model} closure, median CPU ms per grasp over {len(poses)} poses of each study box)"
+    )
 
 
 def shapes(n_poses: int = 300) -> None:
@@ -119,8 +137,10 @@ def shapes(n_poses: int = 300) -> None:
                 times.append(time.process_time() - t0)
                 contacts.append(len(result.links))
             medians[name] = float(np.median(times)) * 1e3
-            print(f"{name}: {len(poses)} poses, median {medians[name]:.2f} ms, p90 {1e3 * np.percentile(times, 90):.2f} ms "
-                  f"per grasp, median {np.median(contacts):g} contacts")
+            print(
+                f"{name}: {len(poses)} poses, median {medians[name]:.2f} ms, p90 {1e3 * np.percentile(times, 90):.2f} ms "
+                f"per grasp, median {np.median(contacts):g} contacts"
+            )
     finally:
         closer.close()
         placer.close()

@@ -57,8 +57,7 @@ def main() -> None:
         env = dict(os.environ, NUMBA_CACHE_DIR=str(Path(tmp) / "cache"))
         first = child_cpu(env)
         clone = Path(tmp) / "clone"
-        shutil.copytree(Path(synergrasp.__file__).parent, clone / "synergrasp",
-                        ignore=shutil.ignore_patterns("__pycache__"))
+        shutil.copytree(Path(synergrasp.__file__).parent, clone / "synergrasp", ignore=shutil.ignore_patterns("__pycache__"))
         env["PYTHONPATH"] = str(clone)
         loads = [child_cpu(env) for _ in range(args.repeats)]
         cached = sorted(p.name for p in (Path(tmp) / "cache").rglob("*.nbi"))
@@ -67,18 +66,28 @@ def main() -> None:
         env["PYTHONPATH"] = str(clone)
         closure_loads = [child_cpu(env, CLOSE_ONE_POSE) for _ in range(args.repeats)]
     print(f"first compile (empty cache, one process): {first:.1f} CPU s; {len(cached)} compiled functions cached")
-    print(f"warm-up from a copy in a new path, same cache (median of {args.repeats}): {statistics.median(loads):.2f} CPU s"
-          f" (runs {min(loads):.2f}-{max(loads):.2f})")
-    print(f"closure of one pose, empty cache: {closure_first:.1f} CPU s; from a new path, same cache (median of "
-          f"{args.repeats}): {statistics.median(closure_loads):.2f} CPU s (runs {min(closure_loads):.2f}-"
-          f"{max(closure_loads):.2f})")
+    print(
+        f"warm-up from a copy in a new path, same cache (median of {args.repeats}): {statistics.median(loads):.2f} CPU s"
+        f" (runs {min(loads):.2f}-{max(loads):.2f})"
+    )
+    print(
+        f"closure of one pose, empty cache: {closure_first:.1f} CPU s; from a new path, same cache (median of "
+        f"{args.repeats}): {statistics.median(closure_loads):.2f} CPU s (runs {min(closure_loads):.2f}-"
+        f"{max(closure_loads):.2f})"
+    )
     print(f"first_compile_s: {first:.1f}  (the compiled kernel's first compile with an empty cache, CPU s of one process)")
-    print(f"new_path_load_s: {statistics.median(loads):.2f}  (the warm-up from a new checkout path with the same "
-          f"cache, CPU s, median of {args.repeats})")
-    print(f"closure_first_compile_s: {closure_first - statistics.median(closure_loads):.1f}  (the closure's distance "
-          f"queries' first compile: one pose closed with an empty cache less with the cache loaded, CPU s)")
-    print(f"closure_new_path_load_s: {statistics.median(closure_loads):.2f}  (one pose closed from a new checkout path "
-          f"with the same cache, CPU s, median of {args.repeats})")
+    print(
+        f"new_path_load_s: {statistics.median(loads):.2f}  (the warm-up from a new checkout path with the same "
+        f"cache, CPU s, median of {args.repeats})"
+    )
+    print(
+        f"closure_first_compile_s: {closure_first - statistics.median(closure_loads):.1f}  (the closure's distance "
+        f"queries' first compile: one pose closed with an empty cache less with the cache loaded, CPU s)"
+    )
+    print(
+        f"closure_new_path_load_s: {statistics.median(closure_loads):.2f}  (one pose closed from a new checkout path "
+        f"with the same cache, CPU s, median of {args.repeats})"
+    )
 
 
 if __name__ == "__main__":

@@ -27,9 +27,18 @@ def main(argv: list[str]) -> None:
         overlay = Path(work) / "n_objects.yaml"
         overlay.write_text(f"random_objects:\n  n_objects: {n}\n")
         env = {**os.environ, "XDG_CACHE_HOME": f"{work}/cache"}
-        command = [str(ROOT / ".venv" / "bin" / "snakemake"), "-s", str(ROOT / "Snakefile"), "-d", f"{work}/run",
-                   "-n", "across_objects", "--configfile", str(ROOT / "config" / "examples" / "random_objects.yaml"),
-                   str(overlay)]
+        command = [
+            str(ROOT / ".venv" / "bin" / "snakemake"),
+            "-s",
+            str(ROOT / "Snakefile"),
+            "-d",
+            f"{work}/run",
+            "-n",
+            "across_objects",
+            "--configfile",
+            str(ROOT / "config" / "examples" / "random_objects.yaml"),
+            str(overlay),
+        ]
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         wall = time.perf_counter()
         out = subprocess.run(command, env=env, capture_output=True, text=True, cwd=ROOT)
@@ -44,10 +53,13 @@ def main(argv: list[str]) -> None:
     print(f"dry_run_wall_s_{n}_objects: {wall:.1f}  (snakemake -n across_objects, {n} objects drawn, wall s)")
     print(f"dry_run_cpu_s_{n}_objects: {cpu:.1f}  (the same, CPU s of Snakemake's process)")
     print(f"dry_run_jobs_{n}_objects: {int(jobs.group(1)) if jobs else -1}  (jobs planned)")
-    print(f"dry_run_mesh_parts_jobs_{n}_objects: {int(parts.group(1)) if parts else 0}  "
-          "(of which mesh_parts: one per mesh studied)")
-    print(f"dry_run_meshes_decomposed_{n}_objects: {int(made)}  "
-          "(1 if the dry run wrote any mesh's parts, per-user cache or results/meshes)")
+    print(
+        f"dry_run_mesh_parts_jobs_{n}_objects: {int(parts.group(1)) if parts else 0}  (of which mesh_parts: one per mesh studied)"
+    )
+    print(
+        f"dry_run_meshes_decomposed_{n}_objects: {int(made)}  "
+        "(1 if the dry run wrote any mesh's parts, per-user cache or results/meshes)"
+    )
 
 
 if __name__ == "__main__":

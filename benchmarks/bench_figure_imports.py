@@ -64,8 +64,10 @@ def main() -> None:
             continue
         imports = import_cpu_s(ROOT / "workflow" / "scripts" / f"{rule}.py")
         share = imports / job if job > 0 else 0.0
-        print(f"{rule}: job {job:.2f} CPU s, imports {imports:.2f} s ({100 * share:.0f} %), the rest {job - imports:.2f} s",
-              flush=True)
+        print(
+            f"{rule}: job {job:.2f} CPU s, imports {imports:.2f} s ({100 * share:.0f} %), the rest {job - imports:.2f} s",
+            flush=True,
+        )
         if share > worst:
             worst, worst_rule = share, rule
     print(f"figure_imports_share_max: {worst:.2f}  (largest share of a figure job's CPU spent importing: {worst_rule})")

@@ -20,8 +20,10 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-WARM_UP = ("from synergrasp.simulation.closure import warm_up; warm_up()",
-           "from synergrasp.optimisation.gfo import warm_up; warm_up()")
+WARM_UP = (
+    "from synergrasp.simulation.closure import warm_up; warm_up()",
+    "from synergrasp.optimisation.gfo import warm_up; warm_up()",
+)
 
 
 def _cpu() -> float:
@@ -41,21 +43,20 @@ def set_up(commit: str) -> tuple[float, float, float, float]:
         clone = Path(work) / "repo"
         subprocess.run(["git", "clone", "-q", str(ROOT), str(clone)], check=True)
         subprocess.run(["git", "-C", str(clone), "checkout", "-q", commit], check=True)
-        env = {**os.environ, "XDG_CACHE_HOME": f"{work}/cache", "NUMBA_CACHE_DIR": f"{work}/cache/numba",
-               "PIP_NO_CACHE_DIR": "1"}
-        venv = _timed(lambda: subprocess.run(["make", "venv"], cwd=clone, env=env, check=True,
-                                             stdout=subprocess.DEVNULL))
+        env = {**os.environ, "XDG_CACHE_HOME": f"{work}/cache", "NUMBA_CACHE_DIR": f"{work}/cache/numba", "PIP_NO_CACHE_DIR": "1"}
+        venv = _timed(lambda: subprocess.run(["make", "venv"], cwd=clone, env=env, check=True, stdout=subprocess.DEVNULL))
         python = str(clone / ".venv" / "bin" / "python")
 
         def compile_() -> None:
             runs = [subprocess.Popen([python, "-c", code], cwd=clone, env=env) for code in WARM_UP]
             if any(run.wait() for run in runs):
                 raise SystemExit(f"the warm-up failed at {commit}")
+
         return (*venv, *_timed(compile_))
 
 
 def main(argv: list[str]) -> None:
-    base, new = (argv + ["cec0629", "HEAD"][len(argv):])[:2]
+    base, new = (argv + ["cec0629", "HEAD"][len(argv) :])[:2]
     pairs = int(argv[2]) if len(argv) > 2 else 1
     for pair in range(1, pairs + 1):
         for label, commit in (("base", base), ("new", new)):

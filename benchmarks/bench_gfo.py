@@ -80,8 +80,16 @@ def main() -> None:
     for grasp in grasps:
         mech = mechanics_for(grasp, params)
         if mech.rank_G == 6:
-            g = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, synergies, params.f_min_N, params.cone,
-                          params.basis_rtol)
+            g = GraspSets(
+                mech.f_p,
+                mech.normals,
+                mech.projector,
+                mech.response_norm,
+                synergies,
+                params.f_min_N,
+                params.cone,
+                params.basis_rtol,
+            )
             problems += [(g, j) for j in range(len(g))]
     pick = rng.permutation(len(problems))
 
@@ -99,16 +107,17 @@ def main() -> None:
     print(f"problems: {n} ({n_poses} grasps x {len(sets)} sets), statuses {statuses}")
     print(f"mean interior-point iterations: {out['iterations'][out['solver'] == 'ipm'].mean():.2f}")
     print(f"compiled kernel load (once per process): {t_load:.2f} s")
-    print(f"every set solved (IPMSettings(nested=False)), solves per CPU second: {n / float(np.median(every)):.0f}; "
-          f"implied by nested sets: {np.mean(out['solver'] == 'implied'):.3f} of the problems")
-    print(f"gfo_solves_per_s: {ipm_rate:.0f}  (the study's loop, solves per second, wall; mechanics, bases and "
-          f"building included; median of {args.repeats} runs of {n:,} problems, {min(walls):.2f}-{max(walls):.2f} s)")
-    print(f"gfo_solves_per_cpu_s: {n / c_ipm:.0f}  (the same loop, solves per CPU second: steadier on a loaded "
-          f"machine)")
-    print(f"clarabel_solves_per_s: {exact_rate:.0f}  (per-problem Clarabel, solves per second, "
-          f"{min(args.exact, n)} problems)")
-    print(f"cvxpy_solves_per_s: {cvxpy_rate:.1f}  (per-problem cvxpy, solves per second, "
-          f"{min(args.cvxpy, n)} problems)")
+    print(
+        f"every set solved (IPMSettings(nested=False)), solves per CPU second: {n / float(np.median(every)):.0f}; "
+        f"implied by nested sets: {np.mean(out['solver'] == 'implied'):.3f} of the problems"
+    )
+    print(
+        f"gfo_solves_per_s: {ipm_rate:.0f}  (the study's loop, solves per second, wall; mechanics, bases and "
+        f"building included; median of {args.repeats} runs of {n:,} problems, {min(walls):.2f}-{max(walls):.2f} s)"
+    )
+    print(f"gfo_solves_per_cpu_s: {n / c_ipm:.0f}  (the same loop, solves per CPU second: steadier on a loaded machine)")
+    print(f"clarabel_solves_per_s: {exact_rate:.0f}  (per-problem Clarabel, solves per second, {min(args.exact, n)} problems)")
+    print(f"cvxpy_solves_per_s: {cvxpy_rate:.1f}  (per-problem cvxpy, solves per second, {min(args.cvxpy, n)} problems)")
     print(f"gfo_speedup_vs_cvxpy: {ipm_rate / cvxpy_rate:.0f}  (the study's loop over per-problem cvxpy)")
     print(f"gfo_fallback_share: {fallback:.4f}  (share of the problems the Clarabel fallback decided)")
 

@@ -33,8 +33,12 @@ def _cpu_children() -> float:
 def run_once(args: list[str], results: Path) -> tuple[float, float]:
     """Wall and CPU seconds of one run of the command in its own process."""
     cpu, start = _cpu_children(), time.perf_counter()
-    subprocess.run([sys.executable, "-m", "synergrasp.cli", *COMMAND, "--results", str(results), *args],
-                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    subprocess.run(
+        [sys.executable, "-m", "synergrasp.cli", *COMMAND, "--results", str(results), *args],
+        check=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     return time.perf_counter() - start, _cpu_children() - cpu
 
 
@@ -65,8 +69,12 @@ def main() -> None:
         raise SystemExit(f"no finished default study under {args.results} (obj4's placement.csv): run `make study`")
     what = f"synergrasp grasp obj4 --alpha -30 --beta 0, 29 sets, warm, median of {args.runs} runs"
     with tempfile.TemporaryDirectory() as tmp:
-        variants = {"": [], "_png": ["--png", f"{tmp}/g.png"], "_html": ["--html", f"{tmp}/g.html"],
-                    "_png_html": ["--png", f"{tmp}/g.png", "--html", f"{tmp}/g.html"]}
+        variants = {
+            "": [],
+            "_png": ["--png", f"{tmp}/g.png"],
+            "_html": ["--html", f"{tmp}/g.html"],
+            "_png_html": ["--png", f"{tmp}/g.png", "--html", f"{tmp}/g.html"],
+        }
         run_once([], args.results)  # warm: the kernel's cache and the files in the page cache
         for name, extra in variants.items():
             times = [run_once(extra, args.results) for _ in range(args.runs)]
@@ -74,8 +82,10 @@ def main() -> None:
             print(f"inspector{name}_wall_s: {statistics.median(t[0] for t in times):.2f}  ({what}; {flags}: wall s)")
             print(f"inspector{name}_cpu_s: {statistics.median(t[1] for t in times):.2f}  ({what}; {flags}: CPU s)")
         wall, cpu = pages_cost(args.results, Path(tmp) / "pages")
-    print(f"grasps_3d_pages_wall_s: {wall:.2f}  (the 3-D pages of Fig. 2's 12 grasps with the full set's forces, "
-          "imports included: wall s)")
+    print(
+        f"grasps_3d_pages_wall_s: {wall:.2f}  (the 3-D pages of Fig. 2's 12 grasps with the full set's forces, "
+        "imports included: wall s)"
+    )
     print(f"grasps_3d_pages_cpu_s: {cpu:.2f}  (the same: CPU s)")
 
 

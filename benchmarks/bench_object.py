@@ -60,9 +60,19 @@ def run_object(cfg: dict, name: str, folder: Path) -> dict[str, tuple[float, str
     hand = load_hand(sim.hand)
     synergies = load_synergies(sim.synergies, joint_names=hand.joint_names)
     period = alpha_period_deg(sim.placement, sim.object.shape, hand.palm_normal)
-    result = search_object(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo,
-                           full_synergy_set(synergies.matrix, sim.full_set_size), sim.search, period, processes=1,
-                           opposition=sim.opposition)
+    result = search_object(
+        hand,
+        synergies,
+        sim.object,
+        sim.placement,
+        sim.closure,
+        sim.gfo,
+        full_synergy_set(synergies.matrix, sim.full_set_size),
+        sim.search,
+        period,
+        processes=1,
+        opposition=sim.opposition,
+    )
     tables.write_csv(tables.PLACEMENT, result.table(sim.distinct_mm), folder / "placement.csv")
     out["search"] = (time.process_time() - clock, digest((folder / "placement.csv").read_text()))
 
@@ -71,8 +81,9 @@ def run_object(cfg: dict, name: str, folder: Path) -> dict[str, tuple[float, str
     placement = params.placement
     if placement.mode == "searched":
         placement = searched_placement(placement, tables.read_csv(tables.PLACEMENT, folder / "placement.csv"))
-    contacts = closure.simulate_object(hand, params.synergies(hand.joint_names), params.object, placement,
-                                       params.closure, mechanics=params.mechanics)
+    contacts = closure.simulate_object(
+        hand, params.synergies(hand.joint_names), params.object, placement, params.closure, mechanics=params.mechanics
+    )
     tables.write(tables.CONTACTS, contacts, folder / "contacts.parquet")
     out["closure"] = (time.process_time() - clock, digest(contacts.to_json()))
 
@@ -85,8 +96,12 @@ def run_object(cfg: dict, name: str, folder: Path) -> dict[str, tuple[float, str
 
     clock = time.process_time()
     plan_params = PlanParams.from_config(cfg, name)
-    plan = plan_object(tables.read(tables.CONTACTS, folder / "contacts.parquet"),
-                       tables.read(tables.GFO, folder / "gfo.parquet"), synergies.matrix, plan_params)
+    plan = plan_object(
+        tables.read(tables.CONTACTS, folder / "contacts.parquet"),
+        tables.read(tables.GFO, folder / "gfo.parquet"),
+        synergies.matrix,
+        plan_params,
+    )
     out["plan"] = (time.process_time() - clock, digest(plan.table.to_csv() + plan.enrollment.to_csv()))
     return out
 
@@ -99,8 +114,12 @@ def main(objects: list[str]) -> None:
         with tempfile.TemporaryDirectory() as folder:
             steps = run_object(cfg, name, Path(folder))
         total = sum(cpu for cpu, _ in steps.values())
-        print(f"{name}: " + ", ".join(f"{step} {cpu:.1f} s (tables {tag})" for step, (cpu, tag) in steps.items())
-              + f"; load average {os.getloadavg()[0]:.1f}", flush=True)
+        print(
+            f"{name}: "
+            + ", ".join(f"{step} {cpu:.1f} s (tables {tag})" for step, (cpu, tag) in steps.items())
+            + f"; load average {os.getloadavg()[0]:.1f}",
+            flush=True,
+        )
         for step in STEPS:
             print(f"object_{step}_cpu_s_{name}: {steps[step][0]:.1f}  ({name}: CPU s of the {step} step, one process)")
         print(f"object_cpu_s_{name}: {total:.1f}  ({name}: CPU s of the four steps)", flush=True)

@@ -30,19 +30,32 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         for obj in checked_configuration(args.configfile)["objects"]:
             out = Path(folder) / f"{obj}.csv"
-            code = synergrasp(["plan", obj, "--on-demand", "--planner", args.planner, "--seed", str(args.seed),
-                               "--results", args.results, "--csv", str(out)]
-                               + (["--configfile", *args.configfile] if args.configfile else []))
+            code = synergrasp(
+                [
+                    "plan",
+                    obj,
+                    "--on-demand",
+                    "--planner",
+                    args.planner,
+                    "--seed",
+                    str(args.seed),
+                    "--results",
+                    args.results,
+                    "--csv",
+                    str(out),
+                ]
+                + (["--configfile", *args.configfile] if args.configfile else [])
+            )
             if code:
                 raise SystemExit(code)
             rows.append(tables.read_csv(tables.PLAN_ON_DEMAND, out).iloc[0])
     for r in rows:
-        print(f"closures_{r['object']}: {r['closures']}  ({r['planner']}, seed {r['seed']}: closures run of "
-              f"{r['n_poses']} poses)")
+        print(
+            f"closures_{r['object']}: {r['closures']}  ({r['planner']}, seed {r['seed']}: closures run of {r['n_poses']} poses)"
+        )
         print(f"closure_share_{r['object']}: {100.0 * r['closures'] / r['n_poses']:.1f}  (% of the exhaustive closures)")
         print(f"wall_s_{r['object']}: {r['wall_s']:.1f}  (the plan's wall time, closures and solves, s)")
-        print(f"regret_percent_{r['object']}: {r['regret_percent']:.2f}  (its force over the study's exhaustive "
-              f"minimum, -1, %)")
+        print(f"regret_percent_{r['object']}: {r['regret_percent']:.2f}  (its force over the study's exhaustive minimum, -1, %)")
 
 
 if __name__ == "__main__":

@@ -36,7 +36,7 @@ def main() -> None:
     rng = np.random.default_rng(0)
     sets = study_sets()
     grasps = [random_grasp(rng, int(rng.integers(4, 13)), palm_contacts=int(rng.integers(0, 2))) for _ in range(200)]
-    grasps = grasps[:args.grasps]
+    grasps = grasps[: args.grasps]
     synergies = SynergySets(random_synergies(rng), tuple(sets))
     base = replace(OptimiseParams.from_config(defaults(), "obj1").gfo, gravity_direction=(0.0, 0.0, -1.0))
     n = len(grasps) * len(sets)
@@ -60,8 +60,10 @@ def main() -> None:
         line = ", ".join(f"{m} {statistics.median(r):,.0f}" for m, r in rates.items())
         print(f"{model}: {line}; fallback share of the last method {fallback:.4f}")
         for method, rate in rates.items():
-            print(f"pairs_per_cpu_s_{model}_{method}: {statistics.median(rate):.0f}  ({model}, {method}, (pose, set) "
-                  f"pairs per CPU second with the strict test, median of {args.repeats}, {n:,} pairs)")
+            print(
+                f"pairs_per_cpu_s_{model}_{method}: {statistics.median(rate):.0f}  ({model}, {method}, (pose, set) "
+                f"pairs per CPU second with the strict test, median of {args.repeats}, {n:,} pairs)"
+            )
 
 
 if __name__ == "__main__":

@@ -47,9 +47,21 @@ def run_sweep(extra: list[str]) -> tuple[float, int, float, float]:
         config = yaml.safe_load((ROOT / "tests/config/small.yaml").read_text())
         config.update(yaml.safe_load((ROOT / "tests/config/small_sweep.yaml").read_text()))
         (Path(work) / "sweep.yaml").write_text(yaml.safe_dump(config))
-        cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "--directory", work,
-               "--configfile", str(Path(work) / "sweep.yaml"), "--replace-workflow-config", "-j2", "sensitivity",
-               *extra]
+        cmd = [
+            sys.executable,
+            "-m",
+            "snakemake",
+            "-s",
+            str(ROOT / "Snakefile"),
+            "--directory",
+            work,
+            "--configfile",
+            str(Path(work) / "sweep.yaml"),
+            "--replace-workflow-config",
+            "-j2",
+            "sensitivity",
+            *extra,
+        ]
         start, cpu, log_path = time.perf_counter(), 0.0, Path(work) / "snakemake.log"
         with open(log_path, "w") as log_file, subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=log_file) as proc:
             all_done = None
@@ -69,13 +81,21 @@ def run_sweep(extra: list[str]) -> tuple[float, int, float, float]:
 def main() -> None:
     for name, extra in SETTINGS.items():
         cpu, jobs, wall, linger = run_sweep(extra)
-        print(f"{name}: {jobs} jobs, wall {wall:.1f} s, Snakemake's own CPU {cpu:.1f} s, "
-              f"load average {os.getloadavg()[0]:.1f}", flush=True)
+        print(
+            f"{name}: {jobs} jobs, wall {wall:.1f} s, Snakemake's own CPU {cpu:.1f} s, load average {os.getloadavg()[0]:.1f}",
+            flush=True,
+        )
         suffix = "" if name == "profile" else f"_{name}"
-        print(f"snakemake_cpu_s_per_job{suffix}: {cpu / max(jobs, 1):.3f}  (Snakemake's own CPU s per job, "
-              f"small sweep, -j2, limiter: {' '.join(extra) or 'the profile'})", flush=True)
-        print(f"exit_after_last_job_s{suffix}: {linger:.1f}  (wall s from the last job's end to Snakemake's exit, "
-              f"sampled every 0.2 s)", flush=True)
+        print(
+            f"snakemake_cpu_s_per_job{suffix}: {cpu / max(jobs, 1):.3f}  (Snakemake's own CPU s per job, "
+            f"small sweep, -j2, limiter: {' '.join(extra) or 'the profile'})",
+            flush=True,
+        )
+        print(
+            f"exit_after_last_job_s{suffix}: {linger:.1f}  (wall s from the last job's end to Snakemake's exit, "
+            f"sampled every 0.2 s)",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

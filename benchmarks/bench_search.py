@@ -43,12 +43,18 @@ def main(objects: list[str], processes: int = 2) -> None:
         result = search_object_types(hand, synergies, sim, period, processes)  # the gate and the chain too
         wall, cpu = time.perf_counter() - wall, _cpu_s() - cpu
         n_poses = result.chosen.n_poses
-        print(f"{name}: {len(result.ranked)} targets x {n_poses} poses, {processes} processes: wall {wall:.1f} s, "
-              f"CPU {cpu:.1f} s ({1e3 * cpu / (len(result.ranked) * n_poses):.1f} ms per grasp), "
-              f"load average {os.getloadavg()[0]:.1f}; chosen {result.chosen.target_mm}", flush=True)
+        print(
+            f"{name}: {len(result.ranked)} targets x {n_poses} poses, {processes} processes: wall {wall:.1f} s, "
+            f"CPU {cpu:.1f} s ({1e3 * cpu / (len(result.ranked) * n_poses):.1f} ms per grasp), "
+            f"load average {os.getloadavg()[0]:.1f}; chosen {result.chosen.target_mm}",
+            flush=True,
+        )
         print(f"search_wall_s_{name}: {wall:.1f}  ({name}: wall s of the search, {processes} processes)")
-        print(f"search_cpu_s_{name}: {cpu:.1f}  ({name}: CPU s of the search's processes, {len(result.ranked)} targets x "
-              f"{n_poses} poses)", flush=True)
+        print(
+            f"search_cpu_s_{name}: {cpu:.1f}  ({name}: CPU s of the search's processes, {len(result.ranked)} targets x "
+            f"{n_poses} poses)",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

@@ -35,13 +35,19 @@ def main() -> None:
     own = [_solved_here(f) for f in gfo_files]
     distinct, own_solved = sum(d for d, _ in own), sum(r for _, r in own)
     print(f"{args.root}: {len(gfo_files)} objects, {len(bench)} optimisation jobs, {cpu:.2f} CPU s of jobs")
-    print(f"(pose, set) rows: {n} ({solved} decided by a solver, {n - solved} without a solve); "
-          f"{n / cpu:.0f} rows per CPU s, {solved / cpu:.0f} solver-decided rows per CPU s")
-    print(f"grasps solved once for all their poses: {distinct} distinct grasps; {own_solved} (pose, set) problems "
-          f"solved, {own_solved / cpu:.0f} per CPU s")
+    print(
+        f"(pose, set) rows: {n} ({solved} decided by a solver, {n - solved} without a solve); "
+        f"{n / cpu:.0f} rows per CPU s, {solved / cpu:.0f} solver-decided rows per CPU s"
+    )
+    print(
+        f"grasps solved once for all their poses: {distinct} distinct grasps; {own_solved} (pose, set) problems "
+        f"solved, {own_solved / cpu:.0f} per CPU s"
+    )
     print(f"fallback: {fallback} rows, {fallback / n:.4f} of all rows, {fallback / max(solved, 1):.4f} of the solved")
-    print(f"study_problems_per_cpu_s: {n / cpu:.0f}  (the last study's optimisation jobs, (pose, set) rows per CPU "
-          f"second, imports and I/O included)")
+    print(
+        f"study_problems_per_cpu_s: {n / cpu:.0f}  (the last study's optimisation jobs, (pose, set) rows per CPU "
+        f"second, imports and I/O included)"
+    )
     print(f"study_fallback_share: {fallback / n:.4f}  (share of the last study's rows the Clarabel fallback decided)")
 
 

@@ -36,17 +36,25 @@ def one(results: Path, copies: int) -> None:
     params = TablesParams.from_config(step_config(cfg, "tables"))
     warnings.simplefilter("ignore")
     start = time.process_time()
-    gfo = pd.concat([read(GFO, results / "objects" / o / "gfo.parquet").assign(object=f"{o}_{k}")
-                     for k in range(copies) for o in base], ignore_index=True)
-    minima = pd.concat([read(MINIMA, results / "objects" / o / "minima.parquet").assign(object=f"{o}_{k}")
-                        for k in range(copies) for o in base], ignore_index=True)
+    gfo = pd.concat(
+        [read(GFO, results / "objects" / o / "gfo.parquet").assign(object=f"{o}_{k}") for k in range(copies) for o in base],
+        ignore_index=True,
+    )
+    minima = pd.concat(
+        [read(MINIMA, results / "objects" / o / "minima.parquet").assign(object=f"{o}_{k}") for k in range(copies) for o in base],
+        ignore_index=True,
+    )
     read_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     study_tables(gfo, minima, params.synergy_sets, params.table2_k_max, params.settings)
     n = len(cfg["objects"])
-    print(f"tables_read_peak_mb_{n}_objects: {read_mb:.0f}  (peak resident MB once the {n} objects' gfo and minima "
-          f"tables are read, {len(gfo)} gfo rows)")
-    print(f"tables_peak_mb_{n}_objects: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f}  "
-          f"(peak resident MB of the study's tables over {n} objects)")
+    print(
+        f"tables_read_peak_mb_{n}_objects: {read_mb:.0f}  (peak resident MB once the {n} objects' gfo and minima "
+        f"tables are read, {len(gfo)} gfo rows)"
+    )
+    print(
+        f"tables_peak_mb_{n}_objects: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f}  "
+        f"(peak resident MB of the study's tables over {n} objects)"
+    )
     print(f"tables_cpu_s_{n}_objects: {time.process_time() - start:.1f}  (CPU s, reading and tables)")
 
 
@@ -58,8 +66,7 @@ def main(argv: list[str]) -> None:
         raise SystemExit("usage: bench_tables_memory.py --results RESULTS [M ...]")
     results = Path(argv[1])
     for copies in [int(m) for m in argv[2:]] or [1, 4, 10]:
-        run = subprocess.run([sys.executable, __file__, "--one", str(results), str(copies)], capture_output=True,
-                             text=True)
+        run = subprocess.run([sys.executable, __file__, "--one", str(results), str(copies)], capture_output=True, text=True)
         if run.returncode:
             raise SystemExit(f"{copies} copies failed:\n{run.stderr[-2000:]}")
         sys.stdout.write(run.stdout)

@@ -12,8 +12,16 @@ import pybullet as pb
 from numpy.typing import NDArray
 
 from synergrasp.hand.kinematics import Hand, write_urdf
-from synergrasp.simulation.bullet import (MM, HandBody, _exact_surface, _hand_body, _to_hand_links, collision_shape,
-                                          move_body, set_posture)
+from synergrasp.simulation.bullet import (
+    MM,
+    HandBody,
+    _exact_surface,
+    _hand_body,
+    _to_hand_links,
+    collision_shape,
+    move_body,
+    set_posture,
+)
 
 
 def load_hand_body(client: int, hand: Hand) -> HandBody:
@@ -21,9 +29,14 @@ def load_hand_body(client: int, hand: Hand) -> HandBody:
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "hand.urdf"
         write_urdf(hand, path)
-        body = pb.loadURDF(str(path), basePosition=[0, 0, 0], baseOrientation=[0, 0, 0, 1],
-                           useFixedBase=True, flags=pb.URDF_USE_INERTIA_FROM_FILE,
-                           physicsClientId=client)
+        body = pb.loadURDF(
+            str(path),
+            basePosition=[0, 0, 0],
+            baseOrientation=[0, 0, 0, 1],
+            useFixedBase=True,
+            flags=pb.URDF_USE_INERTIA_FROM_FILE,
+            physicsClientId=client,
+        )
     return _hand_body(client, body, hand)
 
 
@@ -35,18 +48,20 @@ def joint_positions(client: int, body: HandBody) -> NDArray[np.float64]:
 
 def link_frames(client: int, body: HandBody) -> NDArray[np.float64]:
     """(n_links, 4, 4) hand link frames as pybullet has them, palm frame, mm (single precision)."""
-    states = pb.getLinkStates(body.body, body.link_index[1:].tolist(), computeForwardKinematics=1,
-                              physicsClientId=client)
+    states = pb.getLinkStates(body.body, body.link_index[1:].tolist(), computeForwardKinematics=1, physicsClientId=client)
     pos = np.array([s[4] for s in states]) / MM
     x, y, z, w = np.array([s[5] for s in states]).T  # pybullet quaternions (x, y, z, w)
     out = np.zeros((body.hand.n_links, 4, 4))
     out[:, 3, 3] = 1.0
     out[0, :3, :3] = np.eye(3)
-    out[1:, :3, :3] = np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=-1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=-1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=-1),
-    ], axis=1)
+    out[1:, :3, :3] = np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=-1),
+            np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=-1),
+            np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=-1),
+        ],
+        axis=1,
+    )
     out[1:, :3, 3] = pos
     return out
 
@@ -68,8 +83,9 @@ def bullet_jacobian(client: int, body: HandBody, q: NDArray, link: int, point_mm
     values = body.joint_scale * np.asarray(q, dtype=float)[body.joint_q]
     for j, v in zip(body.joint_indices, values):
         positions[int(j)] = float(v)
-    lin, _ = pb.calculateJacobian(body.body, int(body.link_index[link]), (local * MM).tolist(),
-                                  positions, [0.0] * n, [0.0] * n, physicsClientId=client)
+    lin, _ = pb.calculateJacobian(
+        body.body, int(body.link_index[link]), (local * MM).tolist(), positions, [0.0] * n, [0.0] * n, physicsClientId=client
+    )
     lin = np.array(lin)  # (3, n) m/rad, columns in pybullet joint order
     jac = np.zeros((3, hand.n_joints))
     for j, qi, s in zip(body.joint_indices, body.joint_q, body.joint_scale):
@@ -81,8 +97,7 @@ def load_object(client: int, shape: Any, center_mm: NDArray, rotation: NDArray |
     """A static body of ``shape`` (``synergrasp.simulation.shapes``) centred at ``center_mm``
     (palm frame), oriented by the 3 × 3 rotation matrix ``rotation`` (identity if None).
     Returns its body id."""
-    body = pb.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=collision_shape(client, shape),
-                              physicsClientId=client)
+    body = pb.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=collision_shape(client, shape), physicsClientId=client)
     _exact_surface(client, body, shape)
     move_body(client, body, center_mm, rotation)
     return body
@@ -99,6 +114,5 @@ def contact_force_vectors(client: int, body_a: int | HandBody, body_b: HandBody)
     points = np.array([p[6] for p in pts]).reshape(-1, 3) / MM
     # pybullet's friction components act on B along its lateral directions: on A, opposite
     # (checked by the soft-synergy balance at rest, tests/test_dynamic_closure.py)
-    force = np.array([p[9] * np.array(p[7]) - p[10] * np.array(p[11]) - p[12] * np.array(p[13])
-                      for p in pts]).reshape(-1, 3)
+    force = np.array([p[9] * np.array(p[7]) - p[10] * np.array(p[11]) - p[12] * np.array(p[13]) for p in pts]).reshape(-1, 3)
     return links, points, force

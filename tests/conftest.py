@@ -1,5 +1,6 @@
 """Fixtures shared by the test modules: the shipped hand and its synergies, the generated
 GFO problems that the solvers are checked on, the study's GFO parameters."""
+
 import os
 
 # One BLAS thread per test process, set before numpy loads: the tests' matrices are small, and

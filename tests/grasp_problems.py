@@ -259,8 +259,9 @@ def random_gfo_problems(
             else:
                 delta = sign * math.exp(rng.uniform(math.log(near_delta[0]), math.log(near_delta[1])))
                 kind = "near_boundary"
-            problems.append(GeneratedProblem(mu=mu_star * (1.0 + delta), kind=kind, delta=float(delta), mu_star=mu_star,
-                                       **common))
+            problems.append(
+                GeneratedProblem(mu=mu_star * (1.0 + delta), kind=kind, delta=float(delta), mu_star=mu_star, **common)
+            )
     return problems
 
 

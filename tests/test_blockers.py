@@ -37,9 +37,14 @@ def hand_made(hand, contacts, motions, center):
     links = np.array([hand.link_index(name) for name, _, _ in contacts])
     J = np.zeros((3 * len(contacts), len(motions)))
     for j, (i, direction) in enumerate(motions):
-        J[3 * i:3 * i + 3, j] = direction
-    return Grasp(np.array([p for _, p, _ in contacts], dtype=float), np.array([n for _, _, n in contacts], dtype=float),
-                 links, 20.0 * J, np.asarray(center, dtype=float))
+        J[3 * i : 3 * i + 3, j] = direction
+    return Grasp(
+        np.array([p for _, p, _ in contacts], dtype=float),
+        np.array([n for _, _, n in contacts], dtype=float),
+        links,
+        20.0 * J,
+        np.asarray(center, dtype=float),
+    )
 
 
 def strict(grasp, S):
@@ -52,8 +57,12 @@ def strict(grasp, S):
 
 def test_a_box_squeezed_between_palm_and_fingers_has_no_blocker(hand, axes):
     # the palm pushes the box off the palm (+x); two fingertips close on it (-x)
-    contacts = [("palm", (20, 10, -10), X), ("palm", (20, -10, -10), X),
-                ("middle_distal", (60, 5, 10), -X), ("ring_distal", (60, -5, 10), -X)]
+    contacts = [
+        ("palm", (20, 10, -10), X),
+        ("palm", (20, -10, -10), X),
+        ("middle_distal", (60, 5, 10), -X),
+        ("ring_distal", (60, -5, 10), -X),
+    ]
     grasp = hand_made(hand, contacts, [(2, -X), (3, -X)], (40, 0, 0))
     S = np.array([[1.0, 1.0], [1.0, -1.0]]) / math.sqrt(2)  # S1 closes both, S2 one against the other
     full, s1 = set_blockers(grasp, S, [(1, 2), (1,)], PARAMS)
@@ -66,8 +75,7 @@ def test_a_box_squeezed_between_palm_and_fingers_has_no_blocker(hand, axes):
 
 
 def test_a_pinch_squeezes_and_a_rigid_motion_reaches_no_internal_force(hand, axes):
-    contacts = [("thumb_distal", (40, -20, 0), Y), ("index_distal", (40, 20, 8), -Y),
-                ("middle_distal", (40, 20, -8), -Y)]
+    contacts = [("thumb_distal", (40, -20, 0), Y), ("index_distal", (40, 20, 8), -Y), ("middle_distal", (40, 20, -8), -Y)]
     grasp = hand_made(hand, contacts, [(0, Y), (1, -Y), (2, -Y)], (40, 0, 0))
     S = np.array([[1.0, -1.0], [1.0, 1.0], [1.0, 1.0]]) / math.sqrt(3)
     pinch, rigid = set_blockers(grasp, S, [(1,), (2,)], PARAMS)
@@ -83,8 +91,13 @@ def one_sided_push(hand):
     the box face toward the palm (all pushing the box away from the palm, +x), the thumb and
     little tips on its sides. S1 curls the index and middle tips toward the palm (-x, off the
     box) and closes thumb and little on the sides; each tip has three joints (x, y, z)."""
-    contacts = [("palm", (20, 0, -15), X), ("index_distal", (20, 25, 25), X), ("middle_distal", (20, -25, 25), X),
-                ("thumb_distal", (50, -30, 0), Y), ("little_distal", (50, 30, 0), -Y)]
+    contacts = [
+        ("palm", (20, 0, -15), X),
+        ("index_distal", (20, 25, 25), X),
+        ("middle_distal", (20, -25, 25), X),
+        ("thumb_distal", (50, -30, 0), Y),
+        ("little_distal", (50, 30, 0), -Y),
+    ]
     motions = [(i, d) for i in range(1, 5) for d in (X, Y, Z)]
     grasp = hand_made(hand, contacts, motions, (50, 0, 0))
     s1 = np.zeros(len(motions))
@@ -148,10 +161,9 @@ def test_t_star_agrees_with_cvxpy_and_with_a_search_along_the_line():
         found = blocking_contacts(problem)
         # cvxpy: the tangential part without contact frames, its own canonicalisation
         y, t = cp.Variable(e), cp.Variable()
-        F = [problem.E[3 * i:3 * i + 3] @ y for i in range(m)]
+        F = [problem.E[3 * i : 3 * i + 3] @ y for i in range(m)]
         fn = [problem.normals[i] @ F[i] for i in range(m)]
-        cons = [sum(fn) == 1] + [cp.norm(F[i] - fn[i] * problem.normals[i]) <= problem.cone.mu * fn[i] - t
-                                 for i in range(m)]
+        cons = [sum(fn) == 1] + [cp.norm(F[i] - fn[i] * problem.normals[i]) <= problem.cone.mu * fn[i] - t for i in range(m)]
         cp.Problem(cp.Maximize(t), cons).solve(solver="CLARABEL")
         assert found.margin == pytest.approx(float(t.value), abs=1e-6 * max(1.0, abs(float(t.value))))
     # e_s = 2: the feasible y lie on a line; t(y) is concave on it, so a ternary search finds t*
@@ -159,8 +171,10 @@ def test_t_star_agrees_with_cvxpy_and_with_a_search_along_the_line():
         problem = random_problem(rng, 5, 2, CircularCone(1.0))
         c = np.einsum("ij,ijk->k", problem.normals, problem.E.reshape(5, 3, 2))
         y0, d = c / (c @ c), np.array([-c[1], c[0]])
+
         def t_at(s):
             return contact_margins(problem.E @ (y0 + s * d), problem).min()
+
         lo, hi = -1e4, 1e4
         for _ in range(300):
             a, b = lo + (hi - lo) / 3, hi - (hi - lo) / 3
@@ -181,8 +195,15 @@ def test_pyramid_t_star_agrees_with_a_linear_programme():
         A = np.einsum("isj,ijk->isk", faces, problem.E.reshape(m, 3, e)).reshape(-1, e)
         c = np.einsum("ij,ijk->k", problem.normals, problem.E.reshape(m, 3, e))
         # max t: a_k.E y + t <= 0, c.y = 1
-        res = linprog(np.r_[np.zeros(e), -1.0], A_ub=np.hstack([A, np.ones((A.shape[0], 1))]), b_ub=np.zeros(A.shape[0]),
-                      A_eq=np.r_[c, 0.0][None, :], b_eq=[1.0], bounds=[(None, None)] * (e + 1), method="highs")
+        res = linprog(
+            np.r_[np.zeros(e), -1.0],
+            A_ub=np.hstack([A, np.ones((A.shape[0], 1))]),
+            b_ub=np.zeros(A.shape[0]),
+            A_eq=np.r_[c, 0.0][None, :],
+            b_eq=[1.0],
+            bounds=[(None, None)] * (e + 1),
+            method="highs",
+        )
         assert res.status == 0
         assert blocking_contacts(problem).margin == pytest.approx(-res.fun, abs=1e-6)
 
@@ -191,12 +212,17 @@ def test_sets_examined_and_the_summary_counts_poses():
     sets = blocker_sets({"hierarchy_first": 3, "incremental_max": 15})
     assert list(sets) == ["1", "1-2", "1-2-3", "2", "3"]
     assert list(blocker_sets({"hierarchy_first": 3, "incremental_max": 2})) == ["1", "1-2", "2", "3"]
-    rows = pd.DataFrame({"object": ["a", "a", "a"], "set_id": ["1", "1", "2"], "reason": ["contacts", "contacts",
-                                                                                        "no_internal_force"],
-                         "margin": [-1.0, -0.5, np.nan],
-                         "blocker_link_kind": [["finger_pad", "palm"], ["finger_pad"], []],
-                         "blocker_face": [["palm_face", "palm_face"], ["side_face"], []],
-                         "blocker_feature": [["edge", "face"], ["corner"], []]})
+    rows = pd.DataFrame(
+        {
+            "object": ["a", "a", "a"],
+            "set_id": ["1", "1", "2"],
+            "reason": ["contacts", "contacts", "no_internal_force"],
+            "margin": [-1.0, -0.5, np.nan],
+            "blocker_link_kind": [["finger_pad", "palm"], ["finger_pad"], []],
+            "blocker_face": [["palm_face", "palm_face"], ["side_face"], []],
+            "blocker_feature": [["edge", "face"], ["corner"], []],
+        }
+    )
     table = blockers_summary(rows, sets).set_index(["object", "set_id"])
     assert table.loc[("a", "1"), "n_failing"] == 2
     assert table.loc[("a", "1"), "pct_kind_finger_pad"] == 100.0 and table.loc[("a", "1"), "pct_kind_palm"] == 50.0
@@ -211,16 +237,40 @@ def test_the_table_solves_twin_poses_once_and_keeps_its_contract(hand, axes, tmp
 
     grasp, S = one_sided_push(hand)
     m = grasp.n_contacts
-    row = {"object": "box", "alpha_deg": 0.0, "beta_deg": 0.0, "status": "grasp", "n_contacts": m,
-           "contact_link": grasp.links.tolist(), "contact_point": grasp.points.ravel().tolist(),
-           "contact_normal": grasp.normals.ravel().tolist(), "jacobian": grasp.jacobian.ravel().tolist(),
-           "object_center": grasp.center.tolist(), "object_rotation": np.eye(3).ravel().tolist()}
+    row = {
+        "object": "box",
+        "alpha_deg": 0.0,
+        "beta_deg": 0.0,
+        "status": "grasp",
+        "n_contacts": m,
+        "contact_link": grasp.links.tolist(),
+        "contact_point": grasp.points.ravel().tolist(),
+        "contact_normal": grasp.normals.ravel().tolist(),
+        "jacobian": grasp.jacobian.ravel().tolist(),
+        "object_center": grasp.center.tolist(),
+        "object_rotation": np.eye(3).ravel().tolist(),
+    }
     contacts = pd.DataFrame([{**row, "pose": 0}, {**row, "pose": 1, "alpha_deg": 90.0}])
     full_id = "-".join(str(k) for k in range(2, S.shape[1] + 1))
-    gfo = pd.DataFrame([{"object": "box", "pose": p, "alpha_deg": 90.0 * p, "beta_deg": 0.0, "set_id": sid,
-                         "n_synergies": n, "status": "feasible", "load_feasible": True, "force_closure_def1": ok,
-                         "rank_G": 6, "force_norm": 1.0} for p in (0, 1)
-                        for sid, n, ok in ((full_id, S.shape[1] - 1, True), ("1", 1, False))])
+    gfo = pd.DataFrame(
+        [
+            {
+                "object": "box",
+                "pose": p,
+                "alpha_deg": 90.0 * p,
+                "beta_deg": 0.0,
+                "set_id": sid,
+                "n_synergies": n,
+                "status": "feasible",
+                "load_feasible": True,
+                "force_closure_def1": ok,
+                "rank_G": 6,
+                "force_norm": 1.0,
+            }
+            for p in (0, 1)
+            for sid, n, ok in ((full_id, S.shape[1] - 1, True), ("1", 1, False))
+        ]
+    )
     box = shape_from_config({"box": {"size_mm": [60, 60, 60]}}, "test")
     params = module.BlockersParams(None, None, PARAMS, {"1": (1,)}, full_id, RULE, box)
     calls = []

@@ -1,6 +1,7 @@
 """The block bootstrap over distinct poses: blocks, weights, weighted medians, and the
 coverage of its intervals on synthetic grids with a known difference of rates, with
 independent and with spatially correlated poses."""
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -10,13 +11,15 @@ from scipy.stats import norm
 from synergrasp.analysis.bootstrap import BootstrapSettings, PoseResampler, block_index, interval, weighted_median
 
 ALPHAS = np.arange(-180.0, 180.0, 5.0)  # 72, folded to 18 by a 90 deg period
-BETAS = np.arange(-60.0, 61.0, 5.0)     # 25
+BETAS = np.arange(-60.0, 61.0, 5.0)  # 25
 A, B = np.meshgrid(ALPHAS, BETAS, indexing="ij")
 
 
 def poses(objects=("o",)) -> pd.DataFrame:
-    return pd.concat([pd.DataFrame({"object": o, "pose": np.arange(A.size), "alpha_deg": A.ravel(),
-                                    "beta_deg": B.ravel()}) for o in objects], ignore_index=True)
+    return pd.concat(
+        [pd.DataFrame({"object": o, "pose": np.arange(A.size), "alpha_deg": A.ravel(), "beta_deg": B.ravel()}) for o in objects],
+        ignore_index=True,
+    )
 
 
 def settings(seed: int = 0, resamples: int = 1000, block_deg: float = 15.0) -> BootstrapSettings:
@@ -77,17 +80,20 @@ def periodic_field(rng: np.random.Generator, sigma_cells: float) -> np.ndarray:
     in alpha (as the study's results do), correlated over about sigma_cells cells."""
     period = rng.normal(size=(18, 25))
     smooth = gaussian_filter(period, sigma_cells, mode=("wrap", "reflect"))
-    smooth /= np.sqrt((gaussian_filter(np.eye(1, 18 * 25, 212).reshape(18, 25), sigma_cells,
-                                       mode=("wrap", "reflect")) ** 2).sum())
+    smooth /= np.sqrt(
+        (gaussian_filter(np.eye(1, 18 * 25, 212).reshape(18, 25), sigma_cells, mode=("wrap", "reflect")) ** 2).sum()
+    )
     return np.tile(smooth, (4, 1))
 
 
 def test_coverage_with_independent_poses():
     """Each distinct pose succeeds with probability 0.3 (set a) and 0.2 (set b), independently:
     the true difference is 10 percentage points."""
+
     def draw(rng):
         one = rng.random((18, 25))
         return np.tile(one < 0.3, (4, 1)), np.tile(rng.random((18, 25)) < 0.2, (4, 1))
+
     assert 0.9 <= coverage(draw, 10.0) <= 0.99
 
 
@@ -96,6 +102,8 @@ def test_coverage_with_spatially_correlated_poses():
     neighbours succeed together (field correlation exp(-d^2 / (4 sigma^2)), sigma = 0.5 cell:
     0.37 at 5 deg, 0.02 at 10 deg); the true difference is 10 points. (With sigma = 1 cell,
     correlated over 15 deg, 15 deg blocks cover 0.79: docs/analyses.md.)"""
+
     def draw(rng):
         return (periodic_field(rng, 0.5) > norm.ppf(0.7)), (periodic_field(rng, 0.5) > norm.ppf(0.8))
+
     assert 0.9 <= coverage(draw, 10.0) <= 0.99

@@ -51,8 +51,25 @@ def inspection():
 @pytest.fixture(scope="module")
 def page_file(tmp_path_factory):
     out = tmp_path_factory.mktemp("page") / "grasp.html"
-    assert main(["grasp", POSE[0], "--alpha", str(POSE[1]), "--beta", str(POSE[2]), "--sets", "1-15",
-                 "--html", str(out), "--configfile", str(SMALL)]) == 0
+    assert (
+        main(
+            [
+                "grasp",
+                POSE[0],
+                "--alpha",
+                str(POSE[1]),
+                "--beta",
+                str(POSE[2]),
+                "--sets",
+                "1-15",
+                "--html",
+                str(out),
+                "--configfile",
+                str(SMALL),
+            ]
+        )
+        == 0
+    )
     return out
 
 
@@ -101,8 +118,16 @@ def test_report_pages_load_the_shared_script_beside_them(browser, inspection, tm
 
     links = inspection.contacts["link"].to_numpy()
     points = np.array(list(inspection.contacts["point_mm"]))
-    scene = GraspScene.of(inspection.hand, inspection.q_rad, _object_in_picture(inspection), links, points,
-                          inspection.sets[-1].forces_N, "{S1..S15}", "a grasp")
+    scene = GraspScene.of(
+        inspection.hand,
+        inspection.q_rad,
+        _object_in_picture(inspection),
+        links,
+        points,
+        inspection.sets[-1].forces_N,
+        "{S1..S15}",
+        "a grasp",
+    )
     write_grasp_pages(tmp_path, {"a": ("first", scene), "b": ("second", scene)}, "grasps")
     opened = browser_tool.open_page(browser, tmp_path / "b.html")
     try:

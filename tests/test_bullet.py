@@ -74,8 +74,11 @@ def test_numpy_jacobian_equals_pybullet_calculate_jacobian(sim, hand):
         frames = forward_kinematics(hand, q)
         for link in rng.choice(np.arange(1, hand.n_links), size=4, replace=False):
             point = frames[link, :3, :3] @ rng.uniform(-8, 20, size=3) + frames[link, :3, 3]
-            np.testing.assert_allclose(bullet_reference.bullet_jacobian(client, body, q, int(link), point),
-                                       point_jacobian(hand, q, int(link), point), atol=1e-3)
+            np.testing.assert_allclose(
+                bullet_reference.bullet_jacobian(client, body, q, int(link), point),
+                point_jacobian(hand, q, int(link), point),
+                atol=1e-3,
+            )
 
 
 def test_pybullet_jacobian_against_its_own_finite_differences(sim, hand):
@@ -128,8 +131,8 @@ def test_no_self_contact_at_open_hand_but_crossed_fingers_collide(sim, hand):
     bullet.set_posture(client, body, np.zeros(19))
     assert len(bullet.self_closest_points(client, body, 1.0)) == 0
     q = np.zeros(19)
-    q[JOINT_NAMES.index("index_abd")] = -math.radians(30)   # index toward the middle finger
-    q[JOINT_NAMES.index("middle_abd")] = math.radians(30)   # middle toward the index
+    q[JOINT_NAMES.index("index_abd")] = -math.radians(30)  # index toward the middle finger
+    q[JOINT_NAMES.index("middle_abd")] = math.radians(30)  # middle toward the index
     bullet.set_posture(client, body, q)
     cp = bullet.self_closest_points(client, body, 0.0)
     names = {(hand.link_names[a], hand.link_names[b]) for a, b in zip(cp.link_a, cp.link_b)}

@@ -47,8 +47,9 @@ def test_segment_segment_distance_matches_dense_sampling():
         u = np.clip((a - q0[i]) @ d / (d @ d), 0.0, 1.0)
         sampled = np.min(np.linalg.norm(a - (q0[i] + u[:, None] * d), axis=1))
         assert exact[i] <= sampled + 1e-9 and sampled - exact[i] < 0.1
-    parallel = segment_segment_distance(np.array([[0.0, 0, 0]]), np.array([[10.0, 0, 0]]),
-                                        np.array([[5.0, 3, 0]]), np.array([[15.0, 3, 0]]))
+    parallel = segment_segment_distance(
+        np.array([[0.0, 0, 0]]), np.array([[10.0, 0, 0]]), np.array([[5.0, 3, 0]]), np.array([[15.0, 3, 0]])
+    )
     np.testing.assert_allclose(parallel, [3.0])
 
 

@@ -1,4 +1,5 @@
 """The null model of minimum preservation on grids where the answer is known."""
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -6,15 +7,26 @@ import pytest
 from synergrasp.analysis.chance import allowed_offsets, identical_force_maps, preservation_vs_chance, reflected
 
 ALPHAS = np.arange(-180.0, 180.0, 5.0)  # 72
-BETAS = np.arange(-60.0, 61.0, 5.0)     # 25
+BETAS = np.arange(-60.0, 61.0, 5.0)  # 25
 
 
 def grid_table(obj: str, forces: dict[str, np.ndarray]) -> pd.DataFrame:
     """A success everywhere, one force map per set (72 x 25 poses)."""
     a, b = np.meshgrid(ALPHAS, BETAS, indexing="ij")
-    parts = [pd.DataFrame({"object": obj, "set_id": sid, "pose": np.arange(a.size), "alpha_deg": a.ravel(),
-                           "beta_deg": b.ravel(), "success": True, "success_force": f.ravel()})
-             for sid, f in forces.items()]
+    parts = [
+        pd.DataFrame(
+            {
+                "object": obj,
+                "set_id": sid,
+                "pose": np.arange(a.size),
+                "alpha_deg": a.ravel(),
+                "beta_deg": b.ravel(),
+                "success": True,
+                "success_force": f.ravel(),
+            }
+        )
+        for sid, f in forces.items()
+    ]
     return pd.concat(parts, ignore_index=True)
 
 

@@ -1,6 +1,7 @@
 """The claims' verdicts from intervals on hand-made study tables: where a claim holds, does
 not hold, is a tie, rests on too few poses or on nothing; both views of "averaged over
 objects"; forces compared like with like."""
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -11,15 +12,14 @@ from synergrasp.analysis.intervals import StudyCounts
 
 FULL = "1-2-3-4-5-6-7"
 ALPHAS = np.arange(0.0, 90.0, 5.0)  # 18
-BETAS = np.arange(0.0, 50.0, 5.0)   # 10: 180 poses, 6 x 4 blocks of 15 deg
+BETAS = np.arange(0.0, 50.0, 5.0)  # 10: 180 poses, 6 x 4 blocks of 15 deg
 N = ALPHAS.size * BETAS.size
 RULES = VerdictRules(rate_points=1.0, force_relative=0.05, min_distinct_poses=30, headline_view="per_object")
 SETTINGS = BootstrapSettings(resamples=300, seed=1, block_deg=15.0, level=0.95)
 SETS = [str(i) for i in range(1, 8)] + [f"{i}-{j}" for i in range(1, 8) for j in range(i + 1, 8)] + [FULL]
 
 
-def study(objects: dict[str, dict[str, np.ndarray]], forces: dict[str, dict[str, np.ndarray]] | None = None
-          ) -> StudyCounts:
+def study(objects: dict[str, dict[str, np.ndarray]], forces: dict[str, dict[str, np.ndarray]] | None = None) -> StudyCounts:
     """A study of objects on an 18 x 10 grid (period 360: every pose distinct); per object
     the poses (bool, length N) where each set succeeds (absent sets: nowhere; the full set:
     wherever any set does unless given) and optional forces (N) per set."""
@@ -30,16 +30,31 @@ def study(objects: dict[str, dict[str, np.ndarray]], forces: dict[str, dict[str,
         for sid in SETS:
             ok = full if sid == FULL else succeeds.get(sid, np.zeros(N, bool))
             force = (forces or {}).get(obj, {}).get(sid, np.ones(N))
-            parts.append(pd.DataFrame({"object": obj, "pose": np.arange(N), "alpha_deg": a.ravel(),
-                                       "beta_deg": b.ravel(), "set_id": sid, "success": ok,
-                                       "success_force": np.where(ok, force, np.nan)}))
+            parts.append(
+                pd.DataFrame(
+                    {
+                        "object": obj,
+                        "pose": np.arange(N),
+                        "alpha_deg": a.ravel(),
+                        "beta_deg": b.ravel(),
+                        "set_id": sid,
+                        "success": ok,
+                        "success_force": np.where(ok, force, np.nan),
+                    }
+                )
+            )
     table = pd.concat(parts, ignore_index=True)
     return StudyCounts(table, FULL, PoseResampler(table[table["set_id"] == FULL], {}, SETTINGS))
 
 
 def claims(counts: StudyCounts) -> pd.DataFrame:
-    minima = pd.DataFrame({"object": counts.objects, "n_minima": [np.zeros(counts.rows)] * len(counts.objects),
-                           "n_preserved": [np.zeros(counts.rows)] * len(counts.objects)})
+    minima = pd.DataFrame(
+        {
+            "object": counts.objects,
+            "n_minima": [np.zeros(counts.rows)] * len(counts.objects),
+            "n_preserved": [np.zeros(counts.rows)] * len(counts.objects),
+        }
+    )
     chance = pd.DataFrame({"object": ["all"], "pairs": ["all"], "null_high_percent": [30.0]})
     return claims_table(counts, minima, chance, RULES).set_index(["claim", "view"])
 
@@ -57,8 +72,7 @@ def test_interval_rules():
     assert interval_verdict(Difference(-5.0, -8.0, -2.0, **d), 30)[0] == FAILS
     assert interval_verdict(Difference(1.5, 0.5, 2.5, **d), 30) == (UNDEFINED, "interval overlaps the tie band (±1)")
     assert interval_verdict(Difference(0.0, -0.5, 0.5, **d), 30)[1].startswith("interval inside the tie band")
-    assert interval_verdict(Difference(5.0, 2.0, 8.0, band=1.0, n=29), 30) == (
-        UNDEFINED, "fewer than 30 distinct poses: 29")
+    assert interval_verdict(Difference(5.0, 2.0, 8.0, band=1.0, n=29), 30) == (UNDEFINED, "fewer than 30 distinct poses: 29")
     assert interval_verdict(Difference(5.0, 2.0, 8.0, band=1.0, n=0), 30)[1].startswith("nothing to compare")
     # a claim of equality: "reaches 100 %" (d <= 0) holds within the band, fails beyond it
     assert interval_verdict(Difference(-0.5, -0.9, 0.0, band=1.0, n=50, kind="within_below"), 30)[0] == HOLDS

@@ -38,9 +38,13 @@ def sample(hand, synergies, grid):
     base = [grid.index(a, b) for a, b in [(-180, 0), (-90, 30), (-30, -60), (5, 10), (45, 20), (10, -25)]]
     mirrored = [(p + 36 * grid.n_beta) % grid.n_poses for p in base]
     # two runs: within one, a mirrored pose would share its base pose's closure (same region)
-    tables = {box.name: pd.concat([simulate_object(hand, synergies, box, PLACEMENT, PARAMS, poses=poses)
-                                   for poses in (base, mirrored)], ignore_index=True)
-              for box in (CUBE, PLATE)}
+    tables = {
+        box.name: pd.concat(
+            [simulate_object(hand, synergies, box, PLACEMENT, PARAMS, poses=poses) for poses in (base, mirrored)],
+            ignore_index=True,
+        )
+        for box in (CUBE, PLATE)
+    }
     return base, mirrored, tables
 
 
@@ -52,6 +56,7 @@ def _grasp_rows(tables):
 
 # ------------------------------------------------------------------ placement and grid
 
+
 def test_grid_has_72_by_25_poses_and_index_round_trips(grid):
     assert (grid.n_alpha, grid.n_beta, grid.n_poses) == (72, 25, 1800)
     assert grid.angles_deg(0) == (-180.0, -60.0)
@@ -61,18 +66,21 @@ def test_grid_has_72_by_25_poses_and_index_round_trips(grid):
     assert grid.index(180.0, 0.0) == grid.index(-180.0, 0.0)  # α is periodic
 
 
-@pytest.mark.parametrize("block, key, value, message", [
-    ("placement", "box_axes", [0, 0, 2], "'placement.box_axes'"),
-    ("placement", "mode", "drop", "'placement.mode'"),
-    ("placement", "clearance_mm", -1.0, "'placement.clearance_mm'"),
-    ("placement", "approach_point_mm", [1.0, 2.0], "'placement.approach_point_mm'"),
-    ("placement", "rotation_order", "xyz", "'placement.rotation_order'"),
-    ("placement", "center_mm", [1.0, 2.0], "'placement.center_mm'"),
-    ("grid", "alpha_deg", {"start": -180, "stop": 180, "step": 5}, "'grid.alpha_deg'"),
-    ("grid", "beta_deg", {"start": -60, "stop": 61, "step": 5}, "'grid.beta_deg.step'"),
-    ("closure", "step_mm", 0.1, "'closure.step_mm'"),
-    ("closure", "tolerance_mm", 0.0, "'closure.tolerance_mm'"),
-])
+@pytest.mark.parametrize(
+    "block, key, value, message",
+    [
+        ("placement", "box_axes", [0, 0, 2], "'placement.box_axes'"),
+        ("placement", "mode", "drop", "'placement.mode'"),
+        ("placement", "clearance_mm", -1.0, "'placement.clearance_mm'"),
+        ("placement", "approach_point_mm", [1.0, 2.0], "'placement.approach_point_mm'"),
+        ("placement", "rotation_order", "xyz", "'placement.rotation_order'"),
+        ("placement", "center_mm", [1.0, 2.0], "'placement.center_mm'"),
+        ("grid", "alpha_deg", {"start": -180, "stop": 180, "step": 5}, "'grid.alpha_deg'"),
+        ("grid", "beta_deg", {"start": -60, "stop": 61, "step": 5}, "'grid.beta_deg.step'"),
+        ("closure", "step_mm", 0.1, "'closure.step_mm'"),
+        ("closure", "tolerance_mm", 0.0, "'closure.tolerance_mm'"),
+    ],
+)
 def test_bad_placement_and_closure_values_name_the_key(block, key, value, message):
     """Placement and closure values are checked once, before any job (the schema and the
     relations of the configuration); the typed classes only carry them."""
@@ -109,6 +117,7 @@ def test_alpha_and_alpha_plus_180_place_the_same_box(alpha, beta):
 
 
 # ------------------------------------------------------------------ closure
+
 
 def test_sample_has_grasps(sample):
     _, _, tables = sample
@@ -185,8 +194,7 @@ def test_one_region_one_closure_within_a_run(hand, synergies, sample, monkeypatc
     base, mirrored, tables = sample
     calls = []
     real = kinematic_closure.KinematicClosure.grasp
-    monkeypatch.setattr(kinematic_closure.KinematicClosure, "grasp",
-                        lambda self, placed: calls.append(1) or real(self, placed))
+    monkeypatch.setattr(kinematic_closure.KinematicClosure, "grasp", lambda self, placed: calls.append(1) or real(self, placed))
     both = simulate_object(hand, synergies, PLATE, PLACEMENT, PARAMS, poses=base + mirrored)
     assert len(calls) == len(base)
     n = len(base)
@@ -196,8 +204,9 @@ def test_one_region_one_closure_within_a_run(hand, synergies, sample, monkeypatc
     assert not np.allclose(np.stack(both["object_rotation"].iloc[:n]), np.stack(both["object_rotation"].iloc[n:]))
     # the shared rows are the separate closures' to round-off
     apart = tables["obj2"]
-    np.testing.assert_allclose(np.concatenate(both["contact_point"].tolist()),
-                               np.concatenate(apart["contact_point"].tolist()), atol=1e-9)
+    np.testing.assert_allclose(
+        np.concatenate(both["contact_point"].tolist()), np.concatenate(apart["contact_point"].tolist()), atol=1e-9
+    )
 
 
 def test_a_pose_alone_as_in_the_grid_is_the_grid_runs_row(hand, synergies, sample):
@@ -228,7 +237,7 @@ def test_jacobian_rows_match_finite_differences_of_fk(hand, sample):
                 fp = forward_kinematics(hand, q + h * np.eye(hand.n_joints)[j])[link]
                 fm = forward_kinematics(hand, q - h * np.eye(hand.n_joints)[j])[link]
                 fd[:, j] = ((fp[:3, :3] @ local + fp[:3, 3]) - (fm[:3, :3] @ local + fm[:3, 3])) / (2 * h)
-            np.testing.assert_allclose(jac[3 * i:3 * i + 3], fd, atol=1e-5)
+            np.testing.assert_allclose(jac[3 * i : 3 * i + 3], fd, atol=1e-5)
             checked += 1
         if checked >= 12:
             break
@@ -239,8 +248,7 @@ def test_jacobian_rows_match_finite_differences_of_fk(hand, sample):
 def empty_hand(hand, synergies):
     """Closures with nothing to grasp (the box 600 mm away)."""
     far = study_placement(mode="fixed", center_mm=(600.0, 0.0, 0.0))
-    return pd.concat([simulate_object(hand, synergies, CUBE, far, PARAMS, poses=[p]) for p in (0, 900)],
-                     ignore_index=True)
+    return pd.concat([simulate_object(hand, synergies, CUBE, far, PARAMS, poses=[p]) for p in (0, 900)], ignore_index=True)
 
 
 def test_closing_on_nothing_ends_at_limits_or_blocked_by_the_hand(hand, synergies, empty_hand):
@@ -351,16 +359,17 @@ def test_the_approach_preset_is_the_earlier_approach_bit_for_bit(hand, synergies
                 a, b = grid.angles_deg(pose)
                 placed = place_object(model.scene, model.q_open, PLACEMENT, shape, a, b)
                 turned = object_pose(PLACEMENT, shape, a, b, hand.palm_normal)
-                earlier = model.scene.bring_object(shape, turned.rotation, point, normal, model.q_open,
-                                                   PLACEMENT.clearance_mm)
+                earlier = model.scene.bring_object(shape, turned.rotation, point, normal, model.q_open, PLACEMENT.clearance_mm)
                 np.testing.assert_array_equal(placed.center_mm, earlier.center_mm)
                 np.testing.assert_array_equal(placed.rotation, earlier.rotation)
     finally:
         model.close()
 
 
-@pytest.mark.parametrize("target", [(-20.0, -9.0, 52.0), (9.5, -50.0, 20.0), (29.5, 30.0, 180.0),
-                                    (49.5, -10.0, 100.0), (9.5, 10.0, 120.0), (38.0, 5.0, 112.0)])
+@pytest.mark.parametrize(
+    "target",
+    [(-20.0, -9.0, 52.0), (9.5, -50.0, 20.0), (29.5, 30.0, 180.0), (49.5, -10.0, 100.0), (9.5, 10.0, 120.0), (38.0, 5.0, 112.0)],
+)
 def test_no_pose_is_dropped_at_any_target(hand, synergies, target):
     obj4 = GraspedObject("obj4", Box((100.0, 60.0, 100.0)), 1.0)
     placement = study_placement("obj4", mode="searched", target_mm=target)
@@ -394,8 +403,9 @@ def test_simulate_object_rejects_poses_off_the_grid(hand, synergies):
 
 def _final_rows(sample, empty_hand):
     _, _, tables = sample
-    return [row for table in [*tables.values(), empty_hand] for _, row in table.iterrows()
-            if row.status != "intersects_open_hand"]
+    return [
+        row for table in [*tables.values(), empty_hand] for _, row in table.iterrows() if row.status != "intersects_open_hand"
+    ]
 
 
 def test_every_finger_ends_in_contact_blocked_by_the_hand_or_at_its_limits(hand, synergies, sample, empty_hand):
@@ -442,6 +452,7 @@ def test_no_two_hand_links_overlap_at_the_end(hand, synergies, sample, empty_han
 
 
 # ------------------------------------------------------------------ approach placement
+
 
 def test_palm_centre_is_the_middle_of_the_palm_face(hand):
     """The shipped palm is one box: centre (-2.5, -9, 52), 24 mm thick along the palm normal x."""

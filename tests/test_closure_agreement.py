@@ -1,5 +1,6 @@
 """tools/closure_agreement.py: the agreement in distribution (per object counts against the
 band the reference's copies span), on hand-made tables."""
+
 import importlib.util
 from pathlib import Path
 
@@ -13,8 +14,14 @@ SPEC.loader.exec_module(closure_agreement)
 
 def table(grasps: int, verdicts: int, n: int = 60) -> pd.DataFrame:
     """One object, n poses: the first ``grasps`` are grasps, the first ``verdicts`` of them force closure."""
-    return pd.DataFrame({"object": "obj", "pose": range(n), "status": ["grasp"] * grasps + ["lost"] * (n - grasps),
-                         "force_closure": [True] * verdicts + [False] * (n - verdicts)})
+    return pd.DataFrame(
+        {
+            "object": "obj",
+            "pose": range(n),
+            "status": ["grasp"] * grasps + ["lost"] * (n - grasps),
+            "force_closure": [True] * verdicts + [False] * (n - verdicts),
+        }
+    )
 
 
 def band(table: pd.DataFrame, count: str) -> pd.Series:
@@ -28,8 +35,10 @@ def test_band_is_the_copies_range_widened_by_one_binomial_standard_error():
     assert (result["copies_min"], result["copies_max"]) == (10, 14)
     assert result["band_low"] == pytest.approx(10 - 2.9241, abs=1e-3)
     assert result["band_high"] == pytest.approx(14 + 3.2973, abs=1e-3)
-    inside = {k: bool(band(closure_agreement.distribution_agreement(table(k, 0), copies), "grasps")["agrees"])
-              for k in (6, 7, 8, 17, 18)}
+    inside = {
+        k: bool(band(closure_agreement.distribution_agreement(table(k, 0), copies), "grasps")["agrees"])
+        for k in (6, 7, 8, 17, 18)
+    }
     assert inside == {6: False, 7: False, 8: True, 17: True, 18: False}
 
 
@@ -48,7 +57,10 @@ def test_every_object_is_judged():
     moved = pd.concat([table(10, 5), table(20, 30).assign(object="obj2")], ignore_index=True)
     result = closure_agreement.distribution_agreement(moved, [two])
     assert result[["object", "count", "agrees"]].values.tolist() == [
-        ["obj", "grasps", True], ["obj", "force_closure", True],
-        ["obj2", "grasps", False], ["obj2", "force_closure", True]]
+        ["obj", "grasps", True],
+        ["obj", "force_closure", True],
+        ["obj2", "grasps", False],
+        ["obj2", "force_closure", True],
+    ]
     with pytest.raises(ValueError, match="at least one copy"):
         closure_agreement.distribution_agreement(two, [])

@@ -32,8 +32,11 @@ def _group_of(rel: str):
 
 
 def test_every_module_with_compiled_functions_is_in_a_group():
-    with_compiled = {str(p.relative_to(PACKAGE)) for p in PACKAGE.rglob("*.py")
-                     if _COMPILED.search(p.read_text()) and p.name != "compiled_cache.py"}
+    with_compiled = {
+        str(p.relative_to(PACKAGE))
+        for p in PACKAGE.rglob("*.py")
+        if _COMPILED.search(p.read_text()) and p.name != "compiled_cache.py"
+    }
     assert with_compiled == {f for g in GROUPS for f in g.files}
     assert all(f.count("/") >= 1 and (PACKAGE / f).is_file() for g in GROUPS for f in g.files)
 
@@ -55,8 +58,7 @@ def test_a_module_importing_another_groups_compiled_module_is_in_that_group():
 def test_every_compiled_function_is_cached_by_its_groups_sources(group):
     for rel in group.files:
         module = _module(rel)
-        dispatchers = [d for d in vars(module).values()
-                       if hasattr(d, "py_func") and d.py_func.__module__ == module.__name__]
+        dispatchers = [d for d in vars(module).values() if hasattr(d, "py_func") and d.py_func.__module__ == module.__name__]
         assert dispatchers or rel.endswith("compiled.py"), rel
         for d in dispatchers:
             assert d._cache.cache_path == str(group.cache_dir()), (rel, d.py_func.__name__)

@@ -1,5 +1,6 @@
 """The one config model: defaults from the schema, the overlay rule, every check before any
 job (one message naming the key) and scenarios."""
+
 import copy
 import math
 from pathlib import Path
@@ -91,8 +92,11 @@ def _broken(path, value, config=SMALL):
         (("synergy_sets", "incremental_max"), 16, "exceeds the 15 synergies"),
         (("hand",), "", "'hand': '' should be non-empty"),
         # issue 12, defect 1: relations between values, before any job
-        (("grid", "alpha_deg"), {"start": -180, "stop": 150, "step": 25},
-         "'grid.alpha_deg.step': 25 does not divide stop - start (330)"),
+        (
+            ("grid", "alpha_deg"),
+            {"start": -180, "stop": 150, "step": 25},
+            "'grid.alpha_deg.step': 25 does not divide stop - start (330)",
+        ),
         (("grid", "beta_deg"), {"start": 60, "stop": -60, "step": 20}, "'grid.beta_deg.stop': -60 is below start"),
         (("grid", "alpha_deg"), {"start": -180, "stop": 180, "step": 30}, "'grid.alpha_deg': alpha is periodic"),
         (("closure", "contact_distance_mm"), 0.1, "'closure.contact_distance_mm': 0.1 must be at least closure.tolerance_mm"),
@@ -108,12 +112,21 @@ def _broken(path, value, config=SMALL):
         # defect 7: a fractional number where an integer is expected
         (("solver", "pose_shards"), 2.5, "'solver.pose_shards': 2.5 is not of type 'integer'"),
         # issue 48, kind 8: a value matching no form of a oneOf names the closest form's error
-        (("placement", "search", "region_mm", "power"), {"x": [0, 10, 20], "y": [0, 10], "z": [0, 10]},
-         "config error at 'placement.search.region_mm.power.x': [0, 10, 20] is too long"),
-        (("placement", "search", "region_mm", "power"), {"x": [0, 10], "y": [0, 10]},
-         "config error at 'placement.search.region_mm.power': 'z' is a required property"),
-        (("placement", "search", "region_mm", "power"), "hands",
-         "config error at 'placement.search.region_mm.power': 'hands' is not allowed; allowed values: ['hand']"),
+        (
+            ("placement", "search", "region_mm", "power"),
+            {"x": [0, 10, 20], "y": [0, 10], "z": [0, 10]},
+            "config error at 'placement.search.region_mm.power.x': [0, 10, 20] is too long",
+        ),
+        (
+            ("placement", "search", "region_mm", "power"),
+            {"x": [0, 10], "y": [0, 10]},
+            "config error at 'placement.search.region_mm.power': 'z' is a required property",
+        ),
+        (
+            ("placement", "search", "region_mm", "power"),
+            "hands",
+            "config error at 'placement.search.region_mm.power': 'hands' is not allowed; allowed values: ['hand']",
+        ),
     ],
 )
 def test_bad_values_name_the_key(path, value, expected):
@@ -122,12 +135,23 @@ def test_bad_values_name_the_key(path, value, expected):
     assert expected in str(info.value)
 
 
-@pytest.mark.parametrize("path", [("mechanics", "mu"), ("closure", "step_mm"), ("grid", "alpha_deg", "step"),
-                                  ("analyses", "minima_radius_deg"), ("objects", "obj1", "mass_kg")])
+@pytest.mark.parametrize(
+    "path",
+    [
+        ("mechanics", "mu"),
+        ("closure", "step_mm"),
+        ("grid", "alpha_deg", "step"),
+        ("analyses", "minima_radius_deg"),
+        ("objects", "obj1", "mass_kg"),
+    ],
+)
 @pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf])
 def test_nan_and_inf_are_rejected_wherever_a_number_is_expected(path, value):
-    with pytest.raises(ConfigError, match=rf"config error at '{'.'.join(path)}': {value} is not allowed; "
-                                          "a finite number is required"):
+    with pytest.raises(
+        ConfigError,
+        match=rf"config error at '{'.'.join(path)}': {value} is not allowed; "
+        "a finite number is required",
+    ):
         validate_config(_broken(path, value))
 
 
@@ -193,10 +217,14 @@ def _with_scenarios(scenarios):
 
 
 def test_scenarios_are_overlays_of_the_main_config():
-    configs = scenario_configs(_with_scenarios({
-        "mu1": {"mechanics": {"mu": 1.0}},
-        "one_object": {"objects": {"obj4": None}},
-    }))
+    configs = scenario_configs(
+        _with_scenarios(
+            {
+                "mu1": {"mechanics": {"mu": 1.0}},
+                "one_object": {"objects": {"obj4": None}},
+            }
+        )
+    )
     assert list(configs) == ["default", "mu1", "one_object"]
     assert configs["mu1"]["mechanics"]["mu"] == 1.0 and configs["default"]["mechanics"]["mu"] == 1.5
     assert configs["mu1"]["mechanics"]["f_min_N"] == 0.1
@@ -212,17 +240,22 @@ def test_a_scenario_set_to_null_by_an_overlay_is_removed():
     assert list(validate_config(merged)["scenarios"]) == ["kss"]
 
 
-@pytest.mark.parametrize("scenarios, expected", [
-    ({"s1": {"mechanics": {"muu": 1.0}}}, "scenario 's1': config error at 'mechanics': unknown key(s) ['muu']"),
-    ({"s1": {"closure": {"step_mm": math.nan}}}, "scenario 's1': config error at 'closure.step_mm': nan"),
-    ({"s1": {"grid": {"alpha_deg": {"step": 25}}}}, "scenario 's1': config error at 'grid.alpha_deg.step'"),
-    ({"s1": {"scenarios": {"s2": {}}}}, "scenario 's1': config error at 'scenarios'"),
-    ({"default": {"mechanics": {"mu": 1.0}}}, "config error at 'scenarios': name 'default' is not allowed"),
-    ({"a b": {}}, "config error at 'scenarios': name 'a b' is not allowed"),
-    ({"s1": 3}, "config error at 'scenarios.s1': 3 is not of type 'object'"),
-    ({"s1": {"random_objects": {"n_objects": 3}}},
-     "scenario 's1': config error at 'scenarios.s1.random_objects': a scenario cannot draw objects of its own"),
-])
+@pytest.mark.parametrize(
+    "scenarios, expected",
+    [
+        ({"s1": {"mechanics": {"muu": 1.0}}}, "scenario 's1': config error at 'mechanics': unknown key(s) ['muu']"),
+        ({"s1": {"closure": {"step_mm": math.nan}}}, "scenario 's1': config error at 'closure.step_mm': nan"),
+        ({"s1": {"grid": {"alpha_deg": {"step": 25}}}}, "scenario 's1': config error at 'grid.alpha_deg.step'"),
+        ({"s1": {"scenarios": {"s2": {}}}}, "scenario 's1': config error at 'scenarios'"),
+        ({"default": {"mechanics": {"mu": 1.0}}}, "config error at 'scenarios': name 'default' is not allowed"),
+        ({"a b": {}}, "config error at 'scenarios': name 'a b' is not allowed"),
+        ({"s1": 3}, "config error at 'scenarios.s1': 3 is not of type 'object'"),
+        (
+            {"s1": {"random_objects": {"n_objects": 3}}},
+            "scenario 's1': config error at 'scenarios.s1.random_objects': a scenario cannot draw objects of its own",
+        ),
+    ],
+)
 def test_a_bad_scenario_names_the_scenario_and_the_key(scenarios, expected):
     with pytest.raises(ConfigError) as info:
         scenario_configs(_with_scenarios(scenarios))
@@ -231,17 +264,19 @@ def test_a_bad_scenario_names_the_scenario_and_the_key(scenarios, expected):
 
 # ----------------------------------------------------------------------------- steps
 
+
 def test_every_key_of_the_schema_is_described_in_config_readme():
     text = (ROOT / "config" / "README.md").read_text()
+
     def documented(path):  # the key itself or the block it belongs to has a row
         parts = path.replace("objects.*.", "objects.<name>.").split(".")
         return any(f"| `{'.'.join(parts[:n])}` |" in text for n in range(len(parts), 0, -1))
+
     missing = [p for p in schema_leaf_paths() if not documented(p)]
     assert missing == []
 
 
 # ----------------------------------------------------------------------------- the workflow's view
-
 
 
 def test_a_synergy_table_that_cannot_close_the_hand_or_is_not_in_rad_is_named():
@@ -251,8 +286,9 @@ def test_a_synergy_table_that_cannot_close_the_hand_or_is_not_in_rad_is_named():
     mean, matrix = [0.1, 0.2], [[0.5, 0.1], [0.2, 0.0]]
     assert synergy_problems(config, mean, matrix) == []
     zero_s1 = synergy_problems(config, mean, [[0.0, 0.1], [0.0, 0.0]])
-    assert zero_s1 == ["config error at 'synergies' (the shipped table): S1 is zero for every joint; "
-                       "closing along S1 would move no joint"]
+    assert zero_s1 == [
+        "config error at 'synergies' (the shipped table): S1 is zero for every joint; closing along S1 would move no joint"
+    ]
     degrees = synergy_problems({**config, "synergies": "mine.csv"}, [10.0, 45.0], matrix)
     assert len(degrees) == 1 and "'synergies' (mine.csv): values up to 45 exceed 2π" in degrees[0]
     assert "exceed 2π" in synergy_problems(config, mean, [[1e300, 0.1], [0.2, 0.0]])[0]

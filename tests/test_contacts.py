@@ -11,14 +11,28 @@ from synergrasp.simulation.contacts import load_carrying_contacts
 
 def _row(pose: int, links: list[int], loads: list[float], status: str = "grasp") -> dict:
     m = len(links)
-    return {"object": "a", "pose": pose, "alpha_deg": 0.0, "beta_deg": 0.0, "status": status,
-            "q": [0.0] * 19, "finger_state": ["contact"] * 5, "n_contacts": m, "contact_link": links,
-            "contact_point": [float(10 * k + c) for k in range(m) for c in range(3)],
-            "contact_normal": [1.0, 0.0, 0.0] * m,
-            "jacobian": [float(100 * r + c) for r in range(3 * m) for c in range(19)],
-            "object_center": [0.0] * 3, "object_rotation": list(np.eye(3).ravel()), "max_penetration_mm": 0.1,
-            "closure_model": "dynamic", "contact_normal_force_N": loads, "object_translation_mm": [0.0] * 3,
-            "object_rotation_deg": 0.0, "settled": True}
+    return {
+        "object": "a",
+        "pose": pose,
+        "alpha_deg": 0.0,
+        "beta_deg": 0.0,
+        "status": status,
+        "q": [0.0] * 19,
+        "finger_state": ["contact"] * 5,
+        "n_contacts": m,
+        "contact_link": links,
+        "contact_point": [float(10 * k + c) for k in range(m) for c in range(3)],
+        "contact_normal": [1.0, 0.0, 0.0] * m,
+        "jacobian": [float(100 * r + c) for r in range(3 * m) for c in range(19)],
+        "object_center": [0.0] * 3,
+        "object_rotation": list(np.eye(3).ravel()),
+        "max_penetration_mm": 0.1,
+        "closure_model": "dynamic",
+        "contact_normal_force_N": loads,
+        "object_translation_mm": [0.0] * 3,
+        "object_rotation_deg": 0.0,
+        "settled": True,
+    }
 
 
 def _table(rows: list[dict]) -> pd.DataFrame:

@@ -1,4 +1,5 @@
 """The documentation generated from the code agrees with it."""
+
 import importlib.util
 from pathlib import Path
 
@@ -26,8 +27,13 @@ def test_every_doc_the_docs_cite_exists():
     import re
 
     cited = set()
-    for path in [*ROOT.glob("*.md"), *(ROOT / "docs").glob("*.md"), *(ROOT / "config").glob("*"),
-                 *(ROOT / "src").rglob("*.py"), *(ROOT / "workflow").rglob("*")]:
+    for path in [
+        *ROOT.glob("*.md"),
+        *(ROOT / "docs").glob("*.md"),
+        *(ROOT / "config").glob("*"),
+        *(ROOT / "src").rglob("*.py"),
+        *(ROOT / "workflow").rglob("*"),
+    ]:
         if path.is_file():
             cited |= set(re.findall(r"docs/([a-z_]+\.md)", path.read_text(errors="ignore")))
     assert cited and not [name for name in cited if not (ROOT / "docs" / name).is_file()]
@@ -41,10 +47,14 @@ def test_measurements_page_is_what_the_tool_writes_from_the_committed_files():
 
     page = (ROOT / "docs" / "measurements.md").read_text()
     assert _tool("measurements").page() == page
-    anchors = {re.sub(r"[^a-z0-9 -]", "", title.lower()).replace(" ", "-")
-               for title in re.findall(r"^## (.+)$", page, flags=re.M)}
-    linked = {anchor for path in [*ROOT.glob("*.md"), *(ROOT / "docs").glob("*.md")]
-              for anchor in re.findall(r"measurements\.md#([a-z0-9-]+)", path.read_text())}
+    anchors = {
+        re.sub(r"[^a-z0-9 -]", "", title.lower()).replace(" ", "-") for title in re.findall(r"^## (.+)$", page, flags=re.M)
+    }
+    linked = {
+        anchor
+        for path in [*ROOT.glob("*.md"), *(ROOT / "docs").glob("*.md")]
+        for anchor in re.findall(r"measurements\.md#([a-z0-9-]+)", path.read_text())
+    }
     assert "closure" in anchors and not linked - anchors
 
 
@@ -53,8 +63,9 @@ def test_every_module_of_the_package_is_in_design_md():
     described where a contributor looks for it)."""
     text = (ROOT / "docs" / "design.md").read_text()
     package = ROOT / "src" / "synergrasp"
-    modules = ["/".join(p.relative_to(package).with_suffix("").parts) for p in sorted(package.rglob("*.py"))
-               if p.name != "__init__.py"]
+    modules = [
+        "/".join(p.relative_to(package).with_suffix("").parts) for p in sorted(package.rglob("*.py")) if p.name != "__init__.py"
+    ]
     missing = [m for m in modules if f"| `{m}` |" not in text]
     assert len(modules) > 50 and missing == []
 
@@ -64,20 +75,29 @@ _COST_TIME = r"[0-9](?:[.,][0-9]+)?\s?(?:µs|us|ms|min|minutes?|h|hours?|CPU ?(?
 #: A number of seconds: a cost when words of _COST_WORDS are near it, else a model parameter.
 _SECONDS = r"[0-9](?:[.,][0-9]+)?\s?(?:s|sec|seconds?)\b"
 #: A rate of work (solves per second, pairs per CPU s, 3× faster): a cost whatever its unit.
-_RATE = (r"[0-9][0-9,.]*(?:\s?[→–-]\s?[0-9][0-9,.]*)?\s+(?:\S+\s+){0,3}?(?:per (?:CPU )?s(?:econd)?\b|solves/s\b)"
-         r"|[0-9] ?(?:×|x) (?:faster|slower|cheaper|dearer)\b")
+_RATE = (
+    r"[0-9][0-9,.]*(?:\s?[→–-]\s?[0-9][0-9,.]*)?\s+(?:\S+\s+){0,3}?(?:per (?:CPU )?s(?:econd)?\b|solves/s\b)"
+    r"|[0-9] ?(?:×|x) (?:faster|slower|cheaper|dearer)\b"
+)
 #: Words that make seconds a cost (what the software spends), not a parameter.
-_COST_WORDS = (r"\bCPU\b|\bwall\b|per (?:grasp|job|pose|problem|posture|target|shard)\b|\btook\b"
-               r"|\bcosts?\b|\bruns? in\b|\bfaster\b|\bslower\b|\bspeed-?ups?\b|\bbenchmark|\bprofil|\bload average\b"
-               r"|\bcores?\b|\bimports?\b|\bjobs?\b")
+_COST_WORDS = (
+    r"\bCPU\b|\bwall\b|per (?:grasp|job|pose|problem|posture|target|shard)\b|\btook\b"
+    r"|\bcosts?\b|\bruns? in\b|\bfaster\b|\bslower\b|\bspeed-?ups?\b|\bbenchmark|\bprofil|\bload average\b"
+    r"|\bcores?\b|\bimports?\b|\bjobs?\b"
+)
 #: A commit hash: 7-40 hex digits with at least one letter and one digit, as a word.
 _COMMIT = r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}\b"
 
 
 def _markdown_pages():
-    pages = [ROOT / "README.md", ROOT / "config" / "README.md", *(ROOT / "docs").glob("*.md"),
-             *(ROOT / "docs" / "figures").glob("*.md"), *(ROOT / "config" / "examples").rglob("README.md"),
-             *(ROOT / "src" / "synergrasp" / "data").rglob("README.md")]
+    pages = [
+        ROOT / "README.md",
+        ROOT / "config" / "README.md",
+        *(ROOT / "docs").glob("*.md"),
+        *(ROOT / "docs" / "figures").glob("*.md"),
+        *(ROOT / "config" / "examples").rglob("README.md"),
+        *(ROOT / "src" / "synergrasp" / "data").rglob("README.md"),
+    ]
     return sorted(p for p in pages if p.name != "measurements.md" or p.parent.name != "docs")
 
 
@@ -91,7 +111,7 @@ def _sections(path):
             section = line.strip()
         if line.startswith("|") and not (number > 1 and lines[number - 2].startswith("|")):
             header = line
-        context = " ".join(lines[max(number - 2, 0):number + 1]) + (header if line.startswith("|") else "")
+        context = " ".join(lines[max(number - 2, 0) : number + 1]) + (header if line.startswith("|") else "")
         yield section, number, line, context
 
 
@@ -121,8 +141,12 @@ def test_docs_state_no_cost_and_no_commit():
         name = path.relative_to(ROOT).as_posix()
         for section, number, line, context in _sections(path):
             words = re.sub(r"\S*/\S*", "", context)
-            if (re.search(_COST_TIME, line) or re.search(_RATE, line)
-                    or re.search(_SECONDS, line) and re.search(_COST_WORDS, words, flags=re.I)):
+            if (
+                re.search(_COST_TIME, line)
+                or re.search(_RATE, line)
+                or re.search(_SECONDS, line)
+                and re.search(_COST_WORDS, words, flags=re.I)
+            ):
                 found.append(f"{name}:{number}: cost: {line.strip()}")
             changelog = name == "docs/placement_search.md" and section == "## Changes since pre-registration"
             if re.search(_COMMIT, line) and not changelog:
@@ -146,20 +170,96 @@ def test_readme_lists_every_page_of_docs():
 # --------------------------------------------------------------------------- names the docs cite
 
 #: Names the docs cite that belong to other packages (a module or object of theirs first).
-_OTHER_PACKAGES = {"np", "numpy", "pd", "pandas", "scipy", "pybullet", "mujoco", "plotly", "time", "os", "snakemake",
-                   "matplotlib", "numba", "cvxpy", "clarabel", "piqp", "json", "yaml", "re", "math", "shutil",
-                   "threading", "importlib", "subprocess", "pytest", "sys", "pathlib", "warnings", "jsonschema"}
+_OTHER_PACKAGES = {
+    "np",
+    "numpy",
+    "pd",
+    "pandas",
+    "scipy",
+    "pybullet",
+    "mujoco",
+    "plotly",
+    "time",
+    "os",
+    "snakemake",
+    "matplotlib",
+    "numba",
+    "cvxpy",
+    "clarabel",
+    "piqp",
+    "json",
+    "yaml",
+    "re",
+    "math",
+    "shutil",
+    "threading",
+    "importlib",
+    "subprocess",
+    "pytest",
+    "sys",
+    "pathlib",
+    "warnings",
+    "jsonschema",
+}
 #: Variables the docs name the members of (an object, not a module): `hand.point_jacobian` is a
 #: method of a `Hand` called ``hand``, `params.cone` a field of a problem's parameters.
 #: `W.step_input` a method of the `Wiring` common.smk calls ``W``; `palm.shapes` a hand file's field;
 #: `ipm_solver` the name gfo.py imports ``ipm.solver`` as.
-_OBJECTS = {"hand", "params", "problem", "problems", "self", "out", "snakemake", "spec", "cfg", "config", "grasp",
-            "rule", "job", "workflow", "wildcards", "W", "palm", "fingers", "cp", "table", "settings", "result",
-            "GROUP", "ipm_solver"}
+_OBJECTS = {
+    "hand",
+    "params",
+    "problem",
+    "problems",
+    "self",
+    "out",
+    "snakemake",
+    "spec",
+    "cfg",
+    "config",
+    "grasp",
+    "rule",
+    "job",
+    "workflow",
+    "wildcards",
+    "W",
+    "palm",
+    "fingers",
+    "cp",
+    "table",
+    "settings",
+    "result",
+    "GROUP",
+    "ipm_solver",
+}
 _FILE_SUFFIXES = (".py", ".smk")
 #: Other files the docs name (outputs, data, pages): not checked.
-_DATA_SUFFIXES = {"md", "yaml", "csv", "toml", "lock", "html", "png", "pdf", "parquet", "js", "json", "rst", "txt", "tsv",
-                  "zip", "dot", "sh", "obj", "stl", "urdf", "xml", "svg", "log", "cfg", "dae"}
+_DATA_SUFFIXES = {
+    "md",
+    "yaml",
+    "csv",
+    "toml",
+    "lock",
+    "html",
+    "png",
+    "pdf",
+    "parquet",
+    "js",
+    "json",
+    "rst",
+    "txt",
+    "tsv",
+    "zip",
+    "dot",
+    "sh",
+    "obj",
+    "stl",
+    "urdf",
+    "xml",
+    "svg",
+    "log",
+    "cfg",
+    "dae",
+}
 
 
 def _doc_texts():
@@ -212,13 +312,14 @@ def _defines(path: Path, name: str) -> bool:
 
     if path.name == "__init__.py" and ((path.parent / f"{name}.py").is_file() or (path.parent / name).is_dir()):
         return True
-    pattern = (rf"^\s*(?:def|class)\s+{name}\b|^\s*{name}\s*[:=]|^\s*from\s+\S+\s+import\s+[^(\n]*\b{name}\b"
-               rf"|^\s+{name},?\s*(?:#.*)?$|\b{name}\s*=\s*|namedtuple\([^)]*\b{name}\b")  # an import block's line
+    pattern = (
+        rf"^\s*(?:def|class)\s+{name}\b|^\s*{name}\s*[:=]|^\s*from\s+\S+\s+import\s+[^(\n]*\b{name}\b"
+        rf"|^\s+{name},?\s*(?:#.*)?$|\b{name}\s*=\s*|namedtuple\([^)]*\b{name}\b"
+    )  # an import block's line
     return re.search(pattern, path.read_text(), flags=re.M) is not None
 
 
-def stale_names(text: str, modules: dict[tuple[str, ...], Path], schema: set[tuple[str, ...]],
-                files: set[str]) -> list[str]:
+def stale_names(text: str, modules: dict[tuple[str, ...], Path], schema: set[tuple[str, ...]], files: set[str]) -> list[str]:
     """The backticked names in ``text`` that name nothing of the code: a ``.py`` or ``.smk`` file
     no folder of the checkout holds; a dotted name (``optimise.optimise_grasps``,
     ``synergrasp.wiring.Wiring``, ``Wiring.step_file``) whose leading parts are no module of
@@ -240,7 +341,7 @@ def stale_names(text: str, modules: dict[tuple[str, ...], Path], schema: set[tup
             parts = parts[1:]
         elif parts[0] in _OTHER_PACKAGES | _OBJECTS:
             continue
-        if any(parts == path[-len(parts):] for path in schema if len(path) >= len(parts)):
+        if any(parts == path[-len(parts) :] for path in schema if len(path) >= len(parts)):
             continue  # a configuration key
         if parts[0][:1].isupper():  # Class.member: the class is defined once, the member in it
             owners = [p for p in modules.values() if re.search(rf"^(?:class {parts[0]}\b|{parts[0]} = )", p.read_text(), re.M)]
@@ -280,20 +381,30 @@ def test_every_module_file_and_name_the_code_cites_exists():
     sources = [ROOT / "Snakefile", *(ROOT / "workflow").rglob("*.smk"), *(ROOT / "profiles").rglob("*.yaml")]
     for folder in ("src", "benchmarks", "tools", "workflow"):
         sources += (ROOT / folder).rglob("*.py")
-    found = {p.relative_to(ROOT).as_posix(): stale for p in sorted(sources)
-             if (stale := stale_names(p.read_text().replace("``", "`"), modules, schema, files))}
+    found = {
+        p.relative_to(ROOT).as_posix(): stale
+        for p in sorted(sources)
+        if (stale := stale_names(p.read_text().replace("``", "`"), modules, schema, files))
+    }
     assert len(sources) > 100 and found == {}
 
 
 def test_a_planted_stale_name_is_found():
     modules, schema, files = _modules(), _schema_paths(), _file_names()
-    planted = ("the step (`study.py`) runs `study.optimise_grasps`; rules in `resources.smk`; "
-               "`optimise.optimise_grasps`, `gfo.solve_gfo`, `Wiring.step_file`, `placement.search.distinct_mm`, "
-               "`synergrasp.wiring.code_files`, `np.linalg.svd` and `hand.point_jacobian` exist; "
-               "`gfo.solve_everything`, `Wiring.no_such_member` and `synergrasp.studies` do not")
+    planted = (
+        "the step (`study.py`) runs `study.optimise_grasps`; rules in `resources.smk`; "
+        "`optimise.optimise_grasps`, `gfo.solve_gfo`, `Wiring.step_file`, `placement.search.distinct_mm`, "
+        "`synergrasp.wiring.code_files`, `np.linalg.svd` and `hand.point_jacobian` exist; "
+        "`gfo.solve_everything`, `Wiring.no_such_member` and `synergrasp.studies` do not"
+    )
     assert stale_names(planted, modules, schema, files) == [
-        "study.py", "study.optimise_grasps", "resources.smk", "gfo.solve_everything", "Wiring.no_such_member",
-        "synergrasp.studies"]
+        "study.py",
+        "study.optimise_grasps",
+        "resources.smk",
+        "gfo.solve_everything",
+        "Wiring.no_such_member",
+        "synergrasp.studies",
+    ]
 
 
 def _status_values() -> set[str]:
@@ -314,15 +425,15 @@ def stale_statuses(text: str, known: set[str]) -> list[str]:
 
     flat = re.sub(r"\s+", " ", text)
     found = []
-    for listed in re.findall(r"\bstatus(?:es)?\b(?: (?:to|is|are|of|as|becomes))?:? ((?:`\w+`(?:, | or | and )?)+)",
-                             flat):
+    for listed in re.findall(r"\bstatus(?:es)?\b(?: (?:to|is|are|of|as|becomes))?:? ((?:`\w+`(?:, | or | and )?)+)", flat):
         found += [value for value in re.findall(r"`(\w+)`", listed) if value not in known]
     return found
 
 
 def test_every_status_the_docs_give_is_one_the_code_writes():
     known = _status_values()
-    assert stale_statuses("mapping its statuses to `force_closure`, `infeasible` or `numerical_failure`", known) \
-        == ["force_closure"]
+    assert stale_statuses("mapping its statuses to `force_closure`, `infeasible` or `numerical_failure`", known) == [
+        "force_closure"
+    ]
     found = {name: stale for name, text in _doc_texts().items() if (stale := stale_statuses(text, known))}
     assert found == {}

@@ -44,13 +44,17 @@ def test_settings_name_the_key_and_allowed_values():
     """The dynamic settings are checked once, by the schema and the relations of the config."""
     with pytest.raises(ConfigError, match=r"'closure.model': 'soft' is not allowed; allowed values: \['kinematic', 'dynamic'\]"):
         validate_config({**defaults(), "closure": {**defaults()["closure"], "model": "soft"}})
-    with pytest.raises(ConfigError,
-                       match=r"'closure.dynamic.unloaded_contacts': 'ignore' is not allowed; allowed values: \['drop', 'keep'\]"):
+    with pytest.raises(
+        ConfigError, match=r"'closure.dynamic.unloaded_contacts': 'ignore' is not allowed; allowed values: \['drop', 'keep'\]"
+    ):
         validate_config(_with_dynamic(unloaded_contacts="ignore"))
     with pytest.raises(ConfigError, match=r"'closure.dynamic'.*'timestep'"):
         validate_config(_with_dynamic(timestep=0.01))
-    with pytest.raises(ConfigError, match=r"'closure.dynamic.time_limit_s': 0.2 must be at least "
-                                          r"closure.dynamic.ramp_time_s \(0.3\)"):
+    with pytest.raises(
+        ConfigError,
+        match=r"'closure.dynamic.time_limit_s': 0.2 must be at least "
+        r"closure.dynamic.ramp_time_s \(0.3\)",
+    ):
         validate_config(_with_dynamic(time_limit_s=0.2))
     # the workflow's one path from the config to the parameters
     config = validate_config(_with_dynamic(settle_window_s=0.1))
@@ -102,12 +106,12 @@ def _generalised_contact_forces(model) -> np.ndarray:
     def add(link: int, point: np.ndarray, force: np.ndarray) -> None:
         if link <= 0:
             return
-        state = pb.getLinkState(body.body, int(body.link_index[link]), computeForwardKinematics=1,
-                                physicsClientId=client)
+        state = pb.getLinkState(body.body, int(body.link_index[link]), computeForwardKinematics=1, physicsClientId=client)
         rotation = np.array(pb.getMatrixFromQuaternion(state[5])).reshape(3, 3)
         local = rotation.T @ (point * 1e-3 - np.array(state[4]))
-        lin, _ = pb.calculateJacobian(body.body, int(body.link_index[link]), local.tolist(), positions,
-                                      [0.0] * n, [0.0] * n, physicsClientId=client)
+        lin, _ = pb.calculateJacobian(
+            body.body, int(body.link_index[link]), local.tolist(), positions, [0.0] * n, [0.0] * n, physicsClientId=client
+        )
         total[:] += (np.array(lin)[:, body.joint_indices] * 1e3).T @ force  # mm/rad · N = N·mm
 
     links, points, forces = contact_force_vectors(client, model.box, body)
@@ -151,8 +155,7 @@ def _check_balance(model, hand, params, result):
     off_limits = checked & (theta > scale * hand.lower[axis] + 0.01) & (theta < scale * hand.upper[axis] - 0.01)
     assert off_limits.sum() >= 6 and np.abs(spring[off_limits]).max() > 20.0  # loaded joints are checked
     bad = off_limits & (np.abs(spring - contact) > 0.1 * np.abs(spring) + 1.0)
-    assert not bad.any(), [(hand.joint_names[axis[i]], round(spring[i], 2), round(contact[i], 2))
-                           for i in np.flatnonzero(bad)]
+    assert not bad.any(), [(hand.joint_names[axis[i]], round(spring[i], 2), round(contact[i], 2)) for i in np.flatnonzero(bad)]
 
 
 def test_deterministic_on_rerun_and_whatever_ran_before(hand, synergies):
@@ -177,8 +180,9 @@ def test_twins_are_closed_each_on_their_own(hand, synergies, monkeypatch):
     calls = []
     real = dynamic_closure.DynamicClosure.grasp
     monkeypatch.setattr(dynamic_closure.DynamicClosure, "grasp", lambda self, placed: calls.append(1) or real(self, placed))
-    table = simulate_object(hand, synergies, box, placement, params, poses=[grid.index(-30.0, 0.0), grid.index(60.0, 0.0)],
-                            mechanics=MECHANICS)
+    table = simulate_object(
+        hand, synergies, box, placement, params, poses=[grid.index(-30.0, 0.0), grid.index(60.0, 0.0)], mechanics=MECHANICS
+    )
     assert len(calls) == 2 and list(table["closure_model"]) == ["dynamic", "dynamic"]
 
 
@@ -202,8 +206,9 @@ def test_a_box_pushed_out_of_the_hand_is_lost(hand, synergies):
     β = −40° the closing fingers push it away and nothing holds it (no gravity)."""
     box = GraspedObject("obj4", Box((100.0, 60.0, 100.0)), 1.0, 9.81)
     placement = study_placement(mode="fixed", center_mm=(90.0, 5.0, 112.0), box_axes=(1, 0, 2))
-    row = simulate_object(hand, synergies, box, placement, study_closure_params(model="dynamic"), poses=[4],
-                          mechanics=MECHANICS).iloc[0]
+    row = simulate_object(
+        hand, synergies, box, placement, study_closure_params(model="dynamic"), poses=[4], mechanics=MECHANICS
+    ).iloc[0]
     assert (row["alpha_deg"], row["beta_deg"]) == (-180.0, -40.0)
     assert row["status"] == "lost" and row["n_contacts"] == 0
     assert np.linalg.norm(row["object_translation_mm"]) > 10.0
@@ -215,11 +220,13 @@ def test_a_box_moved_but_left_inside_the_closed_hand_is_caged(hand, synergies):
     """obj1 (30 mm cube, approach placement) at α = −180°, β = −60°: the closing fingers push it
     toward the wrist and close past it; nothing touches it at the end, and its centre is inside
     the closed hand's hull, so it is caged, not lost."""
-    config = {**defaults(), "closure": {**defaults()["closure"], "model": "dynamic"},
-              "placement": {**defaults()["placement"], "mode": "approach"}}
+    config = {
+        **defaults(),
+        "closure": {**defaults()["closure"], "model": "dynamic"},
+        "placement": {**defaults()["placement"], "mode": "approach"},
+    }
     sim = SimulateParams.from_config(config, "obj1")
-    row = simulate_object(hand, synergies, sim.object, sim.placement, sim.closure, poses=[0],
-                          mechanics=sim.mechanics).iloc[0]
+    row = simulate_object(hand, synergies, sim.object, sim.placement, sim.closure, poses=[0], mechanics=sim.mechanics).iloc[0]
     assert row["status"] == "caged" and row["n_contacts"] == 0
     assert np.linalg.norm(row["object_translation_mm"]) > sim.closure.dynamic.lost_distance_mm
     assert HandCapsules.of(hand).encloses(np.asarray(row["q"]), np.asarray(row["object_center"]))
@@ -254,8 +261,9 @@ def test_thumb_index_pinch_of_a_small_box_settles_with_a_near_zero_net_wrench(ha
         x /= np.linalg.norm(x)
         y = np.cross(x, [0.0, 0.0, 1.0])
         y /= np.linalg.norm(y)
-        placed = ObjectPose(near.point_a[k] + (edge / 2 + 0.3) * x, np.stack([x, y, np.cross(x, y)], axis=1),
-                            Box((edge, edge, edge)))
+        placed = ObjectPose(
+            near.point_a[k] + (edge / 2 + 0.3) * x, np.stack([x, y, np.cross(x, y)], axis=1), Box((edge, edge, edge))
+        )
         result = model.grasp(placed)
         assert result.status == "grasp" and result.settled
         fingertips = set(hand.finger_links[0]) | set(hand.finger_links[1])
@@ -289,14 +297,16 @@ def test_a_held_box_stays_put_and_the_fingers_settle_on_it_in_equilibrium(hand, 
     assert np.all(np.asarray(row["contact_normal_force_N"]) > 0.01)
     assert np.array_equal(row["object_center"], placement.center_mm) and row["object_rotation_deg"] == 0.0
     assert np.array_equal(row["object_translation_mm"], np.zeros(3))
-    checks = grasp_equilibrium(rows, EquilibriumParams.of(hand, synergies, MECHANICS.k_ss_Nmm_per_rad, MECHANICS.mu),
-                               synergies.columns([1])[:, 0])
+    checks = grasp_equilibrium(
+        rows, EquilibriumParams.of(hand, synergies, MECHANICS.k_ss_Nmm_per_rad, MECHANICS.mu), synergies.columns([1])[:, 0]
+    )
     assert checks["torque_residual"].iloc[0] < 0.1
 
 
 def test_the_held_setting_is_a_checked_key():
-    with pytest.raises(ConfigError,
-                       match=r"'closure.dynamic.object': 'fixed' is not allowed; allowed values: \['free', 'held'\]"):
+    with pytest.raises(
+        ConfigError, match=r"'closure.dynamic.object': 'fixed' is not allowed; allowed values: \['free', 'held'\]"
+    ):
         validate_config(_with_dynamic(object="fixed"))
     assert SimulateParams.from_config(validate_config(_with_dynamic(object="held")), "obj1").closure.dynamic.held
     assert not SimulateParams.from_config(defaults(), "obj1").closure.dynamic.held

@@ -8,8 +8,7 @@ import pandas as pd
 import pytest
 
 from synergrasp.hand.kinematics import contact_jacobian
-from synergrasp.optimisation.equilibrium import (EquilibriumParams, grasp_equilibrium, push_angles_deg,
-                                                 torque_residual)
+from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium, push_angles_deg, torque_residual
 from synergrasp.optimisation.mechanics import contact_frames
 
 
@@ -74,8 +73,12 @@ def test_s1_push_angles_and_the_outside_count_on_a_hand_made_contact():
     """Contact 0 moves at 30° from its normal, contact 1 at 70°, contact 2 backwards (180°),
     contact 3 is not moved by S1: with μ = 1.5 (cone 56.3°) two contacts are outside."""
     synergy = np.array([1.0, 0.0])
-    directions = [(np.cos(np.radians(30)), np.sin(np.radians(30)), 0.0),
-                  (np.cos(np.radians(70)), 0.0, np.sin(np.radians(70))), (-1.0, 0.0, 0.0), (0.0, 0.0, 0.0)]
+    directions = [
+        (np.cos(np.radians(30)), np.sin(np.radians(30)), 0.0),
+        (np.cos(np.radians(70)), 0.0, np.sin(np.radians(70))),
+        (-1.0, 0.0, 0.0),
+        (0.0, 0.0, 0.0),
+    ]
     J = np.zeros((12, 2))
     J[:, 0] = 5.0 * np.concatenate(directions)  # 5 mm per unit σ along each direction
     J[:, 1] = 1.0  # a second joint S1 does not move
@@ -83,10 +86,23 @@ def test_s1_push_angles_and_the_outside_count_on_a_hand_made_contact():
     angles = push_angles_deg(J, normals, synergy)
     np.testing.assert_allclose(angles[:3], [30.0, 70.0, 180.0], atol=1e-9)
     assert np.isnan(angles[3])
-    contacts = pd.DataFrame([{"object": "a", "closure_model": "kinematic", "pose": 3, "status": "grasp",
-                              "n_contacts": 4, "q": [0.0, 0.0], "jacobian": J.ravel().tolist(),
-                              "contact_normal": normals.ravel().tolist(), "contact_link": [1, 2, 3, 4],
-                              "contact_point": [0.0] * 12, "object_center": [0.0] * 3}])
+    contacts = pd.DataFrame(
+        [
+            {
+                "object": "a",
+                "closure_model": "kinematic",
+                "pose": 3,
+                "status": "grasp",
+                "n_contacts": 4,
+                "q": [0.0, 0.0],
+                "jacobian": J.ravel().tolist(),
+                "contact_normal": normals.ravel().tolist(),
+                "contact_link": [1, 2, 3, 4],
+                "contact_point": [0.0] * 12,
+                "object_center": [0.0] * 3,
+            }
+        ]
+    )
     row = grasp_equilibrium(contacts, EquilibriumParams(200.0, 1.5, np.array([0.1, 0.0])), synergy).iloc[0]
     assert (row["s1_outside_cone"], row["s1_pushed_contacts"]) == (2, 3)
     # τ = k_ss (q_r − q) = (20, 0) N·mm on the two joints, both moving a contact
@@ -101,11 +117,20 @@ def test_one_grasp_in_one_posture_is_checked_once(monkeypatch):
 
     rng = np.random.default_rng(7)
     J, normals = rng.normal(size=(9, 2)), np.tile([1.0, 0.0, 0.0], (3, 1))
-    row = {"object": "a", "closure_model": "kinematic", "status": "grasp", "n_contacts": 3,
-           "jacobian": J.ravel().tolist(), "contact_normal": normals.ravel().tolist(), "contact_link": [1, 2, 3],
-           "contact_point": rng.normal(size=9).tolist(), "object_center": [0.0] * 3}
-    contacts = pd.DataFrame([{**row, "pose": 0, "q": [0.0, 0.0]}, {**row, "pose": 1, "q": [0.0, 1e-13]},
-                             {**row, "pose": 2, "q": [0.0, 0.2]}])
+    row = {
+        "object": "a",
+        "closure_model": "kinematic",
+        "status": "grasp",
+        "n_contacts": 3,
+        "jacobian": J.ravel().tolist(),
+        "contact_normal": normals.ravel().tolist(),
+        "contact_link": [1, 2, 3],
+        "contact_point": rng.normal(size=9).tolist(),
+        "object_center": [0.0] * 3,
+    }
+    contacts = pd.DataFrame(
+        [{**row, "pose": 0, "q": [0.0, 0.0]}, {**row, "pose": 1, "q": [0.0, 1e-13]}, {**row, "pose": 2, "q": [0.0, 0.2]}]
+    )
     calls = []
     real = equilibrium._one
     monkeypatch.setattr(equilibrium, "_one", lambda r, *a: calls.append(r.pose) or real(r, *a))
@@ -127,8 +152,12 @@ def test_the_residual_agrees_with_an_independent_cvxpy_model():
         normals /= np.linalg.norm(normals, axis=1, keepdims=True)
         tau = rng.normal(size=6) * 50.0
         f = cp.Variable(3 * m)
-        cones = [cp.SOC(mu * (normals[i] @ f[3 * i:3 * i + 3]),
-                        f[3 * i:3 * i + 3] - normals[i] * (normals[i] @ f[3 * i:3 * i + 3])) for i in range(m)]
+        cones = [
+            cp.SOC(
+                mu * (normals[i] @ f[3 * i : 3 * i + 3]), f[3 * i : 3 * i + 3] - normals[i] * (normals[i] @ f[3 * i : 3 * i + 3])
+            )
+            for i in range(m)
+        ]
         cp.Problem(cp.Minimize(cp.norm(tau - J.T @ f)), cones).solve(solver="CLARABEL")
         expected = np.linalg.norm(tau - J.T @ f.value) / np.linalg.norm(tau)
         assert torque_residual(tau, J, normals, mu) == pytest.approx(expected, abs=1e-6)

@@ -1,11 +1,11 @@
 """Figure helpers: the force grid, the rule-graph parser, and files written for the study's plots."""
+
 import numpy as np
 import pytest
 import pandas as pd
 
 from synergrasp.figures.rulegraph import parse_rulegraph
-from synergrasp.figures.study_figures import (figure_exploded_views, figure_force_maps, figure_hierarchy,
-                                force_grid)
+from synergrasp.figures.study_figures import figure_exploded_views, figure_force_maps, figure_hierarchy, force_grid
 from synergrasp.tables import write_study_table
 
 
@@ -16,8 +16,15 @@ def _gfo() -> pd.DataFrame:
     for alpha in (0.0, 180.0):
         for beta in (-10.0, 0.0, 10.0):
             fc = not (alpha == 0.0 and beta == 10.0)
-            rows.append({"set_id": "1", "alpha_deg": alpha, "beta_deg": beta, "success": fc,
-                         "success_force": (1.0 + alpha / 90.0 + beta / 10.0 + 2.0) if fc else np.nan})
+            rows.append(
+                {
+                    "set_id": "1",
+                    "alpha_deg": alpha,
+                    "beta_deg": beta,
+                    "success": fc,
+                    "success_force": (1.0 + alpha / 90.0 + beta / 10.0 + 2.0) if fc else np.nan,
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -43,10 +50,27 @@ def test_figures_and_tables_are_written(tmp_path):
     figure_force_maps(gfo, minima, [1], "box", tmp_path / "m.png", tmp_path / "m.pdf")
     # the β slice at 10 deg has force closure only at α = 180; the α slice at β = 99 -> 10 deg
     figure_exploded_views(gfo, [1], 0.0, 99.0, "box", tmp_path / "e.png", tmp_path / "e.pdf")
-    matrices = pd.DataFrame({"k": [1, 1, 2], "i": [1, 1, 2], "j": [1, 2, 2], "success_rate": [50.0, 80.0, 0.0],
-                             "force_ratio_median": [3.0, 3000.0, np.nan]})
-    figure_hierarchy(matrices, "force_ratio_median", 2, "t", ".1f", (1.0, 10.0), "ratio", tmp_path / "h.png",
-                     tmp_path / "h.pdf", log_scale=True)
+    matrices = pd.DataFrame(
+        {
+            "k": [1, 1, 2],
+            "i": [1, 1, 2],
+            "j": [1, 2, 2],
+            "success_rate": [50.0, 80.0, 0.0],
+            "force_ratio_median": [3.0, 3000.0, np.nan],
+        }
+    )
+    figure_hierarchy(
+        matrices,
+        "force_ratio_median",
+        2,
+        "t",
+        ".1f",
+        (1.0, 10.0),
+        "ratio",
+        tmp_path / "h.png",
+        tmp_path / "h.pdf",
+        log_scale=True,
+    )
     write_study_table(pd.DataFrame({"a": [1.23456]}), tmp_path / "t.csv", tmp_path / "t.md", title="T")
     for name in ("m.png", "m.pdf", "e.png", "e.pdf", "h.png", "h.pdf"):
         assert (tmp_path / name).stat().st_size > 1000, name
@@ -62,8 +86,8 @@ def test_hierarchy_grey_scale_is_black_at_the_low_end_and_prints_every_cell():
 
     fig, ax = plt.subplots()
     image = _hierarchy_panel(ax, np.array([[0.0, 100.0], [np.nan, 50.0]]), Normalize(0.0, 100.0), ".0f", ["S1", "S2"])
-    assert tuple(image.cmap(image.norm(0.0))[:3]) == (0.0, 0.0, 0.0)      # 0 % black
-    assert tuple(image.cmap(image.norm(100.0))[:3]) == (1.0, 1.0, 1.0)    # 100 % white
+    assert tuple(image.cmap(image.norm(0.0))[:3]) == (0.0, 0.0, 0.0)  # 0 % black
+    assert tuple(image.cmap(image.norm(100.0))[:3]) == (1.0, 1.0, 1.0)  # 100 % white
     assert sorted(t.get_text() for t in ax.texts) == ["0", "100", "50", "–"]
     plt.close(fig)
 

@@ -40,16 +40,16 @@ def solve_gfo_one(f_p, E, normals, mu, f_min, method="clarabel"):
 def strict_internal_forces(E, normals, mu, method="clarabel"):
     """Bicchi's strict test of the internal forces E y (f_p and f_min play no part)."""
     E = np.asarray(E, dtype=float).reshape(np.shape(E)[0], -1)
-    sol = solve_gfo([GFOProblem(np.zeros(E.shape[0]), E, normals, 0.0, CircularCone(mu))], method,
-                    strict_shrink=STRICT_SHRINK)
+    sol = solve_gfo([GFOProblem(np.zeros(E.shape[0]), E, normals, 0.0, CircularCone(mu))], method, strict_shrink=STRICT_SHRINK)
     return bool(sol.strict_internal[0])
 
 
 def optimise_grasp(mech, synergy_subset, params, method="clarabel"):
     """GFO and strict test of one grasp (rank(G) = 6) for the set of all given columns."""
     sets = SynergySets(synergy_subset, (tuple(range(1, synergy_subset.shape[1] + 1)),))
-    problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, params.f_min_N, params.cone,
-                         params.basis_rtol)
+    problems = GraspSets(
+        mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, params.f_min_N, params.cone, params.basis_rtol
+    )
     return row(solve_gfo(problems, method, strict_shrink=params.strict_shrink))
 
 
@@ -125,7 +125,7 @@ def tripod_grasp(radius=30.0, lever=50.0):
     out = np.c_[np.cos(angles), np.sin(angles), np.zeros(3)]
     J = np.zeros((9, 19))
     for i, joint in enumerate((4, 8, 12)):
-        J[3 * i:3 * i + 3, joint] = -lever * out[i]
+        J[3 * i : 3 * i + 3, joint] = -lever * out[i]
     return Grasp(radius * out, -out, np.array([5, 9, 13]), J, np.zeros(3))
 
 
@@ -255,9 +255,11 @@ def test_clarabel_agrees_with_cvxpy_reference(generated):
             assert rel <= 1e-4, (p.index, a.force_norm, b.force_norm)
             assert a.max_violation <= 1e-6 * max(1.0, a.force_norm)
     failures = sum(r.status == "numerical_failure" for r in ours)
-    print(f"\n{len(problems)} problems, {in_band} within |delta| < {BOUNDARY_BAND}; "
-          f"{len(disagree_in_band)} of those differ (verdict or ||f|| > 1e-4 rel); "
-          f"solve_gfo numerical failures: {failures}; worst ||f|| rel. difference off the band: {worst_rel:.2e}")
+    print(
+        f"\n{len(problems)} problems, {in_band} within |delta| < {BOUNDARY_BAND}; "
+        f"{len(disagree_in_band)} of those differ (verdict or ||f|| > 1e-4 rel); "
+        f"solve_gfo numerical failures: {failures}; worst ||f|| rel. difference off the band: {worst_rel:.2e}"
+    )
     for row in disagree_in_band:
         print("  in band: index %d delta %+.2e ours %s ref %s |f| %.6g vs %.6g" % row)
     # The band is the only place where they may differ, and even there most agree.

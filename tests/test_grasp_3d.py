@@ -50,8 +50,26 @@ def external_references(page: str) -> list[str]:
 
 def test_the_page_holds_plotly_once_and_fetches_nothing(tmp_path):
     out = tmp_path / "grasp.html"
-    assert main(["grasp", *POSE[:1], "--alpha", str(POSE[1]), "--beta", str(POSE[2]), "--sets", "1", "1-15",
-                 "--html", str(out), "--configfile", str(SMALL)]) == 0
+    assert (
+        main(
+            [
+                "grasp",
+                *POSE[:1],
+                "--alpha",
+                str(POSE[1]),
+                "--beta",
+                str(POSE[2]),
+                "--sets",
+                "1",
+                "1-15",
+                "--html",
+                str(out),
+                "--configfile",
+                str(SMALL),
+            ]
+        )
+        == 0
+    )
     page = out.read_text()
     assert page.count("* plotly.js v") == 1  # the library's banner: its script inlined once
     assert page.count("Plotly.newPlot(") == 1
@@ -112,8 +130,16 @@ def test_report_pages_share_one_copy_of_plotly(inspection, tmp_path):
 
     links = inspection.contacts["link"].to_numpy()
     points = np.array(list(inspection.contacts["point_mm"]))
-    scene = GraspScene.of(inspection.hand, inspection.q_rad, _object_in_picture(inspection), links, points,
-                          inspection.sets[-1].forces_N, "{S1..S15}", "a grasp")
+    scene = GraspScene.of(
+        inspection.hand,
+        inspection.q_rad,
+        _object_in_picture(inspection),
+        links,
+        points,
+        inspection.sets[-1].forces_N,
+        "{S1..S15}",
+        "a grasp",
+    )
     write_grasp_pages(tmp_path, {"a": ("first", scene), "b": ("second", scene)}, "grasps")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.html", "b.html", "index.html", PLOTLY_JS]
     assert (tmp_path / PLOTLY_JS).read_text().count("* plotly.js v") == 1

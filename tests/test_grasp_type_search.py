@@ -11,10 +11,8 @@ import pytest
 
 from synergrasp.config import defaults, overlay
 from synergrasp.optimisation import placement_search
-from synergrasp.optimisation.grasp_type_search import (KEPT, FallbackParams, fallback_line, search_with_fallback,
-                                                       type_label)
-from synergrasp.optimisation.placement_search import (SearchResult, SearchStepParams, TargetScore, grown_region,
-                                                      search_object)
+from synergrasp.optimisation.grasp_type_search import KEPT, FallbackParams, fallback_line, search_with_fallback, type_label
+from synergrasp.optimisation.placement_search import SearchResult, SearchStepParams, TargetScore, grown_region, search_object
 from synergrasp.simulation.reach import HandReach
 from synergrasp.simulation.shapes.box import Box
 
@@ -85,11 +83,9 @@ def test_when_every_type_scores_zero_the_box_goes_to_the_palm_centre_chosen_by_n
 
 def test_a_minimum_share_stated_in_advance_is_a_further_trigger():
     runs = _Searches(precision=[40.0], any=[90.0])
-    strict = search_with_fallback("precision", CUBE60, _reach(), replace(ON, min_typed_percent=50.0), runs,
-                                  _palm_centre)
+    strict = search_with_fallback("precision", CUBE60, _reach(), replace(ON, min_typed_percent=50.0), runs, _palm_centre)
     assert strict.effective_type == "any" and "(<= min_typed_percent 50)" in strict.type_reason
-    assert search_with_fallback("precision", CUBE60, _reach(), ON, runs, _palm_centre).effective_type == \
-        "precision-circular"
+    assert search_with_fallback("precision", CUBE60, _reach(), ON, runs, _palm_centre).effective_type == "precision-circular"
 
 
 def test_version_2_searches_the_stated_type_only_even_when_infeasible_and_all_zero():
@@ -130,21 +126,25 @@ class _FakeScorer:
 
 
 def _sim(**search):
-    cfg = overlay(defaults(), {"placement": {"search": {"region_mm": {"precision": {"z": [60.0, 100.0]}},
-                                                        "grow_region": True, **search}},
-                               "objects": {"obj1": {"grasp_type": "precision"}}})
+    cfg = overlay(
+        defaults(),
+        {
+            "placement": {"search": {"region_mm": {"precision": {"z": [60.0, 100.0]}}, "grow_region": True, **search}},
+            "objects": {"obj1": {"grasp_type": "precision"}},
+        },
+    )
     return SearchStepParams.from_config(cfg, "obj1")
 
 
-def test_the_search_grows_its_region_until_the_chosen_target_is_inside_or_the_reach_stops_it(hand, synergies,
-                                                                                              monkeypatch):
+def test_the_search_grows_its_region_until_the_chosen_target_is_inside_or_the_reach_stops_it(hand, synergies, monkeypatch):
     monkeypatch.setattr(placement_search, "TargetScorer", _FakeScorer)
     sim = _sim()
     bound = ((9.0, 55.0), (-48.0, 30.0), (14.0, 130.0))
 
     def run(params, bound_mm):
-        return search_object(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo, None, params, 90.0,
-                             bound_mm=bound_mm)
+        return search_object(
+            hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo, None, params, 90.0, bound_mm=bound_mm
+        )
 
     grown = run(sim.search, bound)
     assert grown.chosen.target_mm[2] == 130.0  # the best z the reach allows (bound 130)
@@ -175,6 +175,7 @@ def test_the_graspable_table_reads_each_searched_objects_stated_and_effective_ty
     assert types["obj1"] == ("precision", "precision", "")  # not searched: the configured type
     stated, effective, reason = types["obj3"]
     assert (stated, effective) == ("power-circular", "precision-circular") and "infeasible" in reason
-    table = pd.DataFrame([{"object": o, "stated_type": t[0], "effective_type": t[1], "type_reason": t[2]}
-                          for o, t in types.items()])
+    table = pd.DataFrame(
+        [{"object": o, "stated_type": t[0], "effective_type": t[1], "type_reason": t[2]} for o, t in types.items()]
+    )
     assert fallback_lines(table) == [f"obj3: stated grasp type power-circular, effective precision-circular ({reason})"]

@@ -136,8 +136,7 @@ def test_flexion_moves_tips_toward_palm_normal(hand):
     r = 13.0 / math.sqrt(2.0)
     frames = forward_kinematics(hand, q)
     knuckle = np.array(KNUCKLES_MM["middle"])
-    np.testing.assert_allclose(frames[hand.link_index("middle_middle"), :3, 3] - knuckle,
-                               [9.0 + 2 * r, 0.0, 9.0], atol=1e-9)
+    np.testing.assert_allclose(frames[hand.link_index("middle_middle"), :3, 3] - knuckle, [9.0 + 2 * r, 0.0, 9.0], atol=1e-9)
     tip = fingertip_positions(hand, q)[FINGERS.index("middle")]
     np.testing.assert_allclose(tip - knuckle, [9.0 + r - 23.3, 0.0, -r], atol=1e-9)
 
@@ -204,7 +203,7 @@ def test_palm_jacobian_zero_and_contact_jacobian_stacks(hand):
     stacked = contact_jacobian(hand, q, links, points)
     assert stacked.shape == (12, 19)
     for i, (link, p) in enumerate(zip(links, points)):
-        np.testing.assert_array_equal(stacked[3 * i:3 * i + 3], point_jacobian(hand, q, int(link), p))
+        np.testing.assert_array_equal(stacked[3 * i : 3 * i + 3], point_jacobian(hand, q, int(link), p))
     assert contact_jacobian(hand, q, np.zeros(0, int), np.zeros((0, 3))).shape == (0, 19)
 
 
@@ -252,22 +251,27 @@ def test_loading_explicit_path_equals_default(hand):
     assert other.link_names == hand.link_names
 
 
-@pytest.mark.parametrize("mutate, field", [
-    (lambda d: d.pop("fingers"), "fingers"),
-    (lambda d: d["fingers"]["index"]["joints"][1].update(name="index_pip"), "fingers.index.joints[1].name"),
-    (lambda d: d["fingers"]["ring"]["joints"][2].update(limits_deg=[90, 0]), "fingers.ring.joints[2].limits_deg"),
-    (lambda d: d["fingers"]["thumb"]["knuckle"].update(xyz_mm=[1, 2]), "fingers.thumb.knuckle.xyz_mm"),
-    (lambda d: d["palm"]["shapes"][0].update(sphere={"r": 1}), "palm.shapes[0]"),
-    (lambda d: d["fingers"]["little"]["joints"][0]["shapes"][0]["capsule"].update(radius_mm=-1),
-     "fingers.little.joints[0].shapes[0].capsule.radius_mm"),
-    (lambda d: d.update(palm_normal=[1, 1, 0]), "palm_normal"),
-    # a misspelt optional key is an error, not a silent default (rolling joints would vanish)
-    (lambda d: d["fingers"]["index"]["joints"][1].update(rolling_gap=13.0), "fingers.index.joints[1]: unknown key"),
-    (lambda d: d.update(palm_normals=[1, 0, 0]), "<top level>: unknown key"),
-    (lambda d: d["fingers"]["thumb"].update(tip=[1, 0, 0]), "fingers.thumb: unknown key"),
-    (lambda d: d["fingers"]["thumb"]["knuckle"].update(rpy=[0, 0, 0]), "fingers.thumb.knuckle: unknown key"),
-    (lambda d: d["palm"]["shapes"][0]["box"].update(centre_mm=[0, 0, 0]), "palm.shapes[0].box: unknown key"),
-])
+@pytest.mark.parametrize(
+    "mutate, field",
+    [
+        (lambda d: d.pop("fingers"), "fingers"),
+        (lambda d: d["fingers"]["index"]["joints"][1].update(name="index_pip"), "fingers.index.joints[1].name"),
+        (lambda d: d["fingers"]["ring"]["joints"][2].update(limits_deg=[90, 0]), "fingers.ring.joints[2].limits_deg"),
+        (lambda d: d["fingers"]["thumb"]["knuckle"].update(xyz_mm=[1, 2]), "fingers.thumb.knuckle.xyz_mm"),
+        (lambda d: d["palm"]["shapes"][0].update(sphere={"r": 1}), "palm.shapes[0]"),
+        (
+            lambda d: d["fingers"]["little"]["joints"][0]["shapes"][0]["capsule"].update(radius_mm=-1),
+            "fingers.little.joints[0].shapes[0].capsule.radius_mm",
+        ),
+        (lambda d: d.update(palm_normal=[1, 1, 0]), "palm_normal"),
+        # a misspelt optional key is an error, not a silent default (rolling joints would vanish)
+        (lambda d: d["fingers"]["index"]["joints"][1].update(rolling_gap=13.0), "fingers.index.joints[1]: unknown key"),
+        (lambda d: d.update(palm_normals=[1, 0, 0]), "<top level>: unknown key"),
+        (lambda d: d["fingers"]["thumb"].update(tip=[1, 0, 0]), "fingers.thumb: unknown key"),
+        (lambda d: d["fingers"]["thumb"]["knuckle"].update(rpy=[0, 0, 0]), "fingers.thumb.knuckle: unknown key"),
+        (lambda d: d["palm"]["shapes"][0]["box"].update(centre_mm=[0, 0, 0]), "palm.shapes[0].box: unknown key"),
+    ],
+)
 def test_load_hand_rejects_malformed_file_naming_the_file_and_field(tmp_path, mutate, field):
     doc = copy.deepcopy(_doc())
     mutate(doc)
@@ -279,8 +283,10 @@ def test_load_hand_rejects_malformed_file_naming_the_file_and_field(tmp_path, mu
     assert field in str(info.value)
 
 
-@pytest.mark.parametrize("content, reason", [(None, "No such file"), ("dir", "is a folder"), (b"", "is empty"),
-                                             (bytes(range(256)), "not a readable YAML file")])
+@pytest.mark.parametrize(
+    "content, reason",
+    [(None, "No such file"), ("dir", "is a folder"), (b"", "is empty"), (bytes(range(256)), "not a readable YAML file")],
+)
 def test_unreadable_hand_file_gives_one_message_naming_it(tmp_path, content, reason):
     path = tmp_path / "hand.yaml"
     if content == "dir":

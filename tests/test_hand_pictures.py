@@ -22,16 +22,16 @@ def test_capsule_silhouette_depth_and_normal_are_exact():
     hit = rays.label == 5
     # Silhouette: a 20 mm wide band (40 px) from z = -30 to 30 mm with round ends: area of a
     # 20 x 40 mm rectangle plus a 10 mm disc, in pixels of 0.25 mm^2.
-    expected = (20.0 * 40.0 + np.pi * 10.0 ** 2) / 0.25
+    expected = (20.0 * 40.0 + np.pi * 10.0**2) / 0.25
     assert abs(hit.sum() - expected) / expected < 0.01
     assert hit[100].sum() == 40
     # Pixel (100, 100) looks at y = +0.25 mm (image right is +y), z = -0.25 mm: the cylinder's
     # surface there is at x = sqrt(100 - 0.25^2), its normal (x, 0.25, 0) / 10.
-    x = np.sqrt(100.0 - 0.25 ** 2)
+    x = np.sqrt(100.0 - 0.25**2)
     assert rays.depth[100, 100] == pytest.approx(rays.depth_of(np.array([[x, 0.25, -0.25]]))[0], abs=1e-9)
     np.testing.assert_allclose(rays.normal[100, 100], [x / 10.0, 0.025, 0.0], atol=1e-12)
     # Row 50 looks at z = 24.75 mm, 4.75 mm beyond the segment end: on the end sphere.
-    x = np.sqrt(100.0 - 0.25 ** 2 - 4.75 ** 2)
+    x = np.sqrt(100.0 - 0.25**2 - 4.75**2)
     assert rays.depth[50, 100] == pytest.approx(rays.depth_of(np.array([[x, 0.25, 24.75]]))[0], abs=1e-9)
 
 
@@ -99,12 +99,27 @@ def test_a_touching_link_gets_the_highlight_colour(hand):
 
 def _one_grasp_table(hand, synergies) -> pd.DataFrame:
     q = np.clip(synergies.mean, hand.lower, hand.upper)
-    return pd.DataFrame([{"object": "cube", "pose": 0, "alpha_deg": 0.0, "beta_deg": 0.0, "status": "grasp",
-                          "q": list(q), "finger_state": ["contact"] * 5, "n_contacts": 1,
-                          "contact_link": [hand.link_index("index_distal")], "contact_point": [40.0, 10.0, 120.0],
-                          "contact_normal": [0.0, 0.0, 1.0], "jacobian": [0.0] * 57,
-                          "object_center": [45.0, 0.0, 110.0], "object_rotation": list(np.eye(3).ravel()),
-                          "max_penetration_mm": 0.0}])
+    return pd.DataFrame(
+        [
+            {
+                "object": "cube",
+                "pose": 0,
+                "alpha_deg": 0.0,
+                "beta_deg": 0.0,
+                "status": "grasp",
+                "q": list(q),
+                "finger_state": ["contact"] * 5,
+                "n_contacts": 1,
+                "contact_link": [hand.link_index("index_distal")],
+                "contact_point": [40.0, 10.0, 120.0],
+                "contact_normal": [0.0, 0.0, 1.0],
+                "jacobian": [0.0] * 57,
+                "object_center": [45.0, 0.0, 110.0],
+                "object_rotation": list(np.eye(3).ravel()),
+                "max_penetration_mm": 0.0,
+            }
+        ]
+    )
 
 
 def test_touching_links_in_words(hand):
@@ -122,10 +137,17 @@ def test_figures_are_written_and_the_same_on_rerun(hand, synergies, tmp_path):
     table = _one_grasp_table(hand, synergies)
     dropped = table.assign(object="big", status="intersects_open_hand", n_contacts=0, contact_link=[[]])
     for run in ("a", "b"):
-        figure_synergy_postures(hand, synergies, tmp_path / f"f1{run}.png", tmp_path / f"f1{run}.pdf",
-                                n_synergies=1, sigmas=(-1.0, 0.0))
-        figure_example_grasps(hand, [box, GraspedObject("big", Box((90.0, 60.0, 90.0)), 1.0)], [table, dropped],
-                              tmp_path / f"f2{run}.png", tmp_path / f"f2{run}.pdf", n_grasps=2)
+        figure_synergy_postures(
+            hand, synergies, tmp_path / f"f1{run}.png", tmp_path / f"f1{run}.pdf", n_synergies=1, sigmas=(-1.0, 0.0)
+        )
+        figure_example_grasps(
+            hand,
+            [box, GraspedObject("big", Box((90.0, 60.0, 90.0)), 1.0)],
+            [table, dropped],
+            tmp_path / f"f2{run}.png",
+            tmp_path / f"f2{run}.pdf",
+            n_grasps=2,
+        )
     for name in ("f1", "f2"):
         for ext in ("png", "pdf"):
             first = (tmp_path / f"{name}a.{ext}").read_bytes()
@@ -139,16 +161,29 @@ def test_placement_map_is_written_and_the_same_on_rerun(hand, synergies, tmp_pat
 
     box = GraspedObject("cube", Box((30.0, 30.0, 30.0)), 1.0)
     targets = [(9.5, y, z) for y in (-10.0, 10.0) for z in (60.0, 80.0)] + [(19.5, -10.0, 60.0)]
-    placement = pd.DataFrame({"object": "cube", "rank": range(1, 6), "chosen": [True] + [False] * 4,
-                              "distinct_rank": range(1, 6), "x_mm": [t[0] for t in targets],
-                              "y_mm": [t[1] for t in targets], "z_mm": [t[2] for t in targets], "round": 0,
-                              "n_poses": 27, "grasp_type": "power", "typed_percent": [80.0, 60.0, 0.0, 0.0, 90.0],
-                              "force_closure_percent": [90.0, 80.0, 50.0, 0.0, 90.0],
-                              "median_force_per_weight": [1.0, 2.0, 3.0, float("inf"), 1.0],
-                              "median_contacts": 4.0, "distance_to_chosen_mm": 0.0})
+    placement = pd.DataFrame(
+        {
+            "object": "cube",
+            "rank": range(1, 6),
+            "chosen": [True] + [False] * 4,
+            "distinct_rank": range(1, 6),
+            "x_mm": [t[0] for t in targets],
+            "y_mm": [t[1] for t in targets],
+            "z_mm": [t[2] for t in targets],
+            "round": 0,
+            "n_poses": 27,
+            "grasp_type": "power",
+            "typed_percent": [80.0, 60.0, 0.0, 0.0, 90.0],
+            "force_closure_percent": [90.0, 80.0, 50.0, 0.0, 90.0],
+            "median_force_per_weight": [1.0, 2.0, 3.0, float("inf"), 1.0],
+            "median_contacts": 4.0,
+            "distance_to_chosen_mm": 0.0,
+        }
+    )
     for run in ("a", "b"):
-        figure_placement_map(hand, box, placement, _one_grasp_table(hand, synergies), 10.0,
-                             tmp_path / f"m{run}.png", tmp_path / f"m{run}.pdf")
+        figure_placement_map(
+            hand, box, placement, _one_grasp_table(hand, synergies), 10.0, tmp_path / f"m{run}.png", tmp_path / f"m{run}.pdf"
+        )
     for ext in ("png", "pdf"):
         first = (tmp_path / f"ma.{ext}").read_bytes()
         assert len(first) > 10_000 and first == (tmp_path / f"mb.{ext}").read_bytes(), ext

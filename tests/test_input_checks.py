@@ -31,15 +31,14 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_a_repeated_key_names_the_file_the_line_and_the_key(tmp_path):
     path = tmp_path / "my.yaml"
-    path.write_text("scenarios:\n  s: {mechanics: {mu: 1.0}}\n  s: {mechanics: {mu: 2.0}}\n"
-                    "objects:\n  - {a: 1, b: 2, a: 3}\n")
+    path.write_text("scenarios:\n  s: {mechanics: {mu: 1.0}}\n  s: {mechanics: {mu: 2.0}}\nobjects:\n  - {a: 1, b: 2, a: 3}\n")
     with pytest.raises(YamlFileError) as info:
         read_yaml(path, "config file")
     lines = str(info.value).splitlines()
-    assert lines == [f"config file '{path}', line 3: key 'scenarios.s' appears twice (first at line 2); "
-                     "each key may appear once",
-                     f"config file '{path}', line 5: key 'objects[0].a' appears twice (first at line 5); "
-                     "each key may appear once"]
+    assert lines == [
+        f"config file '{path}', line 3: key 'scenarios.s' appears twice (first at line 2); each key may appear once",
+        f"config file '{path}', line 5: key 'objects[0].a' appears twice (first at line 5); each key may appear once",
+    ]
 
 
 def test_keys_that_differ_only_in_type_or_nesting_are_not_repeats(tmp_path):
@@ -48,10 +47,18 @@ def test_keys_that_differ_only_in_type_or_nesting_are_not_repeats(tmp_path):
     assert read_yaml(path) == {"a": {"x": 1}, "b": {"x": 2}, "1": "one", 1: "int one"}
 
 
-@pytest.mark.parametrize("path", [
-    ROOT / "config" / "config.yaml", ROOT / "config" / "sensitivity.yaml", ROOT / "tests" / "config" / "small.yaml",
-    SCHEMA_PATH, default_hand_path(),
-    *sorted((ROOT / "src" / "synergrasp" / "data").glob("synergy_mapping_*.yaml"))], ids=lambda p: p.name)
+@pytest.mark.parametrize(
+    "path",
+    [
+        ROOT / "config" / "config.yaml",
+        ROOT / "config" / "sensitivity.yaml",
+        ROOT / "tests" / "config" / "small.yaml",
+        SCHEMA_PATH,
+        default_hand_path(),
+        *sorted((ROOT / "src" / "synergrasp" / "data").glob("synergy_mapping_*.yaml")),
+    ],
+    ids=lambda p: p.name,
+)
 def test_every_shipped_yaml_reads_as_plain_yaml_does(path):
     assert read_yaml(path) == yaml.safe_load(path.read_text(encoding="utf-8"))
 
@@ -61,7 +68,8 @@ def test_configfile_problems_lists_each_file_once(tmp_path):
     good.write_text("objects: {obj1: {mass_kg: 1.0}}\n")
     bad.write_text("hand: a.yaml\nhand: b.yaml\n")
     assert configfile_problems([good, bad, str(bad)]) == [
-        f"config file '{bad}', line 2: key 'hand' appears twice (first at line 1); each key may appear once"]
+        f"config file '{bad}', line 2: key 'hand' appears twice (first at line 1); each key may appear once"
+    ]
 
 
 def test_a_hand_file_with_a_repeated_key_is_refused_naming_it(tmp_path):
@@ -69,8 +77,9 @@ def test_a_hand_file_with_a_repeated_key_is_refused_naming_it(tmp_path):
     path = tmp_path / "hand.yaml"
     path.write_text(text.replace("name: softhand_like\n", "name: softhand_like\nname: other\n", 1))
     line = text.splitlines().index("name: softhand_like") + 1  # 1-based line of the first 'name'
-    with pytest.raises(ValueError, match=f"hand file '{path}', line {line + 1}: key 'name' appears twice "
-                                         f"\\(first at line {line}\\)"):
+    with pytest.raises(
+        ValueError, match=f"hand file '{path}', line {line + 1}: key 'name' appears twice \\(first at line {line}\\)"
+    ):
         load_hand(path)
 
 
@@ -91,16 +100,24 @@ def _capsule_palm(doc):
     doc["palm"]["shapes"] = [{"capsule": {"from_mm": [0, 0, 20], "to_mm": [0, 0, 80], "radius_mm": 20}}]
 
 
-@pytest.mark.parametrize("mutate, field", [
-    (lambda d: d["palm"].update(shapes=[]), "palm.shapes: the closure needs a palm made of one or more boxes, got []"),
-    (_capsule_palm, "palm.shapes: the closure needs a palm made of one or more boxes, got ['capsule']"),
-    (lambda d: d["fingers"]["ring"]["joints"][2].pop("shapes"),
-     "fingers.ring.joints[2].shapes: the closure needs exactly one capsule per finger link (link 'ring_middle'), got []"),
-    (lambda d: d["fingers"]["thumb"]["joints"][0]["shapes"].append(
-        {"box": {"center_mm": [0, 0, 0], "size_mm": [5, 5, 5]}}),
-     "fingers.thumb.joints[0].shapes: the closure needs exactly one capsule per finger link "
-     "(link 'thumb_knuckle'), got ['capsule', 'box']"),
-])
+@pytest.mark.parametrize(
+    "mutate, field",
+    [
+        (lambda d: d["palm"].update(shapes=[]), "palm.shapes: the closure needs a palm made of one or more boxes, got []"),
+        (_capsule_palm, "palm.shapes: the closure needs a palm made of one or more boxes, got ['capsule']"),
+        (
+            lambda d: d["fingers"]["ring"]["joints"][2].pop("shapes"),
+            "fingers.ring.joints[2].shapes: the closure needs exactly one capsule per finger link (link 'ring_middle'), got []",
+        ),
+        (
+            lambda d: d["fingers"]["thumb"]["joints"][0]["shapes"].append(
+                {"box": {"center_mm": [0, 0, 0], "size_mm": [5, 5, 5]}}
+            ),
+            "fingers.thumb.joints[0].shapes: the closure needs exactly one capsule per finger link "
+            "(link 'thumb_knuckle'), got ['capsule', 'box']",
+        ),
+    ],
+)
 def test_a_hand_the_closure_cannot_collide_is_a_problem_naming_file_and_field(tmp_path, mutate, field):
     doc = _hand_doc()
     mutate(doc)
@@ -126,8 +143,10 @@ def test_a_link_offset_of_minus_9000_mm_is_warned_naming_the_field(tmp_path):
     path = _write(tmp_path, doc)
     _, problems, warnings = check_hand(path)
     assert problems == []
-    assert warnings == [f"hand file '{path}': fingers.index.joints[1] (index_mcp) offset: 9000 mm is far from a "
-                        "human hand's dimensions (a hand is about 190 mm long); lengths are in mm"]
+    assert warnings == [
+        f"hand file '{path}': fingers.index.joints[1] (index_mcp) offset: 9000 mm is far from a "
+        "human hand's dimensions (a hand is about 190 mm long); lengths are in mm"
+    ]
 
 
 def test_a_hand_file_in_metres_is_warned(tmp_path):
@@ -160,8 +179,9 @@ def _with_object(name: str) -> dict:
 def test_a_300_character_object_name_is_refused_naming_the_key():
     with pytest.raises(ConfigError) as info:
         validate_config(_with_object("o" * 300))
-    assert str(info.value).startswith("config error at 'objects': name 'oooooooooooooooooooooooooooooooooooooooo…' "
-                                      "(300 characters) is not allowed")
+    assert str(info.value).startswith(
+        "config error at 'objects': name 'oooooooooooooooooooooooooooooooooooooooo…' (300 characters) is not allowed"
+    )
     assert "at most 64 characters" in str(info.value)
 
 
@@ -178,13 +198,15 @@ def test_names_up_to_64_characters_and_periodic_names_are_valid():
 def test_a_settle_window_the_time_limit_cannot_hold_is_a_config_error(window, ok):
     # ramp 0.3 s, limit 1.0 s, step 1/240 s: 168 steps after the ramp hold a window of 167
     config = defaults()
-    config["closure"]["dynamic"].update(ramp_time_s=0.3, time_limit_s=1.0, time_step_s=1 / 240,
-                                        settle_window_s=window)
+    config["closure"]["dynamic"].update(ramp_time_s=0.3, time_limit_s=1.0, time_step_s=1 / 240, settle_window_s=window)
     if ok:
         assert validate_config(config)
     else:
-        with pytest.raises(ConfigError, match="config error at 'closure.dynamic.settle_window_s': .* must be "
-                                              "shorter than closure.dynamic.time_limit_s - ramp_time_s"):
+        with pytest.raises(
+            ConfigError,
+            match="config error at 'closure.dynamic.settle_window_s': .* must be "
+            "shorter than closure.dynamic.time_limit_s - ramp_time_s",
+        ):
             validate_config(config)
 
 
@@ -192,27 +214,43 @@ def test_a_settle_window_the_time_limit_cannot_hold_is_a_config_error(window, ok
 
 
 def _contacts(obj: str, statuses: list[str], settled: bool = True, model: str = "kinematic") -> pd.DataFrame:
-    return pd.DataFrame({"object": obj, "pose": range(len(statuses)), "status": statuses,
-                         "settled": settled, "closure_model": model})
+    return pd.DataFrame(
+        {"object": obj, "pose": range(len(statuses)), "status": statuses, "settled": settled, "closure_model": model}
+    )
 
 
 def _gfo(obj: str, fc_poses: list[int], n_poses: int, full: str = "1-2-3") -> pd.DataFrame:
-    rows = [{"object": obj, "pose": p, "set_id": s, "status": "feasible" if p in fc_poses else "infeasible",
-             "load_feasible": p in fc_poses, "force_closure_def1": p in fc_poses, "rank_G": 6, "force_norm": np.nan}
-            for p in range(n_poses) for s in ("1", full)]
+    rows = [
+        {
+            "object": obj,
+            "pose": p,
+            "set_id": s,
+            "status": "feasible" if p in fc_poses else "infeasible",
+            "load_feasible": p in fc_poses,
+            "force_closure_def1": p in fc_poses,
+            "rank_G": 6,
+            "force_norm": np.nan,
+        }
+        for p in range(n_poses)
+        for s in ("1", full)
+    ]
     return pd.DataFrame(rows)
 
 
 def test_each_object_that_can_never_be_grasped_has_its_reason():
-    contacts = pd.concat([
-        _contacts("a", ["intersects_open_hand"] * 3 + ["lost"]),
-        _contacts("b", ["no_contact"] * 2 + ["caged"]),
-        _contacts("c", ["grasp"] * 3, settled=False, model="dynamic"),
-        _contacts("d", ["grasp", "no_contact"]),
-        _contacts("e", ["grasp", "grasp"]),
-    ], ignore_index=True)
-    gfo = pd.concat([_gfo("a", [], 4), _gfo("b", [], 3), _gfo("c", [], 3), _gfo("d", [], 2), _gfo("e", [1], 2)],
-                    ignore_index=True)
+    contacts = pd.concat(
+        [
+            _contacts("a", ["intersects_open_hand"] * 3 + ["lost"]),
+            _contacts("b", ["no_contact"] * 2 + ["caged"]),
+            _contacts("c", ["grasp"] * 3, settled=False, model="dynamic"),
+            _contacts("d", ["grasp", "no_contact"]),
+            _contacts("e", ["grasp", "grasp"]),
+        ],
+        ignore_index=True,
+    )
+    gfo = pd.concat(
+        [_gfo("a", [], 4), _gfo("b", [], 3), _gfo("c", [], 3), _gfo("d", [], 2), _gfo("e", [1], 2)], ignore_index=True
+    )
     table = graspable_objects(contacts, gfo, "1-2-3")
     assert list(table["object"]) == ["a", "b", "c", "d", "e"]
     assert list(table["graspable"]) == [False, False, False, False, True]
@@ -220,10 +258,10 @@ def test_each_object_that_can_never_be_grasped_has_its_reason():
     assert list(table["reason"]) == [
         "every pose dropped (intersects_open_hand: 3, lost: 1)",
         "nothing touched: no closure ends touching the box (caged: 1, no_contact: 2)",
-        "no pose settled: every closure stopped at closure.dynamic.time_limit_s, and no force closure with "
-        "the full set {S1..S3}",
+        "no pose settled: every closure stopped at closure.dynamic.time_limit_s, and no force closure with the full set {S1..S3}",
         "no force closure with the full set {S1..S3} at any of the 1 grasps",
-        ""]
+        "",
+    ]
     assert ungraspable_lines(table)[0] == "a can never be grasped: every pose dropped (intersects_open_hand: 3, lost: 1)"
     assert len(ungraspable_lines(table)) == 4
 
@@ -248,7 +286,8 @@ def test_slurm_profile_without_variables_or_commands_names_them():
     assert problems == [
         "$SBATCH_PARTITION is not set (the profile's slurm_partition reads it; export it, empty if your site has none)",
         "$SBATCH_ACCOUNT is not set (the profile's slurm_account reads it; export it, empty if your site has none)",
-        "not on PATH: sbatch, scancel, sacct or squeue"]
+        "not on PATH: sbatch, scancel, sacct or squeue",
+    ]
 
 
 def test_slurm_profile_needs_what_its_account_setting_calls():
@@ -256,14 +295,13 @@ def test_slurm_profile_needs_what_its_account_setting_calls():
     env = {"SBATCH_PARTITION": "main", "SBATCH_ACCOUNT": ""}
     assert slurm_problems(_Settings("squeue"), _PROFILE, env, _which(everything)) == []
     # no account given: the executor guesses one with sacct
-    assert slurm_problems(_Settings("squeue"), _PROFILE, env, _which(everything - {"sacct"})) == [
-        "not on PATH: sacct"]
+    assert slurm_problems(_Settings("squeue"), _PROFILE, env, _which(everything - {"sacct"})) == ["not on PATH: sacct"]
     assert slurm_problems(_Settings("squeue", no_account=True), _PROFILE, env, _which(everything - {"sacct"})) == []
     # an account given: the executor checks it with sacctmgr or sshare
     env["SBATCH_ACCOUNT"] = "lab"
     assert slurm_problems(_Settings("squeue"), _PROFILE, env, _which(everything - {"sacctmgr"})) == [
-        "not on PATH: sacctmgr or sshare"]
-
+        "not on PATH: sacctmgr or sshare"
+    ]
 
 
 # --------------------------------------------------------------------------- kind 8: make report first
@@ -273,11 +311,15 @@ def test_make_report_before_the_study_says_it_must_run_first(tmp_path):
     for name in ("Makefile", "environment.lock", "pyproject.toml"):
         shutil.copy2(ROOT / name, tmp_path / name)
     venv = Path(sys.executable).parent.parent  # this venv, taken as built (-o: not remade)
-    out = subprocess.run(["make", "-s", "-o", str(venv / "bin" / ".installed"), "report", f"VENV={venv}"],
-                         cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    out = subprocess.run(
+        ["make", "-s", "-o", str(venv / "bin" / ".installed"), "report", f"VENV={venv}"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert out.returncode != 0
-    assert out.stdout.strip() == ("make report: the study has not run yet (no results/tables/claims.csv): "
-                                  "run 'make study' first")
+    assert out.stdout.strip() == ("make report: the study has not run yet (no results/tables/claims.csv): run 'make study' first")
     assert not (tmp_path / "results").exists()
 
 
@@ -287,8 +329,7 @@ def test_make_report_before_the_study_says_it_must_run_first(tmp_path):
 def test_the_object_names_include_the_defaults_a_scenario_takes_by_null():
     from synergrasp.config import object_names
 
-    config = {"scenarios": {"a": {"objects": None}, "b": {"objects": {"obj9": {"mass_kg": 1}}}, "c": {"mu": 1},
-                            "gone": None}}
+    config = {"scenarios": {"a": {"objects": None}, "b": {"objects": {"obj9": {"mass_kg": 1}}}, "c": {"mu": 1}, "gone": None}}
     assert object_names(config, ["x"]) == {"x", "obj1", "obj2", "obj3", "obj4", "obj9"}
     assert object_names({"scenarios": {"c": {"mechanics": {"mu": 1.0}}}}, ["x"]) == {"x"}
 
@@ -297,11 +338,13 @@ def test_a_scenario_removing_an_object_the_study_lacks_names_it():
     from synergrasp.config import scenario_config
 
     config = {"objects": {"obj1": defaults()["objects"]["obj1"]}, "scenarios": {"s": {"objects": {"obj9": None}}}}
-    with pytest.raises(ConfigError, match=r"^scenario 's': config error at 'objects.obj9': null removes an object, "
-                                          r"but the study has no object 'obj9'; objects: \['obj1'\]$"):
+    with pytest.raises(
+        ConfigError,
+        match=r"^scenario 's': config error at 'objects.obj9': null removes an object, "
+        r"but the study has no object 'obj9'; objects: \['obj1'\]$",
+    ):
         scenario_config(config, "s")
-    config["scenarios"]["s"] = {"objects": {"obj1": None, "obj2": {"shape": {"sphere": {"radius_mm": 20}},
-                                                                   "mass_kg": 1.0}}}
+    config["scenarios"]["s"] = {"objects": {"obj1": None, "obj2": {"shape": {"sphere": {"radius_mm": 20}}, "mass_kg": 1.0}}}
     assert list(scenario_config(config, "s")["objects"]) == ["obj2"]
 
 
@@ -314,8 +357,10 @@ def test_the_search_lattice_bounds_the_rank():
     assert [search_lattice_size(search, kind) for kind in ("any", "power", "precision")] == [765, 81, 324]
     assert not [p for p in _rank(81) if "search_rank" in p]
     (line,) = [p for p in _rank(82) if "search_rank" in p]  # obj3 and obj4 are power objects
-    assert line.startswith("config error at 'placement.search_rank': 82 exceeds the 81 points of the search "
-                           "lattice of obj3, obj4 (search.region_mm of its grasp type at search.spacing_mm 10 mm)")
+    assert line.startswith(
+        "config error at 'placement.search_rank': 82 exceeds the 81 points of the search "
+        "lattice of obj3, obj4 (search.region_mm of its grasp type at search.spacing_mm 10 mm)"
+    )
 
 
 def _rank(rank: int) -> list[str]:
@@ -338,18 +383,21 @@ def test_a_search_rank_beyond_an_existing_table_is_a_problem(tmp_path):
     assert search_rank_problems(cfg, "obj1", table) == []  # no table yet: the closure judges it
     table.write_text("distinct_rank\n1\n0\n2\n")
     assert search_rank_problems(cfg, "obj1", table) == [
-        "config error at 'placement.search_rank': 3 exceeds the 2 distinct targets of obj1's placement search "
-        f"({table})"]
+        f"config error at 'placement.search_rank': 3 exceeds the 2 distinct targets of obj1's placement search ({table})"
+    ]
     table.write_text("distinct_rank\n1\n2\n3\n")
     assert search_rank_problems(cfg, "obj1", table) == []
 
 
-@pytest.mark.parametrize("shape, warned", [
-    ({"box": {"size_mm": [30, 30, 30]}}, None),
-    ({"box": {"size_mm": [0.03, 0.03, 0.03]}}, "0.052 mm across"),
-    ({"sphere": {"radius_mm": 600}}, "1.2e+03 mm across"),
-    ({"sphere": {"radius_mm": 0.5}}, None),  # 1 mm across: the limit itself is no warning
-])
+@pytest.mark.parametrize(
+    "shape, warned",
+    [
+        ({"box": {"size_mm": [30, 30, 30]}}, None),
+        ({"box": {"size_mm": [0.03, 0.03, 0.03]}}, "0.052 mm across"),
+        ({"sphere": {"radius_mm": 600}}, "1.2e+03 mm across"),
+        ({"sphere": {"radius_mm": 0.5}}, None),  # 1 mm across: the limit itself is no warning
+    ],
+)
 def test_an_object_far_from_a_hands_size_is_warned_naming_the_key(shape, warned):
     from synergrasp.simulation.objects import object_warnings
 
@@ -367,7 +415,8 @@ def test_no_success_under_the_setting_is_one_sentence_with_its_reason():
     settings = type("S", (), {"success": "force_closure_bounded", "marginal_weight_multiple": 0.001})
     assert no_success_note(table, settings).startswith(
         "no grasp succeeds under analyses.success = force_closure_bounded: none of the 1 force-closure (pose, set) "
-        "rows holds the weight within analyses.marginal_weight_multiple = 0.001 times the weight")
+        "rows holds the weight within analyses.marginal_weight_multiple = 0.001 times the weight"
+    )
     table.loc[0, "success"] = True
     assert no_success_note(table, settings) == ""
 

@@ -72,12 +72,15 @@ def test_sets_are_parsed_as_singles_ranges_and_lists():
     assert default_sets(3) == [(1,), (2,), (3,), (1, 2), (1, 2, 3)]
 
 
-@pytest.mark.parametrize("argv, names", [
-    (["grasp", "obj9", "--alpha", "0", "--beta", "0"], "object"),
-    (["grasp", "obj1", "--alpha", "7", "--beta", "0"], "--alpha/--beta"),
-    (["grasp", "obj1", "--alpha", "0", "--beta", "0", "--sets", "16"], "--sets"),
-    (["grasp", "obj1", "--alpha", "0", "--beta", "0", "--sets", "1-x"], "--sets"),
-])
+@pytest.mark.parametrize(
+    "argv, names",
+    [
+        (["grasp", "obj9", "--alpha", "0", "--beta", "0"], "object"),
+        (["grasp", "obj1", "--alpha", "7", "--beta", "0"], "--alpha/--beta"),
+        (["grasp", "obj1", "--alpha", "0", "--beta", "0", "--sets", "16"], "--sets"),
+        (["grasp", "obj1", "--alpha", "0", "--beta", "0", "--sets", "1-x"], "--sets"),
+    ],
+)
 def test_bad_arguments_give_one_line_naming_the_argument(capsys, argv, names):
     assert main(argv + ["--configfile", str(SMALL)]) == 2
     err = [line for line in capsys.readouterr().err.strip().splitlines() if ": warning: " not in line]
@@ -85,8 +88,9 @@ def test_bad_arguments_give_one_line_naming_the_argument(capsys, argv, names):
 
 
 def test_json_output_holds_the_same_numbers(capsys, small):
-    assert main(["grasp", "obj4", "--alpha", "-150", "--beta", "-20", "--sets", "1-15", "--json",
-                 "--configfile", str(SMALL)]) == 0
+    assert (
+        main(["grasp", "obj4", "--alpha", "-150", "--beta", "-20", "--sets", "1-15", "--json", "--configfile", str(SMALL)]) == 0
+    )
     data = json.loads(capsys.readouterr().out)
     direct = inspect_grasp(small, "obj4", -150.0, -20.0, [tuple(range(1, 16))])
     assert data["pose"] == direct.pose
@@ -100,10 +104,23 @@ def test_a_searched_placement_takes_its_target_from_the_search_table(small, tmp_
     target = (38.0, 5.0, 112.0)
     folder = tmp_path / "objects" / "obj1"
     folder.mkdir(parents=True)
-    row = {"object": "obj1", "rank": 1, "chosen": True, "distinct_rank": 1, "x_mm": target[0], "y_mm": target[1],
-           "z_mm": target[2], "round": 0, "n_poses": 27, "grasp_type": "precision", "typed_percent": 100.0,
-           "force_closure_percent": 100.0,
-           "median_force_per_weight": 1.0, "median_contacts": 5.0, "distance_to_chosen_mm": 0.0}
+    row = {
+        "object": "obj1",
+        "rank": 1,
+        "chosen": True,
+        "distinct_rank": 1,
+        "x_mm": target[0],
+        "y_mm": target[1],
+        "z_mm": target[2],
+        "round": 0,
+        "n_poses": 27,
+        "grasp_type": "precision",
+        "typed_percent": 100.0,
+        "force_closure_percent": 100.0,
+        "median_force_per_weight": 1.0,
+        "median_contacts": 5.0,
+        "distance_to_chosen_mm": 0.0,
+    }
     import pandas as pd
 
     pd.DataFrame([{c: row.get(c, 0) for c in tables.PLACEMENT.names}]).to_csv(folder / "placement.csv", index=False)
@@ -134,8 +151,12 @@ def test_png_draws_the_grasp_from_two_views_with_its_touching_links(tmp_path):
     from synergrasp.figures.hand_pictures import TOUCHING
 
     out = tmp_path / "grasp.png"
-    assert main(["grasp", "obj4", "--alpha", "-150", "--beta", "-20", "--sets", "1-15", "--png", str(out),
-                 "--configfile", str(SMALL)]) == 0
+    assert (
+        main(
+            ["grasp", "obj4", "--alpha", "-150", "--beta", "-20", "--sets", "1-15", "--png", str(out), "--configfile", str(SMALL)]
+        )
+        == 0
+    )
     rgb = imread(out)[..., :3].astype(float)
     # the highlight's hue (shading scales brightness, not hue) in the left and in the right view
     chroma = rgb / np.maximum(rgb.sum(axis=2, keepdims=True), 1e-9)
@@ -155,11 +176,18 @@ def test_the_inspector_names_the_blockers_of_the_blockers_table(small, study_row
     contacts, gfo = study_rows[obj]
     full_id = incremental_set_id(15)
     base = BlockersParams.from_config(cfg, obj)
-    params = BlockersParams(base.hand, base.synergies, base.gfo, {set_id(s): s for s in SETS if set_id(s) != full_id},
-                            full_id, base.rule, base.shape)
+    params = BlockersParams(
+        base.hand, base.synergies, base.gfo, {set_id(s): s for s in SETS if set_id(s) != full_id}, full_id, base.rule, base.shape
+    )
     hand = load_hand(params.hand)
-    table = blockers_table(contacts, gfo, hand.link_names, HandAxes.from_hand(hand),
-                           load_synergies(params.synergies, joint_names=hand.joint_names).matrix, params)
+    table = blockers_table(
+        contacts,
+        gfo,
+        hand.link_names,
+        HandAxes.from_hand(hand),
+        load_synergies(params.synergies, joint_names=hand.joint_names).matrix,
+        params,
+    )
     assert len(table) and set(table["reason"]) <= {"contacts", "no_internal_force"}
     row = table[table["reason"] == "contacts"].iloc[0]
     result = inspect_grasp(small, obj, float(row["alpha_deg"]), float(row["beta_deg"]), SETS)

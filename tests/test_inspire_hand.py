@@ -17,11 +17,20 @@ from synergrasp.yaml_io import read_yaml
 
 INSPIRE = Path(__file__).parents[1] / "src" / "synergrasp" / "data" / "hands" / "inspire"
 #: the robosuite body of each project link (the link names of hand.yaml)
-BODIES = {"palm": "r_palm", "thumb_base": "r_thumb_proximal_1", "thumb_proximal": "r_thumb_proximal_2",
-          "thumb_middle": "r_thumb_middle", "thumb_distal": "r_thumb_distal"}
-BODIES.update({f"{f}_{s}": f"r_{b}_{s}" for f, b in zip(("index", "middle", "ring", "little"),
-                                                         ("index", "middle", "ring", "pinky"))
-               for s in ("proximal", "distal")})
+BODIES = {
+    "palm": "r_palm",
+    "thumb_base": "r_thumb_proximal_1",
+    "thumb_proximal": "r_thumb_proximal_2",
+    "thumb_middle": "r_thumb_middle",
+    "thumb_distal": "r_thumb_distal",
+}
+BODIES.update(
+    {
+        f"{f}_{s}": f"r_{b}_{s}"
+        for f, b in zip(("index", "middle", "ring", "little"), ("index", "middle", "ring", "pinky"))
+        for s in ("proximal", "distal")
+    }
+)
 
 
 @pytest.fixture(scope="module")
@@ -89,18 +98,23 @@ def test_couplings_are_the_models_joint_equalities(inspire):
     so coupled MuJoCo's own equality constraints are met (constraint residuals zero)."""
     hand, model, doc = inspire
     assert hand.joint_names == ("thumb_abd", "thumb_flex1", "index_mcp", "middle_mcp", "ring_mcp", "little_mcp")
-    coupled = {hand.frame_joint_names[k]: (hand.joint_names[hand.frame_joint[k]], hand.frame_scale[k])
-               for k in range(1, len(hand.frame_names)) if hand.frame_joint_names[k].startswith("joint_r_")}
-    expected = {model.joint(model.eq_obj1id[eq]).name: (model.joint(model.eq_obj2id[eq]).name, model.eq_data[eq][1])
-                for eq in range(model.neq)}
+    coupled = {
+        hand.frame_joint_names[k]: (hand.joint_names[hand.frame_joint[k]], hand.frame_scale[k])
+        for k in range(1, len(hand.frame_names))
+        if hand.frame_joint_names[k].startswith("joint_r_")
+    }
+    expected = {
+        model.joint(model.eq_obj1id[eq]).name: (model.joint(model.eq_obj2id[eq]).name, model.eq_data[eq][1])
+        for eq in range(model.neq)
+    }
     names = {e["mjcf"]: e.get("name") for node in doc["fingers"].values() for e in node["joints"]}
     assert len(expected) == 6 and {k: (names[m], r) for k, (m, r) in expected.items()} == coupled
     data = mujoco.MjData(model)
     for q in _postures(hand, n=5):
         data.qpos[:] = _qpos(hand, model, doc, q)
         mujoco.mj_forward(model, data)
-        rows = data.efc_type[:data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
-        assert rows.sum() == 6 and np.max(np.abs(data.efc_pos[:data.nefc][rows])) < 1e-12
+        rows = data.efc_type[: data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+        assert rows.sum() == 6 and np.max(np.abs(data.efc_pos[: data.nefc][rows])) < 1e-12
     # the master's range keeps every coupled joint inside its own (distal ranges 0.77-1.87 rad)
     assert np.allclose(hand.upper, [1.3, 0.68, 1.62, 1.62, 1.62, 1.62]) and np.all(hand.lower == 0.0)
 
@@ -111,10 +125,15 @@ def _world_geom(spec_body, shape, palm_pose):
     quat = np.zeros(4)
     mujoco.mju_mat2Quat(quat, pose[:3, :3].flatten())
     if shape.kind == "capsule":
-        return spec_body.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, pos=pose[:3, 3] / MM_PER_M, quat=quat,
-                                  size=[shape.radius / MM_PER_M, 0.5 * shape.length / MM_PER_M, 0])
-    return spec_body.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, pos=pose[:3, 3] / MM_PER_M, quat=quat,
-                              size=0.5 * shape.size / MM_PER_M)
+        return spec_body.add_geom(
+            type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+            pos=pose[:3, 3] / MM_PER_M,
+            quat=quat,
+            size=[shape.radius / MM_PER_M, 0.5 * shape.length / MM_PER_M, 0],
+        )
+    return spec_body.add_geom(
+        type=mujoco.mjtGeom.mjGEOM_BOX, pos=pose[:3, 3] / MM_PER_M, quat=quat, size=0.5 * shape.size / MM_PER_M
+    )
 
 
 def test_fitted_shapes_contain_each_meshs_hull_by_mujocos_distance(inspire):
@@ -159,15 +178,22 @@ def test_fitted_shapes_contain_each_meshs_hull_by_mujocos_distance(inspire):
             excess.append((d_fit - d_hull) * MM_PER_M)
         worst_inside = max(worst_inside, max(excess))
         reach[name] = -min(excess)
-    print("largest d(p, fit) - d(p, hull): %.3g mm; the fits reach past their hulls by up to (mm): %s"
-          % (worst_inside, ", ".join(f"{k} {v:.1f}" for k, v in reach.items())))
+    print(
+        "largest d(p, fit) - d(p, hull): %.3g mm; the fits reach past their hulls by up to (mm): %s"
+        % (worst_inside, ", ".join(f"{k} {v:.1f}" for k, v in reach.items()))
+    )
     assert worst_inside <= 1.0
     assert all(v > 0.5 for v in reach.values())  # the probes see the fits: no shape equals its hull
 
 
 def _collision_geom(model, body):
-    (geom,) = [g for g in range(model.ngeom) if model.geom_bodyid[g] == model.body(body).id
-               and model.geom_contype[g] + model.geom_conaffinity[g] > 0 and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH]
+    (geom,) = [
+        g
+        for g in range(model.ngeom)
+        if model.geom_bodyid[g] == model.body(body).id
+        and model.geom_contype[g] + model.geom_conaffinity[g] > 0
+        and model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH
+    ]
     return geom
 
 
@@ -212,8 +238,12 @@ def test_enclosing_circle_against_an_independent_minimiser():
         points = rng.normal(size=(n, 2)) * [10.0, 4.0]
         centre, radius = enclosing_circle(points)
         assert np.max(np.linalg.norm(points - centre, axis=1)) <= radius * (1 + 1e-9)
-        best = minimize(lambda c: np.max(np.linalg.norm(points - c, axis=1)), points.mean(axis=0),
-                        method="Nelder-Mead", options={"xatol": 1e-10, "fatol": 1e-10, "maxiter": 20000})
+        best = minimize(
+            lambda c: np.max(np.linalg.norm(points - c, axis=1)),
+            points.mean(axis=0),
+            method="Nelder-Mead",
+            options={"xatol": 1e-10, "fatol": 1e-10, "maxiter": 20000},
+        )
         assert radius <= best.fun + 1e-6 and radius >= best.fun - 1e-3
 
 
@@ -254,18 +284,23 @@ _FINGER = """<body name="{f}1" pos="0 {y} 0.06"><joint name="{f}_j1" axis="0 1 0
 def _mesh_hand(tmp_path, fit="true", polycoef="0 0.5 0 0 0", couplings="", mesh="tet"):
     """Five two-joint fingers of tetrahedron meshes on a box palm, each distal joint held to
     its proximal one by a joint equality; a flat mesh when ``mesh='flat'``."""
-    fingers = "".join(_FINGER.format(f=f, y=0.02 * k, mesh=mesh)
-                      for k, f in enumerate(("thumb", "index", "middle", "ring", "little")))
-    equalities = "".join(f'<joint joint1="{f}_j2" joint2="{f}_j1" polycoef="{polycoef}"/>'
-                         for f in ("thumb", "index", "middle", "ring", "little"))
+    fingers = "".join(
+        _FINGER.format(f=f, y=0.02 * k, mesh=mesh) for k, f in enumerate(("thumb", "index", "middle", "ring", "little"))
+    )
+    equalities = "".join(
+        f'<joint joint1="{f}_j2" joint2="{f}_j1" polycoef="{polycoef}"/>' for f in ("thumb", "index", "middle", "ring", "little")
+    )
     flat = '<mesh name="flat" vertex="0 0 0  0.01 0 0  0 0.01 0  0.01 0.01 0"/>' if mesh == "flat" else ""
     (tmp_path / "mini.xml").write_text(
         f'<mujoco><asset><mesh name="tet" vertex="0 0 0  0.01 0 0  0 0.01 0  0 0 0.03"/>{flat}</asset>'
         f'<worldbody><body name="palm"><geom type="box" size="0.04 0.01 0.05"/>{fingers}</body></worldbody>'
-        f"<equality>{equalities}</equality></mujoco>")
-    chains = "\n".join(f"  {f}:\n    tip_mm: [0, 0, 10]\n    joints:\n"
-                       f"      - {{mjcf: {f}_j1, name: {f}_flex, link: {f}_a}}\n      - {{mjcf: {f}_j2, link: {f}_b}}"
-                       for f in ("thumb", "index", "middle", "ring", "little"))
+        f"<equality>{equalities}</equality></mujoco>"
+    )
+    chains = "\n".join(
+        f"  {f}:\n    tip_mm: [0, 0, 10]\n    joints:\n"
+        f"      - {{mjcf: {f}_j1, name: {f}_flex, link: {f}_a}}\n      - {{mjcf: {f}_j2, link: {f}_b}}"
+        for f in ("thumb", "index", "middle", "ring", "little")
+    )
     (tmp_path / "hand.yaml").write_text(f"mjcf: mini.xml\npalm: palm\nfit_meshes: {fit}\n{couplings}fingers:\n{chains}\n")
     return tmp_path / "hand.yaml"
 
@@ -287,14 +322,19 @@ def test_mesh_hand_through_the_door(tmp_path):
     assert np.all(gap <= 1e-5) and np.max(gap) > -1e-5  # MuJoCo keeps mesh vertices in float32
 
 
-@pytest.mark.parametrize("case, expected", [
-    ({"fit": "maybe"}, "fit_meshes: must be true or false, got 'maybe'"),
-    ({"fit": "false"}, "a mesh collision geom is refused"),
-    ({"polycoef": "0.1 1 0 0 0"}, "only a coupling joint1 = c1 × joint2"),
-    ({"couplings": "couplings: {index_j2: {follows: index_j1, ratio: 1.0}}\n"},
-     "couplings.index_j2: joint 'index_j2' is coupled by equality"),
-    ({"mesh": "flat"}, "MuJoCo cannot compile"),
-])
+@pytest.mark.parametrize(
+    "case, expected",
+    [
+        ({"fit": "maybe"}, "fit_meshes: must be true or false, got 'maybe'"),
+        ({"fit": "false"}, "a mesh collision geom is refused"),
+        ({"polycoef": "0.1 1 0 0 0"}, "only a coupling joint1 = c1 × joint2"),
+        (
+            {"couplings": "couplings: {index_j2: {follows: index_j1, ratio: 1.0}}\n"},
+            "couplings.index_j2: joint 'index_j2' is coupled by equality",
+        ),
+        ({"mesh": "flat"}, "MuJoCo cannot compile"),
+    ],
+)
 def test_mesh_hand_refused_in_one_line(tmp_path, case, expected):
     path = _mesh_hand(tmp_path, **case)
     with pytest.raises(ValueError) as err:

@@ -1,4 +1,5 @@
 """The pipeline's invariant checks on hand-made results."""
+
 import pandas as pd
 import pytest
 
@@ -34,10 +35,21 @@ def test_force_beyond_the_solver_is_explained_not_warned():
     from synergrasp.analysis.summaries import success_rates
     from synergrasp.analysis.verdicts import with_verdicts
 
-    gfo = pd.DataFrame({"object": ["a"] * 4, "pose": [0, 0, 1, 1], "alpha_deg": [0.0, 0.0, 5.0, 5.0],
-                        "beta_deg": [0.0] * 4, "set_id": ["1", "1-2", "1", "1-2"], "n_synergies": [1, 2, 1, 2],
-                        "status": ["infeasible", "feasible"] * 2, "load_feasible": [False, True] * 2,
-                        "force_closure_def1": [True] * 4, "rank_G": [6] * 4, "force_norm": [np.nan, 500.0, np.nan, 50.0]})
+    gfo = pd.DataFrame(
+        {
+            "object": ["a"] * 4,
+            "pose": [0, 0, 1, 1],
+            "alpha_deg": [0.0, 0.0, 5.0, 5.0],
+            "beta_deg": [0.0] * 4,
+            "set_id": ["1", "1-2", "1", "1-2"],
+            "n_synergies": [1, 2, 1, 2],
+            "status": ["infeasible", "feasible"] * 2,
+            "load_feasible": [False, True] * 2,
+            "force_closure_def1": [True] * 4,
+            "rank_G": [6] * 4,
+            "force_norm": [np.nan, 500.0, np.nan, 50.0],
+        }
+    )
     table = with_verdicts(gfo, "force_closure", {"a": 9.81}, 10.0)
     with pytest.warns(InvariantWarning) as caught:
         checks = invariant_checks(table, success_rates(table, "1-2"), {}, 1.0).set_index("check")

@@ -201,8 +201,8 @@ def _strict_margin(problem: GFOProblem, shrink: float) -> float:
     f, mu = problem.E @ y, problem.cone.mu * (1.0 - shrink)
     cons = [cp.norm(y) <= 1]
     for i, n in enumerate(problem.normals):
-        fn = n @ f[3 * i:3 * i + 3]
-        cons += [fn >= s, mu * fn - cp.norm(f[3 * i:3 * i + 3] - fn * n) >= s]
+        fn = n @ f[3 * i : 3 * i + 3]
+        cons += [fn >= s, mu * fn - cp.norm(f[3 * i : 3 * i + 3] - fn * n) >= s]
     cp.Problem(cp.Maximize(s), cons).solve(solver="CLARABEL")
     F = (problem.E @ y.value).reshape(-1, 3)
     fn = np.einsum("ij,ij->i", F, problem.normals)
@@ -343,9 +343,9 @@ def test_set_basis_against_lapack_svd(seed):
     assert np.linalg.norm(F - E @ (E.T @ F), 2) <= dropped + 1e-13 * lapack[0]
     # the same set started from its parent's rotated columns (the set without its last column)
     table = np.zeros((2, s), dtype=np.int64)
-    table[0, :s - 1], table[1] = cols[:s - 1], cols
+    table[0, : s - 1], table[1] = cols[: s - 1], cols
     bases, e_s = _bases(F_all, table, [s - 1, s], [-1, 0])
-    E = bases[1, :, :e_s[1]]
+    E = bases[1, :, : e_s[1]]
     assert e_s[1] == rank
     np.testing.assert_allclose(E.T @ E, np.eye(rank), atol=1e-13)
     assert np.linalg.norm(F - E @ (E.T @ F), 2) <= dropped + 1e-13 * lapack[0]

@@ -1,5 +1,6 @@
 """What a workflow job leaves behind: its log (with the traceback of a failure) and figure
 files that are the same bytes in every run."""
+
 import sys
 import time
 
@@ -47,18 +48,16 @@ def test_saved_figures_are_identical_bytes_across_runs(tmp_path):
     assert b"CreationDate" not in (tmp_path / "a.pdf").read_bytes()
 
 
-_HEADER = 'digraph snakemake_dag {\n    graph[bgcolor=white, margin=0];\n'
+_HEADER = "digraph snakemake_dag {\n    graph[bgcolor=white, margin=0];\n"
 
 
 def _dot(numbering: dict[str, int], edges: list[tuple[str, str]]) -> str:
-    nodes = "".join(f'\t{i}[label = "{name}", color = "0.1 0.6 0.85", style="rounded"];\n'
-                    for name, i in numbering.items())
+    nodes = "".join(f'\t{i}[label = "{name}", color = "0.1 0.6 0.85", style="rounded"];\n' for name, i in numbering.items())
     return _HEADER + nodes + "".join(f"\t{numbering[a]} -> {numbering[b]}\n" for a, b in edges) + "}\n"
 
 
 def test_canonical_rulegraph_does_not_depend_on_snakemake_order():
-    edges = [("simulate", "optimise"), ("optimise", "tables"), ("simulate", "fig2"), ("tables", "all"),
-             ("fig2", "all")]
+    edges = [("simulate", "optimise"), ("optimise", "tables"), ("simulate", "fig2"), ("tables", "all"), ("fig2", "all")]
     one = _dot({"all": 0, "simulate": 1, "optimise": 2, "tables": 3, "fig2": 4}, edges)
     other = _dot({"fig2": 0, "tables": 1, "all": 2, "optimise": 3, "simulate": 4}, edges[::-1])
     assert one != other

@@ -1,4 +1,5 @@
 """tools/job_times.py: jobs, wall and CPU seconds per rule from Snakemake benchmark files."""
+
 import importlib.util
 from pathlib import Path
 

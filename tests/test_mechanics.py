@@ -115,7 +115,7 @@ def test_internal_force_basis_rank_decision_on_null_synergies(grasp):
     """Synergies that the projector annihilates (and their round-off) give e_s = 0."""
     mech = grasp_mechanics(grasp, weight_wrench(W, [0, 0, -1]), 1.0, 200.0)
     _, sv, Vt = np.linalg.svd(mech.projector)
-    null = Vt[np.sum(sv > 1e-12 * sv[0]):].T  # joint motions with no internal force
+    null = Vt[np.sum(sv > 1e-12 * sv[0]) :].T  # joint motions with no internal force
     if null.shape[1] == 0:  # with 6 finger contacts the projector is full column rank
         null = np.zeros((19, 1))
     assert internal_force_basis(mech.projector, null[:, :1], mech.response_norm).shape[1] == 0
@@ -131,7 +131,7 @@ def test_random_grasp_jacobian_structure():
     assert np.all(g.links[:3] == 0)
     np.testing.assert_array_equal(g.jacobian[:9], 0)
     for i, link in enumerate(g.links):
-        rows = g.jacobian[3 * i:3 * i + 3]
+        rows = g.jacobian[3 * i : 3 * i + 3]
         moving = set(np.flatnonzero(np.abs(rows).sum(0) > 0))
         assert moving == set(LINK_CHAINS[link])
         col_norms = np.linalg.norm(rows[:, list(LINK_CHAINS[link])], axis=0)

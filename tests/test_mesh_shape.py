@@ -39,11 +39,16 @@ def _write_obj(path: Path, vertices, triangles) -> Path:
 def _write_stl(path: Path, vertices, triangles, binary: bool) -> Path:
     corners = np.asarray(vertices, dtype=float)[np.asarray(triangles)]
     if binary:
-        path.write_bytes(b"box".ljust(80) + struct.pack("<I", len(corners))
-                         + b"".join(struct.pack("<12fH", 0, 0, 0, *t.ravel(), 0) for t in corners))
+        path.write_bytes(
+            b"box".ljust(80)
+            + struct.pack("<I", len(corners))
+            + b"".join(struct.pack("<12fH", 0, 0, 0, *t.ravel(), 0) for t in corners)
+        )
     else:
-        facets = "".join("facet normal 0 0 0\n outer loop\n" + "".join(f"  vertex {x} {y} {z}\n" for x, y, z in t)
-                         + " endloop\nendfacet\n" for t in corners)
+        facets = "".join(
+            "facet normal 0 0 0\n outer loop\n" + "".join(f"  vertex {x} {y} {z}\n" for x, y, z in t) + " endloop\nendfacet\n"
+            for t in corners
+        )
         path.write_text(f"solid box\n{facets}endsolid box\n")
     return path
 
@@ -55,10 +60,17 @@ def test_obj_and_stl_of_one_box_read_alike(tmp_path):
     """Quads with ``v//vn`` tokens, negative indices, ASCII and binary STL: the same solid."""
     box = _CORNERS * HALF
     negative = tmp_path / "negative.obj"
-    negative.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in box) + "vt 0 0\n"
-                        + "".join("f " + " ".join(f"{k - 8}/1" for k in q) + "\n" for q in _QUADS))
-    files = [BOX_OBJ, negative, _write_stl(tmp_path / "a.stl", box, _triangles(), binary=False),
-             _write_stl(tmp_path / "b.STL", box, _triangles(), binary=True)]
+    negative.write_text(
+        "".join(f"v {x} {y} {z}\n" for x, y, z in box)
+        + "vt 0 0\n"
+        + "".join("f " + " ".join(f"{k - 8}/1" for k in q) + "\n" for q in _QUADS)
+    )
+    files = [
+        BOX_OBJ,
+        negative,
+        _write_stl(tmp_path / "a.stl", box, _triangles(), binary=False),
+        _write_stl(tmp_path / "b.STL", box, _triangles(), binary=True),
+    ]
     for path in files:
         mesh = read_mesh(path)
         assert len(mesh.vertices) == 8 and len(mesh.triangles) == 12, path
@@ -80,8 +92,7 @@ def test_a_mesh_is_centred_on_its_solid_and_scaled(tmp_path):
 
 
 def _config(path, scale=1.0):
-    return validate_config({"objects": {"thing": {"shape": {"mesh": {"path": str(path), "scale": scale}},
-                                                  "mass_kg": 0.3}}})
+    return validate_config({"objects": {"thing": {"shape": {"mesh": {"path": str(path), "scale": scale}}, "mass_kg": 0.3}}})
 
 
 def _bad_files(tmp_path: Path) -> dict[str, tuple[Path, str]]:
@@ -102,17 +113,19 @@ def _bad_files(tmp_path: Path) -> dict[str, tuple[Path, str]]:
         "wrong extension": (tmp_path / "box.ply", "is not an OBJ or STL file"),
         "a folder": (tmp_path, "is a folder; give an OBJ or STL file"),
         "open": (_write_obj(tmp_path / "open.obj", box, _triangles()[:-1]), "is not closed: 3 edges belong to one"),
-        "non-manifold": (_write_obj(tmp_path / "pair.obj", np.unique(two, axis=0), edge_pair),
-                         "is non-manifold: 1 edges are shared by more than two triangles"),
+        "non-manifold": (
+            _write_obj(tmp_path / "pair.obj", np.unique(two, axis=0), edge_pair),
+            "is non-manifold: 1 edges are shared by more than two triangles",
+        ),
         "inconsistent": (_write_obj(tmp_path / "flip.obj", box, flipped), "are not consistently oriented"),
-        "flat": (_write_obj(tmp_path / "flat.obj", flat, [(0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2)]),
-                 "encloses no volume"),
+        "flat": (_write_obj(tmp_path / "flat.obj", flat, [(0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2)]), "encloses no volume"),
         "bad line": (_write_obj(tmp_path / "line.obj", box, _triangles()), ""),
     }
 
 
-@pytest.mark.parametrize("case", ["missing", "empty", "not an STL", "wrong extension", "a folder", "open", "non-manifold",
-                                  "inconsistent", "flat"])
+@pytest.mark.parametrize(
+    "case", ["missing", "empty", "not an STL", "wrong extension", "a folder", "open", "non-manifold", "inconsistent", "flat"]
+)
 def test_a_bad_mesh_file_is_one_error_naming_the_key(tmp_path, case):
     path, problem = _bad_files(tmp_path)[case]
     problems = object_problems(_config(path))
@@ -237,7 +250,8 @@ def test_a_mesh_of_a_box_has_the_boxs_distances_normals_and_symmetry(pair):
     palm = np.eye(4)
     palm[:3, 3] = [-70.0, 10.0, 60.0]
     assert mesh.box_gap(R, c, palm, np.array([12.0, 39.0, 38.0]))[0] == pytest.approx(
-        box.box_gap(R, c, palm, np.array([12.0, 39.0, 38.0]))[0], abs=1e-9)
+        box.box_gap(R, c, palm, np.array([12.0, 39.0, 38.0]))[0], abs=1e-9
+    )
     # overlapping: minus the penetration depth (2 mm along x); touching edge on edge (a box
     # turned 45° about z with an edge on the mesh's edge): 0
     palm[:3, 3] = [15.0 + 12.0 - 2.0, 5.0, -3.0]
@@ -258,14 +272,15 @@ def test_a_mesh_of_a_box_gets_the_boxs_period_and_contacts(pair, hand, synergies
     placement = study_placement()
     assert alpha_period_deg(placement, mesh) == alpha_period_deg(placement, box) == 180.0
     poses = [0, 301, 777, 1024, 1500, 1799]
-    tables = [simulate_object(hand, synergies, GraspedObject(name, shape, 1.0), placement, study_closure_params(),
-                              poses=poses) for name, shape in (("box", box), ("mesh", mesh))]
+    tables = [
+        simulate_object(hand, synergies, GraspedObject(name, shape, 1.0), placement, study_closure_params(), poses=poses)
+        for name, shape in (("box", box), ("mesh", mesh))
+    ]
     for column in ("status", "finger_state", "contact_link"):
         assert [list(np.ravel(v)) for v in tables[1][column]] == [list(np.ravel(v)) for v in tables[0][column]]
     for column in ("q", "contact_point", "contact_normal", "object_center"):
         for got, want in zip(tables[1][column], tables[0][column]):
-            np.testing.assert_allclose(np.asarray(got, dtype=float), np.asarray(want, dtype=float), atol=1e-6,
-                                       err_msg=column)
+            np.testing.assert_allclose(np.asarray(got, dtype=float), np.asarray(want, dtype=float), atol=1e-6, err_msg=column)
     assert (tables[0].n_contacts >= 1).all() and tables[0].n_contacts.sum() >= 12
 
 
@@ -306,8 +321,7 @@ def test_the_example_studys_meshes_are_grasped_and_optimised(monkeypatch, obj, a
     assert result.closure_status == "grasp" and len(result.contacts) >= 2
     np.testing.assert_allclose(np.linalg.norm(np.array(result.contacts["normal"].tolist()), axis=1), 1.0, atol=1e-9)
     (one, every) = result.sets
-    assert every.status in {"feasible", "infeasible", "rank_deficient"} and not (one.force_closure
-                                                                                      and not every.force_closure)
+    assert every.status in {"feasible", "infeasible", "rank_deficient"} and not (one.force_closure and not every.force_closure)
 
 
 def test_fig2_draws_a_mesh(hand, synergies, tmp_path, monkeypatch):

@@ -1,4 +1,3 @@
-
 import numpy as np
 import pandas as pd
 import pytest
@@ -127,8 +126,11 @@ def test_minima_table():
     rows = []
     for set_id, n, f in (("1", 1, force), ("1-2", 2, np.where(alpha == 90.0, 9.0, force))):
         for pose, (a, b, x) in enumerate(zip(alpha, beta, f)):
-            rows.append(dict(object="obj1", pose=pose, alpha_deg=a, beta_deg=b, set_id=set_id, n_synergies=n,
-                             success=True, success_force=x))
+            rows.append(
+                dict(
+                    object="obj1", pose=pose, alpha_deg=a, beta_deg=b, set_id=set_id, n_synergies=n, success=True, success_force=x
+                )
+            )
     table = minima_table(pd.DataFrame(rows))
     assert table[["set_id", "alpha_deg"]].values.tolist() == [["1", -180.0], ["1", 90.0], ["1-2", -180.0]]
     assert list(table.columns) == ["object", "set_id", "n_synergies", "pose", "alpha_deg", "beta_deg", "force_norm"]

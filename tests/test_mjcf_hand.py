@@ -35,7 +35,8 @@ def _qpos(hand, model, doc, q):
                 qpos[model.jnt_qposadr[model.joint(entry["mjcf"]).id]] = sign * q[hand.joint_names.index(entry["name"])]
     for name, coupling in doc["couplings"].items():
         qpos[model.jnt_qposadr[model.joint(name).id]] = (
-            coupling["ratio"] * qpos[model.jnt_qposadr[model.joint(coupling["follows"]).id]])
+            coupling["ratio"] * qpos[model.jnt_qposadr[model.joint(coupling["follows"]).id]]
+        )
     return qpos
 
 
@@ -96,9 +97,13 @@ def test_shadow_collision_shapes_equal_mujoco_geoms(shadow):
         frames = forward_kinematics(hand, q)
         ours = [(frames[link] @ s.pose, s) for link in range(hand.n_links) for s in hand.link_shapes[link]]
         palm = model.body(doc["palm"]).id
-        geoms = [g for g in range(model.ngeom) if model.geom(g).name not in ignored
-                 and model.geom_contype[g] + model.geom_conaffinity[g] > 0
-                 and _below(model, int(model.geom_bodyid[g]), palm)]
+        geoms = [
+            g
+            for g in range(model.ngeom)
+            if model.geom(g).name not in ignored
+            and model.geom_contype[g] + model.geom_conaffinity[g] > 0
+            and _below(model, int(model.geom_bodyid[g]), palm)
+        ]
         assert len(geoms) == len(ours) == 18  # 3 palm boxes (one the fixed little metacarpal), 15 capsules
         for g in geoms:
             centre = rotation @ (data.geom_xpos[g] - origin) * MM_PER_M
@@ -153,27 +158,39 @@ def _mini(tmp_path, kind="hinge", geom="capsule", palm="palm", joint="j1"):
     mesh, asset = "", ""
     if geom == "mesh":
         mesh = 'mesh="tet"'
-        asset = ('<asset><mesh name="tet" vertex="0 0 0  0.01 0 0  0 0.01 0  0 0 0.01"/></asset>')
-    bodies = "".join(MINI.format(finger=f, kind=kind, geom=geom, mesh=mesh, asset="")
-                     .split("<worldbody>")[1].split("</worldbody>")[0].replace('<body name="palm">', "")
-                     .replace('<geom type="box" size="0.04 0.01 0.05"/>', "").rsplit("</body>", 1)[0]
-                     for f in ("thumb", "index", "middle", "ring", "little"))
-    xml = (f'<mujoco><worldbody><body name="palm"><geom type="box" size="0.04 0.01 0.05"/>{bodies}</body>'
-           f"</worldbody>{asset}</mujoco>")
+        asset = '<asset><mesh name="tet" vertex="0 0 0  0.01 0 0  0 0.01 0  0 0 0.01"/></asset>'
+    bodies = "".join(
+        MINI.format(finger=f, kind=kind, geom=geom, mesh=mesh, asset="")
+        .split("<worldbody>")[1]
+        .split("</worldbody>")[0]
+        .replace('<body name="palm">', "")
+        .replace('<geom type="box" size="0.04 0.01 0.05"/>', "")
+        .rsplit("</body>", 1)[0]
+        for f in ("thumb", "index", "middle", "ring", "little")
+    )
+    xml = (
+        f'<mujoco><worldbody><body name="palm"><geom type="box" size="0.04 0.01 0.05"/>{bodies}</body>'
+        f"</worldbody>{asset}</mujoco>"
+    )
     (tmp_path / "mini.xml").write_text(xml)
-    fingers = "\n".join(f"  {f}:\n    tip_site: null\n    joints: [{{mjcf: {f}_{joint}, name: {f}_flex, link: {f}_a}}]"
-                        for f in ("thumb", "index", "middle", "ring", "little"))
+    fingers = "\n".join(
+        f"  {f}:\n    tip_site: null\n    joints: [{{mjcf: {f}_{joint}, name: {f}_flex, link: {f}_a}}]"
+        for f in ("thumb", "index", "middle", "ring", "little")
+    )
     (tmp_path / "hand.yaml").write_text(f"mjcf: mini.xml\npalm: {palm}\nfingers:\n{fingers}\n")
     return tmp_path / "hand.yaml"
 
 
-@pytest.mark.parametrize("case, expected", [
-    ({"palm": "wrist"}, "palm: no body named 'wrist' in 'mini.xml'"),
-    ({"joint": "j9"}, "fingers.thumb.joints[0].mjcf: no joint named 'thumb_j9' in 'mini.xml'"),
-    ({"kind": "ball"}, "fingers.thumb.joints[0].mjcf: joint 'thumb_j1' in 'mini.xml' is a ball joint"),
-    ({"kind": "slide"}, "fingers.thumb.joints[0].mjcf: joint 'thumb_j1' in 'mini.xml' is a slide joint"),
-    ({"geom": "mesh"}, "a mesh collision geom is refused"),
-])
+@pytest.mark.parametrize(
+    "case, expected",
+    [
+        ({"palm": "wrist"}, "palm: no body named 'wrist' in 'mini.xml'"),
+        ({"joint": "j9"}, "fingers.thumb.joints[0].mjcf: no joint named 'thumb_j9' in 'mini.xml'"),
+        ({"kind": "ball"}, "fingers.thumb.joints[0].mjcf: joint 'thumb_j1' in 'mini.xml' is a ball joint"),
+        ({"kind": "slide"}, "fingers.thumb.joints[0].mjcf: joint 'thumb_j1' in 'mini.xml' is a slide joint"),
+        ({"geom": "mesh"}, "a mesh collision geom is refused"),
+    ],
+)
 def test_unusable_description_is_one_line_naming_file_and_element(tmp_path, case, expected):
     path = _mini(tmp_path, **case)
     with pytest.raises(ValueError) as err:
@@ -232,8 +249,9 @@ def test_config_region_hand_is_accepted():
     from synergrasp.config import validate_config
     from synergrasp.optimisation.placement_search import SearchStepParams
 
-    config = validate_config({"hand": "shadow_hand", "synergies": "shadow_hand",
-                              "placement": {"search": {"region_mm": {"precision": "hand"}}}})  # obj1: a precision object
+    config = validate_config(
+        {"hand": "shadow_hand", "synergies": "shadow_hand", "placement": {"search": {"region_mm": {"precision": "hand"}}}}
+    )  # obj1: a precision object
     params = SearchStepParams.from_config(config, "obj1")
     assert params.search.region_mm[1] == (-43.0, 43.0)
 
@@ -265,8 +283,10 @@ def softhand_urdf(folder: Path, factor: float = 1.0) -> Path:
     soft = load_hand(None)
     write_urdf(soft, folder / "soft.urdf")
     if factor != 1.0:
+
         def scaled(m):
             return f'{m.group(1)}="' + " ".join(f"{float(v) * factor:.9g}" for v in m.group(2).split()) + '"'
+
         text = re.sub(r'\b(xyz|size|radius|length)="([^"]*)"', scaled, (folder / "soft.urdf").read_text())
         (folder / "soft.urdf").write_text(text)
     fingers, couplings = {}, {}
@@ -282,9 +302,18 @@ def softhand_urdf(folder: Path, factor: float = 1.0) -> Path:
                 couplings[f"{joint}_b"] = {"follows": f"{joint}_a", "ratio": 1.0}
         fingers[finger] = {"joints": entries, "tip_mm": soft.fingertip_point[len(fingers)].tolist()}
     path = folder / "hand.yaml"
-    path.write_text(yaml.safe_dump(
-        {"urdf": "soft.urdf", "palm": "world", "palm_normal": [1, 0, 0], "finger_direction": [0, 0, 1],
-         "couplings": couplings, "fingers": fingers}))
+    path.write_text(
+        yaml.safe_dump(
+            {
+                "urdf": "soft.urdf",
+                "palm": "world",
+                "palm_normal": [1, 0, 0],
+                "finger_direction": [0, 0, 1],
+                "couplings": couplings,
+                "fingers": fingers,
+            }
+        )
+    )
     return path
 
 
@@ -326,6 +355,7 @@ def test_a_urdf_in_mm_gets_the_size_warning_a_yaml_hand_gets(tmp_path):
 
 def test_a_folder_given_as_the_model_says_so(tmp_path):
     (tmp_path / "hand.yaml").write_text("mjcf: .\npalm: palm\nfingers: {}\n")
-    with pytest.raises(ValueError, match=f"^hand file '{tmp_path / 'hand.yaml'}': mjcf: '{tmp_path}' is a folder; "
-                                         "give the model's file$"):
+    with pytest.raises(
+        ValueError, match=f"^hand file '{tmp_path / 'hand.yaml'}': mjcf: '{tmp_path}' is a folder; give the model's file$"
+    ):
         check_hand(tmp_path / "hand.yaml")

@@ -31,35 +31,41 @@ def test_mass_may_be_left_out_where_a_step_does_not_read_it():
     assert GraspedObject("a", Box((1, 2, 3))).mass_kg is None
 
 
-@pytest.mark.parametrize("change, match", [
-    ({"mass_kg": 0}, "object 'cube': field 'mass_kg'"),
-    ({"mass_kg": -1.0}, "field 'mass_kg'"),
-    ({"mass_kg": math.nan}, "field 'mass_kg'"),
-    ({"mass_kg": "heavy"}, "field 'mass_kg'"),
-    ({"name": "my box"}, r"\[A-Za-z0-9_\]\+"),
-    ({"name": "../x"}, "field 'name'"),
-    ({"name": ""}, "field 'name'"),
-    ({"shape": (10, 20, 30)}, "field 'shape'"),
-])
+@pytest.mark.parametrize(
+    "change, match",
+    [
+        ({"mass_kg": 0}, "object 'cube': field 'mass_kg'"),
+        ({"mass_kg": -1.0}, "field 'mass_kg'"),
+        ({"mass_kg": math.nan}, "field 'mass_kg'"),
+        ({"mass_kg": "heavy"}, "field 'mass_kg'"),
+        ({"name": "my box"}, r"\[A-Za-z0-9_\]\+"),
+        ({"name": "../x"}, "field 'name'"),
+        ({"name": ""}, "field 'name'"),
+        ({"shape": (10, 20, 30)}, "field 'shape'"),
+    ],
+)
 def test_bad_objects_raise_one_clear_error(change, match):
     with pytest.raises(ObjectError, match=match):
         GraspedObject(**{"name": "cube", "shape": Box((10, 20, 30)), "mass_kg": 0.5, **change})
 
 
-@pytest.mark.parametrize("spec, match", [
-    ({"box": {"size_mm": [10, 0, 30]}}, r"'s\.box\.size_mm': \[10, 0, 30\] is not allowed"),
-    ({"box": {"size_mm": [10, -1, 30]}}, "'s.box.size_mm'"),
-    ({"box": {"size_mm": [10, math.inf, 30]}}, "'s.box.size_mm'"),
-    ({"box": {"size_mm": [10, math.nan, 30]}}, "'s.box.size_mm'"),
-    ({"box": {"size_mm": [10, 20]}}, "'s.box.size_mm'"),
-    ({"box": {"size_mm": 10}}, "'s.box.size_mm'"),
-    ({"box": {"size_mm": ["a", 1, 2]}}, "'s.box.size_mm'"),
-    ({"box": {"size_mm": "abc"}}, "'s.box.size_mm'"),
-    ({"box": {"size": [1, 2, 3]}}, r"'s\.box': .*size"),
-    ({"cone": {"size_mm": [1, 2, 3]}}, r"'s': unknown shape 'cone'; allowed: \['box'"),
-    ({"box": {"size_mm": [1, 2, 3]}, "sphere": {}}, "'s': one of"),
-    ([1, 2, 3], "'s': one of"),
-])
+@pytest.mark.parametrize(
+    "spec, match",
+    [
+        ({"box": {"size_mm": [10, 0, 30]}}, r"'s\.box\.size_mm': \[10, 0, 30\] is not allowed"),
+        ({"box": {"size_mm": [10, -1, 30]}}, "'s.box.size_mm'"),
+        ({"box": {"size_mm": [10, math.inf, 30]}}, "'s.box.size_mm'"),
+        ({"box": {"size_mm": [10, math.nan, 30]}}, "'s.box.size_mm'"),
+        ({"box": {"size_mm": [10, 20]}}, "'s.box.size_mm'"),
+        ({"box": {"size_mm": 10}}, "'s.box.size_mm'"),
+        ({"box": {"size_mm": ["a", 1, 2]}}, "'s.box.size_mm'"),
+        ({"box": {"size_mm": "abc"}}, "'s.box.size_mm'"),
+        ({"box": {"size": [1, 2, 3]}}, r"'s\.box': .*size"),
+        ({"cone": {"size_mm": [1, 2, 3]}}, r"'s': unknown shape 'cone'; allowed: \['box'"),
+        ({"box": {"size_mm": [1, 2, 3]}, "sphere": {}}, "'s': one of"),
+        ([1, 2, 3], "'s': one of"),
+    ],
+)
 def test_bad_shapes_raise_one_error_naming_the_key(spec, match):
     with pytest.raises(ShapeError, match=match):
         shape_from_config(spec, "s")

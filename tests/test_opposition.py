@@ -49,8 +49,7 @@ def test_the_shipped_hands_axes_and_link_kinds(hand, axes):
     for finger in ("index", "middle", "ring", "little"):
         assert kinds[f"{finger}_distal"] == "finger_pad" and kinds[f"{finger}_middle"] == "finger_middle"
         assert kinds[f"{finger}_knuckle"] == kinds[f"{finger}_proximal"] == "palm_side"
-    assert {hand.link_names[i] for i in axes.index_links} == {f"index_{s}" for s in
-                                                                ("knuckle", "proximal", "middle", "distal")}
+    assert {hand.link_names[i] for i in axes.index_links} == {f"index_{s}" for s in ("knuckle", "proximal", "middle", "distal")}
 
 
 def test_a_box_squeezed_between_palm_and_fingers_is_palm_opposition(hand, axes):
@@ -79,8 +78,7 @@ def test_the_thumb_pad_against_the_side_of_the_index_is_side_opposition(hand, ax
 def test_a_one_sided_fingertip_push_is_no_opposition(hand, axes):
     # obj4's grasp: the palm and the fingertips all push the box away from the palm (+x),
     # the thumb and little tips touch its sides
-    links = [link(hand, n) for n in ("palm", "index_distal", "middle_distal", "ring_distal", "thumb_distal",
-                                     "little_distal")]
+    links = [link(hand, n) for n in ("palm", "index_distal", "middle_distal", "ring_distal", "thumb_distal", "little_distal")]
     normals = np.array([X, X, X, X, -Y, Y])
     assert classify_grasp(links, normals, axes, RULE) == "none"
     assert classify_grasp(links[:1], normals[:1], axes, RULE) == "none"
@@ -114,10 +112,14 @@ def test_faces_and_surface_features_of_contacts_on_a_box(axes):
     assert face_classes(np.array([X, -X, Y, -Z]), axes) == ["palm_face", "outer_face", "side_face", "end_face"]
     box = shape_from_config({"box": {"size_mm": [20, 40, 60]}})
     R, c = np.eye(3), np.array([20.0, 0.0, 50.0])
-    points = np.array([[10.0, 0.0, 50.0],     # middle of the face toward the palm
-                       [10.0, 20.0, 50.0],    # edge
-                       [10.0, 20.0, 80.0],    # corner
-                       [10.5, 19.5, 50.0]])   # within 1 mm of two faces: an edge
+    points = np.array(
+        [
+            [10.0, 0.0, 50.0],  # middle of the face toward the palm
+            [10.0, 20.0, 50.0],  # edge
+            [10.0, 20.0, 80.0],  # corner
+            [10.5, 19.5, 50.0],
+        ]
+    )  # within 1 mm of two faces: an edge
     assert surface_features(points, box, R, c, RULE) == ["face", "edge", "corner", "edge"]
     assert surface_features(points[3:], box, R, c, OppositionRule(45.0, 0.2)) == ["face"]
 
@@ -125,8 +127,16 @@ def test_faces_and_surface_features_of_contacts_on_a_box(axes):
 def test_a_contacts_table_is_classified_row_by_row(hand, axes):
     import pandas as pd
 
-    rows = pd.DataFrame({"status": ["grasp", "grasp", "no_contact", "lost"],
-                         "contact_link": [[0, link(hand, "middle_distal")], [link(hand, "thumb_distal"),
-                                          link(hand, "index_distal")], [], [0, link(hand, "middle_distal")]],
-                         "contact_normal": [np.r_[X, -X], np.r_[-Y, Y], np.zeros(0), np.r_[X, -X]]})
+    rows = pd.DataFrame(
+        {
+            "status": ["grasp", "grasp", "no_contact", "lost"],
+            "contact_link": [
+                [0, link(hand, "middle_distal")],
+                [link(hand, "thumb_distal"), link(hand, "index_distal")],
+                [],
+                [0, link(hand, "middle_distal")],
+            ],
+            "contact_normal": [np.r_[X, -X], np.r_[-Y, Y], np.zeros(0), np.r_[X, -X]],
+        }
+    )
     assert contacts_oppositions(rows, axes, RULE) == ["palm", "pad", "none", "none"]

@@ -29,8 +29,10 @@ def test_optimise_grasps_matches_clarabel_per_grasp():
     rng = np.random.default_rng(21)
     grasps = [random_grasp(rng, int(rng.integers(3, 13)), palm_contacts=int(rng.integers(0, 2))) for _ in range(5)]
     grasps.insert(2, None)
-    sets = SynergySets(random_synergies(rng), tuple([tuple(range(1, k + 1)) for k in (1, 2, 3, 7, 15)]
-                                                    + list(itertools.combinations(range(1, 8), 2))[:6]))
+    sets = SynergySets(
+        random_synergies(rng),
+        tuple([tuple(range(1, k + 1)) for k in (1, 2, 3, 7, 15)] + list(itertools.combinations(range(1, 8), 2))[:6]),
+    )
     out = optimise_grasps(grasps, sets, PARAMS)
     n = len(sets)
     assert len(out["status"]) == len(grasps) * n
@@ -41,8 +43,11 @@ def test_optimise_grasps_matches_clarabel_per_grasp():
             assert set(out["status"][rows]) == {"no_grasp"} and not out["load_feasible"][rows].any()
             continue
         mech = mechanics_for(grasp, PARAMS)
-        ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, PARAMS.f_min_N, PARAMS.cone),
-                        "clarabel", strict_shrink=PARAMS.strict_shrink)
+        ref = solve_gfo(
+            GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, PARAMS.f_min_N, PARAMS.cone),
+            "clarabel",
+            strict_shrink=PARAMS.strict_shrink,
+        )
         np.testing.assert_array_equal(out["status"][rows], ref.status)
         np.testing.assert_array_equal(out["e_s"][rows], ref.e_s)
         np.testing.assert_array_equal(out["force_closure_def1"][rows], ref.strict_internal)
@@ -82,8 +87,11 @@ def test_pyramid_cone_study_runs_through_the_kernel_and_matches_clarabel():
         mech = mechanics_for(grasp, params)
         if mech.rank_G < 6:
             continue
-        ref = solve_gfo(GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, params.f_min_N, params.cone),
-                        "clarabel", strict_shrink=params.strict_shrink)
+        ref = solve_gfo(
+            GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, sets, params.f_min_N, params.cone),
+            "clarabel",
+            strict_shrink=params.strict_shrink,
+        )
         np.testing.assert_array_equal(out["status"][rows], ref.status)
         np.testing.assert_array_equal(out["force_closure_def1"][rows], ref.strict_internal)
         assert set(out["solver"][rows]) <= {"ipm", "implied", "clarabel_fallback", "direct"}
@@ -124,19 +132,28 @@ def _contacts_of(grasps) -> pd.DataFrame:
     rows = []
     for pose, g in enumerate(grasps):
         m = 0 if g is None else g.n_contacts
-        rows.append({"object": "box", "pose": pose, "alpha_deg": 5.0 * pose, "beta_deg": 0.0,
-                     "status": "no_grasp" if g is None else "grasp", "n_contacts": m,
-                     "contact_link": [] if g is None else g.links.tolist(),
-                     "contact_point": [] if g is None else g.points.ravel().tolist(),
-                     "contact_normal": [] if g is None else g.normals.ravel().tolist(),
-                     "jacobian": [] if g is None else g.jacobian.ravel().tolist(),
-                     "object_center": [0.0] * 3 if g is None else g.center.tolist()})
+        rows.append(
+            {
+                "object": "box",
+                "pose": pose,
+                "alpha_deg": 5.0 * pose,
+                "beta_deg": 0.0,
+                "status": "no_grasp" if g is None else "grasp",
+                "n_contacts": m,
+                "contact_link": [] if g is None else g.links.tolist(),
+                "contact_point": [] if g is None else g.points.ravel().tolist(),
+                "contact_normal": [] if g is None else g.normals.ravel().tolist(),
+                "jacobian": [] if g is None else g.jacobian.ravel().tolist(),
+                "object_center": [0.0] * 3 if g is None else g.center.tolist(),
+            }
+        )
     return pd.DataFrame(rows)
 
 
 def _twin(grasp, delta_mm=1e-12):
-    return type(grasp)(points=grasp.points + delta_mm, normals=grasp.normals, links=grasp.links,
-                       jacobian=grasp.jacobian, center=grasp.center)
+    return type(grasp)(
+        points=grasp.points + delta_mm, normals=grasp.normals, links=grasp.links, jacobian=grasp.jacobian, center=grasp.center
+    )
 
 
 def test_first_same_grasp_points_each_grasp_at_the_first_of_its_kind():
@@ -158,8 +175,11 @@ def test_gfo_table_solves_one_grasp_once_whatever_the_shards(monkeypatch):
     contacts = _contacts_of(grasps)
     solved = []
     real = optimise.optimise_grasps
-    monkeypatch.setattr(optimise, "optimise_grasps",
-                        lambda gs, *args, **kw: solved.append(sum(g is not None for g in gs)) or real(gs, *args, **kw))
+    monkeypatch.setattr(
+        optimise,
+        "optimise_grasps",
+        lambda gs, *args, **kw: solved.append(sum(g is not None for g in gs)) or real(gs, *args, **kw),
+    )
     whole = optimise.gfo_table(contacts, sets, PARAMS)
     assert solved == [3]
     sharded = merge_shards([optimise.optimise_shard(contacts, k, 4, sets, PARAMS) for k in range(4)])
@@ -167,10 +187,10 @@ def test_gfo_table_solves_one_grasp_once_whatever_the_shards(monkeypatch):
     # bit for bit (an empty shard leaves the string columns' dtype to pandas' concat)
     pd.testing.assert_frame_equal(sharded, whole, check_exact=True, check_dtype=False)
     n = len(sets)
-    rows = lambda p: whole.iloc[p * n:(p + 1) * n].drop(columns=["pose", "alpha_deg"]).reset_index(drop=True)  # noqa: E731
+    rows = lambda p: whole.iloc[p * n : (p + 1) * n].drop(columns=["pose", "alpha_deg"]).reset_index(drop=True)  # noqa: E731
     pd.testing.assert_frame_equal(rows(3), rows(0))
     pd.testing.assert_frame_equal(rows(4), rows(1))
-    assert set(whole["status"].iloc[2 * n:3 * n]) == {"no_grasp"}
+    assert set(whole["status"].iloc[2 * n : 3 * n]) == {"no_grasp"}
     # solving every pose on its own decides the same and finds the same forces to round-off
     alone = optimise_grasps(grasps, sets, PARAMS)
     np.testing.assert_array_equal(whole["status"].to_numpy(), alone["status"])

@@ -106,8 +106,14 @@ def test_targets_without_force_closure_stay_tied_on_force():
 
 def test_ranking_does_not_depend_on_the_order_of_the_targets():
     rng = np.random.default_rng(3)
-    scores = [_score((x, y, z), rng.choice([0.0, 48.0, 50.0, 51.0, 70.0, 71.5]), rng.choice([1.0, 1.04, 2.0, math.inf]),
-                     rng.integers(2, 7)) for x in (9.5, 19.5) for y in (-10, 0, 10) for z in (40, 50, 60)]
+    scores = [
+        _score(
+            (x, y, z), rng.choice([0.0, 48.0, 50.0, 51.0, 70.0, 71.5]), rng.choice([1.0, 1.04, 2.0, math.inf]), rng.integers(2, 7)
+        )
+        for x in (9.5, 19.5)
+        for y in (-10, 0, 10)
+        for z in (40, 50, 60)
+    ]
     first = _ranked(scores)
     for seed in range(5):
         shuffled = list(scores)
@@ -166,17 +172,39 @@ def test_scored_poses_are_the_first_alpha_period_on_the_search_steps():
 
 def _tiny(obj="obj1", **search):
     """The study's search of ``obj`` on a toy region (2 coarse targets, 4 poses, 1 round)."""
-    cfg = overlay(defaults(), {"placement": {"search": {
-        "region_mm": {kind: {"x": [9.5, 9.5], "y": [-10.0, -10.0], "z": [60.0, 80.0]} for kind in GRASP_TYPES},
-        "pose_alpha_step_deg": 60.0,
-        "pose_beta_step_deg": 60.0, "refine_top": 1, "max_rounds": 1, **search}}})
+    cfg = overlay(
+        defaults(),
+        {
+            "placement": {
+                "search": {
+                    "region_mm": {kind: {"x": [9.5, 9.5], "y": [-10.0, -10.0], "z": [60.0, 80.0]} for kind in GRASP_TYPES},
+                    "pose_alpha_step_deg": 60.0,
+                    "pose_beta_step_deg": 60.0,
+                    "refine_top": 1,
+                    "max_rounds": 1,
+                    **search,
+                }
+            }
+        },
+    )
     return SearchStepParams.from_config(cfg, obj)
 
 
 def _run(sim, hand, synergies, processes=1):
     full = placement_search.full_synergy_set(synergies.matrix, sim.full_set_size)
-    return search_object(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo, full, sim.search,
-                         period_deg=90.0, processes=processes, opposition=sim.opposition)
+    return search_object(
+        hand,
+        synergies,
+        sim.object,
+        sim.placement,
+        sim.closure,
+        sim.gfo,
+        full,
+        sim.search,
+        period_deg=90.0,
+        processes=processes,
+        opposition=sim.opposition,
+    )
 
 
 def test_the_search_passes_the_solver_the_full_synergy_set_and_nothing_else(hand, synergies, monkeypatch):
@@ -211,8 +239,13 @@ def test_the_search_is_deterministic_for_any_number_of_processes(hand, synergies
 def test_bad_search_settings_are_refused_before_any_job_naming_the_key():
     from synergrasp.config import ConfigError, validate_config
 
-    bad = overlay(defaults(), {"placement": {"search": {"region_mm": {"any": {"x": [9.5, 0.0]}}}},
-                               "objects": {"obj1": {"placement": {"search": {"coarse_spacing_mm": 25.0}}}}})
+    bad = overlay(
+        defaults(),
+        {
+            "placement": {"search": {"region_mm": {"any": {"x": [9.5, 0.0]}}}},
+            "objects": {"obj1": {"placement": {"search": {"coarse_spacing_mm": 25.0}}}},
+        },
+    )
     with pytest.raises(ConfigError) as err:
         validate_config(bad)
     assert "'placement.search.region_mm.any.x'" in str(err.value)

@@ -18,8 +18,7 @@ from synergrasp.optimisation.problem import SynergySets
 from synergrasp.optimisation.optimise import gfo_table
 
 # a 12 x 5 grid, 30 deg steps: alpha -180..150 (wraps), beta -60..60
-ALPHA, BETA = (a.ravel() for a in np.meshgrid(np.arange(-180.0, 180.0, 30.0), np.arange(-60.0, 61.0, 30.0),
-                                               indexing="ij"))
+ALPHA, BETA = (a.ravel() for a in np.meshgrid(np.arange(-180.0, 180.0, 30.0), np.arange(-60.0, 61.0, 30.0), indexing="ij"))
 #: level k: two cones, A at (0, 0) of apex 1 and B_k of apex 0.5, 0.4, 0.3 drifting one cell a level
 WELLS = {1: (90.0, 30.0, 0.5), 2: (120.0, 30.0, 0.4), 3: (150.0, 60.0, 0.3)}
 
@@ -133,8 +132,9 @@ def test_the_planner_on_the_study_solver_reproduces_the_gfo_table():
     assert ok.any(), "the random grasps should give some load-feasible pose"
     assert wide["is_global_min"] and wide["best_force_N"] == pytest.approx(full["force_norm"][ok].min(), rel=1e-5)
     assert enrollment["k"].tolist() == list(range(1, n + 1))
-    assert enrollment["pca_n_success"].tolist() == [int(gfo[gfo["set_id"] == incremental_set_id(k)]["load_feasible"].sum())
-                                                    for k in range(1, n + 1)]
+    assert enrollment["pca_n_success"].tolist() == [
+        int(gfo[gfo["set_id"] == incremental_set_id(k)]["load_feasible"].sum()) for k in range(1, n + 1)
+    ]
     assert enrollment["greedy_n_success"].iloc[-1] == enrollment["full_n_success"].iloc[0] == ok.sum()
     assert enrollment["greedy_n_success"].iloc[0] >= enrollment["pca_n_success"].iloc[0]
     assert sorted(enrollment["greedy_added"]) == list(range(1, n + 1))
@@ -151,22 +151,48 @@ def test_synergrasp_plan_reads_the_study_s_tables_and_prints_one_line_per_radius
     rng = np.random.default_rng(7)
     contacts = _contacts_of([random_grasp(rng, int(rng.integers(4, 10))) for _ in range(6)])
     contacts["alpha_deg"], contacts["beta_deg"] = np.repeat([-180.0, 0.0], 3), np.tile([-10.0, 0.0, 10.0], 2)
-    gfo = gfo_table(contacts, SynergySets(load_synergies(None).matrix, tuple(tuple(range(1, k + 1)) for k in range(1, 16))),
-                    study_gfo_params())
+    gfo = gfo_table(
+        contacts,
+        SynergySets(load_synergies(None).matrix, tuple(tuple(range(1, k + 1)) for k in range(1, 16))),
+        study_gfo_params(),
+    )
     folder = tmp_path / "objects" / "box"
     folder.mkdir(parents=True)
     filler = {"string": "kinematic", "int32": 0, "float64": 0.0, "bool": True}
     for column in tables.CONTACTS.columns:  # what the closure writes and the planner does not read
         if column.name not in contacts:
-            contacts[column.name] = [[] for _ in range(len(contacts))] if column.dtype.startswith("list") \
-                else filler[column.dtype]
+            contacts[column.name] = (
+                [[] for _ in range(len(contacts))] if column.dtype.startswith("list") else filler[column.dtype]
+            )
     tables.write(tables.CONTACTS, contacts, folder / "contacts.parquet")
     tables.write(tables.GFO, gfo, folder / "gfo.parquet")
     overlay = tmp_path / "box.yaml"
-    overlay.write_text(yaml.safe_dump({"objects": {"box": {"shape": {"box": {"size_mm": [30, 30, 30]}}, "mass_kg": 1.0}},
-                                       "analyses": {"success": "load_feasible"}}))
-    assert main(["plan", "box", "--radius", "10", "400", "--configfile", str(overlay), "--results", str(tmp_path),
-                 "--csv", str(tmp_path / "plan.csv")]) == 0
+    overlay.write_text(
+        yaml.safe_dump(
+            {
+                "objects": {"box": {"shape": {"box": {"size_mm": [30, 30, 30]}}, "mass_kg": 1.0}},
+                "analyses": {"success": "load_feasible"},
+            }
+        )
+    )
+    assert (
+        main(
+            [
+                "plan",
+                "box",
+                "--radius",
+                "10",
+                "400",
+                "--configfile",
+                str(overlay),
+                "--results",
+                str(tmp_path),
+                "--csv",
+                str(tmp_path / "plan.csv"),
+            ]
+        )
+        == 0
+    )
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 2 and lines[1].startswith("box radius 400 deg: 90 of 90 solves (100.0 %)")
     plan = tables.read_csv(tables.PLAN, tmp_path / "plan.csv")

@@ -16,16 +16,25 @@ from grasp_problems import random_grasp, random_synergies
 from synergrasp.analysis.claims import FAILS, HOLDS, VerdictRules, planner_claim
 from synergrasp.analysis.minima import MinimaParams
 from synergrasp.analysis.plan_study import PlanParams, StudySolver, compare_on_study, replay_oracle
-from synergrasp.analysis.planners import (CANDIDATES, SOLVE_COST_BY_SET_SIZE, PlannerSpec, PoseGrid, ReplayOracle,
-                                          across_objects, compare_planners, conjecture, recommended, run_planner)
+from synergrasp.analysis.planners import (
+    CANDIDATES,
+    SOLVE_COST_BY_SET_SIZE,
+    PlannerSpec,
+    PoseGrid,
+    ReplayOracle,
+    across_objects,
+    compare_planners,
+    conjecture,
+    recommended,
+    run_planner,
+)
 from synergrasp.ids import incremental_set_id
 from synergrasp.optimisation.optimise import gfo_table
 from synergrasp.optimisation.problem import SynergySets
 
 ROOT = Path(__file__).resolve().parents[1]
 # a 12 x 5 grid, 30 deg steps: alpha -180..150 (wraps), beta -60..60
-ALPHA, BETA = (a.ravel() for a in np.meshgrid(np.arange(-180.0, 180.0, 30.0), np.arange(-60.0, 61.0, 30.0),
-                                               indexing="ij"))
+ALPHA, BETA = (a.ravel() for a in np.meshgrid(np.arange(-180.0, 180.0, 30.0), np.arange(-60.0, 61.0, 30.0), indexing="ij"))
 GRID = PoseGrid.from_angles(ALPHA, BETA)
 
 
@@ -47,8 +56,7 @@ def _oracle(levels: list[np.ndarray], grasp: np.ndarray | None = None):
 def test_grid_neighbours_wrap_in_alpha_and_stop_at_the_beta_bounds():
     assert GRID.index.shape == (12, 5)
     corner = GRID.neighbours(_pose(-180, -60))
-    assert sorted(corner.tolist()) == sorted(_pose(a, b) for a in (150, -180, -150) for b in (-60, -30)
-                                             if (a, b) != (-180, -60))
+    assert sorted(corner.tolist()) == sorted(_pose(a, b) for a in (150, -180, -150) for b in (-60, -30) if (a, b) != (-180, -60))
     assert GRID.neighbours(_pose(0, 0)).size == 8
     assert sorted(GRID.coarse(3, (1, 2)).tolist()) == sorted(_pose(a, 0) for a in (-150, -60, 30, 120))
 
@@ -88,9 +96,17 @@ def test_full_set_planners_find_the_single_well_and_pay_what_they_asked():
 def test_descent_stops_in_a_local_well_and_the_table_says_how_often():
     # a deep well at (90, 30) and a shallow one at (-90, -30): a walker stops in either
     force = np.minimum(_cone(90, 30, 1.0), _cone(-90, -30, 2.0))
-    rows = compare_planners("map", GRID, _oracle([force]), np.ones(60, bool), force, 1, 30.0,
-                            [PlannerSpec("descent_1", "descent", 1), PlannerSpec("exhaustive", "exhaustive")],
-                            seeds=range(40)).set_index("planner")
+    rows = compare_planners(
+        "map",
+        GRID,
+        _oracle([force]),
+        np.ones(60, bool),
+        force,
+        1,
+        30.0,
+        [PlannerSpec("descent_1", "descent", 1), PlannerSpec("exhaustive", "exhaustive")],
+        seeds=range(40),
+    ).set_index("planner")
     one = rows.loc["descent_1"]
     # the start decides: closer (Chebyshev, cells) to the deep well, or not
     assert 0.2 < one["global_min_probability"] < 0.8 and one["runs"] == 40
@@ -113,9 +129,15 @@ def _across(rows):
 
 
 def test_the_rule_picks_the_fewest_closures_among_planners_meeting_the_aim_ties_by_solve_time():
-    table = _across([("cheap_but_wrong", "full_set", 90.0, 50, 10), ("a", "full_set", 100.0, 200, 90),
-                     ("b", "full_set", 95.0, 201, 80), ("c", "incremental", 100.0, 1800, 30),
-                     ("exhaustive", "full_set", 100.0, 1800, 446)])
+    table = _across(
+        [
+            ("cheap_but_wrong", "full_set", 90.0, 50, 10),
+            ("a", "full_set", 100.0, 200, 90),
+            ("b", "full_set", 95.0, 201, 80),
+            ("c", "incremental", 100.0, 1800, 30),
+            ("exhaustive", "full_set", 100.0, 1800, 446),
+        ]
+    )
     assert recommended(table) == "b"  # 201 is within 1 % of 200: the lower solve time wins
     assert recommended(table, "incremental") == "c"
     assert recommended(table, "full_set", "solve_cost") == "b"
@@ -124,17 +146,34 @@ def test_the_rule_picks_the_fewest_closures_among_planners_meeting_the_aim_ties_
 
 def _per_object(costs):
     """(object, planner, family, solve_cost, meets_aim) rows as the comparison writes them."""
-    return pd.DataFrame([{"object": o, "planner": p, "family": f, "randomised": False, "closures": c, "solve_cost": s,
-                          "closure_share_percent": 100.0 * c / 1800, "regret_percent_mean": 0.0 if m else 9.0,
-                          "regret_percent_max": 0.0 if m else 9.0, "meets_aim": m,
-                          "within_aim_probability": float(m)} for o, p, f, c, s, m in costs])
+    return pd.DataFrame(
+        [
+            {
+                "object": o,
+                "planner": p,
+                "family": f,
+                "randomised": False,
+                "closures": c,
+                "solve_cost": s,
+                "closure_share_percent": 100.0 * c / 1800,
+                "regret_percent_mean": 0.0 if m else 9.0,
+                "regret_percent_max": 0.0 if m else 9.0,
+                "meets_aim": m,
+                "within_aim_probability": float(m),
+            }
+            for o, p, f, c, s, m in costs
+        ]
+    )
 
 
 def test_claim_8_compares_the_two_families_chosen_planners_per_object():
     rows = []
     for obj, full_cost in (("o1", 100.0), ("o2", 200.0), ("o3", 400.0)):
-        rows += [(obj, "inc", "incremental", 1800, full_cost / 2, True), (obj, "full", "full_set", 600, full_cost, True),
-                 (obj, "inc_bad", "incremental", 1800, 1.0, obj != "o2")]
+        rows += [
+            (obj, "inc", "incremental", 1800, full_cost / 2, True),
+            (obj, "full", "full_set", 600, full_cost, True),
+            (obj, "inc_bad", "incremental", 1800, 1.0, obj != "o2"),
+        ]
     per_object = _per_object(rows)
     c = conjecture(per_object)
     # inc_bad meets the aim on 2 of 3 objects: not chosen; inc halves the cost on every object
@@ -173,7 +212,7 @@ def test_replayed_planners_agree_with_planners_that_solve():
     new_replay = replay_oracle(contacts, gfo, n, minima)
     solvers = []
     for spec in CANDIDATES:
-        for seed in ((0, 1, 2) if spec.randomised else (None,)):
+        for seed in (0, 1, 2) if spec.randomised else (None,):
             replay, solver = new_replay(), StudySolver(contacts, matrix, params)
             solvers.append(solver)
             mine = run_planner(spec, grid, replay, n, 10.0, np.random.default_rng(seed) if seed is not None else None)
@@ -220,8 +259,12 @@ def test_synergrasp_plan_on_demand_closes_only_where_the_planner_asks_and_agrees
     overlay = tmp_path / "new.yaml"
     overlay.write_text(yaml.safe_dump(config))
     args = ["plan", "obj1", "--configfile", str(overlay), "--results", str(tmp_path)]
-    for bad, says in ((["--planner", "nope"], "--planner 'nope' is not a candidate"), (["--seed", "-1"], "--seed -1"),
-                      (["--radius", "10"], "--radius"), (["--csv", str(tmp_path / "no" / "x.csv")], "--csv")):
+    for bad, says in (
+        (["--planner", "nope"], "--planner 'nope' is not a candidate"),
+        (["--seed", "-1"], "--seed -1"),
+        (["--radius", "10"], "--radius"),
+        (["--csv", str(tmp_path / "no" / "x.csv")], "--csv"),
+    ):
         assert main(args + bad) == 2
         err = [line for line in capsys.readouterr().err.strip().splitlines() if ": warning: " not in line]
         assert len(err) == 1 and says in err[0]

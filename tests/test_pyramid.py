@@ -72,8 +72,9 @@ def generated(generated_problems):
     return {
         "circular": solve_gfo(base, "clarabel"),
         **{(s, i): solve_gfo(with_cone(lambda mu, s=s, i=i: PyramidCone(mu, s, i)), "piqp") for s, i in MODELS},
-        "clarabel_pyramids": {(s, i): solve_gfo(with_cone(lambda mu, s=s, i=i: PyramidCone(mu, s, i)), "clarabel")
-                              for s, i in MODELS},
+        "clarabel_pyramids": {
+            (s, i): solve_gfo(with_cone(lambda mu, s=s, i=i: PyramidCone(mu, s, i)), "clarabel") for s, i in MODELS
+        },
     }
 
 
@@ -99,17 +100,19 @@ def test_inscribed_pyramids_inside_the_circular_cone_inside_the_circumscribed(ge
         ok = small.feasible
         large_feasible = large.feasible.copy()
         if large_name != "circular":
-            contradicted = (large.status == "infeasible") & _verified_feasible(
-                generated["clarabel_pyramids"][large_name])
+            contradicted = (large.status == "infeasible") & _verified_feasible(generated["clarabel_pyramids"][large_name])
             wrong_piqp += int(np.sum(contradicted & ok))
             large_feasible |= contradicted
         assert np.all(large_feasible[ok] | (large.status[ok] == "numerical_failure")), np.flatnonzero(
-            ok & ~large_feasible & (large.status != "numerical_failure"))
+            ok & ~large_feasible & (large.status != "numerical_failure")
+        )
         both = ok & large.feasible
         assert np.all(large.force_norm[both] <= small.force_norm[both] * (1 + 1e-6))
     if wrong_piqp:
-        warnings.warn(f"WARNING: PIQP called {wrong_piqp} circumscribed or inscribed pyramid(s) infeasible that "
-                      "Clarabel solves with a verified feasible point")
+        warnings.warn(
+            f"WARNING: PIQP called {wrong_piqp} circumscribed or inscribed pyramid(s) infeasible that "
+            "Clarabel solves with a verified feasible point"
+        )
     assert wrong_piqp <= 1
     counts = [int(s.feasible.sum()) for s in chain]
     assert counts == sorted(counts) and counts[0] < counts[-1]

@@ -26,8 +26,7 @@ def _grasp(points, normals, n_joints=2, jacobian=None):
     points = np.asarray(points, dtype=float)
     m = len(points)
     jac = np.zeros((3 * m, n_joints)) if jacobian is None else jacobian
-    return Grasp(points=points, normals=np.asarray(normals, dtype=float), links=np.arange(m),
-                 jacobian=jac, center=np.zeros(3))
+    return Grasp(points=points, normals=np.asarray(normals, dtype=float), links=np.arange(m), jacobian=jac, center=np.zeros(3))
 
 
 def _cube_face_grasp(a):
@@ -87,8 +86,7 @@ def _radial(W, u):
     A_eq = np.zeros((7, k + 1))
     A_eq[:6, :k], A_eq[:6, -1] = W.T, -u
     A_eq[6, :k] = 1.0
-    res = linprog(c, A_eq=A_eq, b_eq=np.r_[np.zeros(6), 1.0], bounds=[(0, None)] * k + [(None, None)],
-                  method="highs")
+    res = linprog(c, A_eq=A_eq, b_eq=np.r_[np.zeros(6), 1.0], bounds=[(0, None)] * k + [(None, None)], method="highs")
     if res.status == 2:  # the line through the origin along u misses the hull
         return -math.inf
     assert res.status == 0
@@ -161,14 +159,37 @@ def test_quality_table_rows_for_a_grasp_and_a_pose_without_one(tmp_path):
 
     g = _cube_face_grasp(15.0)
     # the palm (link 0) pushes the cube off the palm, the middle fingertip (link 11) back: palm opposition
-    contacts = pd.DataFrame({"object": ["cube", "cube"], "pose": [0, 1], "alpha_deg": [0.0, 5.0],
-                             "beta_deg": [0.0, 0.0], "n_contacts": [6, 0], "status": ["grasp", "no_contact"],
-                             "contact_link": [[0, 11, 1, 2, 4, 5], []],
-                             "contact_normal": [np.r_[1.0, 0, 0, -1.0, 0, 0, np.zeros(12)], np.zeros(0)]})
-    gfo = pd.DataFrame({"object": "cube", "pose": [0, 1], "set_id": "1-2", "force_closure_def1": [True, False],
-                        "rank_G": [6, 0], "force_norm": [19.62, np.nan]})
-    params = QualityParams(hand=None, synergies=None, mu=0.8, full_set_id="1-2", weight_N=9.81,
-                           torque_length_mm=15.0 * math.sqrt(3.0), opposition=OppositionRule(45.0, 1.0))
+    contacts = pd.DataFrame(
+        {
+            "object": ["cube", "cube"],
+            "pose": [0, 1],
+            "alpha_deg": [0.0, 5.0],
+            "beta_deg": [0.0, 0.0],
+            "n_contacts": [6, 0],
+            "status": ["grasp", "no_contact"],
+            "contact_link": [[0, 11, 1, 2, 4, 5], []],
+            "contact_normal": [np.r_[1.0, 0, 0, -1.0, 0, 0, np.zeros(12)], np.zeros(0)],
+        }
+    )
+    gfo = pd.DataFrame(
+        {
+            "object": "cube",
+            "pose": [0, 1],
+            "set_id": "1-2",
+            "force_closure_def1": [True, False],
+            "rank_G": [6, 0],
+            "force_norm": [19.62, np.nan],
+        }
+    )
+    params = QualityParams(
+        hand=None,
+        synergies=None,
+        mu=0.8,
+        full_set_id="1-2",
+        weight_N=9.81,
+        torque_length_mm=15.0 * math.sqrt(3.0),
+        opposition=OppositionRule(45.0, 1.0),
+    )
     table = quality_table(contacts, gfo, [g, None], np.zeros((2, 2)), params, HandAxes.from_hand(load_hand()))
     assert table["opposition"].tolist() == ["palm", "none"]
     tables.write(tables.QUALITY, table, tmp_path / "quality.parquet")  # the contract's columns and types
@@ -182,8 +203,13 @@ def test_quality_table_rows_for_a_grasp_and_a_pose_without_one(tmp_path):
 
 
 def _moved(grasp, delta_mm, links=None):
-    return Grasp(points=grasp.points + delta_mm, normals=grasp.normals,
-                 links=grasp.links if links is None else links, jacobian=grasp.jacobian, center=grasp.center)
+    return Grasp(
+        points=grasp.points + delta_mm,
+        normals=grasp.normals,
+        links=grasp.links if links is None else links,
+        jacobian=grasp.jacobian,
+        center=grasp.center,
+    )
 
 
 def test_same_grasp_within_round_off_only():
@@ -209,13 +235,30 @@ def test_quality_table_computes_one_grasp_once_and_shares_it(monkeypatch):
     calls = []
     real = quality.grasp_quality
     monkeypatch.setattr(quality, "grasp_quality", lambda g, *args, **kw: calls.append(g) or real(g, *args, **kw))
-    contacts = pd.DataFrame({"object": "box", "pose": range(4), "alpha_deg": [0.0, 5.0, 90.0, 95.0],
-                             "beta_deg": 0.0, "n_contacts": [5, 6, 5, 6], "status": "grasp",
-                             "contact_link": [g.links for g in grasps], "contact_normal": [g.normals for g in grasps]})
-    gfo = pd.DataFrame({"object": "box", "pose": range(4), "set_id": "1-2", "force_closure_def1": True, "rank_G": 6,
-                        "force_norm": 9.81})
-    params = quality.QualityParams(hand=None, synergies=None, mu=0.8, full_set_id="1-2", weight_N=9.81,
-                                   torque_length_mm=20.0, opposition=OppositionRule(45.0, 1.0))
+    contacts = pd.DataFrame(
+        {
+            "object": "box",
+            "pose": range(4),
+            "alpha_deg": [0.0, 5.0, 90.0, 95.0],
+            "beta_deg": 0.0,
+            "n_contacts": [5, 6, 5, 6],
+            "status": "grasp",
+            "contact_link": [g.links for g in grasps],
+            "contact_normal": [g.normals for g in grasps],
+        }
+    )
+    gfo = pd.DataFrame(
+        {"object": "box", "pose": range(4), "set_id": "1-2", "force_closure_def1": True, "rank_G": 6, "force_norm": 9.81}
+    )
+    params = quality.QualityParams(
+        hand=None,
+        synergies=None,
+        mu=0.8,
+        full_set_id="1-2",
+        weight_N=9.81,
+        torque_length_mm=20.0,
+        opposition=OppositionRule(45.0, 1.0),
+    )
     table = quality.quality_table(contacts, gfo, grasps, np.zeros((2, 1)), params, HandAxes.from_hand(load_hand()))
     assert [id(g) for g in calls] == [id(grasps[0]), id(grasps[1]), id(grasps[3])]
     assert table["epsilon"].iloc[2] == table["epsilon"].iloc[0] > 0

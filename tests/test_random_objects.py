@@ -66,8 +66,13 @@ def test_every_drawn_mesh_is_studied_or_left_out_with_its_reason(tmp_path, monke
 
 def test_the_installed_package_matches_the_shipped_manifest():
     root = Path(__file__).resolve().parents[1]
-    spec = {"n_objects": 3, "seed": 2018, "longest_side_mm": [50, 110], "mass_kg": 0.1,
-            "sha256_file": "config/examples/meshes/pybullet_random_urdfs.sha256"}
+    spec = {
+        "n_objects": 3,
+        "seed": 2018,
+        "longest_side_mm": [50, 110],
+        "mass_kg": 0.1,
+        "sha256_file": "config/examples/meshes/pybullet_random_urdfs.sha256",
+    }
     drawn = ro.drawn_objects(spec, root)
     expected = np.sort(np.random.default_rng(2018).choice(1000, 3, replace=False))
     assert [d.index for d in drawn] == expected.tolist()
@@ -76,14 +81,29 @@ def test_the_installed_package_matches_the_shipped_manifest():
 
 
 def test_summary_rows_and_intervals_from_hand_made_tables():
-    rates = pd.DataFrame({"object": ["a"] * 5, "view": "object",
-                          "set_id": ["1", "1-2", "1-2-3", "2", "3"], "success_rate": [40.0, 100.0, 100.0, 50.0, 10.0]})
+    rates = pd.DataFrame(
+        {
+            "object": ["a"] * 5,
+            "view": "object",
+            "set_id": ["1", "1-2", "1-2-3", "2", "3"],
+            "success_rate": [40.0, 100.0, 100.0, 50.0, 10.0],
+        }
+    )
     preservation = pd.DataFrame({"object": ["a", "a"], "k": [1.0, np.nan], "preserved_percent": [50.0, 75.0]})
     graspable = pd.DataFrame({"object": ["a"], "graspable": [True], "reason": [np.nan], "force_closure_full_set": [9]})
-    plans = pd.DataFrame({"object": ["a"], "radius_deg": [10.0], "solve_share_percent": [12.5], "regret_percent": [3.0],
-                          "is_global_min": [False], "best_pose": [4]})
-    enrollment = pd.DataFrame({"object": "a", "k": [1, 2, 3], "greedy_added": [2, 1, 3],
-                               "greedy_success_rate": [50.0, 100.0, 100.0]})
+    plans = pd.DataFrame(
+        {
+            "object": ["a"],
+            "radius_deg": [10.0],
+            "solve_share_percent": [12.5],
+            "regret_percent": [3.0],
+            "is_global_min": [False],
+            "best_pose": [4],
+        }
+    )
+    enrollment = pd.DataFrame(
+        {"object": "a", "k": [1, 2, 3], "greedy_added": [2, 1, 3], "greedy_success_rate": [50.0, 100.0, 100.0]}
+    )
     rows = object_rows(rates, preservation, graspable, plans, enrollment, n_full=3, hierarchy_first=3)
     row = rows.iloc[0]
     assert row["preserved_percent"] == 75.0 and row["s1_minus_best_other"] == -10.0
@@ -107,10 +127,14 @@ def test_summary_rows_and_intervals_from_hand_made_tables():
 def test_planner_budget_counts_objects_within_each_aim():
     """Four objects at two radii, counted by hand: the aims are <= 20 % of the solves and a
     regret <= 5 %; an object without a plan (NaN) is not counted."""
-    rows = pd.DataFrame({"solve_share_percent_10": [12.0, 20.0, 35.0, np.nan],
-                         "regret_percent_10": [0.0, 7.5, 1.0, np.nan],
-                         "solve_share_percent_20": [60.0, 70.0, 90.0, np.nan],
-                         "regret_percent_20": [0.0, 5.0, 0.0, np.nan]})
+    rows = pd.DataFrame(
+        {
+            "solve_share_percent_10": [12.0, 20.0, 35.0, np.nan],
+            "regret_percent_10": [0.0, 7.5, 1.0, np.nan],
+            "solve_share_percent_20": [60.0, 70.0, 90.0, np.nan],
+            "regret_percent_20": [0.0, 5.0, 0.0, np.nan],
+        }
+    )
     budget = planner_budget(rows, [10.0, 20.0, 30.0]).set_index("radius_deg")
     assert budget.loc[10.0, ["objects", "within_solves", "within_regret", "within_both"]].tolist() == [3, 2, 2, 1]
     assert not budget.loc[10.0, "every_object_within_regret"]
@@ -119,20 +143,36 @@ def test_planner_budget_counts_objects_within_each_aim():
     assert budget.loc[30.0, "objects"] == 0 and not budget.loc[30.0, "every_object_within_regret"]
 
 
-@pytest.mark.parametrize("changes, lines", [
-    ({"n_objects": -1}, ["config error at 'random_objects.n_objects': -1 is less than the minimum of 1"]),
-    ({"n_objects": "three", "seed": -1}, ["config error at 'random_objects.n_objects': 'three' is not of type 'integer'",
-                                          "config error at 'random_objects.seed': -1 is less than the minimum of 0"]),
-    ({"longest_side_mm": [110, 50]}, ["config error at 'random_objects.longest_side_mm': [110, 50] is reversed; give "
-                                      "[shortest, longest] (mm)"]),
-    ({"mass_kg": 0.0}, ["config error at 'random_objects.mass_kg': 0.0 is less than or equal to the minimum of 0"]),
-    ({"seed": None}, ["config error at 'random_objects': 'seed' is a required property"]),
-])
+@pytest.mark.parametrize(
+    "changes, lines",
+    [
+        ({"n_objects": -1}, ["config error at 'random_objects.n_objects': -1 is less than the minimum of 1"]),
+        (
+            {"n_objects": "three", "seed": -1},
+            [
+                "config error at 'random_objects.n_objects': 'three' is not of type 'integer'",
+                "config error at 'random_objects.seed': -1 is less than the minimum of 0",
+            ],
+        ),
+        (
+            {"longest_side_mm": [110, 50]},
+            ["config error at 'random_objects.longest_side_mm': [110, 50] is reversed; give [shortest, longest] (mm)"],
+        ),
+        ({"mass_kg": 0.0}, ["config error at 'random_objects.mass_kg': 0.0 is less than or equal to the minimum of 0"]),
+        ({"seed": None}, ["config error at 'random_objects': 'seed' is a required property"]),
+    ],
+)
 def test_the_block_is_checked_before_numpy_sees_a_value(tmp_path, monkeypatch, changes, lines):
     """Every problem of the block, one line each under random_objects.*, and nothing drawn."""
     _fake_package(tmp_path, monkeypatch)
-    spec = {k: v for k, v in ({"n_objects": 2, "seed": 1, "longest_side_mm": [50.0, 110.0], "mass_kg": 0.1,
-                               "sha256_file": "manifest.sha256"} | changes).items() if v is not None}
+    spec = {
+        k: v
+        for k, v in (
+            {"n_objects": 2, "seed": 1, "longest_side_mm": [50.0, 110.0], "mass_kg": 0.1, "sha256_file": "manifest.sha256"}
+            | changes
+        ).items()
+        if v is not None
+    }
     monkeypatch.setattr(ro, "drawn_objects", lambda *a, **k: pytest.fail("drawn before the block was checked"))
     config = {"random_objects": spec, "objects": {"obj1": {}}}
     with pytest.raises(ConfigError) as info:
@@ -153,4 +193,5 @@ def test_a_missing_manifest_and_an_object_named_like_a_drawn_one_are_named(tmp_p
     # rand_000 is studied and clashes; rand_002 (removed by null, and left out: its file is missing) does not
     assert str(info.value).splitlines() == [
         "config error at 'objects.rand_000': an object of the configuration has the name of an object random_objects "
-        "draws (rand_000); rename the object or change random_objects.seed"]
+        "draws (rand_000); rename the object or change random_objects.seed"
+    ]

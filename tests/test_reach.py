@@ -8,12 +8,12 @@ import yaml
 
 import synergrasp
 from synergrasp.config import defaults
-from synergrasp.hand.kinematics import hand_from_dict, load_hand
+from synergrasp.hand.hand_file import check_hand_doc
+from synergrasp.hand.kinematics import build_hand, load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.placement import hand_region
-from synergrasp.simulation.reach import (HandReachStepParams, feasible_types, hand_reach, object_extents,
-                                         shape_class)
+from synergrasp.simulation.reach import HandReachStepParams, feasible_types, hand_reach, object_extents, shape_class
 from synergrasp.simulation.shapes.box import Box
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
@@ -41,7 +41,7 @@ def _scaled_hand(factor: float):
                 capsule = shape["capsule"]
                 capsule["from_mm"] = [factor * v for v in capsule["from_mm"]]
                 capsule["to_mm"] = [factor * v for v in capsule["to_mm"]]
-    return hand_from_dict(doc)
+    return build_hand(check_hand_doc(doc))
 
 
 @pytest.fixture(scope="module")

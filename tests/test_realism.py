@@ -29,13 +29,30 @@ def _contacts(obj: str = "a", poses=_POSES, normals=None, points=None) -> pd.Dat
     rows = []
     for pose, (status, links, forces) in enumerate(poses):
         m = len(links)
-        rows.append({"object": obj, "pose": pose, "alpha_deg": 5.0 * pose, "beta_deg": 0.0, "status": status,
-                     "q": [0.0] * 19, "finger_state": [], "n_contacts": m, "contact_link": links,
-                     "contact_point": [0.0] * 3 * m if points is None else points[pose],
-                     "contact_normal": [1.0, 0.0, 0.0] * m if normals is None else normals[pose],
-                     "jacobian": [0.0] * 57 * m, "object_center": [0.0] * 3, "object_rotation": list(np.eye(3).ravel()),
-                     "max_penetration_mm": 0.0, NORMAL_FORCE_COLUMN: forces, "closure_model": "kinematic",
-                     "object_translation_mm": [0.0] * 3, "object_rotation_deg": 0.0, "settled": True})
+        rows.append(
+            {
+                "object": obj,
+                "pose": pose,
+                "alpha_deg": 5.0 * pose,
+                "beta_deg": 0.0,
+                "status": status,
+                "q": [0.0] * 19,
+                "finger_state": [],
+                "n_contacts": m,
+                "contact_link": links,
+                "contact_point": [0.0] * 3 * m if points is None else points[pose],
+                "contact_normal": [1.0, 0.0, 0.0] * m if normals is None else normals[pose],
+                "jacobian": [0.0] * 57 * m,
+                "object_center": [0.0] * 3,
+                "object_rotation": list(np.eye(3).ravel()),
+                "max_penetration_mm": 0.0,
+                NORMAL_FORCE_COLUMN: forces,
+                "closure_model": "kinematic",
+                "object_translation_mm": [0.0] * 3,
+                "object_rotation_deg": 0.0,
+                "settled": True,
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -44,10 +61,25 @@ def _gfo(obj: str = "a") -> pd.DataFrame:
     rows = []
     for pose, (rank, fc, force) in enumerate(full):
         for set_id, values in (("1-2", (rank, fc, force)), ("1", (6, True, 1000.0))):  # "1" must not be read
-            rows.append({"object": obj, "pose": pose, "alpha_deg": 5.0 * pose, "beta_deg": 0.0, "set_id": set_id,
-                         "n_synergies": len(set_id.split("-")), "status": "feasible" if values[1] else "infeasible",
-                         "load_feasible": values[1], "force_closure_def1": values[1], "force_norm": values[2], "e_s": 1,
-                         "rank_G": values[0], "n_contacts": 0, "iterations": 1, "solver": "ipm"})
+            rows.append(
+                {
+                    "object": obj,
+                    "pose": pose,
+                    "alpha_deg": 5.0 * pose,
+                    "beta_deg": 0.0,
+                    "set_id": set_id,
+                    "n_synergies": len(set_id.split("-")),
+                    "status": "feasible" if values[1] else "infeasible",
+                    "load_feasible": values[1],
+                    "force_closure_def1": values[1],
+                    "force_norm": values[2],
+                    "e_s": 1,
+                    "rank_G": values[0],
+                    "n_contacts": 0,
+                    "iterations": 1,
+                    "solver": "ipm",
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -55,15 +87,32 @@ def _checks(contacts: pd.DataFrame) -> pd.DataFrame:
     """Per-grasp equilibrium checks, made up: residual 0.1 × pose, pose p has p contacts pushed
     outside their cone (the real ones are tested in tests/test_equilibrium.py)."""
     grasps = contacts[contacts["status"] == "grasp"]
-    return pd.DataFrame({"object": grasps["object"], "closure_model": grasps["closure_model"], "pose": grasps["pose"],
-                         "torque_residual": 0.1 * grasps["pose"], "s1_outside_cone": grasps["pose"]})
+    return pd.DataFrame(
+        {
+            "object": grasps["object"],
+            "closure_model": grasps["closure_model"],
+            "pose": grasps["pose"],
+            "torque_residual": 0.1 * grasps["pose"],
+            "s1_outside_cone": grasps["pose"],
+        }
+    )
 
 
 def _table(hand, contacts=None, gfo=None, load_threshold_N=0.01, grasp_type="power"):
     contacts = _contacts() if contacts is None else contacts
     labels = grasp_labels(contacts, HandAxes.from_hand(hand), _RULE, {"a": _BOX})
-    return grasp_realism(contacts, _gfo() if gfo is None else gfo, _checks(contacts), hand.link_names,
-                         hand.link_finger, "1-2", {"a": 10.0}, load_threshold_N, labels, {"a": grasp_type})
+    return grasp_realism(
+        contacts,
+        _gfo() if gfo is None else gfo,
+        _checks(contacts),
+        hand.link_names,
+        hand.link_finger,
+        "1-2",
+        {"a": 10.0},
+        load_threshold_N,
+        labels,
+        {"a": grasp_type},
+    )
 
 
 def test_counts_and_shares_by_hand(hand):
@@ -75,8 +124,7 @@ def test_counts_and_shares_by_hand(hand):
     assert row["dropped_by"] == "intersects_open_hand: 1"
     assert row["contacts_median"] == 4.0  # m = 2, 4, 7
     third = 100.0 / 3.0
-    expected_bins = {"pct_m0": 0, "pct_m1": 0, "pct_m2": third, "pct_m3": 0, "pct_m4": third, "pct_m5": 0,
-                     "pct_m6plus": third}
+    expected_bins = {"pct_m0": 0, "pct_m1": 0, "pct_m2": third, "pct_m3": 0, "pct_m4": third, "pct_m5": 0, "pct_m6plus": third}
     for column, value in expected_bins.items():
         assert row[column] == pytest.approx(value), column
     assert row["pct_thumb"] == pytest.approx(100.0)  # link 3 in every grasp
@@ -160,17 +208,39 @@ def test_link_categories_of_the_shipped_hand(hand):
     assert cats["thumb"] == {1, 2, 3}
     assert {hand.link_names[i] for i in cats["index"]} == {f"index_{s}" for s in ("knuckle", "proximal", "middle", "distal")}
     assert {hand.link_names[i] for i in cats["proximal_or_middle"]} == {
-        "thumb_proximal", *(f"{f}_{s}" for f in ("index", "middle", "ring", "little") for s in ("proximal", "middle"))}
+        "thumb_proximal",
+        *(f"{f}_{s}" for f in ("index", "middle", "ring", "little") for s in ("proximal", "middle")),
+    }
 
 
 def test_missing_weight_or_full_set_is_one_clear_error(hand):
     labels = grasp_labels(_contacts(), HandAxes.from_hand(hand), _RULE, {"a": _BOX})
     with pytest.raises(ValueError, match=r"no weight for object\(s\) \['a'\]"):
-        grasp_realism(_contacts(), _gfo(), _checks(_contacts()), hand.link_names, hand.link_finger, "1-2",
-                      {"b": 1.0}, 0.01, labels, {"a": "any"})
+        grasp_realism(
+            _contacts(),
+            _gfo(),
+            _checks(_contacts()),
+            hand.link_names,
+            hand.link_finger,
+            "1-2",
+            {"b": 1.0},
+            0.01,
+            labels,
+            {"a": "any"},
+        )
     with pytest.raises(ValueError, match="full_set_id '1-2-3'"):
-        grasp_realism(_contacts(), _gfo(), _checks(_contacts()), hand.link_names, hand.link_finger, "1-2-3",
-                      {"a": 1.0}, 0.01, labels, {"a": "any"})
+        grasp_realism(
+            _contacts(),
+            _gfo(),
+            _checks(_contacts()),
+            hand.link_names,
+            hand.link_finger,
+            "1-2-3",
+            {"a": 1.0},
+            0.01,
+            labels,
+            {"a": "any"},
+        )
 
 
 def test_figure_is_written_and_the_same_on_rerun(hand, tmp_path):
@@ -190,9 +260,16 @@ def test_representative_grasps_follow_the_stated_rule(hand):
 
     # Patterns: {3, 7} x 3 grasps, {3, 7, 11} x 2, {7, 11, 15} x 1, {3, 7, 11, 15} x 1, one dropped pose.
     # Contacts 2, 2, 3 (two on link 7), 3, 3, 3, 4: median 3, the typical count.
-    poses = [("grasp", [3, 7], []), ("grasp", [7, 3], []), ("grasp", [3, 7, 7], []),
-             ("grasp", [3, 7, 11], []), ("grasp", [3, 7, 11], []), ("grasp", [7, 11, 15], []),
-             ("grasp", [3, 7, 11, 15], []), ("intersects_open_hand", [], [])]
+    poses = [
+        ("grasp", [3, 7], []),
+        ("grasp", [7, 3], []),
+        ("grasp", [3, 7, 7], []),
+        ("grasp", [3, 7, 11], []),
+        ("grasp", [3, 7, 11], []),
+        ("grasp", [7, 11, 15], []),
+        ("grasp", [3, 7, 11, 15], []),
+        ("intersects_open_hand", [], []),
+    ]
     contacts = _contacts(poses=poses)
     contacts["alpha_deg"] = [40.0, -10.0, 5.0, 0.0, 180.0, 0.0, 0.0, 0.0]
     contacts["beta_deg"] = [0.0, 0.0, 0.0, 20.0, 0.0, 0.0, 0.0, 0.0]
@@ -214,7 +291,6 @@ def test_a_closure_without_contact_is_simulated_not_dropped(hand):
     assert row["pct_m0"] == pytest.approx(25.0)
     assert row["pct_thumb"] == pytest.approx(75.0)
     assert row["median_force_per_weight"] == pytest.approx(2.0)
-
 
 
 def test_a_contact_carries_load_from_the_configured_threshold_on(hand):

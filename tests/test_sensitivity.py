@@ -1,6 +1,7 @@
 """The sweep's summary on hand-made study tables: one row per scenario, each claim's verdict
 and figure carried over, Table II rows, single-synergy rates averaged over objects, and the
 share of minima preserved."""
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -9,20 +10,32 @@ from synergrasp.analysis.sensitivity import ScenarioTables, sensitivity_table, t
 
 
 def tables(verdict1: str, rate_s1_obj1: float, preserved: float) -> ScenarioTables:
-    claims = pd.DataFrame({"claim": [1, 2], "statement": ["a", "b"], "tested_by": ["T2", "T2"],
-                           "measured": [f"fig {verdict1}", "0 pairs"], "verdict": [verdict1, "holds"]})
-    table2 = pd.DataFrame({"object": ["obj1", "obj2"], "1": [rate_s1_obj1, 20.0], "2": [80.0, 60.0],
-                           "3": [100.0, 90.0], "4": [100.0, 100.0]})
-    rates = pd.DataFrame({"object": ["obj1", "obj2", "obj1", "obj1"], "set_id": ["1", "1", "2", "1-2"],
-                          "n_synergies": [1, 1, 1, 2], "success_rate": [rate_s1_obj1, 20.0, 30.0, 80.0]})
-    preservation = pd.DataFrame({"object": ["obj1", "all"], "pairs": ["all", "all"],
-                                 "preserved_percent": [50.0, preserved]})
+    claims = pd.DataFrame(
+        {
+            "claim": [1, 2],
+            "statement": ["a", "b"],
+            "tested_by": ["T2", "T2"],
+            "measured": [f"fig {verdict1}", "0 pairs"],
+            "verdict": [verdict1, "holds"],
+        }
+    )
+    table2 = pd.DataFrame(
+        {"object": ["obj1", "obj2"], "1": [rate_s1_obj1, 20.0], "2": [80.0, 60.0], "3": [100.0, 90.0], "4": [100.0, 100.0]}
+    )
+    rates = pd.DataFrame(
+        {
+            "object": ["obj1", "obj2", "obj1", "obj1"],
+            "set_id": ["1", "1", "2", "1-2"],
+            "n_synergies": [1, 1, 1, 2],
+            "success_rate": [rate_s1_obj1, 20.0, 30.0, 80.0],
+        }
+    )
+    preservation = pd.DataFrame({"object": ["obj1", "all"], "pairs": ["all", "all"], "preserved_percent": [50.0, preserved]})
     return ScenarioTables(claims, table2, rates, preservation)
 
 
 def test_one_row_per_scenario_with_each_figure():
-    summary = sensitivity_table({"default": tables("holds", 40.0, 95.0),
-                                 "mu_1_0": tables("does not hold", 10.0, 70.0)})
+    summary = sensitivity_table({"default": tables("holds", 40.0, 95.0), "mu_1_0": tables("does not hold", 10.0, 70.0)})
     assert list(summary["scenario"]) == ["default", "mu_1_0"]
     assert list(summary["claim1_verdict"]) == ["holds", "does not hold"]
     assert list(summary["claim1_measured"]) == ["fig holds", "fig does not hold"]
@@ -39,8 +52,15 @@ def test_one_row_per_scenario_with_each_figure():
 
 def test_preservation_share_from_counts_when_no_overall_row():
     t = tables("holds", 40.0, 95.0)
-    counts = pd.DataFrame({"object": ["obj1", "obj2"], "k": [1, 1], "n_minima": [3, 1],
-                           "n_preserved": [2, 1], "preserved_percent": [200 / 3, 100.0]})
+    counts = pd.DataFrame(
+        {
+            "object": ["obj1", "obj2"],
+            "k": [1, 1],
+            "n_minima": [3, 1],
+            "n_preserved": [2, 1],
+            "preserved_percent": [200 / 3, 100.0],
+        }
+    )
     summary = sensitivity_table({"default": ScenarioTables(t.claims, t.table2, t.success_rates, counts)})
     assert summary["minima_preserved_percent"].iloc[0] == pytest.approx(75.0)
 
@@ -86,9 +106,17 @@ def test_realism_per_object_in_scenario_order():
     """Each grasp-realism figure is every object's value, in the table's order, joined by "/";
     a missing value is a dash, and a scenario without the table has no such column."""
     t = tables("holds", 40.0, 95.0)
-    realism = pd.DataFrame({"object": ["obj1", "obj2"], "contacts_median": [5.0, 6.0],
-                            "pct_palm": [89.6, 18.9], "pct_thumb": [72.7, 100.0], "pct_index": [0.0, 69.3],
-                            "pct_force_closure": [100.0, 92.7], "median_force_per_weight": [0.541, np.nan]})
+    realism = pd.DataFrame(
+        {
+            "object": ["obj1", "obj2"],
+            "contacts_median": [5.0, 6.0],
+            "pct_palm": [89.6, 18.9],
+            "pct_thumb": [72.7, 100.0],
+            "pct_index": [0.0, 69.3],
+            "pct_force_closure": [100.0, 92.7],
+            "median_force_per_weight": [0.541, np.nan],
+        }
+    )
     with_realism = ScenarioTables(t.claims, t.table2, t.success_rates, t.preservation, realism)
     summary = sensitivity_table({"default": with_realism, "other": t})
     row = summary.iloc[0]

@@ -27,10 +27,12 @@ SPACING_MM = 0.25
 DATA = Path(__file__).parent / "data"
 #: Meshes: a convex one of 1000 faces (binary STL), a box (OBJ of quads), the duck of the
 #: example study (non-convex: its convex decomposition, 5 parts).
-MESHES = [Mesh(str(DATA / "rounded_cube_1000.stl"), 1.0), Mesh(str(DATA / "box_30x60x100.obj"), 1.0),
-          Mesh(str(Path(__file__).parents[1] / "config" / "examples" / "meshes" / "duck.obj"), 50.0)]
-SHAPES = [Box((30.0, 60.0, 100.0)), Box((30.0, 30.0, 30.0)), Sphere(25.0), Cylinder(30.0, 120.0), Cylinder(40.0, 15.0),
-          *MESHES]
+MESHES = [
+    Mesh(str(DATA / "rounded_cube_1000.stl"), 1.0),
+    Mesh(str(DATA / "box_30x60x100.obj"), 1.0),
+    Mesh(str(Path(__file__).parents[1] / "config" / "examples" / "meshes" / "duck.obj"), 50.0),
+]
+SHAPES = [Box((30.0, 60.0, 100.0)), Box((30.0, 30.0, 30.0)), Sphere(25.0), Cylinder(30.0, 120.0), Cylinder(40.0, 15.0), *MESHES]
 
 
 def dense_surface(shape, spacing=SPACING_MM) -> np.ndarray:
@@ -49,10 +51,10 @@ def dense_surface(shape, spacing=SPACING_MM) -> np.ndarray:
                 faces.append(face)
         return np.concatenate(faces)
     if shape.kind == "sphere":  # a Fibonacci lattice, ~spacing apart
-        n = int(np.ceil(4 * np.pi * shape.radius_mm ** 2 / spacing ** 2))
+        n = int(np.ceil(4 * np.pi * shape.radius_mm**2 / spacing**2))
         k = np.arange(n) + 0.5
         z = 1 - 2 * k / n
-        phi = np.pi * (1 + 5 ** 0.5) * k
+        phi = np.pi * (1 + 5**0.5) * k
         s = np.sqrt(1 - z * z)
         return shape.radius_mm * np.c_[s * np.cos(phi), s * np.sin(phi), z]
     if shape.kind == "cylinder":
@@ -236,9 +238,9 @@ def _volume(shape) -> float:
     if shape.kind == "box":
         return float(np.prod(shape.size_mm))
     if shape.kind == "sphere":
-        return 4.0 / 3.0 * np.pi * shape.radius_mm ** 3
+        return 4.0 / 3.0 * np.pi * shape.radius_mm**3
     if shape.kind == "cylinder":
-        return np.pi * shape.radius_mm ** 2 * shape.height_mm
+        return np.pi * shape.radius_mm**2 * shape.height_mm
     return sum(ConvexHull(part).volume for part in shape.geometry.parts)  # a mesh: its convex parts
 
 
@@ -308,10 +310,28 @@ def test_a_cylinder_tilted_by_a_microradian_is_another_region():
 PINNED_SMALL_CONTACTS = Path(__file__).parent / "data" / "small_contacts.npz"
 #: Absolute tolerances of the pinned values, per column (mm for lengths, rad for q, unitless
 #: for normals and rotations); columns not listed must match exactly.
-PINNED_ATOL = {"q": 1e-12, "contact_point": 1e-9, "contact_normal": 1e-12, "jacobian": 1e-9,
-               "object_center": 1e-9, "object_rotation": 1e-12, "max_penetration_mm": 1e-9}
-_DIGESTED = ("pose", "status", "q", "finger_state", "contact_link", "contact_point", "contact_normal", "jacobian",
-             "object_center", "object_rotation", "max_penetration_mm")
+PINNED_ATOL = {
+    "q": 1e-12,
+    "contact_point": 1e-9,
+    "contact_normal": 1e-12,
+    "jacobian": 1e-9,
+    "object_center": 1e-9,
+    "object_rotation": 1e-12,
+    "max_penetration_mm": 1e-9,
+}
+_DIGESTED = (
+    "pose",
+    "status",
+    "q",
+    "finger_state",
+    "contact_link",
+    "contact_point",
+    "contact_normal",
+    "jacobian",
+    "object_center",
+    "object_rotation",
+    "max_penetration_mm",
+)
 
 
 def _is_text(value) -> bool:
@@ -384,8 +404,9 @@ def _same_grasps(table, rows, atol=1e-6):
             if isinstance(a, str):
                 assert a == b, (column, i)
             else:
-                np.testing.assert_allclose(np.asarray(b, dtype=float), np.asarray(a, dtype=float), atol=atol,
-                                           err_msg=f"{column} at row {i}")
+                np.testing.assert_allclose(
+                    np.asarray(b, dtype=float), np.asarray(a, dtype=float), atol=atol, err_msg=f"{column} at row {i}"
+                )
 
 
 def _closed_apart(hand, synergies, grasped, placement, poses):
@@ -394,8 +415,10 @@ def _closed_apart(hand, synergies, grasped, placement, poses):
     from conftest import study_closure_params
     from synergrasp.simulation.closure import simulate_object
 
-    return pd.concat([simulate_object(hand, synergies, grasped, placement, study_closure_params(), poses=[p])
-                      for p in poses], ignore_index=True)
+    return pd.concat(
+        [simulate_object(hand, synergies, grasped, placement, study_closure_params(), poses=[p]) for p in poses],
+        ignore_index=True,
+    )
 
 
 def test_a_sphere_on_the_approach_gives_the_same_grasp_at_every_pose(hand, synergies):
@@ -435,8 +458,11 @@ def test_the_cylinders_period_and_its_grasps_repeat_with_it(hand, synergies, axe
         _same_grasps(_closed_apart(hand, synergies, can, placement, poses), [0, 1, 2, 3])
 
 
-@pytest.mark.parametrize("shape", [Box((30.0, 60.0, 100.0)), Sphere(25.0), Cylinder(30.0, 120.0), MESHES[0], MESHES[2]],
-                         ids=lambda s: s.kind if s.kind != "mesh" else Path(s.path).stem)
+@pytest.mark.parametrize(
+    "shape",
+    [Box((30.0, 60.0, 100.0)), Sphere(25.0), Cylinder(30.0, 120.0), MESHES[0], MESHES[2]],
+    ids=lambda s: s.kind if s.kind != "mesh" else Path(s.path).stem,
+)
 def test_the_engines_collision_shape_is_the_same_shape(shape):
     """pybullet's body of the shape (``collision_geometry``), turned and moved, against small
     probe spheres off the middle of its faces (where the engine does not round its edges):

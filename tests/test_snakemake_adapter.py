@@ -21,8 +21,13 @@ ROOT = Path(__file__).resolve().parents[1]
 def _snakemake(workdir: Path, *args: str) -> subprocess.CompletedProcess:
     """Run the installed Snakemake on ``workdir``'s Snakefile, from there (the checkout's profile
     unread); a hang guard of two minutes, never reached by a run of these workflows."""
-    return subprocess.run([sys.executable, "-m", "snakemake", "-c1", "-s", str(workdir / "Snakefile"), *args],
-                          cwd=workdir, capture_output=True, text=True, timeout=120)
+    return subprocess.run(
+        [sys.executable, "-m", "snakemake", "-c1", "-s", str(workdir / "Snakefile"), *args],
+        cwd=workdir,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
 
 
 # --------------------------------------------------------------------------- the version
@@ -65,11 +70,15 @@ rule make:
 """
 
 
-@pytest.mark.parametrize("accept, planned", [
-    ("accept_configured_wildcards([NAME])", True),
-    ("accept_configured_wildcards(['obj_1'])", False),  # another name: Snakemake's own guard
-    ("", False),
-], ids=["configured", "other name configured", "none configured"])
+@pytest.mark.parametrize(
+    "accept, planned",
+    [
+        ("accept_configured_wildcards([NAME])", True),
+        ("accept_configured_wildcards(['obj_1'])", False),  # another name: Snakemake's own guard
+        ("", False),
+    ],
+    ids=["configured", "other name configured", "none configured"],
+)
 def test_the_recursion_guard_accepts_the_configured_names_only(tmp_path, accept, planned):
     (tmp_path / "Snakefile").write_text(_PERIODIC.format(accept=accept))
     out = _snakemake(tmp_path, "-n")
@@ -239,8 +248,19 @@ def test_the_workflows_rules_are_snakemakes_parse():
 #: Snakemake's public modules (its documented API and what a Snakefile is documented to import).
 PUBLIC_MODULES = {"api", "settings", "exceptions", "logging", "utils"}
 #: The attributes of the ``snakemake`` object a rule's script is handed.
-SCRIPT_OBJECT = {"input", "output", "params", "wildcards", "threads", "resources", "log", "config", "rule",
-                 "scriptdir", "bench_iteration"}
+SCRIPT_OBJECT = {
+    "input",
+    "output",
+    "params",
+    "wildcards",
+    "threads",
+    "resources",
+    "log",
+    "config",
+    "rule",
+    "scriptdir",
+    "bench_iteration",
+}
 #: The attributes of the Snakefile's ``workflow`` object the documentation describes.
 PUBLIC_WORKFLOW = {"basedir", "current_basedir", "snakefile", "source_path"}
 
@@ -250,13 +270,11 @@ def private_uses(text: str, snakefile: bool) -> list[str]:
     modules (imported or named), ``from snakemake import <name>``, an attribute with a
     leading underscore of a Snakemake API object, and in a Snakefile or rule file a
     ``workflow.<attribute>`` the documentation does not describe."""
-    found = [f"snakemake.{m}" for m in re.findall(r"\bsnakemake\.(\w+)", text)
-             if m not in PUBLIC_MODULES | SCRIPT_OBJECT]
+    found = [f"snakemake.{m}" for m in re.findall(r"\bsnakemake\.(\w+)", text) if m not in PUBLIC_MODULES | SCRIPT_OBJECT]
     found += [f"from snakemake import {n}" for n in re.findall(r"^\s*from snakemake import (\w+)", text, re.M)]
     found += re.findall(r"\b(?:api|wf|dag|workflow)\._\w+", text)
     if snakefile:
-        found += [f"workflow.{a}" for a in re.findall(r"(?<![\w./])workflow\.(\w+)", text)
-                  if a not in PUBLIC_WORKFLOW]
+        found += [f"workflow.{a}" for a in re.findall(r"(?<![\w./])workflow\.(\w+)", text) if a not in PUBLIC_WORKFLOW]
     return found
 
 

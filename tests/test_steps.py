@@ -1,5 +1,6 @@
 """The step registry (synergrasp.steps): the keys each step reads, its hash, its typed
 parameters, and the workflow's view of it (rules, outputs, costs, shared outputs)."""
+
 import ast
 import importlib
 import re
@@ -35,11 +36,12 @@ def step_params(config, step, obj=None):
     module, name = STEPS[step].params.split(":")
     return getattr(importlib.import_module(module), name).from_config(config, obj)
 
+
 def _read_by(path, steps_keys):
     parts = path.split(".")
     for key in steps_keys:
         key_parts = key.replace("{object}", "*").split(".")
-        if parts[:len(key_parts)] == key_parts:
+        if parts[: len(key_parts)] == key_parts:
             return True
     return False
 
@@ -70,7 +72,7 @@ def test_the_closure_does_not_rerun_when_an_object_mass_changes():
 
 
 def test_a_conditional_key_is_read_only_when_its_condition_holds():
-    (key, value, reads), = STEPS["simulate"].reads_when
+    ((key, value, reads),) = STEPS["simulate"].reads_when
     config = validate_config(STUDY)
     node = config
     for part in key.split(".")[:-1]:
@@ -183,9 +185,15 @@ def _rules():
     def bare(path):  # wildcards without their constraints: {root,...} -> {root}
         return re.sub(r"\{(\w+),[^{}]*\}", r"{\1}", str(path))
 
-    return {rule.name: ([bare(f) for f in rule.output], [bare(f) for f in rule.log],
-                        bare(rule.benchmark) if rule.benchmark else None, rule.script)
-            for rule in workflow_rules(ROOT / "Snakefile", ROOT)}
+    return {
+        rule.name: (
+            [bare(f) for f in rule.output],
+            [bare(f) for f in rule.log],
+            bare(rule.benchmark) if rule.benchmark else None,
+            rule.script,
+        )
+        for rule in workflow_rules(ROOT / "Snakefile", ROOT)
+    }
 
 
 TARGET_RULES = ("all", "figures", "scenarios", "placement_claims", "plans", "across_objects")
@@ -201,8 +209,13 @@ def test_every_step_has_its_rules_outputs_and_costs_and_every_rule_its_step():
         assert step.outputs, name
         written = rules[list(step.rules)[-1]][0]
         assert sorted(written) == sorted(prefix[step.scope] + rel for rel in step.outputs.values()), name
-        assert all(c.unit in ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose", "object_pose_set")
-                   and c.fixed_s > 0 and c.fixed_mb > 0 and c.threads >= 1 for c in step.rules.values()), name
+        assert all(
+            c.unit in ("none", "pose", "closure_pose", "shard_pose_set", "pose_set", "object_pose", "object_pose_set")
+            and c.fixed_s > 0
+            and c.fixed_mb > 0
+            and c.threads >= 1
+            for c in step.rules.values()
+        ), name
         assert set(step.upstream) <= set(STEPS), name
         assert set(step.report) | set(step.folders) <= set(step.outputs), name
         assert all((ROOT / "workflow" / "report" / f"{caption}.rst").is_file() for caption, _ in step.report.values())
@@ -237,8 +250,9 @@ def test_a_steps_script_imports_the_module_its_parameters_come_from(step):
     script = ROOT / "workflow" / "scripts" / f"{list(STEPS[step].rules)[0]}.py"
     module, name = STEPS[step].params.split(":")
     tree = ast.parse(script.read_text())
-    assert any(isinstance(n, ast.ImportFrom) and n.module == module and name in {a.name for a in n.names}
-               for n in ast.walk(tree)), (script, module, name)
+    assert any(
+        isinstance(n, ast.ImportFrom) and n.module == module and name in {a.name for a in n.names} for n in ast.walk(tree)
+    ), (script, module, name)
 
 
 def test_study_synergy_sets_are_the_75_distinct_sets():  # synergrasp.ids
@@ -248,7 +262,6 @@ def test_study_synergy_sets_are_the_75_distinct_sets():  # synergrasp.ids
     assert sets["1-2-3"] == (1, 2, 3)
     assert "2-5-7" in sets and "1-2-3-4-5-6-7-8-9-10-11-12-13-14-15" in sets
     assert all(set_id(v) == k for k, v in sets.items())
-
 
 
 def _path(shown: str) -> str:
@@ -265,9 +278,25 @@ def _dry_run(tmp_path, target, scenarios):
     config = tmp_path / "config.yaml"
     config.write_text(yaml.safe_dump({**SMALL, "scenarios": scenarios}))
     targets = [target] if isinstance(target, str) else list(target)
-    run = subprocess.run([sys.executable, "-m", "snakemake", *targets, "-n", "-s", str(ROOT / "Snakefile"),
-                          "--directory", str(tmp_path), "--configfile", str(config),
-                          "--replace-workflow-config"], capture_output=True, text=True, timeout=600)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "snakemake",
+            *targets,
+            "-n",
+            "-s",
+            str(ROOT / "Snakefile"),
+            "--directory",
+            str(tmp_path),
+            "--configfile",
+            str(config),
+            "--replace-workflow-config",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     jobs, rule = {}, None
     for line in run.stdout.splitlines():
         if line.startswith(("rule ", "localrule ")):
@@ -278,16 +307,17 @@ def _dry_run(tmp_path, target, scenarios):
 
 
 def test_scenarios_differing_in_an_analysis_key_share_simulation_and_optimisation(tmp_path):
-    code, out, jobs = _dry_run(tmp_path, "scenario_wide", {"wide": {"analyses": {"minima_radius_deg": 60}},
-                                                           "mu1": {"mechanics": {"mu": 1.0}}})
+    code, out, jobs = _dry_run(
+        tmp_path, "scenario_wide", {"wide": {"analyses": {"minima_radius_deg": 60}}, "mu1": {"mechanics": {"mu": 1.0}}}
+    )
     assert code == 0, out[-3000:]
     shared = jobs["simulate"] + jobs["optimise_shard"] + jobs["optimise"]
     assert sorted(shared) == sorted(
         [f"results/objects/{o}/contacts.parquet" for o in ("obj1", "obj4")]
         + [f"results/objects/{o}/gfo_shards/{i}.parquet" for o in ("obj1", "obj4") for i in (0, 1)]
-        + [f"results/objects/{o}/gfo.parquet" for o in ("obj1", "obj4")])
-    assert sorted(jobs["minima"]) == [f"results/scenarios/wide/objects/{o}/minima.parquet"
-                                            for o in ("obj1", "obj4")]
+        + [f"results/objects/{o}/gfo.parquet" for o in ("obj1", "obj4")]
+    )
+    assert sorted(jobs["minima"]) == [f"results/scenarios/wide/objects/{o}/minima.parquet" for o in ("obj1", "obj4")]
     assert "results/scenarios/wide/tables/table2_success_rates.csv" in jobs["tables"]
     # an optimisation key: the contacts are shared, the optimisation is its own
     code, out, jobs = _dry_run(tmp_path, "scenario_mu1", {"mu1": {"mechanics": {"mu": 1.0}}})
@@ -300,14 +330,17 @@ def test_dropping_or_keeping_unloaded_contacts_shares_one_dynamic_closure(tmp_pa
     """`unloaded_contacts` is read by the contacts step, not by the closure: the two dynamic
     scenarios run one closure per object; only `drop` selects the load-carrying contacts, and
     each scenario optimises its own contacts."""
-    scenarios = {"dyn": {"closure": {"model": "dynamic"}},
-                 "dyn_all": {"closure": {"model": "dynamic", "dynamic": {"unloaded_contacts": "keep"}}}}
+    scenarios = {
+        "dyn": {"closure": {"model": "dynamic"}},
+        "dyn_all": {"closure": {"model": "dynamic", "dynamic": {"unloaded_contacts": "keep"}}},
+    }
     code, out, jobs = _dry_run(tmp_path, "scenarios", scenarios)
     assert code == 0, out[-3000:]
     closures = sorted(p for p in jobs["simulate"] if "/scenarios/" in p)
     assert closures == [f"results/scenarios/dyn/objects/{o}/contacts.parquet" for o in ("obj1", "obj4")]
-    assert sorted(jobs["contacts"]) == [f"results/scenarios/dyn/objects/{o}/load_carrying_contacts.parquet"
-                                              for o in ("obj1", "obj4")]
+    assert sorted(jobs["contacts"]) == [
+        f"results/scenarios/dyn/objects/{o}/load_carrying_contacts.parquet" for o in ("obj1", "obj4")
+    ]
     gfo_roots = sorted({p.split("/objects/")[0] for p in jobs["optimise"]})
     assert gfo_roots == ["results", "results/scenarios/dyn", "results/scenarios/dyn_all"]
 
@@ -358,8 +391,10 @@ def test_resources_follow_each_scenarios_own_size(tmp_path):
             fields = dict(kv.split("=", 1) for kv in line.split(":", 1)[1].replace(" ", "").split(","))
             if "runtime" in fields:
                 requests[output] = (int(fields["runtime"]), int(fields["mem_mb"]))
-    small, fine_kin, fine_dyn = (requests[f"{root}/objects/obj1/contacts.parquet"] for root in
-                                 ("results", "results/scenarios/fine", "results/scenarios/fine_dyn"))
+    small, fine_kin, fine_dyn = (
+        requests[f"{root}/objects/obj1/contacts.parquet"]
+        for root in ("results", "results/scenarios/fine", "results/scenarios/fine_dyn")
+    )
     assert small[0] < fine_kin[0] < fine_dyn[0] and small[1] <= fine_kin[1] <= fine_dyn[1]
 
 
@@ -380,29 +415,37 @@ def test_scenarios_differing_in_an_analysis_key_draw_each_shared_figure_once(tmp
     code, out, jobs = _dry_run(tmp_path, "scenarios", scenarios)
     assert code == 0, out[-3000:]
     assert jobs["fig1"] == [f"results/figures/fig1_synergy_postures.{e}" for e in ("png", "pdf")]
-    assert jobs["fig2"] == [*(f"results/figures/fig2_example_grasps.{e}" for e in ("png", "pdf")),
-                                           "results/figures/grasps_3d"]
+    assert jobs["fig2"] == [*(f"results/figures/fig2_example_grasps.{e}" for e in ("png", "pdf")), "results/figures/grasps_3d"]
     # the minima radius changes the tables and Fig. 5 (they read the minima), not the realism table
     roots = lambda rule, name: sorted(p.rsplit("/", 2)[0] for p in jobs[rule] if p.endswith(name))  # noqa: E731
     assert roots("tables", "/claims.csv") == ["results", "results/scenarios/wide"]
     assert roots("fig5", "/fig5a_hierarchy_success.png") == ["results", "results/scenarios/wide"]
     assert roots("realism", "/grasp_realism.csv") == ["results"]
     fig4 = sorted(p for p in jobs["fig4"] if p.endswith("obj1/fig4_force_maps.png"))
-    assert fig4 == [f"{r}/objects/obj1/fig4_force_maps.png" for r in
-                    ("results", "results/scenarios/panels", "results/scenarios/wide")]
+    assert fig4 == [
+        f"{r}/objects/obj1/fig4_force_maps.png" for r in ("results", "results/scenarios/panels", "results/scenarios/wide")
+    ]
     out = _dry_run(tmp_path, ["scenario_default", "scenario_panels"], scenarios)[1]
     default, panels = (_target_inputs(out, f"scenario_{name}") for name in ("default", "panels"))
     assert len(panels) == len(default) == len(set(default))
     assert [p for p in panels if p not in default] == [
-        f"results/scenarios/panels/objects/{o}/fig4_{k}.{e}" for o in ("obj1", "obj4")
-        for k in ("force_maps", "exploded") for e in ("png", "pdf")]
+        f"results/scenarios/panels/objects/{o}/fig4_{k}.{e}"
+        for o in ("obj1", "obj4")
+        for k in ("force_maps", "exploded")
+        for e in ("png", "pdf")
+    ]
 
 
-@pytest.mark.parametrize("scenarios, expected", [
-    ({"s1": {"mechanics": {"muu": 1.0}}}, "scenario 's1': config error at 'mechanics': unknown key(s) ['muu']"),
-    ({"s1": {"synergy_sets": {"incremental_max": 20}}},
-     "scenario 's1': config error at 'synergy_sets.incremental_max': 20 exceeds the 15 synergies"),
-])
+@pytest.mark.parametrize(
+    "scenarios, expected",
+    [
+        ({"s1": {"mechanics": {"muu": 1.0}}}, "scenario 's1': config error at 'mechanics': unknown key(s) ['muu']"),
+        (
+            {"s1": {"synergy_sets": {"incremental_max": 20}}},
+            "scenario 's1': config error at 'synergy_sets.incremental_max': 20 exceeds the 15 synergies",
+        ),
+    ],
+)
 def test_a_bad_scenario_stops_the_workflow_before_any_job(tmp_path, scenarios, expected):
     # a scenario is read only by the targets that need it: `figures` does not
     code, out, jobs = _dry_run(tmp_path, "figures", scenarios)
@@ -410,7 +453,6 @@ def test_a_bad_scenario_stops_the_workflow_before_any_job(tmp_path, scenarios, e
     code, out, jobs = _dry_run(tmp_path, "scenarios", scenarios)
     assert code != 0 and jobs == {}
     assert "Invalid input, nothing was run" in out and expected in out
-
 
 
 def test_no_module_of_the_package_imports_another_by_name_at_run_time():

@@ -1,5 +1,6 @@
 """Study summaries on hand-made gfo tables: success rates under both verdicts, distinct
 poses, paired forces, Table II, hierarchy matrices, minimum preservation, cross-checks."""
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -21,25 +22,40 @@ from synergrasp.analysis.verdicts import with_verdicts
 FULL = "1-2-3"
 
 
-def gfo_rows(obj: str, set_id: str, forces: list[float | None], strict: list[bool] | None = None,
-             step_deg: float = 5.0) -> list[dict]:
+def gfo_rows(
+    obj: str, set_id: str, forces: list[float | None], strict: list[bool] | None = None, step_deg: float = 5.0
+) -> list[dict]:
     """One row per pose (α = step·pose, β = 0); None = the optimisation is infeasible.
     ``strict`` (default: wherever feasible) is the strict internal-force test."""
     strict = strict if strict is not None else [f is not None for f in forces]
-    return [dict(object=obj, pose=p, alpha_deg=step_deg * p, beta_deg=0.0, set_id=set_id,
-                 n_synergies=len(set_id.split("-")), status="feasible" if f is not None else "infeasible",
-                 load_feasible=f is not None, force_closure_def1=s, rank_G=6, force_norm=np.nan if f is None else f)
-            for p, (f, s) in enumerate(zip(forces, strict))]
+    return [
+        dict(
+            object=obj,
+            pose=p,
+            alpha_deg=step_deg * p,
+            beta_deg=0.0,
+            set_id=set_id,
+            n_synergies=len(set_id.split("-")),
+            status="feasible" if f is not None else "infeasible",
+            load_feasible=f is not None,
+            force_closure_def1=s,
+            rank_G=6,
+            force_norm=np.nan if f is None else f,
+        )
+        for p, (f, s) in enumerate(zip(forces, strict))
+    ]
 
 
 @pytest.fixture
 def gfo() -> pd.DataFrame:
-    rows = (gfo_rows("a", "1", [1.0, None, None, None])
-            + gfo_rows("a", "1-2", [2.0, 4.0, None, None])
-            + gfo_rows("a", FULL, [1.0, 2.0, 3.0, 10.0])
-            + gfo_rows("b", "1", [None, None, None, None])
-            + gfo_rows("b", "1-2", [5.0, None, None, None])
-            + gfo_rows("b", FULL, [None, None, None, None]))
+    rows = (
+        gfo_rows("a", "1", [1.0, None, None, None])
+        + gfo_rows("a", "1-2", [2.0, 4.0, None, None])
+        + gfo_rows("a", FULL, [1.0, 2.0, 3.0, 10.0])
+        + gfo_rows("b", "1", [None, None, None, None])
+        + gfo_rows("b", "1-2", [5.0, None, None, None])
+        + gfo_rows("b", FULL, [None, None, None, None])
+    )
     return pd.DataFrame(rows)
 
 
@@ -66,8 +82,9 @@ def test_success_rates_by_hand(gfo):
 
 def test_success_rates_under_both_verdicts():
     """Set 1 is feasible under the weight at poses 0-3 but strictly prehensile only at 0."""
-    rows = (gfo_rows("a", "1", [1.0, 2.0, 3.0, 4.0], strict=[True, False, False, False])
-            + gfo_rows("a", "1-2", [1.0, 1.0, 1.0, 1.0]))
+    rows = gfo_rows("a", "1", [1.0, 2.0, 3.0, 4.0], strict=[True, False, False, False]) + gfo_rows(
+        "a", "1-2", [1.0, 1.0, 1.0, 1.0]
+    )
     table = pd.DataFrame(rows)
     fc = success_rates(with_verdicts(table, "force_closure"), "1-2").set_index("set_id")
     lf = success_rates(with_verdicts(table, "load_feasible"), "1-2").set_index("set_id")
@@ -79,8 +96,7 @@ def test_success_rates_under_both_verdicts():
 
 def test_distinct_poses_count_one_period():
     """Eight poses 0..315 deg step 45 with period 90: two distinct poses (0 and 45)."""
-    table = pd.DataFrame(gfo_rows("a", "1", [1.0, None] * 4, step_deg=45.0)
-                         + gfo_rows("a", "1-2", [1.0, 1.0] * 4, step_deg=45.0))
+    table = pd.DataFrame(gfo_rows("a", "1", [1.0, None] * 4, step_deg=45.0) + gfo_rows("a", "1-2", [1.0, 1.0] * 4, step_deg=45.0))
     r = success_rates(with_verdicts(table, "force_closure"), "1-2", {"a": 90.0}).set_index("set_id")
     assert r.loc["1", "n_success"] == 1 and r.loc["1", "n_success_grid"] == 4  # the headline: distinct poses
     assert r.loc["1", "n_poses"] == 2
@@ -122,8 +138,14 @@ def test_mean_over_objects_skips_undefined(gfo):
 
 def test_hierarchy_matrices_collapse_duplicates():
     sets = ["1", "2", "3", "1-2", "1-3", "2-3", "1-2-3"]
-    rates = pd.DataFrame({"set_id": sets, "success_rate": np.arange(7.0), "force_ratio_median": 1 + np.arange(7.0),
-                          "plain_mean_force_N": 10 + np.arange(7.0)})
+    rates = pd.DataFrame(
+        {
+            "set_id": sets,
+            "success_rate": np.arange(7.0),
+            "force_ratio_median": 1 + np.arange(7.0),
+            "plain_mean_force_N": 10 + np.arange(7.0),
+        }
+    )
     h = hierarchy_matrices(rates, first=3)
     assert len(h) == 27
     cell = h.set_index(["k", "i", "j"])
@@ -145,13 +167,15 @@ def test_hierarchy_missing_set_is_nan_and_duplicates_rejected():
 
 
 def test_minimum_preservation_by_hand(gfo):
-    minima = pd.DataFrame([
-        dict(object="a", set_id="1", alpha_deg=-180.0, beta_deg=0.0),   # kept: 1-2 has one at 175 (wrap)
-        dict(object="a", set_id="1", alpha_deg=0.0, beta_deg=-60.0),    # lost
-        dict(object="a", set_id="1-2", alpha_deg=175.0, beta_deg=5.0),  # kept: 1-2-3 has one at 170
-        dict(object="a", set_id="1-2-3", alpha_deg=170.0, beta_deg=10.0),
-        dict(object="b", set_id="1-2", alpha_deg=0.0, beta_deg=0.0),    # lost: b's 1-2-3 has none
-    ])
+    minima = pd.DataFrame(
+        [
+            dict(object="a", set_id="1", alpha_deg=-180.0, beta_deg=0.0),  # kept: 1-2 has one at 175 (wrap)
+            dict(object="a", set_id="1", alpha_deg=0.0, beta_deg=-60.0),  # lost
+            dict(object="a", set_id="1-2", alpha_deg=175.0, beta_deg=5.0),  # kept: 1-2-3 has one at 170
+            dict(object="a", set_id="1-2-3", alpha_deg=170.0, beta_deg=10.0),
+            dict(object="b", set_id="1-2", alpha_deg=0.0, beta_deg=0.0),  # lost: b's 1-2-3 has none
+        ]
+    )
     p = minimum_preservation(gfo, minima, k_max=3)
     rows = {(o, None if pd.isna(k) else k): r for o, k, r in zip(p["object"], p["k"], p.to_dict("records"))}
     assert (rows[("a", 1)]["n_minima"], rows[("a", 1)]["n_preserved"]) == (2, 1)
@@ -161,8 +185,15 @@ def test_minimum_preservation_by_hand(gfo):
     assert rows[("b", 1)]["n_minima"] == 0 and np.isnan(rows[("b", 1)]["preserved_percent"])
     assert (rows[("all", 2)]["n_minima"], rows[("all", 2)]["n_preserved"]) == (2, 1)
     assert (rows[("all", None)]["n_minima"], rows[("all", None)]["n_preserved"]) == (4, 2)
-    assert list(p.columns) == ["object", "k", "n_minima", "n_preserved", "preserved_percent", "n_minima_distinct",
-                               "n_preserved_distinct"]
+    assert list(p.columns) == [
+        "object",
+        "k",
+        "n_minima",
+        "n_preserved",
+        "preserved_percent",
+        "n_minima_distinct",
+        "n_preserved_distinct",
+    ]
     # with a 180 deg period, a's grid starts at alpha 0: the minimum at -180 is outside [0, 180)
     q = minimum_preservation(gfo, minima, k_max=3, periods_deg={"a": 180.0}).set_index(["object", "k"])
     assert q.loc[("a", 1), ["n_minima_distinct", "n_preserved_distinct"]].tolist() == [1, 0]
@@ -174,20 +205,28 @@ def test_full_but_not_first7(gfo):
     assert out["full_force_norm"].tolist() == [3.0, 10.0]
     assert set(out["first7_status"]) == {"infeasible"}
     partial = gfo[~((gfo["set_id"] == "1-2") & (gfo["pose"] == 3))]
-    assert full_but_not_first7(with_verdicts(partial, "force_closure"), FULL, "1-2")["first7_status"].tolist() == ["infeasible",
-                                                                                                  "missing"]
+    assert full_but_not_first7(with_verdicts(partial, "force_closure"), FULL, "1-2")["first7_status"].tolist() == [
+        "infeasible",
+        "missing",
+    ]
     with pytest.raises(ValueError, match="first7_set_id"):
         full_but_not_first7(with_verdicts(gfo, "force_closure"), FULL, "1-2-3-4-5-6-7")
 
 
 def test_verdict_disagreements():
-    rows = (gfo_rows("a", "1", [1.0, 2.0, None, None], strict=[True, False, True, False])
-            + gfo_rows("a", "1-2", [1.0, None], strict=[True, False]))
+    rows = gfo_rows("a", "1", [1.0, 2.0, None, None], strict=[True, False, True, False]) + gfo_rows(
+        "a", "1-2", [1.0, None], strict=[True, False]
+    )
     out = verdict_disagreements(with_verdicts(pd.DataFrame(rows), "force_closure"))
     assert len(out) == 1  # 1-2 agrees everywhere
     row = out.iloc[0]
-    assert (row["set_id"], row["n_poses"], row["n_disagree"], row["n_load_feasible_only"],
-            row["n_force_closure_only"]) == ("1", 4, 2, 1, 1)
+    assert (row["set_id"], row["n_poses"], row["n_disagree"], row["n_load_feasible_only"], row["n_force_closure_only"]) == (
+        "1",
+        4,
+        2,
+        1,
+        1,
+    )
     assert row["disagree_percent"] == pytest.approx(50.0)
 
 
@@ -195,11 +234,18 @@ def test_study_tables_names_and_csv_round_trip(gfo, tmp_path):
     minima = pd.DataFrame([dict(object="a", set_id="1", pose=0, alpha_deg=0.0, beta_deg=0.0)])
     settings = study_analysis_settings(null_draws=20)
     with pytest.warns(UserWarning):  # b's set 1-2 succeeds where its full set does not
-        tables = study_tables(gfo, minima, {"incremental_max": 3, "hierarchy_first": 2, "hierarchy_max_size": 2}, 3,
-                              settings)
-    assert set(tables) == {"success_rates", "table2_success_rates", "hierarchy", "minimum_preservation",
-                           "preservation_vs_chance", "full_not_first7", "verdict_disagreements", "invariant_checks",
-                           "claims"}
+        tables = study_tables(gfo, minima, {"incremental_max": 3, "hierarchy_first": 2, "hierarchy_max_size": 2}, 3, settings)
+    assert set(tables) == {
+        "success_rates",
+        "table2_success_rates",
+        "hierarchy",
+        "minimum_preservation",
+        "preservation_vs_chance",
+        "full_not_first7",
+        "verdict_disagreements",
+        "invariant_checks",
+        "claims",
+    }
     from synergrasp.steps import TABLES
     from synergrasp.tables import STUDY_TABLES
 
@@ -223,6 +269,10 @@ def test_study_tables_stop_on_a_rate_far_above_100(gfo):
     """A subset succeeding on twice the full set's poses (e.g. a synergy entry of 1e300)."""
     broken = pd.DataFrame(gfo_rows("a", "1", [1.0, 1.0, 1.0, 1.0]) + gfo_rows("a", "1-2", [1.0, 1.0, None, None]))
     with pytest.raises(InvariantError, match=r"success_rate_tolerance_percent \(1.0\).*a \{1\}: 200 %"):
-        study_tables(broken, broken.iloc[:0].assign(pose=[], alpha_deg=[], beta_deg=[]),
-                     {"incremental_max": 2, "hierarchy_first": 2, "hierarchy_max_size": 1}, 2,
-                     study_analysis_settings(null_draws=5))
+        study_tables(
+            broken,
+            broken.iloc[:0].assign(pose=[], alpha_deg=[], beta_deg=[]),
+            {"incremental_max": 2, "hierarchy_first": 2, "hierarchy_max_size": 1},
+            2,
+            study_analysis_settings(null_draws=5),
+        )

@@ -90,13 +90,14 @@ def test_mean_posture_is_reachable_and_clipped_where_needed():
 
 
 def test_mapping_weights_and_offsets_by_hand():
-    human = Synergies(HUMAN_JOINT_NAMES, np.linspace(0.2, 0.4, 20), np.arange(40.0).reshape(20, 2) / 100,
-                      ("S1", "S2"))
+    human = Synergies(HUMAN_JOINT_NAMES, np.linspace(0.2, 0.4, 20), np.arange(40.0).reshape(20, 2) / 100, ("S1", "S2"))
     mapping = load_synergy_mapping()
     mapping["column_sign"] = {"syn2": -1}
-    mapping["joints"]["thumb_flex1"] = {"terms": [{"human": "thumb_j2", "weight": 0.5},
-                                                  {"human": "thumb_j3", "weight": 0.5}],
-                                        "offset_rad": 0.1, "limits_deg": [0, 90]}
+    mapping["joints"]["thumb_flex1"] = {
+        "terms": [{"human": "thumb_j2", "weight": 0.5}, {"human": "thumb_j3", "weight": 0.5}],
+        "offset_rad": 0.1,
+        "limits_deg": [0, 90],
+    }
     out = map_human_synergies(human, mapping)
     j = JOINT_NAMES.index("thumb_flex1")
     assert out.mean[j] == pytest.approx(0.1 + 0.5 * (human.mean[1] + human.mean[2]))
@@ -156,18 +157,21 @@ def _good_lines(k: int = 2) -> list[str]:
     return [head] + [f"{n},0.1," + ",".join(["0.5"] * k) for n in JOINT_NAMES]
 
 
-@pytest.mark.parametrize("mutate, match", [
-    (lambda L: [L[0].replace("joint,", "name,")] + L[1:], "missing column 'joint'"),
-    (lambda L: [L[0].replace("mean_rad", "mean")] + L[1:], "missing column 'mean_rad'"),
-    (lambda L: L[:-1], r"missing \['little_dip'\]"),
-    (lambda L: L + [L[1]], r"duplicated \['thumb_abd'\]"),
-    (lambda L: L[:1] + [L[1].replace("thumb_abd", "thumb_rot")] + L[2:], r"unknown \['thumb_rot'\]"),
-    (lambda L: L[:1] + [L[1].replace("0.5", "abc", 1)] + L[2:], "field 'syn1' of joint 'thumb_abd'"),
-    (lambda L: L[:1] + [L[1].replace("0.1", "nan", 1)] + L[2:], "field 'mean_rad'"),
-    (lambda L: L[:1] + [L[1].replace("0.5", "", 1)] + L[2:], "field 'syn1'"),
-    (lambda L: [L[0].replace("syn1,syn2", "syn2,syn1")] + L[1:], "syn1..syn2 in this order"),
-    (lambda L: [L[0].replace("syn2", "extra")] + L[1:], "syn1..syn2"),
-])
+@pytest.mark.parametrize(
+    "mutate, match",
+    [
+        (lambda L: [L[0].replace("joint,", "name,")] + L[1:], "missing column 'joint'"),
+        (lambda L: [L[0].replace("mean_rad", "mean")] + L[1:], "missing column 'mean_rad'"),
+        (lambda L: L[:-1], r"missing \['little_dip'\]"),
+        (lambda L: L + [L[1]], r"duplicated \['thumb_abd'\]"),
+        (lambda L: L[:1] + [L[1].replace("thumb_abd", "thumb_rot")] + L[2:], r"unknown \['thumb_rot'\]"),
+        (lambda L: L[:1] + [L[1].replace("0.5", "abc", 1)] + L[2:], "field 'syn1' of joint 'thumb_abd'"),
+        (lambda L: L[:1] + [L[1].replace("0.1", "nan", 1)] + L[2:], "field 'mean_rad'"),
+        (lambda L: L[:1] + [L[1].replace("0.5", "", 1)] + L[2:], "field 'syn1'"),
+        (lambda L: [L[0].replace("syn1,syn2", "syn2,syn1")] + L[1:], "syn1..syn2 in this order"),
+        (lambda L: [L[0].replace("syn2", "extra")] + L[1:], "syn1..syn2"),
+    ],
+)
 def test_bad_files_raise_one_clear_error(tmp_path, mutate, match):
     path = _write(tmp_path, "\n".join(mutate(_good_lines())) + "\n")
     with pytest.raises(SynergyFileError, match=match) as info:
@@ -184,8 +188,9 @@ def test_no_synergy_columns_and_too_many(tmp_path):
         load_synergies(path)
 
 
-@pytest.mark.parametrize("name, content", [("nope.csv", None), ("folder", "dir"), ("empty.csv", b""),
-                                           ("binary.csv", bytes(range(256)))])
+@pytest.mark.parametrize(
+    "name, content", [("nope.csv", None), ("folder", "dir"), ("empty.csv", b""), ("binary.csv", bytes(range(256)))]
+)
 def test_unreadable_file_gives_one_message_naming_it(tmp_path, name, content):
     path = tmp_path / name
     if content == "dir":
@@ -227,16 +232,14 @@ def test_softhand_human_higher_couples_s1_and_follows_the_human_thumb_above():
 
 
 def test_column_terms_replace_the_terms_in_their_columns_only():
-    human = Synergies(HUMAN_JOINT_NAMES, np.linspace(0.2, 0.4, 20), np.arange(60.0).reshape(20, 3) / 100,
-                      ("S1", "S2", "S3"))
+    human = Synergies(HUMAN_JOINT_NAMES, np.linspace(0.2, 0.4, 20), np.arange(60.0).reshape(20, 3) / 100, ("S1", "S2", "S3"))
     mapping = load_synergy_mapping("legacy_thumb")
     mapping["column_sign"] = {"syn3": -1}
-    mapping["joints"]["thumb_flex2"]["column_terms"] = [{"columns": [2, 3],
-                                                         "terms": [{"human": "thumb_j4", "weight": 2.0}]}]
+    mapping["joints"]["thumb_flex2"]["column_terms"] = [{"columns": [2, 3], "terms": [{"human": "thumb_j4", "weight": 2.0}]}]
     out = map_human_synergies(human, mapping)
     j = JOINT_NAMES.index("thumb_flex2")
     assert out.mean[j] == pytest.approx(-human.mean[2] if -human.mean[2] > 0 else 0.0)  # mean from `terms`
-    assert out.matrix[j, 0] == pytest.approx(-0.06)   # S1 from `terms`: -thumb_j3
+    assert out.matrix[j, 0] == pytest.approx(-0.06)  # S1 from `terms`: -thumb_j3
     assert out.matrix[j, 1] == pytest.approx(2 * 0.10)  # S2: 2 * thumb_j4
     assert out.matrix[j, 2] == pytest.approx(-2 * 0.11)  # S3: 2 * thumb_j4, column sign -1
 

@@ -101,19 +101,25 @@ def test_postures_a_fit_should_question_are_one_line_each():
     assert _problems(x) == []
     # identical up to rounding noise: the fit would explain "100 %" with an S1 of noise
     same = np.tile(x[0], (20, 1)) + 1e-12 * rng.standard_normal((20, 3))
-    assert _problems(same) == ["the 20 postures do not differ (every joint spreads by at most "
-                               f"{np.ptp(same, axis=0).max():.3g} rad): no variance to fit synergies to"]
+    assert _problems(same) == [
+        "the 20 postures do not differ (every joint spreads by at most "
+        f"{np.ptp(same, axis=0).max():.3g} rad): no variance to fit synergies to"
+    ]
     # a CSV saved with its index: a nameless column, or a column counting the rows
     assert _problems(x, ("", "b", "c"))[0].startswith("column 1 has no joint name")
     counted = np.column_stack([np.arange(20), x[:, 1:]])
     assert _problems(counted)[0].startswith("column 1 ('a') counts the rows 0, 1, …, 19")
     # degrees: most postures beyond a full turn; an outlier: a few, named by row (1-based)
-    assert _problems(np.degrees(x)) == [f"20 of 20 postures have angles beyond 2π (up to {np.degrees(x).max():.4g}); "
-                                        "postures are in rad (is the table in degrees?)"]
+    assert _problems(np.degrees(x)) == [
+        f"20 of 20 postures have angles beyond 2π (up to {np.degrees(x).max():.4g}); "
+        "postures are in rad (is the table in degrees?)"
+    ]
     outlier = x.copy()
     outlier[[3, 7], 2] = [50.0, -7.0]
-    assert _problems(outlier) == ["row(s) 4, 8 beyond a full turn (row 4, joint 'c' is 50 rad, beyond 2π): an outlier "
-                                  "no joint reaches; remove or correct it"]
+    assert _problems(outlier) == [
+        "row(s) 4, 8 beyond a full turn (row 4, joint 'c' is 50 rad, beyond 2π): an outlier "
+        "no joint reaches; remove or correct it"
+    ]
     # 2π itself is a posture a joint may have (inclusive bound)
     edge = x.copy()
     edge[0, 0] = 2 * np.pi

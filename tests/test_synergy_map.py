@@ -55,8 +55,12 @@ def test_residual_jacobian_equals_central_differences(shadow):
     goal, previous = rng.normal(size=27) * 30.0, q + 0.1
     jac = problem.jacobian(q, goal, previous)
     h = 1e-6
-    numeric = np.column_stack([(problem.residual(q + h * e, goal, previous) - problem.residual(q - h * e, goal, previous))
-                               / (2 * h) for e in np.eye(shadow.n_joints)])
+    numeric = np.column_stack(
+        [
+            (problem.residual(q + h * e, goal, previous) - problem.residual(q - h * e, goal, previous)) / (2 * h)
+            for e in np.eye(shadow.n_joints)
+        ]
+    )
     np.testing.assert_allclose(jac, numeric, atol=1e-5)
 
 
@@ -113,17 +117,37 @@ def test_command_checks_its_arguments_before_any_work_and_never_writes_over_its_
     table = tmp_path / "table.csv"
     table.write_bytes(load_synergies.__globals__["shipped_path"]().read_bytes())
     before = table.read_bytes()
-    assert main(["synergies", "map", "shadow_hand", "--table", str(table), "--out", str(table),
-                 "--png", str(tmp_path / "v.txt"), "--synergies", "40"]) == 2
+    assert (
+        main(
+            [
+                "synergies",
+                "map",
+                "shadow_hand",
+                "--table",
+                str(table),
+                "--out",
+                str(table),
+                "--png",
+                str(tmp_path / "v.txt"),
+                "--synergies",
+                "40",
+            ]
+        )
+        == 2
+    )
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == [f"synergrasp synergies map: --out {table}: is the file the command reads (--table {table}); "
-                   "write to another file",
-                   f"synergrasp synergies map: --png {tmp_path / 'v.txt'}: the file name must end in .png"]
+    assert err == [
+        f"synergrasp synergies map: --out {table}: is the file the command reads (--table {table}); write to another file",
+        f"synergrasp synergies map: --png {tmp_path / 'v.txt'}: the file name must end in .png",
+    ]
     # the outputs mended, the count is checked before any mapping
-    assert main(["synergies", "map", "shadow_hand", "--table", str(table), "--out", str(tmp_path / "o.csv"),
-                 "--synergies", "40"]) == 2
+    assert (
+        main(["synergies", "map", "shadow_hand", "--table", str(table), "--out", str(tmp_path / "o.csv"), "--synergies", "40"])
+        == 2
+    )
     assert capsys.readouterr().err.strip().splitlines() == [
-        "synergrasp synergies map: --synergies 40: must be 1 … 15 (the table's columns, at most the target's joints)"]
+        "synergrasp synergies map: --synergies 40: must be 1 … 15 (the table's columns, at most the target's joints)"
+    ]
     assert table.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["table.csv"]
     assert main(["synergies", "map", str(tmp_path / "none.yaml"), "--out", str(tmp_path / "o.csv")]) == 2
     assert "none.yaml" in capsys.readouterr().err and not (tmp_path / "o.csv").exists()
@@ -142,8 +166,23 @@ def test_joint_by_joint_option_writes_the_mapping_files_table_and_warns(tmp_path
     expected = map_human_synergies(load_human_synergies(), load_synergy_mapping(mapping), hand.joint_names)
     table = load_synergies(out, joint_names=hand.joint_names)
     np.testing.assert_array_equal(table.matrix, expected.matrix)
-    assert main(["synergies", "map", "shadow_hand", "--joint-mapping", str(mapping), "--out", str(tmp_path / "o.csv"),
-                 "--synergies", "3"]) == 2
-    assert capsys.readouterr().err.strip() == ("synergrasp synergies map: --synergies: not used with --joint-mapping "
-                                               "(it maps the human table joint by joint)")
+    assert (
+        main(
+            [
+                "synergies",
+                "map",
+                "shadow_hand",
+                "--joint-mapping",
+                str(mapping),
+                "--out",
+                str(tmp_path / "o.csv"),
+                "--synergies",
+                "3",
+            ]
+        )
+        == 2
+    )
+    assert capsys.readouterr().err.strip() == (
+        "synergrasp synergies map: --synergies: not used with --joint-mapping (it maps the human table joint by joint)"
+    )
     assert not (tmp_path / "o.csv").exists()

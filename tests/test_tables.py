@@ -12,11 +12,25 @@ from synergrasp import tables
 
 
 def _gfo() -> pd.DataFrame:
-    return pd.DataFrame({
-        "object": ["box"] * 2, "pose": [0, 0], "alpha_deg": [0.0] * 2, "beta_deg": [0.0] * 2,
-        "set_id": ["1", "1-2"], "n_synergies": [1, 2], "status": ["infeasible", "feasible"],
-        "load_feasible": [False, True], "force_closure_def1": [False, False], "force_norm": [float("nan"), 3.0],
-        "e_s": [1, 2], "rank_G": [6, 6], "n_contacts": [4, 4], "iterations": [7, 9], "solver": ["ipm"] * 2})
+    return pd.DataFrame(
+        {
+            "object": ["box"] * 2,
+            "pose": [0, 0],
+            "alpha_deg": [0.0] * 2,
+            "beta_deg": [0.0] * 2,
+            "set_id": ["1", "1-2"],
+            "n_synergies": [1, 2],
+            "status": ["infeasible", "feasible"],
+            "load_feasible": [False, True],
+            "force_closure_def1": [False, False],
+            "force_norm": [float("nan"), 3.0],
+            "e_s": [1, 2],
+            "rank_G": [6, 6],
+            "n_contacts": [4, 4],
+            "iterations": [7, 9],
+            "solver": ["ipm"] * 2,
+        }
+    )
 
 
 def test_a_current_gfo_table_reads_back_as_written(tmp_path):
@@ -30,9 +44,11 @@ def test_an_older_gfo_table_is_refused_naming_the_file_and_the_old_column(tmp_pa
     weight, not Definition 1): read as it stands it would be taken for the study's verdict."""
     path = tmp_path / "gfo.parquet"
     _gfo().rename(columns={"load_feasible": "force_closure", "force_closure_def1": "strict_internal"}).to_parquet(path)
-    expected = (f"gfo table '{path}': written by an older version of the study (column 'force_closure' (now "
-                "'load_feasible'), 'strict_internal' (now 'force_closure_def1')); delete it (or its results folder) "
-                "and rerun the study")
+    expected = (
+        f"gfo table '{path}': written by an older version of the study (column 'force_closure' (now "
+        "'load_feasible'), 'strict_internal' (now 'force_closure_def1')); delete it (or its results folder) "
+        "and rerun the study"
+    )
     with pytest.raises(ValueError, match=f"^{re.escape(expected)}$"):
         tables.read(tables.GFO, path)
     # one old column alone is refused too (a table whose other column is current)

@@ -1,4 +1,5 @@
 """The claims over the placement search's targets (synergrasp.analysis.target_claims)."""
+
 from pathlib import Path
 
 import numpy as np
@@ -24,19 +25,32 @@ TARGET = (9.5, -20.0, 100.0)
 
 
 def _config(**analyses):
-    config = dict(SMALL, placement={**SMALL["placement"], "mode": "searched"},
-                  objects={"obj1": SMALL["objects"]["obj1"]},
-                  synergy_sets={"incremental_max": 6, "hierarchy_first": 4, "hierarchy_max_size": 2})
+    config = dict(
+        SMALL,
+        placement={**SMALL["placement"], "mode": "searched"},
+        objects={"obj1": SMALL["objects"]["obj1"]},
+        synergy_sets={"incremental_max": 6, "hierarchy_first": 4, "hierarchy_max_size": 2},
+    )
     # fewer resamples and null draws than the study: the same code, a fast test
-    config["analyses"] = {**SMALL["analyses"], "table2_k_max": 6, "min_distinct_poses": 3,
-                          "bootstrap": {"resamples": 100}, "null_model": {"draws": 50, "seed": 2018},
-                          "fig4": {"panel_k": [1, 6]}, "target_claims": {"alpha_every": 1, "beta_every": 1, **analyses}}
+    config["analyses"] = {
+        **SMALL["analyses"],
+        "table2_k_max": 6,
+        "min_distinct_poses": 3,
+        "bootstrap": {"resamples": 100},
+        "null_model": {"draws": 50, "seed": 2018},
+        "fig4": {"panel_k": [1, 6]},
+        "target_claims": {"alpha_every": 1, "beta_every": 1, **analyses},
+    }
     return validate_config(config)
 
 
 def _placement_table(targets):
-    return pd.DataFrame([{"object": "obj1", "rank": k + 1, "x_mm": x, "y_mm": y, "z_mm": z,
-                          "force_closure_percent": 100.0 - k} for k, (x, y, z) in enumerate(targets)])
+    return pd.DataFrame(
+        [
+            {"object": "obj1", "rank": k + 1, "x_mm": x, "y_mm": y, "z_mm": z, "force_closure_percent": 100.0 - k}
+            for k, (x, y, z) in enumerate(targets)
+        ]
+    )
 
 
 @pytest.fixture(scope="module")
@@ -80,8 +94,9 @@ def test_claims_at_a_target_equal_the_studys_claims_there(hand, small_claims):
     assert list(at_target["n_distinct_poses"]) == list(study["n_distinct_poses"])
     # claim 3's null model draws shifts over the grid it is given: its numbers may differ
     same = at_target["claim"] != 3
-    np.testing.assert_allclose(at_target.loc[same, "difference"].astype(float),
-                               study.loc[same, "difference"].astype(float), rtol=1e-9, equal_nan=True)
+    np.testing.assert_allclose(
+        at_target.loc[same, "difference"].astype(float), study.loc[same, "difference"].astype(float), rtol=1e-9, equal_nan=True
+    )
 
 
 def test_claims_at_targets_in_rank_order_and_bounded_by_max_targets(hand, small_claims):
@@ -98,8 +113,9 @@ def test_claims_at_targets_in_rank_order_and_bounded_by_max_targets(hand, small_
 
 def test_summary_shares_by_hand():
     rows = []
-    for rank, verdicts in enumerate([("holds", "undefined"), ("holds", "does not hold"),
-                                     ("does not hold", "does not hold"), ("holds", "undefined")], start=1):
+    for rank, verdicts in enumerate(
+        [("holds", "undefined"), ("holds", "does not hold"), ("does not hold", "does not hold"), ("holds", "undefined")], start=1
+    ):
         for claim, verdict in zip((4, 6), verdicts):
             rows.append({"object": "obj9", "rank": rank, "claim": claim, "verdict": verdict})
     summary = claims_summary(pd.DataFrame(rows)).set_index("claim")
@@ -118,5 +134,6 @@ def test_bad_lattice_is_one_error_naming_the_key():
 def test_step_reads_what_its_params_need():
     """Its parameters built from its own part of the configuration equal those from the whole."""
     config = _config()
-    assert TargetClaimsParams.from_config(step_config(config, "target_claims", "obj1"), "obj1") == \
-        TargetClaimsParams.from_config(config, "obj1")
+    assert TargetClaimsParams.from_config(step_config(config, "target_claims", "obj1"), "obj1") == TargetClaimsParams.from_config(
+        config, "obj1"
+    )

@@ -7,8 +7,14 @@ import numpy as np
 import pytest
 
 from synergrasp.hand.kinematics import fingertip_positions, forward_kinematics, load_hand
-from synergrasp.hand.synergies import (SynergyPath, load_human_synergies, load_synergies, load_synergy_mapping,
-                                       map_human_synergies, shadow_hand_files)
+from synergrasp.hand.synergies import (
+    SynergyPath,
+    load_human_synergies,
+    load_synergies,
+    load_synergy_mapping,
+    map_human_synergies,
+    shadow_hand_files,
+)
 from synergrasp.simulation.thumb_check import MIN_FRONT_MM, closing_sigmas, thumb_opposition
 
 
@@ -117,6 +123,10 @@ def test_a_table_whose_s1_opens_a_joint_cannot_be_checked_and_says_why():
     matrix[hand.joint_names.index("index_pip"), 0] = -0.1
     broken = Synergies(table.joint_names, table.mean, matrix, table.names)
     (warning,) = opposition_warnings(hand, broken)
-    assert warning.startswith("thumb opposition: hand 'softhand_like': cannot be checked: the closing synergy S1 "
-                              "must have flexion entries >= 0") and "\n" not in warning
+    assert (
+        warning.startswith(
+            "thumb opposition: hand 'softhand_like': cannot be checked: the closing synergy S1 must have flexion entries >= 0"
+        )
+        and "\n" not in warning
+    )
     assert opposition_line(hand, broken) == (f"WARNING: {warning}", [-1.0, 0.0, 1.0])

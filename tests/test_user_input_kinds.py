@@ -34,8 +34,7 @@ def _state(run: Path, *files: Path) -> dict[str, str]:
 
 
 def _command(run: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "synergrasp.cli", *args], cwd=run, capture_output=True, text=True,
-                          timeout=600)
+    return subprocess.run([sys.executable, "-m", "synergrasp.cli", *args], cwd=run, capture_output=True, text=True, timeout=600)
 
 
 def _without_thumb_warning(stderr: str) -> list[str]:
@@ -67,7 +66,7 @@ def _refused_run(run: Path, configfile: Path, *expected: str) -> None:
     assert out.returncode != 0, text[-3000:]
     _no_frames(text)
     assert "Select jobs to execute" not in text and "rule simulate" not in text, text[-3000:]
-    lines = text[text.index("Invalid input, nothing was run:"):].strip().splitlines()[1:]
+    lines = text[text.index("Invalid input, nothing was run:") :].strip().splitlines()[1:]
     assert len(lines) == len(expected), text[-3000:]
     for fragment in expected:
         assert sum(fragment in line for line in lines) == 1, text[-3000:]
@@ -76,8 +75,9 @@ def _refused_run(run: Path, configfile: Path, *expected: str) -> None:
 
 def _postures(run: Path, name: str = "postures.csv", m: int = 30, change=None, **to_csv) -> Path:
     rng = np.random.default_rng(4)
-    frame = pd.DataFrame(rng.uniform(0.0, 1.2, (m, 5)), columns=["thumb_abd", "index_mcp", "index_pip", "middle_mcp",
-                                                                 "middle_pip"])
+    frame = pd.DataFrame(
+        rng.uniform(0.0, 1.2, (m, 5)), columns=["thumb_abd", "index_mcp", "index_pip", "middle_mcp", "middle_pip"]
+    )
     frame = change(frame) if change else frame
     path = run / name
     frame.to_csv(path, **({"index": False} | to_csv))
@@ -86,27 +86,43 @@ def _postures(run: Path, name: str = "postures.csv", m: int = 30, change=None, *
 
 # --------------------------------------------------------------------------- kind 1: input never output
 
+
 @pytest.mark.parametrize("link", ["same name", "another spelling", "symbolic link", "hard link"])
 def test_no_command_writes_over_the_file_it_reads(run, link):
     postures = _postures(run)
-    out = {"same name": "postures.csv", "another spelling": "./results/../postures.csv",
-           "symbolic link": "linked.csv", "hard link": "hard.csv"}[link]
+    out = {
+        "same name": "postures.csv",
+        "another spelling": "./results/../postures.csv",
+        "symbolic link": "linked.csv",
+        "hard link": "hard.csv",
+    }[link]
     if link == "symbolic link":
         os.symlink(postures, run / out)
     if link == "hard link":
         os.link(postures, run / out)
-    _refused_command(run, ["synergies", "fit", "postures.csv", "--out", out], "synergrasp synergies fit: ",
-                     f"--out {out}: is the file the command reads (POSTURES postures.csv)", files=(postures,))
+    _refused_command(
+        run,
+        ["synergies", "fit", "postures.csv", "--out", out],
+        "synergrasp synergies fit: ",
+        f"--out {out}: is the file the command reads (POSTURES postures.csv)",
+        files=(postures,),
+    )
 
 
 def test_hand_show_does_not_draw_over_its_hand_file(run):
     hand = run / "hand.png"  # a hand description with a .png name: the one output suffix it could take
     hand.write_text((ROOT / "src" / "synergrasp" / "data" / "hand.yaml").read_text())
-    _refused_command(run, ["hand", "show", "hand.png", "--png", "./hand.png"], "synergrasp hand show: ",
-                     "--png ./hand.png: is the file the command reads (HAND hand.png)", files=(hand,))
+    _refused_command(
+        run,
+        ["hand", "show", "hand.png", "--png", "./hand.png"],
+        "synergrasp hand show: ",
+        "--png ./hand.png: is the file the command reads (HAND hand.png)",
+        files=(hand,),
+    )
 
 
 # --------------------------------------------------------------------------- kind 2: a hand in the wrong units
+
 
 def test_a_urdf_hand_in_mm_is_warned_like_a_yaml_hand(run, tmp_path):
     """The same warning, from the same check, in the workflow and in `hand show`; the hand in
@@ -127,12 +143,18 @@ def test_a_urdf_hand_in_mm_is_warned_like_a_yaml_hand(run, tmp_path):
 
 # --------------------------------------------------------------------------- kind 3: drawn objects
 
+
 def test_an_object_named_like_a_drawn_one_is_refused_naming_both(run, tmp_path):
-    objects = {**yaml.safe_load(SMALL.read_text())["objects"],
-               "rand_305": {"shape": {"sphere": {"radius_mm": 20}}, "mass_kg": 0.5}}
-    _refused_run(run, _config(tmp_path, objects=objects, random_objects=DRAWN),
-                 "config error at 'objects.rand_305': an object of the configuration has the name of an object "
-                 "random_objects draws (rand_305)")
+    objects = {
+        **yaml.safe_load(SMALL.read_text())["objects"],
+        "rand_305": {"shape": {"sphere": {"radius_mm": 20}}, "mass_kg": 0.5},
+    }
+    _refused_run(
+        run,
+        _config(tmp_path, objects=objects, random_objects=DRAWN),
+        "config error at 'objects.rand_305': an object of the configuration has the name of an object "
+        "random_objects draws (rand_305)",
+    )
 
 
 def test_a_random_objects_block_in_a_scenario_is_refused_in_one_line(run, tmp_path):
@@ -141,27 +163,35 @@ def test_a_random_objects_block_in_a_scenario_is_refused_in_one_line(run, tmp_pa
     text = out.stdout + out.stderr
     assert out.returncode != 0 and _state(run) == before, text[-3000:]
     _no_frames(text)
-    assert sum("config error at 'scenarios.s.random_objects': a scenario cannot draw objects" in line
-               for line in text.splitlines()) == 1, text[-3000:]
+    assert (
+        sum("config error at 'scenarios.s.random_objects': a scenario cannot draw objects" in line for line in text.splitlines())
+        == 1
+    ), text[-3000:]
 
 
 def test_grasp_knows_the_drawn_objects(run, tmp_path):
     """`synergrasp grasp rand_305` finds the object the workflow studies: here its pose is off the
     grid, the first check that needs the object (no closure runs)."""
-    _refused_command(run, ["grasp", "rand_305", "--alpha", "7", "--beta", "0", "--configfile",
-                           str(_config(tmp_path, random_objects=DRAWN))], "synergrasp grasp: ", "--alpha/--beta")
+    _refused_command(
+        run,
+        ["grasp", "rand_305", "--alpha", "7", "--beta", "0", "--configfile", str(_config(tmp_path, random_objects=DRAWN))],
+        "synergrasp grasp: ",
+        "--alpha/--beta",
+    )
 
 
 # --------------------------------------------------------------------------- kind 4: postures to question
 
 POSTURE_CASES = {
-    "identical postures": (lambda f: f.iloc[[0] * len(f)].reset_index(drop=True), {},
-                           "the 30 postures do not differ"),
+    "identical postures": (lambda f: f.iloc[[0] * len(f)].reset_index(drop=True), {}, "the 30 postures do not differ"),
     "saved with its index": (None, {"index": True}, "column 1 has no joint name"),
     "index as a column": (lambda f: f.reset_index(), {}, "column 1 ('index') counts the rows"),
     "degrees": (lambda f: f * 180.0 / np.pi, {}, "30 of 30 postures have angles beyond 2π"),
-    "one posture at 50 rad": (lambda f: f.assign(index_pip=[50.0] + list(f.index_pip[1:])), {},
-                              "row(s) 1 beyond a full turn (row 1, joint 'index_pip' is 50 rad"),
+    "one posture at 50 rad": (
+        lambda f: f.assign(index_pip=[50.0] + list(f.index_pip[1:])),
+        {},
+        "row(s) 1 beyond a full turn (row 1, joint 'index_pip' is 50 rad",
+    ),
 }
 
 
@@ -169,8 +199,13 @@ POSTURE_CASES = {
 def test_synergies_fit_questions_its_postures(run, case):
     change, to_csv, expected = POSTURE_CASES[case]
     postures = _postures(run, change=change, **to_csv)
-    _refused_command(run, ["synergies", "fit", "postures.csv", "--out", "fitted.csv"], "synergrasp synergies fit: ",
-                     f"postures file 'postures.csv': {expected}", files=(postures,))
+    _refused_command(
+        run,
+        ["synergies", "fit", "postures.csv", "--out", "fitted.csv"],
+        "synergrasp synergies fit: ",
+        f"postures file 'postures.csv': {expected}",
+        files=(postures,),
+    )
     assert not (run / "fitted.csv").exists()
 
 
@@ -180,8 +215,7 @@ RANDOM_CASES = {
     "n_objects -1": ({"n_objects": -1}, ["'random_objects.n_objects': -1 is less than the minimum of 1"]),
     "n_objects 1e9": ({"n_objects": 1000000000}, ["'random_objects.n_objects': 1000000000 is greater than"]),
     "n_objects three": ({"n_objects": "three"}, ["'random_objects.n_objects': 'three' is not of type 'integer'"]),
-    "seed abc and -1 objects": ({"seed": "abc", "n_objects": -1}, ["'random_objects.n_objects'",
-                                                                   "'random_objects.seed': 'abc'"]),
+    "seed abc and -1 objects": ({"seed": "abc", "n_objects": -1}, ["'random_objects.n_objects'", "'random_objects.seed': 'abc'"]),
     "seed -1": ({"seed": -1}, ["'random_objects.seed': -1 is less than the minimum of 0"]),
     "reversed sides": ({"longest_side_mm": [110, 50]}, ["'random_objects.longest_side_mm': [110, 50] is reversed"]),
     "three sides": ({"longest_side_mm": [50, 80, 110]}, ["'random_objects.longest_side_mm': [50, 80, 110] is too long"]),
@@ -195,21 +229,28 @@ RANDOM_CASES = {
 def test_random_objects_values_are_checked_before_any_is_used(run, tmp_path, case):
     changes, expected = RANDOM_CASES[case]
     block = {k: v for k, v in (DRAWN | changes).items() if v is not None}
-    _refused_run(run, _config(tmp_path, random_objects=block), *(f"config error at {e}" if e.startswith("'") else e
-                                                                  for e in expected))
+    _refused_run(
+        run, _config(tmp_path, random_objects=block), *(f"config error at {e}" if e.startswith("'") else e for e in expected)
+    )
 
 
 # --------------------------------------------------------------------------- kind 6: outputs before the work
 
 OUTPUT_CASES = {
-    "fit into a missing folder": (["synergies", "fit", "postures.csv", "--out", "/nonexistent/x.csv"],
-                                  "--out /nonexistent/x.csv: folder '/nonexistent' is not an existing folder"),
+    "fit into a missing folder": (
+        ["synergies", "fit", "postures.csv", "--out", "/nonexistent/x.csv"],
+        "--out /nonexistent/x.csv: folder '/nonexistent' is not an existing folder",
+    ),
     "fit out not a csv": (["synergies", "fit", "postures.csv", "--out", "x.txt"], "--out x.txt: the file name must end"),
     "fit out a folder": (["synergies", "fit", "postures.csv", "--out", "results"], "--out results: is a folder"),
-    "fit png into a missing folder": (["synergies", "fit", "postures.csv", "--out", "x.csv", "--png", "no/v.png"],
-                                      "--png no/v.png: folder 'no'"),
-    "fit png suffix": (["synergies", "fit", "postures.csv", "--out", "x.csv", "--png", "v.jpg"],
-                       "--png v.jpg: the file name must end in .png"),
+    "fit png into a missing folder": (
+        ["synergies", "fit", "postures.csv", "--out", "x.csv", "--png", "no/v.png"],
+        "--png no/v.png: folder 'no'",
+    ),
+    "fit png suffix": (
+        ["synergies", "fit", "postures.csv", "--out", "x.csv", "--png", "v.jpg"],
+        "--png v.jpg: the file name must end in .png",
+    ),
     "fit 0 synergies": (["synergies", "fit", "postures.csv", "--out", "x.csv", "--synergies", "0"], "--synergies 0"),
     "hand count 0": (["hand", "show", "--count", "0"], "--count 0: must be a whole number of at least 1"),
     "hand png into a missing folder": (["hand", "show", "--png", "no/h.png"], "--png no/h.png: folder 'no'"),
@@ -234,30 +275,49 @@ def test_every_command_checks_its_outputs_before_the_work(run, case):
 
 # --------------------------------------------------------------------------- kind 7: an older results folder
 
+
 def test_an_older_results_folder_is_refused_before_any_job(run):
     """A gfo table with the old column names: one line naming the file, before any job (it
     was refused from inside two jobs, each traceback printed twice)."""
     gfo = run / "results" / "objects" / "obj1" / "gfo.parquet"
-    pd.read_parquet(gfo).rename(columns={"load_feasible": "force_closure", "force_closure_def1": "strict_internal"}) \
-        .to_parquet(gfo)
-    _refused_run(run, SMALL, "gfo table 'results/objects/obj1/gfo.parquet': written by an older version of the study "
-                             "(column 'force_closure' (now 'load_feasible'), 'strict_internal' (now "
-                             "'force_closure_def1')); delete it (or its results folder) and rerun the study")
-    _refused_command(run, ["plan", "obj1", "--configfile", str(SMALL)], "synergrasp plan: ",
-                     "gfo table 'results/objects/obj1/gfo.parquet': written by an older version")
+    pd.read_parquet(gfo).rename(columns={"load_feasible": "force_closure", "force_closure_def1": "strict_internal"}).to_parquet(
+        gfo
+    )
+    _refused_run(
+        run,
+        SMALL,
+        "gfo table 'results/objects/obj1/gfo.parquet': written by an older version of the study "
+        "(column 'force_closure' (now 'load_feasible'), 'strict_internal' (now "
+        "'force_closure_def1')); delete it (or its results folder) and rerun the study",
+    )
+    _refused_command(
+        run,
+        ["plan", "obj1", "--configfile", str(SMALL)],
+        "synergrasp plan: ",
+        "gfo table 'results/objects/obj1/gfo.parquet': written by an older version",
+    )
 
 
 # --------------------------------------------------------------------------- kind 8: messages naming the right thing
 
+
 def test_a_search_region_of_the_wrong_length_names_the_axis(run, tmp_path):
-    placement = {**yaml.safe_load(SMALL.read_text())["placement"],
-                 "search": {"region_mm": {"power": {"x": [0, 10, 20], "y": [0, 10], "z": [0, 10]}}}}
-    _refused_run(run, _config(tmp_path, placement=placement),
-                 "config error at 'placement.search.region_mm.power.x': [0, 10, 20] is too long")
+    placement = {
+        **yaml.safe_load(SMALL.read_text())["placement"],
+        "search": {"region_mm": {"power": {"x": [0, 10, 20], "y": [0, 10], "z": [0, 10]}}},
+    }
+    _refused_run(
+        run,
+        _config(tmp_path, placement=placement),
+        "config error at 'placement.search.region_mm.power.x': [0, 10, 20] is too long",
+    )
 
 
 def test_a_folder_given_for_a_model_file_says_so(run, tmp_path):
     description = run / "folder_hand.yaml"
     description.write_text("mjcf: .\npalm: palm\nfingers: {}\n")
-    _refused_run(run, _config(tmp_path, hand=str(description)),
-                 f"hand file '{description}': mjcf: '{run}' is a folder; give the model's file")
+    _refused_run(
+        run,
+        _config(tmp_path, hand=str(description)),
+        f"hand file '{description}': mjcf: '{run}' is a folder; give the model's file",
+    )

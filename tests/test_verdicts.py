@@ -1,6 +1,7 @@
 """The two success verdicts on grasps whose answer is known by hand, solved by the study's
 optimiser: a box resting on a support holds its weight only with gravity's help
 (load-feasible, not force closure); a symmetric tripod with friction is both."""
+
 import math
 
 import numpy as np
@@ -24,7 +25,7 @@ def pushed_inward(points: np.ndarray, normals: np.ndarray) -> Grasp:
     """Contact i is pushed horizontally toward the axis z (along -OUT_i) by joint 4 + 4 i."""
     J = np.zeros((9, 19))
     for i in range(3):
-        J[3 * i:3 * i + 3, 4 + 4 * i] = -LEVER * OUT[i]
+        J[3 * i : 3 * i + 3, 4 + 4 * i] = -LEVER * OUT[i]
     return Grasp(points, normals, np.array([5, 9, 13]), J, np.zeros(3))
 
 
@@ -45,7 +46,7 @@ def resting() -> Grasp:
 
 def verdicts_of(grasp: Grasp, gravity: tuple[float, float, float]) -> pd.Series:
     synergies = np.zeros((19, 2))
-    synergies[[4, 8, 12], 0] = 1.0           # all three contacts pushed together
+    synergies[[4, 8, 12], 0] = 1.0  # all three contacts pushed together
     synergies[[4, 8, 12], 1] = [1.0, -1.0, 0.0]  # two pushed against each other
     out = optimise_grasps([grasp], SynergySets(synergies, ((1, 2),)), study_gfo_params(gravity_direction=gravity, mu=1.5))
     table = pd.DataFrame(out).assign(object="box")
@@ -72,9 +73,17 @@ def test_symmetric_tripod_with_friction_is_both(gravity):
 
 
 def test_with_verdicts_picks_the_success_column_and_flags_marginal_grasps():
-    gfo = pd.DataFrame({"object": ["a"] * 4, "set_id": ["1"] * 4, "status": ["feasible"] * 3 + ["infeasible"],
-                        "load_feasible": [True, True, True, False], "force_closure_def1": [True, False, False, False],
-                        "rank_G": [6, 6, 5, 6], "force_norm": [50.0, 200.0, 3.0, np.nan]})
+    gfo = pd.DataFrame(
+        {
+            "object": ["a"] * 4,
+            "set_id": ["1"] * 4,
+            "status": ["feasible"] * 3 + ["infeasible"],
+            "load_feasible": [True, True, True, False],
+            "force_closure_def1": [True, False, False, False],
+            "rank_G": [6, 6, 5, 6],
+            "force_norm": [50.0, 200.0, 3.0, np.nan],
+        }
+    )
     fc = with_verdicts(gfo, "force_closure", {"a": 9.81}, 10.0)
     assert fc["success"].tolist() == [True, False, False, False]  # rank 5: never Definition 1 (tests/test_gfo.py)
     lf = with_verdicts(gfo, "load_feasible", {"a": 9.81}, 10.0)
@@ -86,9 +95,17 @@ def test_with_verdicts_picks_the_success_column_and_flags_marginal_grasps():
 
 
 def test_force_closure_bounded_is_force_closure_within_the_bound():
-    gfo = pd.DataFrame({"object": ["a"] * 4, "set_id": ["1"] * 4, "status": ["feasible"] * 4,
-                        "load_feasible": [True] * 4, "force_closure_def1": [True, True, True, False],
-                        "rank_G": [6] * 4, "force_norm": [50.0, 98.1, 98.2, 3.0]})
+    gfo = pd.DataFrame(
+        {
+            "object": ["a"] * 4,
+            "set_id": ["1"] * 4,
+            "status": ["feasible"] * 4,
+            "load_feasible": [True] * 4,
+            "force_closure_def1": [True, True, True, False],
+            "rank_G": [6] * 4,
+            "force_norm": [50.0, 98.1, 98.2, 3.0],
+        }
+    )
     bounded = with_verdicts(gfo, "force_closure_bounded", {"a": 9.81}, 10.0)
     assert bounded["success"].tolist() == [True, True, False, False]  # 98.2 N > 10 x 9.81 N; no strict test
     assert not bounded["marginal"].any()  # a bounded success is never marginal
@@ -102,10 +119,18 @@ def test_force_closure_without_a_force_beyond_the_bound_is_reclassified():
     force (the solver's failure at forces of ~1e5 N); its superset 1-2 needs 500 N there,
     above 10 x 9.81 N, so set 1 is load-feasible in exact arithmetic and never bounded. At
     pose 1 the superset needs only 50 N: left as it is (an unexplained invariant breach)."""
-    gfo = pd.DataFrame({"object": ["a"] * 4, "pose": [0, 0, 1, 1], "set_id": ["1", "1-2", "1", "1-2"],
-                        "status": ["infeasible", "feasible", "infeasible", "feasible"],
-                        "load_feasible": [False, True, False, True], "force_closure_def1": [True] * 4,
-                        "rank_G": [6] * 4, "force_norm": [np.nan, 500.0, np.nan, 50.0]})
+    gfo = pd.DataFrame(
+        {
+            "object": ["a"] * 4,
+            "pose": [0, 0, 1, 1],
+            "set_id": ["1", "1-2", "1", "1-2"],
+            "status": ["infeasible", "feasible", "infeasible", "feasible"],
+            "load_feasible": [False, True, False, True],
+            "force_closure_def1": [True] * 4,
+            "rank_G": [6] * 4,
+            "force_norm": [np.nan, 500.0, np.nan, 50.0],
+        }
+    )
     out = with_verdicts(gfo, "force_closure", {"a": 9.81}, 10.0)
     assert out["force_lower_bound_N"].tolist()[0] == 500.0 and out["force_lower_bound_N"].tolist()[2] == 50.0
     assert out["force_beyond_solver"].tolist() == [True, False, False, False]

@@ -37,8 +37,11 @@ def test_a_rules_paths_follow_its_step_scope_and_wildcards():
     assert shard.outputs() == {"out": "{root}/objects/{object}/gfo_shards/{shard}.parquet"}
     assert shard.log() == "{root}/logs/optimise_shard/{object}_{shard}.log"
     assert tables.log() == "{root}/logs/tables.log" and fig3.benchmark() == "results/benchmarks/fig3.tsv"
-    assert fig4.report("maps_png") == {"caption": "../report/fig4_force_maps.rst", "category": "Fig. 4",
-                                       "subcategory": "{object}"}
+    assert fig4.report("maps_png") == {
+        "caption": "../report/fig4_force_maps.rst",
+        "category": "Fig. 4",
+        "subcategory": "{object}",
+    }
     assert fig4.report("maps_pdf") is None and tables.report("claims_csv")["category"] == "Tables"
 
 
@@ -59,7 +62,8 @@ def test_snakemake_flags_go_where_the_registry_says():
     assert html["png"] == ("report", "{root}/figures/fig2_example_grasps.png", "../report/fig2.rst")
     assert html["pdf"] == "{root}/figures/fig2_example_grasps.pdf"
     assert RuleFiles("optimise_shard").snakemake_outputs(report, directory, temp, False) == {
-        "out": ("temp", "{root}/objects/{object}/gfo_shards/{shard}.parquet")}
+        "out": ("temp", "{root}/objects/{object}/gfo_shards/{shard}.parquet")
+    }
 
 
 def test_job_size_and_requests_by_hand():
@@ -89,16 +93,24 @@ def test_the_import_scanner_follows_lazy_imports_and_packages(tmp_path):
     script = tmp_path / "script.py"
     script.write_text("from synergrasp.sub.a import f\n")
     names = {p.relative_to(tmp_path).as_posix() for p in code_files(script, tmp_path)}
-    assert names == {"synergrasp/__init__.py", "synergrasp/sub/__init__.py", "synergrasp/sub/a.py",
-                     "synergrasp/b.py", "synergrasp/c.py"}
+    assert names == {
+        "synergrasp/__init__.py",
+        "synergrasp/sub/__init__.py",
+        "synergrasp/sub/a.py",
+        "synergrasp/b.py",
+        "synergrasp/c.py",
+    }
 
 
-@pytest.mark.parametrize("argv, archive", [
-    (["snakemake", "--report", "results/report.zip"], True),
-    (["snakemake", "--report=results/report.zip"], True),
-    (["snakemake", "--report", "results/report.html"], False),
-    (["snakemake", "-j2", "figures"], False),
-])
+@pytest.mark.parametrize(
+    "argv, archive",
+    [
+        (["snakemake", "--report", "results/report.zip"], True),
+        (["snakemake", "--report=results/report.zip"], True),
+        (["snakemake", "--report", "results/report.html"], False),
+        (["snakemake", "-j2", "figures"], False),
+    ],
+)
 def test_report_archive_reads_the_command_line(argv, archive):
     assert report_archive(argv) is archive
 
@@ -137,6 +149,7 @@ def test_a_bad_scenario_is_one_error_naming_it():
 
 # --------------------------------------------------------------------------- synergrasp.resolved
 
+
 def test_an_objects_placement_is_the_global_one_with_its_override():
     config = defaults()
     config["objects"]["obj2"]["placement"] = {"search_rank": 2, "search": {"spacing_mm": 4.0}}
@@ -168,11 +181,14 @@ def test_set_ids_are_read_in_one_place():
     assert sorted(["1-2-3", "10", "2", "1-3", "1-10"], key=set_order) == ["2", "10", "1-3", "1-10", "1-2-3"]
 
 
-@pytest.mark.parametrize("model, unloaded, contacts", [
-    ("kinematic", "keep", "contacts.parquet"),
-    ("dynamic", "keep", "contacts.parquet"),
-    ("dynamic", "drop", "load_carrying_contacts.parquet"),
-])
+@pytest.mark.parametrize(
+    "model, unloaded, contacts",
+    [
+        ("kinematic", "keep", "contacts.parquet"),
+        ("dynamic", "keep", "contacts.parquet"),
+        ("dynamic", "drop", "load_carrying_contacts.parquet"),
+    ],
+)
 def test_the_commands_read_the_files_the_workflow_reads(model, unloaded, contacts):
     """``synergrasp plan`` and ``synergrasp grasp`` find an object's tables by
     ``steps.object_file``, the workflow by ``Wiring.step_file``: the same file, whatever
@@ -195,8 +211,10 @@ def test_a_mesh_object_reads_its_parts_from_a_job_named_by_the_files_content(tmp
 
     box = ROOT / "tests" / "data" / "box_30x60x100.obj"
     shutil.copy(box, tmp_path / "copy.obj")
-    objects = {name: {"shape": {"mesh": {"path": str(path), "scale": 1.0}}, "mass_kg": 0.2}
-               for name, path in (("a", box), ("b", tmp_path / "copy.obj"))}
+    objects = {
+        name: {"shape": {"mesh": {"path": str(path), "scale": 1.0}}, "mass_kg": 0.2}
+        for name, path in (("a", box), ("b", tmp_path / "copy.obj"))
+    }
     wiring = _wiring(objects=objects)
     parts = {name: wiring.study["objects"][name]["shape"]["mesh"]["parts"] for name in objects}
     assert parts["a"] == parts["b"] and re.fullmatch(r"results/meshes/[0-9a-f]{24}\.obj", parts["a"])

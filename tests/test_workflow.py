@@ -8,6 +8,7 @@ synergrasp module a job loads is among its rule's code inputs, a changed module 
 exactly the rules that load it, and a run killed mid-way (SIGINT, SIGKILL) reruns only
 what did not finish and ends with the same tables as an uninterrupted run.
 """
+
 import base64
 import hashlib
 import os
@@ -30,14 +31,27 @@ pytestmark = pytest.mark.workflow
 
 
 def command(workdir: Path, *args: str, configfile: Path = SMALL, root: Path = ROOT) -> list[str]:
-    return [sys.executable, "-m", "snakemake", "-s", str(root / "Snakefile"), "--directory",
-            str(workdir), "--configfile", str(configfile), "--replace-workflow-config", *args]
+    return [
+        sys.executable,
+        "-m",
+        "snakemake",
+        "-s",
+        str(root / "Snakefile"),
+        "--directory",
+        str(workdir),
+        "--configfile",
+        str(configfile),
+        "--replace-workflow-config",
+        *args,
+    ]
 
 
-def snakemake(workdir: Path, *args: str, configfile: Path = SMALL, root: Path = ROOT,
-              env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run(command(workdir, *args, configfile=configfile, root=root), capture_output=True,
-                          text=True, timeout=1800, env=env)
+def snakemake(
+    workdir: Path, *args: str, configfile: Path = SMALL, root: Path = ROOT, env: dict[str, str] | None = None
+) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        command(workdir, *args, configfile=configfile, root=root), capture_output=True, text=True, timeout=1800, env=env
+    )
 
 
 def digest(paths: list[Path]) -> dict[str, str]:
@@ -84,8 +98,7 @@ def _recording_env(hook_dir: Path, record_dir: Path) -> dict[str, str]:
     record_dir.mkdir()
     (hook_dir / "sitecustomize.py").write_text(_RECORD_MODULES)
     paths = [str(hook_dir), os.environ.get("PYTHONPATH", "")]
-    return {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in paths if p),
-            "SYNERGRASP_RECORD_MODULES": str(record_dir)}
+    return {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in paths if p), "SYNERGRASP_RECORD_MODULES": str(record_dir)}
 
 
 @pytest.fixture(scope="module")
@@ -106,13 +119,17 @@ def expected_targets() -> list[str]:
 
     config = validate_config(yaml.safe_load(SMALL.read_text()))
     assert config["closure"]["model"] == "kinematic"
-    where = {"object": [f"results/objects/{o}/" for o in config["objects"]], "scenario": ["results/"],
-             "workflow": ["results/"]}
+    where = {"object": [f"results/objects/{o}/" for o in config["objects"]], "scenario": ["results/"], "workflow": ["results/"]}
     # the small study's placement is not searched: its small sweep's placement_searched scenario
     # makes the search's table and the placement maps
     skipped = ("sensitivity", "contacts", "search", "placement_map")
-    return [root + rel for name, step in STEPS.items() if name not in skipped and step.rules and not step.optional
-            for root in where[step.scope] for rel in step.outputs.values()]
+    return [
+        root + rel
+        for name, step in STEPS.items()
+        if name not in skipped and step.rules and not step.optional
+        for root in where[step.scope]
+        for rel in step.outputs.values()
+    ]
 
 
 def made(path: Path) -> bool:
@@ -130,8 +147,18 @@ def test_every_target_exists_and_is_not_empty(run_j2):
 def test_tables_have_documented_columns_and_sane_values(run_j2):
     tables = run_j2 / "results" / "tables"
     rates = pd.read_csv(tables / "success_rates.csv")
-    for column in ("object", "set_id", "n_success", "success_rate", "absolute_share", "success_rate_force_closure",
-                   "success_rate_load_feasible", "force_ratio_median", "plain_mean_force_N", "plain_median_force_N"):
+    for column in (
+        "object",
+        "set_id",
+        "n_success",
+        "success_rate",
+        "absolute_share",
+        "success_rate_force_closure",
+        "success_rate_load_feasible",
+        "force_ratio_median",
+        "plain_mean_force_N",
+        "plain_median_force_N",
+    ):
         assert column in rates.columns, column
     defined = rates["success_rate"].dropna()
     assert ((defined >= 0) & (defined <= 100)).all()
@@ -226,11 +253,24 @@ def test_report_holds_every_figure_and_table(run_j2):
     out = snakemake(run_j2, "--report", "results/report.html")
     assert out.returncode == 0, out.stderr[-3000:]
     html = (run_j2 / "results" / "report.html").read_text(errors="replace")
-    for name in ("fig1_synergy_postures.png", "fig2_example_grasps.png", "fig3_rulegraph.png",
-                 "fig4_force_maps.png", "fig4_exploded.png", "fig5a_hierarchy_success.png",
-                 "fig5b_hierarchy_force.png", "table2_success_rates.csv", "minimum_preservation.csv",
-                 "full_not_first7.csv", "verdict_disagreements.csv", "claims.csv", "preservation_vs_chance.csv",
-                 "invariant_checks.csv", "grasp_realism.png", "grasp_realism.csv"):
+    for name in (
+        "fig1_synergy_postures.png",
+        "fig2_example_grasps.png",
+        "fig3_rulegraph.png",
+        "fig4_force_maps.png",
+        "fig4_exploded.png",
+        "fig5a_hierarchy_success.png",
+        "fig5b_hierarchy_force.png",
+        "table2_success_rates.csv",
+        "minimum_preservation.csv",
+        "full_not_first7.csv",
+        "verdict_disagreements.csv",
+        "claims.csv",
+        "preservation_vs_chance.csv",
+        "invariant_checks.csv",
+        "grasp_realism.png",
+        "grasp_realism.csv",
+    ):
         assert name in html, name
     assert "Pisa/IIT SoftHand" in html  # the workflow's description page (report: in the Snakefile)
     out = snakemake(run_j2, "--report", "results/report.zip")
@@ -258,7 +298,7 @@ def planned_jobs(workdir: Path, root: Path = ROOT, env: dict[str, str] | None = 
     if "Job stats:" not in lines:
         return {}
     jobs = {}
-    for line in lines[lines.index("Job stats:") + 3:]:
+    for line in lines[lines.index("Job stats:") + 3 :]:
         fields = line.split()
         if len(fields) != 2 or fields[0] == "total":
             break
@@ -277,8 +317,8 @@ def declared_code_inputs(workdir: Path) -> dict[str, set[str]]:
         if line.startswith(("rule ", "localrule ")) and line.endswith(":"):
             rule = line.split()[1].rstrip(":")
         elif rule and line.strip().startswith("input:"):
-            files = line.strip()[len("input:"):].split(", ")
-            declared.setdefault(rule, set()).update(f.strip()[len(src):] for f in files if f.strip().startswith(src))
+            files = line.strip()[len("input:") :].split(", ")
+            declared.setdefault(rule, set()).update(f.strip()[len(src) :] for f in files if f.strip().startswith(src))
     return declared
 
 
@@ -290,9 +330,24 @@ def test_code_inputs_hold_every_module_a_job_loads(run_j2):
     for record in (run_j2 / "module_records").glob("*.txt"):
         script, *files = record.read_text().splitlines()
         loaded.setdefault(script, set()).update(files)
-    assert set(loaded) == {"simulate", "optimise_shard", "optimise", "minima", "tables", "fig1", "fig2", "fig3",
-                           "fig4", "fig5", "realism", "quality", "blockers", "blockers_table", "planners",
-                           "hand_reach"}
+    assert set(loaded) == {
+        "simulate",
+        "optimise_shard",
+        "optimise",
+        "minima",
+        "tables",
+        "fig1",
+        "fig2",
+        "fig3",
+        "fig4",
+        "fig5",
+        "realism",
+        "quality",
+        "blockers",
+        "blockers_table",
+        "planners",
+        "hand_reach",
+    }
     for script, files in loaded.items():
         assert files, script
         assert files <= declared[script], (script, sorted(files - declared[script]))
@@ -310,15 +365,15 @@ def test_every_data_file_a_job_opens_is_an_input_of_its_rule(run_j2):
     assert opened["simulate"] and "optimise" in opened  # recorded for every job
     # the schema reaches a job through its params (its defaults), not as a file (wiring.shipped_data)
     schema = {"synergrasp/data/config.schema.yaml"}
-    missing = {script: sorted(files - declared[script] - schema) for script, files in opened.items()
-               if files - declared[script] - schema}
+    missing = {
+        script: sorted(files - declared[script] - schema) for script, files in opened.items() if files - declared[script] - schema
+    }
     assert missing == {}
 
 
 def _log_paths(workdir: Path) -> list[str]:
     out = snakemake(workdir, "-n", "--forceall", "figures")
-    return [line.split(":", 1)[1].strip() for line in (out.stdout + out.stderr).splitlines()
-            if line.strip().startswith("log:")]
+    return [line.split(":", 1)[1].strip() for line in (out.stdout + out.stderr).splitlines() if line.strip().startswith("log:")]
 
 
 def test_every_declared_log_is_written(run_j2):
@@ -345,8 +400,7 @@ def project_copy(tmp_path_factory) -> tuple[Path, Path, dict[str, str]]:
     for name in ("Snakefile", "environment.lock"):
         shutil.copy2(ROOT / name, root / name)
     for name in ("workflow", "src", "config", "profiles"):
-        shutil.copytree(ROOT / name, root / name, copy_function=shutil.copy2,
-                        ignore=shutil.ignore_patterns("*.egg-info"))
+        shutil.copytree(ROOT / name, root / name, copy_function=shutil.copy2, ignore=shutil.ignore_patterns("*.egg-info"))
     env = {**os.environ, "PYTHONPATH": str(root / "src")}
     workdir = root / "run"
     out = snakemake(workdir, "-j2", "figures", root=root, env=env)
@@ -387,10 +441,12 @@ def test_changing_a_figure_module_reruns_only_figures(project_copy, module):
 
 def _outputs(workdir: Path) -> dict[str, tuple[int, str]]:
     """Every result file (logs and benchmarks aside): modification time and content digest."""
-    files = [p for p in (workdir / "results").rglob("*") if p.is_file()
-             and p.relative_to(workdir / "results").parts[0] not in ("logs", "benchmarks")]
-    return {str(p.relative_to(workdir)): (p.stat().st_mtime_ns, hashlib.sha256(p.read_bytes()).hexdigest())
-            for p in files}
+    files = [
+        p
+        for p in (workdir / "results").rglob("*")
+        if p.is_file() and p.relative_to(workdir / "results").parts[0] not in ("logs", "benchmarks")
+    ]
+    return {str(p.relative_to(workdir)): (p.stat().st_mtime_ns, hashlib.sha256(p.read_bytes()).hexdigest()) for p in files}
 
 
 def _incomplete(workdir: Path) -> set[str]:
@@ -409,9 +465,13 @@ def test_a_killed_run_reruns_only_what_did_not_finish(run_j2, tmp_path, kill):
     with open(tmp_path / "killed.log", "w") as log:
         # SIGINT handled as in a terminal even when the suite itself was started in the
         # background (a shell then starts it, and so every child, with SIGINT ignored)
-        run = subprocess.Popen(command(tmp_path, "-j2", "figures"), stdout=log, stderr=subprocess.STDOUT,
-                               start_new_session=True,
-                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+        run = subprocess.Popen(
+            command(tmp_path, "-j2", "figures"),
+            stdout=log,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        )
         deadline = time.monotonic() + 900
         while not list((tmp_path / "results" / "objects").glob("*/gfo_shards/*.parquet")):
             assert run.poll() is None, "the run ended before its first optimisation output"
@@ -434,8 +494,11 @@ def test_a_killed_run_reruns_only_what_did_not_finish(run_j2, tmp_path, kill):
 
     after = _outputs(tmp_path)
     # a file of a folder output (the 3-D pages) is unfinished when its folder is
-    kept = {path for path in finished if path in after
-            and not any(path == u or path.startswith(u.rstrip("/") + "/") for u in unfinished)}
+    kept = {
+        path
+        for path in finished
+        if path in after and not any(path == u or path.startswith(u.rstrip("/") + "/") for u in unfinished)
+    }
     assert kept, "nothing had finished before the kill"
     for path in kept:  # finished work is not recomputed
         assert after[path] == finished[path], path
@@ -487,8 +550,9 @@ def test_small_study_on_a_shipped_hand(tmp_path, example, n_joints):
     meshes, 6 joints, 6 synergies) and grasps the box obj4 with its own links."""
     from synergrasp.config import overlay
 
-    config = overlay(yaml.safe_load(SMALL.read_text()),
-                     yaml.safe_load((ROOT / "config" / "examples" / f"{example}.yaml").read_text()))
+    config = overlay(
+        yaml.safe_load(SMALL.read_text()), yaml.safe_load((ROOT / "config" / "examples" / f"{example}.yaml").read_text())
+    )
     configfile = tmp_path / f"{example}_small.yaml"
     configfile.write_text(yaml.safe_dump(config))
     out = snakemake(tmp_path, "-j2", "figures", configfile=configfile)
@@ -515,14 +579,11 @@ def test_random_objects_example_plans_every_drawn_object(tmp_path):
     from synergrasp.simulation.random_objects import drawn_objects
 
     example = yaml.safe_load((ROOT / "config" / "examples" / "random_objects.yaml").read_text())
-    spec = {**example["random_objects"], "n_objects": 3,
-            "sha256_file": str(ROOT / example["random_objects"]["sha256_file"])}
+    spec = {**example["random_objects"], "n_objects": 3, "sha256_file": str(ROOT / example["random_objects"]["sha256_file"])}
     configfile = tmp_path / "three_random.yaml"
-    configfile.write_text(yaml.safe_dump(overlay(overlay(yaml.safe_load(SMALL.read_text()), example),
-                                                 {"random_objects": spec})))
+    configfile.write_text(yaml.safe_dump(overlay(overlay(yaml.safe_load(SMALL.read_text()), example), {"random_objects": spec})))
     cache = tmp_path / "cache"
-    out = snakemake(tmp_path, "-n", "across_objects", configfile=configfile,
-                    env={**os.environ, "XDG_CACHE_HOME": str(cache)})
+    out = snakemake(tmp_path, "-n", "across_objects", configfile=configfile, env={**os.environ, "XDG_CACHE_HOME": str(cache)})
     assert out.returncode == 0, out.stderr[-5000:]
     studied = [o.name for o in drawn_objects(spec, ROOT) if not o.problem]
     assert studied

@@ -79,12 +79,18 @@ def _hand(tmp_path: Path, mutate) -> Path:
     return path
 
 
-@pytest.mark.parametrize("mutate, field", [
-    (lambda d: d["palm"].update(shapes=[]), "palm.shapes"),
-    (lambda d: d["palm"].update(shapes=[{"capsule": {"from_mm": [0, 0, 20], "to_mm": [0, 0, 80], "radius_mm": 20}}]),
-     "palm.shapes"),
-    (lambda d: d["fingers"]["index"]["joints"][2].pop("shapes"), "fingers.index.joints[2].shapes"),
-], ids=["no palm shape", "capsule palm", "link without shapes"])
+@pytest.mark.parametrize(
+    "mutate, field",
+    [
+        (lambda d: d["palm"].update(shapes=[]), "palm.shapes"),
+        (
+            lambda d: d["palm"].update(shapes=[{"capsule": {"from_mm": [0, 0, 20], "to_mm": [0, 0, 80], "radius_mm": 20}}]),
+            "palm.shapes",
+        ),
+        (lambda d: d["fingers"]["index"]["joints"][2].pop("shapes"), "fingers.index.joints[2].shapes"),
+    ],
+    ids=["no palm shape", "capsule palm", "link without shapes"],
+)
 def test_a_hand_the_closure_cannot_use_starts_no_job(run, tmp_path, mutate, field):
     hand = _hand(tmp_path, mutate)
     text = _refused(run, _overlay(tmp_path, hand=str(hand)))
@@ -96,8 +102,10 @@ def test_a_hand_far_from_a_human_hand_is_warned_naming_the_field(run, tmp_path):
     before = _results(run)
     out = snakemake(run, "-n", "figures", configfile=_overlay(tmp_path, hand=str(hand)))
     assert out.returncode == 0, out.stderr[-3000:]
-    _one_line(out.stdout + out.stderr, f"hand file '{hand}': fingers.index.joints[1] (index_mcp) offset: 9000 mm "
-                                       "is far from a human hand's dimensions")
+    _one_line(
+        out.stdout + out.stderr,
+        f"hand file '{hand}': fingers.index.joints[1] (index_mcp) offset: 9000 mm is far from a human hand's dimensions",
+    )
     assert _results(run) == before
 
 
@@ -136,8 +144,9 @@ def test_a_mesh_file_that_bounds_no_solid_starts_no_job(run, tmp_path):
     corners = [(x, y, z) for x in (-15, 15) for y in (-15, 15) for z in (-15, 15)]
     quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4)]  # no sixth face
     mesh = tmp_path / "open.obj"
-    mesh.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in corners)
-                    + "".join("f " + " ".join(str(k + 1) for k in q) + "\n" for q in quads))
+    mesh.write_text(
+        "".join(f"v {x} {y} {z}\n" for x, y, z in corners) + "".join("f " + " ".join(str(k + 1) for k in q) + "\n" for q in quads)
+    )
     config = yaml.safe_load(SMALL.read_text())
     config["objects"]["obj1"] = {"shape": {"mesh": {"path": str(mesh), "scale": 1.0}}, "mass_kg": 1.0}
     path = tmp_path / "my.yaml"
@@ -241,12 +250,16 @@ def _no_frames(text: str) -> None:
 OVERLAY_FORMS = {
     "a mapping merges": ({"mechanics": {"mu": 1.0}}, "results/scenarios/s/objects/obj1/gfo.parquet"),
     "a list replaces": ({"analyses": {"fig4": {"panel_k": [1, 15]}}}, "results/scenarios/s/objects/obj1/fig4_"),
-    "null: a key takes its default": ({"analyses": {"minima_radius_deg": None}},
-                                      "results/scenarios/s/objects/obj1/minima.parquet"),
+    "null: a key takes its default": (
+        {"analyses": {"minima_radius_deg": None}},
+        "results/scenarios/s/objects/obj1/minima.parquet",
+    ),
     "null: objects take their default": ({"objects": None}, "results/scenarios/s/objects/obj2/gfo.parquet"),
     "null: an object is dropped": ({"objects": {"obj1": None}}, "results/scenarios/s/tables/claims.csv"),
-    "a new object": ({"objects": {"obj5": {"shape": {"sphere": {"radius_mm": 20}}, "mass_kg": 0.5}}},
-                     "results/scenarios/s/objects/obj5/contacts.parquet"),
+    "a new object": (
+        {"objects": {"obj5": {"shape": {"sphere": {"radius_mm": 20}}, "mass_kg": 0.5}}},
+        "results/scenarios/s/objects/obj5/contacts.parquet",
+    ),
 }
 
 
@@ -269,8 +282,7 @@ def test_a_removed_scenario_and_an_overlay_on_the_shipped_study_are_planned(run,
     path = tmp_path / "my.yaml"
     path.write_text("objects: {obj2: null, obj3: null}\nscenarios: {mu_1_0: null}\n")
     before = _results(run)
-    command = [a for a in snakemake_command(run, "-n", "sensitivity", configfile=path)
-               if a != "--replace-workflow-config"]
+    command = [a for a in snakemake_command(run, "-n", "sensitivity", configfile=path) if a != "--replace-workflow-config"]
     out = subprocess.run(command, capture_output=True, text=True, timeout=600)
     text = out.stdout + out.stderr
     assert out.returncode == 0, text[-3000:]
@@ -280,8 +292,9 @@ def test_a_removed_scenario_and_an_overlay_on_the_shipped_study_are_planned(run,
 
 
 def _grasp(run: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "synergrasp.cli", "grasp", *args], cwd=run, capture_output=True,
-                          text=True, timeout=600)
+    return subprocess.run(
+        [sys.executable, "-m", "synergrasp.cli", "grasp", *args], cwd=run, capture_output=True, text=True, timeout=600
+    )
 
 
 def test_the_inspector_refuses_what_the_workflow_refuses_with_the_same_line(run, tmp_path):
@@ -293,8 +306,10 @@ def test_the_inspector_refuses_what_the_workflow_refuses_with_the_same_line(run,
     table.to_csv(degrees, index=False)
     twice = tmp_path / "twice.yaml"
     twice.write_text(SMALL.read_text() + "solver: {pose_shards: 1}\n")
-    for configfile, expected in ((_overlay(tmp_path, synergies=str(degrees)), "exceed 2π"),
-                                 (twice, "key 'solver' appears twice")):
+    for configfile, expected in (
+        (_overlay(tmp_path, synergies=str(degrees)), "exceed 2π"),
+        (twice, "key 'solver' appears twice"),
+    ):
         before = _results(run)
         line = _one_line(_refused(run, configfile), expected)
         out = _grasp(run, "obj1", "--alpha", "-30", "--beta", "0", "--configfile", str(configfile))
@@ -303,12 +318,16 @@ def test_the_inspector_refuses_what_the_workflow_refuses_with_the_same_line(run,
         assert _results(run) == before
 
 
-@pytest.mark.parametrize("args, names", [
-    (["--html", "no/such/folder/g.html"], "--html no/such/folder/g.html: folder 'no/such/folder'"),
-    (["--png", "results/tables/claims.csv/g.png"], "--png results/tables/claims.csv/g.png"),
-    (["--configfile", "results/tables/claims.csv"], "not a readable YAML file"),
-    (["--configfile", "results"], "config file 'results': cannot be read"),
-], ids=["html folder missing", "png folder a file", "overlay not YAML", "overlay a folder"])
+@pytest.mark.parametrize(
+    "args, names",
+    [
+        (["--html", "no/such/folder/g.html"], "--html no/such/folder/g.html: folder 'no/such/folder'"),
+        (["--png", "results/tables/claims.csv/g.png"], "--png results/tables/claims.csv/g.png"),
+        (["--configfile", "results/tables/claims.csv"], "not a readable YAML file"),
+        (["--configfile", "results"], "config file 'results': cannot be read"),
+    ],
+    ids=["html folder missing", "png folder a file", "overlay not YAML", "overlay a folder"],
+)
 def test_the_inspectors_errors_are_one_line_before_any_work(run, args, names):
     """Kind 3: output paths and overlays checked before the grasp, one line, exit 2."""
     before = _results(run)
@@ -324,24 +343,28 @@ def test_a_search_rank_no_search_can_reach_starts_no_job(run, tmp_path):
     of the small study's search region has 765 points, so the rank is refused up front."""
     placement = {**yaml.safe_load(SMALL.read_text())["placement"], "mode": "searched", "search_rank": 999}
     text = _refused(run, _overlay(tmp_path, placement=placement))
-    _one_line(text, "config error at 'placement.search_rank': 999 exceeds the 765 points of the search lattice of "
-                    "obj1, obj4")
+    _one_line(text, "config error at 'placement.search_rank': 999 exceeds the 765 points of the search lattice of obj1, obj4")
 
 
 def test_a_search_rank_beyond_an_existing_search_table_starts_no_job(run, tmp_path):
     """Kind 4: the search's table exists: the rank is judged against it before any job."""
     table = run / "results" / "objects" / "obj1" / "placement.csv"
-    table.write_text("object,rank,chosen,distinct_rank,x_mm,y_mm,z_mm,round,n_poses,force_closure_percent,"
-                     "median_force_per_weight,median_contacts,distance_to_chosen_mm\n"
-                     "obj1,1,True,1,38.0,5.0,112.0,0,10,50.0,3.0,4.0,0.0\n"
-                     "obj1,2,False,0,38.0,5.0,122.0,0,10,49.0,3.0,4.0,10.0\n")
+    table.write_text(
+        "object,rank,chosen,distinct_rank,x_mm,y_mm,z_mm,round,n_poses,force_closure_percent,"
+        "median_force_per_weight,median_contacts,distance_to_chosen_mm\n"
+        "obj1,1,True,1,38.0,5.0,112.0,0,10,50.0,3.0,4.0,0.0\n"
+        "obj1,2,False,0,38.0,5.0,122.0,0,10,49.0,3.0,4.0,10.0\n"
+    )
     config = yaml.safe_load(SMALL.read_text())
     config["objects"]["obj1"]["placement"] = {"mode": "searched", "search_rank": 2}
     path = tmp_path / "my.yaml"
     path.write_text(yaml.safe_dump(config, sort_keys=False))
     text = _refused(run, path)
-    _one_line(text, "config error at 'objects.obj1.placement.search_rank': 2 exceeds the 1 distinct targets of "
-                    "obj1's placement search (results/objects/obj1/placement.csv)")
+    _one_line(
+        text,
+        "config error at 'objects.obj1.placement.search_rank': 2 exceeds the 1 distinct targets of "
+        "obj1's placement search (results/objects/obj1/placement.csv)",
+    )
     _no_frames(text)
 
 
@@ -379,8 +402,11 @@ def test_a_scenario_removing_an_object_the_study_lacks_is_refused(run, tmp_path)
     out = snakemake(run, "-j2", "scenario_s", configfile=_with_scenario(tmp_path, {"objects": {"obj9": None}}))
     text = out.stdout + out.stderr
     assert out.returncode != 0 and "Select jobs to execute" not in text, text[-3000:]
-    _one_line(text, "scenario 's': config error at 'objects.obj9': null removes an object, but the study has no "
-                    "object 'obj9'; objects: ['obj1', 'obj4']")
+    _one_line(
+        text,
+        "scenario 's': config error at 'objects.obj9': null removes an object, but the study has no "
+        "object 'obj9'; objects: ['obj1', 'obj4']",
+    )
     _no_frames(text)
     assert _results(run) == before
 
@@ -389,26 +415,30 @@ def _cube(tmp_path: Path, half: float) -> Path:
     corners = [(x, y, z) for x in (-half, half) for y in (-half, half) for z in (-half, half)]
     quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
     mesh = tmp_path / f"cube_{half:g}.obj"
-    mesh.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in corners)
-                    + "".join("f " + " ".join(str(k + 1) for k in q) + "\n" for q in quads))
+    mesh.write_text(
+        "".join(f"v {x} {y} {z}\n" for x, y, z in corners) + "".join("f " + " ".join(str(k + 1) for k in q) + "\n" for q in quads)
+    )
     return mesh
 
 
-@pytest.mark.parametrize("half, scale, across", [(0.015, 1.0, "0.052 mm"), (15.0, 1e6, "5.2e+07 mm")],
-                         ids=["metres at scale 1", "scale 1e6"])
+@pytest.mark.parametrize(
+    "half, scale, across", [(0.015, 1.0, "0.052 mm"), (15.0, 1e6, "5.2e+07 mm")], ids=["metres at scale 1", "scale 1e6"]
+)
 def test_a_mesh_far_from_a_hands_size_is_warned_naming_the_key(run, tmp_path, half, scale, across):
     """Kind 6: such a mesh was only reported as never graspable, after the jobs."""
     config = yaml.safe_load(SMALL.read_text())
-    config["objects"]["obj1"] = {"shape": {"mesh": {"path": str(_cube(tmp_path, half)), "scale": scale}},
-                                 "mass_kg": 1.0}
+    config["objects"]["obj1"] = {"shape": {"mesh": {"path": str(_cube(tmp_path, half)), "scale": scale}}, "mass_kg": 1.0}
     path = tmp_path / "my.yaml"
     path.write_text(yaml.safe_dump(config))
     before = _results(run)
     out = snakemake(run, "-n", "figures", configfile=path)
     text = out.stdout + out.stderr
     assert out.returncode == 0, text[-3000:]
-    _one_line(text, f"Warning: objects.obj1.shape: {across} across, far from what a hand grasps (1 to 1000 mm)",
-              "objects.obj1.shape.mesh.scale")
+    _one_line(
+        text,
+        f"Warning: objects.obj1.shape: {across} across, far from what a hand grasps (1 to 1000 mm)",
+        "objects.obj1.shape.mesh.scale",
+    )
     assert _results(run) == before
 
 

@@ -17,12 +17,22 @@ from typing import Any
 #: The browser: Debian's package, never a download of Playwright's own.
 CHROMIUM = Path(os.environ.get("SYNERGRASP_CHROMIUM", "/usr/bin/chromium"))
 #: Headless, no sandbox (CI runs as root), no GPU but WebGL in software, nothing in the background.
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run", "--use-angle=swiftshader",
-        "--enable-unsafe-swiftshader"]
+ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
+]
 #: A plotly scene is drawn: its WebGL canvas exists and plotly has laid the figure out.
-SCENE_DRAWN = ("() => { const g = document.getElementById('grasp'); "
-               "return !!(window.Plotly && g && g._fullLayout && g.querySelector('.gl-container canvas')); }")
+SCENE_DRAWN = (
+    "() => { const g = document.getElementById('grasp'); "
+    "return !!(window.Plotly && g && g._fullLayout && g.querySelector('.gl-container canvas')); }"
+)
 
 
 def missing() -> str | None:
@@ -51,8 +61,9 @@ class OpenedPage:
     outside: list[str] = field(default_factory=list)
 
 
-def open_page(browser: Any, path: str | Path, wait_for: str = SCENE_DRAWN, size: tuple[int, int] = (1200, 800),
-              timeout_ms: int = 120_000) -> OpenedPage:
+def open_page(
+    browser: Any, path: str | Path, wait_for: str = SCENE_DRAWN, size: tuple[int, int] = (1200, 800), timeout_ms: int = 120_000
+) -> OpenedPage:
     """Open the file ``path`` and wait until ``wait_for`` (a JavaScript function) is true."""
     page = browser.new_page(viewport={"width": size[0], "height": size[1]})
     opened = OpenedPage(page)

@@ -4,6 +4,7 @@ environment or container: this workflow installs its software from the hashed pi
 
     python tools/check_lint.py      exit 1 (and the lints) when any other lint is found
 """
+
 import re
 import subprocess
 import sys
@@ -15,8 +16,11 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def lints() -> tuple[list[str], str]:
     """Titles of the lints Snakemake reports on this workflow, and its full output."""
-    run = subprocess.run([sys.executable, "-m", "snakemake", "--lint", "-s", str(ROOT / "Snakefile"),
-                          "--directory", str(ROOT)], capture_output=True, text=True)
+    run = subprocess.run(
+        [sys.executable, "-m", "snakemake", "--lint", "-s", str(ROOT / "Snakefile"), "--directory", str(ROOT)],
+        capture_output=True,
+        text=True,
+    )
     text = run.stdout + run.stderr
     if "Traceback" in text or "Error" in text.split("Lints for", 1)[0]:
         sys.exit(f"snakemake --lint did not run:\n{text}")

@@ -97,9 +97,19 @@ def run(out: str, n_poses: int, changes: list[str], shift_um: float, engine: dic
             closer.close()
         contacts = load_carrying_contacts(contacts_table(rows), ContactsParams.from_config(config, name).load_threshold_N)
         verdict = verdict_columns(gfo_table(contacts, full, OptimiseParams.from_config(config, name).gfo))
-        parts.append(pd.DataFrame({"object": name, "pose": contacts["pose"], "status": contacts["status"],
-                                   "n_contacts": contacts["n_contacts"], "force_closure": verdict["force_closure"].values,
-                                   "cpu_ms": cpu, "steps": steps}))
+        parts.append(
+            pd.DataFrame(
+                {
+                    "object": name,
+                    "pose": contacts["pose"],
+                    "status": contacts["status"],
+                    "n_contacts": contacts["n_contacts"],
+                    "force_closure": verdict["force_closure"].values,
+                    "cpu_ms": cpu,
+                    "steps": steps,
+                }
+            )
+        )
     placer.close()
     table = pd.concat(parts, ignore_index=True)
     table.to_csv(out, index=False)
@@ -116,8 +126,10 @@ def compare(reference: str, others: list[str]) -> None:
             raise SystemExit(f"{path}: not the poses of {reference}")
         same = 100 * (other["status"] == ref["status"]).mean()
         verdict = 100 * (other["force_closure"] == ref["force_closure"]).mean()
-        print(f"| {path} | {other['cpu_ms'].median():.1f} | {same:.1f} % | {verdict:.1f} % | "
-              f"{(other['status'] == 'grasp').sum()} of {len(other)} | {other['force_closure'].sum()} |")
+        print(
+            f"| {path} | {other['cpu_ms'].median():.1f} | {same:.1f} % | {verdict:.1f} % | "
+            f"{(other['status'] == 'grasp').sum()} of {len(other)} | {other['force_closure'].sum()} |"
+        )
 
 
 def distribution_agreement(other: pd.DataFrame, copies: list[pd.DataFrame], z: float = 1.0) -> pd.DataFrame:
@@ -130,10 +142,13 @@ def distribution_agreement(other: pd.DataFrame, copies: list[pd.DataFrame], z: f
     """
     if not copies:
         raise ValueError("distribution_agreement needs at least one copy of the reference")
+
     def counts(table: pd.DataFrame) -> pd.DataFrame:
         grouped = table.assign(grasps=table["status"] == "grasp").groupby("object", sort=True)
-        return pd.DataFrame({"n": grouped.size(), "grasps": grouped["grasps"].sum(),
-                             "force_closure": grouped["force_closure"].sum()})
+        return pd.DataFrame(
+            {"n": grouped.size(), "grasps": grouped["grasps"].sum(), "force_closure": grouped["force_closure"].sum()}
+        )
+
     mine, theirs = counts(other), [counts(c) for c in copies]
     rows = []
     for name in mine.index:
@@ -144,8 +159,19 @@ def distribution_agreement(other: pd.DataFrame, copies: list[pd.DataFrame], z: f
             se = [math.sqrt(n * p * (1 - p)) for p in ((lo + 0.5) / (n + 1), (hi + 0.5) / (n + 1))]
             low, high = lo - z * se[0], hi + z * se[1]
             count = int(mine.at[name, column])
-            rows.append({"object": name, "count": column, "n": n, "value": count, "copies_min": lo, "copies_max": hi,
-                         "band_low": low, "band_high": high, "agrees": bool(low <= count <= high)})
+            rows.append(
+                {
+                    "object": name,
+                    "count": column,
+                    "n": n,
+                    "value": count,
+                    "copies_min": lo,
+                    "copies_max": hi,
+                    "band_low": low,
+                    "band_high": high,
+                    "agrees": bool(low <= count <= high),
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -155,8 +181,10 @@ def distribution(other: str, copies: list[str], z: float) -> None:
     print("| object | count | of | value | copies | band | agrees |")
     print("|---|---|---|---|---|---|---|")
     for row in table.itertuples():
-        print(f"| {row.object} | {row.count} | {row.n} | {row.value} | {row.copies_min}–{row.copies_max} | "
-              f"{row.band_low:.1f}–{row.band_high:.1f} | {'yes' if row.agrees else 'no'} |")
+        print(
+            f"| {row.object} | {row.count} | {row.n} | {row.value} | {row.copies_min}–{row.copies_max} | "
+            f"{row.band_low:.1f}–{row.band_high:.1f} | {'yes' if row.agrees else 'no'} |"
+        )
 
 
 if __name__ == "__main__":

@@ -50,7 +50,7 @@ def _all_joints(checks: pd.DataFrame) -> pd.Series:
     """The residual over all 19 joints, the joints moving no box contact counted as unbalanced:
     √(r² ‖τ_B‖² + ‖τ_other‖²) / √(‖τ_B‖² + ‖τ_other‖²) (no second solve: Jᵀ f is 0 off B)."""
     box, other = checks["torque_box_Nmm"], checks["torque_other_Nmm"]
-    return ((checks["torque_residual"] * box) ** 2 + other ** 2) ** 0.5 / (box ** 2 + other ** 2) ** 0.5
+    return ((checks["torque_residual"] * box) ** 2 + other**2) ** 0.5 / (box**2 + other**2) ** 0.5
 
 
 def simulate(out: Path, every: int, models: list[str]) -> None:
@@ -66,8 +66,15 @@ def simulate(out: Path, every: int, models: list[str]) -> None:
             scenario = validate_config({**config, "closure": closure})
             sim = SimulateParams.from_config(scenario, name)
             start = time.process_time()
-            contacts = simulate_object(hand, synergies, sim.object, sim.placement, sim.closure,
-                                       poses=range(0, pose_grid(sim.placement).n_poses, every), mechanics=sim.mechanics)
+            contacts = simulate_object(
+                hand,
+                synergies,
+                sim.object,
+                sim.placement,
+                sim.closure,
+                poses=range(0, pose_grid(sim.placement).n_poses, every),
+                mechanics=sim.mechanics,
+            )
             print(f"{name} {label}: closure {time.process_time() - start:.1f} CPU s", flush=True)
             select = ContactsParams.from_config(scenario, name)
             if select.drop_unloaded:
@@ -87,26 +94,61 @@ def summary(out: Path) -> None:
     full = tuple(range(1, config["synergy_sets"]["incremental_max"] + 1))
     parts, extra = [], []
     for label in (m for m in MODELS if (out / m).is_dir()):
-        contacts = pd.concat([tables.read(tables.CONTACTS, out / label / f"{name}.parquet") for name in config["objects"]],
-                             ignore_index=True)
-        gfo = pd.concat([gfo_table(part, SynergySets(synergies.matrix, (full,)),
-                                   OptimiseParams.from_config(config, name).gfo)
-                         for name, part in contacts.groupby("object", sort=False)], ignore_index=True)
+        contacts = pd.concat(
+            [tables.read(tables.CONTACTS, out / label / f"{name}.parquet") for name in config["objects"]], ignore_index=True
+        )
+        gfo = pd.concat(
+            [
+                gfo_table(part, SynergySets(synergies.matrix, (full,)), OptimiseParams.from_config(config, name).gfo)
+                for name, part in contacts.groupby("object", sort=False)
+            ],
+            ignore_index=True,
+        )
         gfo["closure_model"] = label
         start = time.process_time()
         checks = grasp_equilibrium(contacts, checks_params, synergies.columns([1])[:, 0])
         extra.append(checks.assign(cpu_s=time.process_time() - start, all_joints=_all_joints(checks)))
         labels = grasp_labels(contacts, HandAxes.from_hand(hand), realism.opposition, realism.shapes)
-        parts.append(grasp_realism(contacts, gfo, checks, hand.link_names, hand.link_finger, realism.full_set_id,
-                                   realism.weights_N, realism.load_threshold_N, labels, realism.grasp_types))
+        parts.append(
+            grasp_realism(
+                contacts,
+                gfo,
+                checks,
+                hand.link_names,
+                hand.link_finger,
+                realism.full_set_id,
+                realism.weights_N,
+                realism.load_threshold_N,
+                labels,
+                realism.grasp_types,
+            )
+        )
     table = pd.concat(parts, ignore_index=True)
-    more = pd.concat(extra).groupby(["object", "closure_model"]).agg(
-        median_residual_all_joints=("all_joints", "median"), checks_cpu_s=("cpu_s", "first"))
-    columns = ["object", "closure_model", "simulated", "dropped_by", "contacts_median", "pct_thumb", "pct_palm",
-               "pct_index", "pct_force_closure", "median_force_per_weight", "median_torque_residual",
-               "pct_s1_outside_cone"]
-    print(table[columns].merge(more.reset_index(), on=["object", "closure_model"], how="left")
-          .sort_values(["object", "closure_model"]).to_markdown(index=False, floatfmt=".3g"))
+    more = (
+        pd.concat(extra)
+        .groupby(["object", "closure_model"])
+        .agg(median_residual_all_joints=("all_joints", "median"), checks_cpu_s=("cpu_s", "first"))
+    )
+    columns = [
+        "object",
+        "closure_model",
+        "simulated",
+        "dropped_by",
+        "contacts_median",
+        "pct_thumb",
+        "pct_palm",
+        "pct_index",
+        "pct_force_closure",
+        "median_force_per_weight",
+        "median_torque_residual",
+        "pct_s1_outside_cone",
+    ]
+    print(
+        table[columns]
+        .merge(more.reset_index(), on=["object", "closure_model"], how="left")
+        .sort_values(["object", "closure_model"])
+        .to_markdown(index=False, floatfmt=".3g")
+    )
 
 
 def pictures(out: Path, png: Path, poses: list[int]) -> None:
@@ -129,21 +171,25 @@ def pictures(out: Path, png: Path, poses: list[int]) -> None:
     for r, (name, pose) in enumerate(zip(names, poses)):
         shape = SimulateParams.from_config(config, name).object.shape
         rows = [tables.read(tables.CONTACTS, out / m / f"{name}.parquet").set_index("pose").loc[pose] for m in labels]
-        camera = _fit(PALM_CAMERA, hand, [np.asarray(row["q"], dtype=float) for row in rows],
-                      [_object_of(row, shape) for row in rows])
+        camera = _fit(
+            PALM_CAMERA, hand, [np.asarray(row["q"], dtype=float) for row in rows], [_object_of(row, shape) for row in rows]
+        )
         drawn = []
         for c, (label, row) in enumerate(zip(labels, rows)):
             ax = axes[r, c]
             _bare(ax)
             links = [int(i) for i in row["contact_link"]]
-            picture = render(hand, np.asarray(row["q"], dtype=float), camera, PANEL_PX, shape=_object_of(row, shape),
-                             touching=links)
+            picture = render(
+                hand, np.asarray(row["q"], dtype=float), camera, PANEL_PX, shape=_object_of(row, shape), touching=links
+            )
             ax.imshow(picture.rgb, interpolation="antialiased")
             drawn.append(picture)
-            check = grasp_equilibrium(pd.DataFrame([{**row.to_dict(), "pose": pose}]), params,
-                                      synergies.columns([1])[:, 0])
-            words = (f"r = {100 * check['torque_residual'].iloc[0]:.0f} %, S1 outside: {check['s1_outside_cone'].iloc[0]}"
-                     if len(check) else row["status"])
+            check = grasp_equilibrium(pd.DataFrame([{**row.to_dict(), "pose": pose}]), params, synergies.columns([1])[:, 0])
+            words = (
+                f"r = {100 * check['torque_residual'].iloc[0]:.0f} %, S1 outside: {check['s1_outside_cone'].iloc[0]}"
+                if len(check)
+                else row["status"]
+            )
             ax.set_title(f"{name} {label}, pose {pose}\n{int(row['n_contacts'])} contacts, {words}", fontsize=8)
             ax.set_xlabel(_touching_words(hand, links), fontsize=7)
         _frame(axes[r], drawn)

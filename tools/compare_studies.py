@@ -52,8 +52,11 @@ def frame_differences(ref: pd.DataFrame, other: pd.DataFrame, rtol: float, ignor
         return [f"columns differ: {list(ref.columns)} vs {list(other.columns)}"]
     if len(ref) != len(other):
         return [f"rows differ: {len(ref)} vs {len(other)}"]
-    out = [_column_difference(c, ref[c].reset_index(drop=True), other[c].reset_index(drop=True), rtol)
-           for c in ref.columns if c not in ignore]
+    out = [
+        _column_difference(c, ref[c].reset_index(drop=True), other[c].reset_index(drop=True), rtol)
+        for c in ref.columns
+        if c not in ignore
+    ]
     return [d for d in out if d]
 
 
@@ -63,13 +66,15 @@ def _read(path: Path) -> pd.DataFrame:
 
 def compare(ref_root: Path, other_root: Path, rtol: float) -> dict[str, tuple[int, list[str]]]:
     """Per file of REF (path relative to the roots): its rows and what differs in OTHER."""
-    files = [f for pattern in ("objects/*/*.parquet", "objects/*/*.csv", "tables/*.csv")
-             for f in sorted(ref_root.glob(pattern))]
+    files = [f for pattern in ("objects/*/*.parquet", "objects/*/*.csv", "tables/*.csv") for f in sorted(ref_root.glob(pattern))]
     result = {}
     for path in files:
         rel, ref = path.relative_to(ref_root), _read(path)
-        diffs = (frame_differences(ref, _read(other_root / rel), rtol, HOW_DECIDED.get(path.stem, ()))
-                 if (other_root / rel).exists() else ["missing"])
+        diffs = (
+            frame_differences(ref, _read(other_root / rel), rtol, HOW_DECIDED.get(path.stem, ()))
+            if (other_root / rel).exists()
+            else ["missing"]
+        )
         result[str(rel)] = (len(ref), diffs)
     return result
 

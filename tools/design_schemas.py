@@ -27,10 +27,17 @@ def _object_file(step: str, output: str) -> str:
 #: Each table between steps (Parquet; the placement search's CSV) and the files that hold it,
 #: under a scenario's root: (table, step, output name).
 FILES: tuple[tuple[Table, str], ...] = tuple(
-    (table, _object_file(step, output)) for table, step, output in (
-        (CONTACTS, "simulate", "contacts"), (GFO, "optimise", "gfo"), (MINIMA, "minima", "minima"),
-        (QUALITY, "quality", "table"), (BLOCKERS, "blockers", "blockers"), (PLACEMENT, "search", "placement"),
-        (TARGET_CLAIMS, "target_claims", "claims")))
+    (table, _object_file(step, output))
+    for table, step, output in (
+        (CONTACTS, "simulate", "contacts"),
+        (GFO, "optimise", "gfo"),
+        (MINIMA, "minima", "minima"),
+        (QUALITY, "quality", "table"),
+        (BLOCKERS, "blockers", "blockers"),
+        (PLACEMENT, "search", "placement"),
+        (TARGET_CLAIMS, "target_claims", "claims"),
+    )
+)
 
 
 def schema(table: Table) -> str:

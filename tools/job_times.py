@@ -25,11 +25,18 @@ def job_times(results: Path) -> pd.DataFrame:
         at = parts.index("benchmarks")
         rule = parts[at + 1] if len(parts) > at + 2 else path.stem
         bench = pd.read_csv(path, sep="\t")
-        rows.append({"rule": rule, "wall_s": float(bench["s"].iloc[-1]), "cpu_s": float(bench["cpu_time"].iloc[-1]),
-                     "mb": float(bench["max_rss"].iloc[-1])})
+        rows.append(
+            {
+                "rule": rule,
+                "wall_s": float(bench["s"].iloc[-1]),
+                "cpu_s": float(bench["cpu_time"].iloc[-1]),
+                "mb": float(bench["max_rss"].iloc[-1]),
+            }
+        )
     table = pd.DataFrame(rows, columns=["rule", "wall_s", "cpu_s", "mb"])
-    out = table.groupby("rule").agg(jobs=("wall_s", "size"), wall_s=("wall_s", "sum"), cpu_s=("cpu_s", "sum"),
-                                    peak_mb=("mb", "max"))
+    out = table.groupby("rule").agg(
+        jobs=("wall_s", "size"), wall_s=("wall_s", "sum"), cpu_s=("cpu_s", "sum"), peak_mb=("mb", "max")
+    )
     out["cpu_percent"] = 100.0 * out["cpu_s"] / out["cpu_s"].sum()
     return out.sort_values("cpu_s", ascending=False)
 
@@ -37,5 +44,6 @@ def job_times(results: Path) -> pd.DataFrame:
 if __name__ == "__main__":
     table = job_times(Path(sys.argv[1] if len(sys.argv) > 1 else "results"))
     print(table.round(1).to_string())
-    print(f"total: {int(table['jobs'].sum())} jobs, {table['wall_s'].sum():.0f} job-seconds, "
-          f"{table['cpu_s'].sum():.0f} CPU seconds")
+    print(
+        f"total: {int(table['jobs'].sum())} jobs, {table['wall_s'].sum():.0f} job-seconds, {table['cpu_s'].sum():.0f} CPU seconds"
+    )

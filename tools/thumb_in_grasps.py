@@ -43,8 +43,7 @@ if __name__ == "__main__":
             touches += bool(set(np.asarray(r.contact_link).tolist()) & set(thumb_links))
             if r.finger_state[0] == "self":
                 p0, p1 = caps.segments(np.asarray(r.q, dtype=float))
-                gaps = pair_gaps(p0, p1, caps.radius, first, second, caps.palm_rotation, caps.palm_centre,
-                                 caps.palm_half)
+                gaps = pair_gaps(p0, p1, caps.radius, first, second, caps.palm_rotation, caps.palm_centre, caps.palm_half)
                 blocked += bool(np.any(gaps <= distance))
         n = len(grasps)
         print(f"{obj:<8} {n:>7} {100 * touches / max(n, 1):>16.1f} {100 * blocked / max(n, 1):>28.1f}")

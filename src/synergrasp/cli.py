@@ -39,22 +39,32 @@ def _number(value: float, digits: int = 3) -> str:
 
 
 #: The grasp's opposition (docs/opposition.md), in words.
-_OPPOSITION_WORDS = {"palm": "held against the palm: a power grasp", "pad": "between the thumb's and the fingers' pads: "
-                     "a precision grip", "side": "thumb pad against the side of the index: a lateral pinch",
-                     "none": "no two contact groups push against each other"}
+_OPPOSITION_WORDS = {
+    "palm": "held against the palm: a power grasp",
+    "pad": "between the thumb's and the fingers' pads: a precision grip",
+    "side": "thumb pad against the side of the index: a lateral pinch",
+    "none": "no two contact groups push against each other",
+}
 
 #: The optimisation's status under the object's weight, in words.
-_WEIGHT_WORDS = {"feasible": "feasible", "infeasible": "infeasible", "rank_deficient": "rank(G) < 6",
-                 "no_grasp": "no grasp", "numerical_failure": "solver failed"}
+_WEIGHT_WORDS = {
+    "feasible": "feasible",
+    "infeasible": "infeasible",
+    "rank_deficient": "rank(G) < 6",
+    "no_grasp": "no grasp",
+    "numerical_failure": "solver failed",
+}
 
 
 def format_inspection(result: Any) -> str:
     """The inspection as text: pose, contacts, quality indices, one line per synergy set."""
     from synergrasp.ids import set_name
 
-    lines = [f"{result.object} at alpha = {result.alpha_deg:g} deg, beta = {result.beta_deg:g} deg (pose {result.pose}): "
-             f"{result.closure_status}, {len(result.contacts)} contacts; weight {result.weight_N:.3g} N; "
-             f"opposition: {result.opposition} ({_OPPOSITION_WORDS[result.opposition]})"]
+    lines = [
+        f"{result.object} at alpha = {result.alpha_deg:g} deg, beta = {result.beta_deg:g} deg (pose {result.pose}): "
+        f"{result.closure_status}, {len(result.contacts)} contacts; weight {result.weight_N:.3g} N; "
+        f"opposition: {result.opposition} ({_OPPOSITION_WORDS[result.opposition]})"
+    ]
     if len(result.contacts):
         lines.append(f"  {'link':<14} {'point (mm)':<28} {'inward normal':<23} face        on")
         for row in result.contacts.itertuples():
@@ -64,25 +74,34 @@ def format_inspection(result: Any) -> str:
     q = result.quality
     if q is not None:
         axes = ", ".join(_number(v) for v in q.manipulability if v > 0) or "none"
-        lines.append(f"quality: rank(G) {q.rank_G}, sigma_min {_number(q.sigma_min)}, isotropy {_number(q.isotropy)}, "
-                     f"Ferrari-Canny epsilon {_number(q.epsilon)} (fully actuated; torques / {q.torque_length_mm:.1f} mm); "
-                     f"manipulability axes with all synergies: {axes}")
+        lines.append(
+            f"quality: rank(G) {q.rank_G}, sigma_min {_number(q.sigma_min)}, isotropy {_number(q.isotropy)}, "
+            f"Ferrari-Canny epsilon {_number(q.epsilon)} (fully actuated; torques / {q.torque_length_mm:.1f} mm); "
+            f"manipulability axes with all synergies: {axes}"
+        )
     if result.sets:
-        lines.append(f"  {'set':<22} {'force closure':<14} {'under the weight':<17} {'force N':>9} {'/ weight':>9} "
-                     f"{'e_s':>4} {'cone use':>9}")
+        lines.append(
+            f"  {'set':<22} {'force closure':<14} {'under the weight':<17} {'force N':>9} {'/ weight':>9} "
+            f"{'e_s':>4} {'cone use':>9}"
+        )
         for s in result.sets:
-            lines.append(f"  {set_name(s.synergies):<22} "
-                         f"{'yes' if s.force_closure else 'no':<14} {_WEIGHT_WORDS.get(s.status, s.status):<17} "
-                         f"{_number(s.force_N, 4):>9} {_number(s.force_N / result.weight_N, 3):>9} {s.e_s:>4} "
-                         f"{'—' if math.isnan(s.cone_use) else f'{s.cone_use:.3f}':>9}")
+            lines.append(
+                f"  {set_name(s.synergies):<22} "
+                f"{'yes' if s.force_closure else 'no':<14} {_WEIGHT_WORDS.get(s.status, s.status):<17} "
+                f"{_number(s.force_N, 4):>9} {_number(s.force_N / result.weight_N, 3):>9} {s.e_s:>4} "
+                f"{'—' if math.isnan(s.cone_use) else f'{s.cone_use:.3f}':>9}"
+            )
         lines += _blocker_lines(result.sets)
     return "\n".join(lines)
 
 
 #: Why a set fails when no contact is named (docs/blockers.md).
-_REASON_WORDS = {"no_internal_force": "no internal force (e_s = 0)", "rank_deficient": "rank(G) < 6",
-                 "no_squeeze": "every internal force it reaches has zero total normal force",
-                 "numerical_failure": "the max-margin problem was not solved"}
+_REASON_WORDS = {
+    "no_internal_force": "no internal force (e_s = 0)",
+    "rank_deficient": "rank(G) < 6",
+    "no_squeeze": "every internal force it reaches has zero total normal force",
+    "numerical_failure": "the max-margin problem was not solved",
+}
 
 
 def _blocker_lines(sets: Any) -> list[str]:
@@ -100,8 +119,10 @@ def _blocker_lines(sets: Any) -> list[str]:
         lines.append(f"  {set_name(s.synergies):<22} t* = {s.margin:.3g}")
         for b in s.blockers:
             article = "an" if b.feature == "edge" else "a"
-            lines.append(f"    contact {b.contact}: {b.link_name} ({b.link_kind}), {b.face} on {article} {b.feature}, "
-                         f"normal force {b.normal_force:+.3g}, {_number(b.angle_outside_deg)} deg outside its cone")
+            lines.append(
+                f"    contact {b.contact}: {b.link_name} ({b.link_kind}), {b.face} on {article} {b.feature}, "
+                f"normal force {b.normal_force:+.3g}, {_number(b.angle_outside_deg)} deg outside its cone"
+            )
     return lines
 
 
@@ -115,59 +136,89 @@ def _parser() -> argparse.ArgumentParser:
     grasp.add_argument("--alpha", type=float, required=True, help="alpha, deg (a grid value)")
     grasp.add_argument("--beta", type=float, required=True, help="beta, deg (a grid value)")
     grasp.add_argument("--configfile", nargs="+", default=[], help="overlays on the study's configuration")
-    grasp.add_argument("--sets", nargs="+", help="synergy sets: k, a-b (S_a..S_b) or a,b,c (default: each "
-                                                 "single synergy and {S1..Sk} for every k)")
-    grasp.add_argument("--results", default=RESULTS, help="where the study's outputs are (the searched "
-                                                            "placement's target: <results>/objects/<object>/placement.csv)")
+    grasp.add_argument(
+        "--sets",
+        nargs="+",
+        help="synergy sets: k, a-b (S_a..S_b) or a,b,c (default: each single synergy and {S1..Sk} for every k)",
+    )
+    grasp.add_argument(
+        "--results",
+        default=RESULTS,
+        help="where the study's outputs are (the searched placement's target: <results>/objects/<object>/placement.csv)",
+    )
     grasp.add_argument("--json", action="store_true", help="print the result as JSON")
     grasp.add_argument("--png", metavar="PATH", help="write the grasp drawn as in Fig. 2 from two views (PNG)")
-    grasp.add_argument("--html", metavar="PATH", help="write the grasp in 3-D, with the optimal contact forces of "
-                                                      "one set as arrows, as one self-contained page")
-    grasp.add_argument("--forces", metavar="SET", help="the set whose forces --html draws (default: the last set "
-                                                       "asked, {S1..Sk} of every synergy by default)")
+    grasp.add_argument(
+        "--html",
+        metavar="PATH",
+        help="write the grasp in 3-D, with the optimal contact forces of one set as arrows, as one self-contained page",
+    )
+    grasp.add_argument(
+        "--forces",
+        metavar="SET",
+        help="the set whose forces --html draws (default: the last set asked, {S1..Sk} of every synergy by default)",
+    )
     synergies = sub.add_parser("synergies", help="synergy tables").add_subparsers(dest="action", required=True)
     fit = synergies.add_parser("fit", help="fit a synergy table to postures (principal components, docs/synergies.md)")
     fit.add_argument("postures", help="CSV: one column per joint, one row per posture, rad")
     fit.add_argument("--out", required=True, help="the synergy table to write (joint, mean_rad, syn1..synK)")
     fit.add_argument("--synergies", type=int, help="how many synergies to keep (default: all with variance)")
     fit.add_argument("--png", metavar="PATH", help="write the explained variance per synergy (PNG)")
-    mapping = synergies.add_parser("map", help="carry a synergy table over to another hand in the object's terms: "
-                                               "fingertips and thumb-to-fingertip vectors retargeted, then principal "
-                                               "components (docs/synergies.md)")
+    mapping = synergies.add_parser(
+        "map",
+        help="carry a synergy table over to another hand in the object's terms: "
+        "fingertips and thumb-to-fingertip vectors retargeted, then principal "
+        "components (docs/synergies.md)",
+    )
     mapping.add_argument("hand", help="the target hand: a hand file or description, or a shipped hand (shadow_hand)")
     mapping.add_argument("--out", required=True, help="the target hand's synergy table to write (CSV)")
-    mapping.add_argument("--table", help="the source hand's synergy table (name or CSV; default: the study's, "
-                                         "softhand_opposed)")
+    mapping.add_argument("--table", help="the source hand's synergy table (name or CSV; default: the study's, softhand_opposed)")
     mapping.add_argument("--source", help="the source hand (a hand file or description; default: the study's hand)")
     mapping.add_argument("--synergies", type=int, help="how many synergies to keep (default: as many as the table has)")
-    mapping.add_argument("--postures", metavar="PATH", help="also write the mapped postures (CSV, one column per "
-                                                            "joint: the input of synergies fit)")
+    mapping.add_argument(
+        "--postures",
+        metavar="PATH",
+        help="also write the mapped postures (CSV, one column per joint: the input of synergies fit)",
+    )
     mapping.add_argument("--png", metavar="PATH", help="write the explained variance per synergy (PNG)")
-    mapping.add_argument("--joint-mapping", metavar="YAML", help="map the human synergies joint by joint with this "
-                                                                 "mapping file instead (for hands whose joints "
-                                                                 "correspond; docs/synergies.md)")
+    mapping.add_argument(
+        "--joint-mapping",
+        metavar="YAML",
+        help="map the human synergies joint by joint with this "
+        "mapping file instead (for hands whose joints "
+        "correspond; docs/synergies.md)",
+    )
     hands = sub.add_parser("hand", help="hands").add_subparsers(dest="action", required=True)
     show = hands.add_parser("show", help="print a hand's joints; draw it at its mean posture and along each synergy")
-    show.add_argument("hand", nargs="?", help="a hand file or description, or a shipped hand: shadow_hand, inspire_hand "
-                                               "(default: the study's hand)")
-    show.add_argument("--synergies", help="a synergy table (name or CSV; default: the shipped one, or a shipped "
-                                            "hand's own)")
+    show.add_argument(
+        "hand",
+        nargs="?",
+        help="a hand file or description, or a shipped hand: shadow_hand, inspire_hand (default: the study's hand)",
+    )
+    show.add_argument("--synergies", help="a synergy table (name or CSV; default: the shipped one, or a shipped hand's own)")
     show.add_argument("--png", metavar="PATH", help="write the hand at q_m + sigma S_k, sigma = -1, 0, +1 (PNG)")
     show.add_argument("--count", type=int, default=7, help="synergies drawn (default 7)")
-    show.add_argument("--closing-png", metavar="PATH", help="write the hand closing along S1 from the palm side and "
-                                                            "from the thumb side (PNG)")
-    plan = sub.add_parser("plan", help="the incremental planner on one object, against the study's exhaustive search "
-                                       "(reads <results>/objects/<object>/contacts and gfo tables; docs/planner.md)")
+    show.add_argument(
+        "--closing-png", metavar="PATH", help="write the hand closing along S1 from the palm side and from the thumb side (PNG)"
+    )
+    plan = sub.add_parser(
+        "plan",
+        help="the incremental planner on one object, against the study's exhaustive search "
+        "(reads <results>/objects/<object>/contacts and gfo tables; docs/planner.md)",
+    )
     plan.add_argument("object", help="an object of the configuration")
-    plan.add_argument("--radius", type=float, nargs="+", help="neighbourhood radii, deg (default: "
-                                                              "analyses.planner_radii_deg)")
+    plan.add_argument("--radius", type=float, nargs="+", help="neighbourhood radii, deg (default: analyses.planner_radii_deg)")
     plan.add_argument("--configfile", nargs="+", default=[], help="overlays on the study's configuration")
     plan.add_argument("--results", default=RESULTS, help="where the study's outputs are")
     plan.add_argument("--csv", metavar="PATH", help="write the plan table (one row per radius; on demand: one row) as CSV")
-    plan.add_argument("--on-demand", action="store_true", help="close the hand only where the planner asks (the "
-                                                               "default for an object without the study's tables)")
-    plan.add_argument("--planner", help="on demand: a candidate planner of docs/planner.md (default: the one the "
-                                        "pre-registered rule selects)")
+    plan.add_argument(
+        "--on-demand",
+        action="store_true",
+        help="close the hand only where the planner asks (the default for an object without the study's tables)",
+    )
+    plan.add_argument(
+        "--planner", help="on demand: a candidate planner of docs/planner.md (default: the one the pre-registered rule selects)"
+    )
     plan.add_argument("--seed", type=int, default=0, help="on demand: seed of a randomised planner (default 0)")
     return parser
 
@@ -193,18 +244,29 @@ def _inputs(args: argparse.Namespace) -> list[tuple[str, str]]:
     if _command(args) == "synergies fit":
         named.append(("POSTURES", args.postures))
     if _command(args) == "synergies map":
-        named += [(what, path) for what, path in (("HAND", args.hand), ("--table", args.table), ("--source", args.source),
-                                                  ("--joint-mapping", args.joint_mapping))
-                  if path is not None and Path(path).suffix]
+        named += [
+            (what, path)
+            for what, path in (
+                ("HAND", args.hand),
+                ("--table", args.table),
+                ("--source", args.source),
+                ("--joint-mapping", args.joint_mapping),
+            )
+            if path is not None and Path(path).suffix
+        ]
     if _command(args) == "hand show":
         from synergrasp.hand.description import SHIPPED_HANDS
 
-        named += [(what, path) for what, path in (("HAND", args.hand), ("--synergies", args.synergies))
-                  if path is not None and path not in SHIPPED_HANDS and Path(path).suffix]
+        named += [
+            (what, path)
+            for what, path in (("HAND", args.hand), ("--synergies", args.synergies))
+            if path is not None and path not in SHIPPED_HANDS and Path(path).suffix
+        ]
     if args.command == "plan":
         folder = Path(args.results) / "objects" / args.object
-        named += [("--results", str(folder / name)) for name in
-                  ("contacts.parquet", "load_carrying_contacts.parquet", "gfo.parquet")]
+        named += [
+            ("--results", str(folder / name)) for name in ("contacts.parquet", "load_carrying_contacts.parquet", "gfo.parquet")
+        ]
     return named
 
 
@@ -256,8 +318,7 @@ def _count_problems(args: argparse.Namespace) -> list[str]:
             problems.append(f"{option} {value}: must be a whole number of at least 1")
     bad = [r for r in getattr(args, "radius", None) or () if not (math.isfinite(r) and r > 0)]
     if bad:
-        problems.append(f"--radius {' '.join(f'{r:g}' for r in bad)}: each radius must be a positive finite "
-                        "number of degrees")
+        problems.append(f"--radius {' '.join(f'{r:g}' for r in bad)}: each radius must be a positive finite number of degrees")
     results = getattr(args, "results", None)
     if results is not None and Path(results).exists() and not Path(results).is_dir():
         problems.append(f"--results {results}: is a file; give the folder of the study's outputs")
@@ -297,8 +358,10 @@ def _plan(args: argparse.Namespace) -> int:
         if on_demand:
             demand = _on_demand_inputs(args, cfg)
         elif args.planner is not None or args.seed != 0:
-            raise ValueError("--planner and --seed: only with --on-demand (the study's tables are there: the "
-                             "incremental planner runs on them at each --radius)")
+            raise ValueError(
+                "--planner and --seed: only with --on-demand (the study's tables are there: the "
+                "incremental planner runs on them at each --radius)"
+            )
         else:
             params = replace(params, radii_deg=tuple(args.radius)) if args.radius else params
             contacts = tables.read(tables.CONTACTS, contacts_path)
@@ -310,11 +373,13 @@ def _plan(args: argparse.Namespace) -> int:
         return _plan_on_demand(args, params, *demand, contacts_path, gfo_path)
     result = plan_object(contacts, gfo, load_synergies(params.synergies).matrix, params)
     for row in result.table.itertuples():
-        print(f"{row.object} radius {row.radius_deg:g} deg: {row.n_solves} of {row.n_exhaustive_solves} solves "
-              f"({row.solve_share_percent:.1f} %), pose {row.best_pose} (alpha {row.best_alpha_deg:g}, beta "
-              f"{row.best_beta_deg:g}) force {_number(row.best_force_N, 4)} N, exhaustive minimum "
-              f"{_number(row.exhaustive_min_force_N, 4)} N, rank {row.rank} of {row.n_ranked}, regret "
-              f"{_number(row.regret_percent, 3)} %")
+        print(
+            f"{row.object} radius {row.radius_deg:g} deg: {row.n_solves} of {row.n_exhaustive_solves} solves "
+            f"({row.solve_share_percent:.1f} %), pose {row.best_pose} (alpha {row.best_alpha_deg:g}, beta "
+            f"{row.best_beta_deg:g}) force {_number(row.best_force_N, 4)} N, exhaustive minimum "
+            f"{_number(row.exhaustive_min_force_N, 4)} N, rank {row.rank} of {row.n_ranked}, regret "
+            f"{_number(row.regret_percent, 3)} %"
+        )
     if args.csv:
         with _writing("--csv", args.csv):
             tables.write_csv(tables.PLAN, result.table, args.csv)
@@ -335,8 +400,9 @@ def _on_demand_inputs(args: argparse.Namespace, cfg: dict) -> tuple[Any, Any, An
     return (spec, *object_closure(cfg, args.object, args.results))
 
 
-def _plan_on_demand(args: argparse.Namespace, params: Any, spec: Any, close: Any, grid: Any, contacts_path: Path,
-                    gfo_path: Path) -> int:
+def _plan_on_demand(
+    args: argparse.Namespace, params: Any, spec: Any, close: Any, grid: Any, contacts_path: Path, gfo_path: Path
+) -> int:
     """``synergrasp plan --on-demand``: the chosen planner closing the hand only where it asks;
     against the study's exhaustive minimum where the study's tables are there."""
     import numpy as np
@@ -358,11 +424,14 @@ def _plan_on_demand(args: argparse.Namespace, params: Any, spec: Any, close: Any
         order = np.argsort(contacts["pose"].to_numpy())
         versus = pose_against_exhaustive(plan.pose, plan.force_N, full.success[-1][order], full.force[-1][order])
         least, regret = versus["exhaustive_min_force_N"], 100.0 * (versus["regret"] - 1.0)
-    print(f"{plan.object} on demand, planner {plan.planner}" + (f" (seed {plan.seed})" if spec.randomised else "")
-          + f": pose {plan.pose} (alpha {plan.alpha_deg:g}, beta {plan.beta_deg:g}) force {_number(plan.force_N, 4)} N; "
-          f"{plan.closures} of {plan.n_poses} closures ({100.0 * plan.closures / plan.n_poses:.1f} %), "
-          f"{plan.problems} problems, {plan.wall_s:.1f} s"
-          + (f"; the study's exhaustive minimum {_number(least, 4)} N, regret {_number(regret, 3)} %" if study else ""))
+    print(
+        f"{plan.object} on demand, planner {plan.planner}"
+        + (f" (seed {plan.seed})" if spec.randomised else "")
+        + f": pose {plan.pose} (alpha {plan.alpha_deg:g}, beta {plan.beta_deg:g}) force {_number(plan.force_N, 4)} N; "
+        f"{plan.closures} of {plan.n_poses} closures ({100.0 * plan.closures / plan.n_poses:.1f} %), "
+        f"{plan.problems} problems, {plan.wall_s:.1f} s"
+        + (f"; the study's exhaustive minimum {_number(least, 4)} N, regret {_number(regret, 3)} %" if study else "")
+    )
     if args.csv:
         row = vars(plan) | {"exhaustive_min_force_N": least, "regret_percent": regret}
         tables.write_csv(tables.PLAN_ON_DEMAND, pd.DataFrame([row]), args.csv)
@@ -390,15 +459,23 @@ def _show_hand(args: argparse.Namespace) -> int:
     for warning in warnings:
         print(f"synergrasp hand show: warning: {warning}", file=sys.stderr)
     deg = math.degrees
-    print(f"{hand.name} ({hand.source}): {hand.n_joints} joints, {hand.n_links} links "
-          f"({len(hand.shapeless_links)} without shape), {synergies.n_synergies} synergies")
+    print(
+        f"{hand.name} ({hand.source}): {hand.n_joints} joints, {hand.n_links} links "
+        f"({len(hand.shapeless_links)} without shape), {synergies.n_synergies} synergies"
+    )
     print(f"{'joint':<15} {'lower':>7} {'upper':>7} {'mean':>7} {'S1':>8}   (deg; S1 rad per unit sigma)")
     for j, name in enumerate(hand.joint_names):
-        print(f"{name:<15} {deg(hand.lower[j]):7.1f} {deg(hand.upper[j]):7.1f} {deg(synergies.mean[j]):7.1f} "
-              f"{synergies.matrix[j, 0]:8.3f}")
+        print(
+            f"{name:<15} {deg(hand.lower[j]):7.1f} {deg(hand.upper[j]):7.1f} {deg(synergies.mean[j]):7.1f} "
+            f"{synergies.matrix[j, 0]:8.3f}"
+        )
     tips = fingertip_positions(hand, synergies.mean)
-    print("fingertips at the mean posture (palm frame, mm): " + "; ".join(
-        f"{hand.link_finger[link]} ({', '.join(f'{v:.1f}' for v in tip)})" for link, tip in zip(hand.fingertip_link, tips)))
+    print(
+        "fingertips at the mean posture (palm frame, mm): "
+        + "; ".join(
+            f"{hand.link_finger[link]} ({', '.join(f'{v:.1f}' for v in tip)})" for link, tip in zip(hand.fingertip_link, tips)
+        )
+    )
     if args.png:
         from synergrasp.figures.hand_figures import figure_synergy_postures
 
@@ -436,8 +513,9 @@ def _map_synergies(args: argparse.Namespace) -> int:
     except ValueError as err:
         problems += str(err).splitlines()
         target = table_path = None
-    outputs = {option: Path(path) for option, path in (("--out", args.out), ("--postures", args.postures),
-                                                        ("--png", args.png)) if path}
+    outputs = {
+        option: Path(path) for option, path in (("--out", args.out), ("--postures", args.postures), ("--png", args.png)) if path
+    }
     for option, path in outputs.items():
         if table_path is not None and path.resolve() == Path(table_path).resolve():
             problems.append(f"{option} {path}: is the input table; give another file name")
@@ -445,8 +523,7 @@ def _map_synergies(args: argparse.Namespace) -> int:
         problems.append(f"--postures {args.postures}: is the --out file; give another file name")
     k_max = None if target is None else min(table.n_synergies, target.n_joints)
     if args.synergies is not None and k_max is not None and not 1 <= args.synergies <= k_max:
-        problems.append(f"--synergies {args.synergies}: must be 1 … {k_max} (the table's columns, at most the "
-                        "target's joints)")
+        problems.append(f"--synergies {args.synergies}: must be 1 … {k_max} (the table's columns, at most the target's joints)")
     if problems:
         print("\n".join(f"synergrasp synergies map: {line}" for line in problems), file=sys.stderr)
         return 2
@@ -456,10 +533,13 @@ def _map_synergies(args: argparse.Namespace) -> int:
         import pandas as pd
 
         pd.DataFrame(mapped.target, columns=list(target.joint_names)).to_csv(
-            args.postures, index=False, float_format="%.17g", lineterminator="\n")
-    print(f"{target.name}: {len(mapped.sigma)} postures mapped from {source.name}'s table {table_path} "
-          f"(fingertip and thumb-to-fingertip residual, RMS mm: median {np.median(mapped.residual_mm):.2f}, "
-          f"max {np.max(mapped.residual_mm):.2f})")
+            args.postures, index=False, float_format="%.17g", lineterminator="\n"
+        )
+    print(
+        f"{target.name}: {len(mapped.sigma)} postures mapped from {source.name}'s table {table_path} "
+        f"(fingertip and thumb-to-fingertip residual, RMS mm: median {np.median(mapped.residual_mm):.2f}, "
+        f"max {np.max(mapped.residual_mm):.2f})"
+    )
     _print_variance(fit)
     print(f"synergy table: {args.out}" + (f"; mapped postures: {args.postures}" if args.postures else ""))
     print(opposition_line(target, fit.synergies)[0])
@@ -475,17 +555,23 @@ def _map_joint_by_joint(args: argparse.Namespace) -> int:
     """``synergrasp synergies map --joint-mapping``: the human table mapped joint by joint
     (``map_human_synergies``), written, and the thumb-opposition check printed."""
     from synergrasp.hand.kinematics import load_hand
-    from synergrasp.hand.synergies import (load_human_synergies, load_synergy_mapping, map_human_synergies,
-                                           write_synergies)
+    from synergrasp.hand.synergies import load_human_synergies, load_synergy_mapping, map_human_synergies, write_synergies
     from synergrasp.simulation.thumb_check import opposition_line
 
-    problems = [f"{option}: not used with --joint-mapping (it maps the human table joint by joint)"
-                 for option, value in (("--table", args.table), ("--source", args.source), ("--synergies", args.synergies),
-                                       ("--postures", args.postures), ("--png", args.png)) if value is not None]
+    problems = [
+        f"{option}: not used with --joint-mapping (it maps the human table joint by joint)"
+        for option, value in (
+            ("--table", args.table),
+            ("--source", args.source),
+            ("--synergies", args.synergies),
+            ("--postures", args.postures),
+            ("--png", args.png),
+        )
+        if value is not None
+    ]
     try:
         target = load_hand(args.hand)
-        table = map_human_synergies(load_human_synergies(), load_synergy_mapping(args.joint_mapping),
-                                    target.joint_names)
+        table = map_human_synergies(load_human_synergies(), load_synergy_mapping(args.joint_mapping), target.joint_names)
     except (ValueError, KeyError, TypeError) as err:  # a mapping file's missing or malformed field
         problems.append(f"--joint-mapping {args.joint_mapping}: {err}")
     if problems:
@@ -513,8 +599,7 @@ def _fit_synergies(args: argparse.Namespace) -> int:
         names, postures = read_postures(args.postures)
         k_max = min(len(names), len(postures) - 1)
         if args.synergies is not None and args.synergies > k_max:
-            raise ValueError(f"--synergies {args.synergies}: at most {k_max} for {len(postures)} postures of "
-                             f"{len(names)} joints")
+            raise ValueError(f"--synergies {args.synergies}: at most {k_max} for {len(postures)} postures of {len(names)} joints")
         fit = fit_synergies(names, postures, args.synergies)
     except (SynergyFileError, ValueError) as err:
         print(f"synergrasp synergies fit: {err}", file=sys.stderr)
@@ -531,8 +616,6 @@ def _fit_synergies(args: argparse.Namespace) -> int:
             figure_explained_variance(fit, args.png)
         print(f"explained variance: {args.png}")
     return 0
-
-
 
 
 def _grasp(args: argparse.Namespace) -> int:
@@ -596,8 +679,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     command = _command(args)
     lines = _count_problems(args) + _output_problems(args)
     if not lines:
-        run = {"plan": _plan, "synergies fit": _fit_synergies, "synergies map": _map_synergies, "hand show": _show_hand,
-               "grasp": _grasp}[command]
+        run = {
+            "plan": _plan,
+            "synergies fit": _fit_synergies,
+            "synergies map": _map_synergies,
+            "hand show": _show_hand,
+            "grasp": _grasp,
+        }[command]
         try:
             return run(args)
         except ValueError as err:  # grasp: ConfigError, InspectionError, file errors; every command: a write

@@ -61,6 +61,7 @@ class ConfigError(ValueError):
 
 # --------------------------------------------------------------------------- schema walk
 
+
 @functools.cache
 def load_schema() -> dict[str, Any]:
     return read_yaml(SCHEMA_PATH, "schema")
@@ -95,8 +96,7 @@ def _fill(node: Mapping[str, Any], value: Any) -> Any:
     floats turned into ints where the schema wants an integer."""
     schema = _resolve(node)
     types = schema.get("type")
-    if isinstance(value, float) and value.is_integer() and "integer" in (
-            types if isinstance(types, list) else [types]):
+    if isinstance(value, float) and value.is_integer() and "integer" in (types if isinstance(types, list) else [types]):
         return int(value)
     if isinstance(value, list) and isinstance(schema.get("items"), Mapping):
         return [_fill(schema["items"], v) for v in value]
@@ -138,6 +138,7 @@ def defaults() -> dict[str, Any]:
 
 # --------------------------------------------------------------------------- overlays
 
+
 def overlay(base: Mapping[str, Any], over: Mapping[str, Any] | None) -> dict[str, Any]:
     """``base`` overlaid with ``over``: a mapping merges key by key, any other value (lists
     included) replaces, and ``None`` removes the key. Neither argument is changed."""
@@ -156,8 +157,11 @@ def _drop_nulls(config: Mapping[str, Any], top: bool = True) -> dict[str, Any]:
     """Keys whose value is None removed at every depth (the overlay rule applied to a
     configuration that Snakemake merged from several files); a scenario set to None is
     removed, the others keep their nulls, as they are overlays still to be applied."""
-    return {k: _live_scenarios(v) if top and k == "scenarios" else _drop_nulls(v, False) if isinstance(v, Mapping)
-            else v for k, v in config.items() if v is not None}
+    return {
+        k: _live_scenarios(v) if top and k == "scenarios" else _drop_nulls(v, False) if isinstance(v, Mapping) else v
+        for k, v in config.items()
+        if v is not None
+    }
 
 
 def _live_scenarios(scenarios: Any) -> Any:
@@ -166,6 +170,7 @@ def _live_scenarios(scenarios: Any) -> Any:
 
 
 # --------------------------------------------------------------------------- validation
+
 
 def _key_path(path: Sequence[Any]) -> str:
     out = ""
@@ -180,9 +185,11 @@ def _raw_problems(value: Any, path: tuple = ()) -> list[str]:
     if isinstance(value, Mapping):
         for key, sub in value.items():
             if not isinstance(key, str):
-                problems.append(f"config error at '{_key_path(path)}': name {key!r} "
-                                f"({type(key).__name__}) is not allowed; names are text "
-                                "(letters, digits and '_'; quote a name such as '1')")
+                problems.append(
+                    f"config error at '{_key_path(path)}': name {key!r} "
+                    f"({type(key).__name__}) is not allowed; names are text "
+                    "(letters, digits and '_'; quote a name such as '1')"
+                )
             elif path or key != "scenarios" or not isinstance(sub, Mapping):
                 problems += _raw_problems(sub, (*path, key))
             else:  # scenarios: their names here, their values as configurations of their own
@@ -191,8 +198,7 @@ def _raw_problems(value: Any, path: tuple = ()) -> list[str]:
         for i, sub in enumerate(value):
             problems += _raw_problems(sub, (*path, i))
     elif isinstance(value, float) and not math.isfinite(value):
-        problems.append(f"config error at '{_key_path(path)}': {value} is not allowed; "
-                        "a finite number is required")
+        problems.append(f"config error at '{_key_path(path)}': {value} is not allowed; a finite number is required")
     return problems
 
 
@@ -216,13 +222,14 @@ def _describe(error: Any) -> str:
         extra = sorted(set(error.instance) - set(allowed))
         return f"config error at '{where}': unknown key(s) {extra}; allowed keys: {allowed}"
     if error.validator == "enum":
-        return (f"config error at '{where}': {error.instance!r} is not allowed; "
-                f"allowed values: {schema['enum']}")
+        return f"config error at '{where}': {error.instance!r} is not allowed; allowed values: {schema['enum']}"
     if "propertyNames" in error.schema_path:
         name = error.instance
         shown = repr(name) if len(str(name)) <= 70 else f"'{str(name)[:40]}…' ({len(str(name))} characters)"
-        return (f"config error at '{where}': name {shown} is not allowed; names become file "
-                "names: letters, digits and '_' only, at most 64 characters (and not 'default' for a scenario)")
+        return (
+            f"config error at '{where}': name {shown} is not allowed; names become file "
+            "names: letters, digits and '_' only, at most 64 characters (and not 'default' for a scenario)"
+        )
     return f"config error at '{where}': {error.message}"
 
 
@@ -287,12 +294,12 @@ def _grid_problems(grid: Mapping[str, Any]) -> list[str]:
         if span < 0:
             problems.append(f"config error at 'grid.{name}.stop': {rng['stop']} is below start ({rng['start']})")
         elif abs(span / step - round(span / step)) > 1e-9:
-            problems.append(f"config error at 'grid.{name}.step': {step} does not divide stop - start "
-                            f"({span}); the grid must end on stop")
+            problems.append(
+                f"config error at 'grid.{name}.step': {step} does not divide stop - start ({span}); the grid must end on stop"
+            )
     alpha = grid["alpha_deg"]
     if alpha["stop"] - alpha["start"] >= 360:
-        problems.append("config error at 'grid.alpha_deg': alpha is periodic; stop - start must be "
-                        "below 360 deg")
+        problems.append("config error at 'grid.alpha_deg': alpha is periodic; stop - start must be below 360 deg")
     return problems
 
 
@@ -300,6 +307,7 @@ def _on_grid(value: float, axis: Mapping[str, float], periodic: bool) -> bool:
     def gap(a: float) -> float:
         d = value - a
         return abs((d + 180.0) % 360.0 - 180.0) if periodic else abs(d)
+
     return min(gap(a) for a in grid_axis_deg(axis)) < 1e-6
 
 
@@ -309,15 +317,21 @@ def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -
     problems = _grid_problems(config["grid"])
     closure = config["closure"]
     if closure["contact_distance_mm"] < closure["tolerance_mm"]:
-        problems.append(f"config error at 'closure.contact_distance_mm': {closure['contact_distance_mm']} "
-                        f"must be at least closure.tolerance_mm ({closure['tolerance_mm']})")
+        problems.append(
+            f"config error at 'closure.contact_distance_mm': {closure['contact_distance_mm']} "
+            f"must be at least closure.tolerance_mm ({closure['tolerance_mm']})"
+        )
     if closure["step_mm"] <= closure["tolerance_mm"]:
-        problems.append(f"config error at 'closure.step_mm': {closure['step_mm']} must exceed "
-                        f"closure.tolerance_mm ({closure['tolerance_mm']})")
+        problems.append(
+            f"config error at 'closure.step_mm': {closure['step_mm']} must exceed "
+            f"closure.tolerance_mm ({closure['tolerance_mm']})"
+        )
     dynamic = closure["dynamic"]
     if dynamic["time_limit_s"] < dynamic["ramp_time_s"]:
-        problems.append(f"config error at 'closure.dynamic.time_limit_s': {dynamic['time_limit_s']} must be "
-                        f"at least closure.dynamic.ramp_time_s ({dynamic['ramp_time_s']})")
+        problems.append(
+            f"config error at 'closure.dynamic.time_limit_s': {dynamic['time_limit_s']} must be "
+            f"at least closure.dynamic.ramp_time_s ({dynamic['ramp_time_s']})"
+        )
     else:
         problems += _settle_problems(dynamic)
     if all(abs(v) < 1e-12 for v in config["mechanics"]["gravity_direction"]):
@@ -325,21 +339,24 @@ def check_relations(config: Mapping[str, Any], n_synergies: int | None = None) -
     sets = config["synergy_sets"]
     k_max = sets["incremental_max"]
     if sets["hierarchy_max_size"] > sets["hierarchy_first"]:
-        problems.append(f"config error at 'synergy_sets.hierarchy_max_size': {sets['hierarchy_max_size']} "
-                        f"exceeds synergy_sets.hierarchy_first ({sets['hierarchy_first']})")
+        problems.append(
+            f"config error at 'synergy_sets.hierarchy_max_size': {sets['hierarchy_max_size']} "
+            f"exceeds synergy_sets.hierarchy_first ({sets['hierarchy_first']})"
+        )
     if n_synergies is not None:
         for key in ("incremental_max", "hierarchy_first"):
             if sets[key] > n_synergies:
-                problems.append(f"config error at 'synergy_sets.{key}': {sets[key]} exceeds the "
-                                f"{n_synergies} synergies of the synergy file")
+                problems.append(
+                    f"config error at 'synergy_sets.{key}': {sets[key]} exceeds the {n_synergies} synergies of the synergy file"
+                )
     analyses = config["analyses"]
     if analyses["table2_k_max"] > k_max:
-        problems.append(f"config error at 'analyses.table2_k_max': {analyses['table2_k_max']} exceeds "
-                        f"synergy_sets.incremental_max ({k_max})")
+        problems.append(
+            f"config error at 'analyses.table2_k_max': {analyses['table2_k_max']} exceeds synergy_sets.incremental_max ({k_max})"
+        )
     bad_k = [k for k in analyses["fig4"]["panel_k"] if k > k_max]
     if bad_k:
-        problems.append(f"config error at 'analyses.fig4.panel_k': {bad_k} exceed "
-                        f"synergy_sets.incremental_max ({k_max})")
+        problems.append(f"config error at 'analyses.fig4.panel_k': {bad_k} exceed synergy_sets.incremental_max ({k_max})")
     if not _grid_problems(config["grid"]):
         problems += _pose_problems(config)
         problems += _search_problems(config)
@@ -351,19 +368,21 @@ def _search_problems(config: Mapping[str, Any]) -> list[str]:
     the refinement spacing divides the coarse one, every region interval is ordered."""
     problems = []
     for where, block in [("placement", config["placement"])] + [
-            (f"objects.{name}.placement", spec.get("placement") or {}) for name, spec in config["objects"].items()]:
+        (f"objects.{name}.placement", spec.get("placement") or {}) for name, spec in config["objects"].items()
+    ]:
         search = overlay(config["placement"]["search"], block.get("search")) if where != "placement" else block["search"]
         if where != "placement" and "search" not in block:
             continue
         ratio = search["coarse_spacing_mm"] / search["spacing_mm"]
         if abs(ratio - round(ratio)) > 1e-9:
-            problems.append(f"config error at '{where}.search.coarse_spacing_mm': {search['coarse_spacing_mm']} must be "
-                            f"a whole multiple of search.spacing_mm ({search['spacing_mm']})")
+            problems.append(
+                f"config error at '{where}.search.coarse_spacing_mm': {search['coarse_spacing_mm']} must be "
+                f"a whole multiple of search.spacing_mm ({search['spacing_mm']})"
+            )
         for kind, region in search["region_mm"].items():
-            for axis, (lo, hi) in (region.items() if region != "hand" else ()):
+            for axis, (lo, hi) in region.items() if region != "hand" else ():
                 if hi < lo:
-                    problems.append(f"config error at '{where}.search.region_mm.{kind}.{axis}': stop {hi} is below "
-                                    f"start {lo}")
+                    problems.append(f"config error at '{where}.search.region_mm.{kind}.{axis}': stop {hi} is below start {lo}")
     return problems
 
 
@@ -386,9 +405,11 @@ def _settle_problems(dynamic: Mapping[str, Any]) -> list[str]:
     window = max(1, round(dynamic["settle_window_s"] / dt))
     if left >= window + 1:
         return []
-    return [f"config error at 'closure.dynamic.settle_window_s': {dynamic['settle_window_s']} s leaves no pose "
-            f"able to settle: it must be shorter than closure.dynamic.time_limit_s - ramp_time_s "
-            f"({dynamic['time_limit_s']} - {dynamic['ramp_time_s']} s) by at least one time_step_s ({dt:.4g} s)"]
+    return [
+        f"config error at 'closure.dynamic.settle_window_s': {dynamic['settle_window_s']} s leaves no pose "
+        f"able to settle: it must be shorter than closure.dynamic.time_limit_s - ramp_time_s "
+        f"({dynamic['time_limit_s']} - {dynamic['ramp_time_s']} s) by at least one time_step_s ({dt:.4g} s)"
+    ]
 
 
 def synergy_problems(config: Mapping[str, Any], mean_rad: Any, matrix: Any) -> list[str]:
@@ -401,8 +422,10 @@ def synergy_problems(config: Mapping[str, Any], mean_rad: Any, matrix: Any) -> l
     if not np.any(np.abs(syn[:, 0]) > 0):
         problems.append(f"{where}: S1 is zero for every joint; closing along S1 would move no joint")
     if np.abs(mean).max() > 2 * math.pi or np.abs(syn).max() > 2 * math.pi:
-        problems.append(f"{where}: values up to {max(np.abs(mean).max(), np.abs(syn).max()):.4g} exceed "
-                        "2π; postures and synergies are in rad (is the table in degrees?)")
+        problems.append(
+            f"{where}: values up to {max(np.abs(mean).max(), np.abs(syn).max()):.4g} exceed "
+            "2π; postures and synergies are in rad (is the table in degrees?)"
+        )
     return problems
 
 
@@ -412,19 +435,26 @@ def _pose_problems(config: Mapping[str, Any]) -> list[str]:
     alpha, beta = config["grid"]["alpha_deg"], config["grid"]["beta_deg"]
     fig4 = config["analyses"]["fig4"]
     if not _on_grid(fig4["alpha_slice_deg"], alpha, periodic=True):
-        problems.append(f"config error at 'analyses.fig4.alpha_slice_deg': {fig4['alpha_slice_deg']} is "
-                        f"not on grid.alpha_deg {grid_axis_deg(alpha)}")
+        problems.append(
+            f"config error at 'analyses.fig4.alpha_slice_deg': {fig4['alpha_slice_deg']} is "
+            f"not on grid.alpha_deg {grid_axis_deg(alpha)}"
+        )
     if not _on_grid(fig4["beta_slice_deg"], beta, periodic=False):
-        problems.append(f"config error at 'analyses.fig4.beta_slice_deg': {fig4['beta_slice_deg']} is "
-                        f"not on grid.beta_deg {grid_axis_deg(beta)}")
+        problems.append(
+            f"config error at 'analyses.fig4.beta_slice_deg': {fig4['beta_slice_deg']} is "
+            f"not on grid.beta_deg {grid_axis_deg(beta)}"
+        )
     n_poses = len(grid_axis_deg(alpha)) * len(grid_axis_deg(beta))
     if config["solver"]["pose_shards"] > n_poses:
-        problems.append(f"config error at 'solver.pose_shards': {config['solver']['pose_shards']} exceeds "
-                        f"the {n_poses} poses of the grid; allowed values: 1..{n_poses}")
+        problems.append(
+            f"config error at 'solver.pose_shards': {config['solver']['pose_shards']} exceeds "
+            f"the {n_poses} poses of the grid; allowed values: 1..{n_poses}"
+        )
     return problems
 
 
 # --------------------------------------------------------------------------- scenarios
+
 
 def scenario_names(config: Mapping[str, Any]) -> list[str]:
     """The scenarios' names, ``default`` (the configuration itself) first, then the
@@ -452,9 +482,12 @@ def _removed_unknown_objects(base: Mapping[str, Any], changes: Mapping[str, Any]
     if not isinstance(objects, Mapping):
         return []
     known = base.get("objects") if isinstance(base.get("objects"), Mapping) else defaults()["objects"]
-    return [f"config error at 'objects.{key}': null removes an object, but the study has no object {key!r}; "
-            f"objects: {sorted(map(str, known))}"
-            for key, value in objects.items() if value is None and key not in known]
+    return [
+        f"config error at 'objects.{key}': null removes an object, but the study has no object {key!r}; "
+        f"objects: {sorted(map(str, known))}"
+        for key, value in objects.items()
+        if value is None and key not in known
+    ]
 
 
 def scenario_config(config: Mapping[str, Any], name: str) -> dict[str, Any]:
@@ -472,15 +505,16 @@ def scenario_config(config: Mapping[str, Any], name: str) -> dict[str, Any]:
     if name == DEFAULT_SCENARIO:
         return {**main, "scenarios": {}}
     if name not in main["scenarios"]:
-        raise ConfigError(f"config error at 'scenarios': no scenario {name!r}; allowed values: "
-                          f"{scenario_names(main)}")
+        raise ConfigError(f"config error at 'scenarios': no scenario {name!r}; allowed values: {scenario_names(main)}")
     changes = main["scenarios"][name]
     if "scenarios" in changes:
         raise ConfigError(f"scenario '{name}': config error at 'scenarios': a scenario cannot define scenarios")
     if "random_objects" in changes:
-        raise ConfigError(f"scenario '{name}': config error at 'scenarios.{name}.random_objects': a scenario cannot "
-                          "draw objects of its own; the main configuration's random_objects are every scenario's "
-                          "objects (a scenario may drop some with objects: {rand_NNN: null})")
+        raise ConfigError(
+            f"scenario '{name}': config error at 'scenarios.{name}.random_objects': a scenario cannot "
+            "draw objects of its own; the main configuration's random_objects are every scenario's "
+            "objects (a scenario may drop some with objects: {rand_NNN: null})"
+        )
     try:
         base = {k: v for k, v in config.items() if k != "scenarios"}
         problems = _removed_unknown_objects(_drop_nulls(base), changes)

@@ -21,9 +21,19 @@ from synergrasp.ids import set_id, set_name
 from synergrasp.optimisation.quality import GraspQuality, grasp_quality
 from synergrasp.steps import RESULTS
 
-__all__ = ["InspectionError", "searched_target", "object_closure", "BlockingContact",
-           "SetResult", "GraspInspection", "parse_sets", "default_sets", "inspect_grasp",
-           "grasp_picture", "grasp_view"]
+__all__ = [
+    "InspectionError",
+    "searched_target",
+    "object_closure",
+    "BlockingContact",
+    "SetResult",
+    "GraspInspection",
+    "parse_sets",
+    "default_sets",
+    "inspect_grasp",
+    "grasp_picture",
+    "grasp_view",
+]
 
 
 class InspectionError(ValueError):
@@ -108,15 +118,32 @@ class GraspInspection:
 
     def to_dict(self) -> dict[str, Any]:
         """The inspection as plain data (lists and numbers), for ``--json``."""
-        q = None if self.quality is None else {**asdict(self.quality),
-                                                "manipulability": self.quality.manipulability.tolist()}
-        return {"object": self.object, "pose": self.pose, "alpha_deg": self.alpha_deg, "beta_deg": self.beta_deg,
-                "closure_status": self.closure_status, "weight_N": self.weight_N, "opposition": self.opposition,
-                "contacts": [{"link": int(r.link), "link_name": r.link_name, "point_mm": list(r.point_mm),
-                              "normal": list(r.normal), "face": r.face, "feature": r.feature}
-                             for r in self.contacts.itertuples()],
-                "sets": [asdict(s) for s in self.sets], "quality": q, "q_rad": list(self.q_rad),
-                "object_center_mm": list(self.object_center_mm), "object_rotation": list(self.object_rotation)}
+        q = None if self.quality is None else {**asdict(self.quality), "manipulability": self.quality.manipulability.tolist()}
+        return {
+            "object": self.object,
+            "pose": self.pose,
+            "alpha_deg": self.alpha_deg,
+            "beta_deg": self.beta_deg,
+            "closure_status": self.closure_status,
+            "weight_N": self.weight_N,
+            "opposition": self.opposition,
+            "contacts": [
+                {
+                    "link": int(r.link),
+                    "link_name": r.link_name,
+                    "point_mm": list(r.point_mm),
+                    "normal": list(r.normal),
+                    "face": r.face,
+                    "feature": r.feature,
+                }
+                for r in self.contacts.itertuples()
+            ],
+            "sets": [asdict(s) for s in self.sets],
+            "quality": q,
+            "q_rad": list(self.q_rad),
+            "object_center_mm": list(self.object_center_mm),
+            "object_rotation": list(self.object_rotation),
+        }
 
 
 _TOKEN = re.compile(r"^(\d+)(?:-(\d+))?$|^(\d+(?:,\d+)+)$")
@@ -169,7 +196,8 @@ def _pose_index(placement: Any, alpha_deg: float, beta_deg: float) -> tuple[int,
         a, b = placement.alpha_deg, placement.beta_deg
         raise InspectionError(
             f"--alpha/--beta: ({alpha_deg:g}, {beta_deg:g}) deg is not a pose of the grid (alpha {a[0]:g}..{a[1]:g} "
-            f"step {a[2]:g}, beta {b[0]:g}..{b[1]:g} step {b[2]:g})") from None
+            f"step {a[2]:g}, beta {b[0]:g}..{b[1]:g} step {b[2]:g})"
+        ) from None
 
 
 def _contacts_frame(hand: Any, row: pd.Series, shape: Any, rule: Any) -> pd.DataFrame:
@@ -182,10 +210,16 @@ def _contacts_frame(hand: Any, row: pd.Series, shape: Any, rule: Any) -> pd.Data
     points = np.asarray(row["contact_point"], dtype=float).reshape(m, 3)
     normals = np.asarray(row["contact_normal"], dtype=float).reshape(m, 3)
     R, c = np.asarray(row["object_rotation"], dtype=float), np.asarray(row["object_center"], dtype=float)
-    return pd.DataFrame({"link": links, "link_name": [hand.link_names[k] for k in links],
-                         "point_mm": [tuple(p) for p in points], "normal": [tuple(n) for n in normals],
-                         "face": face_classes(normals, HandAxes.from_hand(hand)),
-                         "feature": surface_features(points, shape, R, c, rule)})
+    return pd.DataFrame(
+        {
+            "link": links,
+            "link_name": [hand.link_names[k] for k in links],
+            "point_mm": [tuple(p) for p in points],
+            "normal": [tuple(n) for n in normals],
+            "face": face_classes(normals, HandAxes.from_hand(hand)),
+            "feature": surface_features(points, shape, R, c, rule),
+        }
+    )
 
 
 def searched_target(placement: Any, path: Path) -> Any:
@@ -194,13 +228,21 @@ def searched_target(placement: Any, path: Path) -> Any:
     from synergrasp.simulation.placement import searched_placement
 
     if not path.is_file():
-        raise InspectionError(f"placement: mode 'searched' takes the object's target from {path}, which does not "
-                              f"exist: make it with `snakemake -j2 {path}`, or give placement.mode approach or fixed")
+        raise InspectionError(
+            f"placement: mode 'searched' takes the object's target from {path}, which does not "
+            f"exist: make it with `snakemake -j2 {path}`, or give placement.mode approach or fixed"
+        )
     return searched_placement(placement, tables.read_csv(tables.PLACEMENT, path))
 
 
-def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_deg: float,
-                  sets: Sequence[Sequence[int]] | None = None, results: str | Path = RESULTS) -> GraspInspection:
+def inspect_grasp(
+    config: Mapping[str, Any],
+    obj: str,
+    alpha_deg: float,
+    beta_deg: float,
+    sets: Sequence[Sequence[int]] | None = None,
+    results: str | Path = RESULTS,
+) -> GraspInspection:
     """Close the hand on object ``obj`` at pose (α, β) deg with the configuration's hand,
     synergies, placement and closure, then optimise the grasp for each synergy set in ``sets``
     (1-based synergies; None: :func:`default_sets`), as the study's steps do.
@@ -233,8 +275,16 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     hand = load_hand(sim.hand)
     full = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
     chosen = default_sets(full.matrix.shape[1]) if sets is None else [tuple(sorted(set(s))) for s in sets]
-    table = simulate_object(hand, sim.synergies(hand.joint_names), sim.object, placement, sim.closure,
-                            poses=[pose], mechanics=sim.mechanics, as_in_grid=True)
+    table = simulate_object(
+        hand,
+        sim.synergies(hand.joint_names),
+        sim.object,
+        placement,
+        sim.closure,
+        poses=[pose],
+        mechanics=sim.mechanics,
+        as_in_grid=True,
+    )
     selection = ContactsParams.from_config(cfg, obj)
     if selection.drop_unloaded:
         table = load_carrying_contacts(table, selection.load_threshold_N)
@@ -243,29 +293,68 @@ def inspect_grasp(config: Mapping[str, Any], obj: str, alpha_deg: float, beta_de
     grasp = read_grasps(table)[0]
     weight = opt.gfo.weight_N
     rule = OppositionRule.from_config(cfg)
-    drawing = dict(q_rad=_floats(row["q"]), object_center_mm=_floats(row["object_center"]),
-                   object_rotation=_floats(row["object_rotation"]), hand=hand, shape=sim.object.shape,
-                   opposition=contacts_oppositions(table.iloc[:1], HandAxes.from_hand(hand), rule)[0])
+    drawing = dict(
+        q_rad=_floats(row["q"]),
+        object_center_mm=_floats(row["object_center"]),
+        object_rotation=_floats(row["object_rotation"]),
+        hand=hand,
+        shape=sim.object.shape,
+        opposition=contacts_oppositions(table.iloc[:1], HandAxes.from_hand(hand), rule)[0],
+    )
     contacts = _contacts_frame(hand, row, sim.object.shape, rule)
     if grasp is None:
-        return GraspInspection(obj, pose, float(row["alpha_deg"]), float(row["beta_deg"]), str(row["status"]),
-                               weight, contacts if int(row["n_contacts"]) else pd.DataFrame(), **drawing)
+        return GraspInspection(
+            obj,
+            pose,
+            float(row["alpha_deg"]),
+            float(row["beta_deg"]),
+            str(row["status"]),
+            weight,
+            contacts if int(row["n_contacts"]) else pd.DataFrame(),
+            **drawing,
+        )
     out = optimise_grasps([grasp], SynergySets(full.matrix, tuple(chosen)), opt.gfo, forces=True)
     mu = float(opt.gfo.mu)
     results = tuple(
-        SetResult(set_id(s), s, str(out["status"][k]), bool(out["force_closure_def1"][k]),
-                  bool(out["load_feasible"][k]), float(out["force_norm"][k]), int(out["e_s"][k]),
-                  cone_use(out["forces"][k], grasp.normals, mu) if out["forces"][k] is not None else float("nan"),
-                  _floats(out["forces"][k]) if out["forces"][k] is not None else ())
-        for k, s in enumerate(chosen))
+        SetResult(
+            set_id(s),
+            s,
+            str(out["status"][k]),
+            bool(out["force_closure_def1"][k]),
+            bool(out["load_feasible"][k]),
+            float(out["force_norm"][k]),
+            int(out["e_s"][k]),
+            cone_use(out["forces"][k], grasp.normals, mu) if out["forces"][k] is not None else float("nan"),
+            _floats(out["forces"][k]) if out["forces"][k] is not None else (),
+        )
+        for k, s in enumerate(chosen)
+    )
     results = _with_blockers(results, grasp, full.matrix, opt.gfo, cfg, hand, sim.object.shape, row)
     quality = grasp_quality(grasp, mu, sim.object.shape.bounding_radius_mm, synergies=full.matrix)
-    return GraspInspection(obj, pose, float(row["alpha_deg"]), float(row["beta_deg"]), str(row["status"]), weight,
-                           contacts, results, quality, **drawing)
+    return GraspInspection(
+        obj,
+        pose,
+        float(row["alpha_deg"]),
+        float(row["beta_deg"]),
+        str(row["status"]),
+        weight,
+        contacts,
+        results,
+        quality,
+        **drawing,
+    )
 
 
-def _with_blockers(results: tuple[SetResult, ...], grasp: Any, matrix: np.ndarray, gfo: Any, cfg: Mapping[str, Any],
-                   hand: Any, shape: Any, row: pd.Series) -> tuple[SetResult, ...]:
+def _with_blockers(
+    results: tuple[SetResult, ...],
+    grasp: Any,
+    matrix: np.ndarray,
+    gfo: Any,
+    cfg: Mapping[str, Any],
+    hand: Any,
+    shape: Any,
+    row: pd.Series,
+) -> tuple[SetResult, ...]:
     """The sets, each failing one with what blocks it (`analysis.blockers.set_blockers`)."""
     from dataclasses import replace
 
@@ -277,16 +366,29 @@ def _with_blockers(results: tuple[SetResult, ...], grasp: Any, matrix: np.ndarra
         return results
     found = set_blockers(grasp, matrix, [results[k].synergies for k in failing], gfo)
     rotation = np.asarray(row["object_rotation"], dtype=float).reshape(3, 3)
-    labels = contact_labels(grasp, rotation, shape, hand.link_names, HandAxes.from_hand(hand),
-                            OppositionRule.from_config(cfg))
+    labels = contact_labels(grasp, rotation, shape, hand.link_names, HandAxes.from_hand(hand), OppositionRule.from_config(cfg))
     out = list(results)
     for k, one in zip(failing, found):
         b = one.blocking
         at = np.flatnonzero(b.blockers)
-        out[k] = replace(out[k], blocked_by=one.reason, margin=float(b.margin), blockers=tuple(
-            BlockingContact(int(i), labels.names[i], labels.kinds[i], labels.faces[i], labels.features[i],
-                            float(b.contact_margin[i]), float(b.normal_force[i]), float(b.angle_outside_deg[i]))
-            for i in at))
+        out[k] = replace(
+            out[k],
+            blocked_by=one.reason,
+            margin=float(b.margin),
+            blockers=tuple(
+                BlockingContact(
+                    int(i),
+                    labels.names[i],
+                    labels.kinds[i],
+                    labels.faces[i],
+                    labels.features[i],
+                    float(b.contact_margin[i]),
+                    float(b.normal_force[i]),
+                    float(b.angle_outside_deg[i]),
+                )
+                for i in at
+            ),
+        )
     return tuple(out)
 
 
@@ -302,9 +404,11 @@ def _object_in_picture(result: GraspInspection) -> Any:
 
 def _title(result: GraspInspection) -> str:
     shape = result.shape.label if result.shape.kind in result.shape.label else f"{result.shape.kind} {result.shape.label}"
-    return (f"{result.object} ({shape}) at α = {result.alpha_deg:g}°, "
-            f"β = {result.beta_deg:g}° (pose {result.pose}): {result.closure_status}, {len(result.contacts)} contacts, "
-            f"opposition {result.opposition}")
+    return (
+        f"{result.object} ({shape}) at α = {result.alpha_deg:g}°, "
+        f"β = {result.beta_deg:g}° (pose {result.pose}): {result.closure_status}, {len(result.contacts)} contacts, "
+        f"opposition {result.opposition}"
+    )
 
 
 def grasp_picture(result: GraspInspection, png_path: str | Path) -> None:
@@ -332,8 +436,16 @@ def grasp_view(result: GraspInspection, synergies: Sequence[int] | None = None) 
     links = result.contacts["link"] if len(result.contacts) else []
     points = np.array(list(result.contacts["point_mm"]), dtype=float) if len(result.contacts) else np.zeros((0, 3))
     name = set_name(chosen.synergies) if chosen is not None else ""
-    scene = GraspScene.of(result.hand, result.q_rad, _object_in_picture(result), links, points,
-                          chosen.forces_N if chosen is not None else None, name, _title(result))
+    scene = GraspScene.of(
+        result.hand,
+        result.q_rad,
+        _object_in_picture(result),
+        links,
+        points,
+        chosen.forces_N if chosen is not None else None,
+        name,
+        _title(result),
+    )
     return grasp_figure(scene)
 
 

@@ -49,9 +49,12 @@ def configfile_problems(paths: Iterable[Any]) -> list[str]:
 _VARIABLE = re.compile(r"\$\{?([A-Za-z_][A-Za-z0-9_]*)\}?")
 
 
-def slurm_problems(settings: Any, raw_resources: Mapping[str, Any],
-                   environ: Mapping[str, str] = os.environ,
-                   which: Callable[[str], str | None] = shutil.which) -> list[str]:
+def slurm_problems(
+    settings: Any,
+    raw_resources: Mapping[str, Any],
+    environ: Mapping[str, str] = os.environ,
+    which: Callable[[str], str | None] = shutil.which,
+) -> list[str]:
     """What keeps the SLURM executor from submitting from this shell, one item per problem:
     a variable the profile's default resources read (``$SBATCH_ACCOUNT``) that is not set,
     and each scheduler command the executor will call that is not on PATH: ``sbatch`` and
@@ -61,9 +64,13 @@ def slurm_problems(settings: Any, raw_resources: Mapping[str, Any],
 
     ``settings``: the executor's settings (``status_command``, ``no_account``);
     ``raw_resources``: the default resources as written in the profile."""
-    problems = [f"${name} is not set (the profile's {key} reads it; export it, empty if your site has none)"
-                for key, raw in raw_resources.items() if isinstance(raw, str)
-                for name in _VARIABLE.findall(raw) if name not in environ]
+    problems = [
+        f"${name} is not set (the profile's {key} reads it; export it, empty if your site has none)"
+        for key, raw in raw_resources.items()
+        if isinstance(raw, str)
+        for name in _VARIABLE.findall(raw)
+        if name not in environ
+    ]
     status = getattr(settings, "status_command", None)
     needed: list[tuple[str, ...]] = [("sbatch",), ("scancel",), (status,) if status else ("sacct", "squeue")]
     account = raw_resources.get("slurm_account")

@@ -24,8 +24,7 @@ from typing import Any
 
 from synergrasp.config import overlay
 
-__all__ = ["StudyObject", "study_object", "study_objects", "effective_placement", "weight_N", "friction_mu",
-           "grasp_type"]
+__all__ = ["StudyObject", "study_object", "study_objects", "effective_placement", "weight_N", "friction_mu", "grasp_type"]
 
 
 def effective_placement(config: Mapping[str, Any], obj: str) -> dict[str, Any]:
@@ -67,9 +66,12 @@ def study_object(config: Mapping[str, Any], obj: str) -> StudyObject:
     mass = float(spec["mass_kg"]) if "mass_kg" in spec else None
     g = (config.get("mechanics") or {}).get("g_m_per_s2")
     return StudyObject(
-        name=obj, shape=spec.get("shape"), mass_kg=mass,
+        name=obj,
+        shape=spec.get("shape"),
+        mass_kg=mass,
         weight_N=weight_N(config, obj) if mass is not None and g is not None else None,
-        placement=effective_placement(config, obj) if "placement" in config else None)
+        placement=effective_placement(config, obj) if "placement" in config else None,
+    )
 
 
 def study_objects(config: Mapping[str, Any]) -> dict[str, StudyObject]:

@@ -28,9 +28,18 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-__all__ = ["WRITTEN_FOR", "check_version", "accept_configured_wildcards", "keep_outputs_until_replaced",
-           "outdate_failed_outputs", "cancel_scheduler_timers", "config_files", "slurm_settings",
-           "run_locally", "workflow_rules"]
+__all__ = [
+    "WRITTEN_FOR",
+    "check_version",
+    "accept_configured_wildcards",
+    "keep_outputs_until_replaced",
+    "outdate_failed_outputs",
+    "cancel_scheduler_timers",
+    "config_files",
+    "slurm_settings",
+    "run_locally",
+    "workflow_rules",
+]
 
 #: The Snakemake release series (major.minor) whose internals this module was written for and
 #: tested on (environment.lock pins one release of it).
@@ -41,9 +50,11 @@ def version_problem(version: str) -> str | None:
     """The one line refusing Snakemake ``version``, None for a release of :data:`WRITTEN_FOR`."""
     if version.split(".")[:2] == WRITTEN_FOR.split("."):
         return None
-    return (f"synergrasp's workflow uses Snakemake internals written for Snakemake {WRITTEN_FOR}.x "
-            f"(synergrasp.snakemake_adapter), and this is Snakemake {version}: install the locked "
-            f"environment (make venv), or port snakemake_adapter and its tests to {version}")
+    return (
+        f"synergrasp's workflow uses Snakemake internals written for Snakemake {WRITTEN_FOR}.x "
+        f"(synergrasp.snakemake_adapter), and this is Snakemake {version}: install the locked "
+        f"environment (make venv), or port snakemake_adapter and its tests to {version}"
+    )
 
 
 def check_version(version: str | None = None) -> None:
@@ -56,6 +67,7 @@ def check_version(version: str | None = None) -> None:
 
 
 # --------------------------------------------------------------------------- the recursion guard
+
 
 def accept_configured_wildcards(values: Iterable[str]) -> None:
     """Let Snakemake's guard against endlessly recursing wildcards (a value ending in one
@@ -80,6 +92,7 @@ def accept_configured_wildcards(values: Iterable[str]) -> None:
 
 
 # --------------------------------------------------------------------------- outputs kept, outdated
+
 
 def keep_outputs_until_replaced(workflow: Any) -> None:
     """Keep every output of the workflow's rules until its replacement is complete.
@@ -141,6 +154,7 @@ def outdate_failed_outputs(workflow: Any) -> list[str]:
 
 # --------------------------------------------------------------------------- the scheduler's timers
 
+
 def cancel_scheduler_timers() -> None:
     """Cancel the scheduler's pending re-evaluation timers (``threading.Timer``, not daemon
     threads: Snakemake's job-rate limiter starts one per finished job) once the run is over,
@@ -152,6 +166,7 @@ def cancel_scheduler_timers() -> None:
 
 
 # --------------------------------------------------------------------------- the workflow object
+
 
 def config_files(workflow: Any) -> list[str]:
     """The configuration files Snakemake read (the Snakefile's ``configfile:`` and ``--configfile``)."""
@@ -180,6 +195,10 @@ def workflow_rules(snakefile: Path, workdir: Path) -> list[Any]:
     from snakemake.settings.types import ConfigSettings, OutputSettings, ResourceSettings
 
     with SnakemakeApi(OutputSettings(quiet={"all"})) as api:
-        parsed = api.workflow(resource_settings=ResourceSettings(), snakefile=Path(snakefile),
-                              workdir=Path(workdir), config_settings=ConfigSettings())
+        parsed = api.workflow(
+            resource_settings=ResourceSettings(),
+            snakefile=Path(snakefile),
+            workdir=Path(workdir),
+            config_settings=ConfigSettings(),
+        )
         return list(parsed._workflow.rules)

@@ -37,9 +37,27 @@ from synergrasp.hand.synergies import synergy_values
 from synergrasp.resolved import effective_placement
 from synergrasp.tables import STUDY_TABLES
 
-__all__ = ["Cost", "Step", "STEPS", "UNITS", "WORKFLOW_KEYS", "CLOSURE_COST_FACTOR", "SOLVER_COMPILE",
-           "step_keys", "step_config", "step_hash", "upstream_when", "rule_costs", "rule_step", "step_for_object", "step_made",
-           "RESULTS", "scenario_root", "made_by", "object_file"]
+__all__ = [
+    "Cost",
+    "Step",
+    "STEPS",
+    "UNITS",
+    "WORKFLOW_KEYS",
+    "CLOSURE_COST_FACTOR",
+    "SOLVER_COMPILE",
+    "step_keys",
+    "step_config",
+    "step_hash",
+    "upstream_when",
+    "rule_costs",
+    "rule_step",
+    "step_for_object",
+    "step_made",
+    "RESULTS",
+    "scenario_root",
+    "made_by",
+    "object_file",
+]
 
 #: Where the workflow writes the default scenario's outputs (a scenario's own: ``scenario_root``).
 RESULTS = "results"
@@ -139,12 +157,27 @@ _FORCE_BOUND = ("analyses.marginal_weight_multiple", "objects.{object}.mass_kg",
 _PLACEMENT_TARGETS = ("mode", "search_rank", "approach_point_mm", "center_mm")
 _PNG_PDF = ("png", "pdf")
 #: The keys the placement search reads (and the map of its results).
-STEPS_SEARCH_READS = ("hand", "synergies", "grid", "placement", "closure", "mechanics", "synergy_sets.incremental_max",
-                      "objects.{object}.shape", "objects.{object}.mass_kg", "objects.{object}.placement",
-                      "objects.{object}.grasp_type", "grasp_type", "opposition", "hand_reach")
-STEPS_SEARCH_NOT_READS = ("closure.model", "closure.dynamic",
-                          *(f"{where}.{key}" for where in ("placement", "objects.{object}.placement")
-                            for key in _PLACEMENT_TARGETS))
+STEPS_SEARCH_READS = (
+    "hand",
+    "synergies",
+    "grid",
+    "placement",
+    "closure",
+    "mechanics",
+    "synergy_sets.incremental_max",
+    "objects.{object}.shape",
+    "objects.{object}.mass_kg",
+    "objects.{object}.placement",
+    "objects.{object}.grasp_type",
+    "grasp_type",
+    "opposition",
+    "hand_reach",
+)
+STEPS_SEARCH_NOT_READS = (
+    "closure.model",
+    "closure.dynamic",
+    *(f"{where}.{key}" for where in ("placement", "objects.{object}.placement") for key in _PLACEMENT_TARGETS),
+)
 
 #: Every step of the workflow, in the order they run. Costs: from results/benchmarks/*.tsv
 #: (columns s, cpu_time and max_rss) of the default study and of tests/config/small.yaml on a
@@ -158,73 +191,124 @@ STEPS: dict[str, Step] = {
     "mesh_parts": Step(
         # a job: 3.4 s of CPU and 122-126 MB on two of the random meshes (their benchmark files)
         rules={"mesh_parts": Cost("none", 10.0, 160, local=False)},
-        outputs={"obj": "meshes/{mesh}.obj"}, scope="workflow", optional=True),
+        outputs={"obj": "meshes/{mesh}.obj"},
+        scope="workflow",
+        optional=True,
+    ),
     # the placement search (docs/placement_search.md): the kinematic closure and the
     # optimisation with the full set {S1..S_incremental_max} only; one job per object with
     # 2 processes: ~30 s of CPU (186-195 targets x 27 poses) plus a cold solver cache's compile
     "search": Step(
         rules={"search": Cost("none", 80.0, 700, local=False, threads=2, compiles=True)},
-        outputs={"placement": "placement.csv"}, scope="object",
-        reads=STEPS_SEARCH_READS, not_reads=STEPS_SEARCH_NOT_READS,
+        outputs={"placement": "placement.csv"},
+        scope="object",
+        reads=STEPS_SEARCH_READS,
+        not_reads=STEPS_SEARCH_NOT_READS,
         params="synergrasp.optimisation.placement_search:SearchStepParams",
-        placement_when=(("mode", "searched"),)),
+        placement_when=(("mode", "searched"),),
+    ),
     "simulate": Step(
         rules={"simulate": Cost("closure_pose", 1.5, 178, 4.5e-3, 7.6e-3, local=False)},
-        outputs={"contacts": "contacts.parquet"}, scope="object",
-        reads=("hand", "synergies", "grid", "placement", "closure", "objects.{object}.shape",
-               "objects.{object}.placement"),
+        outputs={"contacts": "contacts.parquet"},
+        scope="object",
+        reads=("hand", "synergies", "grid", "placement", "closure", "objects.{object}.shape", "objects.{object}.placement"),
         # the dynamic closure: a free box of the object's mass, μ, k_ss and gravity of mechanics
         reads_when=(("closure.model", "dynamic", ("objects.{object}.mass_kg", "mechanics")),),
         # which contacts count is the `contacts` step's choice: `drop` and `keep` share one closure
         # nor the search's settings (a searched placement reads the search's output)
         not_reads=(*_CONTACT_SELECTION, "placement.search", "objects.{object}.placement.search"),
-        upstream_when=(("placement.mode", "searched", "search"),), synergy_columns=(1,),
-        params="synergrasp.simulation.closure:SimulateParams"),
+        upstream_when=(("placement.mode", "searched", "search"),),
+        synergy_columns=(1,),
+        params="synergrasp.simulation.closure:SimulateParams",
+    ),
     "contacts": Step(
         rules={"contacts": Cost("pose", 1.0, 150, 5.0e-4, 7.6e-3)},
-        outputs={"contacts": "load_carrying_contacts.parquet"}, scope="object",
+        outputs={"contacts": "load_carrying_contacts.parquet"},
+        scope="object",
         reads=("closure.model",),
         # only the dynamic model records the load each contact carries
         reads_when=(("closure.model", "dynamic", _CONTACT_SELECTION),),
-        upstream=("simulate",), params="synergrasp.simulation.contacts:ContactsParams",
-        made_when=(("closure.model", "dynamic"), ("closure.dynamic.unloaded_contacts", "drop"))),
+        upstream=("simulate",),
+        params="synergrasp.simulation.contacts:ContactsParams",
+        made_when=(("closure.model", "dynamic"), ("closure.dynamic.unloaded_contacts", "drop")),
+    ),
     "optimise": Step(
-        rules={"optimise_shard": Cost("shard_pose_set", 2.2, 271, 6.1e-5, 1.1e-3, local=False, compiles=True),
-               "optimise": Cost("pose_set", 0.6, 134, 2.0e-6, 6.0e-4)},
-        outputs={"gfo": "gfo.parquet"}, scope="object",
-        reads=("synergies", "mechanics", "synergy_sets", "solver.pose_shards", "objects.{object}.mass_kg",
-               "hand"),  # the hand's joints order the synergy table's rows
-        upstream=("contacts",), params="synergrasp.optimisation.optimise:OptimiseParams",
-        rule_outputs={"optimise_shard": "gfo_shards/{shard}.parquet"}),
+        rules={
+            "optimise_shard": Cost("shard_pose_set", 2.2, 271, 6.1e-5, 1.1e-3, local=False, compiles=True),
+            "optimise": Cost("pose_set", 0.6, 134, 2.0e-6, 6.0e-4),
+        },
+        outputs={"gfo": "gfo.parquet"},
+        scope="object",
+        reads=(
+            "synergies",
+            "mechanics",
+            "synergy_sets",
+            "solver.pose_shards",
+            "objects.{object}.mass_kg",
+            "hand",
+        ),  # the hand's joints order the synergy table's rows
+        upstream=("contacts",),
+        params="synergrasp.optimisation.optimise:OptimiseParams",
+        rule_outputs={"optimise_shard": "gfo_shards/{shard}.parquet"},
+    ),
     "minima": Step(
         rules={"minima": Cost("pose_set", 0.6, 136, 1.35e-5, 6.0e-4)},
-        outputs={"minima": "minima.parquet"}, scope="object",
+        outputs={"minima": "minima.parquet"},
+        scope="object",
         reads=("analyses.minima_radius_deg", "analyses.success"),
         # force closure within a multiple of the weight: the minima and Fig. 4 read the bound
         reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
-        upstream=("optimise",), params="synergrasp.analysis.minima:MinimaParams"),
+        upstream=("optimise",),
+        params="synergrasp.analysis.minima:MinimaParams",
+    ),
     # quality indices of every pose and their maps (docs/quality.md)
     "quality": Step(
         rules={"quality": Cost("pose", 3.0, 300, 6.0e-3, 0.05)},
-        outputs={"table": "quality.parquet", "png": "quality_maps.png", "pdf": "quality_maps.pdf"}, scope="object",
-        reads=("hand", "synergies", "mechanics.mu", "mechanics.g_m_per_s2", "synergy_sets.incremental_max",
-               "objects.{object}.shape", "objects.{object}.mass_kg", "opposition"),
-        upstream=("contacts", "optimise"), params="synergrasp.optimisation.quality:QualityParams",
-        report={"png": ("quality_maps", "Quality")}),
+        outputs={"table": "quality.parquet", "png": "quality_maps.png", "pdf": "quality_maps.pdf"},
+        scope="object",
+        reads=(
+            "hand",
+            "synergies",
+            "mechanics.mu",
+            "mechanics.g_m_per_s2",
+            "synergy_sets.incremental_max",
+            "objects.{object}.shape",
+            "objects.{object}.mass_kg",
+            "opposition",
+        ),
+        upstream=("contacts", "optimise"),
+        params="synergrasp.optimisation.quality:QualityParams",
+        report={"png": ("quality_maps", "Quality")},
+    ),
     # what blocks each set of the hierarchy table where the full set succeeds (docs/blockers.md):
     # one small conic problem per distinct failing (grasp, set), ~1.5 ms of CPU per pose
     "blockers": Step(
         rules={"blockers": Cost("pose", 3.0, 300, 1.5e-3, 0.05)},
-        outputs={"blockers": "blockers.parquet"}, scope="object",
-        reads=("hand", "synergies", "mechanics", "synergy_sets", "opposition", "objects.{object}.shape",
-               "objects.{object}.mass_kg"),
-        upstream=("contacts", "optimise"), params="synergrasp.analysis.blockers:BlockersParams"),
+        outputs={"blockers": "blockers.parquet"},
+        scope="object",
+        reads=(
+            "hand",
+            "synergies",
+            "mechanics",
+            "synergy_sets",
+            "opposition",
+            "objects.{object}.shape",
+            "objects.{object}.mass_kg",
+        ),
+        upstream=("contacts", "optimise"),
+        params="synergrasp.analysis.blockers:BlockersParams",
+    ),
     "blockers_table": Step(
         rules={"blockers_table": Cost("none", 4.0, 300)},
-        outputs={"csv": "tables/blockers.csv", "md": "tables/blockers.md",
-                 **_files(("blockers",), "figures", _PNG_PDF, named=False)},
-        reads=("synergy_sets.hierarchy_first", "synergy_sets.incremental_max"), upstream=("blockers",),
-        report={"csv": ("blockers_table", "Tables"), "png": ("blockers", "Figures")}),
+        outputs={
+            "csv": "tables/blockers.csv",
+            "md": "tables/blockers.md",
+            **_files(("blockers",), "figures", _PNG_PDF, named=False),
+        },
+        reads=("synergy_sets.hierarchy_first", "synergy_sets.incremental_max"),
+        upstream=("blockers",),
+        report={"csv": ("blockers_table", "Tables"), "png": ("blockers", "Figures")},
+    ),
     # the incremental planner against the exhaustive search (docs/planner.md): {S1} over the
     # grid, then {S1..Sk} near the previous level's minima, at 3 radii, and the greedy order:
     # 7.7-8.3 CPU s, 356-371 MB per box of 1800 poses (default study)
@@ -232,139 +316,267 @@ STEPS: dict[str, Step] = {
         rules={"plan": Cost("pose", 3.0, 300, 3.0e-3, 0.04)},
         outputs={"plan": "plan.csv", "enrollment": "enrollment.csv", **_files(("plan",), "", _PNG_PDF, named=False)},
         scope="object",
-        reads=("synergies", "mechanics", "synergy_sets.incremental_max", "objects.{object}.mass_kg",
-               "analyses.minima_radius_deg", "analyses.success", "analyses.planner_radii_deg", "hand"),
+        reads=(
+            "synergies",
+            "mechanics",
+            "synergy_sets.incremental_max",
+            "objects.{object}.mass_kg",
+            "analyses.minima_radius_deg",
+            "analyses.success",
+            "analyses.planner_radii_deg",
+            "hand",
+        ),
         reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
-        upstream=("contacts", "optimise"), params="synergrasp.analysis.plan_study:PlanParams", optional=True),
+        upstream=("contacts", "optimise"),
+        params="synergrasp.analysis.plan_study:PlanParams",
+        optional=True,
+    ),
     # planners compared at equal cost, replayed on every object's gfo table (docs/planner.md):
     # 28 candidates, the randomised ones over 200 seeds: 8.2 CPU s, 294 MB for the four boxes of
     # 1800 poses (default study). Before `tables`, whose claims table holds claim 8 from it.
     "planners": Step(
         rules={"planners": Cost("object_pose", 3.0, 300, 1.5e-3, 0.0)},
-        outputs={"csv": "tables/planners.csv", "md": "tables/planners.md",
-                 "across_csv": "tables/planners_across.csv", "across_md": "tables/planners_across.md",
-                 **_files(("planners",), "figures", _PNG_PDF, named=False)},
+        outputs={
+            "csv": "tables/planners.csv",
+            "md": "tables/planners.md",
+            "across_csv": "tables/planners_across.csv",
+            "across_md": "tables/planners_across.md",
+            **_files(("planners",), "figures", _PNG_PDF, named=False),
+        },
         reads=("synergy_sets.incremental_max", "analyses.minima_radius_deg", "analyses.success"),
-        reads_when=(("analyses.success", "force_closure_bounded",
-                     ("analyses.marginal_weight_multiple", "objects.*.mass_kg", "mechanics.g_m_per_s2")),),
-        upstream=("contacts", "optimise"), params="synergrasp.analysis.plan_study:PlannersParams",
-        report={"across_csv": ("planners_across", "Tables"), "png": ("planners", "Figures")}),
+        reads_when=(
+            (
+                "analyses.success",
+                "force_closure_bounded",
+                ("analyses.marginal_weight_multiple", "objects.*.mass_kg", "mechanics.g_m_per_s2"),
+            ),
+        ),
+        upstream=("contacts", "optimise"),
+        params="synergrasp.analysis.plan_study:PlannersParams",
+        report={"across_csv": ("planners_across", "Tables"), "png": ("planners", "Figures")},
+    ),
     "tables": Step(
         rules={"tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
         outputs=_files(TABLES, "tables", ("csv", "md")),
-        reads=("synergy_sets", "analyses.minima_radius_deg", "analyses.table2_k_max", "analyses.success",
-               "analyses.marginal_weight_multiple", "analyses.success_rate_tolerance_percent",
-               "analyses.null_model", "analyses.headline_view", "analyses.tie_band", "analyses.min_distinct_poses",
-               "analyses.bootstrap", "objects", "placement", "grid", "hand", "mechanics.g_m_per_s2"),
-        upstream=("optimise", "minima", "planners"), params="synergrasp.analysis.summaries:TablesParams",
-        report={f"{t}_csv": (t, "Tables") for t in TABLES}),
+        reads=(
+            "synergy_sets",
+            "analyses.minima_radius_deg",
+            "analyses.table2_k_max",
+            "analyses.success",
+            "analyses.marginal_weight_multiple",
+            "analyses.success_rate_tolerance_percent",
+            "analyses.null_model",
+            "analyses.headline_view",
+            "analyses.tie_band",
+            "analyses.min_distinct_poses",
+            "analyses.bootstrap",
+            "objects",
+            "placement",
+            "grid",
+            "hand",
+            "mechanics.g_m_per_s2",
+        ),
+        upstream=("optimise", "minima", "planners"),
+        params="synergrasp.analysis.summaries:TablesParams",
+        report={f"{t}_csv": (t, "Tables") for t in TABLES},
+    ),
     "realism": Step(
         # with the equilibrium checks of every grasp: ~0.5 ms of CPU per grasp over 75 sets
         rules={"realism": Cost("object_pose_set", 4.0, 300, 1.1e-5, 3.0e-4)},
-        outputs={"csv": "tables/grasp_realism.csv", "md": "tables/grasp_realism.md",
-                 "links_csv": "tables/grasp_links.csv", "links_md": "tables/grasp_links.md",
-                 "png": "figures/grasp_realism.png", "pdf": "figures/grasp_realism.pdf",
-                 "graspable_csv": "tables/graspable_objects.csv", "graspable_md": "tables/graspable_objects.md"},
-        reads=("hand", "synergies", "synergy_sets.incremental_max", "objects.*.mass_kg", "mechanics.g_m_per_s2",
-               "mechanics.k_ss_Nmm_per_rad", "mechanics.mu", "closure.model", "objects.*.shape",
-               "objects.*.grasp_type", "grasp_type", "opposition", "random_objects"),
+        outputs={
+            "csv": "tables/grasp_realism.csv",
+            "md": "tables/grasp_realism.md",
+            "links_csv": "tables/grasp_links.csv",
+            "links_md": "tables/grasp_links.md",
+            "png": "figures/grasp_realism.png",
+            "pdf": "figures/grasp_realism.pdf",
+            "graspable_csv": "tables/graspable_objects.csv",
+            "graspable_md": "tables/graspable_objects.md",
+        },
+        reads=(
+            "hand",
+            "synergies",
+            "synergy_sets.incremental_max",
+            "objects.*.mass_kg",
+            "mechanics.g_m_per_s2",
+            "mechanics.k_ss_Nmm_per_rad",
+            "mechanics.mu",
+            "closure.model",
+            "objects.*.shape",
+            "objects.*.grasp_type",
+            "grasp_type",
+            "opposition",
+            "random_objects",
+        ),
         reads_when=(("closure.model", "dynamic", ("closure.dynamic.load_threshold_N",)),),
-        upstream=("contacts", "optimise"), synergy_columns=(1,), params="synergrasp.analysis.realism:RealismParams",
-        report={"csv": ("grasp_realism_table", "Tables"), "png": ("grasp_realism", "Figures"),
-                "graspable_csv": ("graspable_objects", "Tables")}),
+        upstream=("contacts", "optimise"),
+        synergy_columns=(1,),
+        params="synergrasp.analysis.realism:RealismParams",
+        report={
+            "csv": ("grasp_realism_table", "Tables"),
+            "png": ("grasp_realism", "Figures"),
+            "graspable_csv": ("graspable_objects", "Tables"),
+        },
+    ),
     "fig1": Step(
         rules={"fig1": Cost("none", 3.0, 565)},
         outputs=_files(("fig1_synergy_postures",), "figures", _PNG_PDF, named=False),
-        reads=("hand", "synergies"), params="synergrasp.figures.hand_figures:Fig1Params",
-        report={"png": ("fig1", "Figures")}),
+        reads=("hand", "synergies"),
+        params="synergrasp.figures.hand_figures:Fig1Params",
+        report={"png": ("fig1", "Figures")},
+    ),
     # what grasps the hand can make (docs/hand_reach.md): per finger the reach along S1 and in
     # any posture, d_max (~60 kinematic closures on slabs lying on the palm) and the aperture
     "hand_reach": Step(
         rules={"hand_reach": Cost("none", 8.0, 300)},
-        outputs={"csv": "tables/hand_reach.csv", "md": "tables/hand_reach.md",
-                 **_files(("hand_reach",), "figures", _PNG_PDF, named=False)},
+        outputs={
+            "csv": "tables/hand_reach.csv",
+            "md": "tables/hand_reach.md",
+            **_files(("hand_reach",), "figures", _PNG_PDF, named=False),
+        },
         reads=("hand", "synergies", "closure", "opposition.angle_deg", "hand_reach", "objects.*.shape"),
         not_reads=("closure.model", "closure.dynamic"),
         params="synergrasp.simulation.reach:HandReachStepParams",
-        report={"csv": ("hand_reach_table", "Tables"), "png": ("hand_reach", "Figures")}),
+        report={"csv": ("hand_reach_table", "Tables"), "png": ("hand_reach", "Figures")},
+    ),
     # Fig. 2 and the same grasps in 3-D with the full set's optimal forces: pages sharing one
     # plotly script (docs/inspector.md); one job, so that the pages' imports (the solver, a
     # dozen optimisations) are not paid by a job of their own
     "fig2": Step(
         rules={"fig2": Cost("none", 4.5, 510)},
         outputs={**_files(("fig2_example_grasps",), "figures", _PNG_PDF, named=False), "pages": "figures/grasps_3d"},
-        reads=("hand", "synergies", "mechanics", "synergy_sets.incremental_max", "objects.*.shape",
-               "objects.*.mass_kg", "opposition"),
-        upstream=("contacts",), params="synergrasp.figures.grasp_3d:Grasps3dParams",
-        report={"png": ("fig2", "Figures"), "pages": ("grasps_3d", "Figures")}, folders=("pages",)),
+        reads=(
+            "hand",
+            "synergies",
+            "mechanics",
+            "synergy_sets.incremental_max",
+            "objects.*.shape",
+            "objects.*.mass_kg",
+            "opposition",
+        ),
+        upstream=("contacts",),
+        params="synergrasp.figures.grasp_3d:Grasps3dParams",
+        report={"png": ("fig2", "Figures"), "pages": ("grasps_3d", "Figures")},
+        folders=("pages",),
+    ),
     "fig4": Step(
         rules={"fig4": Cost("pose_set", 4.3, 257, 5.1e-6, 4.0e-4)},
-        outputs={"maps_png": "fig4_force_maps.png", "maps_pdf": "fig4_force_maps.pdf",
-                 "exploded_png": "fig4_exploded.png", "exploded_pdf": "fig4_exploded.pdf"}, scope="object",
+        outputs={
+            "maps_png": "fig4_force_maps.png",
+            "maps_pdf": "fig4_force_maps.pdf",
+            "exploded_png": "fig4_exploded.png",
+            "exploded_pdf": "fig4_exploded.pdf",
+        },
+        scope="object",
         reads=("analyses.fig4", "analyses.success"),
-        reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),), upstream=("optimise", "minima"),
+        reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
+        upstream=("optimise", "minima"),
         params="synergrasp.figures.study_figures:Fig4Params",
-        report={"maps_png": ("fig4_force_maps", "Fig. 4"), "exploded_png": ("fig4_exploded", "Fig. 4")}),
+        report={"maps_png": ("fig4_force_maps", "Fig. 4"), "exploded_png": ("fig4_exploded", "Fig. 4")},
+    ),
     # the placement map: the search's score over its targets, grasps at the chosen target
     "placement_map": Step(
         rules={"placement_map": Cost("none", 6.0, 400)},
-        outputs=_files(("placement_map",), "", _PNG_PDF, named=False), scope="object",
-        reads=STEPS_SEARCH_READS, not_reads=STEPS_SEARCH_NOT_READS, upstream=("search", "contacts"),
+        outputs=_files(("placement_map",), "", _PNG_PDF, named=False),
+        scope="object",
+        reads=STEPS_SEARCH_READS,
+        not_reads=STEPS_SEARCH_NOT_READS,
+        upstream=("search", "contacts"),
         params="synergrasp.optimisation.placement_search:SearchStepParams",
         placement_when=(("mode", "searched"), ("search_rank", 1)),
-        report={"png": ("placement_map", "Placement search")}),
+        report={"png": ("placement_map", "Placement search")},
+    ),
     # the study's claims at every scored target of the search (docs/placement_search.md): the
     # closure and every set's optimisation on a 117-pose lattice, ~1 s of CPU per target, 2 processes
     "target_claims": Step(
         rules={"target_claims": Cost("none", 400.0, 900, local=False, threads=2)},
-        outputs={"claims": "target_claims.parquet"}, scope="object",
+        outputs={"claims": "target_claims.parquet"},
+        scope="object",
         reads=(*STEPS_SEARCH_READS, "synergy_sets", "analyses", "objects.{object}"),
         reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
-        not_reads=(*STEPS_SEARCH_NOT_READS, "analyses.fig4"), upstream=("search",),
-        params="synergrasp.analysis.target_claims:TargetClaimsParams", optional=True,
-        placement_when=(("mode", "searched"),)),
+        not_reads=(*STEPS_SEARCH_NOT_READS, "analyses.fig4"),
+        upstream=("search",),
+        params="synergrasp.analysis.target_claims:TargetClaimsParams",
+        optional=True,
+        placement_when=(("mode", "searched"),),
+    ),
     # their summary: made by the target `placement_claims`
     "summarise_target_claims": Step(
         rules={"summarise_target_claims": Cost("none", 4.0, 300)},
-        outputs={"csv": "tables/placement_claims.csv", "md": "tables/placement_claims.md",
-                 **_files(("placement_claims",), "figures", _PNG_PDF, named=False)},
-        upstream=("target_claims",), optional=True,
-        report={"csv": ("placement_claims", "Placement search"), "png": ("placement_claims", "Placement search")}),
+        outputs={
+            "csv": "tables/placement_claims.csv",
+            "md": "tables/placement_claims.md",
+            **_files(("placement_claims",), "figures", _PNG_PDF, named=False),
+        },
+        upstream=("target_claims",),
+        optional=True,
+        report={"csv": ("placement_claims", "Placement search"), "png": ("placement_claims", "Placement search")},
+    ),
     # the study across its objects, with the planner (docs/random_objects.md): made by
     # `snakemake -j2 across_objects`, not by `figures`
     "objects_summary": Step(
         rules={"objects_summary": Cost("none", 5.0, 300)},
-        outputs={"csv": "tables/objects_summary.csv", "md": "tables/objects_summary.md",
-                 "intervals_csv": "tables/objects_intervals.csv", "intervals_md": "tables/objects_intervals.md",
-                 "drawn_csv": "tables/random_objects.csv", "drawn_md": "tables/random_objects.md",
-                 **_files(("objects_summary",), "figures", _PNG_PDF, named=False),
-                 **_files(("planner_tradeoff",), "figures", _PNG_PDF)},
-        reads=("synergy_sets", "analyses.planner_radii_deg", "random_objects"), upstream=("tables", "realism", "plan"),
-        params="synergrasp.analysis.objects_summary:ObjectsSummaryParams", optional=True),
+        outputs={
+            "csv": "tables/objects_summary.csv",
+            "md": "tables/objects_summary.md",
+            "intervals_csv": "tables/objects_intervals.csv",
+            "intervals_md": "tables/objects_intervals.md",
+            "drawn_csv": "tables/random_objects.csv",
+            "drawn_md": "tables/random_objects.md",
+            **_files(("objects_summary",), "figures", _PNG_PDF, named=False),
+            **_files(("planner_tradeoff",), "figures", _PNG_PDF),
+        },
+        reads=("synergy_sets", "analyses.planner_radii_deg", "random_objects"),
+        upstream=("tables", "realism", "plan"),
+        params="synergrasp.analysis.objects_summary:ObjectsSummaryParams",
+        optional=True,
+    ),
     "fig5": Step(
         rules={"fig5": Cost("none", 9.6, 268)},
-        outputs={"success_png": "figures/fig5a_hierarchy_success.png", "success_pdf": "figures/fig5a_hierarchy_success.pdf",
-                 "pooled_png": "figures/fig5a_hierarchy_success_pooled.png",
-                 "pooled_pdf": "figures/fig5a_hierarchy_success_pooled.pdf",
-                 "force_png": "figures/fig5b_hierarchy_force.png", "force_pdf": "figures/fig5b_hierarchy_force.pdf"},
-        reads=("synergy_sets.hierarchy_first", "analyses.success"), upstream=("tables",),
+        outputs={
+            "success_png": "figures/fig5a_hierarchy_success.png",
+            "success_pdf": "figures/fig5a_hierarchy_success.pdf",
+            "pooled_png": "figures/fig5a_hierarchy_success_pooled.png",
+            "pooled_pdf": "figures/fig5a_hierarchy_success_pooled.pdf",
+            "force_png": "figures/fig5b_hierarchy_force.png",
+            "force_pdf": "figures/fig5b_hierarchy_force.pdf",
+        },
+        reads=("synergy_sets.hierarchy_first", "analyses.success"),
+        upstream=("tables",),
         params="synergrasp.figures.study_figures:Fig5Params",
-        report={"success_png": ("fig5a", "Figures"), "pooled_png": ("fig5a_pooled", "Figures"),
-                "force_png": ("fig5b", "Figures")}),
+        report={
+            "success_png": ("fig5a", "Figures"),
+            "pooled_png": ("fig5a_pooled", "Figures"),
+            "force_png": ("fig5b", "Figures"),
+        },
+    ),
     # the workflow's own rule graph: drawn with the shipped configuration, so it reads no key
     "fig3": Step(
         rules={"fig3": Cost("none", 5.3, 380)},
         outputs={**_files(("fig3_rulegraph",), "figures", _PNG_PDF, named=False), "dot": "figures/fig3_rulegraph.dot"},
-        scope="workflow", report={"png": ("fig3", "Figures")}),
+        scope="workflow",
+        report={"png": ("fig3", "Figures")},
+    ),
     # the sweep's summary across every scenario (docs/sensitivity.md): its rule is the target
     "sensitivity": Step(
         rules={"sensitivity": Cost("none", 5.0, 300)},
-        outputs={"csv": "sensitivity/claims.csv", "md": "sensitivity/claims.md",
-                 "grid_png": "sensitivity/claims_grid.png", "grid_pdf": "sensitivity/claims_grid.pdf",
-                 "curves_png": "sensitivity/table2_curves.png", "curves_pdf": "sensitivity/table2_curves.pdf"},
-        scope="workflow", upstream=("tables", "realism"), optional=True,
-        report={"csv": ("sensitivity_claims", "Sensitivity"), "grid_png": ("sensitivity_grid", "Sensitivity"),
-                "curves_png": ("sensitivity_table2", "Sensitivity")}),
+        outputs={
+            "csv": "sensitivity/claims.csv",
+            "md": "sensitivity/claims.md",
+            "grid_png": "sensitivity/claims_grid.png",
+            "grid_pdf": "sensitivity/claims_grid.pdf",
+            "curves_png": "sensitivity/table2_curves.png",
+            "curves_pdf": "sensitivity/table2_curves.pdf",
+        },
+        scope="workflow",
+        upstream=("tables", "realism"),
+        optional=True,
+        report={
+            "csv": ("sensitivity_claims", "Sensitivity"),
+            "grid_png": ("sensitivity_grid", "Sensitivity"),
+            "curves_png": ("sensitivity_table2", "Sensitivity"),
+        },
+    ),
 }
 #: Keys read by the workflow itself, not by a step.
 WORKFLOW_KEYS: tuple[str, ...] = ("scenarios",)
@@ -480,8 +692,7 @@ def step_config(config: Mapping[str, Any], step: str, obj: str | None = None) ->
     return out
 
 
-def step_hash(config: Mapping[str, Any], step: str, obj: str | None = None,
-              _memo: dict | None = None) -> str:
+def step_hash(config: Mapping[str, Any], step: str, obj: str | None = None, _memo: dict | None = None) -> str:
     """Hash of what a step's outputs depend on: the keys it reads and, through its
     ``upstream`` steps, those of the steps before it (12 hex digits). ``obj``: the object of
     a step run per object; None for a step run once per scenario."""
@@ -505,5 +716,4 @@ def upstream_when(config: Mapping[str, Any], step: str, obj: str | None = None) 
     if obj is None or not STEPS[step].upstream_when:
         return ()
     placement = effective_placement(config, obj)
-    return tuple(up for key, value, up in STEPS[step].upstream_when
-                 if placement.get(key.removeprefix("placement.")) == value)
+    return tuple(up for key, value, up in STEPS[step].upstream_when if placement.get(key.removeprefix("placement.")) == value)

@@ -23,15 +23,31 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from synergrasp.config import (DEFAULT_SCENARIO, ConfigError, check_relations, overlay, scenario_config,
-                               search_lattice_size, synergy_problems)
+from synergrasp.config import (
+    DEFAULT_SCENARIO,
+    ConfigError,
+    check_relations,
+    overlay,
+    scenario_config,
+    search_lattice_size,
+    synergy_problems,
+)
 from synergrasp.preflight import refuse
 from synergrasp.resolved import effective_placement, grasp_type
 from synergrasp.yaml_io import read_yaml
 
-__all__ = ["checked_scenario", "checked_configuration", "overlays_with_drawn_objects", "read_overlays",
-           "search_rank_problems", "lattice_rank_problems", "search_table_or_refuse", "searched_objects_or_refuse",
-           "older_results_problems", "unknown_object"]
+__all__ = [
+    "checked_scenario",
+    "checked_configuration",
+    "overlays_with_drawn_objects",
+    "read_overlays",
+    "search_rank_problems",
+    "lattice_rank_problems",
+    "search_table_or_refuse",
+    "searched_objects_or_refuse",
+    "older_results_problems",
+    "unknown_object",
+]
 
 
 @functools.cache
@@ -62,8 +78,13 @@ def checked_scenario(config: Mapping[str, Any], name: str = DEFAULT_SCENARIO) ->
         cfg = scenario_config(config, name)
         hand, problems, warnings = _hand(cfg["hand"])
         synergies = load_synergies(cfg["synergies"], joint_names=hand.joint_names)
-        problems = [*problems, *check_relations(cfg, synergies.matrix.shape[1]), *lattice_rank_problems(cfg),
-                    *synergy_problems(cfg, synergies.mean, synergies.matrix), *object_problems(cfg)]
+        problems = [
+            *problems,
+            *check_relations(cfg, synergies.matrix.shape[1]),
+            *lattice_rank_problems(cfg),
+            *synergy_problems(cfg, synergies.mean, synergies.matrix),
+            *object_problems(cfg),
+        ]
     except ConfigError:
         raise
     except ValueError as err:  # SynergyFileError, hand and YAML file errors: one line each, naming the file
@@ -82,8 +103,9 @@ def read_overlays(paths: Sequence[str | Path], what: str = "config file") -> dic
     for path in paths:
         doc = read_yaml(path, what) or {}
         if not isinstance(doc, Mapping):
-            raise ConfigError(f"{what} '{path}': the top level must be a mapping of keys "
-                              f"(key: value), got a {type(doc).__name__}")
+            raise ConfigError(
+                f"{what} '{path}': the top level must be a mapping of keys (key: value), got a {type(doc).__name__}"
+            )
         config = overlay(config, doc)
     return config
 
@@ -100,8 +122,7 @@ def _distinct_targets(path: Path) -> int | None:
 
 def _rank_key(cfg: Mapping[str, Any], obj: str) -> str:
     """Where object ``obj``'s ``search_rank`` is set: its own placement or the global one."""
-    return "placement" if "search_rank" not in (cfg["objects"][obj].get("placement") or {}) else \
-        f"objects.{obj}.placement"
+    return "placement" if "search_rank" not in (cfg["objects"][obj].get("placement") or {}) else f"objects.{obj}.placement"
 
 
 def lattice_rank_problems(cfg: Mapping[str, Any]) -> list[str]:
@@ -117,9 +138,12 @@ def lattice_rank_problems(cfg: Mapping[str, Any]) -> list[str]:
         if placement["search_rank"] > n:
             key = (_rank_key(cfg, name), placement["search_rank"], n, placement["search"]["spacing_mm"])
             found.setdefault(key, []).append(name)
-    return [f"config error at '{where}.search_rank': {rank} exceeds the {n} points of the search lattice of "
-            f"{', '.join(names)} (search.region_mm of its grasp type at search.spacing_mm {spacing:g} mm): no search "
-            "has that many distinct targets" for (where, rank, n, spacing), names in found.items()]
+    return [
+        f"config error at '{where}.search_rank': {rank} exceeds the {n} points of the search lattice of "
+        f"{', '.join(names)} (search.region_mm of its grasp type at search.spacing_mm {spacing:g} mm): no search "
+        "has that many distinct targets"
+        for (where, rank, n, spacing), names in found.items()
+    ]
 
 
 def search_rank_problems(cfg: Mapping[str, Any], obj: str, table: str | Path) -> list[str]:
@@ -131,26 +155,32 @@ def search_rank_problems(cfg: Mapping[str, Any], obj: str, table: str | Path) ->
     if placement["mode"] != "searched" or n is None or placement["search_rank"] <= n:
         return []
     where = _rank_key(cfg, obj)
-    return [f"config error at '{where}.search_rank': {placement['search_rank']} exceeds the {n} distinct targets of "
-            f"{obj}'s placement search ({table})"]
+    return [
+        f"config error at '{where}.search_rank': {placement['search_rank']} exceeds the {n} distinct targets of "
+        f"{obj}'s placement search ({table})"
+    ]
 
 
-def search_table_or_refuse(cfg: Mapping[str, Any], obj: str, table: str,
-                           stop: Callable[[list[str]], Any] = refuse) -> str:
+def search_table_or_refuse(cfg: Mapping[str, Any], obj: str, table: str, stop: Callable[[list[str]], Any] = refuse) -> str:
     """``table`` (object ``obj``'s search table, an input); its :func:`search_rank_problems`
     stop the run before any job."""
     stop(search_rank_problems(cfg, obj, table))
     return table
 
 
-def searched_objects_or_refuse(files: list[str], target: str, cfg: Mapping[str, Any],
-                               stop: Callable[[list[str]], Any] = refuse) -> list[str]:
+def searched_objects_or_refuse(
+    files: list[str], target: str, cfg: Mapping[str, Any], stop: Callable[[list[str]], Any] = refuse
+) -> list[str]:
     """``files`` (one per object whose placement is searched); an empty list stops the run:
     ``target`` needs the placement search's targets and no object of ``cfg`` is searched."""
     if not files:
         modes = sorted({effective_placement(cfg, name)["mode"] for name in cfg["objects"]})
-        stop([f"{target}: no object's placement is searched (placement.mode: {', '.join(modes)}); the claims at the "
-              "placement search's targets need placement.mode: searched (docs/placement_search.md)"])
+        stop(
+            [
+                f"{target}: no object's placement is searched (placement.mode: {', '.join(modes)}); the claims at the "
+                "placement search's targets need placement.mode: searched (docs/placement_search.md)"
+            ]
+        )
     return files
 
 
@@ -164,8 +194,11 @@ def older_results_problems(results: str | Path = "results") -> list[str]:
     problems = []
     for table in tables.TABLES.values():
         if table.renamed and Path(results).is_dir():
-            problems += [line for path in sorted(Path(results).rglob(f"{table.name}.parquet"))
-                         if (line := tables.older_version(table, path))]
+            problems += [
+                line
+                for path in sorted(Path(results).rglob(f"{table.name}.parquet"))
+                if (line := tables.older_version(table, path))
+            ]
     return problems
 
 
@@ -175,8 +208,11 @@ def unknown_object(cfg: Mapping[str, Any], obj: str) -> str:
     (``rand_NNN``) without a ``random_objects`` block, where the drawn objects come from."""
     if obj in cfg["objects"]:
         return ""
-    hint = ("; objects drawn by random_objects are objects of a --configfile with that block "
-            "(docs/random_objects.md)") if obj.startswith("rand_") and not cfg.get("random_objects") else ""
+    hint = (
+        ("; objects drawn by random_objects are objects of a --configfile with that block (docs/random_objects.md)")
+        if obj.startswith("rand_") and not cfg.get("random_objects")
+        else ""
+    )
     return f"object: {obj!r} is not an object of the configuration; objects: {list(cfg['objects'])}{hint}"
 
 

@@ -40,8 +40,17 @@ from synergrasp.steps import (
 )
 from synergrasp.study_checks import checked_scenario, search_table_or_refuse, searched_objects_or_refuse
 
-__all__ = ["Wiring", "RuleFiles", "code_files", "report_archive", "job_size",
-           "runtime_min", "mem_mb", "RUNTIME_MARGIN", "MEMORY_MARGIN"]
+__all__ = [
+    "Wiring",
+    "RuleFiles",
+    "code_files",
+    "report_archive",
+    "job_size",
+    "runtime_min",
+    "mem_mb",
+    "RUNTIME_MARGIN",
+    "MEMORY_MARGIN",
+]
 
 #: Requests are the measured cost times a margin (slower nodes, shared file systems),
 #: rounded up to whole minutes and to 100 MB (docs/cluster.md).
@@ -51,6 +60,7 @@ _WILDCARD = re.compile(r"\{(\w+)\}")
 
 
 # --------------------------------------------------------------------------- one rule's files
+
 
 class RuleFiles:
     """The paths of one rule, from its step's entry in the registry."""
@@ -93,8 +103,7 @@ class RuleFiles:
         """The rule's benchmark file (pattern)."""
         return self._under("benchmarks", "tsv")
 
-    def snakemake_outputs(self, report: Callable, directory: Callable, temp: Callable,
-                          archive: bool) -> dict[str, Any]:
+    def snakemake_outputs(self, report: Callable, directory: Callable, temp: Callable, archive: bool) -> dict[str, Any]:
         """The rule's ``output`` with Snakemake's flags (``report``, ``directory``, ``temp``
         passed in): a file the report shows in the report; a folder of pages in it only when
         the report is an archive (``archive``: Snakemake's one-file HTML report refuses
@@ -106,8 +115,7 @@ class RuleFiles:
             if self.rule in self.spec.rule_outputs:
                 out[name] = temp(path)
             elif name in self.spec.folders:
-                out[name] = report(directory(path), htmlindex="index.html", **entry) if entry and archive \
-                    else directory(path)
+                out[name] = report(directory(path), htmlindex="index.html", **entry) if entry and archive else directory(path)
             else:
                 out[name] = report(path, **entry) if entry else path
         return out
@@ -180,6 +188,7 @@ def code_files(script: Path, src: Path) -> list[Path]:
 
 # --------------------------------------------------------------------------- requests
 
+
 def job_size(rule: str, cfg: Mapping[str, Any]) -> float:
     """Units of work (``synergrasp.steps.UNITS``) of one job of ``rule`` under the scenario
     configuration ``cfg``: the closure's cost follows the grid and the closure model, the
@@ -214,6 +223,7 @@ def mem_mb(rule: str, cfg: Mapping[str, Any]) -> int:
 
 # --------------------------------------------------------------------------- Snakemake's run
 
+
 def report_archive(argv: Sequence[str]) -> bool:
     """Whether the command line writes the report as an archive (``--report <path>.zip``)."""
     for k, arg in enumerate(argv):
@@ -227,6 +237,7 @@ def report_archive(argv: Sequence[str]) -> bool:
 
 # --------------------------------------------------------------------------- the study's files
 
+
 class Wiring:
     """The workflow of one Snakemake run: its scenarios (each checked when a target first
     needs it), where each step's outputs live, the study's targets and the rules' inputs.
@@ -237,9 +248,14 @@ class Wiring:
     before ``error`` is raised (the workflow's ``preflight.refuse`` stops the run there, with
     the lines alone)."""
 
-    def __init__(self, config: Mapping[str, Any], basedir: str | Path,
-                 error: type[Exception] = ValueError, warn: Callable[[str], Any] = print,
-                 stop: Callable[[list[str]], Any] = lambda lines: None):
+    def __init__(
+        self,
+        config: Mapping[str, Any],
+        basedir: str | Path,
+        error: type[Exception] = ValueError,
+        warn: Callable[[str], Any] = print,
+        stop: Callable[[list[str]], Any] = lambda lines: None,
+    ):
         self.config, self.root, self.error, self.warn, self.stop = config, Path(basedir), error, warn, stop
         if config.get("random_objects") is not None:  # objects drawn from pybullet's meshes, added before any check
             from synergrasp.simulation.random_objects import add_random_objects
@@ -331,9 +347,11 @@ class Wiring:
         scenario (default first) whose step reads the same keys and upstream outputs."""
         if (name, step, obj) not in self._roots:
             key = self._step_hash(name, step, obj)
-            owner = next(other for other in self.scenarios
-                         if (obj is None or obj in self.scenario(other)["objects"])
-                         and self._step_hash(other, step, obj) == key)
+            owner = next(
+                other
+                for other in self.scenarios
+                if (obj is None or obj in self.scenario(other)["objects"]) and self._step_hash(other, step, obj) == key
+            )
             self._roots[name, step, obj] = self.scenario_root[owner]
         return self._roots[name, step, obj]
 
@@ -356,29 +374,33 @@ class Wiring:
     def step_input(self, step: str) -> Callable[[Any], str | list[str]]:
         """Input function: the job's object's ``step`` output in the job's scenario (the path;
         none, ``[]``, where the scenario does not make it for the object, ``placement_when``)."""
+
         def file(w: Any) -> str | list[str]:
             name = self.job_scenario(w)
             return self.step_file(name, step, w.object) if self._for_object(name, step, w.object) else []
+
         return file
 
     def search_input(self) -> Callable[[Any], str | list[str]]:
         """Input function: the job's object's placement-search table where its placement is
         searched; a ``search_rank`` beyond the distinct targets of a table that exists
         already stops the run before any job (``study_checks.search_rank_problems``)."""
+
         def file(w: Any) -> str | list[str]:
             path = self.step_input("search")(w)
             return search_table_or_refuse(self.job_config(w), w.object, path, self._refuse) if path else path
+
         return file
 
     def step_inputs(self, step: str, target: str | None = None) -> Callable[[Any], list[str]]:
         """Input function: every object's ``step`` output in the job's scenario; with
         ``target``, none is refused before any job (the target needs a searched placement)."""
+
         def files(w: Any) -> list[str]:
             name = self.job_scenario(w)
-            found = [self.step_file(name, step, o) for o in self.scenario(name)["objects"]
-                     if self._for_object(name, step, o)]
-            return found if target is None else searched_objects_or_refuse(found, target, self.job_config(w),
-                                                                           self._refuse)
+            found = [self.step_file(name, step, o) for o in self.scenario(name)["objects"] if self._for_object(name, step, o)]
+            return found if target is None else searched_objects_or_refuse(found, target, self.job_config(w), self._refuse)
+
         return files
 
     def _refuse(self, lines: list[str]) -> None:
@@ -397,8 +419,9 @@ class Wiring:
     def shard_files(self, rule: str) -> Callable[[Any], list[str]]:
         """Input function: the job's object's files of every shard of ``rule`` (``solver.pose_shards``)."""
         (path,) = RuleFiles(rule).outputs().values()
-        return lambda w: [path.format(root=w.root, object=w.object, shard=i)
-                          for i in range(self.job_config(w)["solver"]["pose_shards"])]
+        return lambda w: [
+            path.format(root=w.root, object=w.object, shard=i) for i in range(self.job_config(w)["solver"]["pose_shards"])
+        ]
 
     def step_cfg(self, step: str) -> Callable[[Any], dict[str, Any]]:
         """A rule's ``params``: the part of the job's scenario configuration its step reads
@@ -421,8 +444,12 @@ class Wiring:
         cfg = self.job_config(wildcards)
         obj = getattr(wildcards, "object", None)
         objects = [obj] if obj in cfg["objects"] else list(cfg["objects"])
-        meshes = [file for o in objects if "mesh" in cfg["objects"][o]["shape"]
-                  for file in (cfg["objects"][o]["shape"]["mesh"]["path"], cfg["objects"][o]["shape"]["mesh"]["parts"])]
+        meshes = [
+            file
+            for o in objects
+            if "mesh" in cfg["objects"][o]["shape"]
+            for file in (cfg["objects"][o]["shape"]["mesh"]["path"], cfg["objects"][o]["shape"]["mesh"]["parts"])
+        ]
         shipped = (*SHIPPED_TABLES, *SHIPPED_HANDS)  # by name: their files are under shipped_data()
         return [p for p in (cfg["hand"], cfg["synergies"]) if p and p not in shipped] + meshes
 
@@ -430,13 +457,15 @@ class Wiring:
         """The shipped hand and synergy files (not the schema: its defaults reach a job
         through its params, so a new key reruns nothing)."""
         data = self.src / "synergrasp" / "data"
-        return sorted(str(p) for p in [*data.glob("*"), *data.glob("hands/**/*")]
-                      if p.is_file() and p.name not in ("config.schema.yaml", "README.md"))
+        return sorted(
+            str(p)
+            for p in [*data.glob("*"), *data.glob("hands/**/*")]
+            if p.is_file() and p.name not in ("config.schema.yaml", "README.md")
+        )
 
     def resources(self, rule: str) -> dict[str, Callable[[Any], int]]:
         """A rule's ``resources``: memory and run time of one job in its scenario."""
-        return {"mem_mb": lambda w: self._request(rule, w)["mem_mb"],
-                "runtime": lambda w: self._request(rule, w)["runtime"]}
+        return {"mem_mb": lambda w: self._request(rule, w)["mem_mb"], "runtime": lambda w: self._request(rule, w)["runtime"]}
 
     def _request(self, rule: str, wildcards: Any) -> dict[str, int]:
         """The requests of a job of ``rule``, computed once per scenario (the same for every job)."""
@@ -475,23 +504,32 @@ class Wiring:
     def study_targets(self, name: str = DEFAULT_SCENARIO) -> list[str]:
         """Every output of one scenario's study, each where it is made (Fig. 3, the rule
         graph, is the same for all; the sweep's summary is `sensitivity`'s)."""
-        files = [self.study_file(name, step, rel) for step, spec in STEPS.items()
-                 if spec.scope == "scenario" and not spec.optional for rel in spec.outputs.values()]
-        files += [f for step, spec in STEPS.items() if spec.scope == "workflow" and not spec.optional
-                  for f in self.workflow_files(step)]
+        files = [
+            self.study_file(name, step, rel)
+            for step, spec in STEPS.items()
+            if spec.scope == "scenario" and not spec.optional
+            for rel in spec.outputs.values()
+        ]
+        files += [
+            f for step, spec in STEPS.items() if spec.scope == "workflow" and not spec.optional for f in self.workflow_files(step)
+        ]
         return files + [f for obj in self.scenario(name)["objects"] for f in self.object_targets(obj, name)]
 
     def optional_object_targets(self, step: str, name: str = DEFAULT_SCENARIO) -> list[str]:
         """The outputs of the optional per-object ``step`` for every object of scenario ``name``."""
-        return [f"{self.step_root(name, step, obj)}/objects/{obj}/{rel}"
-                for obj in self.scenario(name)["objects"] for rel in STEPS[step].outputs.values()]
+        return [
+            f"{self.step_root(name, step, obj)}/objects/{obj}/{rel}"
+            for obj in self.scenario(name)["objects"]
+            for rel in STEPS[step].outputs.values()
+        ]
 
     def object_files(self, step: str, output: str) -> Callable[[Any], list[str]]:
         """Input function: every object's file ``output`` (an output name) of the per-object
         ``step`` in the job's scenario."""
         rel = STEPS[step].outputs[output]
-        return lambda w: [f"{self.step_root(self.job_scenario(w), step, o)}/objects/{o}/{rel}"
-                          for o in self.job_config(w)["objects"]]
+        return lambda w: [
+            f"{self.step_root(self.job_scenario(w), step, o)}/objects/{o}/{rel}" for o in self.job_config(w)["objects"]
+        ]
 
     def random_objects_manifest(self, wildcards: Any) -> list[str]:
         """Input function: the sha256 manifest of the scenario's random objects (none without them)."""

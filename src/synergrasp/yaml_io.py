@@ -39,8 +39,10 @@ def duplicate_keys(node: yaml.Node, path: tuple[str, ...] = ()) -> list[str]:
                 ident = (key.tag, name)
                 line = key.start_mark.line + 1
                 if ident in seen and name != "<<":
-                    problems.append(f"line {line}: key '{_key_path((*path, name))}' appears twice "
-                                    f"(first at line {seen[ident]}); each key may appear once")
+                    problems.append(
+                        f"line {line}: key '{_key_path((*path, name))}' appears twice "
+                        f"(first at line {seen[ident]}); each key may appear once"
+                    )
                 seen.setdefault(ident, line)
             problems += duplicate_keys(value, (*path, name if name is not None else "?"))
     elif isinstance(node, yaml.SequenceNode):

@@ -10,6 +10,10 @@ from synergrasp.job_log import job_log
 with job_log(snakemake.log[0]):
     blockers = pd.concat([tables.read(tables.BLOCKERS, p) for p in snakemake.input.blockers], ignore_index=True)
     summary = blockers_summary(blockers, blocker_sets(snakemake.params.cfg["synergy_sets"]))
-    tables.write_study_table(summary, snakemake.output.csv, snakemake.output.md,
-                             title="What blocks each synergy set where the full set succeeds (% of failing poses)")
+    tables.write_study_table(
+        summary,
+        snakemake.output.csv,
+        snakemake.output.md,
+        title="What blocks each synergy set where the full set succeeds (% of failing poses)",
+    )
     figure_blockers(summary, snakemake.output.png, snakemake.output.pdf)

@@ -9,5 +9,6 @@ with job_log(snakemake.log[0]):
     params = Fig1Params.from_config(snakemake.params.cfg)
     hand = load_hand(params.hand)
     synergies = load_synergies(params.synergies, joint_names=hand.joint_names)
-    figure_synergy_postures(hand, synergies, snakemake.output.png, snakemake.output.pdf,
-                            n_synergies=min(7, synergies.matrix.shape[1]))
+    figure_synergy_postures(
+        hand, synergies, snakemake.output.png, snakemake.output.pdf, n_synergies=min(7, synergies.matrix.shape[1])
+    )

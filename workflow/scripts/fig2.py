@@ -12,8 +12,8 @@ with job_log(snakemake.log[0]):
     params = Grasps3dParams.from_config(snakemake.params.cfg)
     hand = load_hand(params.hand)
     contacts = [tables.read(tables.CONTACTS, path) for path in snakemake.input.contacts]
-    figure_example_grasps(hand, params.objects, contacts, snakemake.output.png, snakemake.output.pdf,
-                          oppositions=params.oppositions(hand, contacts))
+    figure_example_grasps(
+        hand, params.objects, contacts, snakemake.output.png, snakemake.output.pdf, oppositions=params.oppositions(hand, contacts)
+    )
     matrix = load_synergies(params.synergies, joint_names=hand.joint_names).matrix
-    write_grasp_pages(snakemake.output.pages, fig2_scenes(hand, matrix, params, contacts),
-                      "The grasps of Fig. 2 in 3-D")
+    write_grasp_pages(snakemake.output.pages, fig2_scenes(hand, matrix, params, contacts), "The grasps of Fig. 2 in 3-D")

@@ -1,4 +1,5 @@
 """Fig. 3: the workflow's own rule graph, drawn from `snakemake --rulegraph`."""
+
 import subprocess
 import sys
 
@@ -7,8 +8,19 @@ from synergrasp.figures.rulegraph import canonical_rulegraph, figure_rulegraph
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]) as log:
-    command = [sys.executable, "-m", "snakemake", "figures", "-s", snakemake.input.snakefile,
-               "--nolock", "--quiet", "all", "--rulegraph", "dot"]
+    command = [
+        sys.executable,
+        "-m",
+        "snakemake",
+        "figures",
+        "-s",
+        snakemake.input.snakefile,
+        "--nolock",
+        "--quiet",
+        "all",
+        "--rulegraph",
+        "dot",
+    ]
     command += ["--configfile", snakemake.params.configfile, "--replace-workflow-config"]
     run = subprocess.run(command, capture_output=True, text=True)
     log.write(run.stderr)

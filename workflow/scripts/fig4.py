@@ -12,5 +12,4 @@ with job_log(snakemake.log[0]):
     minima = tables.read(tables.MINIMA, snakemake.input.minima)
     name, out, panel_k = snakemake.wildcards.object, snakemake.output, list(p.panel_k)
     figure_force_maps(gfo, minima, panel_k, name, out.maps_png, out.maps_pdf, p.success)
-    figure_exploded_views(gfo, panel_k, p.alpha_slice_deg, p.beta_slice_deg,
-                          name, out.exploded_png, out.exploded_pdf, p.success)
+    figure_exploded_views(gfo, panel_k, p.alpha_slice_deg, p.beta_slice_deg, name, out.exploded_png, out.exploded_pdf, p.success)

@@ -13,8 +13,19 @@ with job_log(snakemake.log[0]):
     hand = load_hand(params.hand)
     synergies = load_synergies(params.synergies, joint_names=hand.joint_names)
     reach = hand_reach(hand, synergies, params.closure, params.reach)
-    tables.write_study_table(reach.table[list(tables.HAND_REACH.names)], snakemake.output.csv, snakemake.output.md,
-                             title=f"Hand reach (palm face at x = {reach.palm_face_mm:g} mm; "
-                                   f"d_max {reach.d_max_mm:g} mm, aperture {reach.aperture_mm:.1f} mm)")
-    figure_hand_reach(hand, path_postures(hand, synergies), reach, params.objects, params.reach.posture_steps,
-                      snakemake.output.png, snakemake.output.pdf)
+    tables.write_study_table(
+        reach.table[list(tables.HAND_REACH.names)],
+        snakemake.output.csv,
+        snakemake.output.md,
+        title=f"Hand reach (palm face at x = {reach.palm_face_mm:g} mm; "
+        f"d_max {reach.d_max_mm:g} mm, aperture {reach.aperture_mm:.1f} mm)",
+    )
+    figure_hand_reach(
+        hand,
+        path_postures(hand, synergies),
+        reach,
+        params.objects,
+        params.reach.posture_steps,
+        snakemake.output.png,
+        snakemake.output.pdf,
+    )

@@ -14,14 +14,26 @@ with job_log(snakemake.log[0]):
     inp, out = snakemake.input, snakemake.output
     plans = pd.concat([tables.read_csv(tables.PLAN, f) for f in inp.plans], ignore_index=True)
     enrollment = pd.concat([tables.read_csv(tables.ENROLLMENT, f) for f in inp.enrollment], ignore_index=True)
-    rows = object_rows(pd.read_csv(inp.success_rates), pd.read_csv(inp.preservation), pd.read_csv(inp.graspable),
-                       plans, enrollment, p.n_full, p.hierarchy_first)
-    drawn = pd.DataFrame([vars(d) for d in drawn_objects(p.random_objects, manifest=inp.manifest[0])]
-                         if p.random_objects else [],
-                         columns=["name", "index", "path", "scale", "longest_side_mm", "problem"])
+    rows = object_rows(
+        pd.read_csv(inp.success_rates),
+        pd.read_csv(inp.preservation),
+        pd.read_csv(inp.graspable),
+        plans,
+        enrollment,
+        p.n_full,
+        p.hierarchy_first,
+    )
+    drawn = pd.DataFrame(
+        [vars(d) for d in drawn_objects(p.random_objects, manifest=inp.manifest[0])] if p.random_objects else [],
+        columns=["name", "index", "path", "scale", "longest_side_mm", "problem"],
+    )
     tables.write_study_table(rows, out.csv, out.md, title="The study per object")
-    tables.write_study_table(across_objects(rows, p.quantities()), out.intervals_csv, out.intervals_md,
-                             title="Across objects (95 % intervals: bootstrap over objects)")
+    tables.write_study_table(
+        across_objects(rows, p.quantities()),
+        out.intervals_csv,
+        out.intervals_md,
+        title="Across objects (95 % intervals: bootstrap over objects)",
+    )
     tables.write_study_table(drawn, out.drawn_csv, out.drawn_md, title="Drawn meshes (problem: why left out)")
     figure_objects_summary(studied(rows), p.radii_deg, out.png, out.pdf)
     figure_planner_tradeoff(studied(rows), p.radii_deg, out.planner_tradeoff_png, out.planner_tradeoff_pdf)

@@ -12,5 +12,13 @@ with job_log(snakemake.log[0]):
     hand = load_hand(sim.hand)
     contacts = tables.read(tables.CONTACTS, snakemake.input.contacts)
     oppositions = dict(zip(contacts["pose"], contacts_oppositions(contacts, HandAxes.from_hand(hand), sim.opposition)))
-    figure_placement_map(hand, sim.object, tables.read_csv(tables.PLACEMENT, snakemake.input.placement), contacts,
-                         sim.search.spacing_mm, snakemake.output.png, snakemake.output.pdf, oppositions=oppositions)
+    figure_placement_map(
+        hand,
+        sim.object,
+        tables.read_csv(tables.PLACEMENT, snakemake.input.placement),
+        contacts,
+        sim.search.spacing_mm,
+        snakemake.output.png,
+        snakemake.output.pdf,
+        oppositions=oppositions,
+    )

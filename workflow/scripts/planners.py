@@ -18,9 +18,14 @@ with job_log(snakemake.log[0]):
         rows.append(compare_on_study(contacts, tables.read(tables.GFO, gfo_path), p.n_levels, minima))
     per_object = pd.concat(rows, ignore_index=True)
     across = across_objects(per_object)
-    tables.write_study_table(per_object[list(tables.PLANNERS.names)], out.csv, out.md,
-                             title="Planners compared at equal cost, per object")
-    tables.write_study_table(across[list(tables.PLANNERS_ACROSS.names)], out.across_csv, out.across_md,
-                             title="Planners across the objects (recommended: the pre-registered rule's choice)")
+    tables.write_study_table(
+        per_object[list(tables.PLANNERS.names)], out.csv, out.md, title="Planners compared at equal cost, per object"
+    )
+    tables.write_study_table(
+        across[list(tables.PLANNERS_ACROSS.names)],
+        out.across_csv,
+        out.across_md,
+        title="Planners across the objects (recommended: the pre-registered rule's choice)",
+    )
     print(recommendation_line(across))
     figure_planners(per_object, across, out.png, out.pdf)

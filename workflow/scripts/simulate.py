@@ -12,6 +12,5 @@ with job_log(snakemake.log[0]):
     placement = sim.placement
     if placement.mode == "searched":
         placement = searched_placement(placement, tables.read_csv(tables.PLACEMENT, snakemake.input.search))
-    table = simulate_object(hand, sim.synergies(hand.joint_names), sim.object, placement, sim.closure,
-                            mechanics=sim.mechanics)
+    table = simulate_object(hand, sim.synergies(hand.joint_names), sim.object, placement, sim.closure, mechanics=sim.mechanics)
     tables.write(tables.CONTACTS, table, snakemake.output[0])

@@ -10,6 +10,10 @@ from synergrasp.job_log import job_log
 with job_log(snakemake.log[0]):
     per_target = pd.concat([tables.read(tables.TARGET_CLAIMS, p) for p in snakemake.input.claims], ignore_index=True)
     summary = claims_summary(per_target)
-    tables.write_study_table(summary, snakemake.output.csv, snakemake.output.md,
-                             title="The study's claims over the placement search's scored targets (% of targets)")
+    tables.write_study_table(
+        summary,
+        snakemake.output.csv,
+        snakemake.output.md,
+        title="The study's claims over the placement search's scored targets (% of targets)",
+    )
     figure_placement_claims(summary, snakemake.output.png, snakemake.output.pdf)

@@ -1,4 +1,5 @@
 """The study's tables from every object's optimisation results and local minima."""
+
 import warnings
 
 import pandas as pd

@@ -26,11 +26,27 @@ from synergrasp.optimisation.blocking import Blocking, blocking_contacts
 from synergrasp.optimisation.mechanics import Grasp, first_same_grasp, internal_force_basis, read_grasps
 from synergrasp.optimisation.problem import GFOProblem
 from synergrasp.optimisation.optimise import GFOParams, mechanics_for
-from synergrasp.simulation.opposition import (FACE_CLASSES, LINK_KINDS, SURFACE_FEATURES, HandAxes, OppositionRule,
-                                              face_classes, surface_features)
+from synergrasp.simulation.opposition import (
+    FACE_CLASSES,
+    LINK_KINDS,
+    SURFACE_FEATURES,
+    HandAxes,
+    OppositionRule,
+    face_classes,
+    surface_features,
+)
 
-__all__ = ["BlockersParams", "ContactLabels", "SetBlockers", "blocker_sets", "contact_labels", "set_blockers",
-           "blockers_table", "blockers_summary", "SUMMARY_GROUPS"]
+__all__ = [
+    "BlockersParams",
+    "ContactLabels",
+    "SetBlockers",
+    "blocker_sets",
+    "contact_labels",
+    "set_blockers",
+    "blockers_table",
+    "blockers_summary",
+    "SUMMARY_GROUPS",
+]
 
 
 def blocker_sets(sets_config: Mapping[str, int]) -> dict[str, tuple[int, ...]]:
@@ -38,8 +54,7 @@ def blocker_sets(sets_config: Mapping[str, int]) -> dict[str, tuple[int, ...]]:
     incremental_max: the study solves no larger incremental set), then the singles
     {S2} .. {S_hierarchy_first} ({S1} is the first of both)."""
     first = int(sets_config["hierarchy_first"])
-    out = {incremental_set_id(k): tuple(range(1, k + 1))
-           for k in range(1, min(first, int(sets_config["incremental_max"])) + 1)}
+    out = {incremental_set_id(k): tuple(range(1, k + 1)) for k in range(1, min(first, int(sets_config["incremental_max"])) + 1)}
     out.update({set_id([k]): (k,) for k in range(2, first + 1)})
     return out
 
@@ -63,9 +78,15 @@ class BlockersParams:
     def from_config(cls, config: Mapping[str, Any], obj: str) -> BlockersParams:
         from synergrasp.simulation.objects import GraspedObject
 
-        return cls(config["hand"], config["synergies"], GFOParams.from_config(config, obj),
-                   blocker_sets(config["synergy_sets"]), incremental_set_id(config["synergy_sets"]["incremental_max"]),
-                   OppositionRule.from_config(config), GraspedObject.from_config(config, obj, with_mass=False).shape)
+        return cls(
+            config["hand"],
+            config["synergies"],
+            GFOParams.from_config(config, obj),
+            blocker_sets(config["synergy_sets"]),
+            incremental_set_id(config["synergy_sets"]["incremental_max"]),
+            OppositionRule.from_config(config),
+            GraspedObject.from_config(config, obj, with_mass=False).shape,
+        )
 
 
 @dataclass(frozen=True)
@@ -79,13 +100,18 @@ class ContactLabels:
     features: tuple[str, ...]
 
 
-def contact_labels(grasp: Grasp, rotation: NDArray, shape: Any, link_names: Sequence[str], axes: HandAxes,
-                   rule: OppositionRule) -> ContactLabels:
+def contact_labels(
+    grasp: Grasp, rotation: NDArray, shape: Any, link_names: Sequence[str], axes: HandAxes, rule: OppositionRule
+) -> ContactLabels:
     """The labels of a grasp's contacts (rotation: the box's 3 x 3 orientation, palm frame)."""
     links = grasp.links
-    return ContactLabels(links, tuple(link_names[int(k)] for k in links), tuple(axes.link_kind[int(k)] for k in links),
-                         tuple(face_classes(grasp.normals, axes)),
-                         tuple(surface_features(grasp.points, shape, rotation, grasp.center, rule)))
+    return ContactLabels(
+        links,
+        tuple(link_names[int(k)] for k in links),
+        tuple(axes.link_kind[int(k)] for k in links),
+        tuple(face_classes(grasp.normals, axes)),
+        tuple(surface_features(grasp.points, shape, rotation, grasp.center, rule)),
+    )
 
 
 @dataclass(frozen=True)
@@ -103,8 +129,7 @@ class SetBlockers:
         return self.blocking.reason
 
 
-def set_blockers(grasp: Grasp, synergy_matrix: NDArray, sets: Sequence[Sequence[int]],
-                 params: GFOParams) -> list[SetBlockers]:
+def set_blockers(grasp: Grasp, synergy_matrix: NDArray, sets: Sequence[Sequence[int]], params: GFOParams) -> list[SetBlockers]:
     """The blockers of each set (1-based synergies) at one grasp, with E_s as the study's
     solver derives it (`internal_force_basis` with the same tolerance)."""
     mech = mechanics_for(grasp, params)
@@ -128,8 +153,14 @@ def _failing(gfo: pd.DataFrame, sets: Mapping[str, Any], full_set_id: str) -> pd
     return gfo[pick]
 
 
-def blockers_table(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequence[str], axes: HandAxes,
-                   synergy_matrix: NDArray, params: BlockersParams) -> pd.DataFrame:
+def blockers_table(
+    contacts: pd.DataFrame,
+    gfo: pd.DataFrame,
+    link_names: Sequence[str],
+    axes: HandAxes,
+    synergy_matrix: NDArray,
+    params: BlockersParams,
+) -> pd.DataFrame:
     """One row per (pose, set) of the examined sets that fails where the full set succeeds
     (columns of `tables.BLOCKERS`), in the gfo table's order."""
     failing = _failing(gfo, params.sets, params.full_set_id)
@@ -142,10 +173,8 @@ def blockers_table(contacts: pd.DataFrame, gfo: pd.DataFrame, link_names: Sequen
     for rec in failing.itertuples(index=False):
         i = first[row_of[int(rec.pose)]]
         if i not in solved:
-            wanted = sorted(set(failing.loc[failing["pose"].isin(contacts["pose"].iloc[np.flatnonzero(first == i)]),
-                                            "set_id"]))
-            solved[i] = dict(zip(wanted, set_blockers(grasps[i], synergy_matrix, [params.sets[s] for s in wanted],
-                                                      params.gfo)))
+            wanted = sorted(set(failing.loc[failing["pose"].isin(contacts["pose"].iloc[np.flatnonzero(first == i)]), "set_id"]))
+            solved[i] = dict(zip(wanted, set_blockers(grasps[i], synergy_matrix, [params.sets[s] for s in wanted], params.gfo)))
             rotation = np.asarray(contacts["object_rotation"].iloc[i], dtype=float).reshape(3, 3)
             labels[i] = contact_labels(grasps[i], rotation, params.shape, link_names, axes, params.rule)
         rows.append(_row(rec, solved[i][rec.set_id], labels[i]))
@@ -158,15 +187,31 @@ def _row(rec: Any, found: SetBlockers, labels: ContactLabels) -> dict[str, Any]:
     b = found.blocking
     at = np.flatnonzero(b.blockers)
     outside = np.flatnonzero(b.contact_margin <= 0.0) if b.reason == "contacts" else np.zeros(0, dtype=int)
-    return {"object": rec.object, "pose": int(rec.pose), "alpha_deg": rec.alpha_deg, "beta_deg": rec.beta_deg,
-            "set_id": rec.set_id, "n_synergies": int(rec.n_synergies), "e_s": found.e_s, "rank_G": found.rank_G,
-            "n_contacts": len(labels.links), "reason": b.reason, "margin": b.margin, "n_blockers": len(at),
-            "blocker_contact": at.tolist(), "blocker_link": [int(labels.links[k]) for k in at],
-            "blocker_link_name": [labels.names[k] for k in at], "blocker_link_kind": [labels.kinds[k] for k in at],
-            "blocker_face": [labels.faces[k] for k in at], "blocker_feature": [labels.features[k] for k in at],
-            "blocker_margin": b.contact_margin[at].tolist(), "blocker_normal_force": b.normal_force[at].tolist(),
-            "blocker_angle_outside_deg": b.angle_outside_deg[at].tolist(),
-            "n_outside": len(outside), "outside_link_kind": [labels.kinds[k] for k in outside]}
+    return {
+        "object": rec.object,
+        "pose": int(rec.pose),
+        "alpha_deg": rec.alpha_deg,
+        "beta_deg": rec.beta_deg,
+        "set_id": rec.set_id,
+        "n_synergies": int(rec.n_synergies),
+        "e_s": found.e_s,
+        "rank_G": found.rank_G,
+        "n_contacts": len(labels.links),
+        "reason": b.reason,
+        "margin": b.margin,
+        "n_blockers": len(at),
+        "blocker_contact": at.tolist(),
+        "blocker_link": [int(labels.links[k]) for k in at],
+        "blocker_link_name": [labels.names[k] for k in at],
+        "blocker_link_kind": [labels.kinds[k] for k in at],
+        "blocker_face": [labels.faces[k] for k in at],
+        "blocker_feature": [labels.features[k] for k in at],
+        "blocker_margin": b.contact_margin[at].tolist(),
+        "blocker_normal_force": b.normal_force[at].tolist(),
+        "blocker_angle_outside_deg": b.angle_outside_deg[at].tolist(),
+        "n_outside": len(outside),
+        "outside_link_kind": [labels.kinds[k] for k in outside],
+    }
 
 
 #: The summary's columns: per label group, the table's list column and the labels counted.
@@ -189,9 +234,14 @@ def blockers_summary(blockers: pd.DataFrame, sets: Mapping[str, Any]) -> pd.Data
         for sid in sets:
             here = part[part["set_id"] == sid]
             n = len(here)
-            row: dict[str, Any] = {"object": obj, "set_id": sid, "n_synergies": len(sets[sid]), "n_failing": n,
-                                   "pct_no_internal_force": _pct((here["reason"] == "no_internal_force").sum(), n),
-                                   "median_margin": float(here["margin"].median()) if n else np.nan}
+            row: dict[str, Any] = {
+                "object": obj,
+                "set_id": sid,
+                "n_synergies": len(sets[sid]),
+                "n_failing": n,
+                "pct_no_internal_force": _pct((here["reason"] == "no_internal_force").sum(), n),
+                "median_margin": float(here["margin"].median()) if n else np.nan,
+            }
             for group, (column, labels) in SUMMARY_GROUPS.items():
                 held = [set(v) for v in here[column]]
                 for label in labels:

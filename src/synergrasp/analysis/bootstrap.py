@@ -45,8 +45,9 @@ class BootstrapSettings:
             raise ValueError(f"BootstrapSettings.level must lie in (0.5, 1); got {self.level!r}")
 
 
-def block_index(alpha_deg: NDArray, beta_deg: NDArray, block_deg: float, alpha_start_deg: float,
-                beta_start_deg: float) -> NDArray:
+def block_index(
+    alpha_deg: NDArray, beta_deg: NDArray, block_deg: float, alpha_start_deg: float, beta_start_deg: float
+) -> NDArray:
     """Block number of each pose: square blocks of ``block_deg`` counted from the grid's start
     in α and in β (deg). Poses must lie in one α-period; numbers are 0..n_blocks − 1 (only
     blocks holding a pose are numbered)."""
@@ -78,8 +79,11 @@ class PoseResampler:
             keep = distinct_pose_mask(alpha, float(periods_deg.get(obj, 360.0)))
             blocks = block_index(alpha[keep], beta[keep], settings.block_deg, float(alpha.min()), float(beta.min()))
             n_blocks = int(blocks.max()) + 1 if blocks.size else 0
-            draws = (rng.multinomial(n_blocks, np.full(n_blocks, 1.0 / n_blocks), size=settings.resamples)
-                     if n_blocks else np.zeros((settings.resamples, 0), dtype=np.int64))
+            draws = (
+                rng.multinomial(n_blocks, np.full(n_blocks, 1.0 / n_blocks), size=settings.resamples)
+                if n_blocks
+                else np.zeros((settings.resamples, 0), dtype=np.int64)
+            )
             self._poses[obj] = own["pose"].to_numpy()[keep]
             self._blocks[obj] = blocks
             self._block_weights[obj] = np.vstack([np.ones((1, n_blocks)), draws]).astype(float)

@@ -26,8 +26,7 @@ from synergrasp.analysis.bootstrap import PoseResampler
 from synergrasp.analysis.minima import preserved, preserved_counts
 from synergrasp.ids import ALL_OBJECTS, incremental_set_id
 
-__all__ = ["identical_force_maps", "allowed_offsets", "null_preserved", "preservation_vs_chance",
-           "resampled_preservation"]
+__all__ = ["identical_force_maps", "allowed_offsets", "null_preserved", "preservation_vs_chance", "resampled_preservation"]
 
 #: The ``pairs`` of a row over every pair of consecutive levels (besides ``non_identical``).
 ALL_PAIRS = "all"
@@ -88,8 +87,16 @@ def _indices(values: NDArray, grid: NDArray) -> NDArray:
     return idx
 
 
-def null_preserved(this: pd.DataFrame, nxt: pd.DataFrame, alphas: NDArray, betas: NDArray, radius_deg: float,
-                   offsets: NDArray, rng: np.random.Generator, draws: int) -> NDArray:
+def null_preserved(
+    this: pd.DataFrame,
+    nxt: pd.DataFrame,
+    alphas: NDArray,
+    betas: NDArray,
+    radius_deg: float,
+    offsets: NDArray,
+    rng: np.random.Generator,
+    draws: int,
+) -> NDArray:
     """(draws,) number of minima of ``this`` preserved by ``nxt`` shifted by random offsets
     (rows of ``offsets``, drawn uniformly). ``this``, ``nxt``: alpha_deg, beta_deg (deg)."""
     if this.empty or nxt.empty or offsets.size == 0:
@@ -99,24 +106,34 @@ def null_preserved(this: pd.DataFrame, nxt: pd.DataFrame, alphas: NDArray, betas
     shift = offsets[rng.integers(len(offsets), size=draws)]  # (draws, 2) grid steps in α, β
     shifted_a = alphas[(ia[None, :] + shift[:, :1]) % alphas.size]
     shifted_b = betas[reflected(ib[None, :] + shift[:, 1:], betas.size)]
-    return preserved_counts(this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float), shifted_a, shifted_b,
-                            radius_deg)
+    return preserved_counts(this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float), shifted_a, shifted_b, radius_deg)
 
 
-def _level_pairs(mins: pd.DataFrame, k_max: int,
-                 radius_deg: float) -> Iterator[tuple[int, pd.DataFrame, pd.DataFrame, NDArray]]:
+def _level_pairs(mins: pd.DataFrame, k_max: int, radius_deg: float) -> Iterator[tuple[int, pd.DataFrame, pd.DataFrame, NDArray]]:
     """(k, the minima of {S1..Sk}, those of {S1..Sk+1}, which of the first are preserved) for
     k = 1 … k_max − 1, from one object's minima table."""
     for k in range(1, k_max):
         this = mins[mins["set_id"] == incremental_set_id(k)]
         nxt = mins[mins["set_id"] == incremental_set_id(k + 1)]
-        kept = preserved(this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float),
-                         nxt["alpha_deg"].to_numpy(float), nxt["beta_deg"].to_numpy(float), radius_deg)
+        kept = preserved(
+            this["alpha_deg"].to_numpy(float),
+            this["beta_deg"].to_numpy(float),
+            nxt["alpha_deg"].to_numpy(float),
+            nxt["beta_deg"].to_numpy(float),
+            radius_deg,
+        )
         yield k, this, nxt, kept
 
 
-def _pairs(table: pd.DataFrame, minima: pd.DataFrame, k_max: int, radius_deg: float,
-           periods: dict[str, float], draws: int, rng: np.random.Generator) -> list[dict]:
+def _pairs(
+    table: pd.DataFrame,
+    minima: pd.DataFrame,
+    k_max: int,
+    radius_deg: float,
+    periods: dict[str, float],
+    draws: int,
+    rng: np.random.Generator,
+) -> list[dict]:
     """Observed and null preserved counts of every (object, k)."""
     rows = []
     for obj in sorted(set(table["object"].unique())):
@@ -124,9 +141,16 @@ def _pairs(table: pd.DataFrame, minima: pd.DataFrame, k_max: int, radius_deg: fl
         alphas, betas = np.sort(own["alpha_deg"].unique()), np.sort(own["beta_deg"].unique())
         offsets = allowed_offsets(alphas, betas, radius_deg, periods.get(obj, 360.0))
         for k, this, nxt, kept in _level_pairs(minima[minima["object"] == obj], k_max, radius_deg):
-            rows.append({"object": obj, "k": k, "n_minima": len(this), "n_preserved": int(kept.sum()),
-                         "identical": identical_force_maps(own, incremental_set_id(k), incremental_set_id(k + 1)),
-                         "null": null_preserved(this, nxt, alphas, betas, radius_deg, offsets, rng, draws)})
+            rows.append(
+                {
+                    "object": obj,
+                    "k": k,
+                    "n_minima": len(this),
+                    "n_preserved": int(kept.sum()),
+                    "identical": identical_force_maps(own, incremental_set_id(k), incremental_set_id(k + 1)),
+                    "null": null_preserved(this, nxt, alphas, betas, radius_deg, offsets, rng, draws),
+                }
+            )
     return rows
 
 
@@ -136,15 +160,24 @@ def _summary(name: str, which: str, group: list[dict], draws: int) -> dict:
     null = sum((r["null"] for r in group), np.zeros(draws, dtype=np.int64))
     share = 100.0 * n_kept / n_minima if n_minima else np.nan
     null_share = 100.0 * null / n_minima if n_minima else np.full(draws, np.nan)
-    low, high = (np.percentile(null_share, [2.5, 97.5]) if n_minima else (np.nan, np.nan))
-    return {"object": name, "pairs": which, "n_pairs": len(group), "n_minima": n_minima, "n_preserved": n_kept,
-            "preserved_percent": share, "null_mean_percent": float(np.mean(null_share)) if n_minima else np.nan,
-            "null_low_percent": float(low), "null_high_percent": float(high),
-            "above_chance": bool(n_minima and share > high)}
+    low, high = np.percentile(null_share, [2.5, 97.5]) if n_minima else (np.nan, np.nan)
+    return {
+        "object": name,
+        "pairs": which,
+        "n_pairs": len(group),
+        "n_minima": n_minima,
+        "n_preserved": n_kept,
+        "preserved_percent": share,
+        "null_mean_percent": float(np.mean(null_share)) if n_minima else np.nan,
+        "null_low_percent": float(low),
+        "null_high_percent": float(high),
+        "above_chance": bool(n_minima and share > high),
+    }
 
 
-def preservation_vs_chance(table: pd.DataFrame, minima: pd.DataFrame, k_max: int, radius_deg: float,
-                           periods: dict[str, float], draws: int, seed: int) -> tuple[pd.DataFrame, pd.DataFrame]:
+def preservation_vs_chance(
+    table: pd.DataFrame, minima: pd.DataFrame, k_max: int, radius_deg: float, periods: dict[str, float], draws: int, seed: int
+) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Observed preservation share beside the null model's, per object and over all objects.
 
     Returns ``(summary, pairs)``. ``summary``: one row per (object or "all", pairs ∈
@@ -165,13 +198,14 @@ def preservation_vs_chance(table: pd.DataFrame, minima: pd.DataFrame, k_max: int
         group = [r for r in rows if obj in (ALL_OBJECTS, r["object"])]
         summary.append(_summary(obj, ALL_PAIRS, group, draws))
         summary.append(_summary(obj, "non_identical", [r for r in group if not r["identical"]], draws))
-    pairs = pd.DataFrame([{"object": r["object"], "k": r["k"], "identical_maps": r["identical"]} for r in rows],
-                         columns=["object", "k", "identical_maps"])
+    pairs = pd.DataFrame(
+        [{"object": r["object"], "k": r["k"], "identical_maps": r["identical"]} for r in rows],
+        columns=["object", "k", "identical_maps"],
+    )
     return pd.DataFrame(summary), pairs
 
 
-def resampled_preservation(minima: pd.DataFrame, k_max: int, radius_deg: float,
-                           resampler: PoseResampler) -> pd.DataFrame:
+def resampled_preservation(minima: pd.DataFrame, k_max: int, radius_deg: float, resampler: PoseResampler) -> pd.DataFrame:
     """Per object: the minima of {S1..Sk} (k = 1..k_max − 1) at distinct poses and those
     preserved in {S1..Sk+1}, counted under every bootstrap resample.
 
@@ -188,6 +222,5 @@ def resampled_preservation(minima: pd.DataFrame, k_max: int, radius_deg: float,
             here = index >= 0
             np.add.at(n_min, index[here], 1.0)
             np.add.at(n_kept, index[here], kept[here].astype(float))
-        rows.append({"object": obj, "n_minima": resampler.sums(obj, n_min),
-                     "n_preserved": resampler.sums(obj, n_kept)})
+        rows.append({"object": obj, "n_minima": resampler.sums(obj, n_min), "n_preserved": resampler.sums(obj, n_kept)})
     return pd.DataFrame(rows, columns=["object", "n_minima", "n_preserved"])

@@ -22,14 +22,38 @@ from synergrasp.analysis.chance import ALL_PAIRS
 from synergrasp.analysis.intervals import VIEWS, StudyCounts, mean_defined
 from synergrasp.ids import ALL_OBJECTS, incremental_set_id, set_id, set_members
 
-__all__ = ["HOLDS", "FAILS", "UNDEFINED", "CLAIM_VERDICTS", "VerdictRules", "Difference", "interval_verdict", "claims_table",
-           "planner_claim", "CLAIM_COLUMNS"]
+__all__ = [
+    "HOLDS",
+    "FAILS",
+    "UNDEFINED",
+    "CLAIM_VERDICTS",
+    "VerdictRules",
+    "Difference",
+    "interval_verdict",
+    "claims_table",
+    "planner_claim",
+    "CLAIM_COLUMNS",
+]
 
 HOLDS, FAILS, UNDEFINED = "holds", "does not hold", "undefined"
 #: A claim's verdicts (a success verdict of a grasp is ``verdicts.SUCCESS_VERDICTS``).
 CLAIM_VERDICTS = (HOLDS, FAILS, UNDEFINED)
-CLAIM_COLUMNS = ["claim", "view", "headline", "statement", "tested_by", "measured", "difference", "low", "high",
-                 "unit", "tie_band", "n_distinct_poses", "verdict", "reason"]
+CLAIM_COLUMNS = [
+    "claim",
+    "view",
+    "headline",
+    "statement",
+    "tested_by",
+    "measured",
+    "difference",
+    "low",
+    "high",
+    "unit",
+    "tie_band",
+    "n_distinct_poses",
+    "verdict",
+    "reason",
+]
 #: How a difference d decides a claim: "greater" (holds if d > band), "within_below" (a claim
 #: of equality, d ≤ 0: holds if d ≥ −band), "within_above" (d ≥ 0: holds if d ≤ band).
 KINDS = ("greater", "within_below", "within_above")
@@ -92,8 +116,12 @@ def _decide(d: Difference, min_poses: int) -> tuple[str, str]:
     else:
         raise ValueError(f"kind must be one of {list(KINDS)}; got {d.kind!r}")
     if holds:
-        return HOLDS, f"interval wholly beyond the tie band (±{band:g})" if d.kind == "greater" else \
-            f"interval within the tie band (±{band:g})"
+        return (
+            HOLDS,
+            f"interval wholly beyond the tie band (±{band:g})"
+            if d.kind == "greater"
+            else f"interval within the tie band (±{band:g})",
+        )
     if fails:
         return FAILS, f"interval wholly beyond the tie band (±{band:g}) on the other side"
     if d.kind == "greater" and low >= -band and high <= band:
@@ -110,8 +138,15 @@ def _fmt(values: NDArray, counts: StudyCounts, unit: str = "%") -> str:
     return f"{est:.1f} {unit} [{low:.1f}, {high:.1f}]"
 
 
-def _difference(values: NDArray, counts: StudyCounts, band: float, n: int, kind: str = "greater",
-                unit: str = "percentage points", reason: str = "") -> Difference:
+def _difference(
+    values: NDArray,
+    counts: StudyCounts,
+    band: float,
+    n: int,
+    kind: str = "greater",
+    unit: str = "percentage points",
+    reason: str = "",
+) -> Difference:
     est, low, high = counts.estimate_interval(values)
     return Difference(est, low, high, band, n, kind, unit, reason)
 
@@ -121,8 +156,9 @@ def _missing(counts: StudyCounts, set_ids: Sequence[str]) -> str:
     return f"sets not computed: {', '.join(absent)}" if absent else ""
 
 
-def _best_of(counts: StudyCounts, view: str, target: str, others: Sequence[str], rules: VerdictRules,
-             what: str) -> tuple[str, Difference]:
+def _best_of(
+    counts: StudyCounts, view: str, target: str, others: Sequence[str], rules: VerdictRules, what: str
+) -> tuple[str, Difference]:
     """rate(target) − the best of ``others``, the best taken inside each resample."""
     others = [s for s in others if counts.has(s)]
     reason = _missing(counts, [target]) or ("" if others else f"no other {what} computed")
@@ -132,8 +168,9 @@ def _best_of(counts: StudyCounts, view: str, target: str, others: Sequence[str],
     best_rows = np.nanmax(np.where(np.isfinite(rates), rates, -np.inf), axis=0)
     target_rate = counts.rate(target, view)
     best = others[int(np.nanargmax(np.where(np.isfinite(rates[:, 0]), rates[:, 0], -np.inf)))]
-    text = (f"{_label(target)} {_fmt(target_rate, counts)}; best other {what} {_label(best)} "
-            f"{_fmt(counts.rate(best, view), counts)}")
+    text = (
+        f"{_label(target)} {_fmt(target_rate, counts)}; best other {what} {_label(best)} {_fmt(counts.rate(best, view), counts)}"
+    )
     return text, _difference(target_rate - best_rows, counts, rules.rate_points, counts.n_any([target, best]))
 
 
@@ -146,8 +183,10 @@ def _claim1(counts: StudyCounts, first: int, rules: VerdictRules) -> tuple[str, 
     rates = [counts.object_rate(o, sid) for o in objects]
     text = "; ".join(f"{o} {_fmt(r, counts)}" for o, r in zip(objects, rates))
     parts = [(o, r - 100.0, int(counts.count(o, counts.full)[0])) for o, r in zip(objects, rates)]
-    return (f"Table II at k = {first}: {text}",
-            _worst_of(parts, counts, rules.rate_points, rules.min_distinct_poses, kind="within_below"))
+    return (
+        f"Table II at k = {first}: {text}",
+        _worst_of(parts, counts, rules.rate_points, rules.min_distinct_poses, kind="within_below"),
+    )
 
 
 def _claim2(counts: StudyCounts, first: int, view: str, rules: VerdictRules) -> tuple[str, Difference]:
@@ -162,35 +201,45 @@ def _claim2(counts: StudyCounts, first: int, view: str, rules: VerdictRules) -> 
     else:
         share = 100.0 - counts.rate(sid, "per_object")
     full, lost = counts.n_lost(sid)
-    text = (f"{int(lost[0])} of the full set's {int(full[0])} distinct force-closure poses missed by "
-            f"{_label(sid)}: {_fmt(share, counts)}")
+    text = (
+        f"{int(lost[0])} of the full set's {int(full[0])} distinct force-closure poses missed by "
+        f"{_label(sid)}: {_fmt(share, counts)}"
+    )
     return text, _difference(share, counts, rules.rate_points, int(full[0]), "within_above")
 
 
-def _claim3(minima: pd.DataFrame, chance: pd.DataFrame, view: str, rules: VerdictRules,
-            counts: StudyCounts) -> tuple[str, Difference]:
+def _claim3(
+    minima: pd.DataFrame, chance: pd.DataFrame, view: str, rules: VerdictRules, counts: StudyCounts
+) -> tuple[str, Difference]:
     """``minima``: one row per object with (rows,) arrays n_minima, n_preserved (distinct poses)."""
     rows = minima[minima["n_minima"].map(lambda a: a[0] > 0)]
     if rows.empty:
-        return "no local minima", Difference(np.nan, np.nan, np.nan, rules.rate_points, 0,
-                                             reason="nothing to compare: no local minima")
+        return "no local minima", Difference(
+            np.nan, np.nan, np.nan, rules.rate_points, 0, reason="nothing to compare: no local minima"
+        )
     high = chance.set_index(["object", "pairs"])["null_high_percent"]
     with np.errstate(invalid="ignore", divide="ignore"):
         if view == "pooled":
             share = 100.0 * np.sum(np.vstack(rows["n_preserved"]), axis=0) / np.sum(np.vstack(rows["n_minima"]), axis=0)
             null_high = float(high.get((ALL_OBJECTS, ALL_PAIRS), np.nan))
         else:
-            share = mean_defined(np.vstack([100.0 * p / np.where(m > 0, m, np.nan)
-                                            for p, m in zip(rows["n_preserved"], rows["n_minima"])]))
+            share = mean_defined(
+                np.vstack([100.0 * p / np.where(m > 0, m, np.nan) for p, m in zip(rows["n_preserved"], rows["n_minima"])])
+            )
             null_high = float(np.mean([high.get((o, ALL_PAIRS), np.nan) for o in rows["object"]]))
     n = int(sum(m[0] for m in rows["n_minima"]))
-    text = (f"{_fmt(share, counts)} of {n} distinct minima preserved; null model's 97.5 percentile "
-            f"{null_high:.1f} %")
+    text = f"{_fmt(share, counts)} of {n} distinct minima preserved; null model's 97.5 percentile {null_high:.1f} %"
     return text, _difference(np.minimum(share - 90.0, share - null_high), counts, rules.rate_points, n)
 
 
-def _worst_of(parts: Sequence[tuple[str, NDArray, int]], counts: StudyCounts, band: float, min_poses: int,
-              unit: str = "percentage points", kind: str = "greater") -> Difference:
+def _worst_of(
+    parts: Sequence[tuple[str, NDArray, int]],
+    counts: StudyCounts,
+    band: float,
+    min_poses: int,
+    unit: str = "percentage points",
+    kind: str = "greater",
+) -> Difference:
     """The least favourable of several compared differences (name, (rows,) values, distinct
     poses), taken inside each resample, over those resting on at least ``min_poses`` poses.
     Left-out comparisons are named in the reason unless a tested one lies wholly below the band
@@ -199,15 +248,35 @@ def _worst_of(parts: Sequence[tuple[str, NDArray, int]], counts: StudyCounts, ba
     short = ", ".join(f"{name} ({n})" for name, _, n in parts if n < min_poses)
     if not tested:
         n = max((p[2] for p in parts), default=0)
-        return Difference(np.nan, np.nan, np.nan, band, n, kind, unit=unit,
-                          reason=(f"fewer than {min_poses} distinct poses: {short}" if n
-                                  else f"nothing to compare: 0 distinct poses ({short})" if short else ""))
-    d = _difference(np.min(np.vstack([p[1] for p in tested]), axis=0), counts, band, min(p[2] for p in tested),
-                    kind, unit=unit)
+        return Difference(
+            np.nan,
+            np.nan,
+            np.nan,
+            band,
+            n,
+            kind,
+            unit=unit,
+            reason=(
+                f"fewer than {min_poses} distinct poses: {short}"
+                if n
+                else f"nothing to compare: 0 distinct poses ({short})"
+                if short
+                else ""
+            ),
+        )
+    d = _difference(np.min(np.vstack([p[1] for p in tested]), axis=0), counts, band, min(p[2] for p in tested), kind, unit=unit)
     if short:
         left_out = f"comparisons with fewer than {min_poses} distinct poses: {short}"
-        return Difference(d.estimate, d.low, d.high, band, d.n, kind, unit=unit,
-                          **({"note": f"left out: {left_out}"} if d.high < -band else {"reason": left_out}))
+        return Difference(
+            d.estimate,
+            d.low,
+            d.high,
+            band,
+            d.n,
+            kind,
+            unit=unit,
+            **({"note": f"left out: {left_out}"} if d.high < -band else {"reason": left_out}),
+        )
     return d
 
 
@@ -221,8 +290,10 @@ def _claim5(counts: StudyCounts, view: str, rules: VerdictRules) -> tuple[str, D
         low_better = np.minimum(*(counts.rate(s, view) for s in better))
         high_worse = np.maximum(*(counts.rate(s, view) for s in worse))
         compared.append((what, low_better - high_worse, counts.n_any([*better, *worse])))
-        texts.append(f"{what}: min({', '.join(map(_label, better))}) {_fmt(low_better, counts)} vs "
-                     f"max({', '.join(map(_label, worse))}) {_fmt(high_worse, counts)} ({compared[-1][2]} poses)")
+        texts.append(
+            f"{what}: min({', '.join(map(_label, better))}) {_fmt(low_better, counts)} vs "
+            f"max({', '.join(map(_label, worse))}) {_fmt(high_worse, counts)} ({compared[-1][2]} poses)"
+        )
     return "; ".join(texts), _worst_of(compared, counts, rules.rate_points, rules.min_distinct_poses)
 
 
@@ -231,38 +302,55 @@ def _claim7(counts: StudyCounts, first: int, rules: VerdictRules) -> tuple[str, 
     unit = "log force ratio"
     named = [s for s in ("1", "4", "5") if int(s) <= first]
     others = [str(i) for i in range(1, first + 1) if str(i) not in ("1", "4", "5")]
-    reason = _missing(counts, named + others) or ("" if len(named) == 3 and others else "S1, S4, S5 and another "
-                                                  "single synergy are needed")
+    reason = _missing(counts, named + others) or (
+        "" if len(named) == 3 and others else "S1, S4, S5 and another single synergy are needed"
+    )
     if reason:
         return reason, Difference(np.nan, np.nan, np.nan, band, 0, unit=unit, reason=reason)
     compared = [(f"S{a}-S{b}", *counts.paired_log_ratio(a, b)) for a in named for b in others]
-    shown = [f"F(S{name.split('-')[1][1:]})/F(S{name.split('-')[0][1:]}) {_fmt(np.exp(v), counts, '')} ({n})"
-             for name, v, n in compared if n >= rules.min_distinct_poses]
+    shown = [
+        f"F(S{name.split('-')[1][1:]})/F(S{name.split('-')[0][1:]}) {_fmt(np.exp(v), counts, '')} ({n})"
+        for name, v, n in compared
+        if n >= rules.min_distinct_poses
+    ]
     short = [f"{name} ({n})" for name, _, n in compared if n < rules.min_distinct_poses]
-    text = ("median ratio of optimal forces on the distinct poses where both succeed (poses): "
-            + ("; ".join(shown) if shown else "no pair tested")
-            + (f"; fewer than {rules.min_distinct_poses} common distinct poses: {', '.join(short)}" if short else ""))
+    text = (
+        "median ratio of optimal forces on the distinct poses where both succeed (poses): "
+        + ("; ".join(shown) if shown else "no pair tested")
+        + (f"; fewer than {rules.min_distinct_poses} common distinct poses: {', '.join(short)}" if short else "")
+    )
     return text, _worst_of(compared, counts, band, rules.min_distinct_poses, unit)
 
 
 STATEMENTS = {
     1: ("every object reaches 100 % of the full set's force-closure poses by k = {first}", "Table II"),
     2: ("the first {first} synergies reach force closure wherever the full set does", "full_not_first7 table"),
-    3: ("local minima are preserved as synergies are added, well above chance (share >= 90 % and above the null "
-        "model's 97.5 percentile)", "Fig. 4, minimum_preservation and preservation_vs_chance tables"),
+    3: (
+        "local minima are preserved as synergies are added, well above chance (share >= 90 % and above the null "
+        "model's 97.5 percentile)",
+        "Fig. 4, minimum_preservation and preservation_vs_chance tables",
+    ),
     4: ("S1 is the best single synergy for force closure", "Fig. 5A"),
-    5: ("S4 and S5 are more useful for force closure than S2 and S3, as single synergies and as the second "
-        "synergy with S1", "Fig. 5A"),
+    5: (
+        "S4 and S5 are more useful for force closure than S2 and S3, as single synergies and as the second synergy with S1",
+        "Fig. 5A",
+    ),
     6: ("the best pair (by success rate) contains S1 and S5", "Fig. 5A"),
-    7: ("among single synergies, S4, S5 and S1 need the lowest forces (like with like: two sets on the poses "
-        "where both succeed)", "Fig. 5B"),
-    8: ("an incremental planner reaches <= 5 % regret at a lower cost (solve time) than the best planner that "
-        "solves only the full set", "planners and planners_across tables, figures/planners.png"),
+    7: (
+        "among single synergies, S4, S5 and S1 need the lowest forces (like with like: two sets on the poses where both succeed)",
+        "Fig. 5B",
+    ),
+    8: (
+        "an incremental planner reaches <= 5 % regret at a lower cost (solve time) than the best planner that "
+        "solves only the full set",
+        "planners and planners_across tables, figures/planners.png",
+    ),
 }
 
 
-def claims_table(counts: StudyCounts, minima: pd.DataFrame, chance: pd.DataFrame, rules: VerdictRules,
-                 first: int = 7) -> pd.DataFrame:
+def claims_table(
+    counts: StudyCounts, minima: pd.DataFrame, chance: pd.DataFrame, rules: VerdictRules, first: int = 7
+) -> pd.DataFrame:
     """The seven claims (docs/analyses.md), one row per (claim, view), the headline view first.
 
     ``counts``: the study's resampled success counts; ``minima``: per object, the (rows,)
@@ -287,8 +375,24 @@ def claims_table(counts: StudyCounts, minima: pd.DataFrame, chance: pd.DataFrame
         verdict, reason = interval_verdict(d, rules.min_distinct_poses)
         statement, tested_by = STATEMENTS[claim]
         headline = view == rules.headline_view or claim in (1, 7)
-        rows.append((claim, view, headline, statement.format(first=first), tested_by, text, d.estimate, d.low,
-                     d.high, d.unit, d.band, d.n, verdict, reason))
+        rows.append(
+            (
+                claim,
+                view,
+                headline,
+                statement.format(first=first),
+                tested_by,
+                text,
+                d.estimate,
+                d.low,
+                d.high,
+                d.unit,
+                d.band,
+                d.n,
+                verdict,
+                reason,
+            )
+        )
     return pd.DataFrame(rows, columns=CLAIM_COLUMNS)
 
 
@@ -311,10 +415,14 @@ def planner_claim(per_object: pd.DataFrame, rules: VerdictRules) -> pd.DataFrame
         d = Difference(np.nan, np.nan, np.nan, band, n, unit="% of the full-set planner's solve time")
     else:
         d = Difference(c.mean, c.low, c.high, band, n, unit="% of the full-set planner's solve time")
-        text = (f"{c.incremental} against {c.full_set} over {n} objects: solve time {c.mean:.1f} % lower "
-                f"[{c.low:.1f}, {c.high:.1f}] (negative: higher); closures {c.closures_incremental:.0f} against "
-                f"{c.closures_full_set:.0f} (mean)")
+        text = (
+            f"{c.incremental} against {c.full_set} over {n} objects: solve time {c.mean:.1f} % lower "
+            f"[{c.low:.1f}, {c.high:.1f}] (negative: higher); closures {c.closures_incremental:.0f} against "
+            f"{c.closures_full_set:.0f} (mean)"
+        )
         verdict, reason = interval_verdict(d, 0)
     statement, tested_by = STATEMENTS[8]
-    return pd.DataFrame([(8, "across_objects", True, statement, tested_by, text, d.estimate, d.low, d.high, d.unit,
-                          d.band, n, verdict, reason)], columns=CLAIM_COLUMNS)
+    return pd.DataFrame(
+        [(8, "across_objects", True, statement, tested_by, text, d.estimate, d.low, d.high, d.unit, d.band, n, verdict, reason)],
+        columns=CLAIM_COLUMNS,
+    )

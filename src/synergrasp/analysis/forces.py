@@ -49,16 +49,37 @@ def force_summary(table: pd.DataFrame, full_set_id: str) -> pd.DataFrame:
     work["ratio_nm"] = work["ratio"].where(~work["marginal"])
     work["force_nm"] = work["success_force"].where(~work["marginal"])
     work["ratio_undefined"] = work["success"] & work["ratio"].isna()
-    out = work.groupby(["object", "set_id"], sort=False).agg(
-        n_success=("success", "sum"), n_marginal=("marginal", "sum"), n_ratio_undefined=("ratio_undefined", "sum"),
-        force_ratio_median=("ratio", "median"), force_ratio_median_non_marginal=("ratio_nm", "median"),
-        plain_mean_force_N=("success_force", "mean"), plain_median_force_N=("success_force", "median"),
-        plain_mean_force_non_marginal_N=("force_nm", "mean"),
-        plain_median_force_non_marginal_N=("force_nm", "median")).reset_index()
+    out = (
+        work.groupby(["object", "set_id"], sort=False)
+        .agg(
+            n_success=("success", "sum"),
+            n_marginal=("marginal", "sum"),
+            n_ratio_undefined=("ratio_undefined", "sum"),
+            force_ratio_median=("ratio", "median"),
+            force_ratio_median_non_marginal=("ratio_nm", "median"),
+            plain_mean_force_N=("success_force", "mean"),
+            plain_median_force_N=("success_force", "median"),
+            plain_mean_force_non_marginal_N=("force_nm", "mean"),
+            plain_median_force_non_marginal_N=("force_nm", "median"),
+        )
+        .reset_index()
+    )
     out["marginal_percent"] = 100.0 * out["n_marginal"] / out["n_success"].where(out["n_success"] > 0)
     for c in ("n_success", "n_marginal", "n_ratio_undefined"):
         out[c] = out[c].astype("int64")
-    return out[["object", "set_id", "n_success", "n_marginal", "marginal_percent", "force_ratio_median",
-                "force_ratio_median_non_marginal", "n_ratio_undefined", "plain_mean_force_N",
-                "plain_median_force_N", "plain_mean_force_non_marginal_N", "plain_median_force_non_marginal_N"]]
-
+    return out[
+        [
+            "object",
+            "set_id",
+            "n_success",
+            "n_marginal",
+            "marginal_percent",
+            "force_ratio_median",
+            "force_ratio_median_non_marginal",
+            "n_ratio_undefined",
+            "plain_mean_force_N",
+            "plain_median_force_N",
+            "plain_mean_force_non_marginal_N",
+            "plain_median_force_non_marginal_N",
+        ]
+    ]

@@ -25,8 +25,7 @@ from synergrasp.analysis.verdicts import verdict_columns
 from synergrasp.ids import set_members, set_name
 from synergrasp.tables import GRASPABLE_OBJECTS
 
-__all__ = ["graspable_objects", "with_left_out", "studied", "ungraspable_lines", "grasp_types_of", "fallback_lines",
-           "LEFT_OUT"]
+__all__ = ["graspable_objects", "with_left_out", "studied", "ungraspable_lines", "grasp_types_of", "fallback_lines", "LEFT_OUT"]
 
 #: How the reason of an object left out before the study begins.
 LEFT_OUT = "left out: "
@@ -53,8 +52,10 @@ def _reason(rows: pd.DataFrame, n_fc: int, dynamic: bool, full_set_id: str) -> s
     if n_fc:
         return ""
     if dynamic and not rows.loc[grasps, "settled"].astype(bool).any():
-        return ("no pose settled: every closure stopped at closure.dynamic.time_limit_s, and no force closure "
-                f"with the full set {_set_name(full_set_id)}")
+        return (
+            "no pose settled: every closure stopped at closure.dynamic.time_limit_s, and no force closure "
+            f"with the full set {_set_name(full_set_id)}"
+        )
     return f"no force closure with the full set {_set_name(full_set_id)} at any of the {int(grasps.sum())} grasps"
 
 
@@ -73,12 +74,16 @@ def grasp_types_of(grasp_types: Mapping[str, str], placements: Sequence[pd.DataF
 def fallback_lines(table: pd.DataFrame) -> list[str]:
     """One line per object of a graspable-objects table whose effective grasp type is not its
     stated one (version 3's fallback), with the reason."""
-    return [f"{row.object}: stated grasp type {row.stated_type}, effective {row.effective_type} ({row.type_reason})"
-            for row in table.itertuples() if row.stated_type != row.effective_type]
+    return [
+        f"{row.object}: stated grasp type {row.stated_type}, effective {row.effective_type} ({row.type_reason})"
+        for row in table.itertuples()
+        if row.stated_type != row.effective_type
+    ]
 
 
-def graspable_objects(contacts: pd.DataFrame, gfo: pd.DataFrame, full_set_id: str,
-                      types: Mapping[str, tuple[str, str, str]] | None = None) -> pd.DataFrame:
+def graspable_objects(
+    contacts: pd.DataFrame, gfo: pd.DataFrame, full_set_id: str, types: Mapping[str, tuple[str, str, str]] | None = None
+) -> pd.DataFrame:
     """One row per object of ``contacts`` (contacts tables of every object): poses, closures
     that ran, touching grasps, grasps that settled, force-closure poses with the full set
     ``full_set_id`` (from ``gfo``), whether any pose is graspable and, if none is, why; its
@@ -92,10 +97,19 @@ def graspable_objects(contacts: pd.DataFrame, gfo: pd.DataFrame, full_set_id: st
         dynamic = bool((group["closure_model"] == "dynamic").any())
         grasps = group["status"] == "grasp"
         reason = _reason(group, n_fc, dynamic, full_set_id)
-        rows.append({"object": obj, "poses": len(group), "simulated": int(group["status"].isin(_RAN).sum()),
-                     "grasps": int(grasps.sum()), "settled": int(group.loc[grasps, "settled"].astype(bool).sum()),
-                     "force_closure_full_set": n_fc, "graspable": not reason, "reason": reason,
-                     **dict(zip(("stated_type", "effective_type", "type_reason"), types.get(obj, ("", "", ""))))})
+        rows.append(
+            {
+                "object": obj,
+                "poses": len(group),
+                "simulated": int(group["status"].isin(_RAN).sum()),
+                "grasps": int(grasps.sum()),
+                "settled": int(group.loc[grasps, "settled"].astype(bool).sum()),
+                "force_closure_full_set": n_fc,
+                "graspable": not reason,
+                "reason": reason,
+                **dict(zip(("stated_type", "effective_type", "type_reason"), types.get(obj, ("", "", "")))),
+            }
+        )
     return pd.DataFrame(rows, columns=list(GRASPABLE_OBJECTS.names))
 
 
@@ -103,10 +117,25 @@ def with_left_out(table: pd.DataFrame, left_out: Sequence[tuple[str, str]]) -> p
     """A graspable-objects table with one more row per (object, reason) left out before the
     study (a drawn mesh that cannot be read, is degenerate or differs from its manifest):
     nothing simulated, not graspable, reason ``left out: <reason>``."""
-    extra = pd.DataFrame([{"object": name, "poses": 0, "simulated": 0, "grasps": 0, "settled": 0,
-                           "force_closure_full_set": 0, "graspable": False, "reason": f"{LEFT_OUT}{reason}",
-                           "stated_type": "", "effective_type": "", "type_reason": ""}
-                          for name, reason in left_out], columns=list(GRASPABLE_OBJECTS.names))
+    extra = pd.DataFrame(
+        [
+            {
+                "object": name,
+                "poses": 0,
+                "simulated": 0,
+                "grasps": 0,
+                "settled": 0,
+                "force_closure_full_set": 0,
+                "graspable": False,
+                "reason": f"{LEFT_OUT}{reason}",
+                "stated_type": "",
+                "effective_type": "",
+                "type_reason": "",
+            }
+            for name, reason in left_out
+        ],
+        columns=list(GRASPABLE_OBJECTS.names),
+    )
     return pd.concat([table, extra], ignore_index=True) if len(extra) else table
 
 

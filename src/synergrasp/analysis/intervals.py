@@ -48,8 +48,7 @@ class StudyCounts:
     def __init__(self, table: pd.DataFrame, full_set_id: str, resampler: PoseResampler):
         self.resampler = resampler
         self.full = full_set_id
-        self.sets: list[str] = sorted(table["set_id"].astype(str).unique(),
-                                      key=set_order)
+        self.sets: list[str] = sorted(table["set_id"].astype(str).unique(), key=set_order)
         self.objects = resampler.objects
         self._success: dict[str, NDArray] = {}
         self._force: dict[str, NDArray] = {}
@@ -113,16 +112,21 @@ class StudyCounts:
     def n_any(self, set_ids: Sequence[str]) -> int:
         """Distinct poses, over the counted objects, where at least one of ``set_ids`` succeeds."""
         present = [s for s in set_ids if self.has(s)]
-        return int(sum(np.column_stack([self.success(o, s) for s in present]).any(axis=1).sum()
-                       for o in self.counted_objects())) if present else 0
+        return (
+            int(sum(np.column_stack([self.success(o, s) for s in present]).any(axis=1).sum() for o in self.counted_objects()))
+            if present
+            else 0
+        )
 
     def n_lost(self, small: str) -> tuple[NDArray, NDArray]:
         """(rows,) weighted counts, over the counted objects, of the full set's distinct
         successes and of those where ``small`` does not succeed."""
         objects = self.counted_objects()
         full = sum((self.count(o, self.full) for o in objects), np.zeros(self.rows))
-        lost = sum((self.resampler.sums(o, (self.success(o, self.full) & ~self.success(o, small)).astype(float))
-                    for o in objects), np.zeros(self.rows))
+        lost = sum(
+            (self.resampler.sums(o, (self.success(o, self.full) & ~self.success(o, small)).astype(float)) for o in objects),
+            np.zeros(self.rows),
+        )
         return full, lost
 
     def paired_log_ratio(self, a: str, b: str) -> tuple[NDArray, int]:

@@ -46,9 +46,12 @@ def check_success_rates(rates: pd.DataFrame, tolerance_percent: float) -> list[s
         raise InvariantError(
             f"success rate above 100 % + analyses.success_rate_tolerance_percent ({tolerance_percent}) in "
             f"{len(far)} (object, set) rows ({listed}): a set succeeds on poses where the full set does not; "
-            "check the synergy file and the solver settings")
-    return [f"success rate {r.success_rate:.4g} % (above 100 %, within the tolerance) for {r.object} {{{r.set_id}}}"
-            for r in over.itertuples()]
+            "check the synergy file and the solver settings"
+        )
+    return [
+        f"success rate {r.success_rate:.4g} % (above 100 %, within the tolerance) for {r.object} {{{r.set_id}}}"
+        for r in over.itertuples()
+    ]
 
 
 def superset_inconsistencies(table: pd.DataFrame, column: str = "success") -> pd.DataFrame:
@@ -73,8 +76,9 @@ def _row(check: str, obj: str, count: int, detail: str) -> dict:
     return {"check": check, "object": obj, "count": int(count), "detail": detail}
 
 
-def invariant_checks(table: pd.DataFrame, rates: pd.DataFrame, periods: dict[str, float],
-                     tolerance_percent: float) -> pd.DataFrame:
+def invariant_checks(
+    table: pd.DataFrame, rates: pd.DataFrame, periods: dict[str, float], tolerance_percent: float
+) -> pd.DataFrame:
     """Every check, one row per (check, object): count of offending items and a detail.
     Raises :class:`InvariantError` for a success rate beyond the tolerance; warns
     (``warnings.warn``) for every other non-zero count."""
@@ -84,32 +88,69 @@ def invariant_checks(table: pd.DataFrame, rates: pd.DataFrame, periods: dict[str
     for obj in sorted(set(table["object"].unique())):
         own = table[table["object"] == obj]
         bad = inconsistent[inconsistent["object"] == obj].sort_values("n_poses", ascending=False)
-        named = "; ".join(f"{{{r.set_id}}} succeeds, {{{r.superset_id}}} does not: {r.n_poses} poses"
-                          for r in bad.head(_SHOWN).itertuples())
-        rows.append(_row("nested_sets", obj, bad["n_poses"].sum(),
-                         f"{len(bad)} (set, superset) pairs; {named}" if len(bad) else "success is monotone in the sets"))
+        named = "; ".join(
+            f"{{{r.set_id}}} succeeds, {{{r.superset_id}}} does not: {r.n_poses} poses" for r in bad.head(_SHOWN).itertuples()
+        )
+        rows.append(
+            _row(
+                "nested_sets",
+                obj,
+                bad["n_poses"].sum(),
+                f"{len(bad)} (set, superset) pairs; {named}" if len(bad) else "success is monotone in the sets",
+            )
+        )
         beyond = own["force_beyond_solver"] if "force_beyond_solver" in own else pd.Series(False, index=own.index)
         lost = own["verdict_force_closure"] & ~np.isfinite(own["force_norm"].to_numpy(float)) & ~beyond
-        rows.append(_row("force_closure_has_optimal_force", obj, lost.sum(),
-                         "force-closure (pose, set) rows without an optimal force under the weight, unexplained"))
+        rows.append(
+            _row(
+                "force_closure_has_optimal_force",
+                obj,
+                lost.sum(),
+                "force-closure (pose, set) rows without an optimal force under the weight, unexplained",
+            )
+        )
         explained = own[beyond.to_numpy(bool)]
-        listed = "; ".join(f"{{{r.set_id}}} at alpha {r.alpha_deg:g}, beta {r.beta_deg:g}: a superset needs "
-                           f"{r.force_lower_bound_N:.0f} N" for r in explained.head(_SHOWN).itertuples())
-        rows.append(_row("force_beyond_solver", obj, len(explained),
-                         ("force closure whose optimal force under the weight exceeds the solver's accuracy (no "
-                          "force; a superset at the pose already needs more than the bound): reclassified "
-                          f"load-feasible, never bounded (not a warning); {listed}") if len(explained)
-                         else "none"))
+        listed = "; ".join(
+            f"{{{r.set_id}}} at alpha {r.alpha_deg:g}, beta {r.beta_deg:g}: a superset needs {r.force_lower_bound_N:.0f} N"
+            for r in explained.head(_SHOWN).itertuples()
+        )
+        rows.append(
+            _row(
+                "force_beyond_solver",
+                obj,
+                len(explained),
+                (
+                    "force closure whose optimal force under the weight exceeds the solver's accuracy (no "
+                    "force; a superset at the pose already needs more than the bound): reclassified "
+                    f"load-feasible, never bounded (not a warning); {listed}"
+                )
+                if len(explained)
+                else "none",
+            )
+        )
         period = float(periods.get(obj, 360.0))
         broken = period_violations(own, period)
         poses = broken[["alpha_deg", "beta_deg"]].drop_duplicates()
-        rows.append(_row("alpha_period", obj, len(poses),
-                         f"period {period:g} deg: {len(poses)} poses whose results differ at alpha + period "
-                         f"({len(broken)} (pose, set) rows)"))
+        rows.append(
+            _row(
+                "alpha_period",
+                obj,
+                len(poses),
+                f"period {period:g} deg: {len(poses)} poses whose results differ at alpha + period "
+                f"({len(broken)} (pose, set) rows)",
+            )
+        )
         over = rates[(rates["object"] == obj) & (rates["success_rate"] > 100.0)]
-        rows.append(_row("success_rate_at_most_100", obj, len(over),
-                         f"sets above 100 %, within the tolerance of {tolerance_percent} percentage points"
-                         if len(over) else "no rate above 100 %"))
+        rows.append(
+            _row(
+                "success_rate_at_most_100",
+                obj,
+                len(over),
+                f"sets above 100 %, within the tolerance of {tolerance_percent} percentage points"
+                if len(over)
+                else "no rate above 100 %",
+            )
+        )
     out = pd.DataFrame(rows, columns=CHECK_COLUMNS)
     for r in out[(out["count"] > 0) & (out["check"] != "force_beyond_solver")].itertuples():
         messages.append(f"invariant check {r.check} ({r.object}): {r.count} — {r.detail}")

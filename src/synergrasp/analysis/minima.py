@@ -40,7 +40,6 @@ FORCE_TIE_RTOL = 1e-5
 MINIMA_COLUMNS = ("object", "set_id", "n_synergies", "pose", "alpha_deg", "beta_deg", "force_norm")
 
 
-
 @dataclass(frozen=True)
 class MinimaParams:
     """Local minima of one object (the ``minima`` step): neighbourhood radius (deg), the
@@ -55,8 +54,8 @@ class MinimaParams:
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> MinimaParams:
         """From a configuration or the step's own part of it, for the object ``obj``."""
-        return cls(float(config["analyses"]["minima_radius_deg"]), config["analyses"]["success"],
-                   **force_bound(config, obj))
+        return cls(float(config["analyses"]["minima_radius_deg"]), config["analyses"]["success"], **force_bound(config, obj))
+
 
 def _as_1d(name: str, values: ArrayLike, n: int | None = None, dtype: type = float) -> NDArray:
     arr = np.asarray(values, dtype=dtype)
@@ -66,8 +65,9 @@ def _as_1d(name: str, values: ArrayLike, n: int | None = None, dtype: type = flo
     return arr
 
 
-def _within(alpha_a: NDArray, beta_a: NDArray, alpha_b: NDArray, beta_b: NDArray,
-            radius_deg: float, alpha_period_deg: float) -> NDArray[np.bool_]:
+def _within(
+    alpha_a: NDArray, beta_a: NDArray, alpha_b: NDArray, beta_b: NDArray, radius_deg: float, alpha_period_deg: float
+) -> NDArray[np.bool_]:
     """(..., len a, len b) mask: pose b within ±radius of pose a in wrapped α and in β (deg);
     leading axes of b (several sets of poses b) broadcast."""
     d_alpha = np.abs(alpha_a[..., :, None] - alpha_b[..., None, :]) % alpha_period_deg
@@ -83,8 +83,14 @@ def _check_radius(radius_deg: float, alpha_period_deg: float) -> None:
         raise ValueError(f"alpha_period_deg must be a finite number > 0; got {alpha_period_deg}")
 
 
-def local_minima(alpha_deg: ArrayLike, beta_deg: ArrayLike, force: ArrayLike, force_closure: ArrayLike,
-                 radius_deg: float = 10.0, alpha_period_deg: float = 360.0) -> NDArray[np.bool_]:
+def local_minima(
+    alpha_deg: ArrayLike,
+    beta_deg: ArrayLike,
+    force: ArrayLike,
+    force_closure: ArrayLike,
+    radius_deg: float = 10.0,
+    alpha_period_deg: float = 360.0,
+) -> NDArray[np.bool_]:
     """Local minima of the optimal force over one object's pose grid, for one synergy set.
 
     Parameters
@@ -114,8 +120,7 @@ def local_minima(alpha_deg: ArrayLike, beta_deg: ArrayLike, force: ArrayLike, fo
     closure = np.flatnonzero(fc)
     if candidates.size == 0:
         return result
-    near = _within(alpha[candidates], beta[candidates], alpha[closure], beta[closure],
-                   radius_deg, alpha_period_deg)
+    near = _within(alpha[candidates], beta[candidates], alpha[closure], beta[closure], radius_deg, alpha_period_deg)
     near &= candidates[:, None] != closure[None, :]  # a pose is not its own neighbour
     # lowest force among each candidate's force-closure neighbours (inf if none)
     lowest = np.where(near, f[closure][None, :], np.inf).min(axis=1)
@@ -123,8 +128,14 @@ def local_minima(alpha_deg: ArrayLike, beta_deg: ArrayLike, force: ArrayLike, fo
     return result
 
 
-def preserved(minima_alpha: ArrayLike, minima_beta: ArrayLike, next_alpha: ArrayLike, next_beta: ArrayLike,
-              radius_deg: float = 10.0, alpha_period_deg: float = 360.0) -> NDArray[np.bool_]:
+def preserved(
+    minima_alpha: ArrayLike,
+    minima_beta: ArrayLike,
+    next_alpha: ArrayLike,
+    next_beta: ArrayLike,
+    radius_deg: float = 10.0,
+    alpha_period_deg: float = 360.0,
+) -> NDArray[np.bool_]:
     """For each minimum of {S1..Sk}: does {S1..Sk+1} have a minimum within ±radius (α wraps)?
 
     Parameters
@@ -146,8 +157,14 @@ def preserved(minima_alpha: ArrayLike, minima_beta: ArrayLike, next_alpha: Array
     return _within(a, b, na, nb, radius_deg, alpha_period_deg).any(axis=1)
 
 
-def preserved_counts(minima_alpha: NDArray, minima_beta: NDArray, next_alpha: NDArray, next_beta: NDArray,
-                     radius_deg: float = 10.0, alpha_period_deg: float = 360.0) -> NDArray[np.int64]:
+def preserved_counts(
+    minima_alpha: NDArray,
+    minima_beta: NDArray,
+    next_alpha: NDArray,
+    next_beta: NDArray,
+    radius_deg: float = 10.0,
+    alpha_period_deg: float = 360.0,
+) -> NDArray[np.int64]:
     """For each row of ``next_alpha``, ``next_beta`` ((d, m'): d sets of minima, deg): how many
     of the m minima ``minima_alpha``, ``minima_beta`` it preserves (:func:`preserved`, summed);
     (d,) counts, computed a few hundred rows at a time."""
@@ -174,20 +191,26 @@ def minima_table(table: pd.DataFrame, radius_deg: float = 10.0, alpha_period_deg
     Columns: object, set_id, n_synergies, pose, alpha_deg, beta_deg, force_norm (N);
     rows sorted by object, n_synergies, set_id, pose.
     """
-    missing = [c for c in ("object", "set_id", "n_synergies", "pose", "alpha_deg", "beta_deg",
-                           "success", "success_force") if c not in table.columns]
+    missing = [
+        c
+        for c in ("object", "set_id", "n_synergies", "pose", "alpha_deg", "beta_deg", "success", "success_force")
+        if c not in table.columns
+    ]
     if missing:
         raise ValueError(f"gfo table: missing columns {missing}")
     parts = []
     for _, group in table.groupby(["object", "set_id"], sort=False):
         force = group["success_force"].to_numpy(float)
         success = group["success"].to_numpy(dtype=bool) & np.isfinite(force)
-        mask = local_minima(group["alpha_deg"].to_numpy(), group["beta_deg"].to_numpy(), force, success,
-                            radius_deg, alpha_period_deg)
-        parts.append(group.loc[mask, list(MINIMA_COLUMNS[:-1]) + ["success_force"]]
-                     .rename(columns={"success_force": "force_norm"}))
+        mask = local_minima(
+            group["alpha_deg"].to_numpy(), group["beta_deg"].to_numpy(), force, success, radius_deg, alpha_period_deg
+        )
+        parts.append(
+            group.loc[mask, list(MINIMA_COLUMNS[:-1]) + ["success_force"]].rename(columns={"success_force": "force_norm"})
+        )
     if not parts:
-        return pd.DataFrame({c: pd.Series(dtype=table[c].dtype) for c in MINIMA_COLUMNS[:-1]}
-                            | {"force_norm": pd.Series(dtype=float)})
+        return pd.DataFrame(
+            {c: pd.Series(dtype=table[c].dtype) for c in MINIMA_COLUMNS[:-1]} | {"force_norm": pd.Series(dtype=float)}
+        )
     out = pd.concat(parts, ignore_index=True)
     return out.sort_values(["object", "n_synergies", "set_id", "pose"], ignore_index=True)

@@ -28,8 +28,17 @@ import pandas as pd
 
 from synergrasp.ids import incremental_set_id, set_id
 
-__all__ = ["ObjectsSummaryParams", "object_rows", "planner_budget", "planner_columns", "SOLVE_SHARE_BUDGET", "REGRET_BUDGET",
-           "across_objects", "RESAMPLES", "SEED"]
+__all__ = [
+    "ObjectsSummaryParams",
+    "object_rows",
+    "planner_budget",
+    "planner_columns",
+    "SOLVE_SHARE_BUDGET",
+    "REGRET_BUDGET",
+    "across_objects",
+    "RESAMPLES",
+    "SEED",
+]
 
 #: The planner's aims (docs/planner.md): at most this share of the exhaustive solves (%), and a
 #: pose whose force is at most this far above the exhaustive minimum (%).
@@ -39,8 +48,15 @@ SOLVE_SHARE_BUDGET, REGRET_BUDGET = 20.0, 5.0
 RESAMPLES, SEED = 1000, 2018
 
 
-def object_rows(success_rates: pd.DataFrame, preservation: pd.DataFrame, graspable: pd.DataFrame,
-                plans: pd.DataFrame, enrollment: pd.DataFrame, n_full: int, hierarchy_first: int) -> pd.DataFrame:
+def object_rows(
+    success_rates: pd.DataFrame,
+    preservation: pd.DataFrame,
+    graspable: pd.DataFrame,
+    plans: pd.DataFrame,
+    enrollment: pd.DataFrame,
+    n_full: int,
+    hierarchy_first: int,
+) -> pd.DataFrame:
     """One row per object of ``graspable`` (the study's tables as written, concatenated plan and
     enrollment tables of every object)."""
     rates = success_rates[success_rates["view"] == "object"].set_index(["object", "set_id"])["success_rate"]
@@ -72,8 +88,10 @@ def object_rows(success_rates: pd.DataFrame, preservation: pd.DataFrame, graspab
 def planner_columns(rows: pd.DataFrame, radius_deg: float) -> tuple[pd.Series, pd.Series]:
     """The planner's share of the exhaustive solves and its force regret (both %) at
     ``radius_deg``, per row of the summary (NaN where there is no plan or no column)."""
-    return tuple(pd.to_numeric(rows[c], errors="coerce") if c in rows else pd.Series(np.nan, index=rows.index)
-                 for c in (f"solve_share_percent_{radius_deg:g}", f"regret_percent_{radius_deg:g}"))
+    return tuple(
+        pd.to_numeric(rows[c], errors="coerce") if c in rows else pd.Series(np.nan, index=rows.index)
+        for c in (f"solve_share_percent_{radius_deg:g}", f"regret_percent_{radius_deg:g}")
+    )
 
 
 def planner_budget(rows: pd.DataFrame, radii: Sequence[float]) -> pd.DataFrame:
@@ -86,9 +104,16 @@ def planner_budget(rows: pd.DataFrame, radii: Sequence[float]) -> pd.DataFrame:
         share, regret = planner_columns(rows, r)
         planned = share.notna() & regret.notna()
         cheap, close = planned & (share <= SOLVE_SHARE_BUDGET), planned & (regret <= REGRET_BUDGET)
-        out.append({"radius_deg": float(r), "objects": int(planned.sum()), "within_solves": int(cheap.sum()),
-                    "within_regret": int(close.sum()), "within_both": int((cheap & close).sum()),
-                    "every_object_within_regret": bool(planned.any() and close[planned].all())})
+        out.append(
+            {
+                "radius_deg": float(r),
+                "objects": int(planned.sum()),
+                "within_solves": int(cheap.sum()),
+                "within_regret": int(close.sum()),
+                "within_both": int((cheap & close).sum()),
+                "every_object_within_regret": bool(planned.any() and close[planned].all()),
+            }
+        )
     return pd.DataFrame(out)
 
 
@@ -117,8 +142,17 @@ def across_objects(rows: pd.DataFrame, columns: Sequence[str]) -> pd.DataFrame:
             mean, median = values.mean() * scale, float(np.median(values)) * scale
         else:
             low = high = mean = median = np.nan
-        out.append({"quantity": column, "unit": "% of objects" if share else _unit(column), "n_objects": values.size,
-                    "mean": mean, "low": low, "high": high, "median": median})
+        out.append(
+            {
+                "quantity": column,
+                "unit": "% of objects" if share else _unit(column),
+                "n_objects": values.size,
+                "mean": mean,
+                "low": low,
+                "high": high,
+                "median": median,
+            }
+        )
     return pd.DataFrame(out)
 
 
@@ -144,10 +178,19 @@ class ObjectsSummaryParams:
     def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> ObjectsSummaryParams:
         """From a configuration or the step's own part of it."""
         sets = config["synergy_sets"]
-        return cls(int(sets["incremental_max"]), int(sets["hierarchy_first"]),
-                   tuple(float(r) for r in config["analyses"]["planner_radii_deg"]), config.get("random_objects"))
+        return cls(
+            int(sets["incremental_max"]),
+            int(sets["hierarchy_first"]),
+            tuple(float(r) for r in config["analyses"]["planner_radii_deg"]),
+            config.get("random_objects"),
+        )
 
     def quantities(self) -> list[str]:
         """The columns summarised across objects."""
-        return ["preserved_percent", "s1_minus_best_other", "k_full", "greedy_k_full",
-                *(f"{q}_{r:g}" for r in self.radii_deg for q in ("solve_share_percent", "regret_percent", "global_min"))]
+        return [
+            "preserved_percent",
+            "s1_minus_best_other",
+            "k_full",
+            "greedy_k_full",
+            *(f"{q}_{r:g}" for r in self.radii_deg for q in ("solve_share_percent", "regret_percent", "global_min")),
+        ]

@@ -36,9 +36,14 @@ _CANDIDATES_DEG = (90.0, 120.0, 180.0)
 def _candidates_deg(step_deg: float) -> list[float]:
     """The candidate periods, deg: the box's, and every divisor of 360° below it that is a
     whole number of α grid steps, ascending."""
-    on_grid = [k * step_deg for k in range(1, int(180.0 // step_deg) + 1)
-               if abs(360.0 / (k * step_deg) - round(360.0 / (k * step_deg))) < 1e-9]
+    on_grid = [
+        k * step_deg
+        for k in range(1, int(180.0 // step_deg) + 1)
+        if abs(360.0 / (k * step_deg) - round(360.0 / (k * step_deg))) < 1e-9
+    ]
     return sorted(set(_CANDIDATES_DEG) | set(on_grid))
+
+
 _DEG_TOL = 1e-6
 
 
@@ -67,8 +72,9 @@ def alpha_period_deg(placement, shape, palm_normal: Sequence[float] = (1.0, 0.0,
     return 360.0
 
 
-def object_periods(objects: Mapping[str, Mapping[str, Any]], grid: Mapping[str, Any],
-                   hand: str | None = None) -> dict[str, float]:
+def object_periods(
+    objects: Mapping[str, Mapping[str, Any]], grid: Mapping[str, Any], hand: str | None = None
+) -> dict[str, float]:
     """α-period (deg) of every object from the config: ``objects`` maps a name to its
     ``shape`` and effective ``placement`` (the global placement with its override),
     ``grid`` is the config's grid block, ``hand`` the hand file (None: the shipped hand,
@@ -78,9 +84,12 @@ def object_periods(objects: Mapping[str, Mapping[str, Any]], grid: Mapping[str, 
     from synergrasp.simulation.shapes import shape_from_config
 
     normal = load_hand(hand).palm_normal
-    return {name: alpha_period_deg(Placement.from_config(spec["placement"], grid),
-                                   shape_from_config(spec["shape"], f"objects.{name}.shape"), normal)
-            for name, spec in objects.items()}
+    return {
+        name: alpha_period_deg(
+            Placement.from_config(spec["placement"], grid), shape_from_config(spec["shape"], f"objects.{name}.shape"), normal
+        )
+        for name, spec in objects.items()
+    }
 
 
 def distinct_pose_mask(alpha_deg: NDArray, period_deg: float, alpha_start_deg: float | None = None) -> NDArray:
@@ -109,15 +118,15 @@ def period_violations(table: pd.DataFrame, period_deg: float, force_rtol: float 
     columns = ["object", "set_id", "alpha_deg", "beta_deg", "alpha_shifted_deg", "what"]
     if period_deg >= 360.0 - _DEG_TOL or table.empty:
         return pd.DataFrame(columns=columns)
-    keep = ["object", "set_id", "alpha_deg", "beta_deg", "verdict_force_closure", "verdict_load_feasible",
-            "force_norm"]
+    keep = ["object", "set_id", "alpha_deg", "beta_deg", "verdict_force_closure", "verdict_load_feasible", "force_norm"]
     here = table[keep].copy()
     there = table[keep].copy()
     there["alpha_deg"] = np.round((there["alpha_deg"] - period_deg + 180.0) % 360.0 - 180.0, 6)
     here["alpha_deg"] = np.round(here["alpha_deg"], 6)
     pairs = here.merge(there, on=["object", "set_id", "alpha_deg", "beta_deg"], suffixes=("", "_shifted"))
-    verdict = ((pairs["verdict_force_closure"] != pairs["verdict_force_closure_shifted"])
-               | (pairs["verdict_load_feasible"] != pairs["verdict_load_feasible_shifted"]))
+    verdict = (pairs["verdict_force_closure"] != pairs["verdict_force_closure_shifted"]) | (
+        pairs["verdict_load_feasible"] != pairs["verdict_load_feasible_shifted"]
+    )
     f, g = pairs["force_norm"].to_numpy(float), pairs["force_norm_shifted"].to_numpy(float)
     both = np.isfinite(f) & np.isfinite(g)
     force = np.zeros(len(pairs), dtype=bool)

@@ -45,8 +45,9 @@ class OnDemandSolver(StudySolver):
     are not closed yet; twins are found among the poses closed so far (a pose's grasp counts
     once however often it is asked)."""
 
-    def __init__(self, obj: str, n_poses: int, close: Callable[[Sequence[int]], pd.DataFrame], matrix: NDArray,
-                 params: PlanParams) -> None:
+    def __init__(
+        self, obj: str, n_poses: int, close: Callable[[Sequence[int]], pd.DataFrame], matrix: NDArray, params: PlanParams
+    ) -> None:
         Oracle.__init__(self, n_poses, params.n_levels)  # nothing closed yet: no contacts to read
         self.object_name, self.pose_ids = obj, np.arange(n_poses, dtype=np.int64)
         self.grasps: list = [None] * n_poses
@@ -90,8 +91,15 @@ class OnDemandPlan:
     wall_s: float
 
 
-def plan_on_demand(obj: str, grid: PoseGrid, close: Callable[[Sequence[int]], pd.DataFrame], matrix: NDArray,
-                   params: PlanParams, spec: PlannerSpec, seed: int = 0) -> tuple[OnDemandPlan, OnDemandSolver]:
+def plan_on_demand(
+    obj: str,
+    grid: PoseGrid,
+    close: Callable[[Sequence[int]], pd.DataFrame],
+    matrix: NDArray,
+    params: PlanParams,
+    spec: PlannerSpec,
+    seed: int = 0,
+) -> tuple[OnDemandPlan, OnDemandSolver]:
     """Run ``spec`` on object ``obj`` closing the hand only where it asks (module docstring)."""
     t0 = time.perf_counter()
     solver = OnDemandSolver(obj, grid.n_poses, close, matrix, params)
@@ -99,6 +107,6 @@ def plan_on_demand(obj: str, grid: PoseGrid, close: Callable[[Sequence[int]], pd
     pose, force = run_planner(spec, grid, solver, params.n_levels, params.minima.radius_deg, rng)
     wall = time.perf_counter() - t0
     a, b = (float(grid.alpha_deg[pose]), float(grid.beta_deg[pose])) if pose >= 0 else (np.nan, np.nan)
-    return OnDemandPlan(obj, spec.name, seed, pose, a, b, force, int(solver.is_closed.sum()), grid.n_poses,
-                        int(solver.problems.sum()), wall), solver
-
+    return OnDemandPlan(
+        obj, spec.name, seed, pose, a, b, force, int(solver.is_closed.sum()), grid.n_poses, int(solver.problems.sum()), wall
+    ), solver

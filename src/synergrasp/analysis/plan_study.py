@@ -45,9 +45,13 @@ class PlanParams:
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> PlanParams:
         """From a configuration or the step's own part of it, for the object ``obj``."""
-        return cls(tuple(float(r) for r in config["analyses"]["planner_radii_deg"]),
-                   int(config["synergy_sets"]["incremental_max"]), config["synergies"],
-                   GFOParams.from_config(config, obj), MinimaParams.from_config(config, obj))
+        return cls(
+            tuple(float(r) for r in config["analyses"]["planner_radii_deg"]),
+            int(config["synergy_sets"]["incremental_max"]),
+            config["synergies"],
+            GFOParams.from_config(config, obj),
+            MinimaParams.from_config(config, obj),
+        )
 
 
 @dataclass(frozen=True)
@@ -105,8 +109,12 @@ class StudySolver(Oracle):
         for g in grasps:
             if g not in self.mechanics:
                 self.mechanics[g] = mechanics_for(self.grasps[g], self.params.gfo)
-        out = optimise_grasps([self.grasps[g] for g in grasps], SynergySets(self.matrix, tuple(sets)), self.params.gfo,
-                              mechanics=[self.mechanics[g] for g in grasps])
+        out = optimise_grasps(
+            [self.grasps[g] for g in grasps],
+            SynergySets(self.matrix, tuple(sets)),
+            self.params.gfo,
+            mechanics=[self.mechanics[g] for g in grasps],
+        )
         self.n_problems += len(grasps) * len(sets)
         frame = pd.DataFrame({"object": self.object_name, "pose": self.pose_ids[np.repeat(grasps, len(sets))]} | out)
         minima = self.params.minima
@@ -163,20 +171,29 @@ def plan_object(contacts: pd.DataFrame, gfo: pd.DataFrame, matrix: NDArray, para
     for r, plan in plans.items():
         versus = plan_against_exhaustive(plan, full["success"].to_numpy(bool), full["success_force"].to_numpy(float))
         best = plan.best_pose
-        rows.append({"object": str(contacts["object"].iat[0]), "radius_deg": r, "n_levels": n,
-                     "n_solves": plan.n_solves, "n_exhaustive_solves": len(contacts) * n,
-                     "solve_share_percent": 100.0 * plan.n_solves / (len(contacts) * n),
-                     "levels_from_minima": int(sum(plan.from_minima)),
-                     "best_pose": best, "best_alpha_deg": alpha[best] if best >= 0 else np.nan,
-                     "best_beta_deg": beta[best] if best >= 0 else np.nan, "best_force_N": plan.best_force_N,
-                     **versus, "regret_percent": 100.0 * (versus["regret"] - 1.0),
-                     "study_rows_differing": differing})
+        rows.append(
+            {
+                "object": str(contacts["object"].iat[0]),
+                "radius_deg": r,
+                "n_levels": n,
+                "n_solves": plan.n_solves,
+                "n_exhaustive_solves": len(contacts) * n,
+                "solve_share_percent": 100.0 * plan.n_solves / (len(contacts) * n),
+                "levels_from_minima": int(sum(plan.from_minima)),
+                "best_pose": best,
+                "best_alpha_deg": alpha[best] if best >= 0 else np.nan,
+                "best_beta_deg": beta[best] if best >= 0 else np.nan,
+                "best_force_N": plan.best_force_N,
+                **versus,
+                "regret_percent": 100.0 * (versus["regret"] - 1.0),
+                "study_rows_differing": differing,
+            }
+        )
     enrollment = _enrollment(solver, full["success"].to_numpy(bool), judged, contacts, n)
     return ObjectPlan(pd.DataFrame(rows), enrollment, plans, full.reset_index())
 
 
-def _enrollment(solver: StudySolver, full_success: NDArray, judged: pd.DataFrame, contacts: pd.DataFrame,
-                n: int) -> pd.DataFrame:
+def _enrollment(solver: StudySolver, full_success: NDArray, judged: pd.DataFrame, contacts: pd.DataFrame, n: int) -> pd.DataFrame:
     """Greedy order against the PCA order: successes (grid poses) of each order's first k."""
     # The sets are nested, so success only grows with a set: a set succeeds only where the full
     # set does, and every set of a greedy round (the last pick plus one synergy) succeeds
@@ -197,11 +214,19 @@ def _enrollment(solver: StudySolver, full_success: NDArray, judged: pd.DataFrame
     order, greedy = greedy_order(count, n, target)
     pca = [int(judged.loc[judged["set_id"] == incremental_set_id(k), "success"].sum()) for k in range(1, n + 1)]
     pct = (lambda c: 100.0 * c / target) if target else (lambda c: np.nan)
-    return pd.DataFrame({"object": str(contacts["object"].iat[0]), "k": np.arange(1, n + 1),
-                         "greedy_added": order, "greedy_set": [set_id(order[:k]) for k in range(1, n + 1)],
-                         "greedy_n_success": greedy, "greedy_success_rate": [pct(c) for c in greedy],
-                         "pca_n_success": pca, "pca_success_rate": [pct(c) for c in pca],
-                         "full_n_success": target})
+    return pd.DataFrame(
+        {
+            "object": str(contacts["object"].iat[0]),
+            "k": np.arange(1, n + 1),
+            "greedy_added": order,
+            "greedy_set": [set_id(order[:k]) for k in range(1, n + 1)],
+            "greedy_n_success": greedy,
+            "greedy_success_rate": [pct(c) for c in greedy],
+            "pca_n_success": pca,
+            "pca_success_rate": [pct(c) for c in pca],
+            "full_n_success": target,
+        }
+    )
 
 
 @dataclass(frozen=True)
@@ -219,8 +244,9 @@ class PlannersParams:
         none (:func:`minima_for`)."""
         bounded = config["analyses"]["success"] == "force_closure_bounded"
         names = list(config["objects"]) if bounded else [""]
-        return cls(int(config["synergy_sets"]["incremental_max"]),
-                   {name: MinimaParams.from_config(config, name) for name in names})
+        return cls(
+            int(config["synergy_sets"]["incremental_max"]), {name: MinimaParams.from_config(config, name) for name in names}
+        )
 
     def minima_for(self, obj: str) -> MinimaParams:
         """The object's minima policy (the one shared one where no force bound is read)."""
@@ -249,13 +275,20 @@ def replay_oracle(contacts: pd.DataFrame, gfo: pd.DataFrame, n: int, minima: Min
     return lambda: ReplayOracle(success, force, first)
 
 
-def compare_on_study(contacts: pd.DataFrame, gfo: pd.DataFrame, n: int, minima: MinimaParams,
-                     specs: Sequence[PlannerSpec] = CANDIDATES, **kwargs: Any) -> pd.DataFrame:
+def compare_on_study(
+    contacts: pd.DataFrame,
+    gfo: pd.DataFrame,
+    n: int,
+    minima: MinimaParams,
+    specs: Sequence[PlannerSpec] = CANDIDATES,
+    **kwargs: Any,
+) -> pd.DataFrame:
     """Every candidate planner replayed on one object of a study (``planners.compare_planners``'s
     rows): its contacts table (poses in order) and gfo table."""
     contacts = contacts.reset_index(drop=True)
     grid = PoseGrid.from_angles(contacts["alpha_deg"].to_numpy(float), contacts["beta_deg"].to_numpy(float))
     new = replay_oracle(contacts, gfo, n, minima)
     full = new()
-    return compare_planners(str(contacts["object"].iat[0]), grid, new, full.success[n - 1], full.force[n - 1], n,
-                            minima.radius_deg, specs, **kwargs)
+    return compare_planners(
+        str(contacts["object"].iat[0]), grid, new, full.success[n - 1], full.force[n - 1], n, minima.radius_deg, specs, **kwargs
+    )

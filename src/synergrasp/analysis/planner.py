@@ -64,18 +64,26 @@ class Plan:
         return int(sum(s.size for s in self.solved))
 
 
-def _neighbourhood(alpha: NDArray, beta: NDArray, seeds: NDArray[np.int64], radius_deg: float,
-                   alpha_period_deg: float) -> NDArray[np.int64]:
+def _neighbourhood(
+    alpha: NDArray, beta: NDArray, seeds: NDArray[np.int64], radius_deg: float, alpha_period_deg: float
+) -> NDArray[np.int64]:
     """Pose indices within ±radius (α wrapping) of any seed: the minima module's own square
     test (`preserved` asks, per pose, whether a seed lies in its square)."""
     near = preserved(alpha, beta, alpha[seeds], beta[seeds], radius_deg, alpha_period_deg)
     return np.flatnonzero(near).astype(np.int64)
 
 
-def plan_incremental(alpha_deg: ArrayLike, beta_deg: ArrayLike, solve: LevelSolve, n_levels: int,
-                     radius_deg: float, minima_radius_deg: float = 10.0,
-                     alpha_period_deg: float = 360.0, levels: Sequence[int] | None = None,
-                     max_seeds: int | None = None) -> Plan:
+def plan_incremental(
+    alpha_deg: ArrayLike,
+    beta_deg: ArrayLike,
+    solve: LevelSolve,
+    n_levels: int,
+    radius_deg: float,
+    minima_radius_deg: float = 10.0,
+    alpha_period_deg: float = 360.0,
+    levels: Sequence[int] | None = None,
+    max_seeds: int | None = None,
+) -> Plan:
     """Run the planner over a pose grid (module docstring).
 
     alpha_deg, beta_deg: (p,) the grid's poses, deg; solve: :data:`LevelSolve`;
@@ -138,15 +146,22 @@ def plan_against_exhaustive(plan: Plan, full_success: ArrayLike, full_force: Arr
     return pose_against_exhaustive(plan.best_pose, plan.best_force_N, full_success, full_force)
 
 
-def pose_against_exhaustive(best_pose: int, best_force_N: float, full_success: ArrayLike,
-                            full_force: ArrayLike) -> dict[str, float | int | bool]:
+def pose_against_exhaustive(
+    best_pose: int, best_force_N: float, full_success: ArrayLike, full_force: ArrayLike
+) -> dict[str, float | int | bool]:
     """How a planner's pose (index, -1: none) and its full-set force (N) compare with the
     exhaustive search: :func:`plan_against_exhaustive`'s columns."""
     fc = np.asarray(full_success, dtype=bool) & np.isfinite(full_force)
     f = np.where(fc, np.asarray(full_force, dtype=float), np.inf)
     if not fc.any():
-        return {"exhaustive_min_force_N": float("nan"), "exhaustive_best_pose": -1, "is_global_min": False,
-                "rank": 0, "n_ranked": 0, "regret": float("nan")}
+        return {
+            "exhaustive_min_force_N": float("nan"),
+            "exhaustive_best_pose": -1,
+            "is_global_min": False,
+            "rank": 0,
+            "n_ranked": 0,
+            "regret": float("nan"),
+        }
     best = int(np.argmin(f))
     mine = best_force_N
     found = best_pose >= 0
@@ -154,12 +169,19 @@ def pose_against_exhaustive(best_pose: int, best_force_N: float, full_success: A
     is_global = bool(found and mine <= f[best] * (1.0 + FORCE_TIE_RTOL))
     # the minimum itself (or a twin within the tie tolerance): no regret, not rounding's 1 + 1e-16
     regret = 1.0 if is_global else (max(float(mine / f[best]), 1.0) if found else float("nan"))
-    return {"exhaustive_min_force_N": float(f[best]), "exhaustive_best_pose": best, "is_global_min": is_global,
-            "rank": rank, "n_ranked": int(fc.sum()), "regret": regret}
+    return {
+        "exhaustive_min_force_N": float(f[best]),
+        "exhaustive_best_pose": best,
+        "is_global_min": is_global,
+        "rank": rank,
+        "n_ranked": int(fc.sum()),
+        "regret": regret,
+    }
 
 
-def greedy_order(count: Callable[[Sequence[tuple[int, ...]]], NDArray[np.int64]], n_synergies: int,
-                 target: int) -> tuple[tuple[int, ...], NDArray[np.int64]]:
+def greedy_order(
+    count: Callable[[Sequence[tuple[int, ...]]], NDArray[np.int64]], n_synergies: int, target: int
+) -> tuple[tuple[int, ...], NDArray[np.int64]]:
     """The enrollment order the data prefers: start from no synergy; add, each time, the
     synergy whose set has the most successes (``count(sets) -> successes per set``; ties:
     the lower index), until the set reaches ``target`` successes (the full set's); the

@@ -35,9 +35,26 @@ from numpy.typing import NDArray
 
 from synergrasp.analysis.planner import plan_incremental, pose_against_exhaustive
 
-__all__ = ["PoseGrid", "PlannerSpec", "CANDIDATES", "SEEDS", "REGRET_AIM_PERCENT", "PROBABILITY_AIM",
-           "OBJECTS_AIM", "CLOSURE_TIE", "SOLVE_COST_BY_SET_SIZE", "Oracle", "ReplayOracle", "run_planner",
-           "compare_planners", "across_objects", "recommended", "recommendation_line", "Conjecture", "conjecture"]
+__all__ = [
+    "PoseGrid",
+    "PlannerSpec",
+    "CANDIDATES",
+    "SEEDS",
+    "REGRET_AIM_PERCENT",
+    "PROBABILITY_AIM",
+    "OBJECTS_AIM",
+    "CLOSURE_TIE",
+    "SOLVE_COST_BY_SET_SIZE",
+    "Oracle",
+    "ReplayOracle",
+    "run_planner",
+    "compare_planners",
+    "across_objects",
+    "recommended",
+    "recommendation_line",
+    "Conjecture",
+    "conjecture",
+]
 
 #: The aims of the rule (docs/planner.md): a regret of at most this (%), with at least this
 #: probability over the seeds, on at least this share of the objects (%); closures within this
@@ -48,8 +65,23 @@ SEEDS: tuple[int, ...] = tuple(range(200))
 #: Solve time of one (grasp, {S1..Sk}) problem over the full set's, k = 1 … 15 (index k − 1),
 #: the grasp's mechanics included as a planner's level pays them: benchmarks/bench_set_size.py,
 #: recorded in benchmarks/results/set_size.csv (a test checks they agree).
-SOLVE_COST_BY_SET_SIZE: tuple[float, ...] = (0.432, 0.474, 0.457, 0.461, 0.477, 0.525, 0.562, 0.556, 0.656, 0.692,
-                                             0.735, 0.773, 0.877, 0.838, 1.000)
+SOLVE_COST_BY_SET_SIZE: tuple[float, ...] = (
+    0.432,
+    0.474,
+    0.457,
+    0.461,
+    0.477,
+    0.525,
+    0.562,
+    0.556,
+    0.656,
+    0.692,
+    0.735,
+    0.773,
+    0.877,
+    0.838,
+    1.000,
+)
 
 
 @dataclass(frozen=True)
@@ -80,8 +112,7 @@ class PoseGrid:
         """The up to 8 grid neighbours of a pose (α wrapping, β bounded)."""
         na, nb = self.index.shape
         ia, ib = self.cell[pose]
-        out = [self.index[(ia + da) % na, ib + db] for da in (-1, 0, 1) for db in (-1, 0, 1)
-               if (da or db) and 0 <= ib + db < nb]
+        out = [self.index[(ia + da) % na, ib + db] for da in (-1, 0, 1) for db in (-1, 0, 1) if (da or db) and 0 <= ib + db < nb]
         return np.array(sorted({int(v) for v in out if v >= 0 and v != pose}), dtype=np.int64)
 
     def coarse(self, step: int, offset: tuple[int, int]) -> NDArray[np.int64]:
@@ -118,7 +149,7 @@ class PlannerSpec:
         if self.levels == "straight":
             return [1, n] if n > 1 else [1]
         if self.levels == "doubling":
-            return sorted({min(2 ** i, n) for i in range(n.bit_length() + 1)} | {n})
+            return sorted({min(2**i, n) for i in range(n.bit_length() + 1)} | {n})
         return list(range(1, n + 1))
 
 
@@ -130,8 +161,11 @@ def _candidates() -> tuple[PlannerSpec, ...]:
     out += [PlannerSpec(f"incremental_r{r}", "incremental", radius_deg=r) for r in (10, 20, 30)]
     out += [PlannerSpec(f"incremental_m{m}_r{r}", "incremental", radius_deg=r, max_seeds=m) for m in (1, 3) for r in (20, 45)]
     out += [PlannerSpec(f"skip_r{r}", "incremental", radius_deg=r, levels="doubling") for r in (20, 45)]
-    out += [PlannerSpec(f"straight_m{m or 'all'}_r{r}", "incremental", radius_deg=r, max_seeds=m, levels="straight")
-            for m in (1, 3, None) for r in (20, 45)]
+    out += [
+        PlannerSpec(f"straight_m{m or 'all'}_r{r}", "incremental", radius_deg=r, max_seeds=m, levels="straight")
+        for m in (1, 3, None)
+        for r in (20, 45)
+    ]
     return tuple(out)
 
 
@@ -186,8 +220,9 @@ class ReplayOracle(Oracle):
         return ok, np.where(ok, self.force[k - 1, poses], np.nan)
 
 
-def _descent(grid: PoseGrid, known: dict[int, float], ask: Callable[[NDArray[np.int64]], None],
-             starts: NDArray[np.int64]) -> None:
+def _descent(
+    grid: PoseGrid, known: dict[int, float], ask: Callable[[NDArray[np.int64]], None], starts: NDArray[np.int64]
+) -> None:
     """Steepest descent over the 8 neighbours from every start, walkers in lockstep; a pose
     without success is +inf; a walker stops where no neighbour is lower."""
     ask(starts)
@@ -205,14 +240,29 @@ def _descent(grid: PoseGrid, known: dict[int, float], ask: Callable[[NDArray[np.
         walkers = np.unique(np.array(moved, dtype=np.int64))
 
 
-def run_planner(spec: PlannerSpec, grid: PoseGrid, oracle: Oracle, n_levels: int, minima_radius_deg: float,
-                rng: np.random.Generator | None = None) -> tuple[int, float]:
+def run_planner(
+    spec: PlannerSpec,
+    grid: PoseGrid,
+    oracle: Oracle,
+    n_levels: int,
+    minima_radius_deg: float,
+    rng: np.random.Generator | None = None,
+) -> tuple[int, float]:
     """Run one planner; returns its pose (−1: none succeeds) and that pose's full-set force (N):
     the least among the poses where it solved the full set. ``rng`` for a randomised planner."""
     p = grid.n_poses
     if spec.kind == "incremental":
-        plan = plan_incremental(grid.alpha_deg, grid.beta_deg, oracle, n_levels, spec.radius_deg, minima_radius_deg,
-                                360.0, levels=spec.set_sizes(n_levels), max_seeds=spec.max_seeds)
+        plan = plan_incremental(
+            grid.alpha_deg,
+            grid.beta_deg,
+            oracle,
+            n_levels,
+            spec.radius_deg,
+            minima_radius_deg,
+            360.0,
+            levels=spec.set_sizes(n_levels),
+            max_seeds=spec.max_seeds,
+        )
         return plan.best_pose, plan.best_force_N
     known: dict[int, float] = {}
 
@@ -247,33 +297,58 @@ def run_planner(spec: PlannerSpec, grid: PoseGrid, oracle: Oracle, n_levels: int
     return int(poses[j]), float(forces[j])
 
 
-def compare_planners(obj: str, grid: PoseGrid, new_oracle: Callable[[], Oracle], full_success: NDArray[np.bool_],
-                     full_force_N: NDArray[np.float64], n_levels: int, minima_radius_deg: float,
-                     specs: Sequence[PlannerSpec] = CANDIDATES, seeds: Sequence[int] = SEEDS,
-                     costs: Sequence[float] = SOLVE_COST_BY_SET_SIZE) -> pd.DataFrame:
+def compare_planners(
+    obj: str,
+    grid: PoseGrid,
+    new_oracle: Callable[[], Oracle],
+    full_success: NDArray[np.bool_],
+    full_force_N: NDArray[np.float64],
+    n_levels: int,
+    minima_radius_deg: float,
+    specs: Sequence[PlannerSpec] = CANDIDATES,
+    seeds: Sequence[int] = SEEDS,
+    costs: Sequence[float] = SOLVE_COST_BY_SET_SIZE,
+) -> pd.DataFrame:
     """Every planner on one object against the exhaustive search (one row per planner;
     columns of ``tables.PLANNERS`` but the across-objects ones). ``new_oracle()`` gives a
     fresh oracle (empty ledger) per run; a randomised planner runs once per seed."""
     rows = []
     for spec in specs:
         runs = []
-        for seed in (seeds if spec.randomised else (None,)):
+        for seed in seeds if spec.randomised else (None,):
             oracle = new_oracle()
             rng = np.random.default_rng(seed) if seed is not None else None
             pose, force = run_planner(spec, grid, oracle, n_levels, minima_radius_deg, rng)
             versus = pose_against_exhaustive(pose, force, full_success, full_force_N)
-            runs.append((oracle.closures, oracle.solve_cost(costs), int(oracle.problems.sum()),
-                         100.0 * (versus["regret"] - 1.0), bool(versus["is_global_min"])))
+            runs.append(
+                (
+                    oracle.closures,
+                    oracle.solve_cost(costs),
+                    int(oracle.problems.sum()),
+                    100.0 * (versus["regret"] - 1.0),
+                    bool(versus["is_global_min"]),
+                )
+            )
         closures, cost, problems, regret, exact = (np.array(v, dtype=float) for v in zip(*runs))
         within = np.where(np.isfinite(regret), regret <= REGRET_AIM_PERCENT, False)
-        rows.append({"object": obj, "planner": spec.name, "family": spec.family, "randomised": spec.randomised,
-                     "runs": len(runs), "closures": float(closures.mean()),
-                     "closure_share_percent": 100.0 * float(closures.mean()) / grid.n_poses,
-                     "solve_cost": float(cost.mean()), "problems": float(problems.mean()),
-                     "regret_percent_mean": float(np.nanmean(regret)) if np.isfinite(regret).any() else np.nan,
-                     "regret_percent_max": float(np.nanmax(regret)) if np.isfinite(regret).any() else np.nan,
-                     "global_min_probability": float(exact.mean()), "within_aim_probability": float(within.mean()),
-                     "meets_aim": bool(within.mean() >= PROBABILITY_AIM)})
+        rows.append(
+            {
+                "object": obj,
+                "planner": spec.name,
+                "family": spec.family,
+                "randomised": spec.randomised,
+                "runs": len(runs),
+                "closures": float(closures.mean()),
+                "closure_share_percent": 100.0 * float(closures.mean()) / grid.n_poses,
+                "solve_cost": float(cost.mean()),
+                "problems": float(problems.mean()),
+                "regret_percent_mean": float(np.nanmean(regret)) if np.isfinite(regret).any() else np.nan,
+                "regret_percent_max": float(np.nanmax(regret)) if np.isfinite(regret).any() else np.nan,
+                "global_min_probability": float(exact.mean()),
+                "within_aim_probability": float(within.mean()),
+                "meets_aim": bool(within.mean() >= PROBABILITY_AIM),
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -284,15 +359,22 @@ def across_objects(per_object: pd.DataFrame) -> pd.DataFrame:
     judged = per_object[per_object["regret_percent_mean"].notna()]
     rows = []
     for name, part in judged.groupby("planner", sort=False):
-        rows.append({"planner": name, "family": part["family"].iat[0], "randomised": bool(part["randomised"].iat[0]),
-                     "objects": len(part), "objects_meeting_aim": int(part["meets_aim"].sum()),
-                     "meeting_aim_percent": 100.0 * float(part["meets_aim"].mean()),
-                     "closures": float(part["closures"].mean()),
-                     "closure_share_percent": float(part["closure_share_percent"].mean()),
-                     "solve_cost": float(part["solve_cost"].mean()),
-                     "regret_percent_mean": float(part["regret_percent_mean"].mean()),
-                     "regret_percent_max": float(part["regret_percent_max"].max()),
-                     "within_aim_probability": float(part["within_aim_probability"].min())})
+        rows.append(
+            {
+                "planner": name,
+                "family": part["family"].iat[0],
+                "randomised": bool(part["randomised"].iat[0]),
+                "objects": len(part),
+                "objects_meeting_aim": int(part["meets_aim"].sum()),
+                "meeting_aim_percent": 100.0 * float(part["meets_aim"].mean()),
+                "closures": float(part["closures"].mean()),
+                "closure_share_percent": float(part["closure_share_percent"].mean()),
+                "solve_cost": float(part["solve_cost"].mean()),
+                "regret_percent_mean": float(part["regret_percent_mean"].mean()),
+                "regret_percent_max": float(part["regret_percent_max"].max()),
+                "within_aim_probability": float(part["within_aim_probability"].min()),
+            }
+        )
     table = pd.DataFrame(rows)
     if len(table):
         choice = recommended(table)
@@ -342,16 +424,16 @@ def conjecture(per_object: pd.DataFrame, resamples: int = 1000, seed: int = 2018
     inc, full = recommended(table, "incremental", "solve_cost"), recommended(table, "full_set", "solve_cost")
     closures = table.set_index("planner")["closures"]
     if not inc or not full:
-        return Conjecture(inc, full, np.zeros(0), np.nan, np.nan, np.nan,
-                          float(closures.get(inc, np.nan)), float(closures.get(full, np.nan)))
+        return Conjecture(
+            inc, full, np.zeros(0), np.nan, np.nan, np.nan, float(closures.get(inc, np.nan)), float(closures.get(full, np.nan))
+        )
     judged = per_object[per_object["regret_percent_mean"].notna()]
     cost = judged.pivot(index="object", columns="planner", values="solve_cost")
     d = (100.0 * (cost[full] - cost[inc]) / cost[full]).to_numpy(float)
     rng = np.random.default_rng(seed)
     means = d[rng.integers(0, d.size, size=(resamples, d.size))].mean(axis=1)
     low, high = np.percentile(means, [2.5, 97.5])
-    return Conjecture(inc, full, d, float(d.mean()), float(low), float(high), float(closures[inc]),
-                      float(closures[full]))
+    return Conjecture(inc, full, d, float(d.mean()), float(low), float(high), float(closures[inc]), float(closures[full]))
 
 
 def recommendation_line(across: pd.DataFrame) -> str:
@@ -360,6 +442,8 @@ def recommendation_line(across: pd.DataFrame) -> str:
     if not len(chosen):
         return "WARNING: planners: no object has a force-closure pose of the full set; no planner recommended"
     row = across.set_index("planner").loc[chosen.iat[0]]
-    line = (f"planners: recommended {chosen.iat[0]} ({row['closures']:.0f} closures, {row['solve_cost']:.0f} full-set "
-            f"solves on average; meets the aim on {row['objects_meeting_aim']} of {row['objects']} objects)")
+    line = (
+        f"planners: recommended {chosen.iat[0]} ({row['closures']:.0f} closures, {row['solve_cost']:.0f} full-set "
+        f"solves on average; meets the aim on {row['objects_meeting_aim']} of {row['objects']} objects)"
+    )
     return ("WARNING: only the exhaustive search meets the aim; " + line) if chosen.iat[0] == "exhaustive" else line

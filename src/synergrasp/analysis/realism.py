@@ -23,12 +23,28 @@ from synergrasp.analysis.verdicts import verdict_columns
 from synergrasp.hand.synergies import Synergies, synergy_values
 from synergrasp.ids import incremental_set_id
 from synergrasp.resolved import friction_mu, grasp_type, weight_N
-from synergrasp.simulation.opposition import (OPPOSITIONS, HandAxes, OppositionRule, contacts_oppositions,
-                                              edge_contacts, of_grasp_type)
+from synergrasp.simulation.opposition import (
+    OPPOSITIONS,
+    HandAxes,
+    OppositionRule,
+    contacts_oppositions,
+    edge_contacts,
+    of_grasp_type,
+)
 from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
 
-__all__ = ["RealismParams", "SIMULATED_STATUSES", "CONTACT_BINS", "NORMAL_FORCE_COLUMN", "LONG_FINGERS",
-           "link_categories", "grasp_labels", "grasp_realism", "link_shares", "representative_grasps"]
+__all__ = [
+    "RealismParams",
+    "SIMULATED_STATUSES",
+    "CONTACT_BINS",
+    "NORMAL_FORCE_COLUMN",
+    "LONG_FINGERS",
+    "link_categories",
+    "grasp_labels",
+    "grasp_realism",
+    "link_shares",
+    "representative_grasps",
+]
 
 #: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.CLOSURE_STATUSES): a
 #: ``no_contact`` closure is a simulated grasp with 0 contacts; any other status is a dropped pose.
@@ -41,7 +57,6 @@ NORMAL_FORCE_COLUMN = "contact_normal_force_N"
 LONG_FINGERS: tuple[str, ...] = ("index", "middle", "ring", "little")
 #: Segments (the part of a link name after the finger) counted as proximal or middle phalanges.
 _PROXIMAL_OR_MIDDLE = ("proximal", "middle")
-
 
 
 @dataclass(frozen=True)
@@ -78,12 +93,20 @@ class RealismParams:
         if not isinstance(values, Mapping):
             values = synergy_values(config["hand"], values, (1,))
         objects = config["objects"]
-        return cls(config["hand"], incremental_set_id(config["synergy_sets"]["incremental_max"]),
-                   {name: weight_N(config, name) for name in objects},
-                   threshold, tuple(values["mean_rad"]), tuple(values["S1"]), float(mechanics["k_ss_Nmm_per_rad"]),
-                   friction_mu(config), {name: grasp_type(config, name) for name in objects},
-                   {name: shape_from_config(spec["shape"], f"objects.{name}.shape") for name, spec in objects.items()},
-                   OppositionRule.from_config(config), config.get("random_objects"))
+        return cls(
+            config["hand"],
+            incremental_set_id(config["synergy_sets"]["incremental_max"]),
+            {name: weight_N(config, name) for name in objects},
+            threshold,
+            tuple(values["mean_rad"]),
+            tuple(values["S1"]),
+            float(mechanics["k_ss_Nmm_per_rad"]),
+            friction_mu(config),
+            {name: grasp_type(config, name) for name in objects},
+            {name: shape_from_config(spec["shape"], f"objects.{name}.shape") for name, spec in objects.items()},
+            OppositionRule.from_config(config),
+            config.get("random_objects"),
+        )
 
     def synergies(self, joint_names: tuple[str, ...]) -> Synergies:
         """q_m and S1 as a one-synergy :class:`Synergies` of the hand's joints."""
@@ -94,25 +117,39 @@ def link_categories(link_names: Sequence[str], link_finger: Sequence[str]) -> di
     """Hand link indices per category: ``thumb`` (every thumb link), ``palm`` (links of the
     palm), ``proximal_or_middle`` (links named ``<finger>_proximal`` or ``<finger>_middle``),
     and every long finger's links (``index``, ``middle``, ``ring``, ``little``)."""
+
     def finger(name: str) -> frozenset[int]:
         return frozenset(i for i, f in enumerate(link_finger) if f == name)
 
-    phalanx = frozenset(i for i, (name, f) in enumerate(zip(link_names, link_finger))
-                        if f != "palm" and name.rsplit("_", 1)[-1] in _PROXIMAL_OR_MIDDLE)
-    return {"thumb": finger("thumb"), "palm": finger("palm"), "proximal_or_middle": phalanx,
-            **{name: finger(name) for name in LONG_FINGERS}}
+    phalanx = frozenset(
+        i
+        for i, (name, f) in enumerate(zip(link_names, link_finger))
+        if f != "palm" and name.rsplit("_", 1)[-1] in _PROXIMAL_OR_MIDDLE
+    )
+    return {
+        "thumb": finger("thumb"),
+        "palm": finger("palm"),
+        "proximal_or_middle": phalanx,
+        **{name: finger(name) for name in LONG_FINGERS},
+    }
 
 
-def grasp_labels(contacts: pd.DataFrame, axes: HandAxes, rule: OppositionRule,
-                 shapes: Mapping[str, Any]) -> pd.DataFrame:
+def grasp_labels(contacts: pd.DataFrame, axes: HandAxes, rule: OppositionRule, shapes: Mapping[str, Any]) -> pd.DataFrame:
     """Per row of the contacts tables: object, closure_model, pose, the grasp's opposition
     and how many of its contacts sit on an edge or a corner of the object (docs/opposition.md)."""
     parts = []
     for obj, rows in contacts.groupby("object", sort=True):
-        parts.append(pd.DataFrame({"object": obj, "closure_model": rows["closure_model"].to_numpy(),
-                                   "pose": rows["pose"].astype(int).to_numpy(),
-                                   "opposition": contacts_oppositions(rows, axes, rule),
-                                   "edge_contacts": edge_contacts(rows, shapes[obj], rule)}))
+        parts.append(
+            pd.DataFrame(
+                {
+                    "object": obj,
+                    "closure_model": rows["closure_model"].to_numpy(),
+                    "pose": rows["pose"].astype(int).to_numpy(),
+                    "opposition": contacts_oppositions(rows, axes, rule),
+                    "edge_contacts": edge_contacts(rows, shapes[obj], rule),
+                }
+            )
+        )
     columns = ["object", "closure_model", "pose", "opposition", "edge_contacts"]
     return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=columns)
 
@@ -145,9 +182,16 @@ def _weight_multiples(gfo: pd.DataFrame, full_set_id: str, weights_N: Mapping[st
     weight = full["object"].map(weights_N).astype(float)
     verdicts = verdict_columns(full)
     fc = verdicts["force_closure"]
-    out = pd.DataFrame({"object": full["object"], "pose": full["pose"].astype(int), "rank_G": full["rank_G"],
-                        "force_closure": fc, "load_feasible": verdicts["load_feasible"],
-                        "force_per_weight": (full["force_norm"] / weight).where(fc)})
+    out = pd.DataFrame(
+        {
+            "object": full["object"],
+            "pose": full["pose"].astype(int),
+            "rank_G": full["rank_G"],
+            "force_closure": fc,
+            "load_feasible": verdicts["load_feasible"],
+            "force_per_weight": (full["force_norm"] / weight).where(fc),
+        }
+    )
     if "closure_model" in full.columns:  # results of several closure models side by side
         out["closure_model"] = full["closure_model"]
     return out.reset_index(drop=True)
@@ -158,12 +202,15 @@ def _one_group(rows: pd.DataFrame, categories: dict[str, frozenset[int]], grasp_
     grasps = rows[simulated]
     n = len(grasps)
     m = grasps["n_contacts"].astype(int).clip(upper=CONTACT_BINS[-1])
+
     def share(mask: pd.Series) -> float:  # % of the simulated grasps
         return 100.0 * float(mask.sum()) / n if n else np.nan
 
     dropped = rows.loc[~simulated, "status"].value_counts().sort_index()
     out: dict[str, float] = {
-        "poses": len(rows), "simulated": n, "dropped": int((~simulated).sum()),
+        "poses": len(rows),
+        "simulated": n,
+        "dropped": int((~simulated).sum()),
         "dropped_by": ", ".join(f"{s}: {c}" for s, c in dropped.items()),
         "contacts_median": float(grasps["n_contacts"].median()) if n else np.nan,
     }
@@ -195,9 +242,18 @@ def _bin_column(b: int) -> str:
     return f"pct_m{b}plus" if b == CONTACT_BINS[-1] else f"pct_m{b}"
 
 
-def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, equilibrium: pd.DataFrame, link_names: Sequence[str],
-                  link_finger: Sequence[str], full_set_id: str, weights_N: Mapping[str, float],
-                  load_threshold_N: float | None, labels: pd.DataFrame, grasp_types: Mapping[str, str]) -> pd.DataFrame:
+def grasp_realism(
+    contacts: pd.DataFrame,
+    gfo: pd.DataFrame,
+    equilibrium: pd.DataFrame,
+    link_names: Sequence[str],
+    link_finger: Sequence[str],
+    full_set_id: str,
+    weights_N: Mapping[str, float],
+    load_threshold_N: float | None,
+    labels: pd.DataFrame,
+    grasp_types: Mapping[str, str],
+) -> pd.DataFrame:
     """The grasp-realism table (columns of :data:`synergrasp.tables.GRASP_REALISM`).
 
     ``contacts``: contacts tables of the objects (CONTACTS contract; rows are grouped by
@@ -224,18 +280,19 @@ def grasp_realism(contacts: pd.DataFrame, gfo: pd.DataFrame, equilibrium: pd.Dat
     if full_set_id not in set(gfo["set_id"].astype(str).unique()):
         raise ValueError(f"full_set_id {full_set_id!r} is not in the gfo table")
     work = contacts[["object", "closure_model", "pose", "status", "n_contacts", "contact_link"]].assign(
-        pose=contacts["pose"].astype(int), loaded_contacts=_loaded(contacts, load_threshold_N))
+        pose=contacts["pose"].astype(int), loaded_contacts=_loaded(contacts, load_threshold_N)
+    )
     full = _weight_multiples(gfo, full_set_id, weights_N)
     keys = ["object", "pose", "closure_model"] if "closure_model" in full.columns else ["object", "pose"]
     work = work.merge(full, on=keys, how="left", validate="many_to_one")
     checks = equilibrium[["object", "closure_model", "pose", "torque_residual", "s1_outside_cone"]]
-    work = work.merge(checks.astype({"pose": int}), on=["object", "closure_model", "pose"], how="left",
-                      validate="one_to_one")
-    work = work.merge(labels.astype({"pose": int}), on=["object", "closure_model", "pose"], how="left",
-                      validate="one_to_one")
+    work = work.merge(checks.astype({"pose": int}), on=["object", "closure_model", "pose"], how="left", validate="one_to_one")
+    work = work.merge(labels.astype({"pose": int}), on=["object", "closure_model", "pose"], how="left", validate="one_to_one")
     categories = link_categories(link_names, link_finger)
-    rows = [{"object": obj, "closure_model": cm, **_one_group(group, categories, grasp_types[obj])}
-            for (obj, cm), group in work.groupby(["object", "closure_model"], sort=True)]
+    rows = [
+        {"object": obj, "closure_model": cm, **_one_group(group, categories, grasp_types[obj])}
+        for (obj, cm), group in work.groupby(["object", "closure_model"], sort=True)
+    ]
     return pd.DataFrame(rows, columns=list(GRASP_REALISM.names))
 
 
@@ -249,8 +306,15 @@ def link_shares(contacts: pd.DataFrame, link_names: Sequence[str], link_finger: 
         touched = grasps["contact_link"].map(lambda ls: {int(i) for i in ls})
         for index, (name, finger) in enumerate(zip(link_names, link_finger)):
             hits = int(touched.map(lambda s, i=index: i in s).sum())
-            rows.append({"object": obj, "closure_model": model, "finger": finger, "link": name,
-                         "pct_grasps": 100.0 * hits / len(grasps) if len(grasps) else np.nan})
+            rows.append(
+                {
+                    "object": obj,
+                    "closure_model": model,
+                    "finger": finger,
+                    "link": name,
+                    "pct_grasps": 100.0 * hits / len(grasps) if len(grasps) else np.nan,
+                }
+            )
     return pd.DataFrame(rows, columns=["object", "closure_model", "finger", "link", "pct_grasps"])
 
 
@@ -293,6 +357,14 @@ def representative_grasps(contacts: pd.DataFrame, n: int = 3) -> pd.DataFrame:
         mine = np.flatnonzero((patterns == pattern).to_numpy())
         best = mine[np.lexsort((grasps["pose"].to_numpy()[mine], distance[mine]))[0]]
         row = grasps.iloc[best]
-        rows.append({"pose": int(row["pose"]), "alpha_deg": float(row["alpha_deg"]), "beta_deg": float(row["beta_deg"]),
-                     "pattern": pattern, "share_pct": 100.0 * share[pattern] / len(grasps), "reason": reason})
+        rows.append(
+            {
+                "pose": int(row["pose"]),
+                "alpha_deg": float(row["alpha_deg"]),
+                "beta_deg": float(row["beta_deg"]),
+                "pattern": pattern,
+                "share_pct": 100.0 * share[pattern] / len(grasps),
+                "reason": reason,
+            }
+        )
     return pd.DataFrame(rows)

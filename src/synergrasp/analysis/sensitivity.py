@@ -17,8 +17,15 @@ import pandas as pd
 from synergrasp.analysis.chance import ALL_PAIRS
 from synergrasp.ids import ALL_OBJECTS
 
-__all__ = ["ScenarioTables", "scenario_row", "sensitivity_table", "table2_long",
-           "TABLE2_ROWS", "SINGLE_SYNERGIES", "REALISM_COLUMNS"]
+__all__ = [
+    "ScenarioTables",
+    "scenario_row",
+    "sensitivity_table",
+    "table2_long",
+    "TABLE2_ROWS",
+    "SINGLE_SYNERGIES",
+    "REALISM_COLUMNS",
+]
 
 #: Table II's k shown in the summary (k = 1, 2, 3: where the study's curves rise).
 TABLE2_ROWS: tuple[int, ...] = (1, 2, 3)
@@ -122,8 +129,11 @@ def scenario_row(name: str, tables: ScenarioTables) -> dict[str, object]:
 def _realism_row(realism: pd.DataFrame) -> dict[str, str]:
     """The grasp-realism summary (REALISM_COLUMNS) of one scenario: per column, each object's
     value joined by "/" (NaN: "—")."""
-    return {name: "/".join("—" if pd.isna(v) else fmt.format(v) for v in realism[column])
-            for name, (column, fmt) in REALISM_COLUMNS.items() if column in realism.columns}
+    return {
+        name: "/".join("—" if pd.isna(v) else fmt.format(v) for v in realism[column])
+        for name, (column, fmt) in REALISM_COLUMNS.items()
+        if column in realism.columns
+    }
 
 
 def sensitivity_table(scenarios: Mapping[str, ScenarioTables]) -> pd.DataFrame:

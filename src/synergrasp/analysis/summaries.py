@@ -49,7 +49,6 @@ __all__ = [
 ]
 
 
-
 def set_sort_key(set_ids: pd.Series) -> pd.Series:
     """Sort key of set ids: by size, then by the synergy indices ("1-2" < "1-10" < "1-2-3")."""
     return set_ids.map(set_order)
@@ -88,7 +87,6 @@ class AnalysisSettings:
     periods_deg: Mapping[str, float] = field(default_factory=dict)
 
 
-
 @dataclass(frozen=True)
 class TablesParams:
     """The study's tables (the ``tables`` step): the synergy-set bounds (the configuration's
@@ -103,24 +101,32 @@ class TablesParams:
         """From a configuration or the step's own part of it (``obj`` is not read): the
         objects' weights m·g and α-periods (from their boxes, placements and the grid)."""
         analyses = config["analyses"]
-        objects = {name: {**spec, "placement": effective_placement(config, name)}
-                   for name, spec in config["objects"].items()}
+        objects = {name: {**spec, "placement": effective_placement(config, name)} for name, spec in config["objects"].items()}
         try:
             periods_deg = object_periods(objects, config["grid"], config["hand"])
         except (TypeError, ValueError) as err:
             raise ConfigError(f"config error at 'objects' / 'placement': {err}") from None
         settings = AnalysisSettings(
-            success=analyses["success"], marginal_weight_multiple=float(analyses["marginal_weight_multiple"]),
-            radius_deg=float(analyses["minima_radius_deg"]), null_draws=int(analyses["null_model"]["draws"]),
+            success=analyses["success"],
+            marginal_weight_multiple=float(analyses["marginal_weight_multiple"]),
+            radius_deg=float(analyses["minima_radius_deg"]),
+            null_draws=int(analyses["null_model"]["draws"]),
             null_seed=int(analyses["null_model"]["seed"]),
             success_rate_tolerance_percent=float(analyses["success_rate_tolerance_percent"]),
             bootstrap=build(BootstrapSettings, "analyses.bootstrap", **analyses["bootstrap"]),
-            rules=build(VerdictRules, "analyses", rate_points=float(analyses["tie_band"]["rate_points"]),
-                        force_relative=float(analyses["tie_band"]["force_relative"]),
-                        min_distinct_poses=int(analyses["min_distinct_poses"]), headline_view=analyses["headline_view"]),
+            rules=build(
+                VerdictRules,
+                "analyses",
+                rate_points=float(analyses["tie_band"]["rate_points"]),
+                force_relative=float(analyses["tie_band"]["force_relative"]),
+                min_distinct_poses=int(analyses["min_distinct_poses"]),
+                headline_view=analyses["headline_view"],
+            ),
             weights_N={name: weight_N(config, name) for name in objects},
-            periods_deg=periods_deg)
+            periods_deg=periods_deg,
+        )
         return cls(dict(config["synergy_sets"]), int(analyses["table2_k_max"]), settings)
+
 
 def _rate_columns(table: pd.DataFrame, column: str, full_set_id: str) -> pd.DataFrame:
     """Per (object, set): count of ``column`` and its rate relative to the full set (percent)."""
@@ -132,13 +138,38 @@ def _rate_columns(table: pd.DataFrame, column: str, full_set_id: str) -> pd.Data
 
 
 #: Columns of the success-rates table, in order (docs/analyses.md).
-RATE_COLUMNS = ("object", "view", "set_id", "n_synergies", "n_poses", "n_success", "success_rate",
-                "success_rate_low", "success_rate_high", "full_set_empty", "n_success_grid", "success_rate_grid",
-                "absolute_share", "success_rate_force_closure", "success_rate_load_feasible",
-                "success_rate_force_closure_bounded", "above_bound_percent", "n_marginal", "marginal_percent",
-                "force_ratio_median", "force_ratio_low", "force_ratio_high", "n_force_poses",
-                "force_ratio_median_non_marginal", "n_ratio_undefined", "plain_mean_force_N", "plain_median_force_N",
-                "plain_mean_force_non_marginal_N", "plain_median_force_non_marginal_N", "n_objects")
+RATE_COLUMNS = (
+    "object",
+    "view",
+    "set_id",
+    "n_synergies",
+    "n_poses",
+    "n_success",
+    "success_rate",
+    "success_rate_low",
+    "success_rate_high",
+    "full_set_empty",
+    "n_success_grid",
+    "success_rate_grid",
+    "absolute_share",
+    "success_rate_force_closure",
+    "success_rate_load_feasible",
+    "success_rate_force_closure_bounded",
+    "above_bound_percent",
+    "n_marginal",
+    "marginal_percent",
+    "force_ratio_median",
+    "force_ratio_low",
+    "force_ratio_high",
+    "n_force_poses",
+    "force_ratio_median_non_marginal",
+    "n_ratio_undefined",
+    "plain_mean_force_N",
+    "plain_median_force_N",
+    "plain_mean_force_non_marginal_N",
+    "plain_median_force_non_marginal_N",
+    "n_objects",
+)
 #: The ``view`` of a row of one object.
 OBJECT_VIEW = "object"
 
@@ -163,31 +194,66 @@ def success_rates(table: pd.DataFrame, full_set_id: str, periods_deg: Mapping[st
     the same per grid pose, and the columns of :func:`synergrasp.analysis.forces.force_summary`.
     The interval columns are NaN here (:func:`with_intervals` fills them).
     """
-    _require(table, "gfo table", ("object", "set_id", "n_synergies", "pose", "alpha_deg", "success",
-                                  "verdict_force_closure", "verdict_load_feasible", "success_force"))
+    _require(
+        table,
+        "gfo table",
+        (
+            "object",
+            "set_id",
+            "n_synergies",
+            "pose",
+            "alpha_deg",
+            "success",
+            "verdict_force_closure",
+            "verdict_load_feasible",
+            "success_force",
+        ),
+    )
     present = sorted(table["set_id"].unique(), key=lambda s: (len(set_members(s)), s))
     if full_set_id not in present:
         raise ValueError(f"full_set_id {full_set_id!r} is not in the gfo table; allowed values: {present}")
     distinct = _distinct_poses(table, periods_deg or {})
     bounded = table.get("verdict_force_closure_bounded", table["verdict_force_closure"]).astype(bool)
-    work = table.assign(**{f"{c}_d": table[c].astype(bool) & distinct for c in
-                           ("success", "verdict_force_closure", "verdict_load_feasible")},
-                        bounded_d=bounded & distinct, one_d=distinct,
-                        fc_above=table["verdict_force_closure"].astype(bool) & ~bounded)
+    work = table.assign(
+        **{f"{c}_d": table[c].astype(bool) & distinct for c in ("success", "verdict_force_closure", "verdict_load_feasible")},
+        bounded_d=bounded & distinct,
+        one_d=distinct,
+        fc_above=table["verdict_force_closure"].astype(bool) & ~bounded,
+    )
     keys = ["object", "set_id"]
-    out = work.groupby(keys, sort=False).agg(n_synergies=("n_synergies", "first"), n_poses=("one_d", "sum"),
-                                             n_grid=("success", "size"), n_fc=("verdict_force_closure", "sum"),
-                                             n_above=("fc_above", "sum")).reset_index()
-    for name, column in (("", "success_d"), ("_grid", "success"), ("_force_closure", "verdict_force_closure_d"),
-                         ("_load_feasible", "verdict_load_feasible_d"), ("_force_closure_bounded", "bounded_d")):
+    out = (
+        work.groupby(keys, sort=False)
+        .agg(
+            n_synergies=("n_synergies", "first"),
+            n_poses=("one_d", "sum"),
+            n_grid=("success", "size"),
+            n_fc=("verdict_force_closure", "sum"),
+            n_above=("fc_above", "sum"),
+        )
+        .reset_index()
+    )
+    for name, column in (
+        ("", "success_d"),
+        ("_grid", "success"),
+        ("_force_closure", "verdict_force_closure_d"),
+        ("_load_feasible", "verdict_load_feasible_d"),
+        ("_force_closure_bounded", "bounded_d"),
+    ):
         rates = _rate_columns(work, column, full_set_id)
         out = out.merge(rates.rename(columns={"n": f"n_success{name}", "rate": f"success_rate{name}"}), on=keys)
     out["full_set_empty"] = out["success_rate"].isna()
     out["absolute_share"] = 100.0 * out["n_success"] / out["n_poses"]
     out["above_bound_percent"] = 100.0 * out["n_above"] / out["n_fc"].where(out["n_fc"] > 0)
     out = out.merge(force_summary(table, full_set_id).drop(columns="n_success"), on=keys)
-    out = out.assign(view=OBJECT_VIEW, success_rate_low=np.nan, success_rate_high=np.nan, force_ratio_low=np.nan,
-                     force_ratio_high=np.nan, n_force_poses=pd.NA, n_objects=1)
+    out = out.assign(
+        view=OBJECT_VIEW,
+        success_rate_low=np.nan,
+        success_rate_high=np.nan,
+        force_ratio_low=np.nan,
+        force_ratio_high=np.nan,
+        n_force_poses=pd.NA,
+        n_objects=1,
+    )
     out = out.sort_values(keys, key=lambda c: set_sort_key(c) if c.name == "set_id" else c, ignore_index=True)
     return out[list(RATE_COLUMNS)].astype({c: "int64" for c in ("n_poses", "n_success", "n_success_grid")})
 
@@ -211,19 +277,31 @@ def with_intervals(rates: pd.DataFrame, counts: StudyCounts) -> pd.DataFrame:
     for sid in means.index:
         for view in VIEWS:
             rate, low, high = counts.estimate_interval(counts.rate(sid, view))
-            row = {"object": ALL_OBJECTS, "view": view, "set_id": sid, "n_synergies": means.at[sid, "n_synergies"],
-                   **summed.loc[sid].to_dict(), "success_rate": rate, "success_rate_low": low,
-                   "success_rate_high": high, "n_objects": means.at[sid, "n_objects"],
-                   "full_set_empty": not np.isfinite(rate)}
+            row = {
+                "object": ALL_OBJECTS,
+                "view": view,
+                "set_id": sid,
+                "n_synergies": means.at[sid, "n_synergies"],
+                **summed.loc[sid].to_dict(),
+                "success_rate": rate,
+                "success_rate_low": low,
+                "success_rate_high": high,
+                "n_objects": means.at[sid, "n_objects"],
+                "full_set_empty": not np.isfinite(rate),
+            }
             if view == "per_object":
                 row.update({c: means.at[sid, c] for c in AVERAGED if c in means.columns and c != "success_rate"})
             else:
                 ratio, n = counts.pooled_ratio_to_full(sid)
                 est, low, high = counts.estimate_interval(ratio)
-                row.update(force_ratio_median=est, force_ratio_low=low, force_ratio_high=high, n_force_poses=n,
-                           absolute_share=100.0 * row["n_success"] / row["n_poses"] if row["n_poses"] else np.nan,
-                           marginal_percent=100.0 * row["n_marginal"] / row["n_success_grid"]
-                           if row["n_success_grid"] else np.nan)
+                row.update(
+                    force_ratio_median=est,
+                    force_ratio_low=low,
+                    force_ratio_high=high,
+                    n_force_poses=n,
+                    absolute_share=100.0 * row["n_success"] / row["n_poses"] if row["n_poses"] else np.nan,
+                    marginal_percent=100.0 * row["n_marginal"] / row["n_success_grid"] if row["n_success_grid"] else np.nan,
+                )
             views.append(row)
     out = pd.concat([out, pd.DataFrame(views)], ignore_index=True)
     return out[list(RATE_COLUMNS)].astype({"n_force_poses": "Int64"})
@@ -235,9 +313,19 @@ def object_rows(rates: pd.DataFrame) -> pd.DataFrame:
 
 
 #: Columns of the success-rates table averaged over objects (mean_over_objects, Fig. 5).
-AVERAGED = ("success_rate", "success_rate_grid", "success_rate_force_closure", "success_rate_load_feasible",
-            "success_rate_force_closure_bounded", "above_bound_percent", "absolute_share", "marginal_percent",
-            "force_ratio_median", "force_ratio_median_non_marginal", "plain_mean_force_N")
+AVERAGED = (
+    "success_rate",
+    "success_rate_grid",
+    "success_rate_force_closure",
+    "success_rate_load_feasible",
+    "success_rate_force_closure_bounded",
+    "above_bound_percent",
+    "absolute_share",
+    "marginal_percent",
+    "force_ratio_median",
+    "force_ratio_median_non_marginal",
+    "plain_mean_force_N",
+)
 
 
 def mean_over_objects(rates: pd.DataFrame) -> pd.DataFrame:
@@ -266,15 +354,26 @@ def incrementality_table(rates: pd.DataFrame, k_max: int) -> pd.DataFrame:
         raise ValueError(f"k_max must be an integer >= 1; got {k_max!r}")
     rates = object_rows(rates)
     wide = rates.pivot(index="object", columns="set_id", values="success_rate")
-    table = pd.DataFrame({k: wide.get(incremental_set_id(k), pd.Series(np.nan, index=wide.index))
-                          for k in range(1, k_max + 1)}, index=wide.index)
+    table = pd.DataFrame(
+        {k: wide.get(incremental_set_id(k), pd.Series(np.nan, index=wide.index)) for k in range(1, k_max + 1)}, index=wide.index
+    )
     return table.reset_index().rename_axis(columns=None)
 
 
 #: The hierarchy table's values per set (docs/analyses.md).
-HIERARCHY_VALUES = ("success_rate", "success_rate_low", "success_rate_high", "success_rate_pooled",
-                    "success_rate_pooled_low", "success_rate_pooled_high", "force_ratio_median", "force_ratio_low",
-                    "force_ratio_high", "n_force_poses", "plain_mean_force_N")
+HIERARCHY_VALUES = (
+    "success_rate",
+    "success_rate_low",
+    "success_rate_high",
+    "success_rate_pooled",
+    "success_rate_pooled_low",
+    "success_rate_pooled_high",
+    "force_ratio_median",
+    "force_ratio_low",
+    "force_ratio_high",
+    "n_force_poses",
+    "plain_mean_force_N",
+)
 
 
 def hierarchy_input(rates: pd.DataFrame) -> pd.DataFrame:
@@ -292,9 +391,11 @@ def hierarchy_input(rates: pd.DataFrame) -> pd.DataFrame:
     return out.reset_index()
 
 
-def hierarchy_matrices(rates_mean_over_objects: pd.DataFrame, first: int = 7,
-                       values: Sequence[str] = ("success_rate", "force_ratio_median", "plain_mean_force_N")
-                       ) -> pd.DataFrame:
+def hierarchy_matrices(
+    rates_mean_over_objects: pd.DataFrame,
+    first: int = 7,
+    values: Sequence[str] = ("success_rate", "force_ratio_median", "plain_mean_force_N"),
+) -> pd.DataFrame:
     """Fig. 5 data: ``first`` matrices ``first`` × ``first`` in long form.
 
     Cell (i, j) of matrix k is the set {S_k, S_i, S_j}, duplicates collapsing ((k, k) is
@@ -318,8 +419,13 @@ def hierarchy_matrices(rates_mean_over_objects: pd.DataFrame, first: int = 7,
     return pd.DataFrame(rows).astype({v: float for v in values})
 
 
-def minimum_preservation(gfo: pd.DataFrame, minima_table: pd.DataFrame, k_max: int,
-                         radius_deg: float = 10.0, periods_deg: Mapping[str, float] | None = None) -> pd.DataFrame:
+def minimum_preservation(
+    gfo: pd.DataFrame,
+    minima_table: pd.DataFrame,
+    k_max: int,
+    radius_deg: float = 10.0,
+    periods_deg: Mapping[str, float] | None = None,
+) -> pd.DataFrame:
     """Preservation of the local minima of {S1..Sk} in {S1..Sk+1}, k = 1..k_max-1.
 
     One row per object and k, then per object a total over k (k = <NA>), then the same for
@@ -341,11 +447,24 @@ def minimum_preservation(gfo: pd.DataFrame, minima_table: pd.DataFrame, k_max: i
         for k in range(1, k_max):
             this = mins[mins["set_id"] == incremental_set_id(k)]
             nxt = mins[mins["set_id"] == incremental_set_id(k + 1)]
-            kept = preserved(this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float),
-                             nxt["alpha_deg"].to_numpy(float), nxt["beta_deg"].to_numpy(float), radius_deg)
+            kept = preserved(
+                this["alpha_deg"].to_numpy(float),
+                this["beta_deg"].to_numpy(float),
+                nxt["alpha_deg"].to_numpy(float),
+                nxt["beta_deg"].to_numpy(float),
+                radius_deg,
+            )
             one = distinct_pose_mask(this["alpha_deg"].to_numpy(float), periods.get(obj, 360.0), alpha_start)
-            rows.append({"object": obj, "k": k, "n_minima": len(this), "n_preserved": int(kept.sum()),
-                         "n_minima_distinct": int(one.sum()), "n_preserved_distinct": int((kept & one).sum())})
+            rows.append(
+                {
+                    "object": obj,
+                    "k": k,
+                    "n_minima": len(this),
+                    "n_preserved": int(kept.sum()),
+                    "n_minima_distinct": int(one.sum()),
+                    "n_preserved_distinct": int((kept & one).sum()),
+                }
+            )
     per_k = pd.DataFrame(rows, columns=["object", "k", *counts])
     totals = per_k.groupby("object", sort=True)[counts].sum().reset_index()
     totals["k"] = pd.NA
@@ -359,8 +478,7 @@ def minimum_preservation(gfo: pd.DataFrame, minima_table: pd.DataFrame, k_max: i
     out = pd.concat([p for p in parts if len(p)], ignore_index=True)[["object", "k", *counts]]
     out = out.astype({"k": "Int64", **{c: "int64" for c in counts}})
     out["preserved_percent"] = (100.0 * out["n_preserved"] / out["n_minima"].where(out["n_minima"] > 0)).astype(float)
-    return out[["object", "k", "n_minima", "n_preserved", "preserved_percent", "n_minima_distinct",
-                "n_preserved_distinct"]]
+    return out[["object", "k", "n_minima", "n_preserved", "preserved_percent", "n_minima_distinct", "n_preserved_distinct"]]
 
 
 def full_but_not_first7(table: pd.DataFrame, full_set_id: str, first7_set_id: str) -> pd.DataFrame:
@@ -371,25 +489,45 @@ def full_but_not_first7(table: pd.DataFrame, full_set_id: str, first7_set_id: st
     "missing" if it was not computed at that pose), first7_force_closure,
     first7_load_feasible (its two verdicts).
     """
-    _require(table, "gfo table", ("object", "pose", "alpha_deg", "beta_deg", "set_id", "status", "success",
-                                  "force_norm", "verdict_force_closure", "verdict_load_feasible"))
+    _require(
+        table,
+        "gfo table",
+        (
+            "object",
+            "pose",
+            "alpha_deg",
+            "beta_deg",
+            "set_id",
+            "status",
+            "success",
+            "force_norm",
+            "verdict_force_closure",
+            "verdict_load_feasible",
+        ),
+    )
     present = set(table["set_id"].unique())
     for name, sid in (("full_set_id", full_set_id), ("first7_set_id", first7_set_id)):
         if sid not in present:
             raise ValueError(f"{name} {sid!r} is not in the gfo table; allowed values: {sorted(present)}")
     keys = ["object", "pose"]
     full = table[(table["set_id"] == full_set_id) & table["success"].astype(bool)]
-    small = table.loc[table["set_id"] == first7_set_id,
-                      keys + ["status", "success", "verdict_force_closure", "verdict_load_feasible"]]
+    small = table.loc[
+        table["set_id"] == first7_set_id, keys + ["status", "success", "verdict_force_closure", "verdict_load_feasible"]
+    ]
     merged = full.merge(small, on=keys, how="left", suffixes=("", "_first7"))
     lost = merged[~merged["success_first7"].astype("boolean").fillna(False).to_numpy(bool)]
-    out = pd.DataFrame({
-        "object": lost["object"], "pose": lost["pose"], "alpha_deg": lost["alpha_deg"],
-        "beta_deg": lost["beta_deg"], "full_force_norm": lost["force_norm"],
-        "first7_status": lost["status_first7"].fillna("missing"),
-        "first7_force_closure": lost["verdict_force_closure_first7"].astype("boolean").fillna(False).astype(bool),
-        "first7_load_feasible": lost["verdict_load_feasible_first7"].astype("boolean").fillna(False).astype(bool),
-    })
+    out = pd.DataFrame(
+        {
+            "object": lost["object"],
+            "pose": lost["pose"],
+            "alpha_deg": lost["alpha_deg"],
+            "beta_deg": lost["beta_deg"],
+            "full_force_norm": lost["force_norm"],
+            "first7_status": lost["status_first7"].fillna("missing"),
+            "first7_force_closure": lost["verdict_force_closure_first7"].astype("boolean").fillna(False).astype(bool),
+            "first7_load_feasible": lost["verdict_load_feasible_first7"].astype("boolean").fillna(False).astype(bool),
+        }
+    )
     return out.sort_values(keys, ignore_index=True)
 
 
@@ -401,41 +539,64 @@ def verdict_disagreements(table: pd.DataFrame) -> pd.DataFrame:
     f_p), n_force_closure_only (force closure without a feasible optimisation: a solver
     disagreement, see the invariant checks), disagree_percent (of the group's poses).
     """
-    _require(table, "gfo table", ("object", "set_id", "n_synergies", "verdict_force_closure",
-                                  "verdict_load_feasible"))
+    _require(table, "gfo table", ("object", "set_id", "n_synergies", "verdict_force_closure", "verdict_load_feasible"))
     fc = table["verdict_force_closure"].astype(bool)
     lf = table["verdict_load_feasible"].astype(bool)
-    work = pd.DataFrame({"object": table["object"], "set_id": table["set_id"], "n_synergies": table["n_synergies"],
-                         "lf_only": lf & ~fc, "fc_only": fc & ~lf})
-    out = work.groupby(["object", "set_id"], sort=False).agg(
-        n_synergies=("n_synergies", "first"), n_poses=("lf_only", "size"),
-        n_load_feasible_only=("lf_only", "sum"), n_force_closure_only=("fc_only", "sum")).reset_index()
+    work = pd.DataFrame(
+        {
+            "object": table["object"],
+            "set_id": table["set_id"],
+            "n_synergies": table["n_synergies"],
+            "lf_only": lf & ~fc,
+            "fc_only": fc & ~lf,
+        }
+    )
+    out = (
+        work.groupby(["object", "set_id"], sort=False)
+        .agg(
+            n_synergies=("n_synergies", "first"),
+            n_poses=("lf_only", "size"),
+            n_load_feasible_only=("lf_only", "sum"),
+            n_force_closure_only=("fc_only", "sum"),
+        )
+        .reset_index()
+    )
     out["n_disagree"] = out["n_load_feasible_only"] + out["n_force_closure_only"]
     out = out[out["n_disagree"] > 0].copy()
     out["disagree_percent"] = 100.0 * out["n_disagree"] / out["n_poses"]
-    out = out.sort_values(["object", "set_id"], key=lambda c: set_sort_key(c) if c.name == "set_id" else c,
-                          ignore_index=True)
-    cols = ["object", "set_id", "n_synergies", "n_poses", "n_disagree", "n_load_feasible_only",
-            "n_force_closure_only", "disagree_percent"]
+    out = out.sort_values(["object", "set_id"], key=lambda c: set_sort_key(c) if c.name == "set_id" else c, ignore_index=True)
+    cols = [
+        "object",
+        "set_id",
+        "n_synergies",
+        "n_poses",
+        "n_disagree",
+        "n_load_feasible_only",
+        "n_force_closure_only",
+        "disagree_percent",
+    ]
     return out[cols].astype({c: "int64" for c in cols[3:7]})
 
 
-def _claims(gfo: pd.DataFrame, minima: pd.DataFrame, k_max: int, first: int, settings: AnalysisSettings
-            ) -> tuple[pd.DataFrame, StudyCounts, tuple[pd.DataFrame, pd.DataFrame], pd.DataFrame]:
+def _claims(
+    gfo: pd.DataFrame, minima: pd.DataFrame, k_max: int, first: int, settings: AnalysisSettings
+) -> tuple[pd.DataFrame, StudyCounts, tuple[pd.DataFrame, pd.DataFrame], pd.DataFrame]:
     """The gfo table with its verdicts, the resampled counts, the null model's (summary,
     pairs) and the claims table."""
     full = incremental_set_id(k_max)
     table = with_verdicts(gfo, settings.success, settings.weights_N, settings.marginal_weight_multiple)
     resampler = PoseResampler(table[table["set_id"] == full], dict(settings.periods_deg), settings.bootstrap)
     counts = StudyCounts(table, full, resampler)
-    chance = preservation_vs_chance(table, minima, k_max, settings.radius_deg, dict(settings.periods_deg),
-                                    settings.null_draws, settings.null_seed)
+    chance = preservation_vs_chance(
+        table, minima, k_max, settings.radius_deg, dict(settings.periods_deg), settings.null_draws, settings.null_seed
+    )
     kept = resampled_preservation(minima, k_max, settings.radius_deg, resampler)
     return table, counts, chance, claims_table(counts, kept, chance[0], settings.rules, first)
 
 
-def study_claims(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[str, int],
-                 settings: AnalysisSettings) -> pd.DataFrame:
+def study_claims(
+    gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[str, int], settings: AnalysisSettings
+) -> pd.DataFrame:
     """The claims table of :func:`study_tables` alone (the other tables are not made)."""
     return _claims(gfo, minima, int(sets_config["incremental_max"]), int(sets_config["hierarchy_first"]), settings)[3]
 
@@ -453,18 +614,28 @@ def no_success_note(table: pd.DataFrame, settings: AnalysisSettings) -> str:
         return ""
     n_fc = int(table["verdict_force_closure"].astype(bool).sum())
     if settings.success == "force_closure_bounded" and n_fc:
-        why = (f"none of the {n_fc} force-closure (pose, set) rows holds the weight within "
-               f"analyses.marginal_weight_multiple = {settings.marginal_weight_multiple:g} times the weight")
+        why = (
+            f"none of the {n_fc} force-closure (pose, set) rows holds the weight within "
+            f"analyses.marginal_weight_multiple = {settings.marginal_weight_multiple:g} times the weight"
+        )
     elif settings.success == "load_feasible":
         why = "no optimisation under the weight is feasible"
     else:
         why = "no pose of any object is in force closure with any set"
-    return (f"no grasp succeeds under analyses.success = {settings.success}: {why}; every success rate is 0 "
-            "and the rates relative to the full set (Table II) are undefined")
+    return (
+        f"no grasp succeeds under analyses.success = {settings.success}: {why}; every success rate is 0 "
+        "and the rates relative to the full set (Table II) are undefined"
+    )
 
 
-def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[str, int], table2_k_max: int,
-                 settings: AnalysisSettings, planners: pd.DataFrame | None = None) -> dict[str, tuple[str, pd.DataFrame]]:
+def study_tables(
+    gfo: pd.DataFrame,
+    minima: pd.DataFrame,
+    sets_config: Mapping[str, int],
+    table2_k_max: int,
+    settings: AnalysisSettings,
+    planners: pd.DataFrame | None = None,
+) -> dict[str, tuple[str, pd.DataFrame]]:
     """Every study table by name (``tables.STUDY_TABLES``, in that order): (title, table).
 
     ``sets_config`` is the configuration's ``synergy_sets`` (incremental_max,
@@ -483,7 +654,7 @@ def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
         claims = pd.concat([claims, planner_claim(planners, settings.rules)], ignore_index=True)
     rates = success_rates(table, full, periods)
     checks = invariant_checks(table, rates, periods, settings.success_rate_tolerance_percent)
-    lost = (full_but_not_first7(table, full, first_n) if first_n in set(table["set_id"].unique()) else None)
+    lost = full_but_not_first7(table, full, first_n) if first_n in set(table["set_id"].unique()) else None
     preservation = minimum_preservation(table, minima, k_max, settings.radius_deg, periods)
     preservation = preservation.merge(pairs.astype({"k": "Int64"}), on=["object", "k"], how="left")
     table2 = incrementality_table(rates, table2_k_max)
@@ -495,24 +666,49 @@ def study_tables(gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[s
         verdict += f" (WARNING: {nothing})"
     level = f"{100 * settings.bootstrap.level:g} % intervals: block bootstrap over distinct poses"
     entries = {
-        "success_rates": (f"Success rates per distinct pose (every verdict) and forces per object and synergy set, "
-                          f"and averaged over objects in both views; {level}; {verdict}", rates),
-        "table2_success_rates": (f"Table II: success rate (%, per distinct pose) with {{S1..Sk}}, "
-                                 f"k = 1..{table2_k_max}; {verdict}", table2),
-        "hierarchy": (f"Hierarchy: sets {{S_k, S_i, S_j}} of the first {first} synergies, averaged over objects "
-                      f"(per-object and pooled views); {level}; {verdict}",
-                      hierarchy_matrices(hierarchy_input(rates), first, HIERARCHY_VALUES)),
+        "success_rates": (
+            f"Success rates per distinct pose (every verdict) and forces per object and synergy set, "
+            f"and averaged over objects in both views; {level}; {verdict}",
+            rates,
+        ),
+        "table2_success_rates": (
+            f"Table II: success rate (%, per distinct pose) with {{S1..Sk}}, k = 1..{table2_k_max}; {verdict}",
+            table2,
+        ),
+        "hierarchy": (
+            f"Hierarchy: sets {{S_k, S_i, S_j}} of the first {first} synergies, averaged over objects "
+            f"(per-object and pooled views); {level}; {verdict}",
+            hierarchy_matrices(hierarchy_input(rates), first, HIERARCHY_VALUES),
+        ),
         "minimum_preservation": (f"Local minima of {{S1..Sk}} preserved in {{S1..Sk+1}}; {verdict}", preservation),
-        "preservation_vs_chance": (f"Minimum preservation against the null model ({settings.null_draws} draws, "
-                                   f"seed {settings.null_seed}); {verdict}", chance),
-        "full_not_first7": (f"Poses where {{S1..S{k_max}}} succeeds and {{S1..S{first}}} does not; {verdict}",
-                            lost if lost is not None else pd.DataFrame(columns=[
-                                "object", "pose", "alpha_deg", "beta_deg", "full_force_norm", "first7_status",
-                                "first7_force_closure", "first7_load_feasible"])),
-        "verdict_disagreements": ("Force closure (Definition 1) vs feasibility under the weight",
-                                  verdict_disagreements(table)),
+        "preservation_vs_chance": (
+            f"Minimum preservation against the null model ({settings.null_draws} draws, seed {settings.null_seed}); {verdict}",
+            chance,
+        ),
+        "full_not_first7": (
+            f"Poses where {{S1..S{k_max}}} succeeds and {{S1..S{first}}} does not; {verdict}",
+            lost
+            if lost is not None
+            else pd.DataFrame(
+                columns=[
+                    "object",
+                    "pose",
+                    "alpha_deg",
+                    "beta_deg",
+                    "full_force_norm",
+                    "first7_status",
+                    "first7_force_closure",
+                    "first7_load_feasible",
+                ]
+            ),
+        ),
+        "verdict_disagreements": ("Force closure (Definition 1) vs feasibility under the weight", verdict_disagreements(table)),
         "invariant_checks": ("The pipeline's invariant checks on this run", checks),
-        "claims": (f"The study's claims tested on this run, one row per view (headline first); {level}"
-                   + ("; claim 8: bootstrap over objects" if planners is not None else "") + f"; {verdict}", claims),
+        "claims": (
+            f"The study's claims tested on this run, one row per view (headline first); {level}"
+            + ("; claim 8: bootstrap over objects" if planners is not None else "")
+            + f"; {verdict}",
+            claims,
+        ),
     }
     return {name: entries[name] for name in STUDY_TABLES}

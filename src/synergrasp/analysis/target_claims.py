@@ -32,7 +32,6 @@ from synergrasp.optimisation.optimise import gfo_table
 __all__ = ["TargetClaimsParams", "ClaimsAtTargets", "claims_at_target", "claims_at_targets", "claims_summary"]
 
 
-
 @dataclass(frozen=True)
 class TargetClaimsParams:
     """The claims at the scored targets of one object (the ``target_claims`` step): the
@@ -55,9 +54,15 @@ class TargetClaimsParams:
         # the tables of this object alone; its α-period does not depend on the placement's target
         placement = {**config["placement"], "mode": "searched", "approach_point_mm": None, "center_mm": (0.0, 0.0, 0.0)}
         alone = {**config, "objects": {obj: config["objects"][obj]}, "placement": placement}
-        return cls(SearchStepParams.from_config(config, obj), claim_sets(config["synergy_sets"]),
-                   MinimaParams.from_config(config, obj), TablesParams.from_config(alone, obj),
-                   int(spec["alpha_every"]), int(spec["beta_every"]), int(spec["max_targets"]))
+        return cls(
+            SearchStepParams.from_config(config, obj),
+            claim_sets(config["synergy_sets"]),
+            MinimaParams.from_config(config, obj),
+            TablesParams.from_config(alone, obj),
+            int(spec["alpha_every"]),
+            int(spec["beta_every"]),
+            int(spec["max_targets"]),
+        )
 
 
 def claim_sets(sets_config: Mapping[str, int]) -> dict[str, tuple[int, ...]]:
@@ -72,12 +77,23 @@ class ClaimsAtTargets:
 
     def __init__(self, hand: Any, synergies: Any, params: TargetClaimsParams, period_deg: float) -> None:
         s = params.search
-        lattice = replace(s.search, pose_alpha_step_deg=params.alpha_every * s.placement.alpha_deg[2],
-                          pose_beta_step_deg=params.beta_every * s.placement.beta_deg[2])
+        lattice = replace(
+            s.search,
+            pose_alpha_step_deg=params.alpha_every * s.placement.alpha_deg[2],
+            pose_beta_step_deg=params.beta_every * s.placement.beta_deg[2],
+        )
         self.poses = pose_subset(s.placement, period_deg, lattice)
         # the scorer's closure and placement only: its full set is not used here
-        self.scorer = TargetScorer(hand, synergies, s.object, s.placement, s.closure, s.gfo,
-                                   full_synergy_set(synergies.matrix, s.full_set_size), self.poses)
+        self.scorer = TargetScorer(
+            hand,
+            synergies,
+            s.object,
+            s.placement,
+            s.closure,
+            s.gfo,
+            full_synergy_set(synergies.matrix, s.full_set_size),
+            self.poses,
+        )
         self.sets = SynergySets(synergies.matrix, tuple(params.sets.values()))
         self.params, self.period_deg = params, float(period_deg)
 
@@ -100,13 +116,25 @@ def claims_at_target(computer: ClaimsAtTargets, target: Mapping[str, Any]) -> pd
     """Rows of ``tables.TARGET_CLAIMS`` for one row of the placement table."""
     point = (float(target["x_mm"]), float(target["y_mm"]), float(target["z_mm"]))
     claims = computer(point)
-    return pd.DataFrame({
-        "object": str(target["object"]), "rank": int(target["rank"]), "x_mm": point[0], "y_mm": point[1],
-        "z_mm": point[2], "force_closure_percent": float(target["force_closure_percent"]),
-        "n_poses": len(computer.poses), "claim": claims["claim"].astype("int32"), "view": claims["view"],
-        "verdict": claims["verdict"], "difference": claims["difference"].astype(float),
-        "low": claims["low"].astype(float), "high": claims["high"].astype(float),
-        "n_distinct_poses": claims["n_distinct_poses"].astype("int32"), "reason": claims["reason"]})
+    return pd.DataFrame(
+        {
+            "object": str(target["object"]),
+            "rank": int(target["rank"]),
+            "x_mm": point[0],
+            "y_mm": point[1],
+            "z_mm": point[2],
+            "force_closure_percent": float(target["force_closure_percent"]),
+            "n_poses": len(computer.poses),
+            "claim": claims["claim"].astype("int32"),
+            "view": claims["view"],
+            "verdict": claims["verdict"],
+            "difference": claims["difference"].astype(float),
+            "low": claims["low"].astype(float),
+            "high": claims["high"].astype(float),
+            "n_distinct_poses": claims["n_distinct_poses"].astype("int32"),
+            "reason": claims["reason"],
+        }
+    )
 
 
 _WORKER: ClaimsAtTargets | None = None
@@ -122,8 +150,9 @@ def _in_worker(target: dict) -> pd.DataFrame:
     return claims_at_target(_WORKER, target)
 
 
-def claims_at_targets(hand: Any, synergies: Any, params: TargetClaimsParams, period_deg: float,
-                      placement: pd.DataFrame, processes: int = 1) -> pd.DataFrame:
+def claims_at_targets(
+    hand: Any, synergies: Any, params: TargetClaimsParams, period_deg: float, placement: pd.DataFrame, processes: int = 1
+) -> pd.DataFrame:
     """``tables.TARGET_CLAIMS`` of one object: the claims at each target of its placement
     table (``tables.PLACEMENT``, best first; the best ``max_targets`` when > 0), in rank
     order. Deterministic: the same table for any ``processes``."""
@@ -155,9 +184,26 @@ def claims_summary(per_target: pd.DataFrame) -> pd.DataFrame:
     for (obj, claim), group in per_target.groupby(["object", "claim"], sort=True):
         shares = {v: 100.0 * float(np.mean(group["verdict"] == v)) for v in CLAIM_VERDICTS}
         chosen = group.loc[group["rank"] == 1, "verdict"]
-        rows.append({"object": obj, "claim": int(claim), "n_targets": len(group),
-                     "holds_percent": shares[HOLDS], "does_not_hold_percent": shares[FAILS],
-                     "undefined_percent": shares[UNDEFINED],
-                     "at_chosen_target": chosen.iloc[0] if len(chosen) else ""})
-    return pd.DataFrame(rows, columns=["object", "claim", "n_targets", "holds_percent", "does_not_hold_percent",
-                                       "undefined_percent", "at_chosen_target"])
+        rows.append(
+            {
+                "object": obj,
+                "claim": int(claim),
+                "n_targets": len(group),
+                "holds_percent": shares[HOLDS],
+                "does_not_hold_percent": shares[FAILS],
+                "undefined_percent": shares[UNDEFINED],
+                "at_chosen_target": chosen.iloc[0] if len(chosen) else "",
+            }
+        )
+    return pd.DataFrame(
+        rows,
+        columns=[
+            "object",
+            "claim",
+            "n_targets",
+            "holds_percent",
+            "does_not_hold_percent",
+            "undefined_percent",
+            "at_chosen_target",
+        ],
+    )

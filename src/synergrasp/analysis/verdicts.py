@@ -50,9 +50,10 @@ def verdict_columns(gfo: pd.DataFrame) -> pd.DataFrame:
     missing = [c for c in _NEEDED if c not in gfo.columns]
     if missing:
         raise ValueError(f"gfo table: missing columns {missing}")
-    return pd.DataFrame({"force_closure": gfo["force_closure_def1"].astype(bool),
-                         "load_feasible": gfo["load_feasible"].astype(bool)},
-                        index=gfo.index)
+    return pd.DataFrame(
+        {"force_closure": gfo["force_closure_def1"].astype(bool), "load_feasible": gfo["load_feasible"].astype(bool)},
+        index=gfo.index,
+    )
 
 
 def force_lower_bound(table: pd.DataFrame, rows: np.ndarray) -> np.ndarray:
@@ -74,8 +75,9 @@ def force_lower_bound(table: pd.DataFrame, rows: np.ndarray) -> np.ndarray:
     return bound
 
 
-def with_verdicts(gfo: pd.DataFrame, success: str,
-                  weights_N: Mapping[str, float] | None = None, marginal_multiple: float = math.inf) -> pd.DataFrame:
+def with_verdicts(
+    gfo: pd.DataFrame, success: str, weights_N: Mapping[str, float] | None = None, marginal_multiple: float = math.inf
+) -> pd.DataFrame:
     """A copy of the gfo table with the analysis columns added.
 
     Force closure without an optimal force under the weight cannot happen in exact
@@ -115,8 +117,10 @@ def with_verdicts(gfo: pd.DataFrame, success: str,
     above = (out["force_norm"] > marginal_multiple * weight).fillna(False).astype(bool) | (unresolved & weight.notna())
     if success == "force_closure_bounded":
         if weights_N is None or weight.isna().any() or not math.isfinite(marginal_multiple):
-            raise ValueError("success 'force_closure_bounded' needs every object's weight and a finite "
-                             "marginal_multiple (config analyses.marginal_weight_multiple)")
+            raise ValueError(
+                "success 'force_closure_bounded' needs every object's weight and a finite "
+                "marginal_multiple (config analyses.marginal_weight_multiple)"
+            )
         out["success"] = verdicts["force_closure"] & ~above
     else:
         out["success"] = out[f"verdict_{success}"]

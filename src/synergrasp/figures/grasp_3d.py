@@ -34,8 +34,18 @@ from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions
 from synergrasp.simulation.shapes.surface import Surface, frame_along, merge_meshes, placed, revolution_mesh
 
-__all__ = ["GraspScene", "Grasps3dParams", "grasp_figure", "grasp_page", "write_grasp_pages", "fig2_scenes",
-           "arrow_scale", "PLOTLY_JS", "ZERO_FORCE_N", "ARROW_REACH"]
+__all__ = [
+    "GraspScene",
+    "Grasps3dParams",
+    "grasp_figure",
+    "grasp_page",
+    "write_grasp_pages",
+    "fig2_scenes",
+    "arrow_scale",
+    "PLOTLY_JS",
+    "ZERO_FORCE_N",
+    "ARROW_REACH",
+]
 
 #: The file name of plotly's script beside the pages that share it.
 PLOTLY_JS = "plotly.min.js"
@@ -44,8 +54,7 @@ ZERO_FORCE_N = 1e-6
 #: The longest arrow is at most this share of the object's bounding radius.
 ARROW_REACH = 1.5
 #: Colours of the touching links, in the order they are listed (none near the object's blue or the skin).
-LINK_COLOURS = ("#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf", "#bcbd22",
-                "#7f7f7f", "#1a1a1a")
+LINK_COLOURS = ("#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f", "#1a1a1a")
 _CAPSULE_SEGMENTS = 16
 _HEAD_MM = 7.0  # arrow head length
 
@@ -71,13 +80,28 @@ class GraspScene:
     title: str
 
     @classmethod
-    def of(cls, hand: Any, q: ArrayLike, shape: ShapeInPicture, links: ArrayLike, points_mm: ArrayLike,
-           forces_N: ArrayLike | None, force_set: str, title: str) -> GraspScene:
+    def of(
+        cls,
+        hand: Any,
+        q: ArrayLike,
+        shape: ShapeInPicture,
+        links: ArrayLike,
+        points_mm: ArrayLike,
+        forces_N: ArrayLike | None,
+        force_set: str,
+        title: str,
+    ) -> GraspScene:
         m = len(np.ravel(links))
-        return cls(hand, np.asarray(q, dtype=float), shape, np.asarray(links, dtype=np.int64).ravel(),
-                   np.asarray(points_mm, dtype=float).reshape(m, 3),
-                   None if forces_N is None or len(np.ravel(forces_N)) == 0
-                   else np.asarray(forces_N, dtype=float).reshape(m, 3), force_set, title)
+        return cls(
+            hand,
+            np.asarray(q, dtype=float),
+            shape,
+            np.asarray(links, dtype=np.int64).ravel(),
+            np.asarray(points_mm, dtype=float).reshape(m, 3),
+            None if forces_N is None or len(np.ravel(forces_N)) == 0 else np.asarray(forces_N, dtype=float).reshape(m, 3),
+            force_set,
+            title,
+        )
 
 
 def _capsule_mesh(a: NDArray, b: NDArray, r: float) -> Surface:
@@ -85,8 +109,7 @@ def _capsule_mesh(a: NDArray, b: NDArray, r: float) -> Surface:
     length = float(np.linalg.norm(b - a))
     polar = np.linspace(0.0, 0.5 * np.pi, 5)
     profile = [(r * math.sin(t) if k else 0.0, -r * math.cos(t)) for k, t in enumerate(polar)]
-    profile += [(r * math.cos(t), length + r * math.sin(t)) if k < 4 else (0.0, length + r)
-                for k, t in enumerate(polar)]
+    profile += [(r * math.cos(t), length + r * math.sin(t)) if k < 4 else (0.0, length + r) for k, t in enumerate(polar)]
     axis = b - a if length > 1e-9 else np.array([0.0, 0.0, 1.0])
     return placed(revolution_mesh(profile, _CAPSULE_SEGMENTS), frame_along(axis), a)
 
@@ -104,9 +127,21 @@ def _link_meshes(hand: Any, q: NDArray) -> dict[int, Surface]:
 
 def _mesh_trace(mesh: Surface, colour: str, name: str, opacity: float = 1.0, **extra: Any) -> dict[str, Any]:
     (x, y, z), (i, j, k) = mesh[0].T, mesh[1].T
-    return dict(type="mesh3d", x=x, y=y, z=z, i=i, j=j, k=k, color=colour, opacity=opacity, name=name,
-                hovertemplate=f"{html.escape(name)}<extra></extra>",
-                lighting=dict(ambient=0.55, diffuse=0.7, specular=0.15, roughness=0.6), **extra)
+    return dict(
+        type="mesh3d",
+        x=x,
+        y=y,
+        z=z,
+        i=i,
+        j=j,
+        k=k,
+        color=colour,
+        opacity=opacity,
+        name=name,
+        hovertemplate=f"{html.escape(name)}<extra></extra>",
+        lighting=dict(ambient=0.55, diffuse=0.7, specular=0.15, roughness=0.6),
+        **extra,
+    )
 
 
 def arrow_scale(forces_N: NDArray, reach_mm: float) -> float:
@@ -119,8 +154,7 @@ def arrow_scale(forces_N: NDArray, reach_mm: float) -> float:
     return max(m * step for m in (1.0, 2.0, 5.0) if m * step <= raw)
 
 
-def _arrow_traces(points: NDArray, forces: NDArray, scale: float, colour: str, group: str,
-                  name: str) -> list[dict[str, Any]]:
+def _arrow_traces(points: NDArray, forces: NDArray, scale: float, colour: str, group: str, name: str) -> list[dict[str, Any]]:
     """Shafts and heads (cones) of the forces at ``points``, ``scale`` mm per N; none for a zero force."""
     norms = np.linalg.norm(forces, axis=1)
     keep = norms > ZERO_FORCE_N
@@ -136,12 +170,39 @@ def _arrow_traces(points: NDArray, forces: NDArray, scale: float, colour: str, g
     sx, sy, sz = (list(c) for c in zip(*shafts))
     text = [f"{name}: |f| = {v:.3g} N<br>f = ({a:.3g}, {b:.3g}, {c:.3g}) N" for v, (a, b, c) in zip(n, f)]
     head = unit * np.minimum(_HEAD_MM, 0.5 * n * scale)[:, None]
-    return [dict(type="scatter3d", x=sx, y=sy, z=sz, mode="lines", line=dict(color=colour, width=8),
-                 legendgroup=group, showlegend=False, hoverinfo="skip", name=f"{name} force"),
-            dict(type="cone", x=tip[:, 0], y=tip[:, 1], z=tip[:, 2], u=head[:, 0], v=head[:, 1], w=head[:, 2],
-                 anchor="tip", sizemode="raw", sizeref=1.0, colorscale=[[0, colour], [1, colour]], showscale=False,
-                 legendgroup=group, showlegend=False, name=f"{name} force", text=text,
-                 hovertemplate="%{text}<extra></extra>")]
+    return [
+        dict(
+            type="scatter3d",
+            x=sx,
+            y=sy,
+            z=sz,
+            mode="lines",
+            line=dict(color=colour, width=8),
+            legendgroup=group,
+            showlegend=False,
+            hoverinfo="skip",
+            name=f"{name} force",
+        ),
+        dict(
+            type="cone",
+            x=tip[:, 0],
+            y=tip[:, 1],
+            z=tip[:, 2],
+            u=head[:, 0],
+            v=head[:, 1],
+            w=head[:, 2],
+            anchor="tip",
+            sizemode="raw",
+            sizeref=1.0,
+            colorscale=[[0, colour], [1, colour]],
+            showscale=False,
+            legendgroup=group,
+            showlegend=False,
+            name=f"{name} force",
+            text=text,
+            hovertemplate="%{text}<extra></extra>",
+        ),
+    ]
 
 
 def grasp_figure(scene: GraspScene) -> dict[str, Any]:
@@ -154,8 +215,15 @@ def grasp_figure(scene: GraspScene) -> dict[str, Any]:
     touching = sorted(set(scene.links.tolist()))
     colours = {link: LINK_COLOURS[k % len(LINK_COLOURS)] for k, link in enumerate(touching)}
     obj = scene.shape
-    traces = [_mesh_trace(obj.shape.surface_mesh(np.asarray(obj.rotation), np.asarray(obj.center_mm)), _rgb(BOX),
-                          f"object ({_shape_words(obj.shape)})", opacity=0.22, showlegend=False)]
+    traces = [
+        _mesh_trace(
+            obj.shape.surface_mesh(np.asarray(obj.rotation), np.asarray(obj.center_mm)),
+            _rgb(BOX),
+            f"object ({_shape_words(obj.shape)})",
+            opacity=0.22,
+            showlegend=False,
+        )
+    ]
     rest = [meshes[k] for k in sorted(meshes) if k not in colours]
     if rest:
         traces.append(_mesh_trace(merge_meshes(rest), _rgb(SKIN), "hand", showlegend=False))
@@ -171,32 +239,73 @@ def grasp_figure(scene: GraspScene) -> dict[str, Any]:
         if link in meshes:
             traces.append(_mesh_trace(meshes[link], colours[link], label, legendgroup=group, showlegend=True))
         p = scene.points_mm[at]
-        traces.append(dict(type="scatter3d", x=p[:, 0], y=p[:, 1], z=p[:, 2], mode="markers", legendgroup=group,
-                           showlegend=False, name=f"{name} contact",
-                           marker=dict(size=5, color="white", line=dict(color=colours[link], width=3)),
-                           hovertemplate=f"{name} contact<br>(%{{x:.1f}}, %{{y:.1f}}, %{{z:.1f}}) mm<extra></extra>"))
+        traces.append(
+            dict(
+                type="scatter3d",
+                x=p[:, 0],
+                y=p[:, 1],
+                z=p[:, 2],
+                mode="markers",
+                legendgroup=group,
+                showlegend=False,
+                name=f"{name} contact",
+                marker=dict(size=5, color="white", line=dict(color=colours[link], width=3)),
+                hovertemplate=f"{name} contact<br>(%{{x:.1f}}, %{{y:.1f}}, %{{z:.1f}}) mm<extra></extra>",
+            )
+        )
         if forces is not None:
             traces += _arrow_traces(p, forces[at], scale, colours[link], group, name)
-    arrows = (f"arrows: optimal contact forces of {scene.force_set} on the object, 1 N = {scale:g} mm"
-              if forces is not None else f"no arrows: {scene.force_set} is not feasible under the weight"
-              if scene.force_set else "no arrows: no set optimised (no grasp)")
-    views = {name: _plotly_camera(camera) for name, camera in (("palm side", PALM_CAMERA),
-                                                                ("from above the fingertips", ABOVE_CAMERA))}
-    axis = dict(showbackground=True, backgroundcolor="rgb(235, 238, 243)", gridcolor="white", zerolinecolor="white",
-                linecolor="white", showspikes=False)
+    arrows = (
+        f"arrows: optimal contact forces of {scene.force_set} on the object, 1 N = {scale:g} mm"
+        if forces is not None
+        else f"no arrows: {scene.force_set} is not feasible under the weight"
+        if scene.force_set
+        else "no arrows: no set optimised (no grasp)"
+    )
+    views = {
+        name: _plotly_camera(camera) for name, camera in (("palm side", PALM_CAMERA), ("from above the fingertips", ABOVE_CAMERA))
+    }
+    axis = dict(
+        showbackground=True,
+        backgroundcolor="rgb(235, 238, 243)",
+        gridcolor="white",
+        zerolinecolor="white",
+        linecolor="white",
+        showspikes=False,
+    )
     layout = dict(
-        title=dict(text=f"{html.escape(scene.title)}<br><sup>palm frame, mm; hand skin-coloured, object blue "
-                        f"and see-through; drag to turn, scroll to zoom</sup>", x=0.01, font=dict(size=15)),
-        legend=dict(title=dict(text=f"links touching the object<br><sup>{html.escape(arrows)}</sup>"),
-                    bgcolor="rgba(255, 255, 255, 0.8)", font=dict(size=13)),
-        updatemenus=[dict(type="buttons", direction="left", x=0.01, y=0.01, xanchor="left", yanchor="bottom",
-                          buttons=[dict(label=name, method="relayout", args=[{"scene.camera": camera}])
-                                   for name, camera in views.items()])],
-        scene=dict(aspectmode="data", camera=views["palm side"],
-                   xaxis=dict(title=dict(text="x: palm normal (mm)"), **axis),
-                   yaxis=dict(title=dict(text="y (mm)"), **axis),
-                   zaxis=dict(title=dict(text="z: along the fingers (mm)"), **axis)),
-        margin=dict(l=0, r=0, t=70, b=0), paper_bgcolor="white")
+        title=dict(
+            text=f"{html.escape(scene.title)}<br><sup>palm frame, mm; hand skin-coloured, object blue "
+            f"and see-through; drag to turn, scroll to zoom</sup>",
+            x=0.01,
+            font=dict(size=15),
+        ),
+        legend=dict(
+            title=dict(text=f"links touching the object<br><sup>{html.escape(arrows)}</sup>"),
+            bgcolor="rgba(255, 255, 255, 0.8)",
+            font=dict(size=13),
+        ),
+        updatemenus=[
+            dict(
+                type="buttons",
+                direction="left",
+                x=0.01,
+                y=0.01,
+                xanchor="left",
+                yanchor="bottom",
+                buttons=[dict(label=name, method="relayout", args=[{"scene.camera": camera}]) for name, camera in views.items()],
+            )
+        ],
+        scene=dict(
+            aspectmode="data",
+            camera=views["palm side"],
+            xaxis=dict(title=dict(text="x: palm normal (mm)"), **axis),
+            yaxis=dict(title=dict(text="y (mm)"), **axis),
+            zaxis=dict(title=dict(text="z: along the fingers (mm)"), **axis),
+        ),
+        margin=dict(l=0, r=0, t=70, b=0),
+        paper_bgcolor="white",
+    )
     return {"data": traces, "layout": layout}
 
 
@@ -205,8 +314,9 @@ def _plotly_camera(camera: Any) -> dict[str, Any]:
     its direction at the scene's centre, its up toward the top."""
     eye = -np.asarray(camera.direction, dtype=float) / np.linalg.norm(camera.direction) * 2.3
     up = np.asarray(camera.up, dtype=float)
-    return dict(eye=dict(x=float(eye[0]), y=float(eye[1]), z=float(eye[2])),
-                up=dict(x=float(up[0]), y=float(up[1]), z=float(up[2])))
+    return dict(
+        eye=dict(x=float(eye[0]), y=float(eye[1]), z=float(eye[2])), up=dict(x=float(up[0]), y=float(up[1]), z=float(up[2]))
+    )
 
 
 def _shape_words(shape: Any) -> str:
@@ -219,9 +329,17 @@ def grasp_page(fig: Any, plotly_js: str | None = None) -> str:
     path ``plotly_js``. Nothing is fetched from the network; the same figure gives the same page."""
     import plotly.io as pio
 
-    return pio.to_html(fig, full_html=True, include_plotlyjs=True if plotly_js is None else plotly_js,
-                       include_mathjax=False, div_id="grasp", default_width="100%", default_height="100vh",
-                       config={"displaylogo": False, "responsive": True}, validate=False)
+    return pio.to_html(
+        fig,
+        full_html=True,
+        include_plotlyjs=True if plotly_js is None else plotly_js,
+        include_mathjax=False,
+        div_id="grasp",
+        default_width="100%",
+        default_height="100vh",
+        config={"displaylogo": False, "responsive": True},
+        validate=False,
+    )
 
 
 def write_grasp_pages(folder: str | Path, pages: Mapping[str, tuple[str, GraspScene]], title: str) -> None:
@@ -237,8 +355,9 @@ def write_grasp_pages(folder: str | Path, pages: Mapping[str, tuple[str, GraspSc
             (out / f"{name}.html").write_text(grasp_page(grasp_figure(scene), PLOTLY_JS), encoding="utf-8")
             items.append(f'<li><a href="{name}.html" target="view">{html.escape(text)}</a></li>')
         first = f"{next(iter(pages))}.html" if pages else "about:blank"
-        (out / "index.html").write_text(_INDEX.format(title=html.escape(title), items="\n".join(items), first=first),
-                                        encoding="utf-8")
+        (out / "index.html").write_text(
+            _INDEX.format(title=html.escape(title), items="\n".join(items), first=first), encoding="utf-8"
+        )
 
 
 @dataclass(frozen=True)
@@ -257,9 +376,14 @@ class Grasps3dParams:
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> Grasps3dParams:
         names = list(config["objects"])
-        return cls(config["hand"], config["synergies"], tuple(range(1, int(config["synergy_sets"]["incremental_max"]) + 1)),
-                   tuple(GraspedObject.from_config(config, n, with_mass=False) for n in names),
-                   tuple(GFOParams.from_config(config, n) for n in names), OppositionRule.from_config(config))
+        return cls(
+            config["hand"],
+            config["synergies"],
+            tuple(range(1, int(config["synergy_sets"]["incremental_max"]) + 1)),
+            tuple(GraspedObject.from_config(config, n, with_mass=False) for n in names),
+            tuple(GFOParams.from_config(config, n) for n in names),
+            OppositionRule.from_config(config),
+        )
 
     def oppositions(self, hand: Any, tables: Sequence[Any]) -> list[dict[int, str]]:
         """Per object (``tables[i]``: the contacts table of ``objects[i]``), its grasps'
@@ -268,8 +392,9 @@ class Grasps3dParams:
         return [dict(zip(t["pose"].astype(int), contacts_oppositions(t, axes, self.opposition))) for t in tables]
 
 
-def fig2_scenes(hand: Any, synergy_matrix: NDArray, params: Grasps3dParams,
-                tables: Sequence[Any]) -> dict[str, tuple[str, GraspScene]]:
+def fig2_scenes(
+    hand: Any, synergy_matrix: NDArray, params: Grasps3dParams, tables: Sequence[Any]
+) -> dict[str, tuple[str, GraspScene]]:
     """The grasps of Fig. 2 (``draw_grasp_row``'s choice, per object) with the optimal contact
     forces of ``params.full_set`` under each object's weight, by page name ``<object>_<column>``
     -> (link text, scene). ``tables[i]``: the contacts table of ``params.objects[i]``."""
@@ -292,12 +417,24 @@ def fig2_scenes(hand: Any, synergy_matrix: NDArray, params: Grasps3dParams,
         forces = optimise_grasps(read_grasps(rows), sets, gfo, strict=False, forces=True)["forces"]
         for c, (pick, row, f) in enumerate(zip(chosen.itertuples(), rows.itertuples(), forces)):
             text = f"{obj.name}: {pick.reason}, α = {pick.alpha_deg:g}°, β = {pick.beta_deg:g}°"
-            title = (f"{obj.name} ({_shape_words(obj.shape)}), Fig. 2 column {c + 1}: {pick.reason} "
-                     f"({pick.share_pct:.0f} % of grasps) at α = {pick.alpha_deg:g}°, β = {pick.beta_deg:g}°, "
-                     f"{int(row.n_contacts)} contacts")
-            scenes[f"{obj.name}_{c + 1}"] = (text, GraspScene.of(
-                hand, row.q, object_of(pd.Series(row._asdict()), obj.shape), row.contact_link,
-                row.contact_point, f, name_of_set, title))
+            title = (
+                f"{obj.name} ({_shape_words(obj.shape)}), Fig. 2 column {c + 1}: {pick.reason} "
+                f"({pick.share_pct:.0f} % of grasps) at α = {pick.alpha_deg:g}°, β = {pick.beta_deg:g}°, "
+                f"{int(row.n_contacts)} contacts"
+            )
+            scenes[f"{obj.name}_{c + 1}"] = (
+                text,
+                GraspScene.of(
+                    hand,
+                    row.q,
+                    object_of(pd.Series(row._asdict()), obj.shape),
+                    row.contact_link,
+                    row.contact_point,
+                    f,
+                    name_of_set,
+                    title,
+                ),
+            )
     return scenes
 
 

@@ -21,11 +21,18 @@ from synergrasp.figures.output import save_figure
 __all__ = ["figure_grasp_realism"]
 
 #: (column, legend label) of panel B.
-_SHARES = (("pct_thumb", "thumb"), ("pct_index", "index finger"), ("pct_palm", "palm"),
-           ("pct_proximal_or_middle", "proximal/middle phalanx"), ("pct_rank6", "rank G = 6"))
+_SHARES = (
+    ("pct_thumb", "thumb"),
+    ("pct_index", "index finger"),
+    ("pct_palm", "palm"),
+    ("pct_proximal_or_middle", "proximal/middle phalanx"),
+    ("pct_rank6", "rank G = 6"),
+)
 #: (column, legend label, scale to %) of panel D.
-_EQUILIBRIUM = (("median_torque_residual", "median torque residual", 100.0),
-                ("pct_s1_outside_cone", "S1 pushes a contact outside its cone", 1.0))
+_EQUILIBRIUM = (
+    ("median_torque_residual", "median torque residual", 100.0),
+    ("pct_s1_outside_cone", "S1 pushes a contact outside its cone", 1.0),
+)
 
 
 def _labels(table: pd.DataFrame) -> list[str]:
@@ -42,19 +49,34 @@ def _contacts_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
     left = np.zeros(len(table))
     for b, column, colour in zip(CONTACT_BINS, columns, colours):
         width = table[column].fillna(0.0).to_numpy(dtype=float)
-        ax.barh(y, width, left=left, color=colour, edgecolor="white", linewidth=0.5,
-                label=f"{b}+" if b == CONTACT_BINS[-1] else str(b))
+        ax.barh(
+            y,
+            width,
+            left=left,
+            color=colour,
+            edgecolor="white",
+            linewidth=0.5,
+            label=f"{b}+" if b == CONTACT_BINS[-1] else str(b),
+        )
         for yi, (start, w) in enumerate(zip(left, width)):
             if w >= 8.0:
-                ax.text(start + w / 2, yi, f"{w:.0f}", ha="center", va="center", fontsize=7,
-                        color="white" if b < 4 else "black")
+                ax.text(start + w / 2, yi, f"{w:.0f}", ha="center", va="center", fontsize=7, color="white" if b < 4 else "black")
         left += width
     ax.set_yticks(y, labels)
     ax.set_xlim(0, 100)
     ax.set_xlabel("share of simulated grasps (%)")
     ax.set_title("A  contacts per grasp", loc="left", fontsize=10)
-    ax.legend(title="contacts", ncol=len(columns), fontsize=7, title_fontsize=7, loc="lower center",
-              bbox_to_anchor=(0.5, -0.5), frameon=False, handlelength=1.2, columnspacing=0.8)
+    ax.legend(
+        title="contacts",
+        ncol=len(columns),
+        fontsize=7,
+        title_fontsize=7,
+        loc="lower center",
+        bbox_to_anchor=(0.5, -0.5),
+        frameon=False,
+        handlelength=1.2,
+        columnspacing=0.8,
+    )
 
 
 def _shares_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
@@ -77,8 +99,15 @@ def _grouped_bars(ax, table: pd.DataFrame, columns, colours) -> None:
         ax.barh(yk, np.nan_to_num(value), height=height, color=colour, label=label)
         for yi, v in zip(yk, value):
             inside = np.isfinite(v) and v >= 15.0  # the number at the bar's end, inside it when it fits
-            ax.text(v - 1.0 if inside else np.nan_to_num(v) + 1.0, yi, f"{v:.0f}" if np.isfinite(v) else "–",
-                    va="center", ha="right" if inside else "left", fontsize=6, color="white" if inside else "black")
+            ax.text(
+                v - 1.0 if inside else np.nan_to_num(v) + 1.0,
+                yi,
+                f"{v:.0f}" if np.isfinite(v) else "–",
+                va="center",
+                ha="right" if inside else "left",
+                fontsize=6,
+                color="white" if inside else "black",
+            )
     ax.set_xlim(0, 100)
 
 
@@ -96,8 +125,7 @@ def _force_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
     shown = np.where(np.isfinite(value), value, np.nan)
     ax.barh(y, shown, color="#4a78c2")
     for yi, v in enumerate(value):
-        ax.text(v if np.isfinite(v) else 1.0, yi, f" {v:.3g}" if np.isfinite(v) else " no force closure",
-                va="center", fontsize=7)
+        ax.text(v if np.isfinite(v) else 1.0, yi, f" {v:.3g}" if np.isfinite(v) else " no force closure", va="center", fontsize=7)
     ax.axvline(1.0, color="0.3", lw=0.8, ls="--")
     ax.set_xscale("log")
     finite = value[np.isfinite(value)]
@@ -126,7 +154,8 @@ def figure_grasp_realism(table: pd.DataFrame, png_path: str | Path, pdf_path: st
     _equilibrium_panel(axes[3], table, labels)
     axes[0].invert_yaxis()  # the first row on top (the axes share y: once for all)
     dropped = ", ".join(f"{o}: {int(d)} of {int(p)}" for o, d, p in zip(labels, table["dropped"], table["poses"]))
-    fig.suptitle(f"How realistic are the simulated grasps?   Poses dropped — {dropped}".replace("\n", " "),
-                 fontsize=10, x=0.01, ha="left")
+    fig.suptitle(
+        f"How realistic are the simulated grasps?   Poses dropped — {dropped}".replace("\n", " "), fontsize=10, x=0.01, ha="left"
+    )
     fig.tight_layout()
     save_figure(fig, png_path, pdf_path, tight=True)

@@ -15,14 +15,33 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from synergrasp.analysis.realism import SIMULATED_STATUSES, representative_grasps
-from synergrasp.figures.hand_pictures import (ABOVE_CAMERA, BOX, PALM_CAMERA, SKIN, TOUCHING, Camera, ShapeInPicture, hand_shapes,
-                                              render)
+from synergrasp.figures.hand_pictures import (
+    ABOVE_CAMERA,
+    BOX,
+    PALM_CAMERA,
+    SKIN,
+    TOUCHING,
+    Camera,
+    ShapeInPicture,
+    hand_shapes,
+    render,
+)
 from synergrasp.figures.output import save_figure
 from synergrasp.hand.synergies import SynergyPath
 
-__all__ = ["figure_synergy_postures", "figure_closing_views", "THUMB_CAMERA",
-           "figure_example_grasps", "figure_grasp_views", "draw_grasp", "draw_grasp_row",
-           "object_of", "PANEL_PX", "GRASP_VIEWS", "FIG2_GRASPS"]
+__all__ = [
+    "figure_synergy_postures",
+    "figure_closing_views",
+    "THUMB_CAMERA",
+    "figure_example_grasps",
+    "figure_grasp_views",
+    "draw_grasp",
+    "draw_grasp_row",
+    "object_of",
+    "PANEL_PX",
+    "GRASP_VIEWS",
+    "FIG2_GRASPS",
+]
 
 #: Rendered panel size, pixels (width, height).
 PANEL_PX = (330, 330)
@@ -72,8 +91,9 @@ def _palm_point(hand: Any) -> NDArray:
     if not boxes:
         return np.zeros(3)
     normal = np.asarray(hand.palm_normal, dtype=float)
-    front = [np.asarray(b.center_mm) + (np.abs(np.asarray(b.rotation).T @ normal) @ b.shape.half_extents_mm) * normal
-             for b in boxes]
+    front = [
+        np.asarray(b.center_mm) + (np.abs(np.asarray(b.rotation).T @ normal) @ b.shape.half_extents_mm) * normal for b in boxes
+    ]
     return max(front, key=lambda p: float(p @ normal))
 
 
@@ -98,11 +118,21 @@ def _label(ax: Any, name: str, at: NDArray, away_from: NDArray, distance: float 
     direction = np.asarray(at, float) - np.asarray(away_from, float)
     direction = direction / max(float(np.linalg.norm(direction)), 1e-9)
     text = np.asarray(at, float) + distance * (x1 - x0) * direction
-    text = (np.clip(text[0], x0 + 0.1 * (x1 - x0), x1 - 0.1 * (x1 - x0)),
-            np.clip(text[1], y1 + 0.05 * (y0 - y1), y0 - 0.05 * (y0 - y1)))
-    ax.annotate(name, xy=at, xytext=text, fontsize=8, color="0.1", ha="center", va="center",
-                bbox=dict(boxstyle="round,pad=0.15", facecolor="white", edgecolor="none", alpha=0.8),
-                arrowprops=dict(arrowstyle="-", color="0.3", lw=0.7, shrinkA=0, shrinkB=1))
+    text = (
+        np.clip(text[0], x0 + 0.1 * (x1 - x0), x1 - 0.1 * (x1 - x0)),
+        np.clip(text[1], y1 + 0.05 * (y0 - y1), y0 - 0.05 * (y0 - y1)),
+    )
+    ax.annotate(
+        name,
+        xy=at,
+        xytext=text,
+        fontsize=8,
+        color="0.1",
+        ha="center",
+        va="center",
+        bbox=dict(boxstyle="round,pad=0.15", facecolor="white", edgecolor="none", alpha=0.8),
+        arrowprops=dict(arrowstyle="-", color="0.3", lw=0.7, shrinkA=0, shrinkB=1),
+    )
 
 
 def _thumb_point(hand: Any, q: ArrayLike) -> NDArray:
@@ -123,9 +153,15 @@ def _label_parts(ax: Any, hand: Any, q: ArrayLike, picture: Any) -> None:
     ax.text(*palm, "palm", fontsize=8, color="0.1", ha="center", va="center")
 
 
-def figure_synergy_postures(hand: Any, synergies: Any, png_path: str | Path, pdf_path: str | Path,
-                            n_synergies: int = 7, sigmas: Sequence[float] = (-1.0, 0.0, 1.0),
-                            camera: Camera = PALM_CAMERA) -> None:
+def figure_synergy_postures(
+    hand: Any,
+    synergies: Any,
+    png_path: str | Path,
+    pdf_path: str | Path,
+    n_synergies: int = 7,
+    sigmas: Sequence[float] = (-1.0, 0.0, 1.0),
+    camera: Camera = PALM_CAMERA,
+) -> None:
     """Fig. 1: the hand at q_m + σ·S_k (joint limits clip) for k = 1..n_synergies (rows) and
     σ in ``sigmas`` (columns), seen from the palm side; the mean posture q_m is the pale
     silhouette behind the σ ≠ 0 pictures; the parts are named on the first mean posture."""
@@ -140,8 +176,9 @@ def figure_synergy_postures(hand: Any, synergies: Any, png_path: str | Path, pdf
     paths = [SynergyPath.along(synergies, hand.lower, hand.upper, synergy=k + 1) for k in range(n_synergies)]
     mean = paths[0].reference(0.0)
     panel = 2.35  # inches
-    fig, axes = plt.subplots(n_synergies, len(sigmas), figsize=(panel * len(sigmas) + 0.4, panel * n_synergies + 0.6),
-                             squeeze=False)
+    fig, axes = plt.subplots(
+        n_synergies, len(sigmas), figsize=(panel * len(sigmas) + 0.4, panel * n_synergies + 0.6), squeeze=False
+    )
     postures = [[path.reference(sigma) for sigma in sigmas] for path in paths]
     camera = _fit(camera, hand, [q for row in postures for q in row] + [mean])
     pictures, named = [], None  # named: the first mean posture's (axes, q, picture)
@@ -162,8 +199,7 @@ def figure_synergy_postures(hand: Any, synergies: Any, png_path: str | Path, pdf
     _frame(axes.ravel(), pictures)
     if named is not None:
         _label_parts(named[0], hand, named[1], named[2])
-    fig.suptitle("Right hand, palm toward the viewer, along each postural synergy (pale: the mean posture)",
-                 fontsize=10)
+    fig.suptitle("Right hand, palm toward the viewer, along each postural synergy (pale: the mean posture)", fontsize=10)
     fig.tight_layout(rect=(0, 0, 1, 0.99), h_pad=0.3, w_pad=0.3)
     save_figure(fig, png_path, pdf_path)
 
@@ -174,8 +210,9 @@ def figure_synergy_postures(hand: Any, synergies: Any, png_path: str | Path, pdf
 THUMB_CAMERA = Camera(direction=(-0.25, -1.0, 0.1))
 
 
-def figure_closing_views(hand: Any, synergies: Any, png_path: str | Path, pdf_path: str | Path | None,
-                         sigmas: Sequence[float]) -> None:
+def figure_closing_views(
+    hand: Any, synergies: Any, png_path: str | Path, pdf_path: str | Path | None, sigmas: Sequence[float]
+) -> None:
     """The hand closing along S1, q_r(σ) = clip(q_m + σ·S1) for each σ of ``sigmas`` (columns),
     seen from the palm side (top row, as Fig. 1) and from the thumb's side (bottom row, the
     palm normal to the image left: how far in front of the palm the thumb meets the fingers);
@@ -190,8 +227,9 @@ def figure_closing_views(hand: Any, synergies: Any, png_path: str | Path, pdf_pa
     postures = [path.reference(float(sigma)) for sigma in sigmas]
     panel = 2.35  # inches
     views = (("palm side", PALM_CAMERA), ("thumb side", THUMB_CAMERA))
-    fig, axes = plt.subplots(len(views), len(sigmas), figsize=(panel * len(sigmas) + 0.4, panel * len(views) + 0.6),
-                             squeeze=False)
+    fig, axes = plt.subplots(
+        len(views), len(sigmas), figsize=(panel * len(sigmas) + 0.4, panel * len(views) + 0.6), squeeze=False
+    )
     for r, (name, camera) in enumerate(views):
         camera = _fit(camera, hand, [*postures, mean])
         pictures = []
@@ -226,25 +264,28 @@ def _touching_words(hand: Any, links: Sequence[int]) -> str:
 
 def object_of(row: pd.Series, shape: Any) -> ShapeInPicture:
     """The object of a contacts table's row (its end pose) with its ``shape``."""
-    return ShapeInPicture(shape, np.asarray(row["object_center"], dtype=float),
-                          np.asarray(row["object_rotation"], dtype=float).reshape(3, 3))
+    return ShapeInPicture(
+        shape, np.asarray(row["object_center"], dtype=float), np.asarray(row["object_rotation"], dtype=float).reshape(3, 3)
+    )
 
 
 def _legend(fig: Any, ncol: int = 5) -> None:
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    handles = [Patch(facecolor=SKIN, edgecolor="0.2", label="hand"),
-               Patch(facecolor=TOUCHING, edgecolor="0.2", label="link touching the object"),
-               Patch(facecolor=BOX, edgecolor="#1f3f7a", alpha=0.5, label="object (see-through)"),
-               Line2D([], [], ls="", marker="o", color=_CONTACT, markeredgecolor="white", label="contact point"),
-               Line2D([], [], ls="", marker="o", markerfacecolor="none", color=_CONTACT,
-                      label="contact point behind the hand")]
+    handles = [
+        Patch(facecolor=SKIN, edgecolor="0.2", label="hand"),
+        Patch(facecolor=TOUCHING, edgecolor="0.2", label="link touching the object"),
+        Patch(facecolor=BOX, edgecolor="#1f3f7a", alpha=0.5, label="object (see-through)"),
+        Line2D([], [], ls="", marker="o", color=_CONTACT, markeredgecolor="white", label="contact point"),
+        Line2D([], [], ls="", marker="o", markerfacecolor="none", color=_CONTACT, label="contact point behind the hand"),
+    ]
     fig.legend(handles=handles, loc="lower center", ncol=ncol, fontsize=8, frameon=False)
 
 
-def draw_grasp(ax: Any, hand: Any, q: NDArray, shape: ShapeInPicture, touching: Sequence[int], points_mm: ArrayLike,
-               camera: Camera) -> Any:
+def draw_grasp(
+    ax: Any, hand: Any, q: NDArray, shape: ShapeInPicture, touching: Sequence[int], points_mm: ArrayLike, camera: Camera
+) -> Any:
     """One grasp of Fig. 2 on ``ax``: the hand at q (rad) seen by ``camera``, the links in
     ``touching`` highlighted, the object see-through, the contact points (mm, palm frame;
     hollow where the hand hides them). Returns the rendered ``Picture``."""
@@ -260,12 +301,17 @@ def draw_grasp(ax: Any, hand: Any, q: NDArray, shape: ShapeInPicture, touching: 
 #: The two views of one grasp (``figure_grasp_views``): Fig. 2's, and from above the
 #: fingertips with the palm at the bottom and the palm normal up, where the tips and the thumb
 #: are seen on the object side by side.
-GRASP_VIEWS = (("palm side (as Fig. 2)", PALM_CAMERA),
-               ("from above the fingertips (palm below)", ABOVE_CAMERA))
+GRASP_VIEWS = (("palm side (as Fig. 2)", PALM_CAMERA), ("from above the fingertips (palm below)", ABOVE_CAMERA))
 
 
-def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame,
-                   cameras: Sequence[Camera] = (PALM_CAMERA,), oppositions: Mapping[int, str] | None = None) -> None:
+def draw_grasp_row(
+    axes: Sequence[Any],
+    hand: Any,
+    obj: Any,
+    table: pd.DataFrame,
+    cameras: Sequence[Camera] = (PALM_CAMERA,),
+    oppositions: Mapping[int, str] | None = None,
+) -> None:
     """One row of Fig. 2 on ``axes``: the representative grasps of ``obj`` (a
     ``synergrasp.simulation.objects.GraspedObject``) in its contacts ``table``
     (``synergrasp.analysis.realism.representative_grasps``), each drawn from every camera of
@@ -277,16 +323,28 @@ def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame
     chosen = representative_grasps(table, n_grasps)
     simulated = int(table["status"].isin(SIMULATED_STATUSES).sum())
     rows = [table[table["pose"] == pose].iloc[0] for pose in chosen["pose"]]
-    fitted = [_fit(camera, hand, [np.asarray(row["q"], dtype=float) for row in rows],
-                   [object_of(row, obj.shape) for row in rows]) if rows else camera for camera in cameras]
+    fitted = [
+        _fit(camera, hand, [np.asarray(row["q"], dtype=float) for row in rows], [object_of(row, obj.shape) for row in rows])
+        if rows
+        else camera
+        for camera in cameras
+    ]
     pictures, thumbs = [], []
     axes[0].set_ylabel(f"{obj.name}\n{obj.shape.label}", fontsize=10)
     for ax in axes:
         _bare(ax)
     for c in range(n_grasps):
         if c >= len(chosen):
-            axes[c * k].text(0.5, 0.5, "no other contact set" if c else f"no grasp with contacts\n({simulated} simulated)",
-                             ha="center", va="center", transform=axes[c * k].transAxes, fontsize=8, color="0.4")
+            axes[c * k].text(
+                0.5,
+                0.5,
+                "no other contact set" if c else f"no grasp with contacts\n({simulated} simulated)",
+                ha="center",
+                va="center",
+                transform=axes[c * k].transAxes,
+                fontsize=8,
+                color="0.4",
+            )
             continue
         pick, row = chosen.iloc[c], rows[c]
         q = np.asarray(row["q"], dtype=float)
@@ -297,9 +355,12 @@ def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame
             pictures.append((ax, picture))
             thumbs.append((ax, picture, q))
             if v == 0:
-                ax.set_title(f"{pick['reason']}: {pick['share_pct']:.0f} % of grasps\n"
-                             f"α = {pick['alpha_deg']:g}°, β = {pick['beta_deg']:g}°, {int(row['n_contacts'])} contacts"
-                             f"{kind}", fontsize=8)
+                ax.set_title(
+                    f"{pick['reason']}: {pick['share_pct']:.0f} % of grasps\n"
+                    f"α = {pick['alpha_deg']:g}°, β = {pick['beta_deg']:g}°, {int(row['n_contacts'])} contacts"
+                    f"{kind}",
+                    fontsize=8,
+                )
                 ax.set_xlabel(_touching_words(hand, pick["pattern"]), fontsize=7, labelpad=2)
             else:
                 ax.set_title("the same grasp,\nfrom above the fingertips" if k == 2 else f"view {v + 1}", fontsize=8)
@@ -311,10 +372,16 @@ def draw_grasp_row(axes: Sequence[Any], hand: Any, obj: Any, table: pd.DataFrame
         _label(ax, "thumb", picture.pixels(_thumb_point(hand, q)[None])[0], picture.pixels(_palm_point(hand)[None])[0])
 
 
-def figure_example_grasps(hand: Any, objects: Sequence[Any], tables: Sequence[pd.DataFrame], png_path: str | Path,
-                          pdf_path: str | Path, n_grasps: int = FIG2_GRASPS,
-                          cameras: Sequence[Camera] = tuple(c for _, c in GRASP_VIEWS),
-                          oppositions: Sequence[Mapping[int, str]] | None = None) -> None:
+def figure_example_grasps(
+    hand: Any,
+    objects: Sequence[Any],
+    tables: Sequence[pd.DataFrame],
+    png_path: str | Path,
+    pdf_path: str | Path,
+    n_grasps: int = FIG2_GRASPS,
+    cameras: Sequence[Camera] = tuple(c for _, c in GRASP_VIEWS),
+    oppositions: Sequence[Mapping[int, str]] | None = None,
+) -> None:
     """Fig. 2: representative simulated grasps, one row per object, chosen by rule
     (``synergrasp.analysis.realism.representative_grasps``: the most common set of touching
     links, the most common one at the typical contact count, the next most common), each at
@@ -333,8 +400,9 @@ def figure_example_grasps(hand: Any, objects: Sequence[Any], tables: Sequence[pd
     if len(objects) != len(tables):
         raise ValueError(f"objects and tables must have the same length, got {len(objects)} and {len(tables)}")
     panel, k = 2.4, len(cameras)  # inches
-    fig, axes = plt.subplots(len(objects), n_grasps * k, figsize=(panel * n_grasps * k + 0.5,
-                                                                   panel * len(objects) + 0.9), squeeze=False)
+    fig, axes = plt.subplots(
+        len(objects), n_grasps * k, figsize=(panel * n_grasps * k + 0.5, panel * len(objects) + 0.9), squeeze=False
+    )
     for r, (obj, table) in enumerate(zip(objects, tables)):
         draw_grasp_row(axes[r], hand, obj, table, cameras, None if oppositions is None else oppositions[r])
     _legend(fig)
@@ -342,9 +410,17 @@ def figure_example_grasps(hand: Any, objects: Sequence[Any], tables: Sequence[pd
     save_figure(fig, png_path, pdf_path)
 
 
-def figure_grasp_views(hand: Any, shape: ShapeInPicture, q: ArrayLike, links: Sequence[int], points_mm: ArrayLike,
-                       title: str, png_path: str | Path, pdf_path: str | Path | None = None,
-                       views: Sequence[tuple[str, Camera]] = GRASP_VIEWS) -> None:
+def figure_grasp_views(
+    hand: Any,
+    shape: ShapeInPicture,
+    q: ArrayLike,
+    links: Sequence[int],
+    points_mm: ArrayLike,
+    title: str,
+    png_path: str | Path,
+    pdf_path: str | Path | None = None,
+    views: Sequence[tuple[str, Camera]] = GRASP_VIEWS,
+) -> None:
     """One grasp drawn as in Fig. 2 from each of ``views`` (name, camera): the hand at q
     (rad), the object ``shape`` see-through, the ``links`` touching it highlighted (hand
     link indices, one per contact), the contact points (mm, palm frame)."""

@@ -22,16 +22,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Camera", "ShapeInPicture", "HandShapes", "Picture", "hand_shapes", "render", "SKIN", "TOUCHING",
-           "BOX", "PALM_CAMERA"]
+__all__ = ["Camera", "ShapeInPicture", "HandShapes", "Picture", "hand_shapes", "render", "SKIN", "TOUCHING", "BOX", "PALM_CAMERA"]
 
 #: Colours (r, g, b in [0, 1]): the hand, a link touching the object, the object.
 SKIN = (0.96, 0.80, 0.67)
 TOUCHING = (0.93, 0.40, 0.06)
 BOX = (0.33, 0.52, 0.85)
 _BACKGROUND = 1.0
-_GHOST = 0.87        # grey of the reference silhouette
-_OUTLINE = 0.15      # grey of the outlines
+_GHOST = 0.87  # grey of the reference silhouette
+_OUTLINE = 0.15  # grey of the outlines
 _BOX_OPACITY = 0.42  # share of the object's own colour where it covers something
 _NO_LINK = -1
 _FAR = 1e9
@@ -77,6 +76,7 @@ PALM_CAMERA = Camera(direction=(-1.0, 0.32, 0.22), center_mm=(10.0, -2.0, 92.0),
 #: the thumb are seen on the object side by side, and which way each pushes it.
 ABOVE_CAMERA = Camera(direction=(-0.45, 0.3, -1.0), up=(1.0, 0.0, 0.0))
 
+
 @dataclass(frozen=True)
 class ShapeInPicture:
     """A shape (``synergrasp.simulation.shapes``) at its centre (mm, palm frame) and 3 × 3
@@ -118,10 +118,16 @@ def hand_shapes(hand: Any, q: NDArray) -> HandShapes:
 
     capsules = HandCapsules.of(hand)
     start, end = capsules.segments(np.asarray(q, dtype=float))
-    boxes = tuple(ShapeInPicture(Box(tuple(2.0 * half)), centre, rotation) for rotation, centre, half
-                  in zip(capsules.palm_rotation, capsules.palm_centre, capsules.palm_half))
-    return HandShapes(np.stack([start, end], axis=1), np.asarray(capsules.radius, dtype=float),
-                      np.asarray(capsules.links, dtype=np.int64), boxes)
+    boxes = tuple(
+        ShapeInPicture(Box(tuple(2.0 * half)), centre, rotation)
+        for rotation, centre, half in zip(capsules.palm_rotation, capsules.palm_centre, capsules.palm_half)
+    )
+    return HandShapes(
+        np.stack([start, end], axis=1),
+        np.asarray(capsules.radius, dtype=float),
+        np.asarray(capsules.links, dtype=np.int64),
+        boxes,
+    )
 
 
 # ------------------------------------------------------------------------------ ray casting
@@ -155,8 +161,7 @@ class _Rays:
             return None
         u = (np.arange(c0, c1) + 0.5 - self.width / 2.0) * self.scale
         v = (self.height / 2.0 - np.arange(r0, r1) - 0.5) * self.scale
-        origins = (self.center - 1e4 * self.basis[2] + u[None, :, None] * self.basis[0]
-                   + v[:, None, None] * self.basis[1])
+        origins = self.center - 1e4 * self.basis[2] + u[None, :, None] * self.basis[0] + v[:, None, None] * self.basis[1]
         return slice(r0, r1), slice(c0, c1), origins
 
     def keep(self, rows: slice, cols: slice, t: NDArray, normal: NDArray, label: int) -> None:
@@ -180,7 +185,7 @@ def _cast_capsule(rays: _Rays, a: NDArray, b: NDArray, r: float, label: int) -> 
     for c in (a, b):  # spheres: |o + t d - c| = r, first root
         oc = o - c
         half_b = oc @ d
-        disc = half_b ** 2 - (np.einsum("ijk,ijk->ij", oc, oc) - r * r)
+        disc = half_b**2 - (np.einsum("ijk,ijk->ij", oc, oc) - r * r)
         hit = disc >= 0.0
         t = np.where(hit, np.minimum(t, -half_b - np.sqrt(np.where(hit, disc, 0.0))), t)
     ba = b - a
@@ -282,9 +287,16 @@ class Picture:
         return self._rays.depth_of(points_mm) > seen + tolerance_mm
 
 
-def render(hand: Any, q: NDArray, camera: Camera, size_px: tuple[int, int] = (360, 360),
-           shape: ShapeInPicture | None = None, touching: Sequence[int] = (), ghost_q: NDArray | None = None,
-           supersample: int = 2) -> Picture:
+def render(
+    hand: Any,
+    q: NDArray,
+    camera: Camera,
+    size_px: tuple[int, int] = (360, 360),
+    shape: ShapeInPicture | None = None,
+    touching: Sequence[int] = (),
+    ghost_q: NDArray | None = None,
+    supersample: int = 2,
+) -> Picture:
     """The hand at joint angles q (rad) seen by ``camera``; ``size_px`` = (width, height).
 
     ``shape`` (the object) is drawn see-through; hand links in ``touching`` (hand link indices) get the
@@ -315,5 +327,5 @@ def render(hand: Any, q: NDArray, camera: Camera, size_px: tuple[int, int] = (36
             own = _shade(np.asarray(BOX), cover.normal[front], basis)
             rgb[front] = _BOX_OPACITY * own + (1.0 - _BOX_OPACITY) * rgb[front]
             rgb[_edges(face) & ((face >= 0) | (rays.label < 0)) & (cover.depth <= rays.depth)] = (0.12, 0.25, 0.50)
-    link = np.where(on_hand, rays.label, _NO_LINK)[k // 2::k, k // 2::k]
+    link = np.where(on_hand, rays.label, _NO_LINK)[k // 2 :: k, k // 2 :: k]
     return Picture(_downsample(rgb, k), link, rays, k)

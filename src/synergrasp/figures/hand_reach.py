@@ -27,8 +27,15 @@ __all__ = ["figure_hand_reach"]
 _PATH_DRAWN = 7
 
 
-def figure_hand_reach(hand: Hand, path: np.ndarray, reach: HandReach, objects: Mapping[str, Shape],
-                      posture_steps: int, png_path: str | Path, pdf_path: str | Path) -> None:
+def figure_hand_reach(
+    hand: Hand,
+    path: np.ndarray,
+    reach: HandReach,
+    objects: Mapping[str, Shape],
+    posture_steps: int,
+    png_path: str | Path,
+    pdf_path: str | Path,
+) -> None:
     """One panel per finger: its capsules at ``_PATH_DRAWN`` postures of the free S1 path
     ``path`` ((n, n_joints) rad), the axis end points of its capsules over a lattice of its
     joint limits (grey: any posture), the palm, each object lying on the palm as a box of its
@@ -68,17 +75,23 @@ def figure_hand_reach(hand: Hand, path: np.ndarray, reach: HandReach, objects: M
         for k, i in enumerate(drawn):
             p0, p1 = capsules.segments(path[i])
             for r in rows:
-                ax.plot([p0[r, 2], p1[r, 2]], [p0[r, 0], p1[r, 0]], color=colours[k], lw=2.0 * capsules.radius[r] / 3.0,
-                        solid_capstyle="round", alpha=0.8)
+                ax.plot(
+                    [p0[r, 2], p1[r, 2]],
+                    [p0[r, 0], p1[r, 0]],
+                    color=colours[k],
+                    lw=2.0 * capsules.radius[r] / 3.0,
+                    solid_capstyle="round",
+                    alpha=0.8,
+                )
         for d, held in sorted(by_thickness.items()):
             ax.add_patch(Rectangle((z_lo, face), z_hi - z_lo, d, fill=False, ls="--", lw=0.8, edgecolor="#c2000b"))
-            ax.text(z_lo + 1, face + d + 0.5, f"{', '.join(held)}: {d:g} mm", fontsize=6, color="#c2000b",
-                    va="bottom")
+            ax.text(z_lo + 1, face + d + 0.5, f"{', '.join(held)}: {d:g} mm", fontsize=6, color="#c2000b", va="bottom")
         ax.axhline(row["reach_s1_mm"], color="black", lw=0.8, label=f"reach along S1 {row['reach_s1_mm']:.1f}")
         ax.axhline(row["reach_any_mm"], color="0.5", lw=0.8, ls=":", label=f"reach, any posture {row['reach_any_mm']:.1f}")
         if row["press_mm"] > 0:
-            ax.axhline(face + row["press_mm"], color="#1f77b4", lw=1.2,
-                       label=f"d_max {row['press_mm']:g} (presses toward the palm)")
+            ax.axhline(
+                face + row["press_mm"], color="#1f77b4", lw=1.2, label=f"d_max {row['press_mm']:g} (presses toward the palm)"
+            )
         ax.set_title(f"{finger}", fontsize=9)
         ax.set_xlabel("z, along the fingers (mm)", fontsize=8)
         ax.set_ylim(float(palm[:, 0].min()) - 2.0, top)
@@ -87,7 +100,10 @@ def figure_hand_reach(hand: Hand, path: np.ndarray, reach: HandReach, objects: M
         ax.tick_params(labelsize=7)
         ax.legend(fontsize=5.5, loc="upper right")
     axes[0].set_ylabel("x, out of the palm (mm)", fontsize=8)
-    fig.suptitle(f"What each finger reaches closing along S1 (colour: open to closed) and in any posture (grey); "
-                 f"boxes lying on the palm (dashed); hand d_max {reach.d_max_mm:g} mm", fontsize=9)
+    fig.suptitle(
+        f"What each finger reaches closing along S1 (colour: open to closed) and in any posture (grey); "
+        f"boxes lying on the palm (dashed); hand d_max {reach.d_max_mm:g} mm",
+        fontsize=9,
+    )
     fig.tight_layout()
     save_figure(fig, png_path, pdf_path)

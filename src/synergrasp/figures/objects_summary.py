@@ -77,9 +77,12 @@ def figure_planner_tradeoff(rows: pd.DataFrame, radii: Sequence[float], png: str
         ax.set_yscale("log")
         ax.set_xlim(0, 100)
         b = budget.loc[float(r)]
-        ax.set_title(f"±{r:g}°: {b['within_both']} of {b['objects']} objects within both aims\n"
-                     f"(solves ≤ {SOLVE_SHARE_BUDGET:g} %: {b['within_solves']}, regret ≤ {REGRET_BUDGET:g} %: "
-                     f"{b['within_regret']})", fontsize=8)
+        ax.set_title(
+            f"±{r:g}°: {b['within_both']} of {b['objects']} objects within both aims\n"
+            f"(solves ≤ {SOLVE_SHARE_BUDGET:g} %: {b['within_solves']}, regret ≤ {REGRET_BUDGET:g} %: "
+            f"{b['within_regret']})",
+            fontsize=8,
+        )
         ax.set_xlabel("solves used (% of the exhaustive search)")
     axes[0][0].set_ylabel(f"force regret (%; 0 drawn at {floor:g})")
     fig.suptitle("The incremental planner per object, by radius", fontsize=9)

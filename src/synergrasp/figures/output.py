@@ -19,8 +19,7 @@ _PNG_METADATA = {"Software": None}
 _PDF_METADATA = {"CreationDate": None, "ModDate": None, "Producer": None, "Creator": None}
 
 
-def save_figure(fig: Any, png_path: str | Path, pdf_path: str | Path | None, dpi: int = 150,
-                tight: bool = False) -> None:
+def save_figure(fig: Any, png_path: str | Path, pdf_path: str | Path | None, dpi: int = 150, tight: bool = False) -> None:
     """Write a matplotlib figure as PNG (``dpi``) and PDF (none if ``pdf_path`` is None)
     without dates or software versions in their metadata, so that a rerun writes the same
     bytes; then close it."""

@@ -28,8 +28,7 @@ def figure_placement_claims(summary: pd.DataFrame, png_path: str | Path, pdf_pat
     import matplotlib.pyplot as plt
 
     objects = list(dict.fromkeys(summary["object"]))
-    fig, axes = plt.subplots(1, max(len(objects), 1), figsize=(2.9 * max(len(objects), 1) + 0.8, 3.6),
-                             sharey=True, squeeze=False)
+    fig, axes = plt.subplots(1, max(len(objects), 1), figsize=(2.9 * max(len(objects), 1) + 0.8, 3.6), sharey=True, squeeze=False)
     columns = {HOLDS: "holds_percent", FAILS: "does_not_hold_percent", UNDEFINED: "undefined_percent"}
     for ax, obj in zip(axes[0], objects):
         rows = summary[summary["object"] == obj].sort_values("claim")
@@ -37,8 +36,7 @@ def figure_placement_claims(summary: pd.DataFrame, png_path: str | Path, pdf_pat
         left = np.zeros(len(rows))
         for verdict, column in columns.items():
             width = rows[column].to_numpy(float)
-            ax.barh(y, width, left=left, color=VERDICT_COLOURS[verdict], edgecolor="0.5", linewidth=0.5,
-                    label=verdict)
+            ax.barh(y, width, left=left, color=VERDICT_COLOURS[verdict], edgecolor="0.5", linewidth=0.5, label=verdict)
             left += width
         for yi, at_chosen in zip(y, rows["at_chosen_target"]):
             ax.text(102, yi, _MARK.get(at_chosen, ""), va="center", fontsize=8, fontweight="bold", color="black")
@@ -51,7 +49,8 @@ def figure_placement_claims(summary: pd.DataFrame, png_path: str | Path, pdf_pat
         ax.set_title(f"{obj} ({int(rows['n_targets'].iloc[0])} targets)", fontsize=8)
     handles, labels = axes[0][0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=7, frameon=False)
-    fig.suptitle("The study's claims at every target of the placement search (letter: the verdict at the chosen "
-                 "target)", fontsize=9)
+    fig.suptitle(
+        "The study's claims at every target of the placement search (letter: the verdict at the chosen target)", fontsize=9
+    )
     fig.tight_layout(rect=(0, 0.07, 1, 0.93))
     save_figure(fig, png_path, pdf_path)

@@ -27,23 +27,44 @@ def _palm_outline(hand: Any) -> tuple[float, float, float, float]:
     return float(lo[1]), float(hi[1]), float(lo[2]), float(hi[2])
 
 
-def _level_panel(ax: Any, level: pd.DataFrame, spacing_mm: float, outline: tuple[float, float, float, float],
-                 limits: tuple[float, float, float, float]) -> None:
+def _level_panel(
+    ax: Any,
+    level: pd.DataFrame,
+    spacing_mm: float,
+    outline: tuple[float, float, float, float],
+    limits: tuple[float, float, float, float],
+) -> None:
     from matplotlib.patches import Rectangle
 
     half = spacing_mm / 2.0
     for _, row in level.iterrows():
         colour = image_colour(row["typed_percent"])
-        ax.add_patch(Rectangle((row["y_mm"] - half, row["z_mm"] - half), spacing_mm, spacing_mm,
-                               facecolor=colour, edgecolor="white", linewidth=0.4))
+        ax.add_patch(
+            Rectangle(
+                (row["y_mm"] - half, row["z_mm"] - half),
+                spacing_mm,
+                spacing_mm,
+                facecolor=colour,
+                edgecolor="white",
+                linewidth=0.4,
+            )
+        )
     y0, y1, z0, z1 = outline
     ax.add_patch(Rectangle((y0, z0), y1 - y0, z1 - z0, fill=False, edgecolor="0.3", linewidth=1.0, linestyle="--"))
-    ax.text(max(y0, limits[0]) + 2, max(z0, limits[2]) + 2, "palm", fontsize=6, color="0.3", va="bottom",
-            clip_on=True)  # inside the panel where the palm reaches beyond the targets
+    ax.text(
+        max(y0, limits[0]) + 2, max(z0, limits[2]) + 2, "palm", fontsize=6, color="0.3", va="bottom", clip_on=True
+    )  # inside the panel where the palm reaches beyond the targets
     for _, row in level[level["distinct_rank"].between(1, 3)].iterrows():
         k = int(row["distinct_rank"])
-        ax.plot(row["y_mm"], row["z_mm"], marker="*" if k == 1 else "o", ms=13 if k == 1 else 7,
-                mfc="#c2000b" if k == 1 else "none", mec="#c2000b" if k == 1 else "black", mew=1.2)
+        ax.plot(
+            row["y_mm"],
+            row["z_mm"],
+            marker="*" if k == 1 else "o",
+            ms=13 if k == 1 else 7,
+            mfc="#c2000b" if k == 1 else "none",
+            mec="#c2000b" if k == 1 else "black",
+            mew=1.2,
+        )
         if k > 1:
             ax.text(row["y_mm"] + 3, row["z_mm"] + 3, str(k), fontsize=7)
     ax.set_xlim(limits[0], limits[1])
@@ -59,9 +80,17 @@ def image_colour(percent: float) -> Any:
     return matplotlib.colormaps["viridis"](float(percent) / 100.0)
 
 
-def figure_placement_map(hand: Any, obj: Any, placement: pd.DataFrame, contacts: pd.DataFrame,
-                         spacing_mm: float, png_path: str | Path, pdf_path: str | Path, n_grasps: int = 2,
-                         oppositions: Mapping[int, str] | None = None) -> None:
+def figure_placement_map(
+    hand: Any,
+    obj: Any,
+    placement: pd.DataFrame,
+    contacts: pd.DataFrame,
+    spacing_mm: float,
+    png_path: str | Path,
+    pdf_path: str | Path,
+    n_grasps: int = 2,
+    oppositions: Mapping[int, str] | None = None,
+) -> None:
     """The placement map of ``obj`` (a ``synergrasp.simulation.objects.GraspedObject``): one panel per
     distance x of the targets from the palm
     (palm frame, mm): every scored target as a square coloured by the search's score T (the
@@ -81,8 +110,12 @@ def figure_placement_map(hand: Any, obj: Any, placement: pd.DataFrame, contacts:
     levels = sorted(placement["x_mm"].unique())
     chosen = placement[placement["chosen"]].iloc[0]
     half = spacing_mm / 2.0
-    limits = (placement["y_mm"].min() - half - 2, placement["y_mm"].max() + half + 2,
-              placement["z_mm"].min() - half - 2, placement["z_mm"].max() + half + 2)
+    limits = (
+        placement["y_mm"].min() - half - 2,
+        placement["y_mm"].max() + half + 2,
+        placement["z_mm"].min() - half - 2,
+        placement["z_mm"].max() + half + 2,
+    )
     outline = _palm_outline(hand)
     views = len(GRASP_VIEWS)
     fig = plt.figure(figsize=(max(2.2 * len(levels) + 1.0, 2.6 * n_grasps * views), 8.8))
@@ -100,9 +133,12 @@ def figure_placement_map(hand: Any, obj: Any, placement: pd.DataFrame, contacts:
     bar.ax.tick_params(labelsize=7)
     grasp_axes = [fig.add_subplot(bottom[0, c]) for c in range(n_grasps * views)]
     draw_grasp_row(grasp_axes, hand, obj, contacts, tuple(c for _, c in GRASP_VIEWS), oppositions)
-    fig.suptitle(f"{obj.name} ({chosen['grasp_type']}): chosen target ({chosen['x_mm']:g}, {chosen['y_mm']:g}, "
-                 f"{chosen['z_mm']:g}) mm,\n{chosen['typed_percent']:.0f} % {chosen['grasp_type']} grasps in force "
-                 f"closure ({chosen['force_closure_percent']:.0f} % force closure of any kind), median force "
-                 f"{chosen['median_force_per_weight']:.2g} × weight, {len(placement)} targets scored on "
-                 f"{int(chosen['n_poses'])} poses; grasps at it below", fontsize=9)
+    fig.suptitle(
+        f"{obj.name} ({chosen['grasp_type']}): chosen target ({chosen['x_mm']:g}, {chosen['y_mm']:g}, "
+        f"{chosen['z_mm']:g}) mm,\n{chosen['typed_percent']:.0f} % {chosen['grasp_type']} grasps in force "
+        f"closure ({chosen['force_closure_percent']:.0f} % force closure of any kind), median force "
+        f"{chosen['median_force_per_weight']:.2g} × weight, {len(placement)} targets scored on "
+        f"{int(chosen['n_poses'])} poses; grasps at it below",
+        fontsize=9,
+    )
     save_figure(fig, png_path, pdf_path)

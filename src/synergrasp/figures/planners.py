@@ -14,8 +14,7 @@ from synergrasp.figures.output import save_figure
 __all__ = ["figure_planners"]
 
 #: Marker per planner kind (the name's prefix), colour per family.
-_MARKERS = {"exhaustive": "s", "random": "o", "descent": "v", "coarse": "D", "incremental": "^", "skip": ">",
-            "straight": "<"}
+_MARKERS = {"exhaustive": "s", "random": "o", "descent": "v", "coarse": "D", "incremental": "^", "skip": ">", "straight": "<"}
 _COLOURS = {"full_set": "tab:blue", "incremental": "tab:red"}
 
 
@@ -33,12 +32,19 @@ def figure_planners(per_object: pd.DataFrame, across: pd.DataFrame, png: str | P
 
     judged = per_object[per_object["regret_percent_mean"].notna()]
     fig, axes = plt.subplots(2, 2, figsize=(12, 8.5), sharey="col")
-    for row, (cost, label) in enumerate((("closures", "closures (distinct poses asked)"),
-                                         ("solve_cost", "solve time (full-set solves, measured per set size)"))):
+    for row, (cost, label) in enumerate(
+        (("closures", "closures (distinct poses asked)"), ("solve_cost", "solve time (full-set solves, measured per set size)"))
+    ):
         ax_obj, ax_all = axes[row]
         for planner, part in judged.groupby("planner", sort=False):
-            ax_obj.scatter(part[cost], part["within_aim_probability"], marker=_MARKERS.get(_kind(planner), "o"),
-                           color=_COLOURS[part["family"].iat[0]], s=22, alpha=0.6)
+            ax_obj.scatter(
+                part[cost],
+                part["within_aim_probability"],
+                marker=_MARKERS.get(_kind(planner), "o"),
+                color=_COLOURS[part["family"].iat[0]],
+                s=22,
+                alpha=0.6,
+            )
         ax_obj.axhline(PROBABILITY_AIM, color="0.4", lw=0.8, ls="--")
         ax_obj.set_xscale("log")
         ax_obj.set_xlabel(label)
@@ -46,17 +52,30 @@ def figure_planners(per_object: pd.DataFrame, across: pd.DataFrame, png: str | P
         ax_obj.set_title(f"per object ({judged['object'].nunique()} objects, one point per planner)", fontsize=10)
         for r in across.itertuples():
             chosen = bool(getattr(r, "recommended", False))
-            ax_all.scatter(getattr(r, cost), r.meeting_aim_percent, marker=_MARKERS.get(_kind(r.planner), "o"),
-                           color=_COLOURS[r.family], s=120 if chosen else 30, edgecolors="k" if chosen else "none")
+            ax_all.scatter(
+                getattr(r, cost),
+                r.meeting_aim_percent,
+                marker=_MARKERS.get(_kind(r.planner), "o"),
+                color=_COLOURS[r.family],
+                s=120 if chosen else 30,
+                edgecolors="k" if chosen else "none",
+            )
         # planners at the same point share one label (every incremental planner closes every pose)
         spots = across.assign(x=across[cost].round(0), y=across["meeting_aim_percent"].round(1))
         for (x, y), part in spots.groupby(["x", "y"], sort=False):
             names = list(part["planner"])
-            text = "\n".join(", ".join(names[i:i + 3]) for i in range(0, len(names), 3))
+            text = "\n".join(", ".join(names[i : i + 3]) for i in range(0, len(names), 3))
             if cost == "closures":  # few distinct costs: labels beside their point, grouped
                 right = x >= 1000
-                ax_all.annotate(text, (x, y), fontsize=5.5, xytext=(-7 if right else 5, 0), textcoords="offset points",
-                                ha="right" if right else "left", va="center")
+                ax_all.annotate(
+                    text,
+                    (x, y),
+                    fontsize=5.5,
+                    xytext=(-7 if right else 5, 0),
+                    textcoords="offset points",
+                    ha="right" if right else "left",
+                    va="center",
+                )
             else:  # many close costs at the same share: slanted labels
                 ax_all.annotate(text, (x, y), fontsize=6, rotation=35, xytext=(3, 2), textcoords="offset points")
         ax_all.axhline(OBJECTS_AIM, color="0.4", lw=0.8, ls="--")
@@ -71,8 +90,11 @@ def figure_planners(per_object: pd.DataFrame, across: pd.DataFrame, png: str | P
     handles = [Line2D([], [], marker=m, ls="", color="0.3", label=k) for k, m in _MARKERS.items()]
     handles += [Line2D([], [], marker="o", ls="", color=c, label=f"family: {f}") for f, c in _COLOURS.items()]
     fig.legend(handles=handles, loc="lower center", ncol=9, fontsize=8, frameon=False)
-    fig.suptitle(f"Planners at equal cost: aim = regret ≤ {REGRET_AIM_PERCENT:g} % with probability ≥ "
-                 f"{PROBABILITY_AIM:g} (dashed), on ≥ {OBJECTS_AIM:g} % of objects", fontsize=11)
+    fig.suptitle(
+        f"Planners at equal cost: aim = regret ≤ {REGRET_AIM_PERCENT:g} % with probability ≥ "
+        f"{PROBABILITY_AIM:g} (dashed), on ≥ {OBJECTS_AIM:g} % of objects",
+        fontsize=11,
+    )
     fig.tight_layout(rect=(0, 0.04, 1, 0.96))
     save_figure(fig, png, pdf)
     plt.close(fig)

@@ -30,8 +30,9 @@ def quality_grid(quality: pd.DataFrame, column: str) -> tuple[np.ndarray, np.nda
     alphas = np.sort(quality["alpha_deg"].unique())
     betas = np.sort(quality["beta_deg"].unique())
     grid = np.full((betas.size, alphas.size), np.nan)
-    grid[np.searchsorted(betas, quality["beta_deg"]), np.searchsorted(alphas, quality["alpha_deg"])] = (
-        quality[column].to_numpy(dtype=float))
+    grid[np.searchsorted(betas, quality["beta_deg"]), np.searchsorted(alphas, quality["alpha_deg"])] = quality[column].to_numpy(
+        dtype=float
+    )
     return alphas, betas, grid
 
 
@@ -40,8 +41,7 @@ def figure_quality_maps(quality: pd.DataFrame, object_name: str, png: str | Path
     set's optimal force over the weight where the full set is in force closure."""
     shown = quality.copy()
     shown.loc[~shown["force_closure"].astype(bool), "force_per_weight"] = np.nan
-    fig, axes = plt.subplots(len(QUALITY_PANELS), 1, figsize=(9, 2.4 * len(QUALITY_PANELS) + 0.6), sharex=True,
-                             squeeze=False)
+    fig, axes = plt.subplots(len(QUALITY_PANELS), 1, figsize=(9, 2.4 * len(QUALITY_PANELS) + 0.6), sharex=True, squeeze=False)
     cmap = matplotlib.colormaps["viridis"].with_extremes(bad="white")
     for ax, (column, title, label, log) in zip(axes[:, 0], QUALITY_PANELS):
         alphas, betas, values = quality_grid(shown, column)
@@ -50,12 +50,17 @@ def figure_quality_maps(quality: pd.DataFrame, object_name: str, png: str | Path
         lo, hi = colour_range(values)  # one colour where it is constant (a sphere's)
         step_a = alphas[1] - alphas[0] if alphas.size > 1 else 5.0
         step_b = betas[1] - betas[0] if betas.size > 1 else 5.0
-        image = ax.imshow(np.ma.masked_invalid(values), origin="lower", aspect="auto", cmap=cmap, vmin=lo, vmax=hi,
-                          extent=(alphas[0] - step_a / 2, alphas[-1] + step_a / 2,
-                                  betas[0] - step_b / 2, betas[-1] + step_b / 2))
+        image = ax.imshow(
+            np.ma.masked_invalid(values),
+            origin="lower",
+            aspect="auto",
+            cmap=cmap,
+            vmin=lo,
+            vmax=hi,
+            extent=(alphas[0] - step_a / 2, alphas[-1] + step_a / 2, betas[0] - step_b / 2, betas[-1] + step_b / 2),
+        )
         positive = int((np.isfinite(values) & (values > 0)).sum()) if not log else int(np.isfinite(values).sum())
-        ax.set_title(f"{object_name}: {title} ({positive} of {values.size} poses "
-                     f"{'shown' if log else 'above 0'})", fontsize=9)
+        ax.set_title(f"{object_name}: {title} ({positive} of {values.size} poses {'shown' if log else 'above 0'})", fontsize=9)
         ax.set_ylabel("β (deg)")
         fig.colorbar(image, ax=ax, label=label, pad=0.01)
     axes[-1, 0].set_xlabel("α (deg)")

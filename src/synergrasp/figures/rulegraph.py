@@ -47,7 +47,7 @@ def canonical_rulegraph(dot: str) -> str:
             continue
         if (match := _NODE.match(line)) is not None:
             old = int(match.group(1))
-            node_lines[new_id[old]] = line[:match.start(1)] + str(new_id[old]) + line[match.end(1):]
+            node_lines[new_id[old]] = line[: match.start(1)] + str(new_id[old]) + line[match.end(1) :]
         else:
             header.append(line)
     indent = "\t"
@@ -79,11 +79,17 @@ def figure_rulegraph(dot: str, png: str | Path, pdf: str | Path) -> None:
     fig, ax = plt.subplots(figsize=(max(6.0, 2.3 * width), 1.1 * n_layers + 0.5))
     for src, dst in edges:
         (x0, y0), (x1, y1) = pos[src], pos[dst]
-        ax.annotate("", xy=(x1, y1 + 0.18), xytext=(x0, y0 - 0.18),
-                    arrowprops={"arrowstyle": "->", "color": "0.4", "lw": 0.8})
+        ax.annotate("", xy=(x1, y1 + 0.18), xytext=(x0, y0 - 0.18), arrowprops={"arrowstyle": "->", "color": "0.4", "lw": 0.8})
     for n, (x, y) in pos.items():
-        ax.text(x, y, nodes[n], ha="center", va="center", fontsize=8,
-                bbox={"boxstyle": "round,pad=0.3", "fc": "#e8eef7", "ec": "#4a6fa5"})
+        ax.text(
+            x,
+            y,
+            nodes[n],
+            ha="center",
+            va="center",
+            fontsize=8,
+            bbox={"boxstyle": "round,pad=0.3", "fc": "#e8eef7", "ec": "#4a6fa5"},
+        )
     ax.set_xlim(-0.2, width + 0.2)
     ax.set_ylim(-n_layers + 0.4, 0.6)
     ax.axis("off")

@@ -23,8 +23,11 @@ _MISSING = "#dddddd"
 
 
 def _claim_ids(summary: pd.DataFrame) -> list[str]:
-    return [c[len("claim"):-len("_verdict")] for c in summary.columns
-            if c.startswith("claim") and c.endswith("_verdict") and c[len("claim"):-len("_verdict")].isdigit()]
+    return [
+        c[len("claim") : -len("_verdict")]
+        for c in summary.columns
+        if c.startswith("claim") and c.endswith("_verdict") and c[len("claim") : -len("_verdict")].isdigit()
+    ]
 
 
 def figure_claims_grid(summary: pd.DataFrame, png: str | Path, pdf: str | Path) -> None:
@@ -53,8 +56,7 @@ def figure_claims_grid(summary: pd.DataFrame, png: str | Path, pdf: str | Path) 
     ax.set_yticks(np.arange(n_rows) + 0.5, list(summary["scenario"]))
     ax.xaxis.tick_top()
     handles = [plt.Rectangle((0, 0), 1, 1, facecolor=c) for c in VERDICT_COLOURS.values()]
-    ax.legend(handles, list(VERDICT_COLOURS), loc="upper center", bbox_to_anchor=(0.5, -0.01),
-              ncol=3, frameon=False, fontsize=7)
+    ax.legend(handles, list(VERDICT_COLOURS), loc="upper center", bbox_to_anchor=(0.5, -0.01), ncol=3, frameon=False, fontsize=7)
     fig.tight_layout()
     save_figure(fig, png, pdf)
 
@@ -82,17 +84,22 @@ def figure_table2_curves(table2: pd.DataFrame, png: str | Path, pdf: str | Path,
     success_rate (analysis.sensitivity.table2_long)."""
     data = table2[table2["k"] <= k_max]
     objects = sorted(data["object"].unique())
-    fig, axes = plt.subplots(1, len(objects), figsize=(3.2 * len(objects), 4.6), sharey=True,
-                             squeeze=False)
+    fig, axes = plt.subplots(1, len(objects), figsize=(3.2 * len(objects), 4.6), sharey=True, squeeze=False)
     scenarios = list(dict.fromkeys(data["scenario"]))
     colours = plt.get_cmap("tab20")(np.linspace(0, 1, max(len(scenarios), 2)))
     for ax, obj in zip(axes[0], objects):
         for colour, name in zip(colours, scenarios):
             curve = data[(data["object"] == obj) & (data["scenario"] == name)].sort_values("k")
             default = name == DEFAULT_SCENARIO
-            ax.plot(curve["k"], curve["success_rate"], marker=".", label=name,
-                    color="black" if default else colour, lw=2.2 if default else 1.0,
-                    zorder=3 if default else 2)
+            ax.plot(
+                curve["k"],
+                curve["success_rate"],
+                marker=".",
+                label=name,
+                color="black" if default else colour,
+                lw=2.2 if default else 1.0,
+                zorder=3 if default else 2,
+            )
         ax.set_title(obj)
         ax.set_xlabel("k of {S1..Sk}")
         ax.set_xticks(range(1, k_max + 1))

@@ -51,8 +51,13 @@ class Fig4Params:
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> Fig4Params:
         fig4 = config["analyses"]["fig4"]
-        return cls(config["analyses"]["success"], tuple(fig4["panel_k"]), fig4["alpha_slice_deg"],
-                   fig4["beta_slice_deg"], **force_bound(config, obj))
+        return cls(
+            config["analyses"]["success"],
+            tuple(fig4["panel_k"]),
+            fig4["alpha_slice_deg"],
+            fig4["beta_slice_deg"],
+            **force_bound(config, obj),
+        )
 
 
 @dataclass(frozen=True)
@@ -93,41 +98,59 @@ def _verdict_label(verdict: str) -> str:
     return verdict.replace("_", "-")
 
 
-def figure_force_maps(gfo: pd.DataFrame, minima: pd.DataFrame, panel_k: Sequence[int],
-                      object_name: str, png: str | Path, pdf: str | Path, verdict: str = "force_closure") -> None:
+def figure_force_maps(
+    gfo: pd.DataFrame,
+    minima: pd.DataFrame,
+    panel_k: Sequence[int],
+    object_name: str,
+    png: str | Path,
+    pdf: str | Path,
+    verdict: str = "force_closure",
+) -> None:
     """Fig. 4 (maps): log10 of the optimal force (N) over (α, β), one panel per {S1..Sk};
     empty cells where the pose is not a success (``verdict``, the name of the success
     verdict in use, labels the titles), dots on the local minima."""
     grids = [force_grid(gfo, incremental_set_id(k)) for k in panel_k]
     finite = np.concatenate([np.log10(g[2][np.isfinite(g[2])]) for g in grids] + [np.zeros(0)])
     vmin, vmax = colour_range(finite)  # one colour where it is constant (a sphere's)
-    fig, axes = plt.subplots(len(panel_k), 1, figsize=(9, 2.4 * len(panel_k) + 0.6),
-                             sharex=True, squeeze=False)
+    fig, axes = plt.subplots(len(panel_k), 1, figsize=(9, 2.4 * len(panel_k) + 0.6), sharex=True, squeeze=False)
     cmap = matplotlib.colormaps["viridis"].with_extremes(bad="white")
     for ax, k, (alphas, betas, force) in zip(axes[:, 0], panel_k, grids):
         with np.errstate(divide="ignore", invalid="ignore"):
             logf = np.log10(force)
         step_a = alphas[1] - alphas[0] if alphas.size > 1 else 5.0
         step_b = betas[1] - betas[0] if betas.size > 1 else 5.0
-        image = ax.imshow(np.ma.masked_invalid(logf), origin="lower", aspect="auto", cmap=cmap,
-                          vmin=vmin, vmax=vmax,
-                          extent=(alphas[0] - step_a / 2, alphas[-1] + step_a / 2,
-                                  betas[0] - step_b / 2, betas[-1] + step_b / 2))
+        image = ax.imshow(
+            np.ma.masked_invalid(logf),
+            origin="lower",
+            aspect="auto",
+            cmap=cmap,
+            vmin=vmin,
+            vmax=vmax,
+            extent=(alphas[0] - step_a / 2, alphas[-1] + step_a / 2, betas[0] - step_b / 2, betas[-1] + step_b / 2),
+        )
         mins = minima[minima["set_id"] == incremental_set_id(k)]
-        ax.plot(mins["alpha_deg"], mins["beta_deg"], "o", ms=3.5, mfc="none", mec="red", mew=0.8,
-                label="local minimum")
+        ax.plot(mins["alpha_deg"], mins["beta_deg"], "o", ms=3.5, mfc="none", mec="red", mew=0.8, label="local minimum")
         n_fc = int(np.isfinite(force).sum())
-        ax.set_title(f"{object_name}, {_set_label(k)}: {n_fc} {_verdict_label(verdict)} poses, "
-                     f"{len(mins)} local minima", fontsize=9)
+        ax.set_title(
+            f"{object_name}, {_set_label(k)}: {n_fc} {_verdict_label(verdict)} poses, {len(mins)} local minima", fontsize=9
+        )
         ax.set_ylabel("β (deg)")
         fig.colorbar(image, ax=ax, label="log10 ‖f‖ (N)", pad=0.01)
     axes[-1, 0].set_xlabel("α (deg)")
     save_figure(fig, png, pdf, tight=True)
 
 
-def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: float,
-                          beta_deg: float, object_name: str, png: str | Path,
-                          pdf: str | Path, verdict: str = "force_closure") -> None:
+def figure_exploded_views(
+    gfo: pd.DataFrame,
+    panel_k: Sequence[int],
+    alpha_deg: float,
+    beta_deg: float,
+    object_name: str,
+    png: str | Path,
+    pdf: str | Path,
+    verdict: str = "force_closure",
+) -> None:
     """Fig. 4 (exploded views): optimal force vs β at α = ``alpha_deg`` and vs α at
     β = ``beta_deg`` (nearest grid values), one line per {S1..Sk}; gaps where the pose is
     not a success of ``verdict``."""
@@ -148,8 +171,16 @@ def figure_exploded_views(gfo: pd.DataFrame, panel_k: Sequence[int], alpha_deg: 
         ax.set_xlim(grid[0], grid[-1])
         ax.set_xlabel(xlabel)
         if not any(np.isfinite(line.get_ydata()).any() for line in ax.get_lines()):
-            ax.text(0.5, 0.5, f"no {_verdict_label(verdict)} pose on this slice", transform=ax.transAxes,
-                    ha="center", va="center", fontsize=9, color="0.4")
+            ax.text(
+                0.5,
+                0.5,
+                f"no {_verdict_label(verdict)} pose on this slice",
+                transform=ax.transAxes,
+                ha="center",
+                va="center",
+                fontsize=9,
+                color="0.4",
+            )
             ax.set_yticks([])
             continue
         ax.set_yscale("log")
@@ -167,8 +198,14 @@ FIG5B_RATIO_RANGE = (1.0, 10.0)
 NO_VALUE_COLOUR = "#b9cde5"
 
 
-def _hierarchy_panel(ax: plt.Axes, grid: np.ndarray, norm: matplotlib.colors.Normalize, fmt: str,
-                     labels: list[str], counts: np.ndarray | None = None) -> matplotlib.image.AxesImage:
+def _hierarchy_panel(
+    ax: plt.Axes,
+    grid: np.ndarray,
+    norm: matplotlib.colors.Normalize,
+    fmt: str,
+    labels: list[str],
+    counts: np.ndarray | None = None,
+) -> matplotlib.image.AxesImage:
     """One 7 × 7 matrix in grey (black = low, white = high), its value printed in every cell
     ("–" where it has none) and, if given, the count below it."""
     cmap = matplotlib.colormaps["Greys_r"].with_extremes(bad=NO_VALUE_COLOUR)
@@ -177,8 +214,16 @@ def _hierarchy_panel(ax: plt.Axes, grid: np.ndarray, norm: matplotlib.colors.Nor
         if np.isfinite(value):
             shade = float(norm(np.clip(value, norm.vmin, norm.vmax)))
             text = format(value, fmt) + (f"\n{int(counts[i, j])}" if counts is not None else "")
-            ax.text(j, i, text, ha="center", va="center", fontsize=6 if counts is None else 5,
-                    color="black" if shade > 0.5 else "white", linespacing=0.9)
+            ax.text(
+                j,
+                i,
+                text,
+                ha="center",
+                va="center",
+                fontsize=6 if counts is None else 5,
+                color="black" if shade > 0.5 else "white",
+                linespacing=0.9,
+            )
         else:
             ax.text(j, i, "–", ha="center", va="center", fontsize=6, color="0.25")
     ax.set_xticks(range(len(labels)), labels, fontsize=7)
@@ -190,9 +235,19 @@ def _hierarchy_panel(ax: plt.Axes, grid: np.ndarray, norm: matplotlib.colors.Nor
     return image
 
 
-def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str, fmt: str,
-                     value_range: tuple[float, float], colorbar_label: str, png: str | Path, pdf: str | Path,
-                     log_scale: bool = False, counts: str | None = None) -> None:
+def figure_hierarchy(
+    matrices: pd.DataFrame,
+    value: str,
+    first: int,
+    title: str,
+    fmt: str,
+    value_range: tuple[float, float],
+    colorbar_label: str,
+    png: str | Path,
+    pdf: str | Path,
+    log_scale: bool = False,
+    counts: str | None = None,
+) -> None:
     """Fig. 5: ``first`` matrices ``first`` × ``first``, one per first synergy S_k; cell
     (i, j) of matrix k is the set {S_k, S_i, S_j}. Grey scale on the fixed ``value_range``
     (black = its low end, white = its high end; values beyond it take the end's grey), the
@@ -202,8 +257,7 @@ def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str,
     column ``value``. ``log_scale`` spaces the grey levels logarithmically.
     """
     low, high = value_range
-    norm = (matplotlib.colors.LogNorm(vmin=low, vmax=high) if log_scale
-            else matplotlib.colors.Normalize(vmin=low, vmax=high))
+    norm = matplotlib.colors.LogNorm(vmin=low, vmax=high) if log_scale else matplotlib.colors.Normalize(vmin=low, vmax=high)
     ncols = min(first, 4)
     nrows = int(np.ceil(first / ncols))
     fig, axes = plt.subplots(nrows, ncols, figsize=(3.1 * ncols + 0.8, 3.1 * nrows), squeeze=False)
@@ -233,5 +287,3 @@ def figure_hierarchy(matrices: pd.DataFrame, value: str, first: int, title: str,
             bar.set_ticks(ticks, labels=[f"{t:g}" for t in ticks])
             bar.ax.minorticks_off()
     save_figure(fig, png, pdf, tight=True)
-
-

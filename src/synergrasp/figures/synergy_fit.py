@@ -27,8 +27,7 @@ def figure_explained_variance(fit: SynergyFit, png_path: str | Path) -> None:
     ax.set_xticks(k, [f"S{i}" for i in k], fontsize=8)
     ax.set_ylim(0, 100)
     ax.set_ylabel("explained variance (%)")
-    ax.set_title(f"{len(fit.synergies.joint_names)} joints; total variance {fit.total_variance_rad2:.4g} rad²",
-                 fontsize=9)
+    ax.set_title(f"{len(fit.synergies.joint_names)} joints; total variance {fit.total_variance_rad2:.4g} rad²", fontsize=9)
     ax.legend(loc="center right", fontsize=8)
     fig.tight_layout()
     save_figure(fig, png_path, None)

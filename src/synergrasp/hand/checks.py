@@ -38,8 +38,10 @@ def closure_shape_problems(hand: Hand) -> list[str]:
     for link in range(1, hand.n_links):
         kinds = [s.kind for s in hand.link_shapes[link]]
         if kinds != ["capsule"] and not (link in hand.shapeless_links and not kinds):
-            problems.append(f"{link_field(hand, link)}: the closure needs exactly one capsule per finger link "
-                            f"(link '{hand.link_names[link]}'), got {kinds}")
+            problems.append(
+                f"{link_field(hand, link)}: the closure needs exactly one capsule per finger link "
+                f"(link '{hand.link_names[link]}'), got {kinds}"
+            )
     return problems
 
 
@@ -49,5 +51,4 @@ def check_hand(path: str | Path | None) -> tuple[Hand, list[str], list[str]]:
     the field. A malformed file raises ValueError naming the file and the field."""
     spec, where = hand_spec(path)
     hand = build_hand(spec, where)
-    return (hand, [f"{where}: {p}" for p in closure_shape_problems(hand)],
-            [f"{where}: {w}" for w in spec.warnings])
+    return (hand, [f"{where}: {p}" for p in closure_shape_problems(hand)], [f"{where}: {w}" for w in spec.warnings])

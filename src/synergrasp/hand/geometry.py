@@ -34,11 +34,13 @@ def rpy_matrix(rpy: NDArray | tuple[float, float, float]) -> NDArray[np.float64]
     """Rotation matrix of URDF roll-pitch-yaw angles (rad): Rz(yaw) @ Ry(pitch) @ Rx(roll)."""
     r, p, y = (float(a) for a in rpy)
     cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    return np.array([
-        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-        [-sp, cp * sr, cp * cr],
-    ])
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
 
 
 def matrix_rpy(rotation: NDArray) -> NDArray[np.float64]:
@@ -67,11 +69,13 @@ def axis_rotation(axis: NDArray, angle: float) -> NDArray[np.float64]:
     x, y, z = axis
     c, s = math.cos(angle), math.sin(angle)
     v = 1.0 - c
-    return np.array([
-        [c + x * x * v, x * y * v - z * s, x * z * v + y * s],
-        [y * x * v + z * s, c + y * y * v, y * z * v - x * s],
-        [z * x * v - y * s, z * y * v + x * s, c + z * z * v],
-    ])
+    return np.array(
+        [
+            [c + x * x * v, x * y * v - z * s, x * z * v + y * s],
+            [y * x * v + z * s, c + y * y * v, y * z * v - x * s],
+            [z * x * v - y * s, z * y * v + x * s, c + z * z * v],
+        ]
+    )
 
 
 def z_to(direction: NDArray) -> NDArray[np.float64]:
@@ -85,4 +89,3 @@ def z_to(direction: NDArray) -> NDArray[np.float64]:
         return np.diag([1.0, -1.0, -1.0])
     k = np.cross(z, d)
     return axis_rotation(k / np.linalg.norm(k), math.acos(c))
-

@@ -24,17 +24,41 @@ from numpy.typing import NDArray
 from synergrasp.hand.geometry import SHAPE_KINDS, Shape, pose_matrix, z_to
 from synergrasp.yaml_io import read_yaml
 
-__all__ = ["FINGERS", "JOINT_NAMES", "PALM_NORMAL", "HandSpec", "FingerSpec", "JointSpec",
-           "default_hand_path", "read_hand_file", "check_hand_doc", "size_warnings"]
+__all__ = [
+    "FINGERS",
+    "JOINT_NAMES",
+    "PALM_NORMAL",
+    "HandSpec",
+    "FingerSpec",
+    "JointSpec",
+    "default_hand_path",
+    "read_hand_file",
+    "check_hand_doc",
+    "size_warnings",
+]
 
 FINGERS: tuple[str, ...] = ("thumb", "index", "middle", "ring", "little")
 
 JOINT_NAMES: tuple[str, ...] = (
-    "thumb_abd", "thumb_flex1", "thumb_flex2",
-    "index_abd", "index_mcp", "index_pip", "index_dip",
-    "middle_abd", "middle_mcp", "middle_pip", "middle_dip",
-    "ring_abd", "ring_mcp", "ring_pip", "ring_dip",
-    "little_abd", "little_mcp", "little_pip", "little_dip",
+    "thumb_abd",
+    "thumb_flex1",
+    "thumb_flex2",
+    "index_abd",
+    "index_mcp",
+    "index_pip",
+    "index_dip",
+    "middle_abd",
+    "middle_mcp",
+    "middle_pip",
+    "middle_dip",
+    "ring_abd",
+    "ring_mcp",
+    "ring_pip",
+    "ring_dip",
+    "little_abd",
+    "little_mcp",
+    "little_pip",
+    "little_dip",
 )
 
 PALM_NORMAL: NDArray[np.float64] = np.array([1.0, 0.0, 0.0])
@@ -194,8 +218,7 @@ class _Checker:
             raise _err(f"{field}.shapes", "must be a list of {capsule: ...} or {box: ...}")
         return tuple(self.shape(s, f"{field}.shapes[{i}]") for i, s in enumerate(shapes))
 
-    def joint(self, node: Any, field: str, finger: str, index: int, links: set[str],
-              knuckle: NDArray) -> JointSpec:
+    def joint(self, node: Any, field: str, finger: str, index: int, links: set[str], knuckle: NDArray) -> JointSpec:
         jnode = self.mapping(node, field, "joint")
         name = jnode.get("name")
         if index >= len(JOINT_NAMES) or name != JOINT_NAMES[index]:
@@ -206,34 +229,46 @@ class _Checker:
             raise _err(f"{field}.axis", "must be a non-zero vector")
         rpy = self.vector(jnode, "rpy_rad", field) if "rpy_rad" in jnode else np.zeros(3)
         offset = knuckle @ pose_matrix(self.vector(jnode, "offset_mm", field), rpy)
-        gap = (self.number(jnode, "rolling_gap_mm", field, minimum=0.0)
-               if "rolling_gap_mm" in jnode else 0.0)
+        gap = self.number(jnode, "rolling_gap_mm", field, minimum=0.0) if "rolling_gap_mm" in jnode else 0.0
         lim = jnode.get("limits_deg")
-        if (not isinstance(lim, list) or len(lim) != 2
-                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in lim)
-                or not lim[0] < lim[1]):
+        if (
+            not isinstance(lim, list)
+            or len(lim) != 2
+            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in lim)
+            or not lim[0] < lim[1]
+        ):
             raise _err(f"{field}.limits_deg", f"must be [lower, upper] in degrees with lower < upper, got {lim!r}")
         link = jnode.get("link")
         if not isinstance(link, str) or not link.startswith(f"{finger}_") or link in links:
             raise _err(f"{field}.link", f"must be a new link name starting with '{finger}_', got {link!r}")
         links.add(link)
-        return JointSpec(name, axis / np.linalg.norm(axis), offset, gap, math.radians(lim[0]),
-                         math.radians(lim[1]), link, self.shapes(jnode, field))
+        return JointSpec(
+            name,
+            axis / np.linalg.norm(axis),
+            offset,
+            gap,
+            math.radians(lim[0]),
+            math.radians(lim[1]),
+            link,
+            self.shapes(jnode, field),
+        )
 
     def finger(self, node: Any, finger: str, first_joint: int, links: set[str]) -> FingerSpec:
         ff = f"fingers.{finger}"
         fnode = self.mapping(node, ff, "finger")
         knuckle = self.mapping(fnode.get("knuckle"), f"{ff}.knuckle", "knuckle")
-        knuckle_pose = pose_matrix(self.vector(knuckle, "xyz_mm", f"{ff}.knuckle"),
-                                   self.vector(knuckle, "rpy_rad", f"{ff}.knuckle"))
+        knuckle_pose = pose_matrix(
+            self.vector(knuckle, "xyz_mm", f"{ff}.knuckle"), self.vector(knuckle, "rpy_rad", f"{ff}.knuckle")
+        )
         tip = self.vector(fnode, "tip_mm", ff)
         joints = fnode.get("joints")
         if not isinstance(joints, list) or not joints:
             raise _err(f"{ff}.joints", "must be a non-empty list of joints")
         out = []
         for i, jnode in enumerate(joints):  # the knuckle pose is folded into the first joint's offset
-            out.append(self.joint(jnode, f"{ff}.joints[{i}]", finger, first_joint + i, links,
-                                  knuckle_pose if i == 0 else np.eye(4)))
+            out.append(
+                self.joint(jnode, f"{ff}.joints[{i}]", finger, first_joint + i, links, knuckle_pose if i == 0 else np.eye(4))
+            )
         return FingerSpec(finger, tip, tuple(out))
 
 
@@ -306,15 +341,16 @@ def size_warnings(spec: HandSpec, unit: str = "mm") -> tuple[str, ...]:
     far = "far from a human hand's dimensions (a hand is about 190 mm long)"
     if len(big) > _MANY:
         field, value = max(big, key=lambda item: item[1])
-        return (f"<top level>: {len(big)} of the hand's {len(lengths)} lengths exceed {_LONGEST_MM:g} mm, up to "
-                f"{value:.6g} mm ({field}), {far}; {advice}",)
+        return (
+            f"<top level>: {len(big)} of the hand's {len(lengths)} lengths exceed {_LONGEST_MM:g} mm, up to "
+            f"{value:.6g} mm ({field}), {far}; {advice}",
+        )
     if big:
         return tuple(f"{field}: {value:.6g} mm is {far}; lengths are in {unit}" for field, value in big)
     reach = [(f"fingers.{f.name}", _reach_mm(f)) for f in spec.fingers]
     field, value = max(reach, key=lambda item: item[1])
     if value > _REACH_MM:
-        return (f"{field}: the fingertip lies {value:.6g} mm from the palm frame's origin at the zero posture, "
-                f"{far}; {advice}",)
+        return (f"{field}: the fingertip lies {value:.6g} mm from the palm frame's origin at the zero posture, {far}; {advice}",)
     longest = max(value for _, value in lengths)
     if longest < _SHORTEST_MM:
         return (f"<top level>: no length of the hand exceeds {longest:.3g} mm, {far}; {advice}",)

@@ -41,7 +41,11 @@ from synergrasp.hand.hand_file import (  # noqa: F401  (the file format, re-expo
 from synergrasp.hand.description import hand_spec  # noqa: F401  (re-exported)
 
 FINGERTIP_LINKS: tuple[str, ...] = (
-    "thumb_distal", "index_distal", "middle_distal", "ring_distal", "little_distal",
+    "thumb_distal",
+    "index_distal",
+    "middle_distal",
+    "ring_distal",
+    "little_distal",
 )
 """Last link of each finger chain, in FINGERS order (shipped model)."""
 
@@ -55,28 +59,28 @@ class Hand:
 
     name: str
     joint_names: tuple[str, ...]
-    lower: NDArray[np.float64]            # (19,) rad
-    upper: NDArray[np.float64]            # (19,) rad
+    lower: NDArray[np.float64]  # (19,) rad
+    upper: NDArray[np.float64]  # (19,) rad
     link_names: tuple[str, ...]
-    link_finger: tuple[str, ...]          # finger of each link, 'palm' for the palm
-    link_frame: NDArray[np.int64]         # frame each link is attached to
-    link_parent: NDArray[np.int64]        # parent link, -1 for the palm
+    link_finger: tuple[str, ...]  # finger of each link, 'palm' for the palm
+    link_frame: NDArray[np.int64]  # frame each link is attached to
+    link_parent: NDArray[np.int64]  # parent link, -1 for the palm
     link_parent_joint: NDArray[np.int64]  # joint (q index) moving the link, -1 for the palm
     link_shapes: tuple[tuple[Shape, ...], ...]
-    frame_names: tuple[str, ...]          # frame 0 'palm'; hand links keep their names
-    frame_parent: NDArray[np.int64]       # -1 for frame 0
-    frame_offset: NDArray[np.float64]     # (n_frames, 4, 4) parent frame -> axis frame, mm
-    frame_axis: NDArray[np.float64]       # (n_frames, 3) unit axis in the frame
-    frame_joint: NDArray[np.int64]        # q index driving the frame, -1 for the palm
-    frame_scale: NDArray[np.float64]      # angle of the axis per unit q (1, or 1/2 for a rolling half)
-    frame_joint_names: tuple[str, ...]    # name of the elementary axis ('' for the palm)
+    frame_names: tuple[str, ...]  # frame 0 'palm'; hand links keep their names
+    frame_parent: NDArray[np.int64]  # -1 for frame 0
+    frame_offset: NDArray[np.float64]  # (n_frames, 4, 4) parent frame -> axis frame, mm
+    frame_axis: NDArray[np.float64]  # (n_frames, 3) unit axis in the frame
+    frame_joint: NDArray[np.int64]  # q index driving the frame, -1 for the palm
+    frame_scale: NDArray[np.float64]  # angle of the axis per unit q (1, or 1/2 for a rolling half)
+    frame_joint_names: tuple[str, ...]  # name of the elementary axis ('' for the palm)
     finger_joints: tuple[tuple[int, ...], ...]  # q indices per finger, FINGERS order
-    finger_links: tuple[tuple[int, ...], ...]   # link indices per finger, proximal to distal
-    fingertip_link: NDArray[np.int64]     # (5,) distal link of each finger
+    finger_links: tuple[tuple[int, ...], ...]  # link indices per finger, proximal to distal
+    fingertip_link: NDArray[np.int64]  # (5,) distal link of each finger
     fingertip_point: NDArray[np.float64]  # (5, 3) fingertip point in its distal link frame, mm
     ignored_link_pairs: tuple[tuple[int, int], ...]  # self-collision pairs to skip (touching by design)
     palm_normal: NDArray[np.float64]
-    source: str = "the shipped hand"      # where the model was read from (for messages)
+    source: str = "the shipped hand"  # where the model was read from (for messages)
     shapeless_links: tuple[int, ...] = ()  # finger links without a shape (a body carrying only a joint)
 
     @property
@@ -118,12 +122,11 @@ class _Tree:
 
     def __init__(self, palm_shapes: tuple[Shape, ...]) -> None:
         self.frames: list[tuple[str, int, NDArray, NDArray, int, float, str]] = [
-            ("palm", -1, np.eye(4), np.zeros(3), -1, 0.0, "")]
-        self.links: list[tuple[str, str, int, int, int, tuple[Shape, ...]]] = [
-            ("palm", "palm", 0, -1, -1, palm_shapes)]
+            ("palm", -1, np.eye(4), np.zeros(3), -1, 0.0, "")
+        ]
+        self.links: list[tuple[str, str, int, int, int, tuple[Shape, ...]]] = [("palm", "palm", 0, -1, -1, palm_shapes)]
 
-    def frame(self, name: str, parent: int, offset: NDArray, axis: NDArray, joint: int, scale: float,
-              jname: str) -> int:
+    def frame(self, name: str, parent: int, offset: NDArray, axis: NDArray, joint: int, scale: float, jname: str) -> int:
         self.frames.append((name, parent, offset, axis, joint, scale, jname))
         return len(self.frames) - 1
 
@@ -149,10 +152,10 @@ def build_hand(spec: HandSpec, source: str = "the shipped hand") -> Hand:
                 k = joint_names.index(joint.follows)
                 last = tree.frame(joint.link, parent_frame, joint.offset, joint.axis, k, joint.scale, joint.name)
             elif joint.rolling_gap_mm > 0:
-                first = tree.frame(f"{joint.name}_half", parent_frame, joint.offset, joint.axis, k, 0.5,
-                                   f"{joint.name}_a")
-                last = tree.frame(joint.link, first, pose_matrix([joint.rolling_gap_mm, 0.0, 0.0]), joint.axis,
-                                  k, 0.5, f"{joint.name}_b")
+                first = tree.frame(f"{joint.name}_half", parent_frame, joint.offset, joint.axis, k, 0.5, f"{joint.name}_a")
+                last = tree.frame(
+                    joint.link, first, pose_matrix([joint.rolling_gap_mm, 0.0, 0.0]), joint.axis, k, 0.5, f"{joint.name}_b"
+                )
             else:
                 last = tree.frame(joint.link, parent_frame, joint.offset, joint.axis, k, joint.scale, joint.name)
             if not joint.follows:
@@ -181,18 +184,32 @@ def build_hand(spec: HandSpec, source: str = "the shipped hand") -> Hand:
     names = [link[0] for link in links]
     ignored.update(tuple(sorted((names.index(a), names.index(b)))) for a, b in spec.ignored_pairs)
     return Hand(
-        name=spec.name, joint_names=tuple(joint_names), lower=np.array(lower), upper=np.array(upper),
-        link_names=tuple(link[0] for link in links), link_finger=tuple(link[1] for link in links),
-        link_frame=tree.column(links, 2), link_parent=tree.column(links, 3),
-        link_parent_joint=tree.column(links, 4), link_shapes=tuple(link[5] for link in links),
-        frame_names=tuple(f[0] for f in frames), frame_parent=tree.column(frames, 1),
-        frame_offset=tree.column(frames, 2), frame_axis=tree.column(frames, 3),
-        frame_joint=tree.column(frames, 4), frame_scale=tree.column(frames, 5, dtype=float),
-        frame_joint_names=tuple(f[6] for f in frames), finger_joints=tuple(finger_joints),
-        finger_links=tuple(finger_links), fingertip_link=np.array([fl[-1] for fl in finger_links]),
+        name=spec.name,
+        joint_names=tuple(joint_names),
+        lower=np.array(lower),
+        upper=np.array(upper),
+        link_names=tuple(link[0] for link in links),
+        link_finger=tuple(link[1] for link in links),
+        link_frame=tree.column(links, 2),
+        link_parent=tree.column(links, 3),
+        link_parent_joint=tree.column(links, 4),
+        link_shapes=tuple(link[5] for link in links),
+        frame_names=tuple(f[0] for f in frames),
+        frame_parent=tree.column(frames, 1),
+        frame_offset=tree.column(frames, 2),
+        frame_axis=tree.column(frames, 3),
+        frame_joint=tree.column(frames, 4),
+        frame_scale=tree.column(frames, 5, dtype=float),
+        frame_joint_names=tuple(f[6] for f in frames),
+        finger_joints=tuple(finger_joints),
+        finger_links=tuple(finger_links),
+        fingertip_link=np.array([fl[-1] for fl in finger_links]),
         fingertip_point=np.array([f.tip_mm for f in spec.fingers]),
-        ignored_link_pairs=tuple(sorted(ignored)), palm_normal=spec.palm_normal, source=source,
-        shapeless_links=tuple(shapeless) if spec.shapeless_links else ())
+        ignored_link_pairs=tuple(sorted(ignored)),
+        palm_normal=spec.palm_normal,
+        source=source,
+        shapeless_links=tuple(shapeless) if spec.shapeless_links else (),
+    )
 
 
 # --------------------------------------------------------------------------- kinematics
@@ -201,8 +218,9 @@ def build_hand(spec: HandSpec, source: str = "the shipped hand") -> Hand:
 def _check_q(hand: Hand, q: NDArray) -> NDArray[np.float64]:
     q = np.asarray(q, dtype=float)
     if q.shape != (hand.n_joints,):
-        raise ValueError(f"q must have shape ({hand.n_joints},) (joints {hand.joint_names[0]} ... "
-                         f"{hand.joint_names[-1]}), got {q.shape}")
+        raise ValueError(
+            f"q must have shape ({hand.n_joints},) (joints {hand.joint_names[0]} ... {hand.joint_names[-1]}), got {q.shape}"
+        )
     return q
 
 
@@ -304,7 +322,7 @@ def contact_jacobian(hand: Hand, q: NDArray, links: NDArray, points_mm: NDArray)
     frames = frame_transforms(hand, q)
     jac = np.zeros((3 * len(links), hand.n_joints))
     for i, (link, point) in enumerate(zip(links, points)):
-        jac[3 * i:3 * i + 3] = _jacobian_rows(hand, frames, _check_link(hand, int(link)), point)
+        jac[3 * i : 3 * i + 3] = _jacobian_rows(hand, frames, _check_link(hand, int(link)), point)
     return jac
 
 
@@ -334,30 +352,38 @@ def urdf_text(hand: Hand, mass_kg: float = 0.01) -> str:
     each limited to half of the joint's range."""
     lines = ['<?xml version="1.0"?>', f'<robot name="{hand.name}">']
     shapes_of_frame = {int(f): hand.link_shapes[i] for i, f in enumerate(hand.link_frame)}
-    finger_colour = {"palm": "0.55 0.55 0.6 1", "thumb": "0.85 0.45 0.3 1", "index": "0.3 0.6 0.85 1",
-                     "middle": "0.4 0.75 0.4 1", "ring": "0.85 0.75 0.3 1", "little": "0.7 0.45 0.8 1"}
+    finger_colour = {
+        "palm": "0.55 0.55 0.6 1",
+        "thumb": "0.85 0.45 0.3 1",
+        "index": "0.3 0.6 0.85 1",
+        "middle": "0.4 0.75 0.4 1",
+        "ring": "0.85 0.75 0.3 1",
+        "little": "0.7 0.45 0.8 1",
+    }
     for f, fname in enumerate(hand.frame_names):
         finger = "palm" if f == 0 else hand.joint_names[hand.frame_joint[f]].split("_")[0]
         lines.append(f'  <link name="{fname}">')
-        lines.append('    <inertial><origin xyz="0 0 0" rpy="0 0 0"/>'
-                     f'<mass value="{mass_kg:.9g}"/>'
-                     '<inertia ixx="1e-06" ixy="0" ixz="0" iyy="1e-06" iyz="0" izz="1e-06"/></inertial>')
+        lines.append(
+            '    <inertial><origin xyz="0 0 0" rpy="0 0 0"/>'
+            f'<mass value="{mass_kg:.9g}"/>'
+            '<inertia ixx="1e-06" ixy="0" ixz="0" iyy="1e-06" iyz="0" izz="1e-06"/></inertial>'
+        )
         for shape in shapes_of_frame.get(f, ()):
-            lines.append(f'    <visual>{_origin(shape.pose)}<geometry>{_geometry(shape, True)}</geometry>'
-                         f'<material name="{finger}"><color rgba="{finger_colour[finger]}"/></material></visual>')
-            lines.append(f'    <collision>{_origin(shape.pose)}<geometry>{_geometry(shape, False)}</geometry></collision>')
-        lines.append('  </link>')
+            lines.append(
+                f"    <visual>{_origin(shape.pose)}<geometry>{_geometry(shape, True)}</geometry>"
+                f'<material name="{finger}"><color rgba="{finger_colour[finger]}"/></material></visual>'
+            )
+            lines.append(f"    <collision>{_origin(shape.pose)}<geometry>{_geometry(shape, False)}</geometry></collision>")
+        lines.append("  </link>")
     for f in range(1, len(hand.frame_names)):
         k = int(hand.frame_joint[f])
         s = float(hand.frame_scale[f])
         lines.append(f'  <joint name="{hand.frame_joint_names[f]}" type="revolute">')
-        lines.append(f'    <parent link="{hand.frame_names[hand.frame_parent[f]]}"/>'
-                     f'<child link="{hand.frame_names[f]}"/>')
+        lines.append(f'    <parent link="{hand.frame_names[hand.frame_parent[f]]}"/><child link="{hand.frame_names[f]}"/>')
         lines.append(f'    {_origin(hand.frame_offset[f])}<axis xyz="{_fmt(hand.frame_axis[f])}"/>')
-        lines.append(f'    <limit lower="{s * hand.lower[k]:.9g}" upper="{s * hand.upper[k]:.9g}" '
-                     'effort="10" velocity="10"/>')
-        lines.append('  </joint>')
-    lines.append('</robot>')
+        lines.append(f'    <limit lower="{s * hand.lower[k]:.9g}" upper="{s * hand.upper[k]:.9g}" effort="10" velocity="10"/>')
+        lines.append("  </joint>")
+    lines.append("</robot>")
     return "\n".join(lines) + "\n"
 
 

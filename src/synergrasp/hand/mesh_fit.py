@@ -45,9 +45,9 @@ def hull_vertices(model: Any, geom: int) -> NDArray[np.float64]:
         raise MeshFitError("MuJoCo computed no convex hull for its mesh")
     # mesh_graph: numvert, numface, vert_edgeadr[numvert], vert_globalid[numvert], ...
     n = int(model.mesh_graph[address])
-    ids = np.asarray(model.mesh_graph[address + 2 + n: address + 2 + 2 * n], dtype=np.int64)
+    ids = np.asarray(model.mesh_graph[address + 2 + n : address + 2 + 2 * n], dtype=np.int64)
     start = int(model.mesh_vertadr[mesh])
-    points = np.asarray(model.mesh_vert[start: start + int(model.mesh_vertnum[mesh])], dtype=float)[ids]
+    points = np.asarray(model.mesh_vert[start : start + int(model.mesh_vertnum[mesh])], dtype=float)[ids]
     return points * _MM_PER_M
 
 
@@ -64,8 +64,15 @@ def _circle_of_three(a: NDArray, b: NDArray, c: NDArray) -> tuple[NDArray, float
     if abs(d) < 1e-12 * scale * scale:
         return max((_circle_of_two(a, b), _circle_of_two(a, c), _circle_of_two(b, c)), key=lambda t: t[1])
     sa, sb, sc = a @ a, b @ b, c @ c
-    centre = np.array([sa * (b[1] - c[1]) + sb * (c[1] - a[1]) + sc * (a[1] - b[1]),
-                       sa * (c[0] - b[0]) + sb * (a[0] - c[0]) + sc * (b[0] - a[0])]) / d
+    centre = (
+        np.array(
+            [
+                sa * (b[1] - c[1]) + sb * (c[1] - a[1]) + sc * (a[1] - b[1]),
+                sa * (c[0] - b[0]) + sb * (a[0] - c[0]) + sc * (b[0] - a[0]),
+            ]
+        )
+        / d
+    )
     return centre, float(np.linalg.norm(a - centre))
 
 

@@ -32,14 +32,24 @@ __all__ = ["mjcf_hand_spec", "compile_mjcf", "MM_PER_M"]
 
 MM_PER_M = 1000.0
 
-_KEYS = ("name", "mjcf", "urdf", "palm", "palm_normal", "finger_direction", "fixed_joints", "couplings",
-         "ignore_geoms", "fit_meshes", "fingers")
+_KEYS = (
+    "name",
+    "mjcf",
+    "urdf",
+    "palm",
+    "palm_normal",
+    "finger_direction",
+    "fixed_joints",
+    "couplings",
+    "ignore_geoms",
+    "fit_meshes",
+    "fingers",
+)
 _FINGER_KEYS = ("joints", "tip_site", "tip_mm")
 _CHAIN_KEYS = ("mjcf", "name", "link", "reverse", "scale")
 #: MuJoCo's joint, geom and equality type codes (mjtJoint, mjtGeom, mjtEq) and their names in messages.
 _JOINT_TYPES = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
-_GEOM_TYPES = {0: "plane", 1: "hfield", 2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box",
-               7: "mesh", 8: "sdf"}
+_GEOM_TYPES = {0: "plane", 1: "hfield", 2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box", 7: "mesh", 8: "sdf"}
 _EQ_JOINT = 2
 
 
@@ -52,8 +62,8 @@ class _Model:
     """The compiled MJCF model and the description's file names, for messages."""
 
     model: Any
-    where: str   # "hand file '<description>'"
-    xml: str     # the MJCF file's name
+    where: str  # "hand file '<description>'"
+    xml: str  # the MJCF file's name
     fit_meshes: bool = False  # a collision mesh becomes the capsule or box holding its hull
 
     def find(self, kind: str, name: Any, field: str) -> int:
@@ -61,8 +71,12 @@ class _Model:
         description, the field and the MJCF file otherwise."""
         import mujoco
 
-        obj = {"body": mujoco.mjtObj.mjOBJ_BODY, "joint": mujoco.mjtObj.mjOBJ_JOINT,
-               "site": mujoco.mjtObj.mjOBJ_SITE, "geom": mujoco.mjtObj.mjOBJ_GEOM}[kind]
+        obj = {
+            "body": mujoco.mjtObj.mjOBJ_BODY,
+            "joint": mujoco.mjtObj.mjOBJ_JOINT,
+            "site": mujoco.mjtObj.mjOBJ_SITE,
+            "geom": mujoco.mjtObj.mjOBJ_GEOM,
+        }[kind]
         index = mujoco.mj_name2id(self.model, obj, str(name)) if isinstance(name, str) else -1
         if index < 0:
             raise _Error(f"{self.where}: {field}: no {kind} named {name!r} in '{self.xml}'")
@@ -126,8 +140,10 @@ def _geom_shape(m: _Model, geom: int, pose: NDArray, palm: bool) -> Shape:
             raise _Error(f"{where}: the mesh is refused: {err}") from None
         return Shape("capsule", pose @ fitted, radius=radius, length=length)
     hint = "; or fit_meshes: true" if kind == 7 else ""
-    raise _Error(f"{where}: a {_GEOM_TYPES.get(kind, kind)} collision geom is refused (the closure collides "
-                 f"capsules, spheres and boxes); give the hand capsules/boxes or list it in ignore_geoms{hint}")
+    raise _Error(
+        f"{where}: a {_GEOM_TYPES.get(kind, kind)} collision geom is refused (the closure collides "
+        f"capsules, spheres and boxes); give the hand capsules/boxes or list it in ignore_geoms{hint}"
+    )
 
 
 def _geom_pose(model: Any, geom: int) -> NDArray[np.float64]:
@@ -202,22 +218,31 @@ def mjcf_hand_spec(doc: dict, path: Path, where: str) -> HandSpec:
     owner = _link_owner(m, palm, chains, fixed, couplings)
     frame = _palm_frame(doc, where)
     body_pose = _body_poses(m, palm, fixed, frame)
-    joint_frames = {j: body_pose[model.jnt_bodyid[j]] @ pose_matrix(model.jnt_pos[j] * MM_PER_M)
-                    for chain in chains.values() for j, _ in chain}
+    joint_frames = {
+        j: body_pose[model.jnt_bodyid[j]] @ pose_matrix(model.jnt_pos[j] * MM_PER_M)
+        for chain in chains.values()
+        for j, _ in chain
+    }
     shapes: dict[int, list[Shape]] = {-1: []}
     for geom in range(model.ngeom):
         body = int(model.geom_bodyid[geom])
-        if (body not in owner or geom in ignored
-                or (model.geom_contype[geom] == 0 and model.geom_conaffinity[geom] == 0)):
+        if body not in owner or geom in ignored or (model.geom_contype[geom] == 0 and model.geom_conaffinity[geom] == 0):
             continue  # outside the hand, left out, or a visual geom
         link = owner[body]
         base = np.eye(4) if link < 0 else joint_frames[link]
         shapes.setdefault(link, []).append(
-            _geom_shape(m, geom, np.linalg.inv(base) @ body_pose[body] @ _geom_pose(model, geom), link < 0))
-    fingers = tuple(_finger(m, doc["fingers"][f], f, chains[f], joint_frames, shapes, couplings, body_pose)
-                    for f in FINGERS)
-    return HandSpec(str(doc.get("name", xml.stem)), np.array([1.0, 0.0, 0.0]), tuple(shapes[-1]), fingers,
-                    (), shapeless_links=True, ignored_pairs=_excluded_pairs(m, owner, chains))
+            _geom_shape(m, geom, np.linalg.inv(base) @ body_pose[body] @ _geom_pose(model, geom), link < 0)
+        )
+    fingers = tuple(_finger(m, doc["fingers"][f], f, chains[f], joint_frames, shapes, couplings, body_pose) for f in FINGERS)
+    return HandSpec(
+        str(doc.get("name", xml.stem)),
+        np.array([1.0, 0.0, 0.0]),
+        tuple(shapes[-1]),
+        fingers,
+        (),
+        shapeless_links=True,
+        ignored_pairs=_excluded_pairs(m, owner, chains),
+    )
 
 
 def _equality_couplings(m: _Model, palm: int, couplings: dict) -> dict:
@@ -237,8 +262,10 @@ def _equality_couplings(m: _Model, palm: int, couplings: dict) -> dict:
         coef = [float(c) for c in model.eq_data[eq][:5]]
         field = f"equality {model.eq(eq).name or f'#{eq}'!r} in '{m.xml}'"
         if master < 0 or coef[0] != 0.0 or any(c != 0.0 for c in coef[2:]) or coef[1] == 0.0:
-            raise _Error(f"{m.where}: {field}: joint {name!r} is held by polycoef {coef}; only a coupling "
-                         "joint1 = c1 × joint2 (polycoef 0 c1 0 0 0) is read")
+            raise _Error(
+                f"{m.where}: {field}: joint {name!r} is held by polycoef {coef}; only a coupling "
+                "joint1 = c1 × joint2 (polycoef 0 c1 0 0 0) is read"
+            )
         if name in out:
             raise _Error(f"{m.where}: couplings.{name}: joint {name!r} is coupled by {field} already")
         out[name] = {"follows": model.joint(master).name, "ratio": coef[1]}
@@ -252,7 +279,7 @@ def _excluded_pairs(m: _Model, owner: dict[int, int], chains: dict) -> tuple[tup
     link = {j: entry["link"] for chain in chains.values() for j, entry in chain}
     link[-1] = "palm"
     pairs = set()
-    for signature in model.exclude_signature[:model.nexclude]:
+    for signature in model.exclude_signature[: model.nexclude]:
         a, b = int(signature) >> 16, int(signature) & 0xFFFF
         if a in owner and b in owner and owner[a] != owner[b]:
             pairs.add(tuple(sorted((link[owner[a]], link[owner[b]]))))
@@ -262,8 +289,10 @@ def _excluded_pairs(m: _Model, owner: dict[int, int], chains: dict) -> tuple[tup
 def _hinge_joint(m: _Model, joint: int, field: str) -> None:
     kind = int(m.model.jnt_type[joint])
     if kind != 3:
-        raise _Error(f"{m.where}: {field}: joint {m.model.joint(joint).name!r} in '{m.xml}' is a "
-                     f"{_JOINT_TYPES.get(kind, kind)} joint; the hand model has hinge joints only")
+        raise _Error(
+            f"{m.where}: {field}: joint {m.model.joint(joint).name!r} in '{m.xml}' is a "
+            f"{_JOINT_TYPES.get(kind, kind)} joint; the hand model has hinge joints only"
+        )
 
 
 def _chains(m: _Model, doc: dict, palm: int) -> dict[str, list[tuple[int, dict]]]:
@@ -271,8 +300,10 @@ def _chains(m: _Model, doc: dict, palm: int) -> dict[str, list[tuple[int, dict]]
     hinge in the subtree of the previous one's body (the first: of the palm)."""
     fingers = doc.get("fingers")
     if not isinstance(fingers, dict) or sorted(fingers) != sorted(FINGERS):
-        raise _Error(f"{m.where}: fingers: must have exactly the keys {FINGERS}, got "
-                     f"{list(fingers) if isinstance(fingers, dict) else fingers!r}")
+        raise _Error(
+            f"{m.where}: fingers: must have exactly the keys {FINGERS}, got "
+            f"{list(fingers) if isinstance(fingers, dict) else fingers!r}"
+        )
     chains = {}
     for finger in FINGERS:
         node = fingers[finger]
@@ -286,14 +317,18 @@ def _chains(m: _Model, doc: dict, palm: int) -> dict[str, list[tuple[int, dict]]
         for i, entry in enumerate(entries):
             f = f"{field}.joints[{i}]"
             if not isinstance(entry, dict) or [k for k in entry if k not in _CHAIN_KEYS] or "mjcf" not in entry:
-                raise _Error(f"{m.where}: {f}: must be a mapping with mjcf (a joint), link, and name "
-                             f"unless the joint is coupled; allowed keys {list(_CHAIN_KEYS)}")
+                raise _Error(
+                    f"{m.where}: {f}: must be a mapping with mjcf (a joint), link, and name "
+                    f"unless the joint is coupled; allowed keys {list(_CHAIN_KEYS)}"
+                )
             joint = m.find("joint", entry["mjcf"], f"{f}.mjcf")
             _hinge_joint(m, joint, f"{f}.mjcf")
             body = int(m.model.jnt_bodyid[joint])
             if not _descends(m.model, body, above, strictly=True):  # a joint of the palm body moves the palm
-                raise _Error(f"{m.where}: {f}.mjcf: joint {entry['mjcf']!r} (body {m.model.body(body).name!r}) "
-                             f"does not continue the chain: not below body {m.model.body(above).name!r} in '{m.xml}'")
+                raise _Error(
+                    f"{m.where}: {f}.mjcf: joint {entry['mjcf']!r} (body {m.model.body(body).name!r}) "
+                    f"does not continue the chain: not below body {m.model.body(above).name!r} in '{m.xml}'"
+                )
             link = entry.get("link")
             if not isinstance(link, str) or not link.startswith(f"{finger}_"):
                 raise _Error(f"{m.where}: {f}.link: must be a link name starting with '{finger}_', got {link!r}")
@@ -335,11 +370,15 @@ def _link_owner(m: _Model, palm: int, chains: dict, fixed: dict, couplings: dict
             if j in in_chain:
                 moving.append(j)
             elif name not in fixed:
-                raise _Error(f"{m.where}: fingers: joint {name!r} (body {model.body(body).name!r}) in '{m.xml}' "
-                             "is below the palm but in no finger's joints, fixed_joints or couplings")
+                raise _Error(
+                    f"{m.where}: fingers: joint {name!r} (body {model.body(body).name!r}) in '{m.xml}' "
+                    "is below the palm but in no finger's joints, fixed_joints or couplings"
+                )
         if len(moving) > 1:
-            raise _Error(f"{m.where}: fingers: body {model.body(body).name!r} in '{m.xml}' has {len(moving)} "
-                         "moving joints; one per body is supported")
+            raise _Error(
+                f"{m.where}: fingers: body {model.body(body).name!r} in '{m.xml}' has {len(moving)} "
+                "moving joints; one per body is supported"
+            )
         owner[body] = moving[0] if moving else (-1 if body == palm else owner[int(model.body_parentid[body])])
     return owner
 
@@ -364,8 +403,9 @@ def _body_poses(m: _Model, palm: int, fixed: dict, frame: NDArray) -> dict[int, 
     return poses
 
 
-def _finger(m: _Model, node: dict, finger: str, chain: list, joint_frames: dict, shapes: dict,
-            couplings: dict, body_pose: dict) -> FingerSpec:
+def _finger(
+    m: _Model, node: dict, finger: str, chain: list, joint_frames: dict, shapes: dict, couplings: dict, body_pose: dict
+) -> FingerSpec:
     """A finger's :class:`FingerSpec`: one joint per chain entry, its frame at the MuJoCo
     joint's anchor with its body's orientation (the hinge axis in the body's frame)."""
     model = m.model
@@ -386,9 +426,20 @@ def _finger(m: _Model, node: dict, finger: str, chain: list, joint_frames: dict,
             names[j] = entry["name"]
         if not model.jnt_limited[j]:
             lower, upper = -math.pi, math.pi
-        joints.append(JointSpec(entry.get("name", model.joint(j).name) if not follows else model.joint(j).name,
-                                axis, np.linalg.inv(parent) @ joint_frames[j], 0.0, lower, upper, entry["link"],
-                                tuple(shapes.get(j, ())), scale, follows))
+        joints.append(
+            JointSpec(
+                entry.get("name", model.joint(j).name) if not follows else model.joint(j).name,
+                axis,
+                np.linalg.inv(parent) @ joint_frames[j],
+                0.0,
+                lower,
+                upper,
+                entry["link"],
+                tuple(shapes.get(j, ())),
+                scale,
+                follows,
+            )
+        )
         parent = joint_frames[j]
     joints = _limit_masters(joints)
     distal = chain[-1][0]
@@ -398,8 +449,7 @@ def _finger(m: _Model, node: dict, finger: str, chain: list, joint_frames: dict,
         site = m.find("site", node.get("tip_site"), f"fingers.{finger}.tip_site")
         point, body = model.site_pos[site] * MM_PER_M, int(model.site_bodyid[site])
         if not _descends(model, body, int(model.jnt_bodyid[distal]), strictly=False):
-            raise _Error(f"{m.where}: fingers.{finger}.tip_site: site {node['tip_site']!r} is not on the chain's "
-                         "last body")
+            raise _Error(f"{m.where}: fingers.{finger}.tip_site: site {node['tip_site']!r} is not on the chain's last body")
     tip = np.linalg.inv(joint_frames[distal]) @ body_pose[body] @ np.append(point, 1.0)
     return FingerSpec(finger, tip[:3], tuple(joints))
 
@@ -430,8 +480,7 @@ def _coupling(m: _Model, coupling: Any, name: str, earlier: list, names: dict) -
         raise _Error(f"{m.where}: {field}: must be {{follows: <MJCF joint>, ratio: <number>}}, got {coupling!r}")
     master = m.find("joint", coupling["follows"], f"{field}.follows")
     if master not in [j for j, _ in earlier] or master not in names:
-        raise _Error(f"{m.where}: {field}.follows: {coupling['follows']!r} is not an earlier, uncoupled joint "
-                     "of the same finger")
+        raise _Error(f"{m.where}: {field}.follows: {coupling['follows']!r} is not an earlier, uncoupled joint of the same finger")
     ratio = coupling["ratio"]
     if isinstance(ratio, bool) or not isinstance(ratio, (int, float)) or not math.isfinite(ratio) or ratio == 0:
         raise _Error(f"{m.where}: {field}.ratio: must be a non-zero number, got {ratio!r}")
@@ -449,6 +498,7 @@ def _limit_masters(joints: list[JointSpec]) -> list[JointSpec]:
         master = out[k]
         ends = sorted(v / follower.scale for v in (follower.lower_rad, follower.upper_rad))
         lower, upper = max(master.lower_rad, ends[0]), min(master.upper_rad, ends[1])
-        out[k] = JointSpec(master.name, master.axis, master.offset, 0.0, lower, upper, master.link,
-                           master.shapes, master.scale, "")
+        out[k] = JointSpec(
+            master.name, master.axis, master.offset, 0.0, lower, upper, master.link, master.shapes, master.scale, ""
+        )
     return out

@@ -45,11 +45,26 @@ __all__ = [
 ]
 
 HUMAN_JOINT_NAMES: tuple[str, ...] = (
-    "thumb_j1", "thumb_j2", "thumb_j3", "thumb_j4",
-    "index_abd", "index_mcp", "index_pip", "index_dip",
-    "middle_abd", "middle_mcp", "middle_pip", "middle_dip",
-    "ring_abd", "ring_mcp", "ring_pip", "ring_dip",
-    "little_abd", "little_mcp", "little_pip", "little_dip",
+    "thumb_j1",
+    "thumb_j2",
+    "thumb_j3",
+    "thumb_j4",
+    "index_abd",
+    "index_mcp",
+    "index_pip",
+    "index_dip",
+    "middle_abd",
+    "middle_mcp",
+    "middle_pip",
+    "middle_dip",
+    "ring_abd",
+    "ring_mcp",
+    "ring_pip",
+    "ring_dip",
+    "little_abd",
+    "little_mcp",
+    "little_pip",
+    "little_dip",
 )
 """Joints of the 20-joint human hand of the human synergy data, in file order."""
 
@@ -116,8 +131,9 @@ class Synergies:
         matrix = np.array(self.matrix, dtype=float)
         n = len(self.joint_names)
         if mean.shape != (n,) or matrix.ndim != 2 or matrix.shape[0] != n:
-            raise ValueError(f"Synergies: mean must be ({n},) and matrix ({n}, k) for {n} joints; "
-                             f"got {mean.shape} and {matrix.shape}")
+            raise ValueError(
+                f"Synergies: mean must be ({n},) and matrix ({n}, k) for {n} joints; got {mean.shape} and {matrix.shape}"
+            )
         if len(self.names) != matrix.shape[1]:
             raise ValueError(f"Synergies: {len(self.names)} names for {matrix.shape[1]} columns")
         mean.setflags(write=False)
@@ -146,8 +162,9 @@ def _data_file(name: str) -> Path:
 
 def _check_table_name(name: str) -> None:
     if name not in SHIPPED_TABLES:
-        raise SynergyFileError(f"synergies: {name!r} is not a shipped table; allowed names: {list(SHIPPED_TABLES)} "
-                               "(or the path of a CSV file)")
+        raise SynergyFileError(
+            f"synergies: {name!r} is not a shipped table; allowed names: {list(SHIPPED_TABLES)} (or the path of a CSV file)"
+        )
 
 
 def shipped_path(name: str = DEFAULT_TABLE) -> Path:
@@ -176,8 +193,9 @@ def resolve_synergies(source: str | Path | None) -> Path:
     if path.is_dir():
         raise SynergyFileError(f"synergy file '{source}': is a folder; give a synergy CSV file or a shipped table's name")
     if not path.is_file():
-        raise SynergyFileError(f"synergy file '{source}': is neither a shipped table {[*SHIPPED_TABLES, *SHIPPED_HANDS]} "
-                               f"nor an existing CSV file")
+        raise SynergyFileError(
+            f"synergy file '{source}': is neither a shipped table {[*SHIPPED_TABLES, *SHIPPED_HANDS]} nor an existing CSV file"
+        )
     return path
 
 
@@ -193,16 +211,16 @@ def _read_table(path: str | Path, joint_names: Sequence[str]) -> tuple[list[str]
     table.columns = columns
     for required in ("joint", "mean_rad"):
         if required not in columns:
-            raise SynergyFileError(f"{where}: missing column '{required}'; the columns must be "
-                                   "joint, mean_rad, syn1..synK")
+            raise SynergyFileError(f"{where}: missing column '{required}'; the columns must be joint, mean_rad, syn1..synK")
     if columns[:2] != ["joint", "mean_rad"]:
         raise SynergyFileError(f"{where}: columns start {columns[:2]}; they must be joint, mean_rad, syn1..synK")
     syn_cols = columns[2:]
     if not syn_cols:
         raise SynergyFileError(f"{where}: no synergy columns; expected syn1..synK after mean_rad")
     if syn_cols != _syn_names(len(syn_cols)):
-        raise SynergyFileError(f"{where}: synergy columns {syn_cols} are not allowed; they must be "
-                               f"named syn1..syn{len(syn_cols)} in this order")
+        raise SynergyFileError(
+            f"{where}: synergy columns {syn_cols} are not allowed; they must be named syn1..syn{len(syn_cols)} in this order"
+        )
 
     names = [s.strip() for s in table["joint"].tolist()]
     expected = list(joint_names)
@@ -217,21 +235,23 @@ def _read_table(path: str | Path, joint_names: Sequence[str]) -> tuple[list[str]
             parts.append(f"unknown {unknown}")
         if missing:
             parts.append(f"missing {missing}")
-        raise SynergyFileError(f"{where}: field 'joint': {'; '.join(parts)}; expected exactly one row "
-                               f"for each of {expected}")
+        raise SynergyFileError(f"{where}: field 'joint': {'; '.join(parts)}; expected exactly one row for each of {expected}")
     if len(syn_cols) > len(expected):
-        raise SynergyFileError(f"{where}: {len(syn_cols)} synergy columns for {len(expected)} joints; "
-                               f"at most {len(expected)} are allowed")
+        raise SynergyFileError(
+            f"{where}: {len(syn_cols)} synergy columns for {len(expected)} joints; at most {len(expected)} are allowed"
+        )
 
-    values = finite_cells(table, ["mean_rad", *syn_cols], lambda i, col, text: (
-        f"{where}: field '{col}' of joint '{names[i]}' is {text!r}; a finite number (rad) is required"))
+    values = finite_cells(
+        table,
+        ["mean_rad", *syn_cols],
+        lambda i, col, text: f"{where}: field '{col}' of joint '{names[i]}' is {text!r}; a finite number (rad) is required",
+    )
     order = [names.index(n) for n in expected]
     values = values[order]
     return syn_cols, values[:, 0], values[:, 1:]
 
 
-def load_synergies(path: str | Path | None = None,
-                   joint_names: Sequence[str] = JOINT_NAMES) -> Synergies:
+def load_synergies(path: str | Path | None = None, joint_names: Sequence[str] = JOINT_NAMES) -> Synergies:
     """Load a synergy file (joint, mean_rad, syn1..synK; rad and rad per unit σ).
 
     ``path``: None (the default shipped table), a shipped table's name (SHIPPED_TABLES) or a
@@ -247,9 +267,7 @@ def load_synergies(path: str | Path | None = None,
     return Synergies(tuple(joint_names), mean, matrix, tuple(f"S{i}" for i in range(1, len(syn_cols) + 1)))
 
 
-
-def synergy_values(hand: str | Path | None, synergies: str | Path | None,
-                   columns: Sequence[int]) -> dict[str, list[float]]:
+def synergy_values(hand: str | Path | None, synergies: str | Path | None, columns: Sequence[int]) -> dict[str, list[float]]:
     """The mean posture (``mean_rad``) and the synergies ``columns`` (1-based: ``S1``, ...) of
     the synergy table ``synergies`` loaded for the hand file ``hand`` (None: the shipped
     ones): rad, in the hand's joint order, the exact float64 values. What a step that reads
@@ -264,6 +282,7 @@ def _synergy_values(hand: str | Path | None, synergies: str | Path | None, colum
     values.update({f"S{i}": table.columns([i])[:, 0].tolist() for i in columns})
     return json.dumps(values)
 
+
 def load_human_synergies(path: str | Path | None = None) -> Synergies:
     """The 20-joint human synergies (Santello et al. 1998 via SynGrasp); None = the shipped copy."""
     return load_synergies(_data_file(HUMAN_SYNERGIES) if path is None else path, HUMAN_JOINT_NAMES)
@@ -277,8 +296,9 @@ def load_synergy_mapping(path: str | Path | None = None) -> dict[str, Any]:
     return read_yaml(path, "synergy mapping file")
 
 
-def map_human_synergies(human_table: Synergies, mapping: Mapping[str, Any],
-                        joint_names: Sequence[str] = JOINT_NAMES) -> Synergies:
+def map_human_synergies(
+    human_table: Synergies, mapping: Mapping[str, Any], joint_names: Sequence[str] = JOINT_NAMES
+) -> Synergies:
     """Map human synergies onto the hand's joints.
 
     For each hand joint j (``mapping["joints"][j]``: ``terms`` [{human, weight}],
@@ -301,14 +321,16 @@ def map_human_synergies(human_table: Synergies, mapping: Mapping[str, Any],
     unknown = [j for j in joints if j not in joint_names]
     missing = [j for j in joint_names if j not in joints]
     if unknown or missing:
-        raise SynergyFileError(f"synergy mapping: field 'joints': unknown {unknown}, missing {missing}; "
-                               f"expected {list(joint_names)}")
+        raise SynergyFileError(
+            f"synergy mapping: field 'joints': unknown {unknown}, missing {missing}; expected {list(joint_names)}"
+        )
     k = human_table.n_synergies
     signs = np.ones(k)
     for col, sign in (mapping.get("column_sign") or {}).items():
         if col not in _syn_names(k) or sign not in (1, -1):
-            raise SynergyFileError(f"synergy mapping: field 'column_sign': {col}: {sign} is not allowed; "
-                                   f"keys syn1..syn{k}, values +1 or -1")
+            raise SynergyFileError(
+                f"synergy mapping: field 'column_sign': {col}: {sign} is not allowed; keys syn1..syn{k}, values +1 or -1"
+            )
         signs[int(col[3:]) - 1] = sign
 
     n = len(joint_names)
@@ -321,29 +343,29 @@ def map_human_synergies(human_table: Synergies, mapping: Mapping[str, Any],
         spec = joints[name]
         weights[j] = _term_weights(spec["terms"], name, human_table.joint_names)
         for entry in spec.get("column_terms") or ():
-            overrides.append((j, *_column_range(entry, name, k),
-                              _term_weights(entry["terms"], name, human_table.joint_names)))
+            overrides.append((j, *_column_range(entry, name, k), _term_weights(entry["terms"], name, human_table.joint_names)))
         offsets[j] = float(spec.get("offset_rad", 0.0))
         lower[j], upper[j] = np.radians(spec["limits_deg"])
         if not lower[j] < upper[j]:
-            raise SynergyFileError(f"synergy mapping: joint '{name}': limits_deg {spec['limits_deg']} "
-                                   "must be [lower, upper] with lower < upper")
+            raise SynergyFileError(
+                f"synergy mapping: joint '{name}': limits_deg {spec['limits_deg']} must be [lower, upper] with lower < upper"
+            )
     mean = np.clip(offsets + weights @ human_table.mean, lower, upper)
     combined = weights @ human_table.matrix
     for j, first, last, row in overrides:
-        combined[j, first - 1:last] = row @ human_table.matrix[:, first - 1:last]
+        combined[j, first - 1 : last] = row @ human_table.matrix[:, first - 1 : last]
     matrix = combined * signs + 0.0  # + 0.0 turns -0.0 into 0.0
     return Synergies(tuple(joint_names), mean, matrix, human_table.names)
 
 
-def _term_weights(terms: Sequence[Mapping[str, Any]], joint: str,
-                  human_names: Sequence[str]) -> NDArray[np.float64]:
+def _term_weights(terms: Sequence[Mapping[str, Any]], joint: str, human_names: Sequence[str]) -> NDArray[np.float64]:
     """The weights on the human joints of one hand joint's ``terms`` [{human, weight}]."""
     out = np.zeros(len(human_names))
     for term in terms:
         if term["human"] not in human_names:
-            raise SynergyFileError(f"synergy mapping: joint '{joint}': human joint {term['human']!r} "
-                                   f"is not allowed; allowed: {list(human_names)}")
+            raise SynergyFileError(
+                f"synergy mapping: joint '{joint}': human joint {term['human']!r} is not allowed; allowed: {list(human_names)}"
+            )
         out[list(human_names).index(term["human"])] += float(term["weight"])
     return out
 
@@ -351,10 +373,16 @@ def _term_weights(terms: Sequence[Mapping[str, Any]], joint: str,
 def _column_range(entry: Mapping[str, Any], joint: str, k: int) -> tuple[int, int]:
     """The 1-based inclusive column range [first, last] of a ``column_terms`` entry."""
     cols = entry.get("columns")
-    if (not isinstance(cols, Sequence) or len(cols) != 2 or not all(isinstance(c, int) for c in cols)
-            or not 1 <= cols[0] <= cols[1] <= k):
-        raise SynergyFileError(f"synergy mapping: joint '{joint}': field 'column_terms.columns' is {cols!r}; "
-                               f"allowed: [first, last], whole numbers with 1 <= first <= last <= {k}")
+    if (
+        not isinstance(cols, Sequence)
+        or len(cols) != 2
+        or not all(isinstance(c, int) for c in cols)
+        or not 1 <= cols[0] <= cols[1] <= k
+    ):
+        raise SynergyFileError(
+            f"synergy mapping: joint '{joint}': field 'column_terms.columns' is {cols!r}; "
+            f"allowed: [first, last], whole numbers with 1 <= first <= last <= {k}"
+        )
     return cols[0], cols[1]
 
 
@@ -400,8 +428,10 @@ class SynergyPath:
         flex = np.asarray(flexion, dtype=bool)
         moving = self.direction != 0
         if np.any(self.direction[flex] < 0):
-            raise ValueError("the closing synergy S1 must have flexion entries >= 0 (increasing σ closes "
-                             f"the hand); negative at joint indices {np.flatnonzero(flex & (self.direction < 0)).tolist()}")
+            raise ValueError(
+                "the closing synergy S1 must have flexion entries >= 0 (increasing σ closes "
+                f"the hand); negative at joint indices {np.flatnonzero(flex & (self.direction < 0)).tolist()}"
+            )
         if not np.any(flex & moving):
             raise ValueError("the closing synergy S1 moves no flexion joint")
         lo, hi = self.active_interval()

@@ -72,9 +72,14 @@ def read_postures(path: str | Path) -> tuple[tuple[str, ...], NDArray[np.float64
         raise SynergyFileError(f"{where}: joint column(s) {repeated} repeated; one column per joint")
     if len(table) < 2:
         raise SynergyFileError(f"{where}: {len(table)} posture(s); at least 2 rows are needed")
-    values = finite_cells(table, list(table.columns), lambda i, col, text: (
-        f"{where}: row {i + 1}, joint '{names[list(table.columns).index(col)]}' is {text!r}; "
-        "a finite number (rad) is required"))
+    values = finite_cells(
+        table,
+        list(table.columns),
+        lambda i, col, text: (
+            f"{where}: row {i + 1}, joint '{names[list(table.columns).index(col)]}' is {text!r}; "
+            "a finite number (rad) is required"
+        ),
+    )
     problems = posture_problems(names, values)
     if problems:
         raise SynergyFileError("\n".join(f"{where}: {p}" for p in problems))
@@ -92,28 +97,38 @@ def posture_problems(joint_names: tuple[str, ...], postures: NDArray) -> list[st
     problems = []
     for j, name in enumerate(joint_names):
         if not name or name.startswith("Unnamed:"):
-            problems.append(f"column {j + 1} has no joint name: a table saved with its row index? "
-                            "(pandas: to_csv(..., index=False)); one named column per joint")
+            problems.append(
+                f"column {j + 1} has no joint name: a table saved with its row index? "
+                "(pandas: to_csv(..., index=False)); one named column per joint"
+            )
         elif m >= 3 and np.array_equal(x[:, j], np.arange(m)):
-            problems.append(f"column {j + 1} ('{name}') counts the rows 0, 1, …, {m - 1}: a row index, not "
-                            "a joint angle (pandas: to_csv(..., index=False))")
+            problems.append(
+                f"column {j + 1} ('{name}') counts the rows 0, 1, …, {m - 1}: a row index, not "
+                "a joint angle (pandas: to_csv(..., index=False))"
+            )
     if problems:
         return problems
     spread = np.ptp(x, axis=0)
     if spread.max() <= _SAME_POSTURE_RAD:
-        problems.append(f"the {m} postures do not differ (every joint spreads by at most {spread.max():.3g} rad): "
-                        "no variance to fit synergies to")
+        problems.append(
+            f"the {m} postures do not differ (every joint spreads by at most {spread.max():.3g} rad): "
+            "no variance to fit synergies to"
+        )
     beyond = np.abs(x) > _FULL_TURN_RAD
     rows = np.flatnonzero(beyond.any(axis=1))
     if 2 * len(rows) > m:
-        problems.append(f"{len(rows)} of {m} postures have angles beyond 2π (up to {np.abs(x).max():.4g}); "
-                        "postures are in rad (is the table in degrees?)")
+        problems.append(
+            f"{len(rows)} of {m} postures have angles beyond 2π (up to {np.abs(x).max():.4g}); "
+            "postures are in rad (is the table in degrees?)"
+        )
     elif len(rows):
         i = int(rows[0])
         j = int(np.argmax(np.abs(x[i])))
         shown = ", ".join(str(r + 1) for r in rows[:5]) + (", …" if len(rows) > 5 else "")
-        problems.append(f"row(s) {shown} beyond a full turn (row {i + 1}, joint '{joint_names[j]}' is "
-                        f"{x[i, j]:.4g} rad, beyond 2π): an outlier no joint reaches; remove or correct it")
+        problems.append(
+            f"row(s) {shown} beyond a full turn (row {i + 1}, joint '{joint_names[j]}' is "
+            f"{x[i, j]:.4g} rad, beyond 2π): an outlier no joint reaches; remove or correct it"
+        )
     return problems
 
 
@@ -146,14 +161,15 @@ def fit_synergies(joint_names: tuple[str, ...], postures: NDArray, n_synergies: 
     k_max = min(n, m - 1)
     mean = x.mean(axis=0)
     _, singular, vt = np.linalg.svd(x - mean, full_matrices=False)  # ordered by singular value
-    variance = singular ** 2 / (m - 1)
+    variance = singular**2 / (m - 1)
     if np.ptp(x, axis=0).max() <= _SAME_POSTURE_RAD:
-        raise ValueError(f"the {m} postures do not differ (every joint spreads by at most {_SAME_POSTURE_RAD:g} rad): "
-                         "no variance to fit synergies to")
+        raise ValueError(
+            f"the {m} postures do not differ (every joint spreads by at most {_SAME_POSTURE_RAD:g} rad): "
+            "no variance to fit synergies to"
+        )
     k = int(np.sum(variance[:k_max] > _RANK_TOLERANCE * variance[0])) if n_synergies is None else int(n_synergies)
     if not 1 <= k <= k_max:
-        raise ValueError(f"the number of synergies to keep must be 1 … {k_max} for {m} postures of {n} joints, "
-                         f"got {n_synergies}")
+        raise ValueError(f"the number of synergies to keep must be 1 … {k_max} for {m} postures of {n} joints, got {n_synergies}")
     matrix = orient_columns(vt[:k].T)
     synergies = Synergies(tuple(joint_names), mean, matrix, tuple(f"S{i}" for i in range(1, k + 1)))
     return SynergyFit(synergies, variance[:k], float(np.sum(variance)))

@@ -133,11 +133,20 @@ class _Retarget:
         and the RMS of its weighted feature residuals, mm."""
         lower, upper = self.hand.lower, self.hand.upper
         x0 = np.clip(start, lower + 1e-9 * (upper - lower), upper - 1e-9 * (upper - lower))
-        result = least_squares(self.residual, x0, jac=self.jacobian, bounds=(lower, upper), method="trf",
-                               xtol=self.tolerance, ftol=self.tolerance, gtol=self.tolerance, max_nfev=200,
-                               args=(goal, start))
+        result = least_squares(
+            self.residual,
+            x0,
+            jac=self.jacobian,
+            bounds=(lower, upper),
+            method="trf",
+            xtol=self.tolerance,
+            ftol=self.tolerance,
+            gtol=self.tolerance,
+            max_nfev=200,
+            args=(goal, start),
+        )
         q = np.clip(result.x, lower, upper)
-        rms = float(np.sqrt(np.mean(self.residual(q, goal, start)[:goal.size] ** 2)))
+        rms = float(np.sqrt(np.mean(self.residual(q, goal, start)[: goal.size] ** 2)))
         return q, rms
 
 
@@ -157,8 +166,9 @@ def map_postures(source: Hand, table: Synergies, target: Hand, params: MapParams
     of the target's joint ranges; each column's samples are then walked outward from σ = 0 in
     both directions, each solve started from and pulled toward the previous one."""
     if tuple(table.joint_names) != tuple(source.joint_names):
-        raise ValueError(f"the synergy table's joints {list(table.joint_names)} are not the source hand's "
-                         f"{list(source.joint_names)}")
+        raise ValueError(
+            f"the synergy table's joints {list(table.joint_names)} are not the source hand's {list(source.joint_names)}"
+        )
     centre, size = hand_size(source)
     problem = _Retarget(target, params)
     scale = problem.size
@@ -173,19 +183,24 @@ def map_postures(source: Hand, table: Synergies, target: Hand, params: MapParams
         path = SynergyPath.along(table, source.lower, source.upper, synergy=k)
         sigmas = _sigmas(path, k, source, params)
         zero = int(np.flatnonzero(sigmas == 0.0)[0])
-        for walk in (sigmas[zero + 1:], sigmas[:zero][::-1]):
+        for walk in (sigmas[zero + 1 :], sigmas[:zero][::-1]):
             previous = q_mean
             for sigma in walk:
                 q_source = path.reference(float(sigma))
                 previous, rms = problem.solve(goal(q_source), previous)
                 rows.append((k, float(sigma), q_source, previous, rms))
-    return MappedPostures(np.array([r[0] for r in rows], dtype=np.int64), np.array([r[1] for r in rows]),
-                          np.array([r[2] for r in rows]), np.array([r[3] for r in rows]),
-                          np.array([r[4] for r in rows]))
+    return MappedPostures(
+        np.array([r[0] for r in rows], dtype=np.int64),
+        np.array([r[1] for r in rows]),
+        np.array([r[2] for r in rows]),
+        np.array([r[3] for r in rows]),
+        np.array([r[4] for r in rows]),
+    )
 
 
-def map_synergies(source: Hand, table: Synergies, target: Hand, n_synergies: int | None = None,
-                  params: MapParams = MapParams()) -> tuple[SynergyFit, MappedPostures]:
+def map_synergies(
+    source: Hand, table: Synergies, target: Hand, n_synergies: int | None = None, params: MapParams = MapParams()
+) -> tuple[SynergyFit, MappedPostures]:
     """The target hand's synergy table fitted to the mapped postures (:func:`map_postures`) by
     principal components (:func:`fit_synergies`): ``n_synergies`` columns (default: as many as
     the source table has, at most as many as the mapped postures span)."""

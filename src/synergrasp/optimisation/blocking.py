@@ -83,8 +83,9 @@ def contact_margins(forces: NDArray, problem: GFOProblem) -> NDArray:
     return -np.einsum("ikj,ij->ik", problem.cone.face_rows(frames), F).max(axis=1)
 
 
-def blocking_contacts(problem: GFOProblem, *, tol: float = ACTIVE_TOL, solver_tol: float = DEFAULT_TOL,
-                      max_iter: int = MAX_ITER) -> Blocking:
+def blocking_contacts(
+    problem: GFOProblem, *, tol: float = ACTIVE_TOL, solver_tol: float = DEFAULT_TOL, max_iter: int = MAX_ITER
+) -> Blocking:
     """The blockers of one (grasp, set): its basis E, normals and cone (f_p and f_min are not
     used: the question is about internal forces alone). e_s = 0 gives ``no_internal_force``."""
     m, e = problem.n_contacts, problem.e_s
@@ -107,8 +108,7 @@ def blocking_contacts(problem: GFOProblem, *, tol: float = ACTIVE_TOL, solver_to
     settings.max_iter = int(max_iter)
     settings.tol_feas = settings.tol_gap_abs = settings.tol_gap_rel = float(solver_tol)
     try:
-        sol = clarabel.DefaultSolver(sp.csc_matrix((e + 1, e + 1)), q, A, b,
-                                     [clarabel.ZeroConeT(1)] + cones, settings).solve()
+        sol = clarabel.DefaultSolver(sp.csc_matrix((e + 1, e + 1)), q, A, b, [clarabel.ZeroConeT(1)] + cones, settings).solve()
     except Exception:  # a solver crash on one problem is a recorded reason, not an abort
         return Blocking.without_contacts("numerical_failure", m)
     if str(sol.status) not in ("Solved", "AlmostSolved"):

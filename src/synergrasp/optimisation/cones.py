@@ -101,8 +101,11 @@ class PyramidCone:
         frames = np.asarray(frames, dtype=float)
         phi = (2.0 * np.arange(self.sides) + 1.0) * math.pi / self.sides
         mu_face = self.mu * math.cos(math.pi / self.sides) if self.inscribed else self.mu
-        return (np.cos(phi)[None, :, None] * frames[:, None, 1] + np.sin(phi)[None, :, None] * frames[:, None, 2]
-                - mu_face * frames[:, None, 0])
+        return (
+            np.cos(phi)[None, :, None] * frames[:, None, 1]
+            + np.sin(phi)[None, :, None] * frames[:, None, 2]
+            - mu_face * frames[:, None, 0]
+        )
 
     def violation(self, forces: NDArray, normals: NDArray, f_min: float) -> float:
         """Worst violation (N) of n.f >= f_min and of the faces a_k . f <= 0 (<= 0 if admissible)."""

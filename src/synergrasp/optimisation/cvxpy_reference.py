@@ -38,8 +38,8 @@ def solve(problem: GFOProblem, *, solver: str = "CLARABEL") -> Outcome:
     normal_rows = np.zeros((m, 3 * m))
     tangent_proj = np.zeros((3 * m, 3 * m))
     for i in range(m):
-        normal_rows[i, 3 * i:3 * i + 3] = n[i]
-        tangent_proj[3 * i:3 * i + 3, 3 * i:3 * i + 3] = np.eye(3) - np.outer(n[i], n[i])
+        normal_rows[i, 3 * i : 3 * i + 3] = n[i]
+        tangent_proj[3 * i : 3 * i + 3, 3 * i : 3 * i + 3] = np.eye(3) - np.outer(n[i], n[i])
     y = cp.Variable(e)
     f = fp + Em @ y
     fn = normal_rows @ f
@@ -53,8 +53,9 @@ def solve(problem: GFOProblem, *, solver: str = "CLARABEL") -> Outcome:
     iterations = int(getattr(cvx.solver_stats, "num_iters", 0) or 0)
     if status in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
         forces = fp + Em @ y.value
-        return Outcome("feasible", float(np.linalg.norm(forces)), forces, iterations, name, status,
-                       problem.cone.violation(forces, n, f_min))
+        return Outcome(
+            "feasible", float(np.linalg.norm(forces)), forces, iterations, name, status, problem.cone.violation(forces, n, f_min)
+        )
     if status in (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE):
         return Outcome("infeasible", float("nan"), None, iterations, name, status)
     return Outcome("numerical_failure", float("nan"), None, iterations, name, status)

@@ -41,8 +41,7 @@ RESIDUAL_TOL = 1e-9
 #: A Jacobian entry (mm/rad) or a velocity (mm per unit σ) at most this is zero.
 _ZERO = 1e-12
 #: Per-grasp columns of :func:`grasp_equilibrium` (besides object, closure_model, pose).
-EQUILIBRIUM_COLUMNS = ("torque_residual", "torque_box_Nmm", "torque_other_Nmm", "s1_outside_cone",
-                       "s1_pushed_contacts")
+EQUILIBRIUM_COLUMNS = ("torque_residual", "torque_box_Nmm", "torque_other_Nmm", "s1_outside_cone", "s1_pushed_contacts")
 
 
 @dataclass(frozen=True)
@@ -98,7 +97,7 @@ def torque_residual(torques: NDArray, jacobian: NDArray, normals: NDArray, mu: f
     rows[:, 0, :] *= mu
     cones_f = np.zeros((3 * k, 1 + 3 * k))
     for i in range(k):
-        cones_f[3 * i:3 * i + 3, 1 + 3 * i:4 + 3 * i] = -rows[i]
+        cones_f[3 * i : 3 * i + 3, 1 + 3 * i : 4 + 3 * i] = -rows[i]
     A = sp.csc_matrix(np.vstack([top, cones_f]))
     rhs = np.concatenate([[0.0], tau[box] / norm, np.zeros(3 * k)])
     cost = np.zeros(1 + 3 * k)
@@ -135,9 +134,13 @@ def _one(row, params: EquilibriumParams, synergy: NDArray) -> dict[str, float]:
     box = np.any(np.abs(J) > _ZERO, axis=0)
     angles = push_angles_deg(J, normals, synergy)
     limit = np.degrees(np.arctan(params.mu))
-    return {"torque_residual": torque_residual(tau, J, normals, params.mu),
-            "torque_box_Nmm": float(np.linalg.norm(tau[box])), "torque_other_Nmm": float(np.linalg.norm(tau[~box])),
-            "s1_outside_cone": int(np.sum(angles > limit)), "s1_pushed_contacts": int(np.sum(np.isfinite(angles)))}
+    return {
+        "torque_residual": torque_residual(tau, J, normals, params.mu),
+        "torque_box_Nmm": float(np.linalg.norm(tau[box])),
+        "torque_other_Nmm": float(np.linalg.norm(tau[~box])),
+        "s1_outside_cone": int(np.sum(angles > limit)),
+        "s1_pushed_contacts": int(np.sum(np.isfinite(angles))),
+    }
 
 
 def grasp_equilibrium(contacts: pd.DataFrame, params: EquilibriumParams, synergy: NDArray) -> pd.DataFrame:
@@ -157,6 +160,8 @@ def grasp_equilibrium(contacts: pd.DataFrame, params: EquilibriumParams, synergy
         j = int(first[i])
         same = j != i and np.allclose(r.q, grasps["q"].iat[j], rtol=0.0, atol=SAME_GRASP_ATOL)
         checks.append(checks[j] if same else _one(r, params, synergy))
-    rows = [{"object": r.object, "closure_model": r.closure_model, "pose": int(r.pose), **c}
-            for r, c in zip(grasps.itertuples(index=False), checks)]
+    rows = [
+        {"object": r.object, "closure_model": r.closure_model, "pose": int(r.pose), **c}
+        for r, c in zip(grasps.itertuples(index=False), checks)
+    ]
     return pd.DataFrame(rows, columns=["object", "closure_model", "pose", *EQUILIBRIUM_COLUMNS])

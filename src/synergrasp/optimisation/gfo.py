@@ -75,8 +75,9 @@ def solve_gfo(
         raise ValueError(f"method must be one of {list(METHODS)}, got {method!r}")
     cones = {problems.cone.kind} if isinstance(problems, GraspSets) else {p.cone.kind for p in problems}
     if not cones <= set(METHODS[method]):
-        raise ValueError(f"method {method!r} accepts the friction cones {list(METHODS[method])}, "
-                         f"got {sorted(cones - set(METHODS[method]))}")
+        raise ValueError(
+            f"method {method!r} accepts the friction cones {list(METHODS[method])}, got {sorted(cones - set(METHODS[method]))}"
+        )
     if strict_shrink is not None and not (0 < strict_shrink < 1):
         raise ValueError(f"strict_shrink must be in (0, 1), got {strict_shrink}")
     if method == "ipm" and isinstance(problems, GraspSets):
@@ -98,9 +99,11 @@ def solve_gfo(
 def _per_problem(method: str, tol: float, max_iter: int):
     """The one-problem solver of a back end solved problem by problem (every method but the
     kernel's); a method in METHODS without one here is an error, never a silent cvxpy."""
-    solvers = {"clarabel": lambda p: clarabel_solver.solve(p, tol=tol, max_iter=max_iter),
-               "piqp": lambda p: piqp_solver.solve(p, tol=tol, max_iter=max_iter),
-               "cvxpy": cvxpy_reference.solve}
+    solvers = {
+        "clarabel": lambda p: clarabel_solver.solve(p, tol=tol, max_iter=max_iter),
+        "piqp": lambda p: piqp_solver.solve(p, tol=tol, max_iter=max_iter),
+        "cvxpy": cvxpy_reference.solve,
+    }
     if method not in solvers:
         raise ValueError(f"method {method!r} has no one-problem solver (gfo._per_problem)")
     return solvers[method]
@@ -117,30 +120,51 @@ def _strict_fallback(problem: GFOProblem, shrink: float, tol: float, max_iter: i
     return clarabel_solver.solve(problem.strict_test(shrink), tol=tol, max_iter=max_iter).status == "feasible"
 
 
-def _ipm_one(sol: GFOSolution, k: int, problem: GFOProblem, shrink: float | None, tol: float, max_iter: int,
-             ipm: IPMSettings) -> None:
+def _ipm_one(
+    sol: GFOSolution, k: int, problem: GFOProblem, shrink: float | None, tol: float, max_iter: int, ipm: IPMSettings
+) -> None:
     """Row k of a sequence of problems by the kernel, undecided ones by the fallback."""
     if problem.e_s == 0:
         _fallback(sol, k, problem, tol, max_iter)
         if shrink is not None:
             sol.strict_internal[k] = _strict_fallback(problem, shrink, tol, max_iter)
         return
-    res = ipm_solver.solve_problem(contact_frames(problem.normals), problem.E, problem.f_p, problem.cone,
-                                   problem.cone.narrowed(shrink) if shrink is not None else None, problem.f_min, ipm,
-                                   ALMOST_SOLVED_TOL)
+    res = ipm_solver.solve_problem(
+        contact_frames(problem.normals),
+        problem.E,
+        problem.f_p,
+        problem.cone,
+        problem.cone.narrowed(shrink) if shrink is not None else None,
+        problem.f_min,
+        ipm,
+        ALMOST_SOLVED_TOL,
+    )
     status, iters = _STATUS_OF_CODE[res.code[0]], int(res.iterations[0])
     if status == "feasible":
         forces = res.forces[0]
-        sol.record(k, Outcome(status, float(res.force_norm[0]), forces, iters, "ipm", "",
-                              problem.cone.violation(forces, problem.normals, problem.f_min)))
+        sol.record(
+            k,
+            Outcome(
+                status,
+                float(res.force_norm[0]),
+                forces,
+                iters,
+                "ipm",
+                "",
+                problem.cone.violation(forces, problem.normals, problem.f_min),
+            ),
+        )
     elif status == "infeasible":
         sol.record(k, Outcome(status, float("nan"), None, iters, "ipm"))
     else:
         _fallback(sol, k, problem, tol, max_iter)
     if shrink is not None:
         code = res.strict_code[0]
-        sol.strict_internal[k] = (code == ipm_solver.OPTIMAL if code in (ipm_solver.OPTIMAL, ipm_solver.INFEASIBLE)
-                                  else _strict_fallback(problem, shrink, tol, max_iter))
+        sol.strict_internal[k] = (
+            code == ipm_solver.OPTIMAL
+            if code in (ipm_solver.OPTIMAL, ipm_solver.INFEASIBLE)
+            else _strict_fallback(problem, shrink, tol, max_iter)
+        )
 
 
 def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm: IPMSettings) -> GFOSolution:
@@ -150,20 +174,36 @@ def _ipm_sets(g: GraspSets, shrink: float | None, tol: float, max_iter: int, ipm
     thresholds = g.basis_rtol * g.response_norm * S.norms
     strict = shrink is not None
     frames = contact_frames(g.normals) if g.frames is None else g.frames
-    res = ipm_solver.solve_sets(P @ S.matrix, g.f_p, frames, S.table, S.sizes, thresholds,
-                                ipm_solver.Nesting(S.parent, S.within, S.order), g.cone,
-                                g.cone.narrowed(shrink) if strict else None, g.f_min, ipm, ALMOST_SOLVED_TOL)
+    res = ipm_solver.solve_sets(
+        P @ S.matrix,
+        g.f_p,
+        frames,
+        S.table,
+        S.sizes,
+        thresholds,
+        ipm_solver.Nesting(S.parent, S.within, S.order),
+        g.cone,
+        g.cone.narrowed(shrink) if strict else None,
+        g.f_min,
+        ipm,
+        ALMOST_SOLVED_TOL,
+    )
     n = len(g)
     status = _STATUS_OF_CODE[res.code]
     optimal = res.code == ipm_solver.OPTIMAL
     forces = np.full(n, None, dtype=object)
     for j in np.flatnonzero(optimal).tolist():
         forces[j] = res.forces[j]
-    sol = GFOSolution(status=status, force_norm=np.where(optimal, res.force_norm, np.nan), forces=forces,
-                      e_s=res.e_s.astype(np.int32), iterations=res.iterations,
-                      strict_internal=res.strict_code == ipm_solver.OPTIMAL if strict else None,
-                      solver=np.where(res.implied, "implied", "ipm").astype(object),
-                      max_violation=np.where(optimal, res.max_violation, np.nan))
+    sol = GFOSolution(
+        status=status,
+        force_norm=np.where(optimal, res.force_norm, np.nan),
+        forces=forces,
+        e_s=res.e_s.astype(np.int32),
+        iterations=res.iterations,
+        strict_internal=res.strict_code == ipm_solver.OPTIMAL if strict else None,
+        solver=np.where(res.implied, "implied", "ipm").astype(object),
+        max_violation=np.where(optimal, res.max_violation, np.nan),
+    )
     for j in np.flatnonzero((res.code == ipm_solver.UNDECIDED) | (res.code == ipm_solver.NOT_SOLVED)):  # status ''
         _fallback(sol, j, g.problem(j), tol, max_iter)
     if strict:
@@ -184,5 +224,4 @@ def warm_up() -> None:
     normals = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])
     squeeze = np.array([[1.0], [0.0], [0.0], [-1.0], [0.0], [0.0]]) / np.sqrt(2.0)
     sets = SynergySets(np.eye(1), ((1,),))
-    solve_gfo(GraspSets(np.zeros(6), normals, squeeze, 1.0, sets, 0.5, CircularCone(1.0), basis_rtol=1e-9),
-              strict_shrink=1e-5)
+    solve_gfo(GraspSets(np.zeros(6), normals, squeeze, 1.0, sets, 0.5, CircularCone(1.0), basis_rtol=1e-9), strict_shrink=1e-5)

@@ -15,10 +15,11 @@ the search reads no synergy subset, claim or hierarchy figure. mm, %.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable
+from dataclasses import replace
+from typing import TYPE_CHECKING
 
+from synergrasp.optimisation.placement_search import FallbackParams
 from synergrasp.simulation.reach import feasible_types, shape_class
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -28,41 +29,21 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.simulation.reach import HandReach
     from synergrasp.simulation.shapes import Shape
 
-__all__ = ["FallbackParams", "NEXT_TYPE", "type_label", "type_family", "search_with_fallback", "search_object_types",
-           "fallback_line", "KEPT"]
+__all__ = [
+    "FallbackParams",
+    "NEXT_TYPE",
+    "type_label",
+    "type_family",
+    "search_with_fallback",
+    "search_object_types",
+    "fallback_line",
+    "KEPT",
+]
 
 #: The fallback chain: the next grasp type tried when one is infeasible or scores no target.
 NEXT_TYPE: dict[str, str | None] = {"power": "precision", "precision": "any", "any": None}
 #: The reason recorded when the stated type was searched and chosen.
 KEPT = "stated type feasible and scored"
-
-
-@dataclass(frozen=True)
-class FallbackParams:
-    """Version 3's settings (config ``placement.search.fallback``; defaults in the schema).
-
-    enabled:           False: version 2 (the stated type only, its tie rules even among
-                       targets that all score 0)
-    min_typed_percent: a search whose best target scores T at most this (%) falls back; 0:
-                       only when every target scores 0
-    prismatic_aspect:  an object is prismatic when its longest own extent is at least this
-                       many times its shortest, circular otherwise
-    """
-
-    enabled: bool
-    min_typed_percent: float
-    prismatic_aspect: float
-
-    def __post_init__(self) -> None:
-        if not 0.0 <= float(self.min_typed_percent) < 100.0:
-            raise ValueError(f"min_typed_percent must lie in [0, 100), got {self.min_typed_percent!r}")
-        if not float(self.prismatic_aspect) >= 1.0:
-            raise ValueError(f"prismatic_aspect must be >= 1, got {self.prismatic_aspect!r}")
-
-    @classmethod
-    def from_config(cls, spec: Mapping[str, Any]) -> FallbackParams:
-        """From the effective ``placement.search.fallback`` block."""
-        return cls(bool(spec["enabled"]), float(spec["min_typed_percent"]), float(spec["prismatic_aspect"]))
 
 
 def type_label(grasp_type: str, klass: str) -> str:
@@ -76,9 +57,14 @@ def type_family(label: str) -> str:
     return label.split("-", 1)[0]
 
 
-def search_with_fallback(stated: str, shape: Shape, reach: HandReach, fallback: FallbackParams,
-                         run_search: Callable[[str], SearchResult],
-                         palm_centre_result: Callable[[], SearchResult]) -> SearchResult:
+def search_with_fallback(
+    stated: str,
+    shape: Shape,
+    reach: HandReach,
+    fallback: FallbackParams,
+    run_search: Callable[[str], SearchResult],
+    palm_centre_result: Callable[[], SearchResult],
+) -> SearchResult:
     """The search of one object under version 3 (module docstring): ``run_search(type)`` runs
     the search of one grasp type over its region; ``palm_centre_result()`` scores the palm
     centre alone (the last resort, chosen by no score). The result carries the stated and the
@@ -86,8 +72,12 @@ def search_with_fallback(stated: str, shape: Shape, reach: HandReach, fallback: 
     klass = shape_class(shape, fallback.prismatic_aspect)
     if not fallback.enabled:
         result = run_search(stated)
-        return replace(result, stated_type=type_label(stated, klass), effective_type=type_label(stated, klass),
-                       type_reason="version 2: the stated type, no fallback")
+        return replace(
+            result,
+            stated_type=type_label(stated, klass),
+            effective_type=type_label(stated, klass),
+            type_reason="version 2: the stated type, no fallback",
+        )
     feasible = feasible_types(shape, reach)
     reasons: list[str] = []
     grasp_type: str | None = stated
@@ -99,10 +89,16 @@ def search_with_fallback(stated: str, shape: Shape, reach: HandReach, fallback: 
             result = run_search(grasp_type)
             best = result.chosen.typed_percent
             if best > fallback.min_typed_percent:
-                return replace(result, stated_type=type_label(stated, klass), effective_type=label,
-                               type_reason="; ".join(reasons) if reasons else KEPT)
-            reasons.append(f"{label}: the best of {len(result.ranked)} targets scores T = {best:.3g} % "
-                           f"(<= min_typed_percent {fallback.min_typed_percent:g})")
+                return replace(
+                    result,
+                    stated_type=type_label(stated, klass),
+                    effective_type=label,
+                    type_reason="; ".join(reasons) if reasons else KEPT,
+                )
+            reasons.append(
+                f"{label}: the best of {len(result.ranked)} targets scores T = {best:.3g} % "
+                f"(<= min_typed_percent {fallback.min_typed_percent:g})"
+            )
         grasp_type = NEXT_TYPE[grasp_type]
     result = palm_centre_result()
     reasons.append("no type scores: the box is brought to the palm centre, chosen by no score")
@@ -113,16 +109,15 @@ def fallback_line(result: SearchResult) -> str | None:
     """One WARNING line for an object whose effective type is not its stated one (None else)."""
     if result.stated_type == result.effective_type:
         return None
-    return (f"{result.object}: stated grasp type {result.stated_type}, effective {result.effective_type} "
-            f"({result.type_reason})")
+    return f"{result.object}: stated grasp type {result.stated_type}, effective {result.effective_type} ({result.type_reason})"
 
 
-def search_object_types(hand: Hand, synergies: Synergies, sim: SearchStepParams, period_deg: float,
-                        processes: int = 1) -> SearchResult:
+def search_object_types(
+    hand: Hand, synergies: Synergies, sim: SearchStepParams, period_deg: float, processes: int = 1
+) -> SearchResult:
     """The search step's one front door: the hand's reach (the gate), the hand's region (the
     bound of the region's growth) and the search of each grasp type the chain reaches."""
-    from synergrasp.optimisation.placement_search import (SearchResult, TargetScorer, full_synergy_set, pose_subset,
-                                                          search_object)
+    from synergrasp.optimisation.placement_search import SearchResult, TargetScorer, full_synergy_set, pose_subset, search_object
     from synergrasp.simulation.placement import hand_region, palm_centre
     from synergrasp.simulation.reach import hand_reach
 
@@ -131,14 +126,35 @@ def search_object_types(hand: Hand, synergies: Synergies, sim: SearchStepParams,
     full_set = full_synergy_set(synergies.matrix, sim.full_set_size)
 
     def run_search(grasp_type: str) -> SearchResult:
-        return search_object(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo, full_set,
-                             sim.params_of(grasp_type), period_deg, processes=processes, opposition=sim.opposition,
-                             bound_mm=bound)
+        return search_object(
+            hand,
+            synergies,
+            sim.object,
+            sim.placement,
+            sim.closure,
+            sim.gfo,
+            full_set,
+            sim.params_of(grasp_type),
+            period_deg,
+            processes=processes,
+            opposition=sim.opposition,
+            bound_mm=bound,
+        )
 
     def palm_centre_result() -> SearchResult:
         params = sim.params_of("any")
-        scorer = TargetScorer(hand, synergies, sim.object, sim.placement, sim.closure, sim.gfo, full_set,
-                              pose_subset(sim.placement, period_deg, params), "any", sim.opposition)
+        scorer = TargetScorer(
+            hand,
+            synergies,
+            sim.object,
+            sim.placement,
+            sim.closure,
+            sim.gfo,
+            full_set,
+            pose_subset(sim.placement, period_deg, params),
+            "any",
+            sim.opposition,
+        )
         try:
             score = scorer(tuple(float(v) for v in palm_centre(hand)))
         finally:

@@ -96,10 +96,14 @@ def same_grasp(a: Grasp, b: Grasp, atol: float = SAME_GRASP_ATOL) -> bool:
     centre equal to ``atol`` entry by entry (mm, unit normals, mm/rad). A box's poses one
     α-period apart fill the same region and close to the same grasp up to round-off
     (1e-12 mm on the study's boxes)."""
-    return bool(np.array_equal(a.links, b.links) and a.jacobian.shape == b.jacobian.shape
-                and all(np.allclose(x, y, rtol=0.0, atol=atol) for x, y in
-                        ((a.points, b.points), (a.normals, b.normals), (a.center, b.center),
-                         (a.jacobian, b.jacobian))))
+    return bool(
+        np.array_equal(a.links, b.links)
+        and a.jacobian.shape == b.jacobian.shape
+        and all(
+            np.allclose(x, y, rtol=0.0, atol=atol)
+            for x, y in ((a.points, b.points), (a.normals, b.normals), (a.center, b.center), (a.jacobian, b.jacobian))
+        )
+    )
 
 
 def first_same_grasp(grasps: Sequence[Grasp | None]) -> NDArray:
@@ -130,26 +134,32 @@ def read_grasps(table) -> list[Grasp | None]:
     Rows whose status is not ``grasp`` or that have no contact give ``None``. Reads only
     numbers: pybullet is not imported.
     """
-    missing = [c for c in ("status", "n_contacts", "contact_link", "contact_point", "contact_normal",
-                           "jacobian", "object_center") if c not in table.columns]
+    missing = [
+        c
+        for c in ("status", "n_contacts", "contact_link", "contact_point", "contact_normal", "jacobian", "object_center")
+        if c not in table.columns
+    ]
     if missing:
         raise ValueError(f"contacts table: missing column(s) {missing}")
     grasps: list[Grasp | None] = []
-    columns = (table[c] for c in ("status", "n_contacts", "contact_point", "contact_normal", "contact_link",
-                                  "jacobian", "object_center"))
+    columns = (
+        table[c] for c in ("status", "n_contacts", "contact_point", "contact_normal", "contact_link", "jacobian", "object_center")
+    )
     for status, n_contacts, points, normals, links, jacobian, center in zip(*columns):
         m = int(n_contacts)
         if status != "grasp" or m == 0:
             grasps.append(None)
             continue
         jac = np.asarray(jacobian, dtype=float)
-        grasps.append(Grasp(
-            points=np.asarray(points, dtype=float).reshape(m, 3),
-            normals=np.asarray(normals, dtype=float).reshape(m, 3),
-            links=np.asarray(links, dtype=np.int64),
-            jacobian=jac.reshape(3 * m, jac.size // (3 * m)),
-            center=np.asarray(center, dtype=float),
-        ))
+        grasps.append(
+            Grasp(
+                points=np.asarray(points, dtype=float).reshape(m, 3),
+                normals=np.asarray(normals, dtype=float).reshape(m, 3),
+                links=np.asarray(links, dtype=np.int64),
+                jacobian=jac.reshape(3 * m, jac.size // (3 * m)),
+                center=np.asarray(center, dtype=float),
+            )
+        )
     return grasps
 
 
@@ -161,8 +171,9 @@ def _unit_normals(normals: NDArray, m: int | None, field: str) -> NDArray:
         raise ValueError(f"{field} must have shape {want}, got {n.shape}")
     norms = _row_norms(n)
     if n.shape[0] and not (np.abs(norms - 1.0) <= _UNIT_TOL).all():
-        raise ValueError(f"{field} must be unit vectors (|n| = 1 within {_UNIT_TOL}); "
-                         f"got norms {norms.min():.6g}..{norms.max():.6g}")
+        raise ValueError(
+            f"{field} must be unit vectors (|n| = 1 within {_UNIT_TOL}); got norms {norms.min():.6g}..{norms.max():.6g}"
+        )
     return n
 
 
@@ -329,8 +340,17 @@ def grasp_mechanics(
         f_p = GKR @ w
         projector = KJ - GKR @ (G @ KJ)
     return GraspMechanics(
-        G=G, K=K, GKR=GKR, f_p=f_p, projector=projector, rank_G=rank,
-        normals=grasp.normals, links=grasp.links, wrench=w, KJ=KJ, response_norm=_spectral_norm(KJ),
+        G=G,
+        K=K,
+        GKR=GKR,
+        f_p=f_p,
+        projector=projector,
+        rank_G=rank,
+        normals=grasp.normals,
+        links=grasp.links,
+        wrench=w,
+        KJ=KJ,
+        response_norm=_spectral_norm(KJ),
     )
 
 
@@ -390,4 +410,3 @@ def contact_frames(normals: NDArray) -> NDArray:
     t1 /= _row_norms(t1)[:, None]
     t2 = cross_rows(n, t1)
     return np.stack([n, t1, t2], axis=1)
-

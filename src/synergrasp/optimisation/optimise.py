@@ -36,8 +36,7 @@ from synergrasp.optimisation.problem import DEFAULT_TOL, MAX_ITER, STRICT_SHRINK
 from synergrasp.optimisation.shards import shard_positions
 from synergrasp import resolved
 
-__all__ = ["GFOParams", "OptimiseParams", "UNSOLVED_STATUSES", "gfo_table", "mechanics_for", "optimise_grasps",
-           "optimise_shard"]
+__all__ = ["GFOParams", "OptimiseParams", "UNSOLVED_STATUSES", "gfo_table", "mechanics_for", "optimise_grasps", "optimise_shard"]
 
 #: The gfo table's statuses of a problem given before any solve: no grasp at the pose, and
 #: rank(G) < 6 (the solved ones are ``problem.SOLVER_STATUSES``).
@@ -99,8 +98,12 @@ class GFOParams:
     def from_config(cls, config: Mapping[str, Any], obj: str) -> GFOParams:
         """The configuration's ``mechanics`` with the weight of the object ``obj`` (μ and the
         weight as resolved, ``synergrasp.resolved``)."""
-        return build(cls, "mechanics", **{**dataclass_fields(cls, config["mechanics"]), "mu": resolved.friction_mu(config)},
-                     weight_N=resolved.weight_N(config, obj))
+        return build(
+            cls,
+            "mechanics",
+            **{**dataclass_fields(cls, config["mechanics"]), "mu": resolved.friction_mu(config)},
+            weight_N=resolved.weight_N(config, obj),
+        )
 
     def wrench(self) -> NDArray:
         """w_e (6,) the contacts must apply against the weight, N and N·mm (read-only)."""
@@ -127,14 +130,20 @@ class OptimiseParams:
     @classmethod
     def from_config(cls, config: Mapping[str, Any], obj: str) -> OptimiseParams:
         """From a configuration or the step's own part of it, for the object ``obj``."""
-        return cls(config["synergies"], synergy_sets(config["synergy_sets"]), GFOParams.from_config(config, obj),
-                   int(config["solver"]["pose_shards"]), config["hand"])
+        return cls(
+            config["synergies"],
+            synergy_sets(config["synergy_sets"]),
+            GFOParams.from_config(config, obj),
+            int(config["solver"]["pose_shards"]),
+            config["hand"],
+        )
 
 
 def mechanics_for(grasp: Grasp, params: GFOParams) -> GraspMechanics:
     """`grasp_mechanics` with the weight, stiffnesses and rank tolerance of `params`."""
-    return grasp_mechanics(grasp, params.wrench(), params.k_stru_N_per_mm, params.k_ss_Nmm_per_rad,
-                           rank_rtol=params.grasp_rank_rtol)
+    return grasp_mechanics(
+        grasp, params.wrench(), params.k_stru_N_per_mm, params.k_ss_Nmm_per_rad, rank_rtol=params.grasp_rank_rtol
+    )
 
 
 def optimise_grasps(
@@ -192,10 +201,25 @@ def optimise_grasps(
         if mech.rank_G < 6 or mech.projector is None:
             out["status"][rows] = RANK_DEFICIENT
             continue
-        problems = GraspSets(mech.f_p, mech.normals, mech.projector, mech.response_norm, synergies, params.f_min_N,
-                             cone, params.basis_rtol, mech.frames)
-        sol = solve_gfo(problems, method, strict_shrink=params.strict_shrink if strict else None, tol=params.tol,
-                        max_iter=params.max_iter, ipm=ipm)
+        problems = GraspSets(
+            mech.f_p,
+            mech.normals,
+            mech.projector,
+            mech.response_norm,
+            synergies,
+            params.f_min_N,
+            cone,
+            params.basis_rtol,
+            mech.frames,
+        )
+        sol = solve_gfo(
+            problems,
+            method,
+            strict_shrink=params.strict_shrink if strict else None,
+            tol=params.tol,
+            max_iter=params.max_iter,
+            ipm=ipm,
+        )
         out["status"][rows], out["force_norm"][rows], out["e_s"][rows] = sol.status, sol.force_norm, sol.e_s
         out["iterations"][rows], out["solver"][rows] = sol.iterations, sol.solver
         if strict:  # rank(G) = 6 here, so the strict test is Definition 1
@@ -206,8 +230,9 @@ def optimise_grasps(
     return out
 
 
-def gfo_table(contacts: pd.DataFrame, synergies: SynergySets, params: GFOParams, *, strict: bool = True,
-              shard: int = 0, n_shards: int = 1) -> pd.DataFrame:
+def gfo_table(
+    contacts: pd.DataFrame, synergies: SynergySets, params: GFOParams, *, strict: bool = True, shard: int = 0, n_shards: int = 1
+) -> pd.DataFrame:
     """The gfo table (columns of `tables.GFO`) of the poses of a contacts table, or of shard
     `shard` of `n_shards` of them, in pose order, each pose's sets in their given order.
 
@@ -236,7 +261,6 @@ def gfo_table(contacts: pd.DataFrame, synergies: SynergySets, params: GFOParams,
     return table
 
 
-def optimise_shard(contacts: pd.DataFrame, shard: int, n_shards: int, synergies: SynergySets,
-                   params: GFOParams) -> pd.DataFrame:
+def optimise_shard(contacts: pd.DataFrame, shard: int, n_shards: int, synergies: SynergySets, params: GFOParams) -> pd.DataFrame:
     """The gfo table of one shard of an object's contacts table (`gfo_table`)."""
     return gfo_table(contacts, synergies, params, shard=shard, n_shards=n_shards)

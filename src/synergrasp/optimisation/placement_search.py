@@ -31,7 +31,6 @@ from synergrasp import tables
 from synergrasp.config import build, dataclass_fields
 from synergrasp.resolved import effective_placement
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.grasp_type_search import FallbackParams
 from synergrasp.optimisation.mechanics import read_grasps
 from synergrasp.optimisation.optimise import GFOParams, optimise_grasps
 from synergrasp.simulation.contacts import contacts_row, contacts_table
@@ -46,8 +45,22 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.hand.synergies import Synergies
 
-__all__ = ["SearchStepParams", "SearchParams", "TargetScore", "SearchResult", "score_target", "rank_targets", "pose_subset",
-           "full_synergy_set", "TargetScorer", "search_object", "region_lattice", "distinct_ranks", "grown_region"]
+__all__ = [
+    "SearchStepParams",
+    "FallbackParams",
+    "SearchParams",
+    "TargetScore",
+    "SearchResult",
+    "score_target",
+    "rank_targets",
+    "pose_subset",
+    "full_synergy_set",
+    "TargetScorer",
+    "search_object",
+    "region_lattice",
+    "distinct_ranks",
+    "grown_region",
+]
 
 _TOL = 1e-6
 
@@ -95,14 +108,20 @@ class SearchParams:
         if len(region) != 3 or any(b < a for a, b in region):
             raise ValueError(f"region_mm must be three (start, stop) pairs with stop >= start, got {self.region_mm!r}")
         object.__setattr__(self, "region_mm", region)
-        for name in ("coarse_spacing_mm", "spacing_mm", "pose_alpha_step_deg", "pose_beta_step_deg",
-                     "tie_band_points", "force_tie_relative"):
+        for name in (
+            "coarse_spacing_mm",
+            "spacing_mm",
+            "pose_alpha_step_deg",
+            "pose_beta_step_deg",
+            "tie_band_points",
+            "force_tie_relative",
+        ):
             object.__setattr__(self, name, float(getattr(self, name)))
         ratio = self.coarse_spacing_mm / self.spacing_mm
         if not (self.spacing_mm > 0 and abs(ratio - round(ratio)) < 1e-9 and round(ratio) >= 1):
-            raise ValueError(f"coarse_spacing_mm ({self.coarse_spacing_mm}) must be a whole multiple of "
-                             f"spacing_mm ({self.spacing_mm})")
-
+            raise ValueError(
+                f"coarse_spacing_mm ({self.coarse_spacing_mm}) must be a whole multiple of spacing_mm ({self.spacing_mm})"
+            )
 
 
 def _hand_region(hand: str | None, synergies: str | None) -> tuple[tuple[float, float], ...]:
@@ -112,6 +131,34 @@ def _hand_region(hand: str | None, synergies: str | None) -> tuple[tuple[float, 
 
     loaded = load_hand(hand)
     return hand_region(loaded, load_synergies(synergies, joint_names=loaded.joint_names))
+
+
+@dataclass(frozen=True)
+class FallbackParams:
+    """Version 3's settings (config ``placement.search.fallback``; defaults in the schema).
+
+    enabled:           False: version 2 (the stated type only, its tie rules even among
+                       targets that all score 0)
+    min_typed_percent: a search whose best target scores T at most this (%) falls back; 0:
+                       only when every target scores 0
+    prismatic_aspect:  an object is prismatic when its longest own extent is at least this
+                       many times its shortest, circular otherwise
+    """
+
+    enabled: bool
+    min_typed_percent: float
+    prismatic_aspect: float
+
+    def __post_init__(self) -> None:
+        if not 0.0 <= float(self.min_typed_percent) < 100.0:
+            raise ValueError(f"min_typed_percent must lie in [0, 100), got {self.min_typed_percent!r}")
+        if not float(self.prismatic_aspect) >= 1.0:
+            raise ValueError(f"prismatic_aspect must be >= 1, got {self.prismatic_aspect!r}")
+
+    @classmethod
+    def from_config(cls, spec: Mapping[str, Any]) -> FallbackParams:
+        """From the effective ``placement.search.fallback`` block."""
+        return cls(bool(spec["enabled"]), float(spec["min_typed_percent"]), float(spec["prismatic_aspect"]))
 
 
 @dataclass(frozen=True)
@@ -154,20 +201,34 @@ class SearchStepParams:
                 regions[kind] = _hand_region(config["hand"], config["synergies"])
             else:
                 regions[kind] = tuple(tuple(value[axis]) for axis in ("x", "y", "z"))
-        search = build(SearchParams, "placement.search", region_mm=regions[grasp_type], grasp_type=grasp_type,
-                       **dataclass_fields(SearchParams, {k: v for k, v in spec.items() if k != "region_mm"}))
+        search = build(
+            SearchParams,
+            "placement.search",
+            region_mm=regions[grasp_type],
+            grasp_type=grasp_type,
+            **dataclass_fields(SearchParams, {k: v for k, v in spec.items() if k != "region_mm"}),
+        )
         fallback = build(FallbackParams, "placement.search.fallback", **spec["fallback"])
         closure = {**config["closure"], "model": "kinematic"}
         return cls(
-            hand=config["hand"], synergies=config["synergies"], object=GraspedObject.from_config(config, obj),
+            hand=config["hand"],
+            synergies=config["synergies"],
+            object=GraspedObject.from_config(config, obj),
             # the search places the box toward each of its targets: the modes' own targets are not read
-            placement=Placement.from_config({**placement, "mode": "searched", "approach_point_mm": None,
-                                             "center_mm": (0.0, 0.0, 0.0)}, config["grid"]),
+            placement=Placement.from_config(
+                {**placement, "mode": "searched", "approach_point_mm": None, "center_mm": (0.0, 0.0, 0.0)}, config["grid"]
+            ),
             closure=build(ClosureParams, "closure", **{**dataclass_fields(ClosureParams, closure), "dynamic": None}),
             gfo=GFOParams.from_config(config, obj),
-            full_set_size=int(config["synergy_sets"]["incremental_max"]), search=search,
-            distinct_mm=float(spec["distinct_mm"]), opposition=OppositionRule.from_config(config),
-            regions=regions, fallback=fallback, reach=ReachParams.from_config(config))
+            full_set_size=int(config["synergy_sets"]["incremental_max"]),
+            search=search,
+            distinct_mm=float(spec["distinct_mm"]),
+            opposition=OppositionRule.from_config(config),
+            regions=regions,
+            fallback=fallback,
+            reach=ReachParams.from_config(config),
+        )
+
 
 @dataclass(frozen=True)
 class TargetScore:
@@ -191,8 +252,14 @@ class TargetScore:
     median_contacts: float
 
 
-def score_target(target_mm: Sequence[float], force_closure: NDArray, force_N: NDArray, n_contacts: NDArray,
-                 weight_N: float, of_type: NDArray | None = None) -> TargetScore:
+def score_target(
+    target_mm: Sequence[float],
+    force_closure: NDArray,
+    force_N: NDArray,
+    n_contacts: NDArray,
+    weight_N: float,
+    of_type: NDArray | None = None,
+) -> TargetScore:
     """The objective of one target from its per-pose results with the full synergy set
     (one entry per scored pose): force closure (bool), optimal force under the weight (N,
     NaN where none), the number of contacts, and whether the grasp's opposition is of the
@@ -202,19 +269,23 @@ def score_target(target_mm: Sequence[float], force_closure: NDArray, force_N: ND
     contacts = np.asarray(n_contacts, dtype=float)
     typed = np.ones_like(fc) if of_type is None else np.asarray(of_type, dtype=bool)
     if not (fc.shape == force.shape == contacts.shape == typed.shape and fc.ndim == 1 and fc.size > 0):
-        raise ValueError("force_closure, force_N, n_contacts and of_type must be equal-length 1-d arrays "
-                         "of the scored poses")
+        raise ValueError("force_closure, force_N, n_contacts and of_type must be equal-length 1-d arrays of the scored poses")
     if not weight_N > 0:
         raise ValueError(f"weight_N must be > 0, got {weight_N}")
     counted = fc & typed
     held = counted & np.isfinite(force)
     median_force = float(np.median(force[held])) / float(weight_N) if held.any() else math.inf
-    return TargetScore(tuple(float(v) for v in target_mm), int(fc.size), 100.0 * float(counted.mean()),
-                       100.0 * float(fc.mean()), median_force, float(np.median(contacts)))
+    return TargetScore(
+        tuple(float(v) for v in target_mm),
+        int(fc.size),
+        100.0 * float(counted.mean()),
+        100.0 * float(fc.mean()),
+        median_force,
+        float(np.median(contacts)),
+    )
 
 
-def _best(scores: Sequence[TargetScore], reference_mm: NDArray, tie_band_points: float,
-          force_tie_relative: float) -> TargetScore:
+def _best(scores: Sequence[TargetScore], reference_mm: NDArray, tie_band_points: float, force_tie_relative: float) -> TargetScore:
     """The tie rules: the highest score T (typed force-closure share), shares within
     ``tie_band_points`` tied; among them the lowest median force over the weight, forces
     within ``force_tie_relative`` of it tied; then the most median contacts; then the target
@@ -226,12 +297,12 @@ def _best(scores: Sequence[TargetScore], reference_mm: NDArray, tie_band_points:
         tied = [s for s in tied if s.median_force_per_weight <= low * (1.0 + force_tie_relative) + _TOL]
     most = max(s.median_contacts for s in tied)
     tied = [s for s in tied if s.median_contacts >= most]
-    return min(tied, key=lambda s: (round(float(np.linalg.norm(np.subtract(s.target_mm, reference_mm))), 9),
-                                    s.target_mm))
+    return min(tied, key=lambda s: (round(float(np.linalg.norm(np.subtract(s.target_mm, reference_mm))), 9), s.target_mm))
 
 
-def rank_targets(scores: Sequence[TargetScore], reference_mm: Sequence[float], tie_band_points: float,
-                 force_tie_relative: float) -> list[TargetScore]:
+def rank_targets(
+    scores: Sequence[TargetScore], reference_mm: Sequence[float], tie_band_points: float, force_tie_relative: float
+) -> list[TargetScore]:
     """Every target, best first: the first is the one the tie rules pick among all, the next
     the one they pick among the rest, and so on (a total order, independent of input order)."""
     left = sorted(scores, key=lambda s: s.target_mm)
@@ -246,8 +317,10 @@ def rank_targets(scores: Sequence[TargetScore], reference_mm: Sequence[float], t
 
 def region_lattice(params: SearchParams, spacing_mm: float) -> NDArray:
     """(n, 3) the lattice points of the region at ``spacing_mm``, anchored at its lower corner."""
-    axes = [start + spacing_mm * np.arange(int(math.floor((stop - start) / spacing_mm + 1e-9)) + 1)
-            for start, stop in params.region_mm]
+    axes = [
+        start + spacing_mm * np.arange(int(math.floor((stop - start) / spacing_mm + 1e-9)) + 1)
+        for start, stop in params.region_mm
+    ]
     return np.array(list(itertools.product(*axes)), dtype=float)
 
 
@@ -265,8 +338,7 @@ def pose_subset(placement: Placement, period_deg: float, params: SearchParams) -
         k = (values - start) / step
         return np.abs(k - np.round(k)) < 1e-9
 
-    alphas = np.flatnonzero(on_step(grid.alpha_deg, a0, params.pose_alpha_step_deg)
-                            & (grid.alpha_deg < a0 + period_deg - 1e-9))
+    alphas = np.flatnonzero(on_step(grid.alpha_deg, a0, params.pose_alpha_step_deg) & (grid.alpha_deg < a0 + period_deg - 1e-9))
     betas = np.flatnonzero(on_step(grid.beta_deg, b0, params.pose_beta_step_deg))
     if alphas.size == 0 or betas.size == 0:
         raise ValueError("placement.search: no pose of the grid lies on the search's pose steps")
@@ -282,9 +354,19 @@ class TargetScorer:
     """Scores targets of one object: placement rule, closure, the grasps' opposition, GFO with
     the full set only; a pose counts when its grasp is of ``grasp_type``."""
 
-    def __init__(self, hand: Hand, synergies: Synergies, box: Any, placement: Placement,
-                 closure: ClosureParams, gfo: GFOParams, full_set: SynergySets, poses: Sequence[int],
-                 grasp_type: str = "any", opposition: OppositionRule | None = None) -> None:
+    def __init__(
+        self,
+        hand: Hand,
+        synergies: Synergies,
+        box: Any,
+        placement: Placement,
+        closure: ClosureParams,
+        gfo: GFOParams,
+        full_set: SynergySets,
+        poses: Sequence[int],
+        grasp_type: str = "any",
+        opposition: OppositionRule | None = None,
+    ) -> None:
         from synergrasp.simulation.closure import closure_model
         from synergrasp.simulation.scene import HandScene
 
@@ -363,17 +445,30 @@ class SearchResult:
         chosen = np.asarray(self.chosen.target_mm)
         distinct = distinct_ranks(self.ranked, distinct_mm)
         region = "; ".join(f"{axis} {lo:g} … {hi:g}" for axis, (lo, hi) in zip("xyz", self.region_mm))
-        rows = [{"object": self.object, "rank": k + 1, "chosen": k == 0, "distinct_rank": distinct[k],
-                 "x_mm": s.target_mm[0],
-                 "y_mm": s.target_mm[1], "z_mm": s.target_mm[2], "round": self.rounds[s.target_mm],
-                 "n_poses": s.n_poses, "grasp_type": self.grasp_type, "typed_percent": s.typed_percent,
-                 "force_closure_percent": s.force_closure_percent,
-                 "median_force_per_weight": s.median_force_per_weight, "median_contacts": s.median_contacts,
-                 "distance_to_chosen_mm": float(np.linalg.norm(np.asarray(s.target_mm) - chosen)),
-                 "stated_type": self.stated_type or self.grasp_type,
-                 "effective_type": self.effective_type or self.grasp_type, "type_reason": self.type_reason,
-                 "region_mm": region}
-                for k, s in enumerate(self.ranked)]
+        rows = [
+            {
+                "object": self.object,
+                "rank": k + 1,
+                "chosen": k == 0,
+                "distinct_rank": distinct[k],
+                "x_mm": s.target_mm[0],
+                "y_mm": s.target_mm[1],
+                "z_mm": s.target_mm[2],
+                "round": self.rounds[s.target_mm],
+                "n_poses": s.n_poses,
+                "grasp_type": self.grasp_type,
+                "typed_percent": s.typed_percent,
+                "force_closure_percent": s.force_closure_percent,
+                "median_force_per_weight": s.median_force_per_weight,
+                "median_contacts": s.median_contacts,
+                "distance_to_chosen_mm": float(np.linalg.norm(np.asarray(s.target_mm) - chosen)),
+                "stated_type": self.stated_type or self.grasp_type,
+                "effective_type": self.effective_type or self.grasp_type,
+                "type_reason": self.type_reason,
+                "region_mm": region,
+            }
+            for k, s in enumerate(self.ranked)
+        ]
         return pd.DataFrame(rows, columns=list(tables.PLACEMENT.names))
 
 
@@ -394,8 +489,9 @@ def _key(point: NDArray) -> tuple[float, float, float]:
     return tuple(float(round(v, 6)) for v in point)
 
 
-def grown_region(region_mm: Sequence[tuple[float, float]], target_mm: Sequence[float], step_mm: float,
-                 bound_mm: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
+def grown_region(
+    region_mm: Sequence[tuple[float, float]], target_mm: Sequence[float], step_mm: float, bound_mm: Sequence[tuple[float, float]]
+) -> tuple[tuple[float, float], ...]:
     """Version 3's region growth (docs/placement_search.md): on every axis where the target
     lies on the region's lower or upper bound, that bound moves one ``step_mm`` outward,
     unless it would pass ``bound_mm`` (the hand's reach, ``placement.hand_region``); an axis
@@ -412,10 +508,20 @@ def grown_region(region_mm: Sequence[tuple[float, float]], target_mm: Sequence[f
     return tuple(out)
 
 
-def search_object(hand: Hand, synergies: Synergies, box: Any, placement: Placement, closure: ClosureParams,
-                  gfo: GFOParams, full_set: SynergySets, params: SearchParams, period_deg: float,
-                  processes: int = 1, opposition: OppositionRule | None = None,
-                  bound_mm: Sequence[tuple[float, float]] | None = None) -> SearchResult:
+def search_object(
+    hand: Hand,
+    synergies: Synergies,
+    box: Any,
+    placement: Placement,
+    closure: ClosureParams,
+    gfo: GFOParams,
+    full_set: SynergySets,
+    params: SearchParams,
+    period_deg: float,
+    processes: int = 1,
+    opposition: OppositionRule | None = None,
+    bound_mm: Sequence[tuple[float, float]] | None = None,
+) -> SearchResult:
     """The coarse-to-fine search of one object (docs/placement_search.md): score the coarse
     lattice, then, round by round, the unscored neighbours at ``spacing_mm`` of the best
     ``refine_top`` targets, until they are all scored or ``max_rounds`` is reached. With
@@ -423,8 +529,18 @@ def search_object(hand: Hand, synergies: Synergies, box: Any, placement: Placeme
     region's boundary grows the region (:func:`grown_region`) and the refinement goes on with
     a fresh round budget, until the target is inside or nothing can grow.
     Deterministic: the same result for any ``processes``."""
-    args = (hand, synergies, box, placement, closure, gfo, full_set, pose_subset(placement, period_deg, params),
-            params.grasp_type, opposition)
+    args = (
+        hand,
+        synergies,
+        box,
+        placement,
+        closure,
+        gfo,
+        full_set,
+        pose_subset(placement, period_deg, params),
+        params.grasp_type,
+        opposition,
+    )
     reference = palm_centre(hand)
     scores: dict[tuple[float, float, float], TargetScore] = {}
     rounds: dict[tuple[float, float, float], int] = {}
@@ -438,9 +554,10 @@ def search_object(hand: Hand, synergies: Synergies, box: Any, placement: Placeme
         scorer = TargetScorer(*args)
         score_many = lambda targets: [scorer(t) for t in targets]  # noqa: E731
     steps = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if any(d)], dtype=float)
+
     def neighbours(region: SearchParams) -> list[tuple[float, float, float]]:
         ranked = rank_targets(list(scores.values()), reference, params.tie_band_points, params.force_tie_relative)
-        near = {_key(np.asarray(s.target_mm) + params.spacing_mm * d) for s in ranked[:params.refine_top] for d in steps}
+        near = {_key(np.asarray(s.target_mm) + params.spacing_mm * d) for s in ranked[: params.refine_top] for d in steps}
         return sorted(t for t in near if t not in scores and _in_region(np.asarray(t), region))
 
     grow = params.grow_region and bound_mm is not None
@@ -473,4 +590,3 @@ def search_object(hand: Hand, synergies: Synergies, box: Any, placement: Placeme
             scorer.close()
     ranked = rank_targets(list(scores.values()), reference, params.tie_band_points, params.force_tie_relative)
     return SearchResult(str(box.name), tuple(ranked), rounds, params.grasp_type, params.region_mm)
-

@@ -151,15 +151,17 @@ class SynergySets:
         object.__setattr__(self, "norms", np.array([np.linalg.norm(S[:, c], 2) for c in columns]))
         table = np.zeros((len(columns), max((c.size for c in columns), default=1)), dtype=np.int64)
         for j, c in enumerate(columns):
-            table[j, :c.size] = c
+            table[j, : c.size] = c
         object.__setattr__(self, "table", table)
         object.__setattr__(self, "sizes", np.array([c.size for c in columns], dtype=np.int64))
         members = [set(c.tolist()) for c in columns]
-        object.__setattr__(self, "within", np.array([[a is not b and a <= b for b in members] for a in members],
-                                                    dtype=bool).reshape(len(members), len(members)))
+        object.__setattr__(
+            self,
+            "within",
+            np.array([[a is not b and a <= b for b in members] for a in members], dtype=bool).reshape(len(members), len(members)),
+        )
         index = {tuple(c.tolist()): j for j, c in reversed(list(enumerate(columns)))}
-        object.__setattr__(self, "parent", np.array([index.get(tuple(c[:-1].tolist()), -1) for c in columns],
-                                                    dtype=np.int64))
+        object.__setattr__(self, "parent", np.array([index.get(tuple(c[:-1].tolist()), -1) for c in columns], dtype=np.int64))
         object.__setattr__(self, "order", np.argsort(self.sizes, kind="stable").astype(np.int64))
 
     def __len__(self) -> int:
@@ -193,8 +195,9 @@ class GraspSets:
 
     def problem(self, j: int) -> GFOProblem:
         """The problem of set j, with E_s from `internal_force_basis`."""
-        E = internal_force_basis(self.projector, self.synergies.matrix[:, self.synergies.columns[j]],
-                                 self.response_norm, self.basis_rtol)
+        E = internal_force_basis(
+            self.projector, self.synergies.matrix[:, self.synergies.columns[j]], self.response_norm, self.basis_rtol
+        )
         return GFOProblem(self.f_p, E, self.normals, self.f_min, self.cone)
 
 
@@ -244,11 +247,16 @@ class GFOSolution:
     @classmethod
     def empty(cls, size: int, strict: bool) -> GFOSolution:
         """`size` problems, none decided yet (status 'numerical_failure')."""
-        return cls(status=np.full(size, "numerical_failure", dtype=object), force_norm=np.full(size, np.nan),
-                   forces=np.full(size, None, dtype=object), e_s=np.zeros(size, dtype=np.int32),
-                   iterations=np.zeros(size, dtype=np.int32),
-                   strict_internal=np.zeros(size, dtype=bool) if strict else None,
-                   solver=np.full(size, "", dtype=object), max_violation=np.full(size, np.nan))
+        return cls(
+            status=np.full(size, "numerical_failure", dtype=object),
+            force_norm=np.full(size, np.nan),
+            forces=np.full(size, None, dtype=object),
+            e_s=np.zeros(size, dtype=np.int32),
+            iterations=np.zeros(size, dtype=np.int32),
+            strict_internal=np.zeros(size, dtype=bool) if strict else None,
+            solver=np.full(size, "", dtype=object),
+            max_violation=np.full(size, np.nan),
+        )
 
     def __len__(self) -> int:
         return int(self.status.size)
@@ -285,8 +293,7 @@ def linear_constraints(problem: GFOProblem) -> tuple[NDArray, NDArray]:
     F3 = problem.f_p.reshape(m, 3)
     faces = problem.cone.face_rows(frames)  # (m, sides, 3)
     G = np.vstack([-np.einsum("ij,ijk->ik", frames[:, 0], E3), np.einsum("isj,ijk->isk", faces, E3).reshape(-1, e)])
-    h = np.concatenate([np.einsum("ij,ij->i", frames[:, 0], F3) - problem.f_min,
-                        -np.einsum("isj,ij->is", faces, F3).ravel()])
+    h = np.concatenate([np.einsum("ij,ij->i", frames[:, 0], F3) - problem.f_min, -np.einsum("isj,ij->is", faces, F3).ravel()])
     return G, h
 
 

@@ -40,8 +40,18 @@ from scipy.spatial import ConvexHull, QhullError
 from synergrasp.optimisation.mechanics import Grasp, contact_frames, first_same_grasp, grasp_matrix
 from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions
 
-__all__ = ["GraspQuality", "grasp_quality", "scaled_grasp_matrix", "primitive_wrenches", "ferrari_canny_l1",
-           "synergy_manipulability", "QualityParams", "quality_table", "QUALITY_EDGES", "RANK_RTOL"]
+__all__ = [
+    "GraspQuality",
+    "grasp_quality",
+    "scaled_grasp_matrix",
+    "primitive_wrenches",
+    "ferrari_canny_l1",
+    "synergy_manipulability",
+    "QualityParams",
+    "quality_table",
+    "QUALITY_EDGES",
+    "RANK_RTOL",
+]
 
 #: Edges of the linearised friction cone in ε (GraspIt! uses 8).
 QUALITY_EDGES = 8
@@ -86,8 +96,9 @@ def primitive_wrenches(grasp: Grasp, mu: float, length_mm: float, edges: int = Q
         raise ValueError(f"edges must be >= 3, got {edges}")
     frames = contact_frames(grasp.normals)  # rows n, t1, t2
     phi = 2.0 * math.pi * np.arange(edges) / edges
-    forces = (frames[:, None, 0] + mu * (np.cos(phi)[None, :, None] * frames[:, None, 1]
-                                         + np.sin(phi)[None, :, None] * frames[:, None, 2]))
+    forces = frames[:, None, 0] + mu * (
+        np.cos(phi)[None, :, None] * frames[:, None, 1] + np.sin(phi)[None, :, None] * frames[:, None, 2]
+    )
     arms = (grasp.points - grasp.center)[:, None, :]
     torques = np.cross(np.broadcast_to(arms, forces.shape), forces) / length_mm
     return np.concatenate([forces, torques], axis=2).reshape(-1, 6)
@@ -112,8 +123,7 @@ def ferrari_canny_l1(wrenches: NDArray, rtol: float = RANK_RTOL) -> float:
     return float(depth.min()) if depth.min() > rtol * scale else 0.0
 
 
-def synergy_manipulability(grasp: Grasp, synergies: NDArray, length_mm: float,
-                           rtol: float = RANK_RTOL) -> NDArray:
+def synergy_manipulability(grasp: Grasp, synergies: NDArray, length_mm: float, rtol: float = RANK_RTOL) -> NDArray:
     """(6,) semi-axes, largest first, of the object twists ν = (Gᵀ)⁺ J S ż over the unit ball
     of the synergy velocities ż whose contact motion J S ż is rigid (in range(Gᵀ))."""
     G = scaled_grasp_matrix(grasp.points, grasp.center, length_mm)
@@ -126,7 +136,7 @@ def synergy_manipulability(grasp: Grasp, synergies: NDArray, length_mm: float,
     off = JS - rigid @ JS
     u, s, vt = np.linalg.svd(off)
     keep = s <= rtol * max(float(np.max(np.abs(JS))), 1.0)
-    null = np.concatenate([vt[: len(s)][keep], vt[len(s):]]).T  # (s, d) orthonormal
+    null = np.concatenate([vt[: len(s)][keep], vt[len(s) :]]).T  # (s, d) orthonormal
     if null.shape[1] == 0:
         return np.zeros(6)
     axes = np.linalg.svd(Gt_pinv @ JS @ null, compute_uv=False)
@@ -136,8 +146,9 @@ def synergy_manipulability(grasp: Grasp, synergies: NDArray, length_mm: float,
     return out
 
 
-def grasp_quality(grasp: Grasp, mu: float, length_mm: float, synergies: NDArray | None = None,
-                  edges: int = QUALITY_EDGES) -> GraspQuality:
+def grasp_quality(
+    grasp: Grasp, mu: float, length_mm: float, synergies: NDArray | None = None, edges: int = QUALITY_EDGES
+) -> GraspQuality:
     """Every quality index of one grasp. ``synergies`` (n, s): the enrolled synergies of the
     manipulability ellipsoid (None: no ellipsoid, zeros)."""
     G = scaled_grasp_matrix(grasp.points, grasp.center, length_mm)
@@ -146,9 +157,13 @@ def grasp_quality(grasp: Grasp, mu: float, length_mm: float, synergies: NDArray 
     sigma_min = float(sv[5]) if rank == 6 else 0.0
     manip = np.zeros(6) if synergies is None else synergy_manipulability(grasp, synergies, length_mm)
     return GraspQuality(
-        rank_G=rank, sigma_min=sigma_min, isotropy=sigma_min / float(sv[0]) if rank == 6 else 0.0,
+        rank_G=rank,
+        sigma_min=sigma_min,
+        isotropy=sigma_min / float(sv[0]) if rank == 6 else 0.0,
         epsilon=ferrari_canny_l1(primitive_wrenches(grasp, mu, length_mm, edges)),
-        manipulability=manip, torque_length_mm=float(length_mm))
+        manipulability=manip,
+        torque_length_mm=float(length_mm),
+    )
 
 
 @dataclass(frozen=True)
@@ -172,13 +187,25 @@ class QualityParams:
         from synergrasp.simulation.objects import GraspedObject
 
         grasped = GraspedObject.from_config(config, obj)
-        return cls(config["hand"], config["synergies"], friction_mu(config),
-                   incremental_set_id(config["synergy_sets"]["incremental_max"]),
-                   weight_N(config, obj), grasped.shape.bounding_radius_mm, OppositionRule.from_config(config))
+        return cls(
+            config["hand"],
+            config["synergies"],
+            friction_mu(config),
+            incremental_set_id(config["synergy_sets"]["incremental_max"]),
+            weight_N(config, obj),
+            grasped.shape.bounding_radius_mm,
+            OppositionRule.from_config(config),
+        )
 
 
-def quality_table(contacts: pd.DataFrame, gfo: pd.DataFrame, grasps: Sequence[Grasp | None],
-                  synergy_matrix: NDArray, params: QualityParams, axes: HandAxes) -> pd.DataFrame:
+def quality_table(
+    contacts: pd.DataFrame,
+    gfo: pd.DataFrame,
+    grasps: Sequence[Grasp | None],
+    synergy_matrix: NDArray,
+    params: QualityParams,
+    axes: HandAxes,
+) -> pd.DataFrame:
     """One row per pose of ``contacts`` (columns of ``synergrasp.tables.QUALITY``): the quality
     indices of its grasp (``grasps``, one per row; None: no grasp, indices NaN), the full
     set's verdict and optimal force over the weight from ``gfo``, and the grasp's opposition
@@ -186,23 +213,38 @@ def quality_table(contacts: pd.DataFrame, gfo: pd.DataFrame, grasps: Sequence[Gr
     (``mechanics.first_same_grasp``: a box's poses one α-period apart) share its indices,
     computed once at the first of them: the ε hull is most of the cost."""
     full = gfo[gfo["set_id"] == params.full_set_id]
-    verdicts = {int(pose): (bool(closure), float(force) / params.weight_N)
-                for pose, closure, force in zip(full["pose"].tolist(), full["force_closure_def1"].tolist(),
-                                                full["force_norm"].tolist())}
+    verdicts = {
+        int(pose): (bool(closure), float(force) / params.weight_N)
+        for pose, closure, force in zip(full["pose"].tolist(), full["force_closure_def1"].tolist(), full["force_norm"].tolist())
+    }
     rows = []
     first = first_same_grasp(grasps)
     computed: dict[int, GraspQuality] = {}
     oppositions = contacts_oppositions(contacts, axes, params.opposition)
     for row, grasp, i, opposition in zip(contacts.itertuples(index=False), grasps, first, oppositions):
-        out = {"object": row.object, "pose": row.pose, "alpha_deg": row.alpha_deg,
-               "beta_deg": row.beta_deg, "n_contacts": int(row.n_contacts), "rank_G": 0,
-               "sigma_min": np.nan, "isotropy": np.nan, "epsilon": np.nan, "manipulability": [np.nan] * 6}
+        out = {
+            "object": row.object,
+            "pose": row.pose,
+            "alpha_deg": row.alpha_deg,
+            "beta_deg": row.beta_deg,
+            "n_contacts": int(row.n_contacts),
+            "rank_G": 0,
+            "sigma_min": np.nan,
+            "isotropy": np.nan,
+            "epsilon": np.nan,
+            "manipulability": [np.nan] * 6,
+        }
         if grasp is not None:
             if i not in computed:
                 computed[i] = grasp_quality(grasp, params.mu, params.torque_length_mm, synergies=synergy_matrix)
             q = computed[i]
-            out.update(rank_G=q.rank_G, sigma_min=q.sigma_min, isotropy=q.isotropy, epsilon=q.epsilon,
-                       manipulability=q.manipulability.tolist())
+            out.update(
+                rank_G=q.rank_G,
+                sigma_min=q.sigma_min,
+                isotropy=q.isotropy,
+                epsilon=q.epsilon,
+                manipulability=q.manipulability.tolist(),
+            )
         out["force_closure"], out["force_per_weight"] = verdicts.get(int(row.pose), (False, np.nan))
         out["torque_length_mm"] = params.torque_length_mm
         out["opposition"] = opposition

@@ -87,8 +87,7 @@ def set_posture(client: int, body: HandBody, q: NDArray) -> None:
     if q.shape != (body.hand.n_joints,):
         raise ValueError(f"q must have shape ({body.hand.n_joints},), got {q.shape}")
     values = body.joint_scale * q[body.joint_q]
-    pb.resetJointStatesMultiDof(body.body, body.joint_indices.tolist(),
-                                [[float(v)] for v in values], physicsClientId=client)
+    pb.resetJointStatesMultiDof(body.body, body.joint_indices.tolist(), [[float(v)] for v in values], physicsClientId=client)
 
 
 def collision_shape(client: int, shape: Any) -> int:
@@ -101,16 +100,19 @@ def collision_shape(client: int, shape: Any) -> int:
     if kind == "sphere":
         return pb.createCollisionShape(pb.GEOM_SPHERE, radius=float(geometry["radius_mm"]) * MM, physicsClientId=client)
     if kind == "cylinder":  # along the shape's own z axis, as pybullet's
-        return pb.createCollisionShape(pb.GEOM_CYLINDER, radius=float(geometry["radius_mm"]) * MM,
-                                       height=float(geometry["height_mm"]) * MM, physicsClientId=client)
+        return pb.createCollisionShape(
+            pb.GEOM_CYLINDER,
+            radius=float(geometry["radius_mm"]) * MM,
+            height=float(geometry["height_mm"]) * MM,
+            physicsClientId=client,
+        )
     if kind == "convex_parts":  # one convex hull per part (a file of several: the engine's compound)
         parts = geometry["parts_mm"]
         if len(parts) == 1:
             return pb.createCollisionShape(pb.GEOM_MESH, vertices=(parts[0] * MM).tolist(), physicsClientId=client)
         from synergrasp.simulation.shapes.convex_parts import bullet_file
 
-        return pb.createCollisionShape(pb.GEOM_MESH, fileName=str(bullet_file(parts)), meshScale=[MM] * 3,
-                                       physicsClientId=client)
+        return pb.createCollisionShape(pb.GEOM_MESH, fileName=str(bullet_file(parts)), meshScale=[MM] * 3, physicsClientId=client)
     raise ValueError(f"no collision shape for a {kind!r}")
 
 
@@ -159,8 +161,14 @@ def _to_hand_links(body: int | HandBody, links: list[int]) -> NDArray[np.int64]:
     return np.array(links, dtype=np.int64)
 
 
-def closest_points(client: int, body_a: int | HandBody, body_b: int | HandBody, distance_mm: float,
-                   link_a: int | None = None, link_b: int | None = None) -> ClosestPoints:
+def closest_points(
+    client: int,
+    body_a: int | HandBody,
+    body_b: int | HandBody,
+    distance_mm: float,
+    link_a: int | None = None,
+    link_b: int | None = None,
+) -> ClosestPoints:
     """Closest points between A and B closer than ``distance_mm`` (all links unless given).
 
     A HandBody argument takes and returns hand link indices. With the object as A and the
@@ -199,12 +207,14 @@ def self_collision_pairs(hand: Hand, links: tuple[int, ...] | None = None) -> tu
     ignored = set(hand.ignored_link_pairs)
     keep = None if links is None else set(links)
     shaped = [i for i in range(hand.n_links) if i not in hand.shapeless_links]  # a link without shape touches nothing
-    return tuple((i, j) for i in shaped for j in shaped
-                 if i < j and (i, j) not in ignored and (keep is None or i in keep or j in keep))
+    return tuple(
+        (i, j) for i in shaped for j in shaped if i < j and (i, j) not in ignored and (keep is None or i in keep or j in keep)
+    )
 
 
-def self_closest_points(client: int, body: HandBody, distance_mm: float,
-                        pairs: tuple[tuple[int, int], ...] | None = None) -> ClosestPoints:
+def self_closest_points(
+    client: int, body: HandBody, distance_mm: float, pairs: tuple[tuple[int, int], ...] | None = None
+) -> ClosestPoints:
     """Closest points between pairs of hand links (default ``self_collision_pairs``), mm.
 
     ``link_a`` / ``link_b`` are hand link indices; distances < 0 are overlaps.
@@ -212,15 +222,23 @@ def self_closest_points(client: int, body: HandBody, distance_mm: float,
     pairs = self_collision_pairs(body.hand) if pairs is None else pairs
     pts: list = []
     for i, j in pairs:
-        pts.extend(pb.getClosestPoints(body.body, body.body, float(distance_mm) * MM,
-                                       linkIndexA=int(body.link_index[i]), linkIndexB=int(body.link_index[j]),
-                                       physicsClientId=client))
+        pts.extend(
+            pb.getClosestPoints(
+                body.body,
+                body.body,
+                float(distance_mm) * MM,
+                linkIndexA=int(body.link_index[i]),
+                linkIndexB=int(body.link_index[j]),
+                physicsClientId=client,
+            )
+        )
     return _closest(body, body, pts)
 
 
 # --------------------------------------------------------------------------------------
 # Dynamics: the compliant hand and a free box (synergrasp.simulation.dynamic_closure)
 # --------------------------------------------------------------------------------------
+
 
 @dataclass(frozen=True)
 class ContactForces(ClosestPoints):
@@ -233,8 +251,7 @@ class ContactForces(ClosestPoints):
     normal_force: NDArray[np.float64]
 
 
-def load_compliant_hand(client: int, hand: Hand, link_mass_kg: float, link_inertia_kg_mm2: float,
-                        friction: float) -> HandBody:
+def load_compliant_hand(client: int, hand: Hand, link_mass_kg: float, link_inertia_kg_mm2: float, friction: float) -> HandBody:
     """Load ``hand`` for dynamics: fixed palm at the origin, self-collision possible (choose the
     pairs with ``set_self_collision``), every elementary link
     with mass ``link_mass_kg`` and inertia ``link_inertia_kg_mm2`` (kg·mm², about its own
@@ -242,20 +259,30 @@ def load_compliant_hand(client: int, hand: Hand, link_mass_kg: float, link_inert
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "hand.urdf"
         write_urdf(hand, path)
-        uid = pb.loadURDF(str(path), basePosition=[0, 0, 0], baseOrientation=[0, 0, 0, 1], useFixedBase=True,
-                          flags=pb.URDF_USE_INERTIA_FROM_FILE | pb.URDF_USE_SELF_COLLISION,
-                          physicsClientId=client)
+        uid = pb.loadURDF(
+            str(path),
+            basePosition=[0, 0, 0],
+            baseOrientation=[0, 0, 0, 1],
+            useFixedBase=True,
+            flags=pb.URDF_USE_INERTIA_FROM_FILE | pb.URDF_USE_SELF_COLLISION,
+            physicsClientId=client,
+        )
     body = _hand_body(client, uid, hand)
     n = pb.getNumJoints(uid, physicsClientId=client)
     inertia = link_inertia_kg_mm2 * MM * MM
     for link in range(-1, n):
-        pb.changeDynamics(uid, link, lateralFriction=float(friction), linearDamping=0.0, angularDamping=0.0,
-                          jointDamping=0.0, physicsClientId=client)
+        pb.changeDynamics(
+            uid,
+            link,
+            lateralFriction=float(friction),
+            linearDamping=0.0,
+            angularDamping=0.0,
+            jointDamping=0.0,
+            physicsClientId=client,
+        )
         if link >= 0:
-            pb.changeDynamics(uid, link, mass=float(link_mass_kg), localInertiaDiagonal=[inertia] * 3,
-                              physicsClientId=client)
-    pb.setJointMotorControlArray(uid, list(range(n)), pb.VELOCITY_CONTROL, forces=[0.0] * n,
-                                 physicsClientId=client)
+            pb.changeDynamics(uid, link, mass=float(link_mass_kg), localInertiaDiagonal=[inertia] * 3, physicsClientId=client)
+    pb.setJointMotorControlArray(uid, list(range(n)), pb.VELOCITY_CONTROL, forces=[0.0] * n, physicsClientId=client)
     return body
 
 
@@ -266,8 +293,14 @@ def set_self_collision(client: int, body: HandBody, pairs: tuple[tuple[int, int]
     n = body.hand.n_links
     for i in range(n):
         for j in range(i + 1, n):
-            pb.setCollisionFilterPair(body.body, body.body, int(body.link_index[i]), int(body.link_index[j]),
-                                      int((i, j) in wanted), physicsClientId=client)
+            pb.setCollisionFilterPair(
+                body.body,
+                body.body,
+                int(body.link_index[i]),
+                int(body.link_index[j]),
+                int((i, j) in wanted),
+                physicsClientId=client,
+            )
 
 
 def _hand_body(client: int, uid: int, hand: Hand) -> HandBody:
@@ -279,17 +312,28 @@ def _hand_body(client: int, uid: int, hand: Hand) -> HandBody:
         by_link_name[info[12].decode()] = j
     joint_indices = np.array([by_joint_name[hand.frame_joint_names[f]] for f in range(1, len(hand.frame_names))])
     link_index = np.array([-1] + [by_link_name[name] for name in hand.link_names[1:]])
-    return HandBody(body=uid, hand=hand, joint_indices=joint_indices, joint_q=hand.frame_joint[1:].copy(),
-                    joint_scale=hand.frame_scale[1:].copy(), link_index=link_index,
-                    hand_link={int(b): i for i, b in enumerate(link_index)})
+    return HandBody(
+        body=uid,
+        hand=hand,
+        joint_indices=joint_indices,
+        joint_q=hand.frame_joint[1:].copy(),
+        joint_scale=hand.frame_scale[1:].copy(),
+        link_index=link_index,
+        hand_link={int(b): i for i, b in enumerate(link_index)},
+    )
 
 
 def set_dynamics(client: int, time_step_s: float, solver_iterations: int) -> None:
     """Time step (s) and constraint-solver iterations of the client; no gravity (a body's weight
     is applied as an explicit force, ``apply_force``)."""
     pb.setGravity(0.0, 0.0, 0.0, physicsClientId=client)
-    pb.setPhysicsEngineParameter(fixedTimeStep=float(time_step_s), numSolverIterations=int(solver_iterations),
-                                 numSubSteps=0, deterministicOverlappingPairs=1, physicsClientId=client)
+    pb.setPhysicsEngineParameter(
+        fixedTimeStep=float(time_step_s),
+        numSolverIterations=int(solver_iterations),
+        numSubSteps=0,
+        deterministicOverlappingPairs=1,
+        physicsClientId=client,
+    )
 
 
 def apply_force(client: int, body: int, force_N: NDArray) -> None:
@@ -306,10 +350,17 @@ def load_free_object(client: int, shape: Any, mass_kg: float, friction: float, d
     the same friction). Place it with ``move_body``; returns its body id."""
     if not mass_kg >= 0:
         raise ValueError(f"mass_kg must be >= 0 (0: a fixed body), got {mass_kg!r}")
-    body = pb.createMultiBody(baseMass=float(mass_kg), baseCollisionShapeIndex=collision_shape(client, shape),
-                              physicsClientId=client)
-    pb.changeDynamics(body, -1, lateralFriction=float(friction), linearDamping=float(damping_per_s),
-                      angularDamping=float(damping_per_s), physicsClientId=client)
+    body = pb.createMultiBody(
+        baseMass=float(mass_kg), baseCollisionShapeIndex=collision_shape(client, shape), physicsClientId=client
+    )
+    pb.changeDynamics(
+        body,
+        -1,
+        lateralFriction=float(friction),
+        linearDamping=float(damping_per_s),
+        angularDamping=float(damping_per_s),
+        physicsClientId=client,
+    )
     _exact_surface(client, body, shape)
     return body
 
@@ -318,8 +369,13 @@ def reset_hand(client: int, body: HandBody, q: NDArray) -> None:
     """Put the hand at joint angles q (19, rad) at rest (zero joint velocities)."""
     q = np.asarray(q, dtype=float)
     values = body.joint_scale * q[body.joint_q]
-    pb.resetJointStatesMultiDof(body.body, body.joint_indices.tolist(), [[float(v)] for v in values],
-                                targetVelocities=[[0.0]] * len(values), physicsClientId=client)
+    pb.resetJointStatesMultiDof(
+        body.body,
+        body.joint_indices.tolist(),
+        [[float(v)] for v in values],
+        targetVelocities=[[0.0]] * len(values),
+        physicsClientId=client,
+    )
 
 
 def reset_body(client: int, body: int, center_mm: NDArray, rotation: NDArray) -> None:
@@ -360,8 +416,11 @@ def contact_forces(client: int, body_a: int | HandBody, body_b: HandBody) -> Con
 
 def step_with_torques(client: int, body: HandBody, torques_Nmm: NDArray) -> None:
     """Apply ``torques_Nmm`` (N·mm, one per elementary axis, HandBody order) and take one step."""
-    pb.setJointMotorControlArray(body.body, body.joint_list, pb.TORQUE_CONTROL,
-                                 forces=(np.asarray(torques_Nmm, dtype=float) * MM).tolist(), physicsClientId=client)
+    pb.setJointMotorControlArray(
+        body.body,
+        body.joint_list,
+        pb.TORQUE_CONTROL,
+        forces=(np.asarray(torques_Nmm, dtype=float) * MM).tolist(),
+        physicsClientId=client,
+    )
     pb.stepSimulation(physicsClientId=client)
-
-

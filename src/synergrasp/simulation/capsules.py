@@ -28,8 +28,7 @@ from synergrasp.simulation.shapes.polytope import WORK
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
 
-__all__ = ["HandCapsules", "segment_segment_distance", "capsule_object", "pair_gaps", "nearest_per_link",
-           "posture_gaps"]
+__all__ = ["HandCapsules", "segment_segment_distance", "capsule_object", "pair_gaps", "nearest_per_link", "posture_gaps"]
 
 _EPS = 1e-12
 
@@ -73,8 +72,7 @@ def segment_segment_distance(p0: NDArray, p1: NDArray, q0: NDArray, q1: NDArray)
 
 
 @jit
-def _frames(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: NDArray,
-            scale: NDArray) -> NDArray:
+def _frames(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: NDArray, scale: NDArray) -> NDArray:
     """(n_frames, 4, 4) frame transforms at q (the same chain as ``hand.frame_transforms``)."""
     n = parent.shape[0]
     out = np.empty((n, 4, 4))
@@ -95,8 +93,9 @@ def _frames(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: 
         top = out[parent[f]]
         for i in range(4):
             for j in range(4):
-                out[f, i, j] = (top[i, 0] * local[0, j] + top[i, 1] * local[1, j] + top[i, 2] * local[2, j]
-                                + top[i, 3] * local[3, j])
+                out[f, i, j] = (
+                    top[i, 0] * local[0, j] + top[i, 1] * local[1, j] + top[i, 2] * local[2, j] + top[i, 3] * local[3, j]
+                )
     return out
 
 
@@ -116,13 +115,13 @@ def _segments(frames: NDArray, cap_frame: NDArray, ends: NDArray) -> tuple[NDArr
 def _to_box(p: NDArray, rotation: NDArray, centre: NDArray, out: NDArray) -> None:
     """p (palm frame) in the frame of a box at (rotation, centre): out = rotationᵀ (p − centre)."""
     for j in range(3):
-        out[j] = ((p[0] - centre[0]) * rotation[0, j] + (p[1] - centre[1]) * rotation[1, j]
-                  + (p[2] - centre[2]) * rotation[2, j])
+        out[j] = (p[0] - centre[0]) * rotation[0, j] + (p[1] - centre[1]) * rotation[1, j] + (p[2] - centre[2]) * rotation[2, j]
 
 
 @jit
-def _capsule_to_box(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray, half: NDArray,
-                    work: NDArray) -> tuple[float, float]:
+def _capsule_to_box(
+    p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray, half: NDArray, work: NDArray
+) -> tuple[float, float]:
     """Signed distance of the axis p0–p1 (palm frame) to a box at (rotation, centre) and its
     parameter; ``work`` (4, 8) is scratch space."""
     _to_box(p0, rotation, centre, work[0])
@@ -133,8 +132,9 @@ def _capsule_to_box(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray
 
 
 @jit
-def _capsule_to_object(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray, code: int, params: NDArray,
-                       work: NDArray) -> tuple[float, float]:
+def _capsule_to_object(
+    p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDArray, code: int, params: NDArray, work: NDArray
+) -> tuple[float, float]:
     """Signed distance of the axis p0–p1 (palm frame) to an object at (rotation, centre) and
     its parameter; ``work`` (3, WORK) is scratch space."""
     _to_box(p0, rotation, centre, work[0])
@@ -145,8 +145,9 @@ def _capsule_to_object(p0: NDArray, p1: NDArray, rotation: NDArray, centre: NDAr
 
 
 @jit
-def capsule_object(p0: NDArray, p1: NDArray, radius: NDArray, rotation: NDArray, centre: NDArray, code: int,
-                   params: NDArray) -> tuple[NDArray, NDArray]:
+def capsule_object(
+    p0: NDArray, p1: NDArray, radius: NDArray, rotation: NDArray, centre: NDArray, code: int, params: NDArray
+) -> tuple[NDArray, NDArray]:
     """Signed distance (c,) of every capsule to the object (shape ``code``, ``params``; palm
     frame pose) and the parameter of the closest point of its axis."""
     c = p0.shape[0]
@@ -159,8 +160,16 @@ def capsule_object(p0: NDArray, p1: NDArray, radius: NDArray, rotation: NDArray,
 
 
 @jit
-def pair_gaps(p0: NDArray, p1: NDArray, radius: NDArray, first: NDArray, second: NDArray,
-              palm_rotation: NDArray, palm_centre: NDArray, palm_half: NDArray) -> NDArray:
+def pair_gaps(
+    p0: NDArray,
+    p1: NDArray,
+    radius: NDArray,
+    first: NDArray,
+    second: NDArray,
+    palm_rotation: NDArray,
+    palm_centre: NDArray,
+    palm_half: NDArray,
+) -> NDArray:
     """Signed distance (p,) of pairs of capsules (rows ``first``, ``second``); ``second`` = -1:
     the capsule against the palm boxes (b, ...) instead."""
     out = np.empty(first.shape[0])
@@ -213,12 +222,33 @@ def _beyond(p0: NDArray, p1: NDArray, radius: float, centre: NDArray, bound_mm: 
 
 
 @jit
-def posture_gaps(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: NDArray, scale: NDArray,
-                 cap_frame: NDArray, ends: NDArray, radius: NDArray, cap_link: NDArray, palm_gap: float,
-                 object_rotation: NDArray, object_centre: NDArray, code: int, params: NDArray, bound_mm: float,
-                 first: NDArray, second: NDArray,
-                 pair_ends: NDArray, palm_rotation: NDArray, palm_centre: NDArray, palm_half: NDArray,
-                 n_links: int, moving_links: NDArray, margin_mm: float) -> tuple[NDArray, NDArray, NDArray]:
+def posture_gaps(
+    q: NDArray,
+    parent: NDArray,
+    offset: NDArray,
+    axis: NDArray,
+    joint: NDArray,
+    scale: NDArray,
+    cap_frame: NDArray,
+    ends: NDArray,
+    radius: NDArray,
+    cap_link: NDArray,
+    palm_gap: float,
+    object_rotation: NDArray,
+    object_centre: NDArray,
+    code: int,
+    params: NDArray,
+    bound_mm: float,
+    first: NDArray,
+    second: NDArray,
+    pair_ends: NDArray,
+    palm_rotation: NDArray,
+    palm_centre: NDArray,
+    palm_half: NDArray,
+    n_links: int,
+    moving_links: NDArray,
+    margin_mm: float,
+) -> tuple[NDArray, NDArray, NDArray]:
     """Everything the closure asks at one posture q (rad), in one call: per link the signed
     distance to the object (the palm's, ``palm_gap``, does not change with q), the distance to
     the nearest link it is paired with and that link (mm; see ``pair_gaps``).
@@ -279,17 +309,28 @@ class HandCapsules:
             radius.append(shape.radius)
         palm = hand.link_shapes[0]
         links_arr = np.asarray(links, dtype=np.int64)
-        return cls(hand, links_arr, np.asarray(hand.link_frame, dtype=np.int64)[links_arr], np.asarray(ends),
-                   np.asarray(radius), np.stack([s.pose[:3, :3] for s in palm]),
-                   np.stack([s.pose[:3, 3] for s in palm]), np.stack([0.5 * s.size for s in palm]))
+        return cls(
+            hand,
+            links_arr,
+            np.asarray(hand.link_frame, dtype=np.int64)[links_arr],
+            np.asarray(ends),
+            np.asarray(radius),
+            np.stack([s.pose[:3, :3] for s in palm]),
+            np.stack([s.pose[:3, 3] for s in palm]),
+            np.stack([0.5 * s.size for s in palm]),
+        )
 
     @property
     def tree(self) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray]:
         """The hand's frame tree as arrays (parent, offset, axis, joint, scale) for ``_frames``."""
         h = self.hand
-        return (np.asarray(h.frame_parent, dtype=np.int64), np.ascontiguousarray(h.frame_offset),
-                np.ascontiguousarray(h.frame_axis), np.asarray(h.frame_joint, dtype=np.int64),
-                np.ascontiguousarray(h.frame_scale))
+        return (
+            np.asarray(h.frame_parent, dtype=np.int64),
+            np.ascontiguousarray(h.frame_offset),
+            np.ascontiguousarray(h.frame_axis),
+            np.asarray(h.frame_joint, dtype=np.int64),
+            np.ascontiguousarray(h.frame_scale),
+        )
 
     def segments(self, q: NDArray) -> tuple[NDArray, NDArray]:
         """Axis end points (c, 3) and (c, 3) of every capsule in the palm frame at q (rad)."""
@@ -306,8 +347,9 @@ class HandCapsules:
         p0, p1 = self.segments(q)
         cube = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
         directions = np.vstack([np.eye(3), -np.eye(3), cube / np.sqrt(3.0)])
-        widened = (np.vstack([p0, p1])[:, None, :]
-                   + np.concatenate([self.radius, self.radius])[:, None, None] * directions[None]).reshape(-1, 3)
+        widened = (
+            np.vstack([p0, p1])[:, None, :] + np.concatenate([self.radius, self.radius])[:, None, None] * directions[None]
+        ).reshape(-1, 3)
         corners = [c + (cube * h) @ r.T for r, c, h in zip(self.palm_rotation, self.palm_centre, self.palm_half)]
         facets = ConvexHull(np.vstack([widened, *corners])).equations  # rows (outward n, offset): n·x + offset ≤ 0 inside
         return bool(np.max(facets[:, :3] @ np.asarray(point_mm, dtype=float) + facets[:, 3]) <= 1e-9)

@@ -35,6 +35,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["SimulateParams", "simulate_object", "closure_model", "place_object", "warm_up"]
 
+
 @dataclass(frozen=True)
 class SimulateParams:
     """The closure of one object (the ``simulate`` step): the hand file (None: the shipped
@@ -62,37 +63,52 @@ class SimulateParams:
         dynamic_model = closure["model"] == "dynamic"  # reads the box's mass and the mechanics
         dynamic = build(DynamicParams, "closure.dynamic", **dataclass_fields(DynamicParams, closure["dynamic"]))
         return cls(
-            hand=config["hand"], mean_rad=tuple(values["mean_rad"]), s1=tuple(values["S1"]),
+            hand=config["hand"],
+            mean_rad=tuple(values["mean_rad"]),
+            s1=tuple(values["S1"]),
             object=GraspedObject.from_config(config, obj, with_mass=dynamic_model),
-            placement=Placement.from_config(effective_placement(config, obj),
-                                            config["grid"]),
+            placement=Placement.from_config(effective_placement(config, obj), config["grid"]),
             closure=build(ClosureParams, "closure", **{**dataclass_fields(ClosureParams, closure), "dynamic": dynamic}),
-            mechanics=build(ClosureMechanics, "mechanics", **{**dataclass_fields(ClosureMechanics, config["mechanics"]),
-                                                              "mu": friction_mu(config)})
-            if dynamic_model else None)
+            mechanics=build(
+                ClosureMechanics,
+                "mechanics",
+                **{**dataclass_fields(ClosureMechanics, config["mechanics"]), "mu": friction_mu(config)},
+            )
+            if dynamic_model
+            else None,
+        )
 
     def synergies(self, joint_names: tuple[str, ...]) -> Synergies:
         """q_m and S1 as a one-synergy :class:`Synergies` of the hand's joints."""
         return Synergies(tuple(joint_names), np.array(self.mean_rad), np.array(self.s1)[:, None], ("S1",))
 
-def closure_model(hand: Hand, synergies: Synergies, params: ClosureParams,
-                  mechanics: ClosureMechanics | None = None, weight_N: float | None = None):
+
+def closure_model(
+    hand: Hand,
+    synergies: Synergies,
+    params: ClosureParams,
+    mechanics: ClosureMechanics | None = None,
+    weight_N: float | None = None,
+):
     """The closure model of ``params`` on a new pybullet scene of ``hand``; the dynamic model
     also needs the :class:`ClosureMechanics` (k_ss, μ, gravity) and the object's weight (N)."""
     if params.model == "dynamic":
         from synergrasp.simulation.dynamic_closure import DynamicClosure
 
         if mechanics is None or weight_N is None:
-            raise ValueError("closure.model: dynamic needs the mechanics block (k_ss_Nmm_per_rad, mu, gravity) "
-                             "and the object's weight (mass_kg, mechanics.g_m_per_s2)")
+            raise ValueError(
+                "closure.model: dynamic needs the mechanics block (k_ss_Nmm_per_rad, mu, gravity) "
+                "and the object's weight (mass_kg, mechanics.g_m_per_s2)"
+            )
         return DynamicClosure(hand, synergies, params, mechanics, weight_N)
     from synergrasp.simulation.kinematic_closure import KinematicClosure
 
     return KinematicClosure(hand, synergies, params)
 
 
-def place_object(scene: HandScene, q_open: NDArray, placement: Placement, shape: Shape, alpha_deg: float,
-                 beta_deg: float) -> ObjectPose:
+def place_object(
+    scene: HandScene, q_open: NDArray, placement: Placement, shape: Shape, alpha_deg: float, beta_deg: float
+) -> ObjectPose:
     """``shape`` at pose (α, β) deg by the placement rule: turned by (α, β), brought along
     the palm normal toward the placement's target, stopped at the target or at first touch
     of the open hand (posture ``q_open``, rad) of ``scene``, whichever comes first
@@ -100,13 +116,20 @@ def place_object(scene: HandScene, q_open: NDArray, placement: Placement, shape:
     hand = scene.hand
     turned = object_pose(placement, shape, alpha_deg, beta_deg, hand.palm_normal)
     point, direction = approach_line(placement, hand)
-    return scene.bring_object(shape, turned.rotation, point, direction, q_open, placement.clearance_mm,
-                              stop_at_point=True)
+    return scene.bring_object(shape, turned.rotation, point, direction, q_open, placement.clearance_mm, stop_at_point=True)
 
 
-def simulate_object(hand: Hand, synergies: Synergies, grasped: GraspedObject, placement: Placement,
-                    closure_params: ClosureParams, poses: Iterable[int] | None = None,
-                    mechanics: ClosureMechanics | None = None, *, as_in_grid: bool = False) -> pd.DataFrame:
+def simulate_object(
+    hand: Hand,
+    synergies: Synergies,
+    grasped: GraspedObject,
+    placement: Placement,
+    closure_params: ClosureParams,
+    poses: Iterable[int] | None = None,
+    mechanics: ClosureMechanics | None = None,
+    *,
+    as_in_grid: bool = False,
+) -> pd.DataFrame:
     """Close the hand on the object ``grasped`` (name, shape, mass) at every pose of the
     placement's grid (or at ``poses``).
 
@@ -133,9 +156,17 @@ def simulate_object(hand: Hand, synergies: Synergies, grasped: GraspedObject, pl
             placed = place_object(placer, model.q_open, placement, shape, a, b)
             result = None if shared is None else shared.get(placed)
             if result is None and shared is not None and as_in_grid:  # close where the grid's run closed
-                first = next((other for other in (place_object(placer, model.q_open, placement, shape,
-                                                               *grid.angles_deg(earlier)) for earlier in range(pose))
-                              if shared.same(other, placed)), None)
+                first = next(
+                    (
+                        other
+                        for other in (
+                            place_object(placer, model.q_open, placement, shape, *grid.angles_deg(earlier))
+                            for earlier in range(pose)
+                        )
+                        if shared.same(other, placed)
+                    ),
+                    None,
+                )
                 if first is not None:
                     result = model.grasp(first)
                     shared.add(first, result)
@@ -187,8 +218,9 @@ class _RegionResults:
         return self._key(a) == self._key(b) and self._fill_alike(a, b)
 
     def get(self, placed: ObjectPose) -> ClosureResult | None:
-        return next((result for other, result in self.buckets.get(self._key(placed), [])
-                     if self._fill_alike(other, placed)), None)
+        return next(
+            (result for other, result in self.buckets.get(self._key(placed), []) if self._fill_alike(other, placed)), None
+        )
 
     def add(self, placed: ObjectPose, result: ClosureResult) -> None:
         if result.settled_pose is not None:  # a box that moved is no longer the region's
@@ -211,6 +243,11 @@ def warm_up() -> None:
     config = defaults()
     params = SimulateParams.from_config(config, next(iter(config["objects"])))
     hand = load_hand(params.hand)
-    simulate_object(hand, params.synergies(hand.joint_names), params.object,
-                    replace(params.placement, mode="approach"), replace(params.closure, model="kinematic"), poses=[0])
-
+    simulate_object(
+        hand,
+        params.synergies(hand.joint_names),
+        params.object,
+        replace(params.placement, mode="approach"),
+        replace(params.closure, model="kinematic"),
+        poses=[0],
+    )

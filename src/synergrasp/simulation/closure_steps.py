@@ -24,8 +24,9 @@ MARCH_END, MARCH_STALL, MARCH_CROSS = 0, 1, 2
 
 
 @jit
-def _posture(sigma: float, held: NDArray, q_held: NDArray, mean: NDArray, direction: NDArray,
-             lower: NDArray, upper: NDArray) -> NDArray:
+def _posture(
+    sigma: float, held: NDArray, q_held: NDArray, mean: NDArray, direction: NDArray, lower: NDArray, upper: NDArray
+) -> NDArray:
     """where(held, q_held, clip(mean + σ·direction, lower, upper)), rad."""
     q = np.empty(mean.shape[0])
     for j in range(mean.shape[0]):
@@ -49,8 +50,7 @@ def _smallest(d_obj: NDArray, d_self: NDArray) -> float:
 
 
 @jit
-def _advance(sigma: float, sigma_closed: float, budget: NDArray, knots: NDArray, travel: NDArray,
-             n_knots: NDArray) -> float:
+def _advance(sigma: float, sigma_closed: float, budget: NDArray, knots: NDArray, travel: NDArray, n_knots: NDArray) -> float:
     """Largest σ' ≤ σ_closed such that no finger f travels more than budget[f] mm on [σ, σ']:
     knots[f, :n_knots[f]] and travel[f, :n_knots[f]] its
     piecewise linear travel bound for its moving joints (n_knots[f] = 0: nothing moves)."""
@@ -63,8 +63,7 @@ def _advance(sigma: float, sigma_closed: float, budget: NDArray, knots: NDArray,
         while i < n and knots[f, i] <= sigma:  # bisect_right
             i += 1
         i = min(max(i, 1), n - 1)
-        level = travel[f, i - 1] + (sigma - knots[f, i - 1]) / (knots[f, i] - knots[f, i - 1]) * (
-            travel[f, i] - travel[f, i - 1])
+        level = travel[f, i - 1] + (sigma - knots[f, i - 1]) / (knots[f, i] - knots[f, i - 1]) * (travel[f, i] - travel[f, i - 1])
         level += budget[f]
         if level > travel[f, n - 1]:
             continue  # the budget outlasts the closure
@@ -93,28 +92,77 @@ def _budget(d_obj: NDArray, d_self: NDArray, finger_links: NDArray, step_mm: flo
 
 
 @jit
-def _gaps(sigma: float, held: NDArray, q_held: NDArray, path: tuple, scene: tuple, pair_rows: tuple,
-          moving_links: NDArray, margin_mm: float) -> tuple:
+def _gaps(
+    sigma: float,
+    held: NDArray,
+    q_held: NDArray,
+    path: tuple,
+    scene: tuple,
+    pair_rows: tuple,
+    moving_links: NDArray,
+    margin_mm: float,
+) -> tuple:
     """(q, d_obj, d_self, partner) at σ: the posture and the gaps of the moving links within
     ``margin_mm`` (+inf for the others; ``KinematicClosure.gaps``)."""
     mean, direction, lower, upper = path
-    (parent, offset, axis, joint, scale, cap_frame, ends, radius, cap_link, palm_gap, rotation, centre, code,
-     params, bound) = scene
+    (parent, offset, axis, joint, scale, cap_frame, ends, radius, cap_link, palm_gap, rotation, centre, code, params, bound) = (
+        scene
+    )
     first, second, pair_ends, palm_rotation, palm_centre, palm_half, n_links = pair_rows
     q = _posture(sigma, held, q_held, mean, direction, lower, upper)
-    d_obj, d_self, partner = posture_gaps(q, parent, offset, axis, joint, scale, cap_frame, ends, radius, cap_link,
-                                          palm_gap, rotation, centre, code, params, bound, first, second, pair_ends,
-                                          palm_rotation, palm_centre, palm_half, n_links, moving_links, margin_mm)
+    d_obj, d_self, partner = posture_gaps(
+        q,
+        parent,
+        offset,
+        axis,
+        joint,
+        scale,
+        cap_frame,
+        ends,
+        radius,
+        cap_link,
+        palm_gap,
+        rotation,
+        centre,
+        code,
+        params,
+        bound,
+        first,
+        second,
+        pair_ends,
+        palm_rotation,
+        palm_centre,
+        palm_half,
+        n_links,
+        moving_links,
+        margin_mm,
+    )
     _masked(d_obj, moving_links, margin_mm)
     _masked(d_self, moving_links, margin_mm)
     return q, d_obj, d_self, partner
 
 
 @jit
-def march(sigma: float, sigma_closed: float, now: tuple, known: bool, held: NDArray, q_held: NDArray, path: tuple,
-          scene: tuple, pair_rows: tuple, moving_links: NDArray, finger_links: NDArray, knots: NDArray,
-          travel: NDArray, n_knots: NDArray, step_mm: float, margin_mm: float, tolerance_mm: float,
-          max_refine: int) -> tuple:
+def march(
+    sigma: float,
+    sigma_closed: float,
+    now: tuple,
+    known: bool,
+    held: NDArray,
+    q_held: NDArray,
+    path: tuple,
+    scene: tuple,
+    pair_rows: tuple,
+    moving_links: NDArray,
+    finger_links: NDArray,
+    knots: NDArray,
+    travel: NDArray,
+    n_knots: NDArray,
+    step_mm: float,
+    margin_mm: float,
+    tolerance_mm: float,
+    max_refine: int,
+) -> tuple:
     """Free steps of the closure from σ until it ends (MARCH_END), stalls (MARCH_STALL) or a
     moving link crosses the box or the hand in (σ, σ'] (MARCH_CROSS), then the event there.
 
@@ -133,17 +181,42 @@ def march(sigma: float, sigma_closed: float, now: tuple, known: bool, held: NDAr
             return MARCH_STALL, sigma, now
         after = _gaps(sigma_next, held, q_held, path, scene, pair_rows, moving_links, margin_mm)
         if _smallest(after[1], after[2]) < 0.0:
-            lo, event = _event(sigma, now, sigma_next, after, held, q_held, path, scene, pair_rows, moving_links,
-                               margin_mm, tolerance_mm, max_refine)
+            lo, event = _event(
+                sigma,
+                now,
+                sigma_next,
+                after,
+                held,
+                q_held,
+                path,
+                scene,
+                pair_rows,
+                moving_links,
+                margin_mm,
+                tolerance_mm,
+                max_refine,
+            )
             return MARCH_CROSS, lo, event
         sigma, now = sigma_next, after
     return MARCH_END, sigma, now
 
 
 @jit
-def _event(sigma: float, now: tuple, sigma_next: float, after: tuple, held: NDArray, q_held: NDArray, path: tuple,
-           scene: tuple, pair_rows: tuple, moving_links: NDArray, margin_mm: float, tolerance_mm: float,
-           max_refine: int) -> tuple:
+def _event(
+    sigma: float,
+    now: tuple,
+    sigma_next: float,
+    after: tuple,
+    held: NDArray,
+    q_held: NDArray,
+    path: tuple,
+    scene: tuple,
+    pair_rows: tuple,
+    moving_links: NDArray,
+    margin_mm: float,
+    tolerance_mm: float,
+    max_refine: int,
+) -> tuple:
     """A moving link crosses something in (σ, σ_next]: the last σ before it, where the
     smallest gap is in [0, tolerance_mm] (Illinois false position, bisection when it
     stalls), and the gaps there (``now``'s at σ when no step forward stays clear)."""

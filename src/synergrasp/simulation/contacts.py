@@ -81,9 +81,16 @@ class ClosureResult:
     settled: bool = True
 
 
-def closure_result(hand: Hand, q: NDArray, finger_state: Sequence[str], links: NDArray, points: NDArray,
-                   normals: NDArray, max_penetration_mm: float,
-                   intersects_open_hand: bool = False) -> ClosureResult:
+def closure_result(
+    hand: Hand,
+    q: NDArray,
+    finger_state: Sequence[str],
+    links: NDArray,
+    points: NDArray,
+    normals: NDArray,
+    max_penetration_mm: float,
+    intersects_open_hand: bool = False,
+) -> ClosureResult:
     """The :class:`ClosureResult` of a final posture ``q`` (rad) and its contacts (links,
     points mm, inward normals): the status follows from them, the Jacobian rows are
     ``hand.contact_jacobian`` at q (zero rows for the palm)."""
@@ -96,17 +103,27 @@ def closure_result(hand: Hand, q: NDArray, finger_state: Sequence[str], links: N
     if len(links) == 0:
         return ClosureResult("no_contact", q, tuple(finger_state), *empty, 0.0)
     jac = contact_jacobian(hand, q, links, points)
-    return ClosureResult("grasp", q, tuple(finger_state), np.asarray(links), np.asarray(points),
-                         np.asarray(normals), jac, float(max_penetration_mm))
+    return ClosureResult(
+        "grasp",
+        q,
+        tuple(finger_state),
+        np.asarray(links),
+        np.asarray(points),
+        np.asarray(normals),
+        jac,
+        float(max_penetration_mm),
+    )
 
 
-def contacts_row(object_name: str, pose: int, alpha_deg: float, beta_deg: float, result: ClosureResult,
-                 placed: ObjectPose) -> dict[str, Any]:
+def contacts_row(
+    object_name: str, pose: int, alpha_deg: float, beta_deg: float, result: ClosureResult, placed: ObjectPose
+) -> dict[str, Any]:
     """One row of the contacts table (``tables.CONTACTS``) from a closure result; the box pose
     columns hold its settled pose (``result.settled_pose``, else ``placed``)."""
     final = placed if result.settled_pose is None else result.settled_pose
-    forces = (np.full(len(result.links), np.nan) if result.normal_force_N is None
-              else np.asarray(result.normal_force_N, dtype=float))
+    forces = (
+        np.full(len(result.links), np.nan) if result.normal_force_N is None else np.asarray(result.normal_force_N, dtype=float)
+    )
     turn = final.rotation @ placed.rotation.T
     angle = float(np.degrees(np.arccos(np.clip(0.5 * (np.trace(turn) - 1.0), -1.0, 1.0))))
     return {
@@ -169,8 +186,10 @@ def load_carrying_contacts(table: pd.DataFrame, threshold_N: float) -> pd.DataFr
     for i, row in enumerate(table.itertuples(index=False)):
         forces = np.asarray(row.contact_normal_force_N, dtype=float)
         if np.isnan(forces).any():
-            raise ValueError(f"contacts table, pose {row.pose}: the closure model ({row.closure_model}) "
-                             "recorded no contact loads, so none can be selected by load")
+            raise ValueError(
+                f"contacts table, pose {row.pose}: the closure model ({row.closure_model}) "
+                "recorded no contact loads, so none can be selected by load"
+            )
         if row.status != "grasp" or np.all(forces >= threshold_N):
             continue
         keep = np.flatnonzero(forces >= threshold_N)

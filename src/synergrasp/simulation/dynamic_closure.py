@@ -74,8 +74,9 @@ class DynamicClosure:
     applied if gravity is on).
     """
 
-    def __init__(self, hand: Hand, synergies: Synergies, params: ClosureParams, mechanics: ClosureMechanics,
-                 weight_N: float) -> None:
+    def __init__(
+        self, hand: Hand, synergies: Synergies, params: ClosureParams, mechanics: ClosureMechanics, weight_N: float
+    ) -> None:
         from synergrasp.simulation import bullet
 
         names = tuple(synergies.joint_names)
@@ -98,8 +99,7 @@ class DynamicClosure:
         # hand–hand friction = product of the two links' coefficients (Bullet's rule): √μ_hh on
         # every hand link; the box's coefficient μ/√μ_hh makes hand–box friction exactly μ
         self.link_friction = math.sqrt(p.hand_hand_mu)
-        self.body = bullet.load_compliant_hand(self.client, hand, p.link_mass_kg, p.link_inertia_kg_mm2,
-                                               self.link_friction)
+        self.body = bullet.load_compliant_hand(self.client, hand, p.link_mass_kg, p.link_inertia_kg_mm2, self.link_friction)
         self.axis_joint = self.body.joint_q
         self.axis_scale = self.body.joint_scale
         self.axis_sum = np.zeros((hand.n_joints, len(self.axis_joint)))  # q = axis_sum @ θ
@@ -131,8 +131,9 @@ class DynamicClosure:
             if self.box is not None:
                 self.bullet.remove_body(self.client, self.box)
             mass = 0.0 if self.params.held else self.params.object_mass_kg  # mass 0: a fixed body
-            self.box = self.bullet.load_free_object(self.client, placed.shape, mass, self.mu / self.link_friction,
-                                                    self.params.object_damping_per_s)
+            self.box = self.bullet.load_free_object(
+                self.client, placed.shape, mass, self.mu / self.link_friction, self.params.object_damping_per_s
+            )
             self.shape = placed.shape
         self.bullet.reset_body(self.client, self.box, placed.center_mm, placed.rotation)
 
@@ -178,8 +179,10 @@ class DynamicClosure:
                 if len(window) > window_steps:
                     q0, c0, r0 = window[0]
                     turn = math.acos(min(1.0, max(-1.0, 0.5 * (float(np.sum(r0 * rotation)) - 1.0))))
-                    if (np.max(np.abs(window[-1][0] - q0)) < p.settle_joint_change_rad
-                            and np.linalg.norm(center - c0) + turn * radius < p.settle_object_change_mm):
+                    if (
+                        np.max(np.abs(window[-1][0] - q0)) < p.settle_joint_change_rad
+                        and np.linalg.norm(center - c0) + turn * radius < p.settle_object_change_mm
+                    ):
                         settled, steps = True, step
                         break
             if weight is not None:
@@ -188,25 +191,47 @@ class DynamicClosure:
         self.steps = steps
         return self._settled(placed, settled)
 
-    def _result(self, status: str, q: NDArray, state: tuple[str, ...], settled_pose: ObjectPose | None,
-                settled: bool, links: list[int] = (), points: list = (), normals: list = (), loads: list = (),
-                depth: float = 0.0) -> ClosureResult:
+    def _result(
+        self,
+        status: str,
+        q: NDArray,
+        state: tuple[str, ...],
+        settled_pose: ObjectPose | None,
+        settled: bool,
+        links: list[int] = (),
+        points: list = (),
+        normals: list = (),
+        loads: list = (),
+        depth: float = 0.0,
+    ) -> ClosureResult:
         from synergrasp.hand.kinematics import contact_jacobian
 
         links_a = np.asarray(links, dtype=np.int64)
         points_a = np.asarray(points, dtype=float).reshape(-1, 3)
         jac = contact_jacobian(self.hand, q, links_a, points_a) if len(links_a) else np.zeros((0, self.hand.n_joints))
-        return ClosureResult(status, q, state, links_a, points_a, np.asarray(normals, dtype=float).reshape(-1, 3),
-                             jac, float(depth), model=self.model_name, normal_force_N=np.asarray(loads, dtype=float),
-                             settled_pose=settled_pose, settled=settled)
+        return ClosureResult(
+            status,
+            q,
+            state,
+            links_a,
+            points_a,
+            np.asarray(normals, dtype=float).reshape(-1, 3),
+            jac,
+            float(depth),
+            model=self.model_name,
+            normal_force_N=np.asarray(loads, dtype=float),
+            settled_pose=settled_pose,
+            settled=settled,
+        )
 
     def _finger_states(self, touching: list[int]) -> tuple[str, ...]:
         """Per finger: ``contact`` (a link touches the box), ``self`` (a link touches the hand), ``limit``."""
         on_hand = self.bullet.contact_forces(self.client, self.body, self.body)
         self_links = set(on_hand.link_a.tolist()) | set(on_hand.link_b.tolist())
-        return tuple("contact" if any(li in touching for li in links)
-                     else "self" if any(li in self_links for li in links) else "limit"
-                     for links in self.hand.finger_links)
+        return tuple(
+            "contact" if any(li in touching for li in links) else "self" if any(li in self_links for li in links) else "limit"
+            for links in self.hand.finger_links
+        )
 
     def _settled(self, placed: ObjectPose, settled: bool) -> ClosureResult:
         """The settled state: q, the box pose, one contact per hand link touching the box (the

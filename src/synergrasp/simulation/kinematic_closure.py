@@ -81,8 +81,16 @@ class KinematicClosure:
         self.scene.place_object(placed)
         q, state, intersects = self.run()
         if intersects:
-            return closure_result(self.hand, q, state, np.zeros(0, dtype=np.int64), np.zeros((0, 3)),
-                                  np.zeros((0, 3)), 0.0, intersects_open_hand=True)
+            return closure_result(
+                self.hand,
+                q,
+                state,
+                np.zeros(0, dtype=np.int64),
+                np.zeros((0, 3)),
+                np.zeros((0, 3)),
+                0.0,
+                intersects_open_hand=True,
+            )
         links, points, normals, depth = self.scene.object_contacts(q, self.params.contact_distance_mm)
         return closure_result(self.hand, q, state, links, points, normals, depth)
 
@@ -151,8 +159,9 @@ class KinematicClosure:
             idx = list(moving)
             lo, hi = self.active_lo[idx], self.active_hi[idx]
             rate = np.abs(self.s1[idx]) * self.reach[idx]  # mm per unit σ while active
-            knots = np.unique(np.clip(np.concatenate([lo, hi, [self.sigma_open, self.sigma_closed]]),
-                                      self.sigma_open, self.sigma_closed))
+            knots = np.unique(
+                np.clip(np.concatenate([lo, hi, [self.sigma_open, self.sigma_closed]]), self.sigma_open, self.sigma_closed)
+            )
             mids = 0.5 * (knots[:-1] + knots[1:])
             speed = np.array([float(np.sum(rate[(lo <= m) & (hi >= m)])) for m in mids])
             profile = (knots.tolist(), np.concatenate([[0.0], np.cumsum(speed * np.diff(knots))]).tolist())
@@ -175,7 +184,7 @@ class KinematicClosure:
             width = max(1, max(len(k) for k, _ in rows))
             knots, travel = np.zeros((len(rows), width)), np.zeros((len(rows), width))
             for f, (k, t) in enumerate(rows):
-                knots[f, :len(k)], travel[f, :len(t)] = k, t
+                knots[f, : len(k)], travel[f, : len(t)] = k, t
             arrays = self._profile_arrays[key] = (knots, travel, np.array([len(k) for k, _ in rows], dtype=np.int64))
         return arrays
 
@@ -204,10 +213,25 @@ class KinematicClosure:
             knots, travel, n_knots = self._profiles_of(state.held)
             now = known if known is not None else _NO_GAPS
             status, sigma, parts = march(
-                sigma, self.sigma_closed, (now.q, now.d_obj, now.d_self, now.partner), known is not None,
-                state.held, state.q_held, path, self.scene.query_args(), self.scene.pair_args(pairs), mv,
-                self.finger_link_mask, knots, travel, n_knots, p.step_mm, _QUERY_MARGIN_MM, p.tolerance_mm,
-                _MAX_REFINE)
+                sigma,
+                self.sigma_closed,
+                (now.q, now.d_obj, now.d_self, now.partner),
+                known is not None,
+                state.held,
+                state.q_held,
+                path,
+                self.scene.query_args(),
+                self.scene.pair_args(pairs),
+                mv,
+                self.finger_link_mask,
+                knots,
+                travel,
+                n_knots,
+                p.step_mm,
+                _QUERY_MARGIN_MM,
+                p.tolerance_mm,
+                _MAX_REFINE,
+            )
             if status != MARCH_CROSS:
                 break
             event = _Gaps(*parts)
@@ -315,5 +339,4 @@ class _HoldState:
                 self.hand[fa] = True
 
     def finger_states(self) -> list[str]:
-        return ["contact" if self.object[f] else "self" if self.hand[f] else "limit"
-                for f in range(len(self.c.fingers))]
+        return ["contact" if self.object[f] else "self" if self.hand[f] else "limit" for f in range(len(self.c.fingers))]

@@ -43,8 +43,9 @@ class GraspedObject:
     def __post_init__(self) -> None:
         _check_name(self.name)
         if not isinstance(self.shape, Shape):
-            raise ObjectError(f"object '{self.name}': field 'shape' must be a shape "
-                              f"(synergrasp.simulation.shapes), got {self.shape!r}")
+            raise ObjectError(
+                f"object '{self.name}': field 'shape' must be a shape (synergrasp.simulation.shapes), got {self.shape!r}"
+            )
         object.__setattr__(self, "mass_kg", _check_mass(self.name, self.mass_kg))
 
     @classmethod
@@ -64,8 +65,10 @@ class GraspedObject:
 
 def _check_name(name: Any) -> None:
     if not isinstance(name, str) or not _NAME.fullmatch(name):
-        raise ObjectError(f"object {name!r}: field 'name' is not allowed; names must match "
-                          "[A-Za-z0-9_]+ (letters, digits, '_'), as they become file-path components")
+        raise ObjectError(
+            f"object {name!r}: field 'name' is not allowed; names must match "
+            "[A-Za-z0-9_]+ (letters, digits, '_'), as they become file-path components"
+        )
 
 
 def _check_mass(name: str, mass: Any) -> float | None:
@@ -76,8 +79,7 @@ def _check_mass(name: str, mass: Any) -> float | None:
     except (TypeError, ValueError):
         value = math.nan
     if isinstance(mass, bool) or not (math.isfinite(value) and value > 0):
-        raise ObjectError(f"object '{name}': field 'mass_kg' is {mass!r}; a finite positive mass in kg "
-                          "is required")
+        raise ObjectError(f"object '{name}': field 'mass_kg' is {mass!r}; a finite positive mass in kg is required")
     return value
 
 
@@ -112,8 +114,8 @@ def object_warnings(config: Mapping[str, Any]) -> list[str]:
             continue
         if not lo <= across <= hi:
             kind = next(iter(spec["shape"]))
-            hint = (f"; sizes are in mm: a file in metres needs {where}.mesh.scale: 1000" if kind == "mesh"
-                    else "; sizes are in mm")
-            warnings.append(f"{where}: {across:.3g} mm across, far from what a hand grasps "
-                            f"({lo:g} to {hi:g} mm){hint}")
+            hint = (
+                f"; sizes are in mm: a file in metres needs {where}.mesh.scale: 1000" if kind == "mesh" else "; sizes are in mm"
+            )
+            warnings.append(f"{where}: {across:.3g} mm across, far from what a hand grasps ({lo:g} to {hi:g} mm){hint}")
     return warnings

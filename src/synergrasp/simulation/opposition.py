@@ -38,9 +38,21 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
 
-__all__ = ["OPPOSITIONS", "GRASP_TYPES", "LINK_KINDS", "FACE_CLASSES", "SURFACE_FEATURES", "OppositionRule",
-           "HandAxes", "classify_grasp", "contacts_oppositions", "edge_contacts", "of_grasp_type", "face_classes",
-           "surface_features"]
+__all__ = [
+    "OPPOSITIONS",
+    "GRASP_TYPES",
+    "LINK_KINDS",
+    "FACE_CLASSES",
+    "SURFACE_FEATURES",
+    "OppositionRule",
+    "HandAxes",
+    "classify_grasp",
+    "contacts_oppositions",
+    "edge_contacts",
+    "of_grasp_type",
+    "face_classes",
+    "surface_features",
+]
 
 #: The classes, in the order the rule tries them.
 OPPOSITIONS: tuple[str, ...] = ("palm", "pad", "side", "none")
@@ -171,8 +183,9 @@ def edge_contacts(contacts: Any, shape: Any, rule: OppositionRule) -> list[int]:
     """Per row of a contacts table, how many of its contacts sit on an edge or a corner of
     the placed shape (``surface_features``)."""
     out = []
-    for m, points, rotation, center in zip(contacts["n_contacts"], contacts["contact_point"],
-                                           contacts["object_rotation"], contacts["object_center"]):
+    for m, points, rotation, center in zip(
+        contacts["n_contacts"], contacts["contact_point"], contacts["object_rotation"], contacts["object_center"]
+    ):
         if int(m) == 0:
             out.append(0)
             continue
@@ -202,8 +215,7 @@ def face_classes(normals: NDArray, axes: HandAxes) -> list[str]:
     return out
 
 
-def surface_features(points: NDArray, shape: Any, rotation: NDArray, center: NDArray,
-                     rule: OppositionRule) -> list[str]:
+def surface_features(points: NDArray, shape: Any, rotation: NDArray, center: NDArray, rule: OppositionRule) -> list[str]:
     """Per contact point ((m, 3) mm, palm frame) on a placed shape, where it sits
     (SURFACE_FEATURES): how many of the shape's faces lie within ``rule.reach_mm``."""
     pts = np.asarray(points, dtype=float).reshape(-1, 3)

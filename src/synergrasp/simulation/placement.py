@@ -22,8 +22,19 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
     from synergrasp.simulation.shapes import Shape
 
-__all__ = ["palm_centre", "approach_line", "placement_target", "searched_placement", "FINGER_AXIS", "MODES", "Placement",
-           "PoseGrid", "ObjectPose", "pose_grid", "object_pose"]
+__all__ = [
+    "palm_centre",
+    "approach_line",
+    "placement_target",
+    "searched_placement",
+    "FINGER_AXIS",
+    "MODES",
+    "Placement",
+    "PoseGrid",
+    "ObjectPose",
+    "pose_grid",
+    "object_pose",
+]
 
 #: The placement modes: presets of one rule, which differ only in where the target comes from.
 MODES: tuple[str, ...] = ("approach", "fixed", "searched")
@@ -44,8 +55,9 @@ def _range_deg(start: float, stop: float, step: float, name: str) -> NDArray:
         raise ValueError(f"{name}.step must be > 0 deg, got {step}")
     n = (stop - start) / step
     if n < 0 or abs(n - round(n)) > 1e-9:
-        raise ValueError(f"{name}: stop - start must be a non-negative multiple of step, "
-                         f"got start={start}, stop={stop}, step={step}")
+        raise ValueError(
+            f"{name}: stop - start must be a non-negative multiple of step, got start={start}, stop={stop}, step={step}"
+        )
     return start + step * np.arange(int(round(n)) + 1, dtype=float)
 
 
@@ -155,8 +167,7 @@ class PoseGrid:
 
 def pose_grid(placement: Placement) -> PoseGrid:
     """The pose grid of a placement (72 × 25 = 1800 poses with the study's values)."""
-    return PoseGrid(_range_deg(*placement.alpha_deg, name="alpha_deg"),
-                    _range_deg(*placement.beta_deg, name="beta_deg"))
+    return PoseGrid(_range_deg(*placement.alpha_deg, name="alpha_deg"), _range_deg(*placement.beta_deg, name="beta_deg"))
 
 
 @dataclass(frozen=True)
@@ -175,8 +186,9 @@ class ObjectPose:
         return self.shape.surface_point(point_mm, self.rotation, self.center_mm)
 
 
-def object_pose(placement: Placement, shape: Shape, alpha_deg: float, beta_deg: float,
-                palm_normal: Sequence[float] = (1.0, 0.0, 0.0)) -> ObjectPose:
+def object_pose(
+    placement: Placement, shape: Shape, alpha_deg: float, beta_deg: float, palm_normal: Sequence[float] = (1.0, 0.0, 0.0)
+) -> ObjectPose:
     """Centre and orientation of ``shape`` at (α, β) deg, at the placement's fixed centre.
 
     It starts at ``shape.start_rotation(placement.box_axes)``; α turns about ``palm_normal``
@@ -204,8 +216,7 @@ def _palm_points(hand: Hand) -> NDArray:
             local = np.concatenate([ends + d for d in r * np.vstack([np.eye(3), -np.eye(3)])])
         corners.append(local @ shape.pose[:3, :3].T + shape.pose[:3, 3])
     if not corners:
-        raise ValueError(f"{hand.source}: palm.shapes: the palm has no collision shape; give "
-                         "placement.approach_point_mm")
+        raise ValueError(f"{hand.source}: palm.shapes: the palm has no collision shape; give placement.approach_point_mm")
     return np.vstack(corners)
 
 
@@ -232,17 +243,24 @@ def hand_region(hand: Hand, synergies: Any) -> tuple[tuple[float, float], ...]:
     from synergrasp.simulation.capsules import HandCapsules
 
     if not np.allclose(hand.palm_normal, (1.0, 0.0, 0.0)):
-        raise ValueError(f"{hand.source}: palm_normal: region_mm 'hand' needs the palm frame of docs/hand.md "
-                         f"(palm normal +x), got {list(hand.palm_normal)}")
+        raise ValueError(
+            f"{hand.source}: palm_normal: region_mm 'hand' needs the palm frame of docs/hand.md "
+            f"(palm normal +x), got {list(hand.palm_normal)}"
+        )
     pts = _palm_points(hand)
     path = SynergyPath.along(synergies, hand.lower, hand.upper)
     sigma_open, sigma_closed = path.closure_range(hand.flexion_joints)
     capsules = HandCapsules.of(hand)
-    reach = max(float(np.max(np.concatenate(capsules.segments(path.reference(s)))[:, 0]))
-                for s in np.linspace(sigma_open, sigma_closed, 201))
+    reach = max(
+        float(np.max(np.concatenate(capsules.segments(path.reference(s)))[:, 0]))
+        for s in np.linspace(sigma_open, sigma_closed, 201)
+    )
     top = float(np.max(fingertip_positions(hand, path.reference(sigma_open))[:, 2]))
-    bounds = ((float(np.max(pts[:, 0])), reach), (float(np.min(pts[:, 1])), float(np.max(pts[:, 1]))),
-              (float(np.min(pts[:, 2])), top))
+    bounds = (
+        (float(np.max(pts[:, 0])), reach),
+        (float(np.min(pts[:, 1])), float(np.max(pts[:, 1]))),
+        (float(np.min(pts[:, 2])), top),
+    )
     return tuple((float(math.floor(lo + 1e-9)), float(math.ceil(hi - 1e-9))) for lo, hi in bounds)
 
 
@@ -252,8 +270,10 @@ def placement_target(placement: Placement, hand: Hand) -> NDArray:
         return np.asarray(placement.center_mm, dtype=float)
     if placement.mode == "searched":
         if placement.target_mm is None:
-            raise ValueError("placement.mode 'searched' needs the object's searched target (target_mm): "
-                             "the closure reads it from the search's placement.csv")
+            raise ValueError(
+                "placement.mode 'searched' needs the object's searched target (target_mm): "
+                "the closure reads it from the search's placement.csv"
+            )
         return np.asarray(placement.target_mm, dtype=float)
     if placement.approach_point_mm is None:
         return palm_centre(hand)
@@ -272,7 +292,9 @@ def searched_placement(placement: Placement, table: Any) -> Placement:
     ``search_rank``."""
     rows = table[table["distinct_rank"] == placement.search_rank]
     if len(rows) != 1:
-        raise ValueError(f"placement.search_rank {placement.search_rank}: the search has "
-                         f"{int((table['distinct_rank'] > 0).sum())} distinct targets")
+        raise ValueError(
+            f"placement.search_rank {placement.search_rank}: the search has "
+            f"{int((table['distinct_rank'] > 0).sum())} distinct targets"
+        )
     row = rows.iloc[0]
     return dataclasses.replace(placement, target_mm=(float(row["x_mm"]), float(row["y_mm"]), float(row["z_mm"])))

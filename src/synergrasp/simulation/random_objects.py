@@ -78,7 +78,7 @@ def _check(path: Path, expected: str | None, longest_mm: float) -> tuple[float, 
     except MeshFileError as err:
         return float("nan"), f"mesh cannot be read: {err}"
     extent = float(np.ptp(mesh.vertices, axis=0).max())
-    if not extent > 0 or not mesh.volume > 1e-9 * extent ** 3:
+    if not extent > 0 or not mesh.volume > 1e-9 * extent**3:
         return float("nan"), "degenerate mesh (no extent or no volume)"
     return longest_mm / extent, ""
 
@@ -123,20 +123,26 @@ def random_objects_problems(spec: Any, root: str | Path = ".") -> list[str]:
         return key in spec and not any(f"'random_objects.{key}'" in p for p in problems)
 
     if fine("longest_side_mm") and spec["longest_side_mm"][1] < spec["longest_side_mm"][0]:
-        problems.append(f"config error at 'random_objects.longest_side_mm': {spec['longest_side_mm']} is reversed; "
-                        "give [shortest, longest] (mm)")
+        problems.append(
+            f"config error at 'random_objects.longest_side_mm': {spec['longest_side_mm']} is reversed; "
+            "give [shortest, longest] (mm)"
+        )
     if not fine("sha256_file"):
         return problems
     manifest = Path(root) / spec["sha256_file"]
     try:
         _manifest(manifest)
     except OSError as err:
-        problems.append(f"config error at 'random_objects.sha256_file': '{manifest}' cannot be read "
-                        f"({'is a folder' if manifest.is_dir() else err.strerror or err}); a sha256sum manifest "
-                        "relative to the project's root is required")
+        problems.append(
+            f"config error at 'random_objects.sha256_file': '{manifest}' cannot be read "
+            f"({'is a folder' if manifest.is_dir() else err.strerror or err}); a sha256sum manifest "
+            "relative to the project's root is required"
+        )
     except (ValueError, UnicodeDecodeError):
-        problems.append(f"config error at 'random_objects.sha256_file': '{manifest}' is not a sha256sum manifest "
-                        "(lines of '<digest>  <path>')")
+        problems.append(
+            f"config error at 'random_objects.sha256_file': '{manifest}' is not a sha256sum manifest "
+            "(lines of '<digest>  <path>')"
+        )
     return problems
 
 
@@ -156,12 +162,15 @@ def add_random_objects(config: MutableMapping[str, Any], root: str | Path = ".")
     objects = {} if not isinstance(objects, MutableMapping) else objects
     clashes = [d.name for d in drawn if not d.problem and objects.get(d.name) is not None]
     if clashes:
-        raise ConfigError("\n".join(
-            f"config error at 'objects.{name}': an object of the configuration has the name of an object "
-            f"random_objects draws ({name}); rename the object or change random_objects.seed" for name in clashes))
+        raise ConfigError(
+            "\n".join(
+                f"config error at 'objects.{name}': an object of the configuration has the name of an object "
+                f"random_objects draws ({name}); rename the object or change random_objects.seed"
+                for name in clashes
+            )
+        )
     for obj in drawn:
         if not obj.problem:
-            objects[obj.name] = {"shape": {"mesh": {"path": obj.path, "scale": obj.scale}},
-                                 "mass_kg": float(spec["mass_kg"])}
+            objects[obj.name] = {"shape": {"mesh": {"path": obj.path, "scale": obj.scale}}, "mass_kg": float(spec["mass_kg"])}
     config["objects"] = objects
     return drawn

@@ -53,8 +53,18 @@ if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.simulation.closure_params import ClosureParams
     from synergrasp.simulation.shapes import Shape
 
-__all__ = ["ReachParams", "HandReachStepParams", "HandReach", "hand_reach", "finger_postures", "object_extents",
-           "shape_class", "feasible_types", "path_postures", "palm_face_mm"]
+__all__ = [
+    "ReachParams",
+    "HandReachStepParams",
+    "HandReach",
+    "hand_reach",
+    "finger_postures",
+    "object_extents",
+    "shape_class",
+    "feasible_types",
+    "path_postures",
+    "palm_face_mm",
+]
 
 #: Samples of the free closure path σ_open … σ_closed (as ``placement.hand_region``).
 PATH_SAMPLES = 201
@@ -81,8 +91,12 @@ class ReachParams:
     def from_config(cls, config: Mapping[str, Any]) -> ReachParams:
         """From a configuration or a step's part of it (``hand_reach``, ``opposition.angle_deg``)."""
         spec = config["hand_reach"]
-        return cls(int(spec["posture_steps"]), float(spec["step_mm"]), float(config["opposition"]["angle_deg"]),
-                   float(spec["length_step_mm"]))
+        return cls(
+            int(spec["posture_steps"]),
+            float(spec["step_mm"]),
+            float(config["opposition"]["angle_deg"]),
+            float(spec["length_step_mm"]),
+        )
 
     def __post_init__(self) -> None:
         if int(self.posture_steps) < 2:
@@ -109,8 +123,11 @@ class HandReachStepParams:
         from synergrasp.simulation.closure_params import ClosureParams
         from synergrasp.simulation.objects import GraspedObject
 
-        closure = build(ClosureParams, "closure", **{**dataclass_fields(ClosureParams, config["closure"]),
-                                                     "model": "kinematic", "dynamic": None})
+        closure = build(
+            ClosureParams,
+            "closure",
+            **{**dataclass_fields(ClosureParams, config["closure"]), "model": "kinematic", "dynamic": None},
+        )
         objects = {name: GraspedObject.from_config(config, name, with_mass=False).shape for name in config["objects"]}
         return cls(config["hand"], config["synergies"], closure, ReachParams.from_config(config), objects)
 
@@ -172,14 +189,12 @@ def finger_postures(hand: Hand, q0: NDArray, finger: int, steps: int) -> Iterato
         yield q
 
 
-def _any_posture_reach(hand: Hand, capsules, q0: NDArray, finger: int, rows: NDArray, normal: NDArray,
-                       steps: int) -> float:
+def _any_posture_reach(hand: Hand, capsules, q0: NDArray, finger: int, rows: NDArray, normal: NDArray, steps: int) -> float:
     """Largest surface reach of one finger over a lattice of its joints' limits."""
     return max(_surface_reach(capsules, q, rows, normal) for q in finger_postures(hand, q0, finger, steps))
 
 
-def _slab_press(hand: Hand, synergies: Synergies, closure: ClosureParams, params: ReachParams,
-                ceiling_mm: float) -> NDArray:
+def _slab_press(hand: Hand, synergies: Synergies, closure: ClosureParams, params: ReachParams, ceiling_mm: float) -> NDArray:
     """Per finger, the largest slab thickness (mm, multiples of ``step_mm``) that one of its
     links presses toward the palm when the hand closes on the slab lying on the palm (0: none)."""
     from dataclasses import replace
@@ -207,14 +222,14 @@ def _slab_press(hand: Hand, synergies: Synergies, closure: ClosureParams, params
         return model.scene.bring_object(slab, np.eye(3), point, normal, model.q_open, 0.0, stop_at_point=True)
 
     # the slab's far end (toward the fingers): the palm's end, then every length_step_mm nearer the wrist
-    ends = [float(hi[2]) - k * params.length_step_mm
-            for k in range(int(math.floor((hi[2] - lo[2]) / params.length_step_mm)))]
+    ends = [float(hi[2]) - k * params.length_step_mm for k in range(int(math.floor((hi[2] - lo[2]) / params.length_step_mm)))]
     try:
         # the palm's whole width, and the widest slab from the palm's little-finger edge that lies on
         # the palm face itself (not on a link standing out of it, as the SoftHand's thumb knuckle does)
         y_end = float(hi[1])
-        while (placed_slab(params.step_mm, y_end, float(hi[2])).center_mm @ normal - 0.5 * params.step_mm > face + 0.5
-               and y_end - params.length_step_mm > float(lo[1])):
+        while placed_slab(
+            params.step_mm, y_end, float(hi[2])
+        ).center_mm @ normal - 0.5 * params.step_mm > face + 0.5 and y_end - params.length_step_mm > float(lo[1]):
             y_end -= params.length_step_mm
         for y_end, end in itertools.product(sorted({float(hi[1]), y_end}, reverse=True), ends):
             found = np.zeros(len(hand.finger_links))
@@ -242,8 +257,10 @@ def hand_reach(hand: Hand, synergies: Synergies, closure: ClosureParams, params:
     from synergrasp.simulation.capsules import HandCapsules, segment_segment_distance
 
     if not np.allclose(hand.palm_normal, (1.0, 0.0, 0.0)):
-        raise ValueError(f"{hand.source}: palm_normal: the reach needs the palm frame of docs/hand.md "
-                         f"(palm normal +x), got {list(hand.palm_normal)}")
+        raise ValueError(
+            f"{hand.source}: palm_normal: the reach needs the palm frame of docs/hand.md "
+            f"(palm normal +x), got {list(hand.palm_normal)}"
+        )
     capsules = HandCapsules.of(hand)
     normal = _unit(hand.palm_normal)
     path = path_postures(hand, synergies)
@@ -251,8 +268,9 @@ def hand_reach(hand: Hand, synergies: Synergies, closure: ClosureParams, params:
     names = [hand.link_finger[chain[0]] for chain in hand.finger_links]
     rows_of = [np.flatnonzero(np.isin(capsules.links, list(chain))) for chain in hand.finger_links]
     reach_s1 = [max(_surface_reach(capsules, q, rows, normal) for q in path) for rows in rows_of]
-    reach_any = [_any_posture_reach(hand, capsules, path[0], f, rows, normal, int(params.posture_steps))
-                 for f, rows in enumerate(rows_of)]
+    reach_any = [
+        _any_posture_reach(hand, capsules, path[0], f, rows, normal, int(params.posture_steps)) for f, rows in enumerate(rows_of)
+    ]
     press = _slab_press(hand, synergies, closure, params, max(reach_any) - face)
     thumb = names.index("thumb")
     pad = [int(np.flatnonzero(capsules.links == chain[-1])[0]) for chain in hand.finger_links]
@@ -268,11 +286,21 @@ def hand_reach(hand: Hand, synergies: Synergies, closure: ClosureParams, params:
         gap = segment_segment_distance(p0[0], p0[1], q0[0], q0[1]) - capsules.radius[a] - capsules.radius[b]
         apertures.append(float(np.max(gap)))
     order = {name: k for k, name in enumerate(FINGERS)}
-    table = pd.DataFrame({
-        "finger": names, "reach_s1_mm": reach_s1, "reach_any_mm": reach_any,
-        "reach_s1_over_palm_mm": [r - face for r in reach_s1], "reach_any_over_palm_mm": [r - face for r in reach_any],
-        "press_mm": press, "aperture_mm": apertures,
-    }).sort_values("finger", key=lambda s: s.map(order), kind="stable").reset_index(drop=True)
+    table = (
+        pd.DataFrame(
+            {
+                "finger": names,
+                "reach_s1_mm": reach_s1,
+                "reach_any_mm": reach_any,
+                "reach_s1_over_palm_mm": [r - face for r in reach_s1],
+                "reach_any_over_palm_mm": [r - face for r in reach_any],
+                "press_mm": press,
+                "aperture_mm": apertures,
+            }
+        )
+        .sort_values("finger", key=lambda s: s.map(order), kind="stable")
+        .reset_index(drop=True)
+    )
     return HandReach(table, face)
 
 
@@ -300,10 +328,14 @@ def feasible_types(shape: Shape, reach: HandReach) -> dict[str, tuple[bool, str]
     thickness = float(object_extents(shape)[0])
     d_max, aperture = reach.d_max_mm, reach.aperture_mm
     return {
-        "power": (thickness <= d_max + 1e-9,
-                  f"thickness {thickness:g} mm {'<=' if thickness <= d_max + 1e-9 else '>'} "
-                  f"d_max {d_max:g} mm (the thickest box on the palm a link presses toward the palm)"),
-        "precision": (thickness <= aperture + 1e-9,
-                      f"width {thickness:g} mm {'<=' if thickness <= aperture + 1e-9 else '>'} "
-                      f"aperture {aperture:.1f} mm (the widest thumb-to-fingertip gap on the S1 path)"),
+        "power": (
+            thickness <= d_max + 1e-9,
+            f"thickness {thickness:g} mm {'<=' if thickness <= d_max + 1e-9 else '>'} "
+            f"d_max {d_max:g} mm (the thickest box on the palm a link presses toward the palm)",
+        ),
+        "precision": (
+            thickness <= aperture + 1e-9,
+            f"width {thickness:g} mm {'<=' if thickness <= aperture + 1e-9 else '>'} "
+            f"aperture {aperture:.1f} mm (the widest thumb-to-fingertip gap on the S1 path)",
+        ),
     }

@@ -68,8 +68,7 @@ class HandScene:
         """The palm's boxes: (4 × 4 pose, half extents mm) each, made once per scene."""
         if self._boxes is None:
             self._boxes = []
-            for rotation, centre, half in zip(self.capsules.palm_rotation, self.capsules.palm_centre,
-                                              self.capsules.palm_half):
+            for rotation, centre, half in zip(self.capsules.palm_rotation, self.capsules.palm_centre, self.capsules.palm_half):
                 pose = np.eye(4)
                 pose[:3, :3], pose[:3, 3] = rotation, centre
                 pose.setflags(write=False)
@@ -116,8 +115,15 @@ class HandScene:
     def _capsule_object(self) -> tuple[NDArray, NDArray]:
         """Signed distance (c,) of every capsule to the object (mm) and the closest axis points (c, 3)."""
         placed = self.placed
-        d, t = capsule_object(self._p0, self._p1, self.capsules.radius, placed.rotation, placed.center_mm,
-                              placed.shape.kernel_code, placed.shape.kernel_params)
+        d, t = capsule_object(
+            self._p0,
+            self._p1,
+            self.capsules.radius,
+            placed.rotation,
+            placed.center_mm,
+            placed.shape.kernel_code,
+            placed.shape.kernel_params,
+        )
         return d, self._p0 + t[:, None] * (self._p1 - self._p0)
 
     def object_distance(self, margin_mm: float = np.inf) -> NDArray:
@@ -130,9 +136,17 @@ class HandScene:
         d[d > margin_mm] = np.inf
         return d
 
-    def bring_object(self, shape: Shape, rotation: NDArray, point_mm: NDArray, direction: NDArray,
-                     q: NDArray, clearance_mm: float = 0.0, tolerance_mm: float = 0.01,
-                     stop_at_point: bool = False) -> ObjectPose:
+    def bring_object(
+        self,
+        shape: Shape,
+        rotation: NDArray,
+        point_mm: NDArray,
+        direction: NDArray,
+        q: NDArray,
+        clearance_mm: float = 0.0,
+        tolerance_mm: float = 0.01,
+        stop_at_point: bool = False,
+    ) -> ObjectPose:
         """Bring an object (``shape``, orientation ``rotation``) from far along the line
         point + t·direction (mm; ``direction`` a unit vector pointing away from the hand)
         toward the hand at posture q, until its gap to the hand is ``clearance_mm`` (to
@@ -191,9 +205,19 @@ class HandScene:
         capsules, the palm's gap to the object (mm) and the placed object with the radius of a
         ball about its centre that holds it (mm)."""
         c, placed = self.capsules, self.placed
-        return (*self._tree, c.frame, c.ends, c.radius, c.links, float(self._palm_gap[0]), placed.rotation,
-                placed.center_mm, placed.shape.kernel_code, placed.shape.kernel_params,
-                float(placed.shape.bounding_radius_mm))
+        return (
+            *self._tree,
+            c.frame,
+            c.ends,
+            c.radius,
+            c.links,
+            float(self._palm_gap[0]),
+            placed.rotation,
+            placed.center_mm,
+            placed.shape.kernel_code,
+            placed.shape.kernel_params,
+            float(placed.shape.bounding_radius_mm),
+        )
 
     def pair_args(self, pairs: tuple[tuple[int, int], ...]) -> tuple:
         """The arguments of ``capsules.posture_gaps`` from the pairs on: the monitored pairs'
@@ -211,7 +235,8 @@ class HandScene:
         d_caps, axis_points = self._capsule_object()
         links, points, normals, depth = [], [], [], 0.0
         candidates = [(0, self._palm_gap[0], self._palm_patch_centre(contact_distance_mm))] + [
-            (int(link), float(dc), p) for link, dc, p in zip(self.capsules.links, d_caps, axis_points)]
+            (int(link), float(dc), p) for link, dc, p in zip(self.capsules.links, d_caps, axis_points)
+        ]
         for link, dist, near in sorted(candidates, key=lambda c: c[0]):
             if dist > contact_distance_mm:
                 continue
@@ -222,6 +247,4 @@ class HandScene:
             points.append(point)
             normals.append(normal)
             depth = max(depth, -dist)
-        return (np.asarray(links, dtype=np.int64), np.asarray(points).reshape(-1, 3),
-                np.asarray(normals).reshape(-1, 3), depth)
-
+        return (np.asarray(links, dtype=np.int64), np.asarray(points).reshape(-1, 3), np.asarray(normals).reshape(-1, 3), depth)

@@ -28,8 +28,16 @@ import numpy as np
 from synergrasp.hand.kinematics import Hand, fingertip_positions
 from synergrasp.hand.synergies import Synergies, SynergyPath
 
-__all__ = ["MIN_FRONT_MM", "ThumbOpposition", "thumb_opposition", "checked_opposition", "opposition_warnings",
-           "opposition_line", "closing_sigmas", "cached_opposition_warnings"]
+__all__ = [
+    "MIN_FRONT_MM",
+    "ThumbOpposition",
+    "thumb_opposition",
+    "checked_opposition",
+    "opposition_warnings",
+    "opposition_line",
+    "closing_sigmas",
+    "cached_opposition_warnings",
+]
 
 #: How far in front of the palm face (mm, along the palm normal) the thumb must meet a finger.
 MIN_FRONT_MM = 20.0
@@ -69,18 +77,25 @@ class ThumbOpposition:
         if self.meet_sigma is None:
             why.append("the thumb's tip never meets the index or middle fingertip")
         elif self.front_mm < MIN_FRONT_MM:
-            why.append(f"the thumb meets the {self.partner} fingertip at sigma = {self.meet_sigma:.2f} only "
-                       f"{self.front_mm:.1f} mm in front of the palm face (at least {MIN_FRONT_MM:g} mm needed)")
-        return (f"thumb opposition: hand '{self.hand}': along S1 " + "; ".join(why)
-                + ": the thumb cannot oppose the fingers (docs/synergies.md)")
+            why.append(
+                f"the thumb meets the {self.partner} fingertip at sigma = {self.meet_sigma:.2f} only "
+                f"{self.front_mm:.1f} mm in front of the palm face (at least {MIN_FRONT_MM:g} mm needed)"
+            )
+        return (
+            f"thumb opposition: hand '{self.hand}': along S1 "
+            + "; ".join(why)
+            + ": the thumb cannot oppose the fingers (docs/synergies.md)"
+        )
 
     def summary(self) -> str:
         """``WARNING: `` and the warning, or one line saying where the thumb meets a finger."""
         warning = self.warning()
         if warning:
             return f"WARNING: {warning}"
-        return (f"thumb opposition: hand '{self.hand}': along S1 the thumb meets the {self.partner} fingertip at "
-                f"sigma = {self.meet_sigma:.2f}, {self.front_mm:.1f} mm in front of the palm face, the palm untouched")
+        return (
+            f"thumb opposition: hand '{self.hand}': along S1 the thumb meets the {self.partner} fingertip at "
+            f"sigma = {self.meet_sigma:.2f}, {self.front_mm:.1f} mm in front of the palm face, the palm untouched"
+        )
 
 
 def closing_sigmas(check: ThumbOpposition) -> list[float]:
@@ -121,8 +136,7 @@ def thumb_opposition(hand: Hand, synergies: Synergies, samples: int = _SAMPLES) 
             partner = 1 if gaps[0] <= 0.0 else 2
             tips = fingertip_positions(hand, q)
             front = float(min(tips[0] @ normal, tips[partner] @ normal)) - face
-            return ThumbOpposition(hand.name, float(sigma), ("index", "middle")[partner - 1], front, palm_sigma,
-                                   palm_link)
+            return ThumbOpposition(hand.name, float(sigma), ("index", "middle")[partner - 1], front, palm_sigma, palm_link)
     return ThumbOpposition(hand.name, None, "", float("nan"), palm_sigma, palm_link)
 
 

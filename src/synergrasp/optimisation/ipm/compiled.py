@@ -29,8 +29,16 @@ from synergrasp.compiled_cache import register_group
 __all__ = ["KERNEL_SOURCES", "KERNEL", "cache_dir", "jit_alloc", "jit_call", "jit_inline"]
 
 #: The modules whose compiled code one cache directory holds (callers embed their callees).
-KERNEL_SOURCES = ("compiled.py", "layout.py", "cone_algebra.py", "linear_systems.py", "certificates.py",
-                  "polish.py", "iteration.py", "sets.py")
+KERNEL_SOURCES = (
+    "compiled.py",
+    "layout.py",
+    "cone_algebra.py",
+    "linear_systems.py",
+    "certificates.py",
+    "polish.py",
+    "iteration.py",
+    "sets.py",
+)
 
 #: The kernel's compiled group; registered before any of its modules defines a function.
 KERNEL = register_group("ipm", [f"optimisation/ipm/{name}" for name in KERNEL_SOURCES])

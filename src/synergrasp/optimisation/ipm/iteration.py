@@ -105,7 +105,6 @@ def corrector_rhs(P, W, dtau_a, dkappa_a, tau, kappa, sm):
     return tau * kappa + dtau_a * dkappa_a - sm
 
 
-
 @jit_inline
 def start(P, W):
     """Scaled h (the data divided by rho = max(||f_p||, f_min), so that the forces are O(1)
@@ -205,8 +204,11 @@ def hsde(P, W, Q, opt, refine, y):
             infeasible = polished_certificate(P, W, opt.tol)
         # The active-set polish: where the iteration stalls, and early once it is near.
         near = max(pres, dres, gap / max(1.0, abs(pcost))) <= opt.polish_from
-        if ((last and opt.polish_from >= 0.0) or near) and not (optimal or infeasible) and polish(
-                P, W, Q, tau, opt.tol, h_norm, y):
+        if (
+            ((last and opt.polish_from >= 0.0) or near)
+            and not (optimal or infeasible)
+            and polish(P, W, Q, tau, opt.tol, h_norm, y)
+        ):
             for j in range(e):
                 y[j] *= rho
             return OPTIMAL, it

@@ -18,8 +18,20 @@ import numpy as np
 
 from synergrasp.optimisation.ipm.compiled import jit_alloc
 
-__all__ = ["INFEASIBLE", "NOT_SOLVED", "OPTIMAL", "UNDECIDED", "Homogeneous", "Nesting", "PolishWork", "Problem",
-           "Settings", "Work", "polish_workspace", "workspace"]
+__all__ = [
+    "INFEASIBLE",
+    "NOT_SOLVED",
+    "OPTIMAL",
+    "UNDECIDED",
+    "Homogeneous",
+    "Nesting",
+    "PolishWork",
+    "Problem",
+    "Settings",
+    "Work",
+    "polish_workspace",
+    "workspace",
+]
 
 #: Codes of the kernel's verdicts.
 NOT_SOLVED, OPTIMAL, INFEASIBLE, UNDECIDED = 0, 1, 2, 3
@@ -27,8 +39,9 @@ NOT_SOLVED, OPTIMAL, INFEASIBLE, UNDECIDED = 0, 1, 2, 3
 #: The settings as the compiled code takes them: `IPMSettings`, the force-check tolerance and
 #: whether only feasibility is asked (the strict test; a runtime value, not a literal passed
 #: down the calls: numba would compile the iteration once for each literal).
-Settings = namedtuple("Settings", "tol reduced_tol max_iter step_fraction stall_step refine retry_refine polish_from "
-                                   "violation_tol feasibility")
+Settings = namedtuple(
+    "Settings", "tol reduced_tol max_iter step_fraction stall_step refine retry_refine polish_from violation_tol feasibility"
+)
 
 #: How the synergy sets of one grasp nest (`sets.solve_sets`): parent (n_sets,) int, the set
 #: without the last column (-1: none); within (n_sets, n_sets) bool, set a a subset of set b;
@@ -46,16 +59,53 @@ Problem = namedtuple("Problem", "D hv a r0 mu f_min m e q nl L DL hl")
 #: (`workspace`), allocated once
 #: and reused by every problem of a pose; a problem uses the leading N (cone layout) or
 #: n (x layout) entries of each vector.
-Work = namedtuple("Work", [
-    "D", "hv", "a", "DL", "hl",              # the problem's data (`Problem` refers to them)
-    "h", "x", "s", "z",                      # scaled h (cone layout); the iterate
-    "w", "beta", "w_lin", "s_over_z", "lam",  # NT scaling: points w (cone layout), beta per SOC (objective last)
-    "H3", "H_obj", "T", "M", "L",            # (W^T W)^-1 blocks (3m, 3), (e+2, e+2); normal matrix, its factor
-    "r_x", "r_z", "x1", "z1", "x2", "z2", "bx", "q", "dsv",  # residuals and right-hand sides
-    "dx", "dz", "ds", "dx_a", "dz_a", "ds_a",                # corrector and predictor directions
-    "wn", "wn2", "ex", "wN", "wN2", "wN3", "ez",             # scratch of the linear solves
-    "R_rows",                                 # Cholesky factor of A^T A, A the constraint rows
-])
+Work = namedtuple(
+    "Work",
+    [
+        "D",
+        "hv",
+        "a",
+        "DL",
+        "hl",  # the problem's data (`Problem` refers to them)
+        "h",
+        "x",
+        "s",
+        "z",  # scaled h (cone layout); the iterate
+        "w",
+        "beta",
+        "w_lin",
+        "s_over_z",
+        "lam",  # NT scaling: points w (cone layout), beta per SOC (objective last)
+        "H3",
+        "H_obj",
+        "T",
+        "M",
+        "L",  # (W^T W)^-1 blocks (3m, 3), (e+2, e+2); normal matrix, its factor
+        "r_x",
+        "r_z",
+        "x1",
+        "z1",
+        "x2",
+        "z2",
+        "bx",
+        "q",
+        "dsv",  # residuals and right-hand sides
+        "dx",
+        "dz",
+        "ds",
+        "dx_a",
+        "dz_a",
+        "ds_a",  # corrector and predictor directions
+        "wn",
+        "wn2",
+        "ex",
+        "wN",
+        "wN2",
+        "wN3",
+        "ez",  # scratch of the linear solves
+        "R_rows",  # Cholesky factor of A^T A, A the constraint rows
+    ],
+)
 
 #: Work arrays of the active-set polish (`polish`), apart from `Work` (every array of a tuple
 #: is an argument of each call that takes it): the active rows, the Jacobian J, H, its
@@ -72,22 +122,69 @@ Homogeneous = namedtuple("Homogeneous", "tau kappa r_tau cx1_hz1")
 def workspace(m, q, nl, e_max):
     L = q + nl
     N, n = L + 3 * q + e_max + 2, e_max + 1
-    return Work(np.empty((m, 3, e_max)), np.empty((m, 3)), np.empty(e_max), np.empty((nl, e_max)), np.empty(nl),
-                 np.empty(N), np.empty(n), np.empty(N), np.empty(N),
-                 np.empty(N), np.empty(q + 1), np.empty(L), np.empty(L), np.empty(N),
-                 np.empty((3 * m, 3)), np.empty((e_max + 2, e_max + 2)), np.empty((m, 3, e_max)),
-                 np.empty((n, n)), np.empty((n, n)),
-                 np.empty(n), np.empty(N), np.empty(n), np.empty(N), np.empty(n), np.empty(N), np.empty(n),
-                 np.empty(N), np.empty(N),
-                 np.empty(n), np.empty(N), np.empty(N), np.empty(n), np.empty(N), np.empty(N),
-                 np.empty(n), np.empty(n), np.empty(n), np.empty(N), np.empty(N), np.empty(N), np.empty(N),
-                 np.empty((n, n)))
+    return Work(
+        np.empty((m, 3, e_max)),
+        np.empty((m, 3)),
+        np.empty(e_max),
+        np.empty((nl, e_max)),
+        np.empty(nl),
+        np.empty(N),
+        np.empty(n),
+        np.empty(N),
+        np.empty(N),
+        np.empty(N),
+        np.empty(q + 1),
+        np.empty(L),
+        np.empty(L),
+        np.empty(N),
+        np.empty((3 * m, 3)),
+        np.empty((e_max + 2, e_max + 2)),
+        np.empty((m, 3, e_max)),
+        np.empty((n, n)),
+        np.empty((n, n)),
+        np.empty(n),
+        np.empty(N),
+        np.empty(n),
+        np.empty(N),
+        np.empty(n),
+        np.empty(N),
+        np.empty(n),
+        np.empty(N),
+        np.empty(N),
+        np.empty(n),
+        np.empty(N),
+        np.empty(N),
+        np.empty(n),
+        np.empty(N),
+        np.empty(N),
+        np.empty(n),
+        np.empty(n),
+        np.empty(n),
+        np.empty(N),
+        np.empty(N),
+        np.empty(N),
+        np.empty(N),
+        np.empty((n, n)),
+    )
 
 
 @jit_alloc
 def polish_workspace(e_max):
-    return PolishWork(np.empty(e_max, dtype=np.int64), np.empty((e_max, e_max)), np.empty((e_max, e_max)),
-                      np.empty((e_max, e_max)), np.empty((e_max, e_max)), np.empty((e_max, e_max)),
-                      np.empty((e_max, e_max)), np.empty(3), np.empty(e_max), np.empty(e_max), np.empty(e_max),
-                      np.empty(e_max), np.empty(e_max), np.empty(e_max), np.empty(e_max),
-                      np.full(e_max + 1, -1, dtype=np.int64))
+    return PolishWork(
+        np.empty(e_max, dtype=np.int64),
+        np.empty((e_max, e_max)),
+        np.empty((e_max, e_max)),
+        np.empty((e_max, e_max)),
+        np.empty((e_max, e_max)),
+        np.empty((e_max, e_max)),
+        np.empty((e_max, e_max)),
+        np.empty(3),
+        np.empty(e_max),
+        np.empty(e_max),
+        np.empty(e_max),
+        np.empty(e_max),
+        np.empty(e_max),
+        np.empty(e_max),
+        np.empty(e_max),
+        np.full(e_max + 1, -1, dtype=np.int64),
+    )

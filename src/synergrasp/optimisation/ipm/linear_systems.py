@@ -10,8 +10,7 @@ import math
 from synergrasp.optimisation.ipm.compiled import jit_call, jit_inline
 from synergrasp.optimisation.ipm.cone_algebra import soc_apply, soc_hessian, soc_nt
 
-__all__ = ["GT_mul", "G_mul", "H_mul", "V_mul", "cho_solve", "cholesky", "reduced", "rows_T_col", "scaling",
-           "solve_kkt"]
+__all__ = ["GT_mul", "G_mul", "H_mul", "V_mul", "cho_solve", "cholesky", "reduced", "rows_T_col", "scaling", "solve_kkt"]
 
 
 @jit_inline
@@ -157,7 +156,6 @@ def solve_kkt(P, W, refine, bx, bz, dx, dz):
             dx[j] += W.ex[j]
         for k in range(N):
             dz[k] += W.ez[k]
-
 
 
 @jit_inline

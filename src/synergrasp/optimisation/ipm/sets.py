@@ -131,7 +131,6 @@ def cone_rows(frames, mu, rows):
             rows[i, 2, q] = frames[i, 2, q] / mu
 
 
-
 @jit_inline
 def rotate(R, start, s):
     """One-sided Jacobi (Hestenes) on the first s columns of R (c, >= s), in place: plane
@@ -213,8 +212,9 @@ def set_bases(F_all, cols, n_cols, thresholds, parent, order, rotated, bases, e_
 
 
 @jit_alloc
-def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, nesting, cone, cone_strict, f_min, strict, opt,
-               opt_strict, out):
+def solve_sets(
+    F_all, fp, frames, cols, n_cols, thresholds, given, nesting, cone, cone_strict, f_min, strict, opt, opt_strict, out
+):
     """Every synergy set of one grasp into `out` (`SetsResult`): E_s from the singular vectors
     of F_s = F_all[:, set] whose singular value is above the set's threshold (`set_bases`),
     or, if `given`, F_s itself (orthonormal columns), then the GFO, its forces f_p + E_s y (N)
@@ -263,7 +263,8 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, nesting, cone
             continue
         # E_s is the first `rank` columns of U
         code, out.force_norm[j], out.max_violation[j], out.iterations[j] = solve_one(
-            build(rows, cone.lin, U, fp, rank, cone.mu, f_min, W), W, Q, opt, y)
+            build(rows, cone.lin, U, fp, rank, cone.mu, f_min, W), W, Q, opt, y
+        )
         out.code[j] = code
         if code == OPTIMAL:
             for k in range(c):
@@ -290,8 +291,9 @@ def solve_sets(F_all, fp, frames, cols, n_cols, thresholds, given, nesting, cone
         if k >= 0:
             out.strict_code[j] = out.strict_code[k]
         else:
-            out.strict_code[j] = solve_one(build(rows, cone_strict.lin, bases[j], zero, rank, cone_strict.mu, 1.0, W),
-                                           W, Q, opt_strict, y)[0]
+            out.strict_code[j] = solve_one(
+                build(rows, cone_strict.lin, bases[j], zero, rank, cone_strict.mu, 1.0, W), W, Q, opt_strict, y
+            )[0]
 
 
 @jit_call

@@ -30,8 +30,17 @@ from synergrasp.optimisation.cones import FrictionCone
 from synergrasp.optimisation.ipm import sets
 from synergrasp.optimisation.ipm.layout import INFEASIBLE, NOT_SOLVED, OPTIMAL, UNDECIDED, Nesting, Settings
 
-__all__ = ["INFEASIBLE", "IPMSettings", "NOT_SOLVED", "Nesting", "OPTIMAL", "SetsResult", "UNDECIDED", "solve_problem",
-           "solve_sets"]
+__all__ = [
+    "INFEASIBLE",
+    "IPMSettings",
+    "NOT_SOLVED",
+    "Nesting",
+    "OPTIMAL",
+    "SetsResult",
+    "UNDECIDED",
+    "solve_problem",
+    "solve_sets",
+]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -88,9 +97,18 @@ class IPMSettings:
 
 
 def _kernel_settings(settings: IPMSettings, violation_tol: float, feasibility: bool = False) -> Settings:
-    return Settings(float(settings.tol), float(settings.reduced_tol), int(settings.max_iter),
-                    float(settings.step_fraction), float(settings.stall_step), int(settings.refine),
-                    int(settings.retry_refine), float(settings.polish_from), float(violation_tol), bool(feasibility))
+    return Settings(
+        float(settings.tol),
+        float(settings.reduced_tol),
+        int(settings.max_iter),
+        float(settings.step_fraction),
+        float(settings.stall_step),
+        int(settings.refine),
+        int(settings.retry_refine),
+        float(settings.polish_from),
+        float(violation_tol),
+        bool(feasibility),
+    )
 
 
 #: A friction cone as the compiled code takes it: mu dividing the tangent rows of the contact
@@ -124,8 +142,16 @@ class SetsResult(NamedTuple):
     implied: NDArray
 
 
-def solve_problem(frames: NDArray, E: NDArray, f_p: NDArray, cone: FrictionCone, strict_cone: FrictionCone | None,
-                  f_min: float, settings: IPMSettings, violation_tol: float) -> SetsResult:
+def solve_problem(
+    frames: NDArray,
+    E: NDArray,
+    f_p: NDArray,
+    cone: FrictionCone,
+    strict_cone: FrictionCone | None,
+    f_min: float,
+    settings: IPMSettings,
+    violation_tol: float,
+) -> SetsResult:
     """One problem: frames (m, 3, 3) from `mechanics.contact_frames`, E (3m, e) orthonormal
     with e >= 1, f_p (3m,) N, the friction-cone model, that of the strict internal-force test
     (None for no strict test), f_min N. An optimal point whose forces violate a constraint by
@@ -133,13 +159,37 @@ def solve_problem(frames: NDArray, E: NDArray, f_p: NDArray, cone: FrictionCone,
     `solve_sets`, with E as the one set's basis; returns its one-row `SetsResult`."""
     e = E.shape[1]
     alone = Nesting(np.full(1, -1), np.zeros((1, 1), dtype=bool), np.zeros(1, dtype=np.int64))  # one set
-    return _solve(np.ascontiguousarray(E, dtype=float), f_p, frames, np.arange(e)[None, :], np.array([e]),
-                  np.zeros(1), True, alone, cone, strict_cone, f_min, settings, violation_tol)
+    return _solve(
+        np.ascontiguousarray(E, dtype=float),
+        f_p,
+        frames,
+        np.arange(e)[None, :],
+        np.array([e]),
+        np.zeros(1),
+        True,
+        alone,
+        cone,
+        strict_cone,
+        f_min,
+        settings,
+        violation_tol,
+    )
 
 
-def solve_sets(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_columns: NDArray,
-               thresholds: NDArray, nesting: Nesting, cone: FrictionCone, strict_cone: FrictionCone | None, f_min: float,
-               settings: IPMSettings, violation_tol: float) -> SetsResult:
+def solve_sets(
+    F_all: NDArray,
+    f_p: NDArray,
+    frames: NDArray,
+    columns: NDArray,
+    n_columns: NDArray,
+    thresholds: NDArray,
+    nesting: Nesting,
+    cone: FrictionCone,
+    strict_cone: FrictionCone | None,
+    f_min: float,
+    settings: IPMSettings,
+    violation_tol: float,
+) -> SetsResult:
     """Every set of one grasp in one compiled call. F_all: (3m, k) projector @ S, N per
     unit activation; columns: (n_sets, max size) 0-based columns of F_all per set (the first
     n_columns[j] of row j); thresholds: (n_sets,) rank thresholds of the singular values;
@@ -149,22 +199,65 @@ def solve_sets(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, 
     cone narrowed), None for no strict test."""
     if not settings.nested:
         nesting = Nesting(np.full_like(nesting.parent, -1), np.zeros_like(nesting.within), nesting.order)
-    return _solve(np.ascontiguousarray(F_all), f_p, frames, columns, n_columns, thresholds, False, nesting, cone,
-                  strict_cone, f_min, settings, violation_tol)
+    return _solve(
+        np.ascontiguousarray(F_all),
+        f_p,
+        frames,
+        columns,
+        n_columns,
+        thresholds,
+        False,
+        nesting,
+        cone,
+        strict_cone,
+        f_min,
+        settings,
+        violation_tol,
+    )
 
 
-def _solve(F_all: NDArray, f_p: NDArray, frames: NDArray, columns: NDArray, n_columns: NDArray,
-           thresholds: NDArray, given: bool, nesting: Nesting, cone: FrictionCone, strict_cone: FrictionCone | None, f_min: float,
-           settings: IPMSettings, violation_tol: float) -> SetsResult:
+def _solve(
+    F_all: NDArray,
+    f_p: NDArray,
+    frames: NDArray,
+    columns: NDArray,
+    n_columns: NDArray,
+    thresholds: NDArray,
+    given: bool,
+    nesting: Nesting,
+    cone: FrictionCone,
+    strict_cone: FrictionCone | None,
+    f_min: float,
+    settings: IPMSettings,
+    violation_tol: float,
+) -> SetsResult:
     n_sets = columns.shape[0]
-    out = SetsResult(code=np.zeros(n_sets, dtype=np.int8), force_norm=np.full(n_sets, np.nan),
-                     max_violation=np.full(n_sets, np.nan),
-                     iterations=np.zeros(n_sets, dtype=np.int32), e_s=np.zeros(n_sets, dtype=np.int64),
-                     strict_code=np.full(n_sets, INFEASIBLE, dtype=np.int8),
-                     forces=np.full((n_sets, f_p.size), np.nan), implied=np.zeros(n_sets, dtype=bool))
+    out = SetsResult(
+        code=np.zeros(n_sets, dtype=np.int8),
+        force_norm=np.full(n_sets, np.nan),
+        max_violation=np.full(n_sets, np.nan),
+        iterations=np.zeros(n_sets, dtype=np.int32),
+        e_s=np.zeros(n_sets, dtype=np.int64),
+        strict_code=np.full(n_sets, INFEASIBLE, dtype=np.int8),
+        forces=np.full((n_sets, f_p.size), np.nan),
+        implied=np.zeros(n_sets, dtype=bool),
+    )
     data = cone_data(cone, frames)
-    sets.solve_sets(F_all, np.ascontiguousarray(f_p, dtype=float), frames, columns, n_columns, thresholds, given, nesting, data,
-                    data if strict_cone is None else cone_data(strict_cone, frames), float(f_min),
-                    strict_cone is not None, _kernel_settings(settings, violation_tol),
-                    _kernel_settings(settings, violation_tol, feasibility=True), out)
+    sets.solve_sets(
+        F_all,
+        np.ascontiguousarray(f_p, dtype=float),
+        frames,
+        columns,
+        n_columns,
+        thresholds,
+        given,
+        nesting,
+        data,
+        data if strict_cone is None else cone_data(strict_cone, frames),
+        float(f_min),
+        strict_cone is not None,
+        _kernel_settings(settings, violation_tol),
+        _kernel_settings(settings, violation_tol, feasibility=True),
+        out,
+    )
     return out

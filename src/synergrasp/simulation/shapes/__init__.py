@@ -24,8 +24,18 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Shape", "ShapeError", "SHAPES", "shape_from_config", "start_rotation", "positive_length", "Box", "Sphere",
-           "Cylinder", "Mesh"]
+__all__ = [
+    "Shape",
+    "ShapeError",
+    "SHAPES",
+    "shape_from_config",
+    "start_rotation",
+    "positive_length",
+    "Box",
+    "Sphere",
+    "Cylinder",
+    "Mesh",
+]
 
 
 class ShapeError(ValueError):
@@ -107,8 +117,9 @@ class Shape(ABC):
         minus a penetration depth). The closure's compiled query, here for tests."""
         from synergrasp.simulation.shapes.kernels import segment_object_distance  # compiled: numba only when asked
 
-        return segment_object_distance(np.ascontiguousarray(p0, dtype=float), np.ascontiguousarray(p1, dtype=float),
-                                       self.kernel_code, self.kernel_params)
+        return segment_object_distance(
+            np.ascontiguousarray(p0, dtype=float), np.ascontiguousarray(p1, dtype=float), self.kernel_code, self.kernel_params
+        )
 
     @abstractmethod
     def gap(self, points: NDArray, rotation: NDArray, center: NDArray) -> NDArray:
@@ -168,7 +179,7 @@ def shape_from_config(spec: Mapping[str, Any], where: str = "shape") -> Shape:
     message starts with the key in quotes (``'<where>.box.size_mm': ...``)."""
     if not isinstance(spec, Mapping) or len(spec) != 1:
         raise ShapeError(f"'{where}': one of {sorted(SHAPES)} with its fields is required, got {spec!r}")
-    (kind, fields), = spec.items()
+    ((kind, fields),) = spec.items()
     if kind not in SHAPES:
         raise ShapeError(f"'{where}': unknown shape {kind!r}; allowed: {sorted(SHAPES)}")
     if not isinstance(fields, Mapping):

@@ -20,8 +20,7 @@ __all__ = ["Box", "box_samples", "box_gap", "box_edges"]
 
 #: The 8 corners of a box as sign vectors and its 12 edges as pairs of corners.
 _CORNERS = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], dtype=float)
-_EDGES = np.array([(a, b) for a in range(8) for b in range(a + 1, 8)
-                   if np.count_nonzero(_CORNERS[a] != _CORNERS[b]) == 1])
+_EDGES = np.array([(a, b) for a in range(8) for b in range(a + 1, 8) if np.count_nonzero(_CORNERS[a] != _CORNERS[b]) == 1])
 #: Corners, edge middles, face centres and centre, as sign vectors.
 _SAMPLES = np.array([[i, j, k] for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)], dtype=float)
 
@@ -69,10 +68,13 @@ class Box(Shape):
             values = tuple(float(v) for v in size)
         except (TypeError, ValueError):
             values = None
-        if (values is None or isinstance(size, (str, bytes)) or len(values) != 3
-                or not all(math.isfinite(v) and v > 0 for v in values)):
-            raise ShapeError(f"size_mm: {size!r} is not allowed; three finite positive edge lengths in mm "
-                             "are required")
+        if (
+            values is None
+            or isinstance(size, (str, bytes))
+            or len(values) != 3
+            or not all(math.isfinite(v) and v > 0 for v in values)
+        ):
+            raise ShapeError(f"size_mm: {size!r} is not allowed; three finite positive edge lengths in mm are required")
         object.__setattr__(self, "size_mm", values)
         self._set_kernel_params(*(np.array(values) / 2.0))  # the half extents
         object.__setattr__(self, "_half", self._params)

@@ -17,9 +17,14 @@ from synergrasp.compiled_cache import register_group
 __all__ = ["SOURCES", "GROUP", "jit"]
 
 #: The modules whose compiled functions call one another (relative to the package).
-SOURCES = ("simulation/shapes/compiled.py", "simulation/shapes/kernels.py", "simulation/shapes/polytope.py",
-           "simulation/shapes/polytope_axes.py", "simulation/capsules.py",
-           "simulation/closure_steps.py")
+SOURCES = (
+    "simulation/shapes/compiled.py",
+    "simulation/shapes/kernels.py",
+    "simulation/shapes/polytope.py",
+    "simulation/shapes/polytope_axes.py",
+    "simulation/capsules.py",
+    "simulation/closure_steps.py",
+)
 
 #: The group; registered before any of its modules defines a function.
 GROUP = register_group("shapes", SOURCES)

@@ -28,15 +28,36 @@ from scipy.spatial import ConvexHull, QhullError
 
 from synergrasp.simulation.shapes.mesh_file import TriangleMesh
 
-__all__ = ["convex_parts", "is_convex", "cache_dir", "bullet_file", "parts_key", "write_parts", "read_parts",
-           "VHACD_PARAMETERS", "CONVEX_RTOL"]
+__all__ = [
+    "convex_parts",
+    "is_convex",
+    "cache_dir",
+    "bullet_file",
+    "parts_key",
+    "write_parts",
+    "read_parts",
+    "VHACD_PARAMETERS",
+    "CONVEX_RTOL",
+]
 
 #: A mesh whose volume is this close to its hull's (relatively) is convex: its hull is it.
 CONVEX_RTOL = 1e-6
 #: V-HACD's parameters (pybullet's defaults, fixed here so the cache key holds them).
-VHACD_PARAMETERS = {"resolution": 1_000_000, "depth": 20, "concavity": 0.001, "planeDownsampling": 4,
-                    "convexhullDownsampling": 4, "alpha": 0.05, "beta": 0.05, "gamma": 0.0005, "pca": 0,
-                    "mode": 0, "maxNumVerticesPerCH": 64, "minVolumePerCH": 0.0001, "convexhullApproximation": 1}
+VHACD_PARAMETERS = {
+    "resolution": 1_000_000,
+    "depth": 20,
+    "concavity": 0.001,
+    "planeDownsampling": 4,
+    "convexhullDownsampling": 4,
+    "alpha": 0.05,
+    "beta": 0.05,
+    "gamma": 0.0005,
+    "pca": 0,
+    "mode": 0,
+    "maxNumVerticesPerCH": 64,
+    "minVolumePerCH": 0.0001,
+    "convexhullApproximation": 1,
+}
 
 
 def cache_dir() -> Path:

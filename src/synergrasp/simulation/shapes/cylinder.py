@@ -129,8 +129,7 @@ class Cylinder(Shape):
         # the axes' angle θ moves the rim and the end faces by about sin θ times the bounding
         # radius (1 − cos θ would accept θ up to √(2 tol / R))
         sine = float(np.linalg.norm(np.cross(rotation_a[:, 2], rotation_b[:, 2])))
-        return (float(np.linalg.norm(np.asarray(center_a) - np.asarray(center_b))) <= tol
-                and sine * self.bounding_radius_mm <= tol)
+        return float(np.linalg.norm(np.asarray(center_a) - np.asarray(center_b))) <= tol and sine * self.bounding_radius_mm <= tol
 
     def collision_geometry(self) -> tuple[str, dict[str, Any]]:
         return "cylinder", {"radius_mm": self.radius_mm, "height_mm": self.height_mm}
@@ -150,14 +149,17 @@ class Cylinder(Shape):
         dz = np.where(np.abs(d[..., 2]) > _EPS, d[..., 2], _EPS)
         t_cap = (-np.sign(dz) * hh - o[..., 2]) / dz  # the cap facing the ray
         x_cap, y_cap = o[..., 0] + t_cap * d[..., 0], o[..., 1] + t_cap * d[..., 1]
-        cap = (np.abs(d[..., 2]) > _EPS) & (t_cap > 0.0) & (x_cap ** 2 + y_cap ** 2 <= r * r)
+        cap = (np.abs(d[..., 2]) > _EPS) & (t_cap > 0.0) & (x_cap**2 + y_cap**2 <= r * r)
         t = np.where(side, t_side, np.inf)
         t = np.where(cap & (t_cap < t), t_cap, t)
         use_cap = cap & (t == t_cap)
         hit = side | cap
         at = o + np.where(hit, t, 0.0)[..., None] * d
-        normal = np.where(use_cap[..., None], np.stack([np.zeros_like(a), np.zeros_like(a), -np.sign(dz)], axis=-1),
-                          np.stack([at[..., 0] / r, at[..., 1] / r, np.zeros_like(a)], axis=-1))
+        normal = np.where(
+            use_cap[..., None],
+            np.stack([np.zeros_like(a), np.zeros_like(a), -np.sign(dz)], axis=-1),
+            np.stack([at[..., 0] / r, at[..., 1] / r, np.zeros_like(a)], axis=-1),
+        )
         face = np.where(use_cap, np.where(dz < 0, 1, 2), 0)
         return t, normal, np.where(hit, face, -1)
 
@@ -171,5 +173,6 @@ class Cylinder(Shape):
 
         r, hh = self.radius_mm, self.half_height_mm
         # caps and side apart, so that the rims stay sharp
-        return merge_meshes([revolution_mesh([(0.0, -hh), (r, -hh)]), revolution_mesh([(r, -hh), (r, hh)]),
-                             revolution_mesh([(r, hh), (0.0, hh)])])
+        return merge_meshes(
+            [revolution_mesh([(0.0, -hh), (r, -hh)]), revolution_mesh([(r, -hh), (r, hh)]), revolution_mesh([(r, hh), (0.0, hh)])]
+        )

@@ -19,8 +19,16 @@ from numpy.typing import NDArray
 from synergrasp.simulation.shapes.compiled import jit
 from synergrasp.simulation.shapes.polytope import WORK, segment_parts
 
-__all__ = ["sort_knots", "segment_sphere", "segment_cylinder", "cylinder_sdf", "segment_box", "segment_box_distance",
-           "segment_object", "segment_object_distance"]
+__all__ = [
+    "sort_knots",
+    "segment_sphere",
+    "segment_cylinder",
+    "cylinder_sdf",
+    "segment_box",
+    "segment_box_distance",
+    "segment_object",
+    "segment_object_distance",
+]
 
 _EPS = 1e-12
 _FLAT_MM = 1e-9  # distances (mm) this close count as equal (a flat stretch of the segment)
@@ -87,8 +95,7 @@ def _golden(p0: NDArray, d: NDArray, lo: float, hi: float, radius: float, half_h
 
 
 @jit
-def segment_cylinder(p0: NDArray, d: NDArray, radius: float, half_height: float,
-                     knots: NDArray) -> tuple[float, float]:
+def segment_cylinder(p0: NDArray, d: NDArray, radius: float, half_height: float, knots: NDArray) -> tuple[float, float]:
     """Signed distance from the segment p0 + t·d to the solid cylinder about the z axis and
     the t attaining it (``knots``: work space of 8 values).
 

@@ -73,8 +73,9 @@ def _geometry(path: str, stamp: tuple[int, int], scale: float, parts: str) -> Me
         try:
             file_parts = read_parts(Path(parts))
         except OSError as err:
-            raise ShapeError(f"parts: {parts!r} cannot be read ({err.strerror or err}); the workflow's rule "
-                             "mesh_parts makes it") from None
+            raise ShapeError(
+                f"parts: {parts!r} cannot be read ({err.strerror or err}); the workflow's rule mesh_parts makes it"
+            ) from None
     else:
         file_parts = convex_parts(mesh, hashlib.sha256(Path(path).read_bytes()).hexdigest())
     parts, planes, regions, first = [], [], [], 0
@@ -88,8 +89,13 @@ def _geometry(path: str, stamp: tuple[int, int], scale: float, parts: str) -> Me
         regions.append(labels + first)
         first += int(labels.max()) + 1
         parts.append(vertices)
-    return MeshGeometry(tuple(parts), tuple(planes), np.concatenate(regions).astype(np.int64), is_convex(mesh),
-                        np.ptp(np.concatenate(parts), axis=0))
+    return MeshGeometry(
+        tuple(parts),
+        tuple(planes),
+        np.concatenate(regions).astype(np.int64),
+        is_convex(mesh),
+        np.ptp(np.concatenate(parts), axis=0),
+    )
 
 
 def _regions(hull: Any, face_of: NDArray, n_faces: int) -> NDArray:
@@ -133,14 +139,14 @@ class Mesh(Shape):
             key = (str(file.resolve()), (stat.st_mtime_ns, stat.st_size))
             mesh = checked_mesh(file)
         except FileNotFoundError:
-            raise ShapeError(f"path: {self.path!r} does not exist (relative paths are read from the "
-                             f"working directory, {Path.cwd()})") from None
+            raise ShapeError(
+                f"path: {self.path!r} does not exist (relative paths are read from the working directory, {Path.cwd()})"
+            ) from None
         except (MeshFileError, OSError) as err:
             raise ShapeError(f"path: {err}") from None
         object.__setattr__(self, "scale", scale)
         object.__setattr__(self, "_file", key)
-        object.__setattr__(self, "_file_radius_mm", scale * float(np.linalg.norm(mesh.vertices - mesh.centroid,
-                                                                                 axis=1).max()))
+        object.__setattr__(self, "_file_radius_mm", scale * float(np.linalg.norm(mesh.vertices - mesh.centroid, axis=1).max()))
         object.__setattr__(self, "_faces", {})  # (part, plane) -> its face polygon packed (normals_near)
         object.__setattr__(self, "_corners", {})  # a box's (pose, half extents) -> its corners (box_gap)
 
@@ -259,13 +265,13 @@ class Mesh(Shape):
         for i, u in enumerate(d):
             groups.setdefault(u.tobytes(), []).append(i)
         for rows in groups.values():
-            t[rows], normal[rows], face[rows] = ray_parts(flat[rows], np.ascontiguousarray(d[rows[0]]), self._params,
-                                                          self.geometry.region)
+            t[rows], normal[rows], face[rows] = ray_parts(
+                flat[rows], np.ascontiguousarray(d[rows[0]]), self._params, self.geometry.region
+            )
         return t.reshape(o.shape[:-1]), normal.reshape(o.shape), face.reshape(o.shape[:-1])
 
     def extent(self, rotation: NDArray, center: NDArray) -> tuple[NDArray, NDArray]:
         return self._hull @ rotation.T + center, np.zeros(len(self._hull))
-
 
     def own_mesh(self) -> tuple[NDArray, NDArray]:
         from synergrasp.simulation.shapes.surface import hull_mesh, merge_meshes

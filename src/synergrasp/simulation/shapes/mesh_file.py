@@ -99,8 +99,7 @@ def _parse_obj(data: bytes, path: Path) -> tuple[NDArray, NDArray]:
         except ValueError:
             raise MeshFileError(f"{str(path)!r} line {number}: cannot read {raw.strip()!r}") from None
         if len(corners) < 3 or not all(0 <= k < len(vertices) for k in corners):
-            raise MeshFileError(f"{str(path)!r} line {number}: a face needs 3 or more existing vertices, "
-                                f"got {raw.strip()!r}")
+            raise MeshFileError(f"{str(path)!r} line {number}: a face needs 3 or more existing vertices, got {raw.strip()!r}")
         triangles += [(corners[0], corners[i], corners[i + 1]) for i in range(1, len(corners) - 1)]
     return np.asarray(vertices, dtype=float).reshape(-1, 3), np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
 
@@ -109,8 +108,9 @@ def _parse_stl(data: bytes, path: Path) -> tuple[NDArray, NDArray]:
     if len(data) >= 84:
         (count,) = struct.unpack_from("<I", data, 80)
         if len(data) == 84 + 50 * count:  # binary: a 50-byte record per triangle
-            records = np.frombuffer(data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]),
-                                    count=count, offset=84)
+            records = np.frombuffer(
+                data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]), count=count, offset=84
+            )
             corners = records["v"].astype(float).reshape(-1, 3)
             return corners, np.arange(len(corners), dtype=np.int64).reshape(-1, 3)
     text = data.decode("ascii", errors="replace")
@@ -134,19 +134,20 @@ def _solid(vertices: NDArray, triangles: NDArray, where: str) -> TriangleMesh:
     undirected = np.sort(directed, axis=1)
     _, uses = np.unique(undirected, axis=0, return_counts=True)
     if (uses == 1).any():
-        raise MeshFileError(f"{where!r} is not closed: {int((uses == 1).sum())} edges belong to one triangle "
-                            "only (a solid is needed)")
+        raise MeshFileError(
+            f"{where!r} is not closed: {int((uses == 1).sum())} edges belong to one triangle only (a solid is needed)"
+        )
     if (uses > 2).any():
-        raise MeshFileError(f"{where!r} is non-manifold: {int((uses > 2).sum())} edges are shared by more than "
-                            "two triangles")
+        raise MeshFileError(f"{where!r} is non-manifold: {int((uses > 2).sum())} edges are shared by more than two triangles")
     if len(np.unique(directed, axis=0)) != len(directed):
-        raise MeshFileError(f"{where!r}: its triangles are not consistently oriented (an edge runs the same "
-                            "way in both of its triangles)")
+        raise MeshFileError(
+            f"{where!r}: its triangles are not consistently oriented (an edge runs the same way in both of its triangles)"
+        )
     a, b, c = (merged[tri[:, k]] for k in range(3))
     signed = np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0  # tetrahedra from the origin
     volume = float(signed.sum())
     extent = float(np.ptp(merged, axis=0).max())
-    if abs(volume) <= 1e-9 * extent ** 3:
+    if abs(volume) <= 1e-9 * extent**3:
         raise MeshFileError(f"{where!r} is degenerate: it encloses no volume")
     if volume < 0:  # wound clockwise throughout: turn every triangle
         tri, signed, volume = tri[:, ::-1].copy(), -signed, -volume

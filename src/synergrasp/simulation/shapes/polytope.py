@@ -29,10 +29,10 @@ _HEADER = 10
 #: Scratch space (float64 values) a segment query needs (``segment_parts``).
 WORK = 48
 _MAX_ITER = 64
-_REL = 1e-15          # GJK stops when |v|² − v·w ≤ _REL·|v|² (no more progress)
-_TOUCH_MM2 = 1e-20    # |v|² at or below this: the sets touch or overlap
-_FLAT_MM = 1e-9       # a segment whose distance changes less than this along its length is parallel
-_ON_PLANE_MM = 1e-7   # slack of the face planes when finding the stretch of equal distance
+_REL = 1e-15  # GJK stops when |v|² − v·w ≤ _REL·|v|² (no more progress)
+_TOUCH_MM2 = 1e-20  # |v|² at or below this: the sets touch or overlap
+_FLAT_MM = 1e-9  # a segment whose distance changes less than this along its length is parallel
+_ON_PLANE_MM = 1e-7  # slack of the face planes when finding the stretch of equal distance
 
 
 def pack_parts(parts: list[tuple[NDArray, NDArray]]) -> NDArray:
@@ -360,8 +360,7 @@ def _deepest_on_segment(params: NDArray, part: int, p0: NDArray, d: NDArray) -> 
 
 
 @jit
-def _flat_middle(params: NDArray, part: int, p0: NDArray, d: NDArray, t: float, work: NDArray,
-                 dist: float) -> float:
+def _flat_middle(params: NDArray, part: int, p0: NDArray, d: NDArray, t: float, work: NDArray, dist: float) -> float:
     """A segment parallel to the part's nearest feature is nearest along a stretch: the t in
     its middle (so that t does not depend on how the segment runs along it). On the stretch
     the nearest points are the segment's points less the gap (work[39:42] − work[36:39], the
@@ -443,7 +442,7 @@ def point_parts(x: NDArray, params: NDArray) -> tuple[float, NDArray, NDArray]:
             dist = min(depth, 0.0) if touching else dist
             if dist < best:
                 j = int(params[1 + _HEADER * k + 2]) + 4 * f
-                n_out = params[j:j + 3]
+                n_out = params[j : j + 3]
                 best, near, normal = dist, x - depth * n_out, -n_out
         elif dist < best:
             a = work[36:39].copy()

@@ -68,8 +68,11 @@ def part_box_overlap(params: NDArray, part: int, corners: NDArray, box_axes: NDA
             length = np.sqrt(ex * ex + ey * ey + ez * ez)
             outside = 0.0
             for k in range(3):  # the edge's middle against the box, less half its length
-                m = ((params[v_off + 3 * i] + 0.5 * ex) * box_axes[k, 0] + (params[v_off + 3 * i + 1] + 0.5 * ey)
-                     * box_axes[k, 1] + (params[v_off + 3 * i + 2] + 0.5 * ez) * box_axes[k, 2])
+                m = (
+                    (params[v_off + 3 * i] + 0.5 * ex) * box_axes[k, 0]
+                    + (params[v_off + 3 * i + 1] + 0.5 * ey) * box_axes[k, 1]
+                    + (params[v_off + 3 * i + 2] + 0.5 * ez) * box_axes[k, 2]
+                )
                 outside += max(abs(m - centre[k]) - half[k], 0.0) ** 2
             if np.sqrt(outside) - 0.5 * length > -best + 1e-9:
                 continue
@@ -110,7 +113,7 @@ def ray_parts(origins: NDArray, direction: NDArray, params: NDArray, region: NDA
     for k in range(int(params[0])):
         h = 1 + _HEADER * k
         _, _, p_off, n_p = _part(params, k)
-        c, radius = params[h + 4:h + 7], params[h + 7]
+        c, radius = params[h + 4 : h + 7], params[h + 7]
         for i in range(r):
             o = origins[i]
             s = _d3(c - o, direction)
@@ -133,7 +136,7 @@ def ray_parts(origins: NDArray, direction: NDArray, params: NDArray, region: NDA
                     leave = min(leave, level / slope)
             if face >= 0 and enter <= leave and leave > 0.0 and 0.0 < enter < t_out[i]:
                 t_out[i] = enter
-                normals[i] = params[p_off + 4 * face:p_off + 4 * face + 3]
+                normals[i] = params[p_off + 4 * face : p_off + 4 * face + 3]
                 labels[i] = region[first_face + face]
         first_face += n_p
     return t_out, normals, labels

@@ -70,7 +70,7 @@ class Sphere(Shape):
         d = np.broadcast_to(np.asarray(direction, dtype=float), np.shape(origins))
         a = np.einsum("...k,...k->...", d, d)
         half_b = np.einsum("...k,...k->...", origins, d)
-        c = np.einsum("...k,...k->...", origins, origins) - self.radius_mm ** 2
+        c = np.einsum("...k,...k->...", origins, origins) - self.radius_mm**2
         disc = half_b * half_b - a * c
         t = (-half_b - np.sqrt(np.maximum(disc, 0.0))) / a
         hit = (disc >= 0.0) & (t > 0.0)
@@ -85,5 +85,6 @@ class Sphere(Shape):
         from synergrasp.simulation.shapes.surface import revolution_mesh
 
         polar = np.linspace(0.0, np.pi, 17)
-        return revolution_mesh([(0.0 if k in (0, 16) else self.radius_mm * np.sin(a), -self.radius_mm * np.cos(a))
-                                for k, a in enumerate(polar)])
+        return revolution_mesh(
+            [(0.0 if k in (0, 16) else self.radius_mm * np.sin(a), -self.radius_mm * np.cos(a)) for k, a in enumerate(polar)]
+        )

@@ -86,8 +86,7 @@ def merge_meshes(meshes: Sequence[Surface]) -> Surface:
     if not meshes:
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
     offsets = np.cumsum([0] + [len(v) for v, _ in meshes[:-1]])
-    return (np.vstack([v for v, _ in meshes]),
-            np.vstack([t + o for (_, t), o in zip(meshes, offsets)]).astype(np.int64))
+    return (np.vstack([v for v, _ in meshes]), np.vstack([t + o for (_, t), o in zip(meshes, offsets)]).astype(np.int64))
 
 
 def placed(mesh: Surface, rotation: NDArray, center: NDArray) -> Surface:
