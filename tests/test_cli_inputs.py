@@ -114,9 +114,10 @@ BAD = {
 
 _PLACEMENT = (
     "object,rank,chosen,distinct_rank,x_mm,y_mm,z_mm,round,n_poses,grasp_type,typed_percent,"
-    "force_closure_percent,median_force_per_weight,median_contacts,distance_to_chosen_mm\n"
-    "obj1,1,True,1,38.0,5.0,112.0,0,10,any,50.0,50.0,3.0,4.0,0.0\n"
-    "obj1,2,False,2,38.0,5.0,132.0,0,10,any,40.0,40.0,3.0,4.0,20.0\n"
+    "force_closure_percent,median_force_per_weight,median_contacts,distance_to_chosen_mm,"
+    "stated_type,effective_type,type_reason,region_mm\n"
+    "obj1,1,True,1,38.0,5.0,112.0,0,10,any,50.0,50.0,3.0,4.0,0.0,any,any,stated type feasible and scored,\n"
+    "obj1,2,False,2,38.0,5.0,132.0,0,10,any,40.0,40.0,3.0,4.0,20.0,any,any,stated type feasible and scored,\n"
 )
 
 
