@@ -352,6 +352,23 @@ def compare_planners(
     return pd.DataFrame(rows)
 
 
+#: The columns :func:`across_objects` computes (``tables.PLANNERS_ACROSS`` adds ``recommended``).
+ACROSS_COLUMNS = (
+    "planner",
+    "family",
+    "randomised",
+    "objects",
+    "objects_meeting_aim",
+    "meeting_aim_percent",
+    "closures",
+    "closure_share_percent",
+    "solve_cost",
+    "regret_percent_mean",
+    "regret_percent_max",
+    "within_aim_probability",
+)
+
+
 def across_objects(per_object: pd.DataFrame) -> pd.DataFrame:
     """Per planner over the objects (rows of objects whose full set succeeds somewhere:
     ``regret_percent_mean`` defined): objects, those where it meets the aim and their share (%),
@@ -375,10 +392,9 @@ def across_objects(per_object: pd.DataFrame) -> pd.DataFrame:
                 "within_aim_probability": float(part["within_aim_probability"].min()),
             }
         )
-    table = pd.DataFrame(rows)
-    if len(table):
-        choice = recommended(table)
-        table["recommended"] = table["planner"] == choice
+    table = pd.DataFrame(rows, columns=ACROSS_COLUMNS)
+    # no object whose full set succeeds anywhere: an empty table of the same columns
+    table["recommended"] = (table["planner"] == recommended(table)) if len(table) else pd.Series(dtype=bool)
     return table
 
 
