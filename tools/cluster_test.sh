@@ -148,8 +148,7 @@ compare_runs() {
 compare_runs small "$SMALL" figures
 
 # 2. the many-object study spread over the cluster: 10 of pybullet's random meshes
-#    (config/examples/random_objects.yaml, n_objects: 10) on the small config's grid and placement,
-#    their jobs grouped by the profile
+#    (config/examples/random_objects.yaml, n_objects: 10) on the small config's grid and placement
 TEN=$WORK/ten_random_objects.yaml
 "$BIN/python" - "$SMALL" "$ROOT/config/examples/random_objects.yaml" "$TEN" "$ROOT" <<'PY'
 import sys
@@ -167,8 +166,5 @@ config = overlay(base, {"objects": {name: None for name in base["objects"]}, "ra
 Path(out).write_text(yaml.safe_dump(config))
 PY
 compare_runs ten_random_objects "$TEN" across_objects
-# the profile groups each object's submitted jobs, twenty objects a job (profiles/slurm): ten
-# objects ungrouped would send 4 jobs each
-[ "$SUBMITTED" -lt 10 ] || fail "ten_random_objects: $SUBMITTED jobs through sbatch; grouped (profiles/slurm, group-components object=20) ten objects send fewer than 10"
 
 echo "cluster-test passed: the small study and 10 random objects under SLURM, $(( $(date +%s) - started )) s in all"
