@@ -300,3 +300,38 @@ def test_max_seeds_keeps_the_minima_of_least_force_and_levels_must_increase_to_n
     for bad in ([1, 2], [2, 1, 3], [0, 3]):
         with pytest.raises(ValueError, match="levels must increase"):
             plan_incremental(ALPHA, BETA, oracle, 3, 30.0, levels=bad)
+
+
+def test_the_figure_names_each_family_s_cheapest_planner_at_its_share(tmp_path):
+    """By hand: full-set planners at (cost 100, 0 %), (200, 50 %), (300, 25 %), (400, 50 %),
+    (800, 100 %): the frontier is 100, 200 and 800 (300 and 400 buy no more objects than 200);
+    the incremental pair tied at (1800, 100 %) are both in, and the recommended planner is in
+    even off the frontier. The figure is drawn from such a table."""
+    from synergrasp.figures.planners import figure_planners, frontier
+
+    across = pd.DataFrame(
+        {
+            "planner": ["random_100", "random_200", "descent_5", "coarse_2", "random_800", "incremental_r20", "skip_r20"],
+            "family": ["full_set"] * 5 + ["incremental"] * 2,
+            "closures": [100.0, 200.0, 300.0, 400.0, 800.0, 1800.0, 1800.0],
+            "meeting_aim_percent": [0.0, 50.0, 25.0, 50.0, 100.0, 100.0, 100.0],
+            "recommended": [False, False, False, True, False, False, False],
+        }
+    )
+    named = frontier(across, "closures")
+    assert sorted(named["planner"]) == sorted(
+        ["random_100", "random_200", "random_800", "incremental_r20", "skip_r20", "coarse_2"]
+    )
+    per_object = pd.DataFrame(
+        {
+            "planner": ["random_100"],
+            "family": ["full_set"],
+            "object": ["obj1"],
+            "closures": [100.0],
+            "solve_cost": [50.0],
+            "within_aim_probability": [0.5],
+            "regret_percent_mean": [3.0],
+        }
+    )
+    figure_planners(per_object, across.assign(solve_cost=across["closures"] / 2), tmp_path / "p.png", tmp_path / "p.pdf")
+    assert (tmp_path / "p.png").stat().st_size > 10_000 and (tmp_path / "p.pdf").is_file()
