@@ -9,8 +9,9 @@ tested on a small workflow of its own (tests/test_snakemake_adapter.py):
 - every output is kept until its replacement is complete (:func:`keep_outputs_until_replaced`)
   and a failed job's kept outputs are outdated (:func:`outdate_failed_outputs`);
 - the scheduler's timers are cancelled at the end of a run (:func:`cancel_scheduler_timers`);
-- what the workflow object holds: its configuration files, the SLURM executor's settings, its
-  rules, the rules run where Snakemake runs (:func:`config_files`, :func:`slurm_settings`,
+- what the workflow object holds: its configuration files, the SLURM executor's settings, the
+  groups and the limits a group's jobs are laid within, its rules, the rules run where
+  Snakemake runs (:func:`config_files`, :func:`slurm_settings`, :func:`group_limits`,
   :func:`workflow_rules`, :func:`run_locally`).
 
 No other module of the project names a private Snakemake module or attribute
@@ -37,6 +38,7 @@ __all__ = [
     "cancel_scheduler_timers",
     "config_files",
     "slurm_settings",
+    "group_limits",
     "run_locally",
     "workflow_rules",
 ]
@@ -180,6 +182,13 @@ def slurm_settings(workflow: Any) -> tuple[Any, dict[str, Any]] | None:
         return None
     raw = {key: value.raw for key, value in workflow.resource_settings.default_resources.items()}
     return workflow.executor_settings, raw
+
+
+def group_limits(workflow: Any) -> tuple[dict[str, str], int | None, int | None]:
+    """The run's job groups (``--groups``: rule -> group) and the limits Snakemake lays a group
+    job's jobs within: ``--cores`` (CPUs) and ``--resources mem_mb`` (MB), None where not given."""
+    limits = workflow.global_resources
+    return dict(workflow.group_settings.overwrite_groups), limits.get("_cores").value, limits.get("mem_mb").value
 
 
 def run_locally(workflow: Any, rules: Iterable[str]) -> None:
