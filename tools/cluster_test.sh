@@ -107,7 +107,7 @@ $(tail -5 "$STATE/log/slurmd.log" 2>/dev/null)"
 echo "SLURM up: node $HOST, $CPUS CPUs, $MEM_MB MB, partition $PARTITION ($(( $(date +%s) - started )) s)"
 
 # The node's size, which the profile's group jobs are cut to (profiles/slurm: cores, resources mem_mb)
-NODE_SIZE=(--cores "$CPUS" --resources "mem_mb=$MEM_MB")
+NODE_SIZE=(--cores "$CPUS" --resources "mem_mb=$MEM_MB")  # last: --resources takes every word after it
 GROUPED_RULES="mesh_parts|search|simulate|optimise_shard"  # profiles/slurm's groups
 
 snakemake() {  # snakemake in working directory $1 on config file $2
@@ -134,7 +134,7 @@ slurm_run() {  # the workflow's own cluster profile in directory $1 on config $2
 compare_runs() {
     local label=$1 config=$2 target=$3
     local slurm_dir=$WORK/$label-slurm local_dir=$WORK/$label-local
-    slurm_run "$slurm_dir" "$config" "${NODE_SIZE[@]}" "$target" >"$slurm_dir.log" 2>&1 \
+    slurm_run "$slurm_dir" "$config" "$target" "${NODE_SIZE[@]}" >"$slurm_dir.log" 2>&1 \
         || { tail -40 "$slurm_dir.log"; fail "$label: the workflow failed under SLURM (log: $slurm_dir.log)"; }
     SUBMITTED=$(grep -c "Job .* has been submitted with SLURM jobid" "$slurm_dir.log" || true)
     [ "$SUBMITTED" -gt 0 ] || fail "$label: no job was submitted to SLURM (log: $slurm_dir.log)"
