@@ -199,7 +199,7 @@ def group_request(levels: Iterable[Iterable[Mapping[str, int]]], cores: int | No
     ``runtime`` (minutes), from its jobs' (``threads``, ``mem_mb``, ``runtime``) level by level
     (a level's jobs need only earlier levels' outputs), within ``cores`` and ``mem_mb`` (the
     run's ``--cores`` and ``--resources mem_mb``; None: no limit). Snakemake's own computation
-    (``GroupResources.basic_layered``): a level's jobs run side by side as far as the limits
+    (its GroupResources.basic_layered): a level's jobs run side by side as far as the limits
     allow, the rest in further layers one after another; CPUs and memory are a layer's sum,
     the largest over layers; the runtime is a layer's longest job, summed over layers."""
     from snakemake.resources import GroupResources, Resources
