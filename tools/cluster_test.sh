@@ -119,8 +119,9 @@ snakemake() {  # snakemake in working directory $1 on config file $2
 slurm_run() {  # the workflow's own cluster profile in directory $1 on config $2, then the arguments
     local dir=$1 config=$2; shift 2
     # partition from the environment as a user would set it; no accounting daemon here, so no
-    # account and squeue for job status; a job SLURM holds would hang the run: 30 min at most
-    SBATCH_PARTITION=$PARTITION SBATCH_ACCOUNT="" timeout 1800 "$BIN/python" -m snakemake -s "$ROOT/Snakefile" \
+    # account and squeue for job status; a job SLURM holds would hang the run: two hours at most
+    # (the ten objects took over 30 min through sbatch on this 2-core machine at a load of 15)
+    SBATCH_PARTITION=$PARTITION SBATCH_ACCOUNT="" timeout 7200 "$BIN/python" -m snakemake -s "$ROOT/Snakefile" \
         --directory "$dir" --configfile "$config" --replace-workflow-config \
         --workflow-profile "$ROOT/profiles/slurm" --jobs 4 \
         --slurm-no-account --slurm-status-command squeue --slurm-init-seconds-before-status-checks 1 "$@"
