@@ -19,7 +19,7 @@ from synergrasp.analysis.graspability import graspable_objects, ungraspable_line
 from synergrasp.config import SCHEMA_PATH, ConfigError, defaults, validate_config
 from synergrasp.hand.checks import check_hand, closure_shape_problems
 from synergrasp.hand.kinematics import default_hand_path, load_hand
-from synergrasp.preflight import configfile_problems, slurm_problems
+from synergrasp.preflight import configfile_problems, group_problems, partition_nodes, slurm_problems
 from synergrasp.simulation.capsules import HandCapsules
 from synergrasp.yaml_io import YamlFileError, read_yaml
 
@@ -302,6 +302,87 @@ def test_slurm_profile_needs_what_its_account_setting_calls():
     assert slurm_problems(_Settings("squeue"), _PROFILE, env, _which(everything - {"sacctmgr"})) == [
         "not on PATH: sacctmgr or sshare"
     ]
+
+
+#: profiles/slurm's groups: the submitted rules of one object.
+_GROUPS = {rule: "object" for rule in ("mesh_parts", "search", "simulate", "optimise_shard")}
+_ENV = {"SBATCH_PARTITION": "main"}
+
+
+def _nodes(*sizes):
+    """A partition of nodes of these (CPUs, MB), as sinfo would report it; records the partition asked."""
+    asked = []
+
+    def nodes_of(partition):
+        asked.append(partition)
+        return list(sizes)
+
+    nodes_of.asked = asked
+    return nodes_of
+
+
+def test_a_group_that_fits_the_partitions_node_is_accepted():
+    nodes = _nodes((2, 23081))
+    # the cluster test's node: 2 CPUs, 23,081 MB; groups cut to exactly that fit
+    assert group_problems(_GROUPS, 2, 23081, [("search", 1300), ("tables", 400)], _PROFILE, _ENV, nodes) == []
+    assert nodes.asked == ["main"]  # $SBATCH_PARTITION read from the environment
+    # a node of a larger kind besides a smaller one: the group fits the larger
+    assert group_problems(_GROUPS, 4, 16000, [], _PROFILE, _ENV, _nodes((2, 8000), (32, 192000))) == []
+
+
+def test_a_group_larger_than_every_node_is_refused_naming_the_limits_and_the_nodes():
+    # the profile's 4 CPUs on the 2-CPU test node: SLURM would hold the job (PartitionConfig)
+    (line,) = group_problems(_GROUPS, 4, 16000, [], _PROFILE, _ENV, _nodes((2, 23081)))
+    assert line == (
+        "a group job may ask for 4 CPUs and 16000 MB (cores and resources mem_mb), more than any node of "
+        "partition 'main' has (sinfo: 2 CPUs 23081 MB); set them to a node's size, e.g. --cores 2 --resources mem_mb=23081"
+    )
+    # CPUs on one kind of node, memory on another: no node holds both
+    (line,) = group_problems(_GROUPS, 8, 64000, [], _PROFILE, _ENV, _nodes((8, 32000), (4, 96000)))
+    assert "(sinfo: 4 CPUs 96000 MB, 8 CPUs 32000 MB)" in line and line.endswith("--cores 8 --resources mem_mb=32000")
+
+
+def test_a_job_asking_more_memory_than_the_node_is_refused_once_per_rule():
+    requests = [("tables", 43900), ("tables", 400), ("simulate", 300), ("realism", 16001), ("fig1", 16000)]
+    problems = group_problems(_GROUPS, 2, 16000, requests, _PROFILE, _ENV, _nodes((2, 23081)))
+    assert [p.split(":")[0] for p in problems] == ["rule tables", "rule realism"]
+    assert problems[0].startswith("rule tables: a job asks for 43900 MB, more than resources mem_mb (16000 MB")
+    assert problems[0].endswith("(--resources mem_mb=43900)")
+    # no memory limit given: nothing to compare a job with (groups then refused for the missing limit)
+    assert group_problems({}, None, None, requests, _PROFILE, _ENV, _nodes()) == []
+
+
+def test_groups_without_limits_or_without_a_readable_node_are_refused():
+    problems = group_problems(_GROUPS, None, None, [], _PROFILE, _ENV, _nodes((2, 23081)))
+    assert len(problems) == 2
+    assert problems[0].startswith("groups (mesh_parts, optimise_shard, search, simulate) without cores")
+    assert "without resources mem_mb" in problems[1]
+    (line,) = group_problems(_GROUPS, 2, 1000, [], _PROFILE, {"SBATCH_PARTITION": ""}, lambda p: "sinfo lists no node")
+    assert line.startswith("the size of a node of the default partition cannot be read") and line.endswith("sinfo lists no node")
+    # ungrouped: no group job to fit, sinfo not asked
+    nodes = _nodes()
+    assert group_problems({}, 2, 1000, [], _PROFILE, _ENV, nodes) == [] and nodes.asked == []
+
+
+def test_sinfo_output_is_read_as_cpus_and_megabytes():
+    def run(output="", code=0, err=""):
+        calls = []
+
+        def fake(command, **kwargs):
+            calls.append(command)
+            return subprocess.CompletedProcess(command, code, output, err)
+
+        fake.calls = calls
+        return fake
+
+    fake = run("2 23081\n48+ 191000+\n")
+    assert partition_nodes("main", fake) == [(2, 23081), (48, 191000)]  # "+": the line's smallest
+    assert fake.calls == [["sinfo", "--noheader", "--format=%c %m", "--partition", "main"]]
+    fake = run("")
+    assert partition_nodes("", fake) == "sinfo --noheader --format=%c %m lists no node"
+    assert fake.calls[0][-1] == "--format=%c %m"  # no partition: sinfo's default
+    said = partition_nodes("gpu", run(code=1, err="sinfo: error: x\nsinfo: fatal: Could not establish a configuration source\n"))
+    assert said.endswith("failed: sinfo: fatal: Could not establish a configuration source") and "\n" not in said
 
 
 # --------------------------------------------------------------------------- kind 8: make report first

@@ -5,6 +5,7 @@ names a private Snakemake module or attribute."""
 
 from __future__ import annotations
 
+import os
 import re
 import subprocess
 import sys
@@ -241,6 +242,94 @@ def test_a_pending_timer_is_cancelled():
 def test_the_workflows_rules_are_snakemakes_parse():
     names = {rule.name for rule in adapter.workflow_rules(ROOT / "Snakefile", ROOT)}
     assert {"all", "figures", "simulate", "optimise_shard", "optimise", "tables"} <= names
+
+
+# --------------------------------------------------------------------------- job groups
+
+#: A workflow of N objects, each with the profile's grouped rules mesh_parts -> simulate; when it
+#: runs, it prints the run's groups and limits as the adapter reads them (Snakemake hands the
+#: workflow its groups only to run it).
+_GROUPED = """
+from synergrasp.snakemake_adapter import group_limits
+
+
+onstart:
+    print("LIMITS", group_limits(workflow))
+
+
+rule all:
+    input:
+        expand("out/{{object}}.sim", object=range({n})),
+
+
+rule mesh_parts:
+    output:
+        "out/{{object}}.parts",
+    shell:
+        "touch {{output}}"
+
+
+rule simulate:
+    input:
+        "out/{{object}}.parts",
+    output:
+        "out/{{object}}.sim",
+    shell:
+        "touch {{output}}"
+"""
+
+
+def _with_slurm_profile(tmp_path: Path, n: int, *args: str) -> str:
+    """Snakemake's output on the workflow of ``n`` objects with profiles/slurm and ``args``."""
+    (tmp_path / "Snakefile").write_text(_GROUPED.format(n=n))
+    env = {**os.environ, "SBATCH_PARTITION": "main", "SBATCH_ACCOUNT": ""}
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "snakemake",
+            "-s",
+            str(tmp_path / "Snakefile"),
+            "--workflow-profile",
+            str(ROOT / "profiles" / "slurm"),
+        ]
+        + ["--slurm-no-account", *args],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    return out.stdout + out.stderr
+
+
+def test_the_slurm_profile_groups_twenty_objects_a_job_within_a_node(tmp_path):
+    # planned on SLURM: 45 objects' 90 jobs, 20 objects a group job: 3 jobs (20, 20 and 5 objects)
+    assert _with_slurm_profile(tmp_path, 45, "-n").count("Group job object") == 3
+    assert _with_slurm_profile(tmp_path, 45, "-n", "--group-components", "object=1").count("Group job object") == 45
+    # run here (the profile's settings, the executor aside): its groups, cores 4 and mem_mb 16000
+    groups = {"mesh_parts": "object", "search": "object", "simulate": "object", "optimise_shard": "object"}
+    assert f"LIMITS ({groups!r}, 4, 16000)" in _with_slurm_profile(tmp_path, 3, "--executor", "local")
+    # the node size given on the command line replaces the profile's
+    text = _with_slurm_profile(tmp_path, 3, "--executor", "local", "-F", "--cores", "2", "--resources", "mem_mb=3000")
+    assert f"LIMITS ({groups!r}, 2, 3000)" in text
+
+
+def test_a_group_jobs_request_is_laid_within_the_node_by_hand():
+    shard = {"threads": 1, "mem_mb": 700, "runtime": 4}
+    # 20 shards side by side: 20 CPUs, 14,000 MB, 4 min - more than a 2-CPU node has
+    assert adapter.group_request([[shard] * 20], None, None) == {"threads": 20, "mem_mb": 14000, "runtime": 4}
+    # within 2 cores: two at a time, 10 layers of 4 min
+    assert adapter.group_request([[shard] * 20], 2, 16000) == {"threads": 2, "mem_mb": 1400, "runtime": 40}
+    # within 2,000 MB (4 cores): two at a time again, by memory
+    assert adapter.group_request([[shard] * 20], 4, 2000) == {"threads": 2, "mem_mb": 1400, "runtime": 40}
+    # levels: three 2-thread searches of 7 min, then three 1-thread closures of 1 min, on 4 cores:
+    # 2 + 1 searches (14 min, 2 x 1,300 MB), then the 3 closures in one layer (1 min)
+    search, closure = {"threads": 2, "mem_mb": 1300, "runtime": 7}, {"threads": 1, "mem_mb": 300, "runtime": 1}
+    assert adapter.group_request([[search] * 3, [closure] * 3], 4, 16000) == {"threads": 4, "mem_mb": 2600, "runtime": 15}
+    # on 2 cores: one search at a time (21 min), closures 2 + 1 (2 min)
+    assert adapter.group_request([[search] * 3, [closure] * 3], 2, 16000) == {"threads": 2, "mem_mb": 1300, "runtime": 23}
 
 
 # --------------------------------------------------------------------------- the scan

@@ -167,7 +167,7 @@ def test_the_slurm_profile_in_a_shell_that_cannot_submit_starts_no_job(run, tmp_
     env = {k: v for k, v in os.environ.items() if not k.startswith("SBATCH_")}
     env["PATH"] = str(tools)
     text = _refused(run, SMALL, "--workflow-profile", str(ROOT / "profiles" / "slurm"), env=env)
-    line = _one_line(text, "The SLURM profile cannot submit from this shell, nothing was run:")
+    line = _one_line(text, "The SLURM profile cannot run this workflow here, nothing was run:")
     assert "$SBATCH_ACCOUNT is not set" in line and "$SBATCH_PARTITION is not set" in line
     assert "not on PATH: sbatch, scancel, sacct or squeue" in line
     assert not (run / "results" / "tables" / "claims.csv").exists()

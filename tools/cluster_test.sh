@@ -2,8 +2,12 @@
 # The small study on a real SLURM scheduler: start a single-node SLURM on this machine
 # (Debian packages slurmctld/slurmd, installed here when missing), run tests/config/small.yaml
 # (`figures`), then 10 of pybullet's random meshes on its grid (`across_objects`), through
-# `--workflow-profile profiles/slurm`; for each, check that every output of a local -j2 run
-# exists and that the tables and per-object Parquet and CSV files are byte-identical to it.
+# `--workflow-profile profiles/slurm` with its job groups (each object's submitted jobs in one
+# group, 20 objects a sbatch job) cut to this node's size; for each, check that every output of a
+# local -j2 run exists and that the tables and per-object Parquet and CSV files are
+# byte-identical to it, and that the groups sent far fewer jobs through sbatch than the
+# submitted jobs they ran, none asking for more than the node has. First, the profile's own
+# node size (4 CPUs) on a node with fewer is refused before any job, with one line.
 # The daemons started here are stopped by their pid files on exit.
 #
 #   tools/cluster_test.sh [BIN]      BIN: the venv's bin directory (default .venv/bin)
@@ -81,6 +85,7 @@ SlurmdPidFile=$STATE/slurmd.pid
 ProctrackType=proctrack/linuxproc
 TaskPlugin=task/none
 JobAcctGatherType=jobacct_gather/none
+MinJobAge=3600
 AccountingStorageType=accounting_storage/none
 SelectType=select/cons_tres
 SelectTypeParameters=CR_Core_Memory
@@ -101,27 +106,61 @@ $(tail -5 "$STATE/log/slurmctld.log" 2>/dev/null)
 $(tail -5 "$STATE/log/slurmd.log" 2>/dev/null)"
 echo "SLURM up: node $HOST, $CPUS CPUs, $MEM_MB MB, partition $PARTITION ($(( $(date +%s) - started )) s)"
 
+# The node's size, which the profile's group jobs are cut to (profiles/slurm: cores, resources mem_mb)
+NODE_SIZE=(--cores "$CPUS" --resources "mem_mb=$MEM_MB")  # last: --resources takes every word after it
+GROUPED_RULES="mesh_parts|search|simulate|optimise_shard"  # profiles/slurm's groups
+
 snakemake() {  # snakemake in working directory $1 on config file $2
     local dir=$1 config=$2; shift 2
     "$BIN/python" -m snakemake -s "$ROOT/Snakefile" --directory "$dir" \
         --configfile "$config" --replace-workflow-config "$@"
 }
 
-# Run TARGET on CONFIG under SLURM and locally with -j2; every output of the local run must
-# exist after the SLURM run, nothing be left to do, and the tables and per-object Parquet files
-# be byte-identical. Sets SUBMITTED, N_OUTPUTS, COMPARED.
+slurm_run() {  # the workflow's own cluster profile in directory $1 on config $2, then the arguments
+    local dir=$1 config=$2; shift 2
+    # partition from the environment as a user would set it; no accounting daemon here, so no
+    # account and squeue for job status; a job SLURM holds would hang the run: two hours at most
+    # (the ten objects took over 30 min through sbatch on this 2-core machine at a load of 15)
+    SBATCH_PARTITION=$PARTITION SBATCH_ACCOUNT="" timeout 7200 "$BIN/python" -m snakemake -s "$ROOT/Snakefile" \
+        --directory "$dir" --configfile "$config" --replace-workflow-config \
+        --workflow-profile "$ROOT/profiles/slurm" --jobs 4 \
+        --slurm-no-account --slurm-status-command squeue --slurm-init-seconds-before-status-checks 1 "$@"
+}
+
+# Run TARGET on CONFIG under SLURM (grouped, cut to the node) and locally with -j2; every output
+# of the local run must exist after the SLURM run, nothing be left to do, and the tables and
+# per-object Parquet files be byte-identical; the group jobs must be fewer than the submitted
+# jobs they ran, each within the node. Sets SUBMITTED, UNGROUPED, MAX_CPUS, MAX_MEM_MB,
+# MAX_TIME, N_OUTPUTS, COMPARED.
 compare_runs() {
     local label=$1 config=$2 target=$3
     local slurm_dir=$WORK/$label-slurm local_dir=$WORK/$label-local
-    # the workflow's own cluster profile; partition from the environment as a user would set it;
-    # no accounting daemon here, so no account and squeue for job status
-    SBATCH_PARTITION=$PARTITION SBATCH_ACCOUNT="" snakemake "$slurm_dir" "$config" \
-        --workflow-profile "$ROOT/profiles/slurm" --jobs 4 \
-        --slurm-no-account --slurm-status-command squeue --slurm-init-seconds-before-status-checks 1 \
-        "$target" >"$slurm_dir.log" 2>&1 || { tail -40 "$slurm_dir.log"; fail "$label: the workflow failed under SLURM (log: $slurm_dir.log)"; }
+    slurm_run "$slurm_dir" "$config" "$target" "${NODE_SIZE[@]}" >"$slurm_dir.log" 2>&1 \
+        || { tail -40 "$slurm_dir.log"; fail "$label: the workflow failed under SLURM (log: $slurm_dir.log)"; }
     SUBMITTED=$(grep -c "Job .* has been submitted with SLURM jobid" "$slurm_dir.log" || true)
     [ "$SUBMITTED" -gt 0 ] || fail "$label: no job was submitted to SLURM (log: $slurm_dir.log)"
-    echo "$label: SLURM run done, $SUBMITTED jobs through sbatch ($(( $(date +%s) - started )) s)"
+    # ungrouped, every job of a submitted rule would be a sbatch job of its own: the run's job stats
+    UNGROUPED=$(awk -v rules="^($GROUPED_RULES)\$" '/^Job stats:/ {on = 1; next} on && $1 ~ rules {n += $2} on && $1 == "total" {exit} END {print n + 0}' "$slurm_dir.log")
+    [ "$SUBMITTED" -lt "$UNGROUPED" ] || fail "$label: $SUBMITTED sbatch jobs for $UNGROUPED submitted jobs: the profile's groups did not group them"
+    # what each sbatch job asked for, as SLURM recorded it (MinJobAge keeps finished jobs an hour)
+    MAX_CPUS=0 MAX_MEM_MB=0 MAX_TIME=0
+    for id in $(sed -n 's/.*has been submitted with SLURM jobid \([0-9]*\).*/\1/p' "$slurm_dir.log"); do
+        read -r cpus mem minutes < <(scontrol show job -o "$id" | awk '{
+            for (i = 1; i <= NF; i++) {
+                split($i, kv, "=")
+                if (kv[1] == "NumCPUs") cpus = kv[2]
+                if (kv[1] == "MinMemoryNode") { mem = kv[2]; if (mem ~ /G$/) mem *= 1024; sub(/M$/, "", mem) }
+                if (kv[1] == "TimeLimit") { n = split(kv[2], t, ":"); minutes = t[1] * 60 + t[2]; if (n == 2) minutes = t[1] }
+            }
+            print cpus + 0, mem + 0, minutes + 0 }')
+        [ "$cpus" -le "$CPUS" ] && [ "$mem" -le "$MEM_MB" ] \
+            || fail "$label: SLURM job $id asked for $cpus CPUs and $mem MB, more than the node's $CPUS CPUs and $MEM_MB MB"
+        [ "$cpus" -gt "$MAX_CPUS" ] && MAX_CPUS=$cpus
+        [ "$mem" -gt "$MAX_MEM_MB" ] && MAX_MEM_MB=$mem
+        [ "$minutes" -gt "$MAX_TIME" ] && MAX_TIME=$minutes
+    done
+    echo "$label: SLURM run done, $SUBMITTED jobs through sbatch for $UNGROUPED submitted jobs, the largest" \
+         "asking $MAX_CPUS CPUs, $MAX_MEM_MB MB, $MAX_TIME min ($(( $(date +%s) - started )) s)"
 
     snakemake "$local_dir" "$config" -j2 "$target" >"$local_dir.log" 2>&1 \
         || { tail -40 "$local_dir.log"; fail "$label: the local -j2 run failed (log: $local_dir.log)"; }
@@ -142,7 +181,27 @@ compare_runs() {
     [ "$COMPARED" -gt 0 ] || fail "$label: no tables were compared"
     echo "$label passed: $SUBMITTED SLURM jobs, $N_OUTPUTS outputs present, $COMPARED tables and" \
          "per-object files byte-identical to a local -j2 run, $(( $(date +%s) - started )) s in all"
+    # machine-read lines (tools/measurements.py record)
+    echo "${label}_sbatch_jobs: $SUBMITTED  (sbatch jobs of the grouped run)"
+    echo "${label}_submitted_jobs: $UNGROUPED  (jobs of the submitted rules: the sbatch jobs of an ungrouped run)"
+    echo "${label}_largest_request_cpus: $MAX_CPUS  (CPUs of the largest sbatch job, scontrol; the node has $CPUS)"
+    echo "${label}_largest_request_mem_mb: $MAX_MEM_MB  (memory of the largest sbatch job, MB, scontrol; the node has $MEM_MB)"
+    echo "${label}_largest_request_min: $MAX_TIME  (time limit of the longest sbatch job, min, scontrol)"
+    echo "${label}_files_compared: $COMPARED  (tables and per-object files byte-identical to the local run)"
 }
+
+# 0. the profile's own node size (4 CPUs, 16000 MB) on a smaller node: refused before any job
+if [ "$CPUS" -lt 4 ]; then
+    refused=$WORK/refused
+    if slurm_run "$refused" "$SMALL" figures >"$refused.log" 2>&1; then
+        fail "the profile's 4-CPU groups on this $CPUS-CPU node were not refused (log: $refused.log)"
+    fi
+    grep -q "more than any node of partition '$PARTITION' has" "$refused.log" \
+        || { tail -20 "$refused.log"; fail "the profile's 4-CPU groups on this $CPUS-CPU node failed without the node-size line (log: $refused.log)"; }
+    ! grep -q "has been submitted with SLURM jobid" "$refused.log" || fail "a job was submitted before the node-size refusal"
+    [ ! -e "$refused/results" ] || [ -z "$(find "$refused/results" -name '*.parquet')" ] || fail "jobs ran before the node-size refusal"
+    echo "refused before any job: $(grep -o "a group job may ask for [^;]*" "$refused.log" | head -1)"
+fi
 
 # 1. the small study (two boxes)
 compare_runs small "$SMALL" figures

@@ -71,6 +71,7 @@ SECTIONS = (
             "cluster_test",
             "dry_run",
             "cluster_thousand",
+            "cluster_groups",
             "tables_memory",
         ),
         "Whole runs besides the default study; `tools/measurements.py record NAME --timed -- COMMAND` records one "

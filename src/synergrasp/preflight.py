@@ -1,7 +1,8 @@
 """Checks the workflow runs before any job besides the configuration's own (``config``): the
-YAML files Snakemake reads itself and the scheduler behind the cluster profile. Each problem
-is one line naming the file, the key, the command or the variable; :func:`refuse` stops the
-run with those lines alone. What the workflow needs of Snakemake's internals is in
+YAML files Snakemake reads itself, the scheduler behind the cluster profile, and the size of the
+group jobs the profile submits against the partition's nodes. Each problem is one line naming
+the file, the key, the command or the variable; :func:`refuse` stops the run with those lines
+alone. What the workflow needs of Snakemake's internals is in
 ``synergrasp.snakemake_adapter``. Imports nothing of the project but ``yaml_io``.
 """
 
@@ -10,13 +11,14 @@ from __future__ import annotations
 import os
 import re
 import shutil
+import subprocess
 import sys
 from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 from synergrasp.yaml_io import YamlFileError, read_yaml
 
-__all__ = ["configfile_problems", "slurm_problems", "refuse"]
+__all__ = ["configfile_problems", "slurm_problems", "group_problems", "partition_nodes", "refuse"]
 
 #: The first line of every refusal before any job.
 REFUSED = "Invalid input, nothing was run:"
@@ -83,4 +85,88 @@ def slurm_problems(
             missing.append(commands)
     if missing:
         problems.append(f"not on PATH: {', '.join(' or '.join(c) for c in missing)}")
+    return problems
+
+
+def partition_nodes(partition: str, run: Callable[..., Any] = subprocess.run) -> list[tuple[int, int]] | str:
+    """The nodes of SLURM partition ``partition`` (the default partition if empty) as ``sinfo``
+    reports them: (CPUs, memory in MB) of each kind of node; or, when sinfo cannot tell, the
+    one line saying why. A value sinfo marks ``+`` (nodes of one line differing) is read as
+    its smallest."""
+    command = ["sinfo", "--noheader", "--format=%c %m", *(["--partition", partition] if partition else [])]
+    try:
+        done = run(command, capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.SubprocessError) as err:
+        return f"{' '.join(command)} could not run ({err})"
+    if done.returncode != 0:
+        said = (done.stderr or "").strip().splitlines()  # sinfo's last line says why
+        return f"{' '.join(command)} failed: {said[-1] if said else f'exit status {done.returncode}'}"
+    nodes = []
+    for line in done.stdout.splitlines():
+        fields = line.replace("+", "").split()
+        if len(fields) == 2 and all(f.isdigit() for f in fields):
+            nodes.append((int(fields[0]), int(fields[1])))
+    return nodes or f"{' '.join(command)} lists no node"
+
+
+def group_problems(
+    groups: Mapping[str, str],
+    cores: int | None,
+    mem_mb: int | None,
+    requests: Iterable[tuple[str, int]],
+    raw_resources: Mapping[str, Any],
+    environ: Mapping[str, str] = os.environ,
+    nodes_of: Callable[[str], list[tuple[int, int]] | str] = partition_nodes,
+) -> list[str]:
+    """What would make a cluster job ask for more than one node has, one item per problem,
+    before any job (docs/cluster.md, "Job groups").
+
+    Snakemake lays the jobs of a group side by side within ``--cores`` (``cores``, CPUs) and
+    ``--resources mem_mb`` (``mem_mb``, MB), the rest one after another, so a group job asks for
+    at most those; without them it asks for all its jobs side by side. Problems: a grouping
+    (``groups``: rule -> group) without either limit; limits that no node of the profile's
+    partition (``slurm_partition`` of ``raw_resources``, its variables read from ``environ``)
+    holds both of, as ``nodes_of`` (sinfo) reports them; a job asking for more memory than
+    ``mem_mb``, which Snakemake would refuse only when the job is ready to run (the jobs run
+    where Snakemake runs count against ``mem_mb`` too). ``requests``: (rule, memory request of
+    one job in MB) of every job the run may start, one line per rule at its largest request."""
+    problems = []
+    if groups:
+        grouped = ", ".join(sorted(groups))
+        if cores is None:
+            problems.append(
+                f"groups ({grouped}) without cores: a group job would ask for the CPUs of all its jobs side by side; "
+                "set cores (--cores N) to a node's CPUs"
+            )
+        if mem_mb is None:
+            problems.append(
+                f"groups ({grouped}) without resources mem_mb: a group job would ask for the memory of all its jobs "
+                "side by side; set it (--resources mem_mb=M) to a node's memory in MB"
+            )
+        if cores is not None and mem_mb is not None:
+            partition = _VARIABLE.sub(lambda m: environ.get(m.group(1), ""), str(raw_resources.get("slurm_partition") or ""))
+            nodes = nodes_of(partition.strip())
+            where = f"partition '{partition.strip()}'" if partition.strip() else "the default partition"
+            if isinstance(nodes, str):
+                problems.append(
+                    f"the size of a node of {where} cannot be read, so a group job cannot be checked to fit one: {nodes}"
+                )
+            elif not any(cpus >= cores and memory >= mem_mb for cpus, memory in nodes):
+                cpus, memory = max(nodes)
+                problems.append(
+                    f"a group job may ask for {cores} CPUs and {mem_mb} MB (cores and resources mem_mb), more than any node "
+                    f"of {where} has (sinfo: {', '.join(f'{c} CPUs {m} MB' for c, m in sorted(set(nodes)))}); "
+                    f"set them to a node's size, e.g. --cores {cpus} --resources mem_mb={memory}"
+                )
+    if mem_mb is not None:
+        largest: dict[str, int] = {}
+        for rule, request in requests:
+            largest[rule] = max(request, largest.get(rule, 0))
+        problems += [
+            f"rule {rule}: a job asks for {request} MB, more than resources mem_mb ({mem_mb} MB, the size of a node "
+            f"that groups are cut to; Snakemake would refuse the job when it is ready to run): raise it to at least "
+            f"{request} if a node has that much (--resources mem_mb={request})"
+            for rule, request in largest.items()
+            if request > mem_mb
+        ]
     return problems

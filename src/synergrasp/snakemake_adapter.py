@@ -9,9 +9,11 @@ tested on a small workflow of its own (tests/test_snakemake_adapter.py):
 - every output is kept until its replacement is complete (:func:`keep_outputs_until_replaced`)
   and a failed job's kept outputs are outdated (:func:`outdate_failed_outputs`);
 - the scheduler's timers are cancelled at the end of a run (:func:`cancel_scheduler_timers`);
-- what the workflow object holds: its configuration files, the SLURM executor's settings, its
-  rules, the rules run where Snakemake runs (:func:`config_files`, :func:`slurm_settings`,
-  :func:`workflow_rules`, :func:`run_locally`).
+- what the workflow object holds: its configuration files, the SLURM executor's settings, the
+  groups and the limits a group's jobs are laid within, its rules, the rules run where
+  Snakemake runs (:func:`config_files`, :func:`slurm_settings`, :func:`group_limits`,
+  :func:`workflow_rules`, :func:`run_locally`);
+- what Snakemake asks the scheduler for a group job (:func:`group_request`).
 
 No other module of the project names a private Snakemake module or attribute
 (tests/test_snakemake_adapter.py scans the sources). Imports nothing of the project.
@@ -24,8 +26,9 @@ import os
 import shutil
 import sys
 import threading
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 __all__ = [
@@ -37,6 +40,8 @@ __all__ = [
     "cancel_scheduler_timers",
     "config_files",
     "slurm_settings",
+    "group_limits",
+    "group_request",
     "run_locally",
     "workflow_rules",
 ]
@@ -180,6 +185,37 @@ def slurm_settings(workflow: Any) -> tuple[Any, dict[str, Any]] | None:
         return None
     raw = {key: value.raw for key, value in workflow.resource_settings.default_resources.items()}
     return workflow.executor_settings, raw
+
+
+def group_limits(workflow: Any) -> tuple[dict[str, str], int | None, int | None]:
+    """The run's job groups (``--groups``: rule -> group) and the limits Snakemake lays a group
+    job's jobs within: ``--cores`` (CPUs) and ``--resources mem_mb`` (MB), None where not given."""
+    limits = workflow.global_resources
+    return dict(workflow.group_settings.overwrite_groups), limits.get("_cores").value, limits.get("mem_mb").value
+
+
+def group_request(levels: Iterable[Iterable[Mapping[str, int]]], cores: int | None, mem_mb: int | None) -> dict[str, int]:
+    """What Snakemake asks the scheduler for a group job: ``threads`` (CPUs), ``mem_mb`` (MB) and
+    ``runtime`` (minutes), from its jobs' (``threads``, ``mem_mb``, ``runtime``) level by level
+    (a level's jobs need only earlier levels' outputs), within ``cores`` and ``mem_mb`` (the
+    run's ``--cores`` and ``--resources mem_mb``; None: no limit). Snakemake's own computation
+    (its GroupResources.basic_layered): a level's jobs run side by side as far as the limits
+    allow, the rest in further layers one after another; CPUs and memory are a layer's sum,
+    the largest over layers; the runtime is a layer's longest job, summed over layers."""
+    from snakemake.resources import GroupResources, Resources
+
+    jobs = [
+        [
+            SimpleNamespace(resources={"_cores": j["threads"], "mem_mb": j["mem_mb"], "runtime": j["runtime"]}, pipe_group=None)
+            for j in level
+        ]
+        for level in levels
+    ]
+    limits = {name: value for name, value in (("_cores", cores), ("mem_mb", mem_mb)) if value is not None}
+    asked = GroupResources.basic_layered(
+        jobs, Resources.from_mapping(limits), run_local=False, additive_resources=["runtime"], sortby=["runtime"]
+    )
+    return {"threads": asked["_cores"], "mem_mb": asked["mem_mb"], "runtime": asked["runtime"]}
 
 
 def run_locally(workflow: Any, rules: Iterable[str]) -> None:

@@ -468,12 +468,23 @@ class Wiring:
         return {"mem_mb": lambda w: self._request(rule, w)["mem_mb"], "runtime": lambda w: self._request(rule, w)["runtime"]}
 
     def _request(self, rule: str, wildcards: Any) -> dict[str, int]:
-        """The requests of a job of ``rule``, computed once per scenario (the same for every job)."""
-        key = (rule, self.job_scenario(wildcards))
+        """The requests of a job of ``rule`` (its wildcards name its scenario)."""
+        return self.scenario_request(rule, self.job_scenario(wildcards))
+
+    def scenario_request(self, rule: str, name: str) -> dict[str, int]:
+        """The requests of a job of ``rule`` in scenario ``name``, computed once per scenario
+        (the same for every job): ``mem_mb`` (MB) and ``runtime`` (minutes)."""
+        key = (rule, name)
         if key not in self._requests:
-            cfg = self.scenario(key[1])
+            cfg = self.scenario(name)
             self._requests[key] = {"mem_mb": mem_mb(rule, cfg), "runtime": runtime_min(rule, cfg)}
         return self._requests[key]
+
+    def memory_requests(self) -> list[tuple[str, int]]:
+        """(rule, memory request of one job in MB) of every rule in every scenario checked so far:
+        every scenario a job of the run belongs to (a job's inputs check its scenario), for the
+        check that no job asks for more than a node has (``preflight.group_problems``)."""
+        return [(rule, self.scenario_request(rule, name)["mem_mb"]) for name in list(self._checked) for rule in rule_costs()]
 
     # ---- targets
 

@@ -12,7 +12,7 @@ from synergrasp import snakemake_adapter as adapter
 # The adapter was written for one Snakemake release series: any other stops here, one line.
 adapter.check_version()
 
-from synergrasp.preflight import configfile_problems, refuse, slurm_problems
+from synergrasp.preflight import configfile_problems, group_problems, refuse, slurm_problems
 from synergrasp.steps import RESULTS, rule_costs
 from synergrasp.study_checks import older_results_problems
 from synergrasp.wiring import RuleFiles, Wiring, report_archive
@@ -66,13 +66,16 @@ adapter.run_locally(workflow, [rule for rule, cost in rule_costs().items() if co
 
 
 onstart:
-    # A cluster profile on a machine or shell that cannot submit: one line, before any job.
+    # A cluster profile on a machine or shell that cannot submit, or whose group jobs would
+    # ask for more than a node has: one line, before any job.
     _slurm = adapter.slurm_settings(workflow)
     if _slurm is not None:
-        _problems = slurm_problems(*_slurm)
+        _problems = slurm_problems(*_slurm) + group_problems(
+            *adapter.group_limits(workflow), W.memory_requests(), _slurm[1]
+        )
         if _problems:
             raise WorkflowError(
-                "The SLURM profile cannot submit from this shell, nothing was run: "
+                "The SLURM profile cannot run this workflow here, nothing was run: "
                 + "; ".join(_problems)
             )
 
