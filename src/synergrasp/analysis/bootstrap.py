@@ -68,25 +68,35 @@ class PoseResampler:
 
     def __init__(self, poses: pd.DataFrame, periods_deg: Mapping[str, float], settings: BootstrapSettings):
         self.settings = settings
-        rng = np.random.default_rng(settings.seed)
+        self._rng = np.random.default_rng(settings.seed)
         self._poses: dict[str, NDArray] = {}
         self._block_weights: dict[str, NDArray] = {}
         self._blocks: dict[str, NDArray] = {}
         unique = poses[["object", "pose", "alpha_deg", "beta_deg"]].drop_duplicates(["object", "pose"])
         for obj in sorted(unique["object"].unique()):
-            own = unique[unique["object"] == obj].sort_values("pose")
-            alpha, beta = own["alpha_deg"].to_numpy(float), own["beta_deg"].to_numpy(float)
-            keep = distinct_pose_mask(alpha, float(periods_deg.get(obj, 360.0)))
-            blocks = block_index(alpha[keep], beta[keep], settings.block_deg, float(alpha.min()), float(beta.min()))
-            n_blocks = int(blocks.max()) + 1 if blocks.size else 0
-            draws = (
-                rng.multinomial(n_blocks, np.full(n_blocks, 1.0 / n_blocks), size=settings.resamples)
-                if n_blocks
-                else np.zeros((settings.resamples, 0), dtype=np.int64)
-            )
-            self._poses[obj] = own["pose"].to_numpy()[keep]
-            self._blocks[obj] = blocks
-            self._block_weights[obj] = np.vstack([np.ones((1, n_blocks)), draws]).astype(float)
+            self.add(obj, unique[unique["object"] == obj], float(periods_deg.get(obj, 360.0)))
+
+    def add(self, obj: str, poses: pd.DataFrame, period_deg: float) -> None:
+        """Draw the blocks of one more object: ``poses`` its rows (columns pose, alpha_deg,
+        beta_deg; repeated poses are read once), ``period_deg`` its α-period. The objects must
+        come in sorted order, each once: one generator draws for all of them, so that an
+        object at a time (``synergrasp.analysis.study_tables``) gives the same weights as
+        every object at once."""
+        if self._poses and not str(obj) > list(self._poses)[-1]:
+            raise ValueError(f"PoseResampler.add: objects in sorted order, each once; {obj!r} after {list(self._poses)[-1]!r}")
+        own = poses[["pose", "alpha_deg", "beta_deg"]].drop_duplicates("pose").sort_values("pose")
+        alpha, beta = own["alpha_deg"].to_numpy(float), own["beta_deg"].to_numpy(float)
+        keep = distinct_pose_mask(alpha, period_deg)
+        blocks = block_index(alpha[keep], beta[keep], self.settings.block_deg, float(alpha.min()), float(beta.min()))
+        n_blocks = int(blocks.max()) + 1 if blocks.size else 0
+        draws = (
+            self._rng.multinomial(n_blocks, np.full(n_blocks, 1.0 / n_blocks), size=self.settings.resamples)
+            if n_blocks
+            else np.zeros((self.settings.resamples, 0), dtype=np.int64)
+        )
+        self._poses[obj] = own["pose"].to_numpy()[keep]
+        self._blocks[obj] = blocks
+        self._block_weights[obj] = np.vstack([np.ones((1, n_blocks)), draws]).astype(float)
 
     @property
     def objects(self) -> list[str]:

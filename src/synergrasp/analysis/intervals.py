@@ -48,20 +48,42 @@ class StudyCounts:
     def __init__(self, table: pd.DataFrame, full_set_id: str, resampler: PoseResampler):
         self.resampler = resampler
         self.full = full_set_id
-        self.sets: list[str] = sorted(table["set_id"].astype(str).unique(), key=set_order)
-        self.objects = resampler.objects
         self._success: dict[str, NDArray] = {}
         self._force: dict[str, NDArray] = {}
         self._sums: dict[str, NDArray] = {}
-        for obj in self.objects:
-            own = table[table["object"] == obj]
-            poses = resampler.poses(obj)
-            success = own.pivot(index="pose", columns="set_id", values="success")
-            force = own.pivot(index="pose", columns="set_id", values="success_force")
-            success = success.reindex(index=poses, columns=self.sets).fillna(False).to_numpy(bool)
-            self._success[obj] = success
-            self._force[obj] = force.reindex(index=poses, columns=self.sets).to_numpy(float)
-            self._sums[obj] = resampler.sums(obj, success)
+        self._own_sets: dict[str, list[str]] = {}
+        for obj in resampler.objects:
+            self.add(obj, table[table["object"] == obj])
+        self.finish(table["set_id"].astype(str).unique())
+
+    def add(self, obj: str, own: pd.DataFrame) -> None:
+        """Count one object of the resampler (``own``: its rows of the gfo table with its
+        verdicts), over the sets it has; :meth:`finish` aligns every object on the study's sets."""
+        poses = self.resampler.poses(obj)
+        sets = sorted(own["set_id"].astype(str).unique(), key=set_order)
+        success = own.pivot(index="pose", columns="set_id", values="success")
+        force = own.pivot(index="pose", columns="set_id", values="success_force")
+        success = success.reindex(index=poses, columns=sets).fillna(False).to_numpy(bool)
+        self._success[obj] = success
+        self._force[obj] = force.reindex(index=poses, columns=sets).to_numpy(float)
+        self._sums[obj] = self.resampler.sums(obj, success)
+        self._own_sets[obj] = sets
+
+    def finish(self, set_ids: Sequence[str]) -> None:
+        """Every object counted: the study's sets are ``set_ids`` (every object's); an object
+        without a set counts no success of it (weighted sums of integers: exact, so the counts
+        are those of every object at once)."""
+        self.sets: list[str] = sorted({str(s) for s in set_ids}, key=set_order)
+        self.objects = self.resampler.objects
+        for obj, own_sets in self._own_sets.items():
+            if own_sets == self.sets:
+                continue
+            where = [self.sets.index(s) for s in own_sets]
+            for store, fill in ((self._success, False), (self._force, np.nan), (self._sums, 0.0)):
+                full = np.full((store[obj].shape[0], len(self.sets)), fill, dtype=store[obj].dtype)
+                full[:, where] = store[obj]
+                store[obj] = full
+        self._own_sets = {}
         self._col = {s: i for i, s in enumerate(self.sets)}
 
     @property
