@@ -96,7 +96,10 @@ class PoseResampler:
         )
         self._poses[obj] = own["pose"].to_numpy()[keep]
         self._blocks[obj] = blocks
-        self._block_weights[obj] = np.vstack([np.ones((1, n_blocks)), draws]).astype(float)
+        weights = np.vstack([np.ones((1, n_blocks), dtype=np.int64), draws])
+        # held as the smallest integer type of the counts (a byte each, not eight: a thousand
+        # objects' resamples fit in a job), read back as floats
+        self._block_weights[obj] = weights.astype(np.min_scalar_type(int(weights.max(initial=1))))
 
     @property
     def objects(self) -> list[str]:
@@ -111,7 +114,7 @@ class PoseResampler:
 
     def weights(self, obj: str) -> NDArray:
         """(1 + resamples, n_distinct) pose weights of ``obj``: row 0 ones, then the resamples."""
-        return self._block_weights[obj][:, self._blocks[obj]]
+        return self._block_weights[obj][:, self._blocks[obj]].astype(float)
 
     def sums(self, obj: str, values: NDArray) -> NDArray:
         """Weighted sums over ``obj``'s distinct poses of ``values`` (n_distinct,) or
@@ -121,7 +124,7 @@ class PoseResampler:
         flat = values.reshape(len(values), -1)
         per_block = np.zeros((n_blocks, flat.shape[1]))
         np.add.at(per_block, self._blocks[obj], flat)
-        out = self._block_weights[obj] @ per_block
+        out = self._block_weights[obj].astype(float) @ per_block
         return out[:, 0] if values.ndim == 1 else out
 
 
