@@ -72,6 +72,7 @@ SECTIONS = (
             "dry_run",
             "cluster_thousand",
             "tables_memory",
+            "tables_memory_1000",
         ),
         "Whole runs besides the default study; `tools/measurements.py record NAME --timed -- COMMAND` records one "
         "(a workflow from an empty `results/`).",

@@ -36,6 +36,7 @@ __all__ = [
     "preservation_vs_chance",
     "resampled_preservation",
     "object_resampled_preservation",
+    "level_pairs",
 ]
 
 #: The ``pairs`` of a row over every pair of consecutive levels (besides ``non_identical``).
@@ -119,7 +120,7 @@ def null_preserved(
     return preserved_counts(this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float), shifted_a, shifted_b, radius_deg)
 
 
-def _level_pairs(mins: pd.DataFrame, k_max: int, radius_deg: float) -> Iterator[tuple[int, pd.DataFrame, pd.DataFrame, NDArray]]:
+def level_pairs(mins: pd.DataFrame, k_max: int, radius_deg: float) -> Iterator[tuple[int, pd.DataFrame, pd.DataFrame, NDArray]]:
     """(k, the minima of {S1..Sk}, those of {S1..Sk+1}, which of the first are preserved) for
     k = 1 … k_max − 1, from one object's minima table."""
     for k in range(1, k_max):
@@ -150,7 +151,7 @@ def object_pairs(
     alphas, betas = np.sort(own["alpha_deg"].unique()), np.sort(own["beta_deg"].unique())
     offsets = allowed_offsets(alphas, betas, radius_deg, period_deg)
     rows = []
-    for k, this, nxt, kept in _level_pairs(mins, k_max, radius_deg):
+    for k, this, nxt, kept in level_pairs(mins, k_max, radius_deg):
         rows.append(
             {
                 "object": obj,
@@ -249,7 +250,7 @@ def object_resampled_preservation(obj: str, mins: pd.DataFrame, k_max: int, radi
     poses = resampler.poses(obj)
     where = {int(p): i for i, p in enumerate(poses)}
     n_min, n_kept = np.zeros(len(poses)), np.zeros(len(poses))
-    for _, this, _, kept in _level_pairs(mins, k_max, radius_deg):
+    for _, this, _, kept in level_pairs(mins, k_max, radius_deg):
         index = np.array([where.get(int(p), -1) for p in this["pose"]], dtype=np.int64)
         here = index >= 0
         np.add.at(n_min, index[here], 1.0)

@@ -14,10 +14,10 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp.analysis.bootstrap import BootstrapSettings
+from synergrasp.analysis.chance import level_pairs
 from synergrasp.analysis.claims import VerdictRules
 from synergrasp.analysis.forces import force_summary
 from synergrasp.analysis.intervals import VIEWS, StudyCounts
-from synergrasp.analysis.minima import preserved
 from synergrasp.analysis.periods import distinct_pose_mask, object_periods
 from synergrasp.config import ConfigError, build
 from synergrasp.ids import ALL_OBJECTS, incremental_set_id, set_id, set_members, set_order
@@ -451,16 +451,7 @@ def object_preservation(
     """The rows k = 1..k_max − 1 of :func:`minimum_preservation` of one object: ``mins`` its
     minima, ``alpha_start`` the first α of its grid (deg; None: its first minimum's)."""
     rows = []
-    for k in range(1, k_max):
-        this = mins[mins["set_id"] == incremental_set_id(k)]
-        nxt = mins[mins["set_id"] == incremental_set_id(k + 1)]
-        kept = preserved(
-            this["alpha_deg"].to_numpy(float),
-            this["beta_deg"].to_numpy(float),
-            nxt["alpha_deg"].to_numpy(float),
-            nxt["beta_deg"].to_numpy(float),
-            radius_deg,
-        )
+    for k, this, _, kept in level_pairs(mins, k_max, radius_deg):
         one = distinct_pose_mask(this["alpha_deg"].to_numpy(float), period_deg, alpha_start)
         rows.append(
             {
