@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from synergrasp.analysis.bootstrap import PoseResampler, interval, weighted_median
+from synergrasp.analysis.bootstrap import PoseResampler, interval, weighted_median_rows
 from synergrasp.ids import set_order
 
 __all__ = ["VIEWS", "StudyCounts", "mean_defined"]
@@ -182,15 +182,18 @@ class StudyCounts:
         """(rows,) weighted median over the distinct poses, of every object, where both ``a``
         and ``b`` succeed, of log(F_b / F_a); and the number of such poses. F_b / F_a > 1:
         ``a`` needs the lower force."""
-        values, weights = [], []
+        values, where = [], []
         for obj in self.objects:
             fa, fb = self.force(obj, a), self.force(obj, b)
             both = np.isfinite(fa) & np.isfinite(fb) & (fa > 0) & (fb > 0)
             values.append(np.log(fb[both] / fa[both]))
-            weights.append(self.resampler.weights(obj)[:, both])
+            where.append((obj, both))
         v = np.concatenate(values) if values else np.zeros(0)
-        w = np.hstack(weights) if weights else np.zeros((self.rows, 0))
-        return weighted_median(v, w), int(v.size)
+
+        def weights(rows: slice) -> NDArray:  # every object's weights of those rows, a few rows at a time
+            return np.hstack([self.resampler.weights(obj, rows)[:, both] for obj, both in where])
+
+        return weighted_median_rows(v, weights, self.rows), int(v.size)
 
     def pooled_ratio_to_full(self, sid: str) -> tuple[NDArray, int]:
         """(rows,) weighted median over every object's distinct successes of ``sid`` of its
