@@ -73,6 +73,7 @@ SECTIONS = (
             "cluster_thousand",
             "tables_memory",
             "tables_memory_1000",
+            "tables_memory_all_jobs",
         ),
         "Whole runs besides the default study; `tools/measurements.py record NAME --timed -- COMMAND` records one "
         "(a workflow from an empty `results/`).",
