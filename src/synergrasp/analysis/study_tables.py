@@ -5,8 +5,8 @@ minima; it judges the object's rows (``with_verdicts``), keeps only what the tab
 them (its success-rate, lost-pose, disagreement, check and preservation rows, its
 successes and optimal forces per distinct pose and set, its null-model counts) and drops
 the rows before the next object is read. So a job holds one object's rows at a time, and
-what it keeps per object is a few MB (docs/measurements.md, tables_memory), whatever the
-number of objects. The bootstrap's and the null model's generators draw for the objects in
+what it keeps of an object is a few hundred kB (docs/measurements.md, tables_memory and
+tables_memory_1000). The bootstrap's and the null model's generators draw for the objects in
 the same sorted order as they did over every object's rows at once, and every sum over
 objects is a sum of integers or is taken in that order: the tables are the same to the
 byte (tests/test_study_tables.py).
@@ -137,8 +137,9 @@ class StudyReduction:
         self._any_success |= bool(own["success"].astype(bool).any())
         self._n_fc += int(own["verdict_force_closure"].astype(bool).sum())
 
-    def claims(self, planners: pd.DataFrame | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
-        """The claims table (claim 8 from ``planners`` where given) and the null model's pairs."""
+    def claims(self, planners: pd.DataFrame | None = None) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+        """(the claims table, claim 8 from ``planners`` where given; the null model's summary;
+        its pairs), from the objects added."""
         self.counts.finish(sorted(self.sets, key=set_order))
         chance, pairs = chance_tables(self._pairs, self.settings.null_draws)
         kept = pd.DataFrame(self._kept, columns=["object", "n_minima", "n_preserved"])
