@@ -1,4 +1,4 @@
-"""The study's tables, built one object at a time (docs/design.md, "The study's tables").
+"""The study's tables, built one object at a time (docs/design.md, "The study-wide tables, one object at a time").
 
 :class:`StudyReduction` takes the objects in sorted order, each as its gfo table and its
 minima; it judges the object's rows (``with_verdicts``), keeps only what the tables need of
