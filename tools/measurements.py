@@ -72,8 +72,7 @@ SECTIONS = (
             "dry_run",
             "cluster_thousand",
             "tables_memory",
-            "tables_memory_1000",
-            "tables_memory_all_jobs",
+            "tables_memory_aggregation",
         ),
         "Whole runs besides the default study; `tools/measurements.py record NAME --timed -- COMMAND` records one "
         "(a workflow from an empty `results/`).",

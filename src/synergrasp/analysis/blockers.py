@@ -264,7 +264,7 @@ def _tally(here: pd.DataFrame) -> dict[str, Any]:
     }
 
 
-def _row(obj: str, sid: str, size: int, tally: Mapping[str, Any]) -> dict[str, Any]:
+def _summary_row(obj: str, sid: str, size: int, tally: Mapping[str, Any]) -> dict[str, Any]:
     n = tally["n"]
     row: dict[str, Any] = {
         "object": obj,
@@ -288,13 +288,13 @@ def _summary(objects: Iterable[tuple[str, pd.DataFrame]], sets: Mapping[str, Any
     for obj, part in objects:
         for sid in sets:
             tally = _tally(part[part["set_id"] == sid])
-            rows.append(_row(obj, sid, len(sets[sid]), tally))
+            rows.append(_summary_row(obj, sid, len(sets[sid]), tally))
             pooled[sid].append(tally)
     for sid, tallies in pooled.items():
         counts = ["n", "none", *(f"{g}_{label}" for g, (_, labels) in SUMMARY_GROUPS.items() for label in labels)]
         total: dict[str, Any] = {k: sum(t[k] for t in tallies) for k in counts}
         total["margins"] = np.concatenate([t["margins"] for t in tallies]) if tallies else np.zeros(0)
-        rows.append(_row(ALL_OBJECTS, sid, len(sets[sid]), total))
+        rows.append(_summary_row(ALL_OBJECTS, sid, len(sets[sid]), total))
     return pd.DataFrame(rows)
 
 
