@@ -282,3 +282,34 @@ def test_the_table_solves_twin_poses_once_and_keeps_its_contract(hand, axes, tmp
     tables.write(tables.BLOCKERS, table, tmp_path / "blockers.parquet")
     back = tables.read(tables.BLOCKERS, tmp_path / "blockers.parquet")
     assert back["margin"].tolist() == table["margin"].tolist() and back["reason"].tolist() == ["contacts"] * 2
+
+
+def test_the_summary_one_object_at_a_time_is_the_summary_of_every_objects_rows(monkeypatch):
+    """Two objects' files read one at a time (handed in unsorted): the same table, to the
+    last digit, as from both objects' rows at once; the pooled median margin by hand."""
+    from synergrasp.analysis import blockers as module
+
+    def rows(obj, margins, kinds):
+        return pd.DataFrame(
+            {
+                "object": obj,
+                "set_id": ["1"] * len(margins),
+                "reason": ["contacts"] * len(margins),
+                "margin": margins,
+                "blocker_link_kind": kinds,
+                "blocker_face": [["palm_face"]] * len(margins),
+                "blocker_feature": [["edge"]] * len(margins),
+            }
+        )
+
+    frames = {
+        "r/b/blockers.parquet": rows("b", [-3.0, -1.0], [["palm"], ["finger_pad"]]),
+        "r/a/blockers.parquet": rows("a", [-2.0, -0.5, -0.25], [["palm"], ["palm"], []]),
+    }
+    monkeypatch.setattr(module, "read", lambda table, path: frames[str(path)])
+    sets = {"1": (1,), "2": (2,)}
+    table = module.blockers_summary_by_object(list(frames), sets)
+    pd.testing.assert_frame_equal(table, blockers_summary(pd.concat(frames.values(), ignore_index=True), sets), check_exact=True)
+    pooled = table.set_index(["object", "set_id"]).loc[("all", "1")]
+    assert pooled["n_failing"] == 5 and pooled["median_margin"] == -1.0 and pooled["pct_kind_palm"] == 60.0
+    assert table["object"].tolist()[:2] == ["a", "a"]

@@ -107,3 +107,22 @@ def test_coverage_with_spatially_correlated_poses():
         return (periodic_field(rng, 0.5) > norm.ppf(0.7)), (periodic_field(rng, 0.5) > norm.ppf(0.8))
 
     assert 0.9 <= coverage(draw, 10.0) <= 0.99
+
+
+def test_weighted_median_a_few_rows_at_a_time_is_every_row_at_once(monkeypatch):
+    """Weights handed three rows at a time (a tiny cap on the weights held) give each row's
+    median as with every row at once; unit weights give numpy's median."""
+    from synergrasp.analysis import bootstrap
+
+    rng = np.random.default_rng(4)
+    values = rng.normal(size=41)
+    weights = rng.integers(0, 4, size=(10, 41)).astype(float)
+    weights[0] = 1.0
+    weights[3] = 0.0  # no weight: NaN
+    whole = bootstrap.weighted_median(values, weights)
+    monkeypatch.setattr(bootstrap, "_CELLS", 3 * values.size)
+    handed = []
+    chunked = bootstrap.weighted_median_rows(values, lambda rows: handed.append(rows) or weights[rows], len(weights))
+    assert len(handed) == 4 and all(r.stop - r.start <= 3 for r in handed)
+    np.testing.assert_array_equal(chunked, whole)
+    assert chunked[0] == np.median(values) and np.isnan(chunked[3])

@@ -300,3 +300,58 @@ def test_a_contact_carries_load_from_the_configured_threshold_on(hand):
     assert _table(hand, load_threshold_N=0.6)["loaded_contacts_median"].iloc[0] == 0.0
     assert _table(hand, load_threshold_N=0.5)["loaded_contacts_median"].iloc[0] == 1.0
     assert np.isnan(_table(hand, load_threshold_N=None)["loaded_contacts_median"].iloc[0])
+
+
+def test_one_object_at_a_time_gives_the_tables_of_every_objects_rows(hand, tmp_path):
+    """``realism_by_object`` (one object's files at a time, the objects handed in unsorted)
+    against the three tables made from both objects' rows at once."""
+    from dataclasses import replace
+
+    from conftest import defaults
+    from synergrasp.analysis.graspability import graspable_objects
+    from synergrasp.analysis.realism import RealismParams, link_shares, realism_by_object
+    from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
+
+    params = replace(
+        RealismParams.from_config(defaults()),
+        full_set_id="1-2",
+        weights_N={"a": 10.0, "b": 4.0},
+        grasp_types={"a": "power", "b": "precision"},
+        shapes={"a": _BOX, "b": _BOX},
+        opposition=_RULE,
+    )
+    types = {"a": ("power", "power", ""), "b": ("precision", "precision", "")}
+    frames = {"b": (_contacts("b", _POSES[::-1]), _gfo("b")), "a": (_contacts("a"), _gfo("a"))}
+    files = []
+    for obj, (contacts, gfo) in frames.items():
+        (tmp_path / obj).mkdir()
+        tables.write(tables.CONTACTS, contacts, tmp_path / obj / "contacts.parquet")
+        tables.write(tables.GFO, gfo, tmp_path / obj / "gfo.parquet")
+        files.append((tmp_path / obj / "contacts.parquet", tmp_path / obj / "gfo.parquet"))
+    table, links, graspable = realism_by_object(files, hand, params, types)
+
+    contacts = pd.concat([frames[o][0] for o in ("b", "a")], ignore_index=True)
+    gfo = pd.concat([frames[o][1] for o in ("b", "a")], ignore_index=True)
+    synergies = params.synergies(hand.joint_names)
+    checks = grasp_equilibrium(
+        contacts, EquilibriumParams.of(hand, synergies, params.k_ss_Nmm_per_rad, params.mu), synergies.columns([1])[:, 0]
+    )
+    labels = grasp_labels(contacts, HandAxes.from_hand(hand), _RULE, params.shapes)
+    expected = grasp_realism(
+        contacts,
+        gfo,
+        checks,
+        hand.link_names,
+        hand.link_finger,
+        "1-2",
+        params.weights_N,
+        params.load_threshold_N,
+        labels,
+        {"a": "power", "b": "precision"},
+    )
+    pd.testing.assert_frame_equal(table, expected, check_exact=True)
+    pd.testing.assert_frame_equal(links, link_shares(contacts, hand.link_names, hand.link_finger), check_exact=True)
+    pd.testing.assert_frame_equal(graspable, graspable_objects(contacts, gfo, "1-2", types), check_exact=True)
+    assert table["object"].tolist() == ["a", "b"] and table["poses"].tolist() == [4, 4]
+    assert table["grasp_type"].tolist() == ["power", "precision"]
+    assert graspable["force_closure_full_set"].tolist() == [2, 2]  # poses 1 and 3 of each, by hand

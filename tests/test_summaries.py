@@ -7,13 +7,13 @@ import pytest
 
 from conftest import study_analysis_settings
 from synergrasp.analysis.invariants import InvariantError
+from synergrasp.analysis.study_tables import frames_by_object, study_tables
 from synergrasp.analysis.summaries import (
     full_but_not_first7,
     hierarchy_matrices,
     incrementality_table,
     mean_over_objects,
     minimum_preservation,
-    study_tables,
     success_rates,
     verdict_disagreements,
 )
@@ -234,7 +234,9 @@ def test_study_tables_names_and_csv_round_trip(gfo, tmp_path):
     minima = pd.DataFrame([dict(object="a", set_id="1", pose=0, alpha_deg=0.0, beta_deg=0.0)])
     settings = study_analysis_settings(null_draws=20)
     with pytest.warns(UserWarning):  # b's set 1-2 succeeds where its full set does not
-        tables = study_tables(gfo, minima, {"incremental_max": 3, "hierarchy_first": 2, "hierarchy_max_size": 2}, 3, settings)
+        tables = study_tables(
+            frames_by_object(gfo, minima), {"incremental_max": 3, "hierarchy_first": 2, "hierarchy_max_size": 2}, 3, settings
+        )
     assert set(tables) == {
         "success_rates",
         "table2_success_rates",
@@ -270,8 +272,7 @@ def test_study_tables_stop_on_a_rate_far_above_100(gfo):
     broken = pd.DataFrame(gfo_rows("a", "1", [1.0, 1.0, 1.0, 1.0]) + gfo_rows("a", "1-2", [1.0, 1.0, None, None]))
     with pytest.raises(InvariantError, match=r"success_rate_tolerance_percent \(1.0\).*a \{1\}: 200 %"):
         study_tables(
-            broken,
-            broken.iloc[:0].assign(pose=[], alpha_deg=[], beta_deg=[]),
+            frames_by_object(broken, broken.iloc[:0].assign(pose=[], alpha_deg=[], beta_deg=[])),
             {"incremental_max": 2, "hierarchy_first": 2, "hierarchy_max_size": 1},
             2,
             study_analysis_settings(null_draws=5),

@@ -9,7 +9,8 @@ import yaml
 
 from synergrasp.analysis.minima import minima_table
 from synergrasp.analysis.periods import alpha_period_deg
-from synergrasp.analysis.summaries import TablesParams, study_tables
+from synergrasp.analysis.study_tables import frames_by_object, study_tables
+from synergrasp.analysis.summaries import TablesParams
 from synergrasp.analysis.target_claims import ClaimsAtTargets, TargetClaimsParams, claims_at_targets, claims_summary
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.config import ConfigError, validate_config
@@ -73,7 +74,7 @@ def _study_claims(hand, synergies, config, target):
     gfo = gfo_table(contacts, sets, params.search.gfo)
     minima = minima_table(with_verdicts(gfo, "force_closure"), params.minima.radius_deg)
     tables = TablesParams.from_config(fixed)
-    claims = study_tables(gfo, minima, tables.synergy_sets, tables.table2_k_max, tables.settings)["claims"][1]
+    claims = study_tables(frames_by_object(gfo, minima), tables.synergy_sets, tables.table2_k_max, tables.settings)["claims"][1]
     return claims[claims["headline"]].reset_index(drop=True)
 
 

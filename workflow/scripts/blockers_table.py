@@ -1,15 +1,13 @@
-"""The study table and figure of what blocks each synergy set, from every object's blockers table."""
-
-import pandas as pd
+"""The study table and figure of what blocks each synergy set, from every object's blockers
+table, read one object at a time."""
 
 from synergrasp import tables
-from synergrasp.analysis.blockers import blocker_sets, blockers_summary
+from synergrasp.analysis.blockers import blocker_sets, blockers_summary_by_object
 from synergrasp.figures.blockers import figure_blockers
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):
-    blockers = pd.concat([tables.read(tables.BLOCKERS, p) for p in snakemake.input.blockers], ignore_index=True)
-    summary = blockers_summary(blockers, blocker_sets(snakemake.params.cfg["synergy_sets"]))
+    summary = blockers_summary_by_object(snakemake.input.blockers, blocker_sets(snakemake.params.cfg["synergy_sets"]))
     tables.write_study_table(
         summary,
         snakemake.output.csv,

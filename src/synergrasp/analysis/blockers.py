@@ -12,8 +12,9 @@ solved once and its rows shared by its twin poses.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -26,6 +27,7 @@ from synergrasp.optimisation.blocking import Blocking, blocking_contacts
 from synergrasp.optimisation.mechanics import Grasp, first_same_grasp, internal_force_basis, read_grasps
 from synergrasp.optimisation.problem import GFOProblem
 from synergrasp.optimisation.optimise import GFOParams, mechanics_for
+from synergrasp.tables import BLOCKERS, read
 from synergrasp.simulation.opposition import (
     FACE_CLASSES,
     LINK_KINDS,
@@ -46,6 +48,7 @@ __all__ = [
     "blockers_table",
     "blockers_summary",
     "SUMMARY_GROUPS",
+    "blockers_summary_by_object",
 ]
 
 
@@ -227,26 +230,71 @@ def blockers_summary(blockers: pd.DataFrame, sets: Mapping[str, Any]) -> pd.Data
     that fail where the full set succeeds (``n_failing``), the share (%) whose reason is
     e_s = 0, and the share with a blocker of each link kind, face class and surface feature
     (a pose with several blockers counts in several columns)."""
-    rows = []
     objects = sorted(blockers["object"].unique()) if len(blockers) else []
-    for obj in objects + [ALL_OBJECTS]:
-        part = blockers if obj == ALL_OBJECTS else blockers[blockers["object"] == obj]
+    return _summary(((obj, blockers[blockers["object"] == obj]) for obj in objects), sets)
+
+
+def blockers_summary_by_object(paths: Sequence[str | Path], sets: Mapping[str, Any]) -> pd.DataFrame:
+    """:func:`blockers_summary` of every object's blockers file (``tables.BLOCKERS``), one
+    object at a time in sorted order (``results/objects/<object>/``): each object's rows are
+    reduced to its counts and margins and dropped before the next is read."""
+
+    def objects():
+        for path in sorted(paths, key=lambda p: Path(p).parent.name):
+            blockers = read(BLOCKERS, path)
+            for obj in sorted(blockers["object"].unique()):
+                yield obj, blockers[blockers["object"] == obj]
+
+    return _summary(objects(), sets)
+
+
+def _tally(here: pd.DataFrame) -> dict[str, Any]:
+    """What a row of the summary needs of one (object, set)'s blockers: their number, those of
+    reason e_s = 0, their margins and how many hold each label of ``SUMMARY_GROUPS``."""
+    held = {column: [set(v) for v in here[column]] for column, _ in SUMMARY_GROUPS.values()}
+    return {
+        "n": len(here),
+        "none": int((here["reason"] == "no_internal_force").sum()),
+        "margins": here["margin"].to_numpy(float),
+        **{
+            f"{group}_{label}": sum(label in h for h in held[column])
+            for group, (column, labels) in SUMMARY_GROUPS.items()
+            for label in labels
+        },
+    }
+
+
+def _summary_row(obj: str, sid: str, size: int, tally: Mapping[str, Any]) -> dict[str, Any]:
+    n = tally["n"]
+    row: dict[str, Any] = {
+        "object": obj,
+        "set_id": sid,
+        "n_synergies": size,
+        "n_failing": n,
+        "pct_no_internal_force": _pct(tally["none"], n),
+        "median_margin": float(pd.Series(tally["margins"]).median()) if n else np.nan,
+    }
+    for group, (_, labels) in SUMMARY_GROUPS.items():
+        for label in labels:
+            row[f"pct_{group}_{label}"] = _pct(tally[f"{group}_{label}"], n)
+    return row
+
+
+def _summary(objects: Iterable[tuple[str, pd.DataFrame]], sets: Mapping[str, Any]) -> pd.DataFrame:
+    """The summary's rows from (object, its blockers) in order, then the ``all`` rows from
+    their tallies pooled (counts summed, margins joined)."""
+    rows: list[dict[str, Any]] = []
+    pooled: dict[str, list[dict[str, Any]]] = {sid: [] for sid in sets}
+    for obj, part in objects:
         for sid in sets:
-            here = part[part["set_id"] == sid]
-            n = len(here)
-            row: dict[str, Any] = {
-                "object": obj,
-                "set_id": sid,
-                "n_synergies": len(sets[sid]),
-                "n_failing": n,
-                "pct_no_internal_force": _pct((here["reason"] == "no_internal_force").sum(), n),
-                "median_margin": float(here["margin"].median()) if n else np.nan,
-            }
-            for group, (column, labels) in SUMMARY_GROUPS.items():
-                held = [set(v) for v in here[column]]
-                for label in labels:
-                    row[f"pct_{group}_{label}"] = _pct(sum(label in h for h in held), n)
-            rows.append(row)
+            tally = _tally(part[part["set_id"] == sid])
+            rows.append(_summary_row(obj, sid, len(sets[sid]), tally))
+            pooled[sid].append(tally)
+    for sid, tallies in pooled.items():
+        counts = ["n", "none", *(f"{g}_{label}" for g, (_, labels) in SUMMARY_GROUPS.items() for label in labels)]
+        total: dict[str, Any] = {k: sum(t[k] for t in tallies) for k in counts}
+        total["margins"] = np.concatenate([t["margins"] for t in tallies]) if tallies else np.zeros(0)
+        rows.append(_summary_row(ALL_OBJECTS, sid, len(sets[sid]), total))
     return pd.DataFrame(rows)
 
 

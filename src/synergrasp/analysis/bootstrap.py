@@ -13,7 +13,7 @@ generator, the objects drawn in a fixed (sorted) order.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from synergrasp.analysis.periods import distinct_pose_mask
 
-__all__ = ["BootstrapSettings", "PoseResampler", "block_index", "interval", "weighted_median"]
+__all__ = ["BootstrapSettings", "PoseResampler", "block_index", "interval", "weighted_median", "weighted_median_rows"]
 
 _TOL_DEG = 1e-6
 
@@ -68,25 +68,38 @@ class PoseResampler:
 
     def __init__(self, poses: pd.DataFrame, periods_deg: Mapping[str, float], settings: BootstrapSettings):
         self.settings = settings
-        rng = np.random.default_rng(settings.seed)
+        self._rng = np.random.default_rng(settings.seed)
         self._poses: dict[str, NDArray] = {}
         self._block_weights: dict[str, NDArray] = {}
         self._blocks: dict[str, NDArray] = {}
         unique = poses[["object", "pose", "alpha_deg", "beta_deg"]].drop_duplicates(["object", "pose"])
         for obj in sorted(unique["object"].unique()):
-            own = unique[unique["object"] == obj].sort_values("pose")
-            alpha, beta = own["alpha_deg"].to_numpy(float), own["beta_deg"].to_numpy(float)
-            keep = distinct_pose_mask(alpha, float(periods_deg.get(obj, 360.0)))
-            blocks = block_index(alpha[keep], beta[keep], settings.block_deg, float(alpha.min()), float(beta.min()))
-            n_blocks = int(blocks.max()) + 1 if blocks.size else 0
-            draws = (
-                rng.multinomial(n_blocks, np.full(n_blocks, 1.0 / n_blocks), size=settings.resamples)
-                if n_blocks
-                else np.zeros((settings.resamples, 0), dtype=np.int64)
-            )
-            self._poses[obj] = own["pose"].to_numpy()[keep]
-            self._blocks[obj] = blocks
-            self._block_weights[obj] = np.vstack([np.ones((1, n_blocks)), draws]).astype(float)
+            self.add(obj, unique[unique["object"] == obj], float(periods_deg.get(obj, 360.0)))
+
+    def add(self, obj: str, poses: pd.DataFrame, period_deg: float) -> None:
+        """Draw the blocks of one more object: ``poses`` its rows (columns pose, alpha_deg,
+        beta_deg; repeated poses are read once), ``period_deg`` its α-period. The objects must
+        come in sorted order, each once: one generator draws for all of them, so that an
+        object at a time (``synergrasp.analysis.study_tables``) gives the same weights as
+        every object at once."""
+        if self._poses and not str(obj) > list(self._poses)[-1]:
+            raise ValueError(f"PoseResampler.add: objects in sorted order, each once; {obj!r} after {list(self._poses)[-1]!r}")
+        own = poses[["pose", "alpha_deg", "beta_deg"]].drop_duplicates("pose").sort_values("pose")
+        alpha, beta = own["alpha_deg"].to_numpy(float), own["beta_deg"].to_numpy(float)
+        keep = distinct_pose_mask(alpha, period_deg)
+        blocks = block_index(alpha[keep], beta[keep], self.settings.block_deg, float(alpha.min()), float(beta.min()))
+        n_blocks = int(blocks.max()) + 1 if blocks.size else 0
+        draws = (
+            self._rng.multinomial(n_blocks, np.full(n_blocks, 1.0 / n_blocks), size=self.settings.resamples)
+            if n_blocks
+            else np.zeros((self.settings.resamples, 0), dtype=np.int64)
+        )
+        self._poses[obj] = own["pose"].to_numpy()[keep]
+        self._blocks[obj] = blocks
+        weights = np.vstack([np.ones((1, n_blocks), dtype=np.int64), draws])
+        # held as the smallest integer type of the counts (a byte each, not eight: a thousand
+        # objects' resamples fit in a job), read back as floats
+        self._block_weights[obj] = weights.astype(np.min_scalar_type(int(weights.max(initial=1))))
 
     @property
     def objects(self) -> list[str]:
@@ -99,9 +112,10 @@ class PoseResampler:
     def n_blocks(self, obj: str) -> int:
         return self._block_weights[obj].shape[1]
 
-    def weights(self, obj: str) -> NDArray:
-        """(1 + resamples, n_distinct) pose weights of ``obj``: row 0 ones, then the resamples."""
-        return self._block_weights[obj][:, self._blocks[obj]]
+    def weights(self, obj: str, rows: slice = slice(None)) -> NDArray:
+        """(1 + resamples, n_distinct) pose weights of ``obj``: row 0 ones, then the resamples
+        (``rows``: those rows only)."""
+        return self._block_weights[obj][rows][:, self._blocks[obj]].astype(float)
 
     def sums(self, obj: str, values: NDArray) -> NDArray:
         """Weighted sums over ``obj``'s distinct poses of ``values`` (n_distinct,) or
@@ -111,7 +125,7 @@ class PoseResampler:
         flat = values.reshape(len(values), -1)
         per_block = np.zeros((n_blocks, flat.shape[1]))
         np.add.at(per_block, self._blocks[obj], flat)
-        out = self._block_weights[obj] @ per_block
+        out = self._block_weights[obj].astype(float) @ per_block
         return out[:, 0] if values.ndim == 1 else out
 
 
@@ -119,17 +133,34 @@ def weighted_median(values: NDArray, weights: NDArray) -> NDArray:
     """Median of ``values`` (n,) under each row of ``weights`` (r, n) (≥ 0): the mean of the
     lower and upper weighted medians, so that unit weights give numpy's median. NaN for a row
     of zero weight or no values."""
-    values = np.asarray(values, dtype=float)
     weights = np.atleast_2d(np.asarray(weights, dtype=float))
+    return weighted_median_rows(values, lambda rows: weights[rows], weights.shape[0])
+
+
+#: Weights held at once by :func:`weighted_median_rows` (cells of 8 bytes: 64 MB).
+_CELLS = 8_000_000
+
+
+def weighted_median_rows(values: NDArray, weight_rows: Callable[[slice], NDArray], n_rows: int) -> NDArray:
+    """:func:`weighted_median` of ``values`` (n,) under ``n_rows`` rows of weights handed a few
+    rows at a time (``weight_rows(slice)``: those rows, (rows, n)), so that the weights of
+    many poses under every resample are never held at once; each row's median is its own,
+    so the result is the same as with every row at once."""
+    values = np.asarray(values, dtype=float)
     if values.size == 0:
-        return np.full(weights.shape[0], np.nan)
+        return np.full(n_rows, np.nan)
     order = np.argsort(values, kind="stable")
-    v, cum = values[order], np.cumsum(weights[:, order], axis=1)
-    total = cum[:, -1:]
-    lower = np.minimum((cum < total / 2.0 - 1e-9).sum(axis=1), v.size - 1)
-    upper = np.minimum((cum <= total / 2.0 + 1e-9).sum(axis=1), v.size - 1)
-    out = 0.5 * (v[lower] + v[upper])
-    return np.where(total[:, 0] > 0, out, np.nan)
+    v = values[order]
+    out = np.empty(n_rows)
+    step = max(1, _CELLS // values.size)
+    for start in range(0, n_rows, step):
+        rows = slice(start, min(start + step, n_rows))
+        cum = np.cumsum(np.asarray(weight_rows(rows), dtype=float)[:, order], axis=1)
+        total = cum[:, -1:]
+        lower = np.minimum((cum < total / 2.0 - 1e-9).sum(axis=1), v.size - 1)
+        upper = np.minimum((cum <= total / 2.0 + 1e-9).sum(axis=1), v.size - 1)
+        out[rows] = np.where(total[:, 0] > 0, 0.5 * (v[lower] + v[upper]), np.nan)
+    return out
 
 
 def interval(resampled: NDArray, level: float) -> tuple[float, float]:

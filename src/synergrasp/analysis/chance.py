@@ -26,7 +26,18 @@ from synergrasp.analysis.bootstrap import PoseResampler
 from synergrasp.analysis.minima import preserved, preserved_counts
 from synergrasp.ids import ALL_OBJECTS, incremental_set_id
 
-__all__ = ["identical_force_maps", "allowed_offsets", "null_preserved", "preservation_vs_chance", "resampled_preservation"]
+__all__ = [
+    "identical_force_maps",
+    "allowed_offsets",
+    "null_preserved",
+    "object_pairs",
+    "chance_tables",
+    "check_draws",
+    "preservation_vs_chance",
+    "resampled_preservation",
+    "object_resampled_preservation",
+    "level_pairs",
+]
 
 #: The ``pairs`` of a row over every pair of consecutive levels (besides ``non_identical``).
 ALL_PAIRS = "all"
@@ -109,7 +120,7 @@ def null_preserved(
     return preserved_counts(this["alpha_deg"].to_numpy(float), this["beta_deg"].to_numpy(float), shifted_a, shifted_b, radius_deg)
 
 
-def _level_pairs(mins: pd.DataFrame, k_max: int, radius_deg: float) -> Iterator[tuple[int, pd.DataFrame, pd.DataFrame, NDArray]]:
+def level_pairs(mins: pd.DataFrame, k_max: int, radius_deg: float) -> Iterator[tuple[int, pd.DataFrame, pd.DataFrame, NDArray]]:
     """(k, the minima of {S1..Sk}, those of {S1..Sk+1}, which of the first are preserved) for
     k = 1 … k_max − 1, from one object's minima table."""
     for k in range(1, k_max):
@@ -125,32 +136,32 @@ def _level_pairs(mins: pd.DataFrame, k_max: int, radius_deg: float) -> Iterator[
         yield k, this, nxt, kept
 
 
-def _pairs(
-    table: pd.DataFrame,
-    minima: pd.DataFrame,
+def object_pairs(
+    obj: str,
+    own: pd.DataFrame,
+    mins: pd.DataFrame,
     k_max: int,
     radius_deg: float,
-    periods: dict[str, float],
+    period_deg: float,
     draws: int,
     rng: np.random.Generator,
 ) -> list[dict]:
-    """Observed and null preserved counts of every (object, k)."""
+    """Observed and null preserved counts of every k of one object: ``own`` its gfo table with
+    its verdicts, ``mins`` its minima; ``rng`` the study's generator (objects in sorted order)."""
+    alphas, betas = np.sort(own["alpha_deg"].unique()), np.sort(own["beta_deg"].unique())
+    offsets = allowed_offsets(alphas, betas, radius_deg, period_deg)
     rows = []
-    for obj in sorted(set(table["object"].unique())):
-        own = table[table["object"] == obj]
-        alphas, betas = np.sort(own["alpha_deg"].unique()), np.sort(own["beta_deg"].unique())
-        offsets = allowed_offsets(alphas, betas, radius_deg, periods.get(obj, 360.0))
-        for k, this, nxt, kept in _level_pairs(minima[minima["object"] == obj], k_max, radius_deg):
-            rows.append(
-                {
-                    "object": obj,
-                    "k": k,
-                    "n_minima": len(this),
-                    "n_preserved": int(kept.sum()),
-                    "identical": identical_force_maps(own, incremental_set_id(k), incremental_set_id(k + 1)),
-                    "null": null_preserved(this, nxt, alphas, betas, radius_deg, offsets, rng, draws),
-                }
-            )
+    for k, this, nxt, kept in level_pairs(mins, k_max, radius_deg):
+        rows.append(
+            {
+                "object": obj,
+                "k": k,
+                "n_minima": len(this),
+                "n_preserved": int(kept.sum()),
+                "identical": identical_force_maps(own, incremental_set_id(k), incremental_set_id(k + 1)),
+                "null": null_preserved(this, nxt, alphas, betas, radius_deg, offsets, rng, draws),
+            }
+        )
     return rows
 
 
@@ -189,10 +200,24 @@ def preservation_vs_chance(
     ``table``: gfo table with the columns of ``with_verdicts``; ``minima``: minima table;
     ``periods``: α-period per object, deg (360 if absent); ``draws`` ≥ 1; ``seed``: int.
     """
+    check_draws(draws)
+    rng = np.random.default_rng(seed)
+    rows = []
+    for obj in sorted(set(table["object"].unique())):
+        own = table[table["object"] == obj]
+        rows += object_pairs(obj, own, minima[minima["object"] == obj], k_max, radius_deg, periods.get(obj, 360.0), draws, rng)
+    return chance_tables(rows, draws)
+
+
+def check_draws(draws: int) -> None:
+    """One line naming the key when the null model's number of draws is not an integer >= 1."""
     if not (isinstance(draws, (int, np.integer)) and draws >= 1):
         raise ValueError(f"config error at 'analyses.null_model.draws': must be an integer >= 1; got {draws!r}")
-    rng = np.random.default_rng(seed)
-    rows = _pairs(table, minima, k_max, radius_deg, periods, draws, rng)
+
+
+def chance_tables(rows: list[dict], draws: int) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """``(summary, pairs)`` of :func:`preservation_vs_chance` from every object's
+    :func:`object_pairs` rows."""
     summary = []
     for obj in [*sorted({r["object"] for r in rows}), ALL_OBJECTS]:
         group = [r for r in rows if obj in (ALL_OBJECTS, r["object"])]
@@ -212,15 +237,22 @@ def resampled_preservation(minima: pd.DataFrame, k_max: int, radius_deg: float, 
     One row per object of the resampler: ``n_minima``, ``n_preserved`` — (1 + resamples,)
     arrays of weighted counts, element 0 the counts on the data (minima per distinct pose).
     """
-    rows = []
-    for obj in resampler.objects:
-        poses = resampler.poses(obj)
-        where = {int(p): i for i, p in enumerate(poses)}
-        n_min, n_kept = np.zeros(len(poses)), np.zeros(len(poses))
-        for _, this, _, kept in _level_pairs(minima[minima["object"] == obj], k_max, radius_deg):
-            index = np.array([where.get(int(p), -1) for p in this["pose"]], dtype=np.int64)
-            here = index >= 0
-            np.add.at(n_min, index[here], 1.0)
-            np.add.at(n_kept, index[here], kept[here].astype(float))
-        rows.append({"object": obj, "n_minima": resampler.sums(obj, n_min), "n_preserved": resampler.sums(obj, n_kept)})
+    rows = [
+        object_resampled_preservation(obj, minima[minima["object"] == obj], k_max, radius_deg, resampler)
+        for obj in resampler.objects
+    ]
     return pd.DataFrame(rows, columns=["object", "n_minima", "n_preserved"])
+
+
+def object_resampled_preservation(obj: str, mins: pd.DataFrame, k_max: int, radius_deg: float, resampler: PoseResampler) -> dict:
+    """One row of :func:`resampled_preservation`: ``obj``'s minima ``mins`` counted under
+    every resample of ``resampler``."""
+    poses = resampler.poses(obj)
+    where = {int(p): i for i, p in enumerate(poses)}
+    n_min, n_kept = np.zeros(len(poses)), np.zeros(len(poses))
+    for _, this, _, kept in level_pairs(mins, k_max, radius_deg):
+        index = np.array([where.get(int(p), -1) for p in this["pose"]], dtype=np.int64)
+        here = index >= 0
+        np.add.at(n_min, index[here], 1.0)
+        np.add.at(n_kept, index[here], kept[here].astype(float))
+    return {"object": obj, "n_minima": resampler.sums(obj, n_min), "n_preserved": resampler.sums(obj, n_kept)}

@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from synergrasp.analysis.bootstrap import PoseResampler, interval, weighted_median
+from synergrasp.analysis.bootstrap import PoseResampler, interval, weighted_median_rows
 from synergrasp.ids import set_order
 
 __all__ = ["VIEWS", "StudyCounts", "mean_defined"]
@@ -48,20 +48,64 @@ class StudyCounts:
     def __init__(self, table: pd.DataFrame, full_set_id: str, resampler: PoseResampler):
         self.resampler = resampler
         self.full = full_set_id
-        self.sets: list[str] = sorted(table["set_id"].astype(str).unique(), key=set_order)
-        self.objects = resampler.objects
         self._success: dict[str, NDArray] = {}
-        self._force: dict[str, NDArray] = {}
+        self._force: dict[str, tuple[NDArray, NDArray, NDArray]] = {}
         self._sums: dict[str, NDArray] = {}
-        for obj in self.objects:
-            own = table[table["object"] == obj]
-            poses = resampler.poses(obj)
-            success = own.pivot(index="pose", columns="set_id", values="success")
-            force = own.pivot(index="pose", columns="set_id", values="success_force")
-            success = success.reindex(index=poses, columns=self.sets).fillna(False).to_numpy(bool)
-            self._success[obj] = success
-            self._force[obj] = force.reindex(index=poses, columns=self.sets).to_numpy(float)
-            self._sums[obj] = resampler.sums(obj, success)
+        self._own_sets: dict[str, list[str]] = {}
+        self._n: dict[str, int] = {}
+        for obj in resampler.objects:
+            self.add(obj, table[table["object"] == obj])
+        self.finish(table["set_id"].astype(str).unique())
+
+    def add(self, obj: str, own: pd.DataFrame) -> None:
+        """Count one object of the resampler (``own``: its rows of the gfo table with its
+        verdicts), over the sets it has; :meth:`finish` aligns every object on the study's sets."""
+        poses = self.resampler.poses(obj)
+        sets = sorted(own["set_id"].astype(str).unique(), key=set_order)
+        success = own.pivot(index="pose", columns="set_id", values="success")
+        force = own.pivot(index="pose", columns="set_id", values="success_force")
+        success = success.reindex(index=poses, columns=sets).fillna(False).to_numpy(bool)
+        self._store(obj, success, force.reindex(index=poses, columns=sets).to_numpy(float), self.resampler.sums(obj, success))
+        self._own_sets[obj] = sets
+
+    def _store(self, obj: str, success: NDArray, force: NDArray, sums: NDArray) -> None:
+        """Hold an object's (distinct poses, sets) successes and forces and (rows, sets) sums
+        compactly (a thousand objects in a job): successes as bits, forces only where finite
+        (column by column), sums as integers (they are sums of integer weights)."""
+        finite = np.isfinite(force)
+        counts = np.rint(sums).astype(np.int64)
+        exact = counts.astype(float) == sums
+        self._success[obj] = np.packbits(success, axis=0)
+        self._force[obj] = (np.packbits(finite, axis=0), force.T[finite.T], np.concatenate([[0], np.cumsum(finite.sum(axis=0))]))
+        self._sums[obj] = counts.astype(np.min_scalar_type(int(counts.max(initial=0)))) if exact.all() else sums
+        self._n[obj] = success.shape[0]
+
+    def _dense(self, obj: str) -> tuple[NDArray, NDArray, NDArray]:
+        """An object's successes, forces and sums as :meth:`_store` was handed them."""
+        n, (finite_bits, values, _) = self._n[obj], self._force[obj]
+        success = np.unpackbits(self._success[obj], axis=0, count=n).astype(bool)
+        finite = np.unpackbits(finite_bits, axis=0, count=n).astype(bool)
+        force = np.full(finite.shape, np.nan)
+        force.T[finite.T] = values
+        return success, force, self._sums[obj].astype(float)
+
+    def finish(self, set_ids: Sequence[str]) -> None:
+        """Every object counted: the study's sets are ``set_ids`` (every object's); an object
+        without a set counts no success of it (weighted sums of integers: exact, so the counts
+        are those of every object at once)."""
+        self.sets: list[str] = sorted({str(s) for s in set_ids}, key=set_order)
+        self.objects = self.resampler.objects
+        for obj, own_sets in self._own_sets.items():
+            if own_sets == self.sets:
+                continue
+            where = [self.sets.index(s) for s in own_sets]
+            aligned = []
+            for values, fill in zip(self._dense(obj), (False, np.nan, 0.0)):
+                full = np.full((values.shape[0], len(self.sets)), fill, dtype=values.dtype)
+                full[:, where] = values
+                aligned.append(full)
+            self._store(obj, *aligned)
+        self._own_sets = {}
         self._col = {s: i for i, s in enumerate(self.sets)}
 
     @property
@@ -74,15 +118,20 @@ class StudyCounts:
 
     def success(self, obj: str, sid: str) -> NDArray:
         """(n_distinct,) success of set ``sid`` at ``obj``'s distinct poses."""
-        return self._success[obj][:, self._col[sid]]
+        return np.unpackbits(self._success[obj][:, self._col[sid]], count=self._n[obj]).astype(bool)
 
     def force(self, obj: str, sid: str) -> NDArray:
         """(n_distinct,) optimal force (N) of ``sid`` where it succeeds, NaN elsewhere."""
-        return self._force[obj][:, self._col[sid]]
+        col = self._col[sid]
+        finite_bits, values, start = self._force[obj]
+        finite = np.unpackbits(finite_bits[:, col], count=self._n[obj]).astype(bool)
+        out = np.full(finite.size, np.nan)
+        out[finite] = values[start[col] : start[col + 1]]
+        return out
 
     def count(self, obj: str, sid: str) -> NDArray:
         """(rows,) weighted success count of ``sid`` on ``obj``: row 0 the distinct-pose count."""
-        return self._sums[obj][:, self._col[sid]]
+        return self._sums[obj][:, self._col[sid]].astype(float)
 
     def counted_objects(self) -> list[str]:
         """Objects whose full set succeeds at some distinct pose (in the data)."""
@@ -133,15 +182,18 @@ class StudyCounts:
         """(rows,) weighted median over the distinct poses, of every object, where both ``a``
         and ``b`` succeed, of log(F_b / F_a); and the number of such poses. F_b / F_a > 1:
         ``a`` needs the lower force."""
-        values, weights = [], []
+        values, where = [], []
         for obj in self.objects:
             fa, fb = self.force(obj, a), self.force(obj, b)
             both = np.isfinite(fa) & np.isfinite(fb) & (fa > 0) & (fb > 0)
             values.append(np.log(fb[both] / fa[both]))
-            weights.append(self.resampler.weights(obj)[:, both])
+            where.append((obj, both))
         v = np.concatenate(values) if values else np.zeros(0)
-        w = np.hstack(weights) if weights else np.zeros((self.rows, 0))
-        return weighted_median(v, w), int(v.size)
+
+        def weights(rows: slice) -> NDArray:  # every object's weights of those rows, a few rows at a time
+            return np.hstack([self.resampler.weights(obj, rows)[:, both] for obj, both in where])
+
+        return weighted_median_rows(v, weights, self.rows), int(v.size)
 
     def pooled_ratio_to_full(self, sid: str) -> tuple[NDArray, int]:
         """(rows,) weighted median over every object's distinct successes of ``sid`` of its

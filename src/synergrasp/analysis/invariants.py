@@ -22,7 +22,15 @@ import pandas as pd
 from synergrasp.analysis.periods import period_violations
 from synergrasp.ids import set_members
 
-__all__ = ["InvariantError", "InvariantWarning", "check_success_rates", "superset_inconsistencies", "invariant_checks"]
+__all__ = [
+    "InvariantError",
+    "InvariantWarning",
+    "check_success_rates",
+    "superset_inconsistencies",
+    "invariant_checks",
+    "object_checks",
+    "reported_checks",
+]
 
 CHECK_COLUMNS = ["check", "object", "count", "detail"]
 _SHOWN = 5  # offending set pairs named per object in the table and the warning
@@ -84,73 +92,83 @@ def invariant_checks(
     (``warnings.warn``) for every other non-zero count."""
     messages = check_success_rates(rates, tolerance_percent)
     rows = []
-    inconsistent = superset_inconsistencies(table)
     for obj in sorted(set(table["object"].unique())):
-        own = table[table["object"] == obj]
-        bad = inconsistent[inconsistent["object"] == obj].sort_values("n_poses", ascending=False)
-        named = "; ".join(
-            f"{{{r.set_id}}} succeeds, {{{r.superset_id}}} does not: {r.n_poses} poses" for r in bad.head(_SHOWN).itertuples()
+        rows += object_checks(obj, table[table["object"] == obj], rates, float(periods.get(obj, 360.0)), tolerance_percent)
+    return reported_checks(rows, messages)
+
+
+def object_checks(obj: str, own: pd.DataFrame, rates: pd.DataFrame, period: float, tolerance_percent: float) -> list[dict]:
+    """The rows of :func:`invariant_checks` of one object: ``own`` its gfo table with its
+    verdicts, ``rates`` a success-rates table holding its rows, ``period`` its α-period (deg)."""
+    rows = []
+    bad = superset_inconsistencies(own).sort_values("n_poses", ascending=False)
+    named = "; ".join(
+        f"{{{r.set_id}}} succeeds, {{{r.superset_id}}} does not: {r.n_poses} poses" for r in bad.head(_SHOWN).itertuples()
+    )
+    rows.append(
+        _row(
+            "nested_sets",
+            obj,
+            bad["n_poses"].sum(),
+            f"{len(bad)} (set, superset) pairs; {named}" if len(bad) else "success is monotone in the sets",
         )
-        rows.append(
-            _row(
-                "nested_sets",
-                obj,
-                bad["n_poses"].sum(),
-                f"{len(bad)} (set, superset) pairs; {named}" if len(bad) else "success is monotone in the sets",
+    )
+    beyond = own["force_beyond_solver"] if "force_beyond_solver" in own else pd.Series(False, index=own.index)
+    lost = own["verdict_force_closure"] & ~np.isfinite(own["force_norm"].to_numpy(float)) & ~beyond
+    rows.append(
+        _row(
+            "force_closure_has_optimal_force",
+            obj,
+            lost.sum(),
+            "force-closure (pose, set) rows without an optimal force under the weight, unexplained",
+        )
+    )
+    explained = own[beyond.to_numpy(bool)]
+    listed = "; ".join(
+        f"{{{r.set_id}}} at alpha {r.alpha_deg:g}, beta {r.beta_deg:g}: a superset needs {r.force_lower_bound_N:.0f} N"
+        for r in explained.head(_SHOWN).itertuples()
+    )
+    rows.append(
+        _row(
+            "force_beyond_solver",
+            obj,
+            len(explained),
+            (
+                "force closure whose optimal force under the weight exceeds the solver's accuracy (no "
+                "force; a superset at the pose already needs more than the bound): reclassified "
+                f"load-feasible, never bounded (not a warning); {listed}"
             )
+            if len(explained)
+            else "none",
         )
-        beyond = own["force_beyond_solver"] if "force_beyond_solver" in own else pd.Series(False, index=own.index)
-        lost = own["verdict_force_closure"] & ~np.isfinite(own["force_norm"].to_numpy(float)) & ~beyond
-        rows.append(
-            _row(
-                "force_closure_has_optimal_force",
-                obj,
-                lost.sum(),
-                "force-closure (pose, set) rows without an optimal force under the weight, unexplained",
-            )
+    )
+    broken = period_violations(own, period)
+    poses = broken[["alpha_deg", "beta_deg"]].drop_duplicates()
+    rows.append(
+        _row(
+            "alpha_period",
+            obj,
+            len(poses),
+            f"period {period:g} deg: {len(poses)} poses whose results differ at alpha + period ({len(broken)} (pose, set) rows)",
         )
-        explained = own[beyond.to_numpy(bool)]
-        listed = "; ".join(
-            f"{{{r.set_id}}} at alpha {r.alpha_deg:g}, beta {r.beta_deg:g}: a superset needs {r.force_lower_bound_N:.0f} N"
-            for r in explained.head(_SHOWN).itertuples()
+    )
+    over = rates[(rates["object"] == obj) & (rates["success_rate"] > 100.0)]
+    rows.append(
+        _row(
+            "success_rate_at_most_100",
+            obj,
+            len(over),
+            f"sets above 100 %, within the tolerance of {tolerance_percent} percentage points"
+            if len(over)
+            else "no rate above 100 %",
         )
-        rows.append(
-            _row(
-                "force_beyond_solver",
-                obj,
-                len(explained),
-                (
-                    "force closure whose optimal force under the weight exceeds the solver's accuracy (no "
-                    "force; a superset at the pose already needs more than the bound): reclassified "
-                    f"load-feasible, never bounded (not a warning); {listed}"
-                )
-                if len(explained)
-                else "none",
-            )
-        )
-        period = float(periods.get(obj, 360.0))
-        broken = period_violations(own, period)
-        poses = broken[["alpha_deg", "beta_deg"]].drop_duplicates()
-        rows.append(
-            _row(
-                "alpha_period",
-                obj,
-                len(poses),
-                f"period {period:g} deg: {len(poses)} poses whose results differ at alpha + period "
-                f"({len(broken)} (pose, set) rows)",
-            )
-        )
-        over = rates[(rates["object"] == obj) & (rates["success_rate"] > 100.0)]
-        rows.append(
-            _row(
-                "success_rate_at_most_100",
-                obj,
-                len(over),
-                f"sets above 100 %, within the tolerance of {tolerance_percent} percentage points"
-                if len(over)
-                else "no rate above 100 %",
-            )
-        )
+    )
+    return rows
+
+
+def reported_checks(rows: list[dict], messages: list[str]) -> pd.DataFrame:
+    """The invariant-checks table of every object's :func:`object_checks` rows; warns
+    (``warnings.warn``) ``messages`` (:func:`check_success_rates`'s) and every other non-zero count."""
     out = pd.DataFrame(rows, columns=CHECK_COLUMNS)
     for r in out[(out["count"] > 0) & (out["check"] != "force_beyond_solver")].itertuples():
         messages.append(f"invariant check {r.check} ({r.object}): {r.count} — {r.detail}")

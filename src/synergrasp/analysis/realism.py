@@ -14,14 +14,19 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from synergrasp.analysis.graspability import graspable_objects
 from synergrasp.analysis.verdicts import verdict_columns
+from synergrasp.hand.kinematics import Hand
 from synergrasp.hand.synergies import Synergies, synergy_values
 from synergrasp.ids import incremental_set_id
+from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
+from synergrasp.optimisation.grasp_type_search import type_family
 from synergrasp.resolved import friction_mu, grasp_type, weight_N
 from synergrasp.simulation.opposition import (
     OPPOSITIONS,
@@ -31,7 +36,7 @@ from synergrasp.simulation.opposition import (
     edge_contacts,
     of_grasp_type,
 )
-from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM
+from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM, read
 
 __all__ = [
     "RealismParams",
@@ -44,6 +49,7 @@ __all__ = [
     "grasp_realism",
     "link_shares",
     "representative_grasps",
+    "realism_by_object",
 ]
 
 #: Statuses of the poses whose closure ran (synergrasp.simulation.contacts.CLOSURE_STATUSES): a
@@ -368,3 +374,49 @@ def representative_grasps(contacts: pd.DataFrame, n: int = 3) -> pd.DataFrame:
             }
         )
     return pd.DataFrame(rows)
+
+
+def realism_by_object(
+    files: Sequence[tuple[str | Path, str | Path]],
+    hand: Hand,
+    params: RealismParams,
+    types: Mapping[str, tuple[str, str, str]],
+) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """The grasp-realism table, the link shares and the graspable-objects table (before the
+    objects left out join it) of every object, one object at a time: ``files`` the (contacts,
+    gfo) files of each object (``results/objects/<object>/``), read in the objects' sorted
+    order and each dropped before the next is read, so that a job holds one object's rows
+    whatever the number of objects; every table is one of groups by object, so the rows are
+    those of every object's rows at once. ``types``: each object's (stated, effective, reason)
+    grasp type (``graspability.grasp_types_of``)."""
+    synergies = params.synergies(hand.joint_names)
+    equilibrium = EquilibriumParams.of(hand, synergies, params.k_ss_Nmm_per_rad, params.mu)
+    axes = HandAxes.from_hand(hand)
+    families = {name: type_family(effective) for name, (_, effective, _) in types.items()}
+    parts: list[tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]] = []
+    for contacts_path, gfo_path in sorted(files, key=lambda pair: Path(pair[0]).parent.name):
+        contacts, gfo = read(CONTACTS, contacts_path), read(GFO, gfo_path)
+        checks = grasp_equilibrium(contacts, equilibrium, synergies.columns([1])[:, 0])
+        labels = grasp_labels(contacts, axes, params.opposition, params.shapes)
+        parts.append(
+            (
+                grasp_realism(
+                    contacts,
+                    gfo,
+                    checks,
+                    hand.link_names,
+                    hand.link_finger,
+                    params.full_set_id,
+                    params.weights_N,
+                    params.load_threshold_N,
+                    labels,
+                    families,
+                ),
+                link_shares(contacts, hand.link_names, hand.link_finger),
+                graspable_objects(contacts, gfo, params.full_set_id, types),
+            )
+        )
+        del contacts, gfo, checks, labels
+    if not parts:
+        raise ValueError("realism_by_object: no object's files")
+    return tuple(pd.concat([p[i] for p in parts], ignore_index=True) for i in range(3))  # type: ignore[return-value]

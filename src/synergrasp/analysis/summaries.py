@@ -5,7 +5,6 @@ documented in docs/analyses.md. Pure functions: DataFrames in, DataFrames out.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -14,19 +13,15 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from synergrasp.analysis.bootstrap import BootstrapSettings, PoseResampler
-from synergrasp.analysis.chance import preservation_vs_chance, resampled_preservation
-from synergrasp.analysis.claims import VerdictRules, claims_table, planner_claim
+from synergrasp.analysis.bootstrap import BootstrapSettings
+from synergrasp.analysis.chance import level_pairs
+from synergrasp.analysis.claims import VerdictRules
 from synergrasp.analysis.forces import force_summary
 from synergrasp.analysis.intervals import VIEWS, StudyCounts
-from synergrasp.analysis.invariants import invariant_checks
-from synergrasp.analysis.minima import preserved
 from synergrasp.analysis.periods import distinct_pose_mask, object_periods
-from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.config import ConfigError, build
 from synergrasp.ids import ALL_OBJECTS, incremental_set_id, set_id, set_members, set_order
 from synergrasp.resolved import effective_placement, weight_N
-from synergrasp.tables import STUDY_TABLES
 
 __all__ = [
     "AnalysisSettings",
@@ -39,13 +34,15 @@ __all__ = [
     "incrementality_table",
     "hierarchy_matrices",
     "minimum_preservation",
+    "object_preservation",
+    "preservation_table",
     "full_but_not_first7",
+    "lost_poses",
     "verdict_disagreements",
     "set_sort_key",
-    "study_tables",
-    "study_claims",
     "NoSuccessWarning",
     "no_success_note",
+    "no_success_sentence",
 ]
 
 
@@ -439,32 +436,40 @@ def minimum_preservation(
         raise ValueError(f"k_max must be an integer >= 2; got {k_max!r}")
     periods = dict(periods_deg or {})
     objects = sorted(set(gfo["object"].unique()) | set(minima_table["object"].unique()))
-    counts = ["n_minima", "n_preserved", "n_minima_distinct", "n_preserved_distinct"]
     rows = []
     for obj in objects:
-        mins = minima_table[minima_table["object"] == obj]
         alpha_start = float(gfo.loc[gfo["object"] == obj, "alpha_deg"].min()) if (gfo["object"] == obj).any() else None
-        for k in range(1, k_max):
-            this = mins[mins["set_id"] == incremental_set_id(k)]
-            nxt = mins[mins["set_id"] == incremental_set_id(k + 1)]
-            kept = preserved(
-                this["alpha_deg"].to_numpy(float),
-                this["beta_deg"].to_numpy(float),
-                nxt["alpha_deg"].to_numpy(float),
-                nxt["beta_deg"].to_numpy(float),
-                radius_deg,
-            )
-            one = distinct_pose_mask(this["alpha_deg"].to_numpy(float), periods.get(obj, 360.0), alpha_start)
-            rows.append(
-                {
-                    "object": obj,
-                    "k": k,
-                    "n_minima": len(this),
-                    "n_preserved": int(kept.sum()),
-                    "n_minima_distinct": int(one.sum()),
-                    "n_preserved_distinct": int((kept & one).sum()),
-                }
-            )
+        rows += object_preservation(
+            obj, minima_table[minima_table["object"] == obj], alpha_start, k_max, radius_deg, periods.get(obj, 360.0)
+        )
+    return preservation_table(rows, objects)
+
+
+def object_preservation(
+    obj: str, mins: pd.DataFrame, alpha_start: float | None, k_max: int, radius_deg: float, period_deg: float
+) -> list[dict]:
+    """The rows k = 1..k_max − 1 of :func:`minimum_preservation` of one object: ``mins`` its
+    minima, ``alpha_start`` the first α of its grid (deg; None: its first minimum's)."""
+    rows = []
+    for k, this, _, kept in level_pairs(mins, k_max, radius_deg):
+        one = distinct_pose_mask(this["alpha_deg"].to_numpy(float), period_deg, alpha_start)
+        rows.append(
+            {
+                "object": obj,
+                "k": k,
+                "n_minima": len(this),
+                "n_preserved": int(kept.sum()),
+                "n_minima_distinct": int(one.sum()),
+                "n_preserved_distinct": int((kept & one).sum()),
+            }
+        )
+    return rows
+
+
+def preservation_table(rows: list[dict], objects: Sequence[str]) -> pd.DataFrame:
+    """:func:`minimum_preservation`'s table from every object's :func:`object_preservation`
+    rows: per object its k rows and their total, then every object's per k and in total."""
+    counts = ["n_minima", "n_preserved", "n_minima_distinct", "n_preserved_distinct"]
     per_k = pd.DataFrame(rows, columns=["object", "k", *counts])
     totals = per_k.groupby("object", sort=True)[counts].sum().reset_index()
     totals["k"] = pd.NA
@@ -509,6 +514,13 @@ def full_but_not_first7(table: pd.DataFrame, full_set_id: str, first7_set_id: st
     for name, sid in (("full_set_id", full_set_id), ("first7_set_id", first7_set_id)):
         if sid not in present:
             raise ValueError(f"{name} {sid!r} is not in the gfo table; allowed values: {sorted(present)}")
+    return lost_poses(table, full_set_id, first7_set_id)
+
+
+def lost_poses(table: pd.DataFrame, full_set_id: str, first7_set_id: str) -> pd.DataFrame:
+    """:func:`full_but_not_first7` without checking that the two sets are in ``table`` (one
+    object's rows, of a study whose tables hold both): a pose where the smaller set was not
+    computed counts as lost, status "missing"."""
     keys = ["object", "pose"]
     full = table[(table["set_id"] == full_set_id) & table["success"].astype(bool)]
     small = table.loc[
@@ -578,29 +590,6 @@ def verdict_disagreements(table: pd.DataFrame) -> pd.DataFrame:
     return out[cols].astype({c: "int64" for c in cols[3:7]})
 
 
-def _claims(
-    gfo: pd.DataFrame, minima: pd.DataFrame, k_max: int, first: int, settings: AnalysisSettings
-) -> tuple[pd.DataFrame, StudyCounts, tuple[pd.DataFrame, pd.DataFrame], pd.DataFrame]:
-    """The gfo table with its verdicts, the resampled counts, the null model's (summary,
-    pairs) and the claims table."""
-    full = incremental_set_id(k_max)
-    table = with_verdicts(gfo, settings.success, settings.weights_N, settings.marginal_weight_multiple)
-    resampler = PoseResampler(table[table["set_id"] == full], dict(settings.periods_deg), settings.bootstrap)
-    counts = StudyCounts(table, full, resampler)
-    chance = preservation_vs_chance(
-        table, minima, k_max, settings.radius_deg, dict(settings.periods_deg), settings.null_draws, settings.null_seed
-    )
-    kept = resampled_preservation(minima, k_max, settings.radius_deg, resampler)
-    return table, counts, chance, claims_table(counts, kept, chance[0], settings.rules, first)
-
-
-def study_claims(
-    gfo: pd.DataFrame, minima: pd.DataFrame, sets_config: Mapping[str, int], settings: AnalysisSettings
-) -> pd.DataFrame:
-    """The claims table of :func:`study_tables` alone (the other tables are not made)."""
-    return _claims(gfo, minima, int(sets_config["incremental_max"]), int(sets_config["hierarchy_first"]), settings)[3]
-
-
 class NoSuccessWarning(UserWarning):
     """No grasp of any object succeeds under the analyses' success setting (said in the log and
     in the title of every table that names the success verdict)."""
@@ -610,9 +599,15 @@ def no_success_note(table: pd.DataFrame, settings: AnalysisSettings) -> str:
     """'' if some (object, pose, set) row of ``table`` (a gfo table with its verdicts,
     ``with_verdicts``) succeeds; else one sentence saying that nothing can succeed under
     ``analyses.success`` and why (the setting, or no force closure at all)."""
-    if table["success"].astype(bool).any():
+    return no_success_sentence(
+        bool(table["success"].astype(bool).any()), int(table["verdict_force_closure"].astype(bool).sum()), settings
+    )
+
+
+def no_success_sentence(any_success: bool, n_fc: int, settings: AnalysisSettings) -> str:
+    """:func:`no_success_note` from whether any row succeeds and the number of force-closure rows."""
+    if any_success:
         return ""
-    n_fc = int(table["verdict_force_closure"].astype(bool).sum())
     if settings.success == "force_closure_bounded" and n_fc:
         why = (
             f"none of the {n_fc} force-closure (pose, set) rows holds the weight within "
@@ -626,89 +621,3 @@ def no_success_note(table: pd.DataFrame, settings: AnalysisSettings) -> str:
         f"no grasp succeeds under analyses.success = {settings.success}: {why}; every success rate is 0 "
         "and the rates relative to the full set (Table II) are undefined"
     )
-
-
-def study_tables(
-    gfo: pd.DataFrame,
-    minima: pd.DataFrame,
-    sets_config: Mapping[str, int],
-    table2_k_max: int,
-    settings: AnalysisSettings,
-    planners: pd.DataFrame | None = None,
-) -> dict[str, tuple[str, pd.DataFrame]]:
-    """Every study table by name (``tables.STUDY_TABLES``, in that order): (title, table).
-
-    ``sets_config`` is the configuration's ``synergy_sets`` (incremental_max,
-    hierarchy_first, ...): the full set is {S1..S_incremental_max}, the hierarchy uses the
-    first ``hierarchy_first`` synergies. ``planners``: the planners compared per object
-    (``tables.PLANNERS``), whose claim 8 joins the claims (None: the seven only). Raises :class:`InvariantError` when a success
-    rate exceeds 100 % beyond the tolerance; warns on the other invariant checks.
-    """
-    k_max = int(sets_config["incremental_max"])
-    first = int(sets_config["hierarchy_first"])
-    full = incremental_set_id(k_max)
-    first_n = incremental_set_id(first)
-    periods = dict(settings.periods_deg)
-    table, counts, (chance, pairs), claims = _claims(gfo, minima, k_max, first, settings)
-    if planners is not None:
-        claims = pd.concat([claims, planner_claim(planners, settings.rules)], ignore_index=True)
-    rates = success_rates(table, full, periods)
-    checks = invariant_checks(table, rates, periods, settings.success_rate_tolerance_percent)
-    lost = full_but_not_first7(table, full, first_n) if first_n in set(table["set_id"].unique()) else None
-    preservation = minimum_preservation(table, minima, k_max, settings.radius_deg, periods)
-    preservation = preservation.merge(pairs.astype({"k": "Int64"}), on=["object", "k"], how="left")
-    table2 = incrementality_table(rates, table2_k_max)
-    rates = with_intervals(rates, counts)
-    verdict = f"success = {settings.success}"
-    nothing = no_success_note(table, settings)
-    if nothing:  # on the console, in the log and in the titles naming the verdict
-        warnings.warn(nothing, NoSuccessWarning, stacklevel=2)
-        verdict += f" (WARNING: {nothing})"
-    level = f"{100 * settings.bootstrap.level:g} % intervals: block bootstrap over distinct poses"
-    entries = {
-        "success_rates": (
-            f"Success rates per distinct pose (every verdict) and forces per object and synergy set, "
-            f"and averaged over objects in both views; {level}; {verdict}",
-            rates,
-        ),
-        "table2_success_rates": (
-            f"Table II: success rate (%, per distinct pose) with {{S1..Sk}}, k = 1..{table2_k_max}; {verdict}",
-            table2,
-        ),
-        "hierarchy": (
-            f"Hierarchy: sets {{S_k, S_i, S_j}} of the first {first} synergies, averaged over objects "
-            f"(per-object and pooled views); {level}; {verdict}",
-            hierarchy_matrices(hierarchy_input(rates), first, HIERARCHY_VALUES),
-        ),
-        "minimum_preservation": (f"Local minima of {{S1..Sk}} preserved in {{S1..Sk+1}}; {verdict}", preservation),
-        "preservation_vs_chance": (
-            f"Minimum preservation against the null model ({settings.null_draws} draws, seed {settings.null_seed}); {verdict}",
-            chance,
-        ),
-        "full_not_first7": (
-            f"Poses where {{S1..S{k_max}}} succeeds and {{S1..S{first}}} does not; {verdict}",
-            lost
-            if lost is not None
-            else pd.DataFrame(
-                columns=[
-                    "object",
-                    "pose",
-                    "alpha_deg",
-                    "beta_deg",
-                    "full_force_norm",
-                    "first7_status",
-                    "first7_force_closure",
-                    "first7_load_feasible",
-                ]
-            ),
-        ),
-        "verdict_disagreements": ("Force closure (Definition 1) vs feasibility under the weight", verdict_disagreements(table)),
-        "invariant_checks": ("The pipeline's invariant checks on this run", checks),
-        "claims": (
-            f"The study's claims tested on this run, one row per view (headline first); {level}"
-            + ("; claim 8: bootstrap over objects" if planners is not None else "")
-            + f"; {verdict}",
-            claims,
-        ),
-    }
-    return {name: entries[name] for name in STUDY_TABLES}

@@ -22,7 +22,8 @@ import pandas as pd
 from synergrasp import tables
 from synergrasp.analysis.claims import CLAIM_VERDICTS, FAILS, HOLDS, UNDEFINED
 from synergrasp.analysis.minima import MinimaParams, minima_table
-from synergrasp.analysis.summaries import TablesParams, study_claims
+from synergrasp.analysis.study_tables import study_claims
+from synergrasp.analysis.summaries import TablesParams
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.ids import synergy_sets
 from synergrasp.optimisation.placement_search import SearchStepParams, TargetScorer, full_synergy_set, pose_subset
