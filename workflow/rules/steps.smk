@@ -2,12 +2,12 @@
 # steps run: each rule is named as in the registry, reads the inputs its registry entry names
 # (and the code its script imports), writes the registry's outputs, log and benchmark, is
 # handed what its registry entry says (the part of the configuration its step reads), and
-# runs workflow/scripts/<rule>.py. No rule is written by hand: a new step is one registry
+# runs workflow/scripts/<rule>.py. Nothing of a rule is written by hand; a new step is one registry
 # entry (docs/design.md, "Adding a step").
 #
-# A function, not a loop's body: Snakemake evaluates `script:` again when the job runs, so it
-# must read this call's rule name, not a loop variable's last value. snakefmt cannot parse a
-# rule inside a function, hence `fmt: off` around it.
+# A function, not a loop's body: Snakemake evaluates the script's path again when the job
+# runs, so it must read this call's name, not a loop variable's last value. snakefmt cannot
+# parse a function making a rule, hence fmt off around it.
 # fmt: off
 def step_rule(_rule):
     rule:
@@ -29,5 +29,5 @@ def step_rule(_rule):
         script:
             f"../scripts/{_rule}.py"
 # fmt: on
-for _rule in rule_costs():
-    step_rule(_rule)
+for _name in rule_costs():
+    step_rule(_name)
