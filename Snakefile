@@ -23,11 +23,7 @@ report: "workflow/report/workflow.rst"
 
 
 include: "workflow/rules/common.smk"
-include: "workflow/rules/simulate.smk"
-include: "workflow/rules/optimise.smk"
-include: "workflow/rules/analyse.smk"
-include: "workflow/rules/figures.smk"
-include: "workflow/rules/sensitivity.smk"
+include: "workflow/rules/steps.smk"
 
 
 rule all:
@@ -71,7 +67,7 @@ rule scenarios:
 # The study's claims at every target the placement search scored (docs/placement_search.md).
 rule placement_claims:
     input:
-        W.optional_targets("summarise_target_claims"),
+        lambda wildcards: W.searched_targets("summarise_target_claims", "placement_claims"),
 
 
 # The incremental planner against the exhaustive search, every object (docs/planner.md).

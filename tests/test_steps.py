@@ -3,6 +3,8 @@ parameters, and the workflow's view of it (rules, outputs, costs, shared outputs
 
 import ast
 import importlib
+import os
+import shutil
 import re
 from pathlib import Path
 
@@ -12,7 +14,19 @@ from conftest import schema_leaf_paths
 
 from synergrasp.config import ConfigError, defaults, validate_config
 from synergrasp.ids import set_id, synergy_sets
-from synergrasp.steps import STEPS, WORKFLOW_KEYS, rule_costs, step_config, step_hash
+from synergrasp.steps import (
+    HANDED,
+    INPUT_SOURCES,
+    STEPS,
+    WORKFLOW_KEYS,
+    reads_key,
+    rule_costs,
+    rule_handed,
+    rule_inputs,
+    rule_step,
+    step_config,
+    step_hash,
+)
 from synergrasp.wiring import RuleFiles
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -221,6 +235,64 @@ def test_every_step_has_its_rules_outputs_and_costs_and_every_rule_its_step():
         assert all((ROOT / "workflow" / "report" / f"{caption}.rst").is_file() for caption, _ in step.report.values())
 
 
+def _read_steps(step):
+    """The steps whose outputs a step's rules read (its registry inputs), in a set."""
+    sources = [source for rule in STEPS[step].rules for source in rule_inputs(rule).values()]
+    return {source.split(".")[0] for source in sources if source.split(".")[0] in STEPS}
+
+
+def _upstream_closure(step):
+    """A step's upstream steps (``upstream`` and ``upstream_when``) and theirs, in turn."""
+    found, todo = set(), [step]
+    while todo:
+        spec = STEPS[todo.pop()]
+        for up in (*spec.upstream, *(up for _, _, up in spec.upstream_when)):
+            if up not in found:
+                found.add(up)
+                todo.append(up)
+    return found
+
+
+def test_every_input_of_a_rule_names_a_source_the_registry_knows():
+    """An input is a file of the study's own, a step's one output, a step's named output, or
+    an earlier rule of the same step (its shards); nothing else resolves."""
+    for rule in rule_costs():
+        step = STEPS[rule_step()[rule]]
+        for name, source in rule_inputs(rule).items():
+            producer, _, output = source.partition(".")
+            if source in INPUT_SOURCES:
+                continue
+            if producer in STEPS:
+                assert (output in STEPS[producer].outputs) if output else len(STEPS[producer].outputs) == 1, (rule, name)
+            else:  # an earlier rule of the same step
+                assert producer in step.rules and producer != rule and not output, (rule, name, source)
+
+
+def test_a_steps_hash_holds_every_step_whose_outputs_it_reads():
+    """Every upstream step's output is read by one of the step's rules, and every step read is
+    upstream, directly or through another upstream step: so the hash of a step (which decides
+    where its outputs are shared between scenarios) changes with every file it reads."""
+    for name, step in STEPS.items():
+        read = _read_steps(name)
+        assert set(step.upstream) | {up for _, _, up in step.upstream_when} <= read, name
+        assert read <= _upstream_closure(name), (name, sorted(read - _upstream_closure(name)))
+
+
+def test_what_a_rule_is_handed_by_hand():
+    assert rule_handed("optimise_shard") == ("cfg",)  # the optimisation reads its keys
+    assert rule_handed("optimise") == ()  # merging the shards reads none
+    assert rule_handed("summarise_target_claims") == ()  # its step reads no key
+    assert rule_handed("fig3") == ("configfile",)
+    assert all(set(rule_handed(rule)) <= set(HANDED) for rule in rule_costs())
+
+
+def test_a_key_read_is_a_key_of_reads_or_inside_a_block_of_it_and_not_of_not_reads():
+    assert reads_key("simulate", "placement.search_rank")  # reads the whole block `placement`
+    assert not reads_key("placement_map", "placement.search_rank")  # the search's keys, not its target
+    assert reads_key("minima", "analyses.success") and not reads_key("minima", "analyses")
+    assert not reads_key("simulate", "closure.dynamic.load_threshold_N")  # in `closure`, but not read
+
+
 def _folder(path, kind):
     """The name under ``<root>/<kind>/`` of a log or benchmark path: its folder, or the file's stem."""
     below = path.split(f"/{kind}/", 1)[1]
@@ -269,9 +341,10 @@ def _path(shown: str) -> str:
     return shown.strip().split(" (")[0]
 
 
-def _dry_run(tmp_path, target, scenarios):
+def _dry_run(tmp_path, target, scenarios, root=ROOT):
     """``snakemake -n target`` (a target or a list of them) on the small config with
-    ``scenarios``: (return code, output, {rule: [output files]} of the jobs it would run)."""
+    ``scenarios``, with the project (workflow and sources) at ``root``: (return code, output,
+    {rule: [output files]} of the jobs it would run)."""
     import subprocess
     import sys
 
@@ -286,7 +359,7 @@ def _dry_run(tmp_path, target, scenarios):
             *targets,
             "-n",
             "-s",
-            str(ROOT / "Snakefile"),
+            str(root / "Snakefile"),
             "--directory",
             str(tmp_path),
             "--configfile",
@@ -296,6 +369,7 @@ def _dry_run(tmp_path, target, scenarios):
         capture_output=True,
         text=True,
         timeout=600,
+        env={**os.environ, "PYTHONPATH": str(root / "src")},
     )
     jobs, rule = {}, None
     for line in run.stdout.splitlines():
@@ -304,6 +378,44 @@ def _dry_run(tmp_path, target, scenarios):
         elif line.strip().startswith("output:") and rule:
             jobs.setdefault(rule, []).extend(_path(p) for p in line.split(":", 1)[1].split(","))
     return run.returncode, run.stdout + run.stderr, jobs
+
+
+#: A toy step: one registry entry (a table from the study's hierarchy table) ...
+_TOY_STEP = """
+
+STEPS["toy"] = Step(
+    rules={"toy": Cost("none", 1.0, 100)},
+    outputs={"csv": "tables/toy.csv"},
+    reads=("synergy_sets.hierarchy_first",),
+    upstream=("tables",),
+    inputs={"hierarchy": "tables.hierarchy_csv"},
+)
+"""
+#: ... and its script.
+_TOY_SCRIPT = """import shutil
+
+shutil.copy(snakemake.input.hierarchy, snakemake.output.csv)
+"""
+
+
+def test_a_step_added_to_the_registry_alone_is_planned(tmp_path):
+    """A new step is its registry entry and its script (with its science and its test): in a
+    copy of the project with a toy step added so, Snakemake plans its rule for the study,
+    with the input the entry names and the output, log and params the registry gives."""
+    root, run = tmp_path / "project", tmp_path / "run"
+    root.mkdir(), run.mkdir()
+    for name in ("Snakefile", "environment.lock"):
+        shutil.copy2(ROOT / name, root / name)
+    for name in ("workflow", "src", "config"):
+        shutil.copytree(ROOT / name, root / name, ignore=shutil.ignore_patterns("*.egg-info", "__pycache__"))
+    steps = root / "src" / "synergrasp" / "steps.py"
+    steps.write_text(steps.read_text() + _TOY_STEP)
+    (root / "workflow" / "scripts" / "toy.py").write_text(_TOY_SCRIPT)
+    code, out, jobs = _dry_run(run, "figures", {}, root=root)
+    assert code == 0, out[-3000:]
+    assert jobs["toy"] == ["results/tables/toy.csv"]
+    toy = out.split("rule toy:", 1)[1].split("\n\n", 1)[0]
+    assert "input: results/tables/hierarchy.csv," in toy and "log: results/logs/toy.log" in toy
 
 
 def test_scenarios_differing_in_an_analysis_key_share_simulation_and_optimisation(tmp_path):

@@ -131,6 +131,44 @@ def test_the_study_targets_and_a_step_not_made_hands_on_its_upstreams_file():
     assert wiring.step_input("search")(_W(root="results", object="obj1")) == "results/objects/obj1/placement.csv"
 
 
+def test_a_rules_inputs_follow_the_registry_and_the_two_steps_scopes():
+    """Each source is the file(s) the scopes say: the job's object's file for a rule per object,
+    every object's for a rule per scenario, the scenario's file of a step per scenario, every
+    scenario's for a rule run once for the workflow; and the code the rule runs."""
+    wiring = _wiring(scenarios={"mu_1_0": {"mechanics": {"mu": 1.0}}})
+    job, study = _W(root="results", object="obj2"), _W(root="results")
+    minima = wiring.inputs("minima")
+    assert minima["gfo"](job) == "results/objects/obj2/gfo.parquet"
+    assert str(ROOT / "src" / "synergrasp" / "analysis" / "minima.py") in minima["code"]
+    tables = wiring.inputs("tables")
+    assert tables["gfo"](study) == [f"results/objects/{o}/gfo.parquet" for o in ("obj1", "obj2", "obj3", "obj4")]
+    assert tables["planners"](study) == "results/tables/planners.csv"
+    assert str(ROOT / "src" / "synergrasp" / "data" / "hand.yaml") in tables["data"]  # the hand it loads
+    summary = wiring.inputs("objects_summary")
+    assert summary["enrollment"](study)[0] == "results/objects/obj1/enrollment.csv"
+    claims = wiring.inputs("sensitivity")["claims"](_W())
+    assert claims == ["results/tables/claims.csv", "results/scenarios/mu_1_0/tables/claims.csv"]
+    assert wiring.inputs("optimise")["shards"](job) == ["results/objects/obj2/gfo_shards/0.parquet"]
+    assert wiring.inputs("fig3")["rules"] == [str(p) for p in sorted((ROOT / "workflow" / "rules").glob("*.smk"))]
+    assert set(wiring.params("fig5")) == {"cfg"} and wiring.params("optimise") == {}
+    assert wiring.params("fig5")["cfg"](study) == step_config(wiring.study, "fig5")
+
+
+def test_only_a_step_reading_the_search_rank_refuses_a_table_without_it(tmp_path):
+    """A search table holding fewer distinct targets than ``search_rank`` stops the closure
+    (which places the box at that rank) before any job; the placement map reads the same
+    table but not the rank."""
+    table = tmp_path / "placement.csv"
+    table.write_text("object,distinct_rank\nobj1,1\nobj1,0\n")  # one distinct target
+    config = defaults()
+    config["placement"]["search_rank"] = 2
+    wiring = _wiring(placement=config["placement"])
+    wiring.step_input = lambda step: lambda w: str(table)
+    assert wiring.search_input("placement_map")(_W(root="results", object="obj1")) == str(table)
+    with pytest.raises(RuntimeError, match="search_rank"):
+        wiring.search_input("simulate")(_W(root="results", object="obj1"))
+
+
 def test_an_approach_placement_has_no_search_and_no_map():
     config = defaults()
     config["placement"]["mode"] = "approach"

@@ -11,6 +11,7 @@ what did not finish and ends with the same tables as an uninterrupted run.
 
 import base64
 import hashlib
+import json
 import os
 import shutil
 import signal
@@ -60,35 +61,54 @@ def digest(paths: list[Path]) -> dict[str, str]:
 
 # Loaded into every Python process of a run (as sitecustomize): at exit, a workflow script's
 # process writes the synergrasp source files it loaded, relative to the package's parent
-# (<pid>.txt), and the package's data files it opened (hand, synergy tables: <pid>.data).
+# (<pid>.txt), and every file it opened to read with the files its job declares (<pid>.json):
+# its inputs, outputs and log, from the script's own `snakemake` object. Python's audit hook
+# sees every open() (CSV, YAML, the hand's files); Parquet is read by pyarrow's C++ code,
+# which no audit event reports, so pyarrow.parquet's readers are wrapped to say what they read.
 _RECORD_MODULES = """
-import atexit, os, sys
+import atexit, json, os, sys
 
-_OPENED = set()
+_READ = set()
+
+def _read(path):
+    if isinstance(path, (str, bytes, os.PathLike)):
+        _READ.add(os.path.realpath(os.fsdecode(path)))
 
 def _opened(event, args):
-    if event == "open" and args and isinstance(args[0], (str, bytes, os.PathLike)):
-        path = os.fsdecode(args[0])
-        if os.sep + "synergrasp" + os.sep + "data" + os.sep in path:
-            _OPENED.add(os.path.realpath(path))
+    if event != "open" or not args:
+        return
+    mode = args[1] if len(args) > 1 else None
+    flags = args[2] if len(args) > 2 else 0
+    reading = ("r" in mode and "+" not in mode) if isinstance(mode, str) else (flags or 0) & os.O_ACCMODE == os.O_RDONLY
+    if reading:
+        _read(args[0])
 
-if "/.snakemake/scripts/" in (sys.argv[0] if sys.argv else ""):
+def _recording(reader):
+    def read(source, *args, **kwargs):
+        _read(source)
+        return reader(source, *args, **kwargs)
+    return read
+
+_SCRIPT = "/.snakemake/scripts/" in (sys.argv[0] if sys.argv else "")
+if _SCRIPT:
     sys.addaudithook(_opened)
+    import pyarrow.parquet as _pq
+    _pq.read_table, _pq.read_schema, _pq.read_metadata = map(_recording, (_pq.read_table, _pq.read_schema, _pq.read_metadata))
 
 def _record():
-    script = os.path.basename(sys.argv[0]) if sys.argv else ""
-    if "/.snakemake/scripts/" not in (sys.argv[0] if sys.argv else "") or "synergrasp" not in sys.modules:
+    if not _SCRIPT or "synergrasp" not in sys.modules:
         return
+    name = os.path.basename(sys.argv[0]).split(".")[-2]
     base = os.path.dirname(os.path.dirname(sys.modules["synergrasp"].__file__))
-    files = sorted(os.path.relpath(m.__file__, base) for name, m in list(sys.modules.items())
-                   if name.split(".")[0] == "synergrasp" and getattr(m, "__file__", None))
-    name = script.split(".")[-2]
+    files = sorted(os.path.relpath(m.__file__, base) for module, m in list(sys.modules.items())
+                   if module.split(".")[0] == "synergrasp" and getattr(m, "__file__", None))
     folder = os.environ["SYNERGRASP_RECORD_MODULES"]
     with open(os.path.join(folder, f"{os.getpid()}.txt"), "w") as out:
         out.write("\\n".join([name] + files))
-    data = sorted(os.path.relpath(p, base) for p in _OPENED if os.path.isfile(p))
-    with open(os.path.join(folder, f"{os.getpid()}.data"), "w") as out:
-        out.write("\\n".join([name] + data))
+    job = sys.modules["__main__"].snakemake
+    declared = {kind: sorted(os.path.realpath(str(f)) for f in getattr(job, kind)) for kind in ("input", "output", "log")}
+    with open(os.path.join(folder, f"{os.getpid()}.json"), "w") as out:
+        json.dump({"rule": job.rule, "read": sorted(_READ), **declared}, out)
 
 atexit.register(_record)
 """
@@ -322,6 +342,27 @@ def declared_code_inputs(workdir: Path) -> dict[str, set[str]]:
     return declared
 
 
+#: The rules of the small study's run (its placement is not searched, its closure kinematic).
+_RULES_RUN = (
+    "simulate",
+    "optimise_shard",
+    "optimise",
+    "minima",
+    "tables",
+    "fig1",
+    "fig2",
+    "fig3",
+    "fig4",
+    "fig5",
+    "realism",
+    "quality",
+    "blockers",
+    "blockers_table",
+    "planners",
+    "hand_reach",
+)
+
+
 def test_code_inputs_hold_every_module_a_job_loads(run_j2):
     """For every rule, the synergrasp files its script had in sys.modules when it ran are among
     the rule's code inputs (lazy imports included), so editing any of them reruns the rule."""
@@ -330,45 +371,53 @@ def test_code_inputs_hold_every_module_a_job_loads(run_j2):
     for record in (run_j2 / "module_records").glob("*.txt"):
         script, *files = record.read_text().splitlines()
         loaded.setdefault(script, set()).update(files)
-    assert set(loaded) == {
-        "simulate",
-        "optimise_shard",
-        "optimise",
-        "minima",
-        "tables",
-        "fig1",
-        "fig2",
-        "fig3",
-        "fig4",
-        "fig5",
-        "realism",
-        "quality",
-        "blockers",
-        "blockers_table",
-        "planners",
-        "hand_reach",
-    }
+    assert set(loaded) == set(_RULES_RUN)
     for script, files in loaded.items():
         assert files, script
         assert files <= declared[script], (script, sorted(files - declared[script]))
 
 
-def test_every_data_file_a_job_opens_is_an_input_of_its_rule(run_j2):
-    """For every rule, the package's data files its script opened when it ran (the hand file,
-    the synergy tables) are among the rule's inputs, so a change to them reruns the rule: a
-    step's inputs follow from what its code reads, not from a list kept by hand."""
-    declared = declared_code_inputs(run_j2)
-    opened: dict[str, set[str]] = {}
-    for record in (run_j2 / "module_records").glob("*.data"):
-        script, *files = record.read_text().splitlines()
-        opened.setdefault(script, set()).update(files)
-    assert opened["simulate"] and "optimise" in opened  # recorded for every job
-    # the schema reaches a job through its params (its defaults), not as a file (wiring.shipped_data)
-    schema = {"synergrasp/data/config.schema.yaml"}
-    missing = {
-        script: sorted(files - declared[script] - schema) for script, files in opened.items() if files - declared[script] - schema
-    }
-    assert missing == {}
+def undeclared_reads(workdir: Path, root: Path = ROOT) -> dict[str, list[str]]:
+    """Per rule, the files its jobs read that are not declared by the job: every file under the
+    project (``root``, its environment and source code aside: the code inputs are checked by
+    the test above) or under the run's folder (Snakemake's own files aside) that a job's
+    script opened to read and is none of its job's inputs, outputs or log. The shipped schema
+    reaches a job through its params (its defaults), not as a file (``wiring.shipped_data``)."""
+    root, workdir = Path(os.path.realpath(root)), Path(os.path.realpath(workdir))
+    schema = str(root / "src" / "synergrasp" / "data" / "config.schema.yaml")
+
+    def project_file(path: str) -> bool:
+        p = Path(path)
+        if p.is_relative_to(workdir):
+            return not p.is_relative_to(workdir / ".snakemake")
+        return p.is_relative_to(root) and not p.is_relative_to(root / ".venv") and p.suffix not in (".py", ".pyc")
+
+    missing: dict[str, set[str]] = {}
+    for record in (workdir / "module_records").glob("*.json"):
+        job = json.loads(record.read_text())
+        declared = {*job["input"], *job["log"], schema}
+        within = tuple(f"{out}/" for out in job["output"])  # a folder of pages is an output
+        for path in job["read"]:
+            if project_file(path) and path not in declared and path not in job["output"] and not path.startswith(within):
+                missing.setdefault(job["rule"], set()).add(path)
+    return {rule: sorted(paths) for rule, paths in missing.items()}
+
+
+def test_every_file_a_job_reads_is_an_input_of_its_job(run_j2):
+    """A step's inputs follow from what its code reads: every file of the project or of the
+    run that a job's script opened to read (upstream outputs, the hand and synergy files, a
+    manifest) is one of the inputs its job declares (so a change to it reruns the job and
+    Snakemake makes it first), or the job's own output or log. Recorded for every job."""
+    records = [json.loads(r.read_text()) for r in (run_j2 / "module_records").glob("*.json")]
+    reads = {job["rule"]: set() for job in records}
+    for job in records:
+        reads[job["rule"]].update(job["read"])
+    assert set(reads) == set(_RULES_RUN)
+    # the recorder sees what each kind of read reports: a parquet file (pyarrow), a CSV and the hand (open)
+    assert any(p.endswith("/gfo.parquet") for p in reads["minima"])
+    assert any(p.endswith("/tables/planners.csv") for p in reads["tables"])
+    assert any("/synergrasp/data/" in p and p.endswith(".yaml") for p in reads["simulate"])
+    assert undeclared_reads(run_j2) == {}
 
 
 def _log_paths(workdir: Path) -> list[str]:

@@ -3,10 +3,11 @@
 :data:`STEPS` is data only: for every step, its rules and the measured cost and threads of
 one job of each, the files it writes (and which of them the report shows), the configuration
 keys it reads (and those it reads only when
-another key has a given value), the steps whose outputs it reads, and the class whose
-``from_config`` builds its typed parameters. The step hash, ``synergrasp.wiring`` (every
-rule's outputs, log, benchmark, threads and requests, the targets, where a shared output
-lives; ``workflow/rules/*.smk`` only wire them) and the tests all read it. A step's last
+another key has a given value), the steps whose outputs it reads, the files each rule reads
+(``inputs``), what its script is handed, and the class whose ``from_config`` builds its
+typed parameters. The step hash, ``synergrasp.wiring`` (every rule's inputs, outputs, log,
+benchmark, threads, requests and params, the targets, where a shared output lives;
+``workflow/rules/steps.smk`` makes every rule from it) and the tests all read it. A step's last
 rule, the one that writes its ``outputs``, is named as the step; an earlier rule of it is
 named ``<step>_<what>``; every rule's log and benchmark live in a folder (one file for a
 step run once) named as the rule.
@@ -51,6 +52,12 @@ __all__ = [
     "upstream_when",
     "rule_costs",
     "rule_step",
+    "rule_inputs",
+    "rule_handed",
+    "reads_key",
+    "HAND_FILES",
+    "HANDED",
+    "INPUT_SOURCES",
     "step_for_object",
     "step_made",
     "RESULTS",
@@ -121,6 +128,18 @@ class Step:
     folders:   the outputs that are folders (of pages), in the report only when it is an archive.
     rule_outputs: the files of a rule before the last (kept only until the last has run),
                under the same folder as ``outputs``: rule -> path (with its own wildcards).
+    inputs:    the files the step's last rule reads, by the name its script reads them under:
+               input name -> source (:data:`INPUT_SOURCES`): ``"<step>"`` (that step's one
+               output), ``"<step>.<output>"`` (its output of that name), ``"<rule>"`` (an earlier
+               rule of this step: every shard's file), or a file of the study's own
+               (``SHIPPED_DATA``, ``USER_FILES``, ``MANIFEST``, ``MESH``, ``RULE_FILES``,
+               ``SNAKEFILE``). Which object's or scenario's file a source is follows from the
+               two steps' scopes (``wiring.Wiring.inputs``); the code a rule runs is added to
+               every rule (``wiring.Wiring.code``).
+    rule_inputs: the same for a rule before the last: rule -> its inputs.
+    handed:    what a rule's script is handed as ``params``, where it differs from the default
+               (``("cfg",)``, the part of the configuration its step reads, for a step that
+               reads any key; nothing otherwise): rule -> names of :data:`HANDED`.
     """
 
     rules: Mapping[str, Cost]
@@ -139,6 +158,31 @@ class Step:
     report: Mapping[str, tuple[str, str]] = field(default_factory=dict)
     folders: tuple[str, ...] = ()
     rule_outputs: Mapping[str, str] = field(default_factory=dict)
+    inputs: Mapping[str, str] = field(default_factory=dict)
+    rule_inputs: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
+    handed: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+
+
+#: A rule's inputs that are files of the study's own, not a step's outputs: the shipped hand
+#: and synergy files; the scenario's own hand, synergy and mesh files with the meshes' convex
+#: parts; the sha256 manifest of its random objects; the mesh file whose parts a job makes;
+#: the workflow's rule files and its Snakefile (``wiring.Wiring.inputs`` resolves them).
+SHIPPED_DATA, USER_FILES, MANIFEST, MESH, RULE_FILES, SNAKEFILE = (
+    "@shipped_data",
+    "@user_files",
+    "@manifest",
+    "@mesh",
+    "@rule_files",
+    "@snakefile",
+)
+INPUT_SOURCES = (SHIPPED_DATA, USER_FILES, MANIFEST, MESH, RULE_FILES, SNAKEFILE)
+#: The hand a step's code loads (``hand.kinematics.load_hand``, ``hand.synergies.load_synergies``),
+#: with the meshes of its objects: the shipped files and the scenario's own.
+HAND_FILES = {"data": SHIPPED_DATA, "user": USER_FILES}
+#: What a rule's script may be handed as ``params`` (``wiring.Wiring.params``): the part of the
+#: scenario's configuration its step reads; the shipped configuration file; the scenarios'
+#: names; how each scenario places the boxes.
+HANDED = ("cfg", "configfile", "scenarios", "placements")
 
 
 def _files(names: tuple[str, ...], folder: str, exts: tuple[str, ...], named: bool = True) -> dict[str, str]:
@@ -194,6 +238,7 @@ STEPS: dict[str, Step] = {
         outputs={"obj": "meshes/{mesh}.obj"},
         scope="workflow",
         optional=True,
+        inputs={"mesh": MESH},
     ),
     # the placement search (docs/placement_search.md): the kinematic closure and the
     # optimisation with the full set {S1..S_incremental_max} only; one job per object with
@@ -206,6 +251,7 @@ STEPS: dict[str, Step] = {
         not_reads=STEPS_SEARCH_NOT_READS,
         params="synergrasp.optimisation.placement_search:SearchStepParams",
         placement_when=(("mode", "searched"),),
+        inputs={**HAND_FILES},
     ),
     "simulate": Step(
         rules={"simulate": Cost("closure_pose", 1.5, 178, 4.5e-3, 7.6e-3, local=False)},
@@ -220,6 +266,7 @@ STEPS: dict[str, Step] = {
         upstream_when=(("placement.mode", "searched", "search"),),
         synergy_columns=(1,),
         params="synergrasp.simulation.closure:SimulateParams",
+        inputs={**HAND_FILES, "search": "search"},
     ),
     "contacts": Step(
         rules={"contacts": Cost("pose", 1.0, 150, 5.0e-4, 7.6e-3)},
@@ -231,6 +278,7 @@ STEPS: dict[str, Step] = {
         upstream=("simulate",),
         params="synergrasp.simulation.contacts:ContactsParams",
         made_when=(("closure.model", "dynamic"), ("closure.dynamic.unloaded_contacts", "drop")),
+        inputs={"contacts": "simulate"},
     ),
     "optimise": Step(
         rules={
@@ -250,6 +298,9 @@ STEPS: dict[str, Step] = {
         upstream=("contacts",),
         params="synergrasp.optimisation.optimise:OptimiseParams",
         rule_outputs={"optimise_shard": "gfo_shards/{shard}.parquet"},
+        rule_inputs={"optimise_shard": {"contacts": "contacts", **HAND_FILES}},
+        inputs={"shards": "optimise_shard"},
+        handed={"optimise": ()},  # merges the shards: reads no configuration
     ),
     "minima": Step(
         rules={"minima": Cost("pose_set", 0.6, 136, 1.35e-5, 6.0e-4)},
@@ -260,6 +311,7 @@ STEPS: dict[str, Step] = {
         reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
         upstream=("optimise",),
         params="synergrasp.analysis.minima:MinimaParams",
+        inputs={"gfo": "optimise"},
     ),
     # quality indices of every pose and their maps (docs/quality.md)
     "quality": Step(
@@ -279,6 +331,7 @@ STEPS: dict[str, Step] = {
         upstream=("contacts", "optimise"),
         params="synergrasp.optimisation.quality:QualityParams",
         report={"png": ("quality_maps", "Quality")},
+        inputs={"contacts": "contacts", "gfo": "optimise", **HAND_FILES},
     ),
     # what blocks each set of the hierarchy table where the full set succeeds (docs/blockers.md):
     # one small conic problem per distinct failing (grasp, set), ~1.5 ms of CPU per pose
@@ -297,6 +350,7 @@ STEPS: dict[str, Step] = {
         ),
         upstream=("contacts", "optimise"),
         params="synergrasp.analysis.blockers:BlockersParams",
+        inputs={"contacts": "contacts", "gfo": "optimise", **HAND_FILES},
     ),
     "blockers_table": Step(
         rules={"blockers_table": Cost("none", 4.0, 300)},
@@ -308,6 +362,7 @@ STEPS: dict[str, Step] = {
         reads=("synergy_sets.hierarchy_first", "synergy_sets.incremental_max"),
         upstream=("blockers",),
         report={"csv": ("blockers_table", "Tables"), "png": ("blockers", "Figures")},
+        inputs={"blockers": "blockers"},
     ),
     # the incremental planner against the exhaustive search (docs/planner.md): {S1} over the
     # grid, then {S1..Sk} near the previous level's minima, at 3 radii, and the greedy order:
@@ -330,6 +385,7 @@ STEPS: dict[str, Step] = {
         upstream=("contacts", "optimise"),
         params="synergrasp.analysis.plan_study:PlanParams",
         optional=True,
+        inputs={"contacts": "contacts", "gfo": "optimise", **HAND_FILES},
     ),
     # planners compared at equal cost, replayed on every object's gfo table (docs/planner.md):
     # 28 candidates, the randomised ones over 200 seeds: 8.2 CPU s, 294 MB for the four boxes of
@@ -354,6 +410,7 @@ STEPS: dict[str, Step] = {
         upstream=("contacts", "optimise"),
         params="synergrasp.analysis.plan_study:PlannersParams",
         report={"across_csv": ("planners_across", "Tables"), "png": ("planners", "Figures")},
+        inputs={"contacts": "contacts", "gfo": "optimise"},
     ),
     "tables": Step(
         rules={"tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
@@ -379,6 +436,7 @@ STEPS: dict[str, Step] = {
         upstream=("optimise", "minima", "planners"),
         params="synergrasp.analysis.summaries:TablesParams",
         report={f"{t}_csv": (t, "Tables") for t in TABLES},
+        inputs={"gfo": "optimise", "minima": "minima", "planners": "planners.csv", **HAND_FILES},
     ),
     "realism": Step(
         # with the equilibrium checks of every grasp: ~0.5 ms of CPU per grasp over 75 sets
@@ -417,6 +475,7 @@ STEPS: dict[str, Step] = {
             "png": ("grasp_realism", "Figures"),
             "graspable_csv": ("graspable_objects", "Tables"),
         },
+        inputs={"contacts": "contacts", "gfo": "optimise", "placements": "search", "manifest": MANIFEST, **HAND_FILES},
     ),
     "fig1": Step(
         rules={"fig1": Cost("none", 3.0, 565)},
@@ -424,6 +483,7 @@ STEPS: dict[str, Step] = {
         reads=("hand", "synergies"),
         params="synergrasp.figures.hand_figures:Fig1Params",
         report={"png": ("fig1", "Figures")},
+        inputs={**HAND_FILES},
     ),
     # what grasps the hand can make (docs/hand_reach.md): per finger the reach along S1 and in
     # any posture, d_max (~60 kinematic closures on slabs lying on the palm) and the aperture
@@ -438,6 +498,7 @@ STEPS: dict[str, Step] = {
         not_reads=("closure.model", "closure.dynamic"),
         params="synergrasp.simulation.reach:HandReachStepParams",
         report={"csv": ("hand_reach_table", "Tables"), "png": ("hand_reach", "Figures")},
+        inputs={**HAND_FILES},
     ),
     # Fig. 2 and the same grasps in 3-D with the full set's optimal forces: pages sharing one
     # plotly script (docs/inspector.md); one job, so that the pages' imports (the solver, a
@@ -458,6 +519,7 @@ STEPS: dict[str, Step] = {
         params="synergrasp.figures.grasp_3d:Grasps3dParams",
         report={"png": ("fig2", "Figures"), "pages": ("grasps_3d", "Figures")},
         folders=("pages",),
+        inputs={"contacts": "contacts", **HAND_FILES},
     ),
     "fig4": Step(
         rules={"fig4": Cost("pose_set", 4.3, 257, 5.1e-6, 4.0e-4)},
@@ -473,6 +535,7 @@ STEPS: dict[str, Step] = {
         upstream=("optimise", "minima"),
         params="synergrasp.figures.study_figures:Fig4Params",
         report={"maps_png": ("fig4_force_maps", "Fig. 4"), "exploded_png": ("fig4_exploded", "Fig. 4")},
+        inputs={"gfo": "optimise", "minima": "minima"},
     ),
     # the placement map: the search's score over its targets, grasps at the chosen target
     "placement_map": Step(
@@ -485,6 +548,7 @@ STEPS: dict[str, Step] = {
         params="synergrasp.optimisation.placement_search:SearchStepParams",
         placement_when=(("mode", "searched"), ("search_rank", 1)),
         report={"png": ("placement_map", "Placement search")},
+        inputs={"placement": "search", "contacts": "contacts", **HAND_FILES},
     ),
     # the study's claims at every scored target of the search (docs/placement_search.md): the
     # closure and every set's optimisation on a 117-pose lattice, ~1 s of CPU per target, 2 processes
@@ -499,6 +563,7 @@ STEPS: dict[str, Step] = {
         params="synergrasp.analysis.target_claims:TargetClaimsParams",
         optional=True,
         placement_when=(("mode", "searched"),),
+        inputs={"placement": "search", **HAND_FILES},
     ),
     # their summary: made by the target `placement_claims`
     "summarise_target_claims": Step(
@@ -511,6 +576,7 @@ STEPS: dict[str, Step] = {
         upstream=("target_claims",),
         optional=True,
         report={"csv": ("placement_claims", "Placement search"), "png": ("placement_claims", "Placement search")},
+        inputs={"claims": "target_claims"},
     ),
     # the study across its objects, with the planner (docs/random_objects.md): made by
     # `snakemake -j2 across_objects`, not by `figures`
@@ -530,6 +596,14 @@ STEPS: dict[str, Step] = {
         upstream=("tables", "realism", "plan"),
         params="synergrasp.analysis.objects_summary:ObjectsSummaryParams",
         optional=True,
+        inputs={
+            "success_rates": "tables.success_rates_csv",
+            "preservation": "tables.minimum_preservation_csv",
+            "graspable": "realism.graspable_csv",
+            "plans": "plan.plan",
+            "enrollment": "plan.enrollment",
+            "manifest": MANIFEST,
+        },
     ),
     "fig5": Step(
         rules={"fig5": Cost("none", 9.6, 268)},
@@ -549,6 +623,7 @@ STEPS: dict[str, Step] = {
             "pooled_png": ("fig5a_pooled", "Figures"),
             "force_png": ("fig5b", "Figures"),
         },
+        inputs={"hierarchy": "tables.hierarchy_csv"},
     ),
     # the workflow's own rule graph: drawn with the shipped configuration, so it reads no key
     "fig3": Step(
@@ -556,6 +631,10 @@ STEPS: dict[str, Step] = {
         outputs={**_files(("fig3_rulegraph",), "figures", _PNG_PDF, named=False), "dot": "figures/fig3_rulegraph.dot"},
         scope="workflow",
         report={"png": ("fig3", "Figures")},
+        inputs={"rules": RULE_FILES, "snakefile": SNAKEFILE},
+        # the rule graph does not depend on the configuration's values: drawn with the shipped
+        # configuration file, so that neither a config value nor a config file's path reruns it
+        handed={"fig3": ("configfile",)},
     ),
     # the sweep's summary across every scenario (docs/sensitivity.md): its rule is the target
     "sensitivity": Step(
@@ -576,6 +655,14 @@ STEPS: dict[str, Step] = {
             "grid_png": ("sensitivity_grid", "Sensitivity"),
             "curves_png": ("sensitivity_table2", "Sensitivity"),
         },
+        inputs={
+            "claims": "tables.claims_csv",
+            "table2": "tables.table2_success_rates_csv",
+            "success_rates": "tables.success_rates_csv",
+            "preservation": "tables.minimum_preservation_csv",
+            "realism": "realism.csv",
+        },
+        handed={"sensitivity": ("scenarios", "placements")},
     ),
 }
 #: Keys read by the workflow itself, not by a step.
@@ -592,6 +679,30 @@ def rule_costs() -> dict[str, Cost]:
 def rule_step() -> dict[str, str]:
     """Every rule of every step -> its step."""
     return {rule: name for name, step in STEPS.items() for rule in step.rules}
+
+
+def rule_inputs(rule: str) -> Mapping[str, str]:
+    """The inputs of ``rule`` (input name -> source, :class:`Step`'s ``inputs``): its step's
+    ``inputs`` for the step's last rule, its ``rule_inputs`` entry for an earlier one."""
+    step = STEPS[rule_step()[rule]]
+    return step.rule_inputs.get(rule, {}) if rule != list(step.rules)[-1] else step.inputs
+
+
+def rule_handed(rule: str) -> tuple[str, ...]:
+    """What ``rule``'s script is handed as ``params`` (names of :data:`HANDED`): its step's
+    ``handed`` entry, else the part of the configuration its step reads where it reads any key."""
+    step = STEPS[rule_step()[rule]]
+    return step.handed.get(rule, ("cfg",) if step.reads else ())
+
+
+def reads_key(step: str, path: str) -> bool:
+    """Whether ``step`` reads the configuration key ``path`` under every configuration: a key
+    of its ``reads`` is ``path`` or a block holding it, and none of its ``not_reads`` is."""
+
+    def within(key: str) -> bool:
+        return path == key or path.startswith(key + ".")
+
+    return any(within(key) for key in STEPS[step].reads) and not any(within(key) for key in STEPS[step].not_reads)
 
 
 def step_for_object(config: Mapping[str, Any], step: str, obj: str) -> bool:

@@ -2,7 +2,8 @@
 each rule's output, log and benchmark paths, threads and requests, the files of each
 scenario's study, where a step's output shared between scenarios lives, the code a rule's
 script runs. ``workflow/rules/common.smk`` builds one :class:`Wiring` from Snakemake's
-configuration and hands its answers to the rules; the rules hold no logic of their own.
+configuration and ``workflow/rules/steps.smk`` makes every rule from its answers
+(:meth:`Wiring.inputs`, :class:`RuleFiles`, :meth:`Wiring.resources`, :meth:`Wiring.params`).
 
 Paths: a step per object writes under ``{root}/objects/{object}/``, one per scenario under
 ``{root}/``, one for the whole workflow under ``results/``; ``{root}`` is ``results`` for the
@@ -27,11 +28,20 @@ from synergrasp.config import DEFAULT_SCENARIO, ConfigError, grid_axis_deg, obje
 from synergrasp.ids import synergy_sets
 from synergrasp.steps import (
     CLOSURE_COST_FACTOR,
+    MANIFEST,
+    MESH,
     RESULTS,
+    RULE_FILES,
+    SHIPPED_DATA,
+    SNAKEFILE,
     SOLVER_COMPILE,
     STEPS,
+    USER_FILES,
     made_by,
+    reads_key,
     rule_costs,
+    rule_handed,
+    rule_inputs,
     rule_step,
     scenario_root,
     step_config,
@@ -369,6 +379,59 @@ class Wiring:
         """Where scenario ``name``'s file ``rel`` (one of the step's outputs) lives."""
         return f"{self.step_root(name, step)}/{rel}"
 
+    # ---- a rule's inputs and params, from the registry
+
+    def inputs(self, rule: str) -> dict[str, Any]:
+        """A rule's ``input``: each of its registry inputs (``steps.rule_inputs``) as the path,
+        list or input function Snakemake takes, and ``code``, the code its script runs.
+
+        A source ``"<step>"`` or ``"<step>.<output>"`` is, by the two steps' scopes: for a
+        rule per object reading a step per object, the job's object's file; for a rule per
+        scenario, every object's file of a step per object, or the scenario's file of a step
+        per scenario; for a rule run once for the workflow, every scenario's file. A source
+        naming an earlier rule of the same step is every one of its shards' files."""
+        scope = STEPS[rule_step()[rule]].scope
+        found: dict[str, Any] = {name: self._source(rule, scope, source) for name, source in rule_inputs(rule).items()}
+        return {**found, "code": self.code(rule)}
+
+    def _source(self, rule: str, scope: str, source: str) -> Any:
+        special = {
+            SHIPPED_DATA: self.shipped_data,
+            USER_FILES: lambda: self.user_files,
+            MANIFEST: lambda: self.random_objects_manifest,
+            MESH: lambda: self.mesh_file,
+            RULE_FILES: lambda: [str(p) for p in sorted((self.root / "workflow" / "rules").glob("*.smk"))],
+            SNAKEFILE: lambda: str(self.root / "Snakefile"),
+        }
+        if source in special:
+            return special[source]()
+        step, _, output = source.partition(".")
+        if step not in STEPS:  # an earlier rule of the same step: every shard's file
+            return self.shard_files(step)
+        producer = STEPS[step].scope
+        if producer == "object" and scope == "object" and not output:
+            return self.search_input(rule_step()[rule]) if step == "search" else self.step_input(step)
+        if producer == "object" and scope == "scenario":
+            return self.object_files(step, output) if output else self.step_inputs(step)
+        rel = STEPS[step].outputs[output] if output else next(iter(STEPS[step].outputs.values()))
+        if producer == "scenario" and scope == "scenario":
+            return self.study_input(step, rel)
+        if producer == "scenario" and scope == "workflow":
+            return lambda w: [self.study_file(s, step, rel) for s in self.scenarios]
+        raise ValueError(f"rule {rule!r}: no input of a rule per {scope} from {source!r} (a step per {producer})")
+
+    def params(self, rule: str) -> dict[str, Any]:
+        """A rule's ``params`` (``steps.rule_handed``): ``cfg``, the part of the job's scenario
+        configuration its step reads; ``configfile``, the shipped configuration file;
+        ``scenarios``, the scenarios' names; ``placements``, how each places the boxes."""
+        handed = {
+            "cfg": lambda: self.step_cfg(rule_step()[rule]),
+            "configfile": lambda: str(self.root / "config" / "config.yaml"),
+            "scenarios": lambda: list(self.scenarios),
+            "placements": lambda: lambda w: [self.placement_label(s) for s in self.scenarios],
+        }
+        return {name: handed[name]() for name in rule_handed(rule)}
+
     # ---- input functions of the rules
 
     def step_input(self, step: str) -> Callable[[Any], str | list[str]]:
@@ -381,10 +444,13 @@ class Wiring:
 
         return file
 
-    def search_input(self) -> Callable[[Any], str | list[str]]:
+    def search_input(self, reader: str) -> Callable[[Any], str | list[str]]:
         """Input function: the job's object's placement-search table where its placement is
-        searched; a ``search_rank`` beyond the distinct targets of a table that exists
-        already stops the run before any job (``study_checks.search_rank_problems``)."""
+        searched; for a ``reader`` step that reads ``placement.search_rank``, a rank beyond
+        the distinct targets of a table that exists already stops the run before any job
+        (``study_checks.search_rank_problems``)."""
+        if not reads_key(reader, "placement.search_rank"):
+            return self.step_input("search")
 
         def file(w: Any) -> str | list[str]:
             path = self.step_input("search")(w)
@@ -392,14 +458,12 @@ class Wiring:
 
         return file
 
-    def step_inputs(self, step: str, target: str | None = None) -> Callable[[Any], list[str]]:
-        """Input function: every object's ``step`` output in the job's scenario; with
-        ``target``, none is refused before any job (the target needs a searched placement)."""
+    def step_inputs(self, step: str) -> Callable[[Any], list[str]]:
+        """Input function: every object's ``step`` output in the job's scenario."""
 
         def files(w: Any) -> list[str]:
             name = self.job_scenario(w)
-            found = [self.step_file(name, step, o) for o in self.scenario(name)["objects"] if self._for_object(name, step, o)]
-            return found if target is None else searched_objects_or_refuse(found, target, self.job_config(w), self._refuse)
+            return [self.step_file(name, step, o) for o in self.scenario(name)["objects"] if self._for_object(name, step, o)]
 
         return files
 
@@ -411,10 +475,6 @@ class Wiring:
     def study_input(self, step: str, rel: str) -> Callable[[Any], str]:
         """Input function: the job's scenario's file ``rel`` of the per-scenario ``step``."""
         return lambda w: self.study_file(self.job_scenario(w), step, rel)
-
-    def scenario_tables(self, table: str, step: str = "tables") -> Callable[[Any], list[str]]:
-        """Input function: every scenario's (default first) table ``table``.csv of ``step``."""
-        return lambda w: [self.study_file(s, step, f"tables/{table}.csv") for s in self.scenarios]
 
     def shard_files(self, rule: str) -> Callable[[Any], list[str]]:
         """Input function: the job's object's files of every shard of ``rule`` (``solver.pose_shards``)."""
@@ -550,6 +610,14 @@ class Wiring:
     def optional_targets(self, step: str, name: str = DEFAULT_SCENARIO) -> list[str]:
         """The files of the optional per-scenario ``step`` of scenario ``name``."""
         return [self.study_file(name, step, rel) for rel in STEPS[step].outputs.values()]
+
+    def searched_targets(self, step: str, target: str, name: str = DEFAULT_SCENARIO) -> list[str]:
+        """:meth:`optional_targets` of a ``step`` that reads the placement search's targets;
+        where no object of scenario ``name`` is searched, ``target`` (the rule asking) is
+        refused before any job (``study_checks.searched_objects_or_refuse``)."""
+        searched = [o for o in self.scenario(name)["objects"] if self._for_object(name, "search", o)]
+        searched_objects_or_refuse(searched, target, self.scenario(name), self._refuse)
+        return self.optional_targets(step, name)
 
     def placement_label(self, name: str) -> str:
         """How scenario ``name`` places the boxes, for the sweep's summary: the mode; for a

@@ -1,6 +1,7 @@
-# Shared wiring: the configuration checked before any job runs, and what every rule is made
-# of (outputs, log, benchmark, threads, requests, inputs, targets), all answered by
-# synergrasp.wiring from the step registry (synergrasp.steps.STEPS). No logic lives here.
+# Shared wiring: the configuration checked before any job runs, and the study's Wiring, which
+# answers from the step registry (synergrasp.steps.STEPS) what every rule is made of (inputs,
+# outputs, log, benchmark, threads, requests, params, targets; workflow/rules/steps.smk makes
+# the rules). No logic lives here.
 # Snakemake's internals are used through synergrasp.snakemake_adapter alone.
 import sys
 
@@ -25,28 +26,9 @@ refuse(older_results_problems(RESULTS))
 
 #: The study: its scenarios (each checked when a target first needs it) and their files.
 W = Wiring(config, workflow.basedir, error=WorkflowError, warn=logger.warning, stop=refuse)
-ROOT = W.root
 OBJECTS = W.objects
 SCENARIOS = W.scenarios
-SHIPPED_DATA = W.shipped_data()
 _ARCHIVE = report_archive(sys.argv)
-
-
-def outputs(rule):
-    """A rule's outputs, from the registry, with Snakemake's report/directory/temp flags."""
-    return RuleFiles(rule).snakemake_outputs(report, directory, temp, _ARCHIVE)
-
-
-def log_file(rule):
-    return RuleFiles(rule).log()
-
-
-def benchmark_file(rule):
-    return RuleFiles(rule).benchmark()
-
-
-def threads(rule):
-    return rule_costs()[rule].threads
 
 
 # Wildcards match the configured names exactly, so Snakemake's guard against endless
