@@ -72,7 +72,6 @@ SECTIONS = (
             "dry_run",
             "cluster_thousand",
             "tables_memory",
-            "tables_memory_aggregation",
         ),
         "Whole runs besides the default study; `tools/measurements.py record NAME --timed -- COMMAND` records one "
         "(a workflow from an empty `results/`).",
