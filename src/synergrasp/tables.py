@@ -662,7 +662,7 @@ PLANNERS_ACROSS = Table(
 )
 
 #: The study's tables, in this order (the ``tables`` step's outputs ``tables/<name>.{csv,md}``, made by
-#: ``analysis.summaries.study_tables``): shown to the reader, no contract between steps.
+#: ``analysis.study_tables.study_tables``): shown to the reader, no contract between steps.
 STUDY_TABLES: tuple[str, ...] = (
     "success_rates",
     "table2_success_rates",

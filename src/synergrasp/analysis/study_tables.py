@@ -6,7 +6,7 @@ them (its success-rate, lost-pose, disagreement, check and preservation rows, it
 successes and optimal forces per distinct pose and set, its null-model counts) and drops
 the rows before the next object is read. So a job holds one object's rows at a time, and
 what it keeps of an object is a few hundred kB (docs/measurements.md, tables_memory and
-tables_memory_1000). The bootstrap's and the null model's generators draw for the objects in
+the benchmark of the tables' aggregation). The bootstrap's and the null model's generators draw for the objects in
 the same sorted order as they did over every object's rows at once, and every sum over
 objects is a sum of integers or is taken in that order: the tables are the same to the
 byte (tests/test_study_tables.py).
