@@ -29,12 +29,12 @@ include: "workflow/rules/steps.smk"
 rule all:
     default_target: True
     input:
-        W.study_targets(),
+        W.scenario_targets(),
 
 
 rule figures:
     input:
-        W.study_targets(),
+        W.scenario_targets(),
 
 
 # One target per object: `snakemake -j2 object_obj4` (re)makes obj4's outputs only.
@@ -56,12 +56,12 @@ for _scenario in SCENARIOS:
         name:
             f"scenario_{_scenario}"
         input:
-            lambda wildcards, name=_scenario: W.study_targets(name),
+            lambda wildcards, name=_scenario: W.scenario_targets(name),
 
 
 rule scenarios:
     input:
-        lambda wildcards: [f for name in SCENARIOS for f in W.study_targets(name)],
+        lambda wildcards: [f for name in SCENARIOS for f in W.scenario_targets(name)],
 
 
 # The study's claims at every target the placement search scored (docs/placement_search.md).

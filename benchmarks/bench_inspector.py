@@ -46,7 +46,7 @@ def pages_cost(results: Path, folder: Path) -> tuple[float, float]:
     """Wall and CPU seconds of the 3-D pages' work on the study under ``results``
     (imports and the solver kernel's load from its cache included)."""
     cpu, start = time.process_time(), time.perf_counter()
-    from synergrasp import tables
+    from synergrasp import table_contracts
     from synergrasp.config import validate_config
     from synergrasp.figures.grasp_3d import Grasps3dParams, fig2_scenes, write_grasp_pages
     from synergrasp.hand.kinematics import load_hand
@@ -55,7 +55,9 @@ def pages_cost(results: Path, folder: Path) -> tuple[float, float]:
     params = Grasps3dParams.from_config(validate_config({}))
     hand = load_hand(params.hand)
     matrix = load_synergies(params.synergies, joint_names=hand.joint_names).matrix
-    contacts = [tables.read(tables.CONTACTS, results / "objects" / o.name / "contacts.parquet") for o in params.objects]
+    contacts = [
+        table_contracts.read(table_contracts.CONTACTS, results / "objects" / o.name / "contacts.parquet") for o in params.objects
+    ]
     write_grasp_pages(folder, fig2_scenes(hand, matrix, params, contacts), "pages")
     return time.perf_counter() - start, time.process_time() - cpu
 

@@ -21,11 +21,12 @@ from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-from synergrasp import tables  # noqa: E402
+from synergrasp import table_contracts  # noqa: E402
 from synergrasp.analysis.periods import alpha_period_deg  # noqa: E402
 from synergrasp.analysis.plan_study import PlanParams, plan_object  # noqa: E402
 from synergrasp.hand.kinematics import load_hand  # noqa: E402
 from synergrasp.hand.synergies import load_synergies  # noqa: E402
+from synergrasp.input_checks import checked_scenario, read_overlays  # noqa: E402
 from synergrasp.optimisation.gfo import warm_up  # noqa: E402
 from synergrasp.optimisation.optimise import OptimiseParams, optimise_shard  # noqa: E402
 from synergrasp.optimisation.placement_search import SearchStepParams, full_synergy_set, search_object  # noqa: E402
@@ -33,7 +34,6 @@ from synergrasp.optimisation.problem import SynergySets  # noqa: E402
 from synergrasp.simulation import closure  # noqa: E402
 from synergrasp.simulation.placement import searched_placement  # noqa: E402
 from synergrasp.simulation.random_objects import add_random_objects  # noqa: E402
-from synergrasp.study_checks import checked_scenario, read_overlays  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 #: What the steps are called in the machine-read lines, in the order they run.
@@ -73,32 +73,32 @@ def run_object(cfg: dict, name: str, folder: Path) -> dict[str, tuple[float, str
         processes=1,
         opposition=sim.opposition,
     )
-    tables.write_csv(tables.PLACEMENT, result.table(sim.distinct_mm), folder / "placement.csv")
+    table_contracts.write_csv(table_contracts.PLACEMENT, result.table(sim.distinct_mm), folder / "placement.csv")
     out["search"] = (time.process_time() - clock, digest((folder / "placement.csv").read_text()))
 
     clock = time.process_time()
     params = closure.SimulateParams.from_config(cfg, name)
     placement = params.placement
     if placement.mode == "searched":
-        placement = searched_placement(placement, tables.read_csv(tables.PLACEMENT, folder / "placement.csv"))
+        placement = searched_placement(placement, table_contracts.read_csv(table_contracts.PLACEMENT, folder / "placement.csv"))
     contacts = closure.simulate_object(
         hand, params.synergies(hand.joint_names), params.object, placement, params.closure, mechanics=params.mechanics
     )
-    tables.write(tables.CONTACTS, contacts, folder / "contacts.parquet")
+    table_contracts.write(table_contracts.CONTACTS, contacts, folder / "contacts.parquet")
     out["closure"] = (time.process_time() - clock, digest(contacts.to_json()))
 
     clock = time.process_time()
     opt = OptimiseParams.from_config(cfg, name)
     sets = SynergySets(synergies.matrix, tuple(opt.sets.values()))
-    gfo = optimise_shard(tables.read(tables.CONTACTS, folder / "contacts.parquet"), 0, 1, sets, opt.gfo)
-    tables.write(tables.GFO, gfo, folder / "gfo.parquet")
+    gfo = optimise_shard(table_contracts.read(table_contracts.CONTACTS, folder / "contacts.parquet"), 0, 1, sets, opt.gfo)
+    table_contracts.write(table_contracts.GFO, gfo, folder / "gfo.parquet")
     out["optimise"] = (time.process_time() - clock, digest(gfo.to_json()))
 
     clock = time.process_time()
     plan_params = PlanParams.from_config(cfg, name)
     plan = plan_object(
-        tables.read(tables.CONTACTS, folder / "contacts.parquet"),
-        tables.read(tables.GFO, folder / "gfo.parquet"),
+        table_contracts.read(table_contracts.CONTACTS, folder / "contacts.parquet"),
+        table_contracts.read(table_contracts.GFO, folder / "gfo.parquet"),
         synergies.matrix,
         plan_params,
     )

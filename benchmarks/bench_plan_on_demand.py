@@ -22,10 +22,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.analysis.plan_new import DEFAULT_PLANNER
 from synergrasp.cli import main as synergrasp
-from synergrasp.study_checks import checked_configuration
+from synergrasp.input_checks import checked_configuration
 
 #: The issue's aim: a pose within this regret (%), with at most this share of the closures.
 AIM_REGRET_PERCENT, AIM_CLOSURE_SHARE = 5.0, 0.5
@@ -50,8 +50,8 @@ def plan_objects(objects: list[str], args: argparse.Namespace) -> tuple[pd.DataF
             if code:
                 failed.append(obj)
                 continue
-            rows.append(tables.read_csv(tables.PLAN_ON_DEMAND, out))
-    return (pd.concat(rows, ignore_index=True) if rows else tables.empty(tables.PLAN_ON_DEMAND)), failed
+            rows.append(table_contracts.read_csv(table_contracts.PLAN_ON_DEMAND, out))
+    return (pd.concat(rows, ignore_index=True) if rows else table_contracts.empty(table_contracts.PLAN_ON_DEMAND)), failed
 
 
 def summarise(table: pd.DataFrame, n_failed: int) -> None:
@@ -79,13 +79,13 @@ def main() -> None:
     ap.add_argument("--summarise", type=Path, nargs="+", help="only summarise these tables")
     args = ap.parse_args()
     if args.summarise:
-        summarise(pd.concat([tables.read_csv(tables.PLAN_ON_DEMAND, p) for p in args.summarise]), 0)
+        summarise(pd.concat([table_contracts.read_csv(table_contracts.PLAN_ON_DEMAND, p) for p in args.summarise]), 0)
         return
     k, n = args.shard
     objects = sorted(checked_configuration(args.configfile)["objects"])[k::n]
     table, failed = plan_objects(objects, args)
     if args.table:
-        tables.write_csv(tables.PLAN_ON_DEMAND, table, args.table)
+        table_contracts.write_csv(table_contracts.PLAN_ON_DEMAND, table, args.table)
     for r in table.itertuples():
         print(f"closures_{r.object}: {r.closures}  ({r.planner}, seed {r.seed}: closures run of {r.n_poses} poses)")
         print(f"closure_share_{r.object}: {100.0 * r.closures / r.n_poses:.1f}  (% of the exhaustive closures)")

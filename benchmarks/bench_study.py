@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.optimisation.mechanics import first_same_grasp, read_grasps
 
 
@@ -29,7 +29,7 @@ def main() -> None:
     if not bench or not gfo_files:
         raise SystemExit(f"no optimisation benchmark files or gfo tables under {args.root}: run `make study` first")
     cpu = sum(float(pd.read_csv(f, sep="\t")["cpu_time"].iloc[-1]) for f in bench)
-    solver = pd.concat([tables.read(tables.GFO, f)["solver"] for f in gfo_files], ignore_index=True)
+    solver = pd.concat([table_contracts.read(table_contracts.GFO, f)["solver"] for f in gfo_files], ignore_index=True)
     n, solved = len(solver), int((solver != "none").sum())
     fallback = int((solver == "clarabel_fallback").sum())
     own = [_solved_here(f) for f in gfo_files]
@@ -60,10 +60,10 @@ def _solved_here(gfo_file: Path) -> tuple[int, int]:
     found = [f for f in (folder / "load_carrying_contacts.parquet", folder / "contacts.parquet") if f.exists()]
     if not found:
         return 0, 0
-    contacts = tables.read(tables.CONTACTS, found[0])
+    contacts = table_contracts.read(table_contracts.CONTACTS, found[0])
     first = first_same_grasp(read_grasps(contacts))
     own = set(contacts["pose"].to_numpy()[first == range(len(first))].tolist())
-    gfo = tables.read(tables.GFO, gfo_file)
+    gfo = table_contracts.read(table_contracts.GFO, gfo_file)
     return len(own), int((gfo["pose"].isin(own) & (gfo["solver"] != "none")).sum())
 
 

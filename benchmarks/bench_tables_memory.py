@@ -67,7 +67,7 @@ def _names(n: int, base: list[str]) -> list[str]:
 def _config(n: int) -> dict:
     import yaml
 
-    from synergrasp.study_checks import checked_scenario
+    from synergrasp.input_checks import checked_scenario
 
     cfg, _ = checked_scenario(yaml.safe_load((ROOT / "config" / "config.yaml").read_text()))
     base = list(cfg["objects"])
@@ -77,7 +77,7 @@ def _config(n: int) -> dict:
 
 def make_objects(results: Path, scratch: Path, n: int) -> None:
     """Copies of the default study's objects under new names in ``scratch/objects/``."""
-    from synergrasp import tables
+    from synergrasp import table_contracts
 
     base = sorted(p.name for p in (results / "objects").iterdir() if (p / "gfo.parquet").exists())
     for name in _names(n, base):
@@ -87,8 +87,8 @@ def make_objects(results: Path, scratch: Path, n: int) -> None:
         folder.mkdir(parents=True)
         source = results / "objects" / name.rsplit("_", 1)[0]
         for file, table in _COPIED.items():
-            contract = getattr(tables, table)
-            tables.write(contract, tables.read(contract, source / file).assign(object=name), folder / file)
+            contract = getattr(table_contracts, table)
+            table_contracts.write(contract, table_contracts.read(contract, source / file).assign(object=name), folder / file)
         shutil.copy(source / "placement.csv", folder / "placement.csv")
 
 
@@ -127,7 +127,7 @@ def aggregation(results: Path, n: int) -> None:
     from synergrasp.analysis.study_tables import StudyReduction, object_loaders
     from synergrasp.analysis.summaries import TablesParams
     from synergrasp.steps import step_config
-    from synergrasp.tables import PLANNERS, read_csv
+    from synergrasp.table_contracts import PLANNERS, read_csv
 
     warnings.simplefilter("ignore")
     cfg = _config(n)

@@ -15,8 +15,8 @@ from synergrasp.optimisation.blocking import ACTIVE_TOL, blocking_contacts, cont
 from synergrasp.optimisation.cones import CircularCone, PyramidCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.mechanics import Grasp, internal_force_basis
-from synergrasp.optimisation.problem import GFOProblem
 from synergrasp.optimisation.optimise import GFOParams, mechanics_for
+from synergrasp.optimisation.problem import GFOProblem
 from synergrasp.simulation.opposition import HandAxes, OppositionRule, classify_grasp
 from synergrasp.simulation.shapes import shape_from_config
 
@@ -232,7 +232,7 @@ def test_sets_examined_and_the_summary_counts_poses():
 
 
 def test_the_table_solves_twin_poses_once_and_keeps_its_contract(hand, axes, tmp_path, monkeypatch):
-    from synergrasp import tables
+    from synergrasp import table_contracts
     from synergrasp.analysis import blockers as module
 
     grasp, S = one_sided_push(hand)
@@ -279,8 +279,8 @@ def test_the_table_solves_twin_poses_once_and_keeps_its_contract(hand, axes, tmp
     table = module.blockers_table(contacts, gfo, hand.link_names, axes, S, params)
     assert len(calls) == 1 and list(table["pose"]) == [0, 1] and list(table["alpha_deg"]) == [0.0, 90.0]
     assert table["blocker_link_name"].tolist() == [["index_distal", "middle_distal"]] * 2
-    tables.write(tables.BLOCKERS, table, tmp_path / "blockers.parquet")
-    back = tables.read(tables.BLOCKERS, tmp_path / "blockers.parquet")
+    table_contracts.write(table_contracts.BLOCKERS, table, tmp_path / "blockers.parquet")
+    back = table_contracts.read(table_contracts.BLOCKERS, tmp_path / "blockers.parquet")
     assert back["margin"].tolist() == table["margin"].tolist() and back["reason"].tolist() == ["contacts"] * 2
 
 

@@ -1,7 +1,7 @@
 """Every command of the package against bad input a user can give (issue 39): one line per
 problem naming the argument, the file or the key, exit status 2, no traceback, and nothing
 done first (no closure run, no file written). The configuration goes through the workflow's
-own check (``study_checks.checked_scenario``), so whatever the workflow refuses the command
+own check (``input_checks.checked_scenario``), so whatever the workflow refuses the command
 refuses too."""
 
 from __future__ import annotations

@@ -8,18 +8,18 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from conftest import study_closure_params, study_placement
 import bullet_reference
-
+from conftest import study_closure_params, study_placement
 from synergrasp.config import ConfigError, defaults, validate_config
-from synergrasp.simulation.closure import simulate_object
-from synergrasp.optimisation.mechanics import read_grasps
-from synergrasp.tables import CONTACTS, write as write_table
-from synergrasp.simulation.placement import approach_line, object_pose, palm_centre, pose_grid
 from synergrasp.hand.kinematics import forward_kinematics
 from synergrasp.hand.synergies import SynergyPath, load_synergies
+from synergrasp.optimisation.mechanics import read_grasps
+from synergrasp.simulation.closure import simulate_object
 from synergrasp.simulation.objects import GraspedObject
+from synergrasp.simulation.placement import approach_line, object_pose, palm_centre, pose_grid
 from synergrasp.simulation.shapes import Box
+from synergrasp.table_contracts import CONTACTS
+from synergrasp.table_contracts import write as write_table
 
 PARAMS = study_closure_params()
 PLACEMENT = study_placement()

@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.optimisation.mechanics import read_grasps
 from synergrasp.simulation.contacts import load_carrying_contacts
 
@@ -36,7 +36,7 @@ def _row(pose: int, links: list[int], loads: list[float], status: str = "grasp")
 
 
 def _table(rows: list[dict]) -> pd.DataFrame:
-    return pd.DataFrame(rows, columns=list(tables.CONTACTS.names))
+    return pd.DataFrame(rows, columns=list(table_contracts.CONTACTS.names))
 
 
 def test_only_contacts_at_or_above_the_threshold_are_kept_with_their_rows():

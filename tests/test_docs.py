@@ -15,7 +15,7 @@ def _tool(name):
 
 def test_design_md_schemas_are_the_table_contracts():
     """docs/design.md's Parquet schemas are what tools/design_schemas.py writes from
-    synergrasp.tables (rerun the tool after changing a contract)."""
+    synergrasp.table_contracts (rerun the tool after changing a contract)."""
     design = _tool("design_schemas")
     text = (ROOT / "docs" / "design.md").read_text()
     assert design.rewritten(text) == text

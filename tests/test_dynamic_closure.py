@@ -13,12 +13,11 @@ from conftest import study_closure_params, study_dynamic_params, study_placement
 from synergrasp.config import ConfigError, defaults, validate_config
 from synergrasp.hand.synergies import Synergies, SynergyPath
 from synergrasp.simulation.capsules import HandCapsules
-from synergrasp.simulation.closure import closure_model, simulate_object
-from synergrasp.simulation.closure import SimulateParams
+from synergrasp.simulation.closure import SimulateParams, closure_model, simulate_object
 from synergrasp.simulation.closure_params import ClosureMechanics, DynamicParams
 from synergrasp.simulation.objects import GraspedObject
-from synergrasp.simulation.shapes import Box
 from synergrasp.simulation.placement import ObjectPose, object_pose
+from synergrasp.simulation.shapes import Box
 
 MECHANICS = ClosureMechanics(k_ss_Nmm_per_rad=200.0, mu=1.5, gravity_direction=(1.0, 0.0, 0.0))
 PARAMS = study_closure_params(model="dynamic", dynamic=study_dynamic_params(time_limit_s=3.0))
@@ -59,7 +58,7 @@ def test_settings_name_the_key_and_allowed_values():
     # the workflow's one path from the config to the parameters
     config = validate_config(_with_dynamic(settle_window_s=0.1))
     params = SimulateParams.from_config(config, "obj1").closure.dynamic
-    assert isinstance(params, DynamicParams) and params.settle_window_s == 0.1 and params.window_steps == 24
+    assert isinstance(params, DynamicParams) and params.settle_window_s == 0.1 and params.window_ticks == 24
     with pytest.raises(ValueError, match="needs the mechanics block"):
         closure_model(None, None, PARAMS)  # type: ignore[arg-type]
 

@@ -1,12 +1,12 @@
 """Figure helpers: the force grid, the rule-graph parser, and files written for the study's plots."""
 
 import numpy as np
-import pytest
 import pandas as pd
+import pytest
 
-from synergrasp.figures.rulegraph import parse_rulegraph
-from synergrasp.figures.study_figures import figure_exploded_views, figure_force_maps, figure_hierarchy, force_grid
-from synergrasp.tables import write_study_table
+from synergrasp.figures.fig3_rulegraph import parse_rulegraph
+from synergrasp.figures.fig4_fig5_forces_hierarchy import figure_exploded_views, figure_force_maps, figure_hierarchy, force_grid
+from synergrasp.table_contracts import write_study_table
 
 
 def _gfo() -> pd.DataFrame:
@@ -82,7 +82,7 @@ def test_hierarchy_grey_scale_is_black_at_the_low_end_and_prints_every_cell():
     import matplotlib.pyplot as plt
     from matplotlib.colors import Normalize
 
-    from synergrasp.figures.study_figures import _hierarchy_panel
+    from synergrasp.figures.fig4_fig5_forces_hierarchy import _hierarchy_panel
 
     fig, ax = plt.subplots()
     image = _hierarchy_panel(ax, np.array([[0.0, 100.0], [np.nan, 50.0]]), Normalize(0.0, 100.0), ".0f", ["S1", "S2"])

@@ -123,14 +123,14 @@ def _one_grasp_table(hand, synergies) -> pd.DataFrame:
 
 
 def test_touching_links_in_words(hand):
-    from synergrasp.figures.hand_figures import _touching_words
+    from synergrasp.figures.fig1_fig2_postures_grasps import _touching_words
 
     links = [hand.link_index(n) for n in ("palm", "thumb_distal", "index_middle", "index_distal")]
     assert _touching_words(hand, links) == "touching: palm, thumb tip, index middle + tip"
 
 
 def test_figures_are_written_and_the_same_on_rerun(hand, synergies, tmp_path):
-    from synergrasp.figures.hand_figures import figure_example_grasps, figure_synergy_postures
+    from synergrasp.figures.fig1_fig2_postures_grasps import figure_example_grasps, figure_synergy_postures
     from synergrasp.simulation.objects import GraspedObject
 
     box = GraspedObject("cube", Box((30.0, 30.0, 30.0)), 1.0)

@@ -445,7 +445,7 @@ def test_the_search_lattice_bounds_the_rank():
 
 
 def _rank(rank: int) -> list[str]:
-    from synergrasp.study_checks import checked_scenario
+    from synergrasp.input_checks import checked_scenario
 
     config = defaults()
     config["placement"]["search_rank"] = rank
@@ -457,7 +457,7 @@ def _rank(rank: int) -> list[str]:
 
 
 def test_a_search_rank_beyond_an_existing_table_is_a_problem(tmp_path):
-    from synergrasp.study_checks import search_rank_problems
+    from synergrasp.input_checks import search_rank_problems
 
     cfg = validate_config({**defaults(), "placement": {**defaults()["placement"], "search_rank": 3}})
     table = tmp_path / "placement.csv"

@@ -15,8 +15,8 @@ from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.ids import set_id
 from synergrasp.inspector import default_sets, inspect_grasp, parse_sets
-from synergrasp.optimisation.problem import SynergySets
 from synergrasp.optimisation.optimise import OptimiseParams, gfo_table
+from synergrasp.optimisation.problem import SynergySets
 from synergrasp.simulation.closure import SimulateParams, simulate_object
 from synergrasp.steps import step_config
 
@@ -99,7 +99,7 @@ def test_json_output_holds_the_same_numbers(capsys, small):
 
 
 def test_a_searched_placement_takes_its_target_from_the_search_table(small, tmp_path):
-    from synergrasp import tables
+    from synergrasp import table_contracts
 
     target = (38.0, 5.0, 112.0)
     folder = tmp_path / "objects" / "obj1"
@@ -123,7 +123,7 @@ def test_a_searched_placement_takes_its_target_from_the_search_table(small, tmp_
     }
     import pandas as pd
 
-    pd.DataFrame([{c: row.get(c, 0) for c in tables.PLACEMENT.names}]).to_csv(folder / "placement.csv", index=False)
+    pd.DataFrame([{c: row.get(c, 0) for c in table_contracts.PLACEMENT.names}]).to_csv(folder / "placement.csv", index=False)
     searched = {**small, "placement": {**small["placement"], "mode": "searched"}}
     fixed = {**small, "placement": {**small["placement"], "mode": "fixed", "center_mm": list(target)}}
     a = inspect_grasp(searched, "obj1", -30.0, 0.0, [(1, 2)], results=tmp_path)

@@ -10,8 +10,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pytest  # noqa: E402
 
+from synergrasp.figures.fig3_rulegraph import canonical_rulegraph, parse_rulegraph  # noqa: E402
 from synergrasp.figures.output import save_figure  # noqa: E402
-from synergrasp.figures.rulegraph import canonical_rulegraph, parse_rulegraph  # noqa: E402
 from synergrasp.job_log import job_log  # noqa: E402
 
 

@@ -327,7 +327,7 @@ def test_the_example_studys_meshes_are_grasped_and_optimised(monkeypatch, obj, a
 def test_fig2_draws_a_mesh(hand, synergies, tmp_path, monkeypatch):
     """Fig. 2's picture of a grasp of the duck: written, the same bytes on a rerun."""
     from conftest import study_closure_params, study_placement
-    from synergrasp.figures.hand_figures import figure_example_grasps
+    from synergrasp.figures.fig1_fig2_postures_grasps import figure_example_grasps
     from synergrasp.simulation.closure import simulate_object
 
     monkeypatch.chdir(ROOT)

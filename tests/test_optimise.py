@@ -10,16 +10,16 @@ import pandas as pd
 import pytest
 
 from conftest import study_gfo_params
+from grasp_problems import random_grasp, random_synergies
+from synergrasp import table_contracts
 from synergrasp.config import defaults
 from synergrasp.ids import synergy_sets
-from synergrasp import tables
 from synergrasp.optimisation.cones import PyramidCone
 from synergrasp.optimisation.gfo import solve_gfo
 from synergrasp.optimisation.ipm.solver import IPMSettings
-from synergrasp.optimisation.problem import GraspSets, SynergySets
-from grasp_problems import random_grasp, random_synergies
-from synergrasp.optimisation.shards import merge_shards, shard_positions
 from synergrasp.optimisation.optimise import mechanics_for, optimise_grasps
+from synergrasp.optimisation.problem import GraspSets, SynergySets
+from synergrasp.optimisation.shards import merge_shards, shard_positions
 
 RTOL_NORM = 1e-4
 PARAMS = study_gfo_params(gravity_direction=(0.0, 0.0, -1.0))
@@ -67,11 +67,11 @@ def test_shards_partition_the_poses_in_order():
 
 
 def test_merge_shards_orders_poses_and_keeps_the_set_order():
-    gfo = tables.empty(tables.GFO)
+    gfo = table_contracts.empty(table_contracts.GFO)
     a = pd.DataFrame({"pose": [2, 2, 0, 0], "set_id": ["1", "1-2", "1", "1-2"]})
     merged = merge_shards([a.iloc[:2], a.iloc[2:]])
     assert merged[["pose", "set_id"]].values.tolist() == [[0, "1"], [0, "1-2"], [2, "1"], [2, "1-2"]]
-    assert list(gfo.columns) == list(tables.GFO.names)
+    assert list(gfo.columns) == list(table_contracts.GFO.names)
 
 
 def test_pyramid_cone_study_runs_through_the_kernel_and_matches_clarabel():

@@ -4,7 +4,6 @@ against the exhaustive gfo table."""
 
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
 
@@ -14,8 +13,8 @@ from synergrasp.analysis.minima import MinimaParams
 from synergrasp.analysis.plan_study import PlanParams, plan_object
 from synergrasp.analysis.planner import greedy_order, plan_against_exhaustive, plan_incremental
 from synergrasp.ids import incremental_set_id
-from synergrasp.optimisation.problem import SynergySets
 from synergrasp.optimisation.optimise import gfo_table
+from synergrasp.optimisation.problem import SynergySets
 
 # a 12 x 5 grid, 30 deg steps: alpha -180..150 (wraps), beta -60..60
 ALPHA, BETA = (a.ravel() for a in np.meshgrid(np.arange(-180.0, 180.0, 30.0), np.arange(-60.0, 61.0, 30.0), indexing="ij"))
@@ -143,7 +142,7 @@ def test_the_planner_on_the_study_solver_reproduces_the_gfo_table():
 def test_synergrasp_plan_reads_the_study_s_tables_and_prints_one_line_per_radius(tmp_path, capsys):
     import yaml
 
-    from synergrasp import tables
+    from synergrasp import table_contracts
     from synergrasp.cli import main
     from synergrasp.hand.synergies import load_synergies
     from test_optimise import _contacts_of
@@ -159,13 +158,13 @@ def test_synergrasp_plan_reads_the_study_s_tables_and_prints_one_line_per_radius
     folder = tmp_path / "objects" / "box"
     folder.mkdir(parents=True)
     filler = {"string": "kinematic", "int32": 0, "float64": 0.0, "bool": True}
-    for column in tables.CONTACTS.columns:  # what the closure writes and the planner does not read
+    for column in table_contracts.CONTACTS.columns:  # what the closure writes and the planner does not read
         if column.name not in contacts:
             contacts[column.name] = (
                 [[] for _ in range(len(contacts))] if column.dtype.startswith("list") else filler[column.dtype]
             )
-    tables.write(tables.CONTACTS, contacts, folder / "contacts.parquet")
-    tables.write(tables.GFO, gfo, folder / "gfo.parquet")
+    table_contracts.write(table_contracts.CONTACTS, contacts, folder / "contacts.parquet")
+    table_contracts.write(table_contracts.GFO, gfo, folder / "gfo.parquet")
     overlay = tmp_path / "box.yaml"
     overlay.write_text(
         yaml.safe_dump(
@@ -195,7 +194,7 @@ def test_synergrasp_plan_reads_the_study_s_tables_and_prints_one_line_per_radius
     )
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 2 and lines[1].startswith("box radius 400 deg: 90 of 90 solves (100.0 %)")
-    plan = tables.read_csv(tables.PLAN, tmp_path / "plan.csv")
+    plan = table_contracts.read_csv(table_contracts.PLAN, tmp_path / "plan.csv")
     assert plan["study_rows_differing"].tolist() == [0, 0] and bool(plan["is_global_min"].iloc[1])
     assert main(["plan", "nothing", "--results", str(tmp_path)]) == 2
     assert "synergrasp plan: object: 'nothing' is not an object of the configuration" in capsys.readouterr().err

@@ -246,11 +246,11 @@ def test_synergrasp_plan_on_demand_closes_only_where_the_planner_asks_and_agrees
     pose with the same force and the same closures (a grid without twin poses)."""
     import yaml
 
-    from synergrasp import tables
-    from synergrasp.inspector import object_closure
+    from synergrasp import table_contracts
     from synergrasp.cli import main
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.study_checks import checked_scenario, read_overlays
+    from synergrasp.input_checks import checked_scenario, read_overlays
+    from synergrasp.inspector import object_closure
 
     config = yaml.safe_load((ROOT / "tests" / "config" / "small.yaml").read_text())
     config["objects"] = {"obj1": config["objects"]["obj1"]}
@@ -270,7 +270,7 @@ def test_synergrasp_plan_on_demand_closes_only_where_the_planner_asks_and_agrees
         assert len(err) == 1 and says in err[0]
     assert main(args + ["--planner", "descent_5", "--seed", "3", "--csv", str(tmp_path / "plan.csv")]) == 0
     assert "obj1 on demand, planner descent_5 (seed 3)" in capsys.readouterr().out
-    plan = tables.read_csv(tables.PLAN_ON_DEMAND, tmp_path / "plan.csv").iloc[0]
+    plan = table_contracts.read_csv(table_contracts.PLAN_ON_DEMAND, tmp_path / "plan.csv").iloc[0]
     assert plan["n_poses"] == 35 and 0 < plan["closures"] < 35 and np.isnan(plan["regret_percent"])
     # the exhaustive study of the same object: every pose closed, every level solved
     cfg, _ = checked_scenario(read_overlays([str(overlay)]))

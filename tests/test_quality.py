@@ -149,13 +149,12 @@ def test_manipulability_of_a_rigid_translation_and_of_a_squeeze():
 
 
 def test_quality_table_rows_for_a_grasp_and_a_pose_without_one(tmp_path):
-    from synergrasp.hand.kinematics import load_hand
-    from synergrasp.simulation.opposition import HandAxes, OppositionRule
-
     import pandas as pd
 
-    from synergrasp import tables
+    from synergrasp import table_contracts
+    from synergrasp.hand.kinematics import load_hand
     from synergrasp.optimisation.quality import QualityParams, quality_table
+    from synergrasp.simulation.opposition import HandAxes, OppositionRule
 
     g = _cube_face_grasp(15.0)
     # the palm (link 0) pushes the cube off the palm, the middle fingertip (link 11) back: palm opposition
@@ -192,8 +191,8 @@ def test_quality_table_rows_for_a_grasp_and_a_pose_without_one(tmp_path):
     )
     table = quality_table(contacts, gfo, [g, None], np.zeros((2, 2)), params, HandAxes.from_hand(load_hand()))
     assert table["opposition"].tolist() == ["palm", "none"]
-    tables.write(tables.QUALITY, table, tmp_path / "quality.parquet")  # the contract's columns and types
-    table = tables.read(tables.QUALITY, tmp_path / "quality.parquet")
+    table_contracts.write(table_contracts.QUALITY, table, tmp_path / "quality.parquet")  # the contract's columns and types
+    table = table_contracts.read(table_contracts.QUALITY, tmp_path / "quality.parquet")
     expected = grasp_quality(g, 0.8, params.torque_length_mm)
     first, second = table.iloc[0], table.iloc[1]
     assert first["epsilon"] == pytest.approx(expected.epsilon) and first["rank_G"] == 6
@@ -222,12 +221,11 @@ def test_same_grasp_within_round_off_only():
 
 
 def test_quality_table_computes_one_grasp_once_and_shares_it(monkeypatch):
-    from synergrasp.hand.kinematics import load_hand
-    from synergrasp.simulation.opposition import HandAxes, OppositionRule
-
     import pandas as pd
 
+    from synergrasp.hand.kinematics import load_hand
     from synergrasp.optimisation import quality
+    from synergrasp.simulation.opposition import HandAxes, OppositionRule
 
     rng = np.random.default_rng(4)
     a, b = _random_grasp(rng, 5), _random_grasp(rng, 6)

@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.analysis.realism import NORMAL_FORCE_COLUMN, grasp_labels, grasp_realism, link_categories
 from synergrasp.simulation.opposition import HandAxes, OppositionRule
 from synergrasp.simulation.shapes import shape_from_config
@@ -117,7 +117,7 @@ def _table(hand, contacts=None, gfo=None, load_threshold_N=0.01, grasp_type="pow
 
 def test_counts_and_shares_by_hand(hand):
     table = _table(hand)
-    assert list(table.columns) == list(tables.GRASP_REALISM.names)
+    assert list(table.columns) == list(table_contracts.GRASP_REALISM.names)
     row = table.iloc[0]
     assert (row["object"], row["closure_model"]) == ("a", "kinematic")
     assert (row["poses"], row["simulated"], row["dropped"]) == (4, 3, 1)
@@ -325,8 +325,8 @@ def test_one_object_at_a_time_gives_the_tables_of_every_objects_rows(hand, tmp_p
     files = []
     for obj, (contacts, gfo) in frames.items():
         (tmp_path / obj).mkdir()
-        tables.write(tables.CONTACTS, contacts, tmp_path / obj / "contacts.parquet")
-        tables.write(tables.GFO, gfo, tmp_path / obj / "gfo.parquet")
+        table_contracts.write(table_contracts.CONTACTS, contacts, tmp_path / obj / "contacts.parquet")
+        table_contracts.write(table_contracts.GFO, gfo, tmp_path / obj / "gfo.parquet")
         files.append((tmp_path / obj / "contacts.parquet", tmp_path / obj / "gfo.parquet"))
     table, links, graspable = realism_by_object(files, hand, params, types)
 

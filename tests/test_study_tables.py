@@ -20,7 +20,7 @@ from synergrasp.analysis.intervals import StudyCounts
 from synergrasp.analysis.invariants import invariant_checks
 from synergrasp.analysis.study_tables import frames_by_object, study_tables
 from synergrasp.analysis.summaries import (
-    full_but_not_first7,
+    full_but_not_first_n,
     incrementality_table,
     minimum_preservation,
     success_rates,
@@ -89,7 +89,7 @@ def all_rows_tables(gfo: pd.DataFrame, minima: pd.DataFrame, settings) -> dict[s
         "success_rates": with_intervals(rates, counts),
         "table2_success_rates": incrementality_table(rates, 3),
         "invariant_checks": invariant_checks(table, rates, periods, settings.success_rate_tolerance_percent),
-        "full_not_first7": full_but_not_first7(table, full, first_n),
+        "full_not_first7": full_but_not_first_n(table, full, first_n),
         "minimum_preservation": preservation.merge(pairs.astype({"k": "Int64"}), on=["object", "k"], how="left"),
         "preservation_vs_chance": chance,
         "verdict_disagreements": verdict_disagreements(table),

@@ -9,7 +9,7 @@ from conftest import study_analysis_settings
 from synergrasp.analysis.invariants import InvariantError
 from synergrasp.analysis.study_tables import frames_by_object, study_tables
 from synergrasp.analysis.summaries import (
-    full_but_not_first7,
+    full_but_not_first_n,
     hierarchy_matrices,
     incrementality_table,
     mean_over_objects,
@@ -199,18 +199,18 @@ def test_minimum_preservation_by_hand(gfo):
     assert q.loc[("a", 1), ["n_minima_distinct", "n_preserved_distinct"]].tolist() == [1, 0]
 
 
-def test_full_but_not_first7(gfo):
-    out = full_but_not_first7(with_verdicts(gfo, "force_closure"), FULL, "1-2")
+def test_full_but_not_first_n(gfo):
+    out = full_but_not_first_n(with_verdicts(gfo, "force_closure"), FULL, "1-2")
     assert out[["object", "pose"]].values.tolist() == [["a", 2], ["a", 3]]
     assert out["full_force_norm"].tolist() == [3.0, 10.0]
     assert set(out["first7_status"]) == {"infeasible"}
     partial = gfo[~((gfo["set_id"] == "1-2") & (gfo["pose"] == 3))]
-    assert full_but_not_first7(with_verdicts(partial, "force_closure"), FULL, "1-2")["first7_status"].tolist() == [
+    assert full_but_not_first_n(with_verdicts(partial, "force_closure"), FULL, "1-2")["first7_status"].tolist() == [
         "infeasible",
         "missing",
     ]
-    with pytest.raises(ValueError, match="first7_set_id"):
-        full_but_not_first7(with_verdicts(gfo, "force_closure"), FULL, "1-2-3-4-5-6-7")
+    with pytest.raises(ValueError, match="first_n_set_id"):
+        full_but_not_first_n(with_verdicts(gfo, "force_closure"), FULL, "1-2-3-4-5-6-7")
 
 
 def test_verdict_disagreements():
@@ -248,10 +248,12 @@ def test_study_tables_names_and_csv_round_trip(gfo, tmp_path):
         "invariant_checks",
         "claims",
     }
-    from synergrasp.steps import TABLES
-    from synergrasp.tables import STUDY_TABLES
+    from synergrasp.steps import STEPS
+    from synergrasp.table_contracts import STUDY_TABLES
 
-    assert list(tables) == list(STUDY_TABLES) and TABLES == STUDY_TABLES  # one list: the step's outputs are these
+    assert list(tables) == list(STUDY_TABLES) and set(STEPS["tables"].outputs) == {
+        f"{t}_{e}" for t in STUDY_TABLES for e in ("csv", "md")
+    }
     assert tables["full_not_first7"][1]["pose"].tolist() == [2, 3]
     rates = tables["success_rates"][1]
     views = rates[rates["object"] == "all"].set_index(["set_id", "view"])

@@ -101,7 +101,7 @@ def test_the_study_hand_folds_its_thumb_onto_the_palm_before_the_pinch(table):
 
 def test_workflow_checks_and_hand_show_warn(tmp_path, capsys):
     from synergrasp.cli import main
-    from synergrasp.study_checks import checked_scenario
+    from synergrasp.input_checks import checked_scenario
 
     _, warnings = checked_scenario({"hand": "shadow_hand", "synergies": "shadow_hand"})
     assert [w for w in warnings if w.startswith("thumb opposition: hand 'shadow_hand': along S1 the thumb meets")]

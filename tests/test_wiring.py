@@ -16,7 +16,6 @@ from synergrasp.resolved import effective_placement, friction_mu, study_object, 
 from synergrasp.steps import rule_costs, step_config
 from synergrasp.wiring import RuleFiles, Wiring, code_files, job_size, mem_mb, report_archive, runtime_min
 
-
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -120,9 +119,9 @@ def _wiring(**changes):
     return Wiring({**defaults(), **changes}, ROOT, error=RuntimeError, warn=lambda text: None)
 
 
-def test_the_study_targets_and_a_step_not_made_hands_on_its_upstreams_file():
+def test_the_scenario_targets_and_a_step_not_made_hands_on_its_upstreams_file():
     wiring = _wiring()
-    targets = wiring.study_targets()
+    targets = wiring.scenario_targets()
     assert "results/objects/obj1/placement.csv" in targets  # the default placement is searched
     assert "results/figures/fig3_rulegraph.png" in targets and "results/sensitivity/claims.csv" not in targets
     assert not any("target_claims" in t or "placement_claims" in t for t in targets)  # optional steps

@@ -482,7 +482,7 @@ def test_changing_the_config_module_reruns_the_optimisation(project_copy):
     assert planned_jobs(workdir, root=root, env=env) == {}
 
 
-@pytest.mark.parametrize("module", ["figures/study_figures.py", "figures/hand_figures.py"])
+@pytest.mark.parametrize("module", ["figures/fig4_fig5_forces_hierarchy.py", "figures/fig1_fig2_postures_grasps.py"])
 def test_changing_a_figure_module_reruns_only_figures(project_copy, module):
     planned = _planned_after_edit(project_copy, module)
     assert planned and set(planned) <= FIGURE_RULES, planned

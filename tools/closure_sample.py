@@ -26,21 +26,17 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from synergrasp import tables
-from synergrasp.analysis.realism import grasp_labels, grasp_realism
-from synergrasp.analysis.realism import RealismParams
-from synergrasp.simulation.opposition import HandAxes
+from synergrasp import table_contracts
+from synergrasp.analysis.realism import RealismParams, grasp_labels, grasp_realism
 from synergrasp.config import defaults, validate_config
-from synergrasp.optimisation.optimise import OptimiseParams
-from synergrasp.simulation.closure import SimulateParams
-from synergrasp.simulation.contacts import ContactsParams
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.optimisation.equilibrium import EquilibriumParams, grasp_equilibrium
+from synergrasp.optimisation.optimise import OptimiseParams, gfo_table
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.optimise import gfo_table
-from synergrasp.simulation.closure import simulate_object
-from synergrasp.simulation.contacts import load_carrying_contacts
+from synergrasp.simulation.closure import SimulateParams, simulate_object
+from synergrasp.simulation.contacts import ContactsParams, load_carrying_contacts
+from synergrasp.simulation.opposition import HandAxes
 from synergrasp.simulation.placement import pose_grid
 
 MODELS = {"kinematic": ("kinematic", "free"), "dynamic": ("dynamic", "free"), "dynamic_held": ("dynamic", "held")}
@@ -80,7 +76,7 @@ def simulate(out: Path, every: int, models: list[str]) -> None:
             if select.drop_unloaded:
                 contacts = load_carrying_contacts(contacts, select.load_threshold_N)
             (out / label).mkdir(parents=True, exist_ok=True)
-            tables.write(tables.CONTACTS, contacts, out / label / f"{name}.parquet")
+            table_contracts.write(table_contracts.CONTACTS, contacts, out / label / f"{name}.parquet")
 
 
 def summary(out: Path) -> None:
@@ -95,7 +91,8 @@ def summary(out: Path) -> None:
     parts, extra = [], []
     for label in (m for m in MODELS if (out / m).is_dir()):
         contacts = pd.concat(
-            [tables.read(tables.CONTACTS, out / label / f"{name}.parquet") for name in config["objects"]], ignore_index=True
+            [table_contracts.read(table_contracts.CONTACTS, out / label / f"{name}.parquet") for name in config["objects"]],
+            ignore_index=True,
         )
         gfo = pd.concat(
             [
@@ -157,7 +154,7 @@ def pictures(out: Path, png: Path, poses: list[int]) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from synergrasp.figures.hand_figures import PANEL_PX, _bare, _fit, _frame, _object_of, _touching_words
+    from synergrasp.figures.fig1_fig2_postures_grasps import PANEL_PX, _bare, _fit, _frame, _object_of, _touching_words
     from synergrasp.figures.hand_pictures import PALM_CAMERA, render
 
     config = defaults()
@@ -170,7 +167,10 @@ def pictures(out: Path, png: Path, poses: list[int]) -> None:
     fig, axes = plt.subplots(len(names), len(labels), figsize=(2.7 * len(labels), 2.9 * len(names)), squeeze=False)
     for r, (name, pose) in enumerate(zip(names, poses)):
         shape = SimulateParams.from_config(config, name).object.shape
-        rows = [tables.read(tables.CONTACTS, out / m / f"{name}.parquet").set_index("pose").loc[pose] for m in labels]
+        rows = [
+            table_contracts.read(table_contracts.CONTACTS, out / m / f"{name}.parquet").set_index("pose").loc[pose]
+            for m in labels
+        ]
         camera = _fit(
             PALM_CAMERA, hand, [np.asarray(row["q"], dtype=float) for row in rows], [_object_of(row, shape) for row in rows]
         )

@@ -1,4 +1,4 @@
-"""Write the Parquet schemas of docs/design.md from the table contracts (synergrasp.tables).
+"""Write the Parquet schemas of docs/design.md from the table contracts (synergrasp.table_contracts).
 
     .venv/bin/python tools/design_schemas.py        rewrite the section in docs/design.md
 
@@ -12,10 +12,10 @@ import sys
 from pathlib import Path
 
 from synergrasp.steps import STEPS
-from synergrasp.tables import BLOCKERS, CONTACTS, GFO, MINIMA, PLACEMENT, QUALITY, TARGET_CLAIMS, Table
+from synergrasp.table_contracts import BLOCKERS, CONTACTS, GFO, MINIMA, PLACEMENT, QUALITY, TARGET_CLAIMS, Table
 
 DESIGN = Path(__file__).resolve().parents[1] / "docs" / "design.md"
-BEGIN = "<!-- schemas: written by tools/design_schemas.py from src/synergrasp/tables.py; do not edit -->"
+BEGIN = "<!-- schemas: written by tools/design_schemas.py from src/synergrasp/table_contracts.py; do not edit -->"
 END = "<!-- end of schemas -->"
 
 

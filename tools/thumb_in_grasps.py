@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.hand.kinematics import load_hand
+from synergrasp.input_checks import checked_scenario, read_overlays
 from synergrasp.simulation.capsules import HandCapsules, pair_gaps
-from synergrasp.study_checks import checked_scenario, read_overlays
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -36,7 +36,7 @@ if __name__ == "__main__":
     distance = float(cfg["closure"]["contact_distance_mm"])
     print(f"{'object':<8} {'grasps':>7} {'thumb touches %':>16} {'thumb blocked by the palm %':>28}")
     for obj in cfg["objects"]:
-        contacts = tables.read(tables.CONTACTS, Path(args.results) / "objects" / obj / "contacts.parquet")
+        contacts = table_contracts.read(table_contracts.CONTACTS, Path(args.results) / "objects" / obj / "contacts.parquet")
         grasps = contacts[contacts.status == "grasp"]
         touches = blocked = 0
         for r in grasps.itertuples():

@@ -13,7 +13,7 @@ path that cannot be written, a count below 1, a radius that is not a positive nu
 output that names a file the command reads: symbolic and hard links included) ends with one
 line per problem naming the argument, the file or the key, and exit status 2, before any
 work, for every command: the configuration goes through the workflow's own checks
-(``synergrasp.study_checks``). Warnings on the configuration are printed too.
+(``synergrasp.input_checks``). Warnings on the configuration are printed too.
 
     synergrasp plan obj4 [--radius 10 20 30] [--configfile my.yaml] [--results results] [--csv plan.csv]
     synergrasp plan obj4 --on-demand [--planner random_1200] [--seed 0] [--csv plan.csv]
@@ -327,8 +327,8 @@ def _count_problems(args: argparse.Namespace) -> list[str]:
 
 def _configuration(args: argparse.Namespace) -> dict[str, Any]:
     """The configuration of ``--configfile`` overlays as the workflow has it, drawn objects
-    included (``study_checks.overlays_with_drawn_objects``)."""
-    from synergrasp.study_checks import overlays_with_drawn_objects
+    included (``input_checks.overlays_with_drawn_objects``)."""
+    from synergrasp.input_checks import overlays_with_drawn_objects
 
     return overlays_with_drawn_objects(args.configfile)
 
@@ -337,12 +337,12 @@ def _plan(args: argparse.Namespace) -> int:
     """``synergrasp plan``: the planner at each radius, one line each."""
     from dataclasses import replace
 
-    from synergrasp import tables
+    from synergrasp import table_contracts
     from synergrasp.analysis.plan_study import PlanParams, plan_object
     from synergrasp.config import ConfigError
     from synergrasp.hand.synergies import load_synergies
+    from synergrasp.input_checks import checked_scenario, unknown_object
     from synergrasp.steps import object_file
-    from synergrasp.study_checks import checked_scenario, unknown_object
 
     try:
         cfg, warnings = checked_scenario(_configuration(args))
@@ -364,8 +364,8 @@ def _plan(args: argparse.Namespace) -> int:
             )
         else:
             params = replace(params, radii_deg=tuple(args.radius)) if args.radius else params
-            contacts = tables.read(tables.CONTACTS, contacts_path)
-            gfo = tables.read(tables.GFO, gfo_path)
+            contacts = table_contracts.read(table_contracts.CONTACTS, contacts_path)
+            gfo = table_contracts.read(table_contracts.GFO, gfo_path)
     except (ConfigError, ValueError, FileNotFoundError) as err:
         print(f"synergrasp plan: {err}", file=sys.stderr)
         return 2
@@ -382,7 +382,7 @@ def _plan(args: argparse.Namespace) -> int:
         )
     if args.csv:
         with _writing("--csv", args.csv):
-            tables.write_csv(tables.PLAN, result.table, args.csv)
+            table_contracts.write_csv(table_contracts.PLAN, result.table, args.csv)
     return 0
 
 
@@ -408,10 +408,10 @@ def _plan_on_demand(
     import numpy as np
     import pandas as pd
 
-    from synergrasp import tables
+    from synergrasp import table_contracts
     from synergrasp.analysis.plan_new import plan_on_demand
-    from synergrasp.analysis.planner import pose_against_exhaustive
     from synergrasp.analysis.plan_study import replay_oracle
+    from synergrasp.analysis.planner import pose_against_exhaustive
     from synergrasp.hand.synergies import load_synergies
 
     study = gfo_path.is_file() and contacts_path.is_file()
@@ -419,7 +419,10 @@ def _plan_on_demand(
     plan, _ = plan_on_demand(args.object, grid, close, matrix, params, spec, args.seed)
     least, regret = float("nan"), float("nan")
     if study:  # the study's exhaustive minimum over the same grid
-        contacts, gfo = tables.read(tables.CONTACTS, contacts_path), tables.read(tables.GFO, gfo_path)
+        contacts, gfo = (
+            table_contracts.read(table_contracts.CONTACTS, contacts_path),
+            table_contracts.read(table_contracts.GFO, gfo_path),
+        )
         full = replay_oracle(contacts, gfo, params.n_levels, params.minima)()
         order = np.argsort(contacts["pose"].to_numpy())
         versus = pose_against_exhaustive(plan.pose, plan.force_N, full.success[-1][order], full.force[-1][order])
@@ -434,7 +437,7 @@ def _plan_on_demand(
     )
     if args.csv:
         row = vars(plan) | {"exhaustive_min_force_N": least, "regret_percent": regret}
-        tables.write_csv(tables.PLAN_ON_DEMAND, pd.DataFrame([row]), args.csv)
+        table_contracts.write_csv(table_contracts.PLAN_ON_DEMAND, pd.DataFrame([row]), args.csv)
     return 0
 
 
@@ -477,7 +480,7 @@ def _show_hand(args: argparse.Namespace) -> int:
         )
     )
     if args.png:
-        from synergrasp.figures.hand_figures import figure_synergy_postures
+        from synergrasp.figures.fig1_fig2_postures_grasps import figure_synergy_postures
 
         with _writing("--png", args.png):
             figure_synergy_postures(hand, synergies, args.png, None, n_synergies=min(args.count, synergies.n_synergies))
@@ -485,7 +488,7 @@ def _show_hand(args: argparse.Namespace) -> int:
     line, sigmas = opposition_line(hand, synergies)
     print(line)
     if args.closing_png:
-        from synergrasp.figures.hand_figures import figure_closing_views
+        from synergrasp.figures.fig1_fig2_postures_grasps import figure_closing_views
 
         figure_closing_views(hand, synergies, args.closing_png, None, sigmas)
         print(f"closing along S1, palm side and thumb side: {args.closing_png}")
@@ -620,8 +623,8 @@ def _fit_synergies(args: argparse.Namespace) -> int:
 
 def _grasp(args: argparse.Namespace) -> int:
     from synergrasp.file_output import replacing
+    from synergrasp.input_checks import checked_scenario
     from synergrasp.inspector import default_sets, inspect_grasp, parse_sets
-    from synergrasp.study_checks import checked_scenario
 
     config = _configuration(args)
     cfg, warnings = checked_scenario(config)

@@ -224,7 +224,7 @@ def _contacts_frame(hand: Any, row: pd.Series, shape: Any, rule: Any) -> pd.Data
 
 def searched_target(placement: Any, path: Path) -> Any:
     """The searched placement with the target the object's search chose (its placement.csv)."""
-    from synergrasp import tables
+    from synergrasp import table_contracts
     from synergrasp.simulation.placement import searched_placement
 
     if not path.is_file():
@@ -232,7 +232,7 @@ def searched_target(placement: Any, path: Path) -> Any:
             f"placement: mode 'searched' takes the object's target from {path}, which does not "
             f"exist: make it with `snakemake -j2 {path}`, or give placement.mode approach or fixed"
         )
-    return searched_placement(placement, tables.read_csv(tables.PLACEMENT, path))
+    return searched_placement(placement, table_contracts.read_csv(table_contracts.PLACEMENT, path))
 
 
 def inspect_grasp(
@@ -248,21 +248,21 @@ def inspect_grasp(
     (1-based synergies; None: :func:`default_sets`), as the study's steps do.
 
     ``config`` is a configuration as read from YAML (an overlay on the defaults); it is
-    checked by the workflow's own check (``study_checks.checked_scenario``: the schema, every
+    checked by the workflow's own check (``input_checks.checked_scenario``: the schema, every
     relation, the hand, the synergy table, the objects). With ``placement.mode: searched`` the object's target is read
     from the search's table ``<results>/objects/<obj>/placement.csv``. Raises InspectionError (naming the argument) or
     ``synergrasp.config.ConfigError``; a closure or solver failure is a status in the result.
     """
     from synergrasp.hand.kinematics import load_hand
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.optimisation.problem import SynergySets
+    from synergrasp.input_checks import checked_scenario, unknown_object
     from synergrasp.optimisation.mechanics import read_grasps
     from synergrasp.optimisation.optimise import OptimiseParams, optimise_grasps
+    from synergrasp.optimisation.problem import SynergySets
     from synergrasp.simulation.closure import SimulateParams, simulate_object
     from synergrasp.simulation.contacts import ContactsParams, load_carrying_contacts
     from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions
     from synergrasp.steps import object_file
-    from synergrasp.study_checks import checked_scenario, unknown_object
 
     cfg, _ = checked_scenario(config)
     if unknown_object(cfg, obj):
@@ -413,7 +413,7 @@ def _title(result: GraspInspection) -> str:
 
 def grasp_picture(result: GraspInspection, png_path: str | Path) -> None:
     """The inspected grasp drawn as in Fig. 2 from two views (``figure_grasp_views``), as a PNG."""
-    from synergrasp.figures.hand_figures import figure_grasp_views
+    from synergrasp.figures.fig1_fig2_postures_grasps import figure_grasp_views
 
     links = result.contacts["link"] if len(result.contacts) else []
     points = np.array(list(result.contacts["point_mm"]), dtype=float) if len(result.contacts) else np.zeros((0, 3))

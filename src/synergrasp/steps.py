@@ -36,7 +36,7 @@ from typing import Any
 from synergrasp.config import DEFAULT_SCENARIO
 from synergrasp.hand.synergies import synergy_values
 from synergrasp.resolved import effective_placement
-from synergrasp.tables import STUDY_TABLES
+from synergrasp.table_contracts import STUDY_TABLES
 
 __all__ = [
     "Cost",
@@ -191,8 +191,6 @@ def _files(names: tuple[str, ...], folder: str, exts: tuple[str, ...], named: bo
     return {f"{n}_{e}" if named else e: f"{folder}/{n}.{e}".lstrip("/") for n in names for e in exts}
 
 
-#: The study's tables (the ``tables`` step), named once in ``synergrasp.tables``.
-TABLES = STUDY_TABLES
 #: The keys of the choice of which contacts count (the ``contacts`` step).
 _CONTACT_SELECTION = ("closure.dynamic.unloaded_contacts", "closure.dynamic.load_threshold_N")
 #: The keys of the force bound of ``analyses.success: force_closure_bounded``.
@@ -414,7 +412,7 @@ STEPS: dict[str, Step] = {
     ),
     "tables": Step(
         rules={"tables": Cost("object_pose_set", 2.3, 231, 3.2e-6, 2.2e-4)},
-        outputs=_files(TABLES, "tables", ("csv", "md")),
+        outputs=_files(STUDY_TABLES, "tables", ("csv", "md")),
         reads=(
             "synergy_sets",
             "analyses.minima_radius_deg",
@@ -435,7 +433,7 @@ STEPS: dict[str, Step] = {
         ),
         upstream=("optimise", "minima", "planners"),
         params="synergrasp.analysis.summaries:TablesParams",
-        report={f"{t}_csv": (t, "Tables") for t in TABLES},
+        report={f"{t}_csv": (t, "Tables") for t in STUDY_TABLES},
         inputs={"gfo": "optimise", "minima": "minima", "planners": "planners.csv", **HAND_FILES},
     ),
     "realism": Step(
@@ -481,7 +479,7 @@ STEPS: dict[str, Step] = {
         rules={"fig1": Cost("none", 3.0, 565)},
         outputs=_files(("fig1_synergy_postures",), "figures", _PNG_PDF, named=False),
         reads=("hand", "synergies"),
-        params="synergrasp.figures.hand_figures:Fig1Params",
+        params="synergrasp.figures.fig1_fig2_postures_grasps:Fig1Params",
         report={"png": ("fig1", "Figures")},
         inputs={**HAND_FILES},
     ),
@@ -533,7 +531,7 @@ STEPS: dict[str, Step] = {
         reads=("analyses.fig4", "analyses.success"),
         reads_when=(("analyses.success", "force_closure_bounded", _FORCE_BOUND),),
         upstream=("optimise", "minima"),
-        params="synergrasp.figures.study_figures:Fig4Params",
+        params="synergrasp.figures.fig4_fig5_forces_hierarchy:Fig4Params",
         report={"maps_png": ("fig4_force_maps", "Fig. 4"), "exploded_png": ("fig4_exploded", "Fig. 4")},
         inputs={"gfo": "optimise", "minima": "minima"},
     ),
@@ -617,7 +615,7 @@ STEPS: dict[str, Step] = {
         },
         reads=("synergy_sets.hierarchy_first", "analyses.success"),
         upstream=("tables",),
-        params="synergrasp.figures.study_figures:Fig5Params",
+        params="synergrasp.figures.fig4_fig5_forces_hierarchy:Fig5Params",
         report={
             "success_png": ("fig5a", "Figures"),
             "pooled_png": ("fig5a_pooled", "Figures"),

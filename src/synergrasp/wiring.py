@@ -26,6 +26,7 @@ from typing import Any
 
 from synergrasp.config import DEFAULT_SCENARIO, ConfigError, grid_axis_deg, object_names, scenario_names
 from synergrasp.ids import synergy_sets
+from synergrasp.input_checks import checked_scenario, search_table_or_refuse, searched_objects_or_refuse
 from synergrasp.steps import (
     CLOSURE_COST_FACTOR,
     MANIFEST,
@@ -45,10 +46,9 @@ from synergrasp.steps import (
     rule_step,
     scenario_root,
     step_config,
-    step_hash,
     step_for_object,
+    step_hash,
 )
-from synergrasp.study_checks import checked_scenario, search_table_or_refuse, searched_objects_or_refuse
 
 __all__ = [
     "Wiring",
@@ -298,7 +298,7 @@ class Wiring:
     def scenario(self, name: str) -> dict[str, Any]:
         """The complete configuration of scenario ``name``, checked with its hand, synergy
         and object files the first time it is asked for, before any job runs
-        (``study_checks.checked_scenario``, the inspector's checks too)."""
+        (``input_checks.checked_scenario``, the inspector's checks too)."""
         if name in self._checked:
             return self._checked[name]
         try:
@@ -375,7 +375,7 @@ class Wiring:
         (rel,) = STEPS[made].outputs.values()
         return f"{self.step_root(name, made, obj)}/objects/{obj}/{rel}"
 
-    def study_file(self, name: str, step: str, rel: str) -> str:
+    def scenario_file(self, name: str, step: str, rel: str) -> str:
         """Where scenario ``name``'s file ``rel`` (one of the step's outputs) lives."""
         return f"{self.step_root(name, step)}/{rel}"
 
@@ -415,9 +415,9 @@ class Wiring:
             return self.object_files(step, output) if output else self.step_inputs(step)
         rel = STEPS[step].outputs[output] if output else next(iter(STEPS[step].outputs.values()))
         if producer == "scenario" and scope == "scenario":
-            return self.study_input(step, rel)
+            return self.scenario_input(step, rel)
         if producer == "scenario" and scope == "workflow":
-            return lambda w: [self.study_file(s, step, rel) for s in self.scenarios]
+            return lambda w: [self.scenario_file(s, step, rel) for s in self.scenarios]
         raise ValueError(f"rule {rule!r}: no input of a rule per {scope} from {source!r} (a step per {producer})")
 
     def params(self, rule: str) -> dict[str, Any]:
@@ -448,7 +448,7 @@ class Wiring:
         """Input function: the job's object's placement-search table where its placement is
         searched; for a ``reader`` step that reads ``placement.search_rank``, a rank beyond
         the distinct targets of a table that exists already stops the run before any job
-        (``study_checks.search_rank_problems``)."""
+        (``input_checks.search_rank_problems``)."""
         if not reads_key(reader, "placement.search_rank"):
             return self.step_input("search")
 
@@ -472,9 +472,9 @@ class Wiring:
             self.stop(lines)
             raise self.error("Invalid input, nothing was run:\n" + "\n".join(lines))
 
-    def study_input(self, step: str, rel: str) -> Callable[[Any], str]:
+    def scenario_input(self, step: str, rel: str) -> Callable[[Any], str]:
         """Input function: the job's scenario's file ``rel`` of the per-scenario ``step``."""
-        return lambda w: self.study_file(self.job_scenario(w), step, rel)
+        return lambda w: self.scenario_file(self.job_scenario(w), step, rel)
 
     def shard_files(self, rule: str) -> Callable[[Any], list[str]]:
         """Input function: the job's object's files of every shard of ``rule`` (``solver.pose_shards``)."""
@@ -572,11 +572,11 @@ class Wiring:
         """The files of a step run once for the whole workflow (under results/)."""
         return [f"{RESULTS}/{rel}" for rel in STEPS[step].outputs.values()]
 
-    def study_targets(self, name: str = DEFAULT_SCENARIO) -> list[str]:
+    def scenario_targets(self, name: str = DEFAULT_SCENARIO) -> list[str]:
         """Every output of one scenario's study, each where it is made (Fig. 3, the rule
         graph, is the same for all; the sweep's summary is `sensitivity`'s)."""
         files = [
-            self.study_file(name, step, rel)
+            self.scenario_file(name, step, rel)
             for step, spec in STEPS.items()
             if spec.scope == "scenario" and not spec.optional
             for rel in spec.outputs.values()
@@ -609,12 +609,12 @@ class Wiring:
 
     def optional_targets(self, step: str, name: str = DEFAULT_SCENARIO) -> list[str]:
         """The files of the optional per-scenario ``step`` of scenario ``name``."""
-        return [self.study_file(name, step, rel) for rel in STEPS[step].outputs.values()]
+        return [self.scenario_file(name, step, rel) for rel in STEPS[step].outputs.values()]
 
     def searched_targets(self, step: str, target: str, name: str = DEFAULT_SCENARIO) -> list[str]:
         """:meth:`optional_targets` of a ``step`` that reads the placement search's targets;
         where no object of scenario ``name`` is searched, ``target`` (the rule asking) is
-        refused before any job (``study_checks.searched_objects_or_refuse``)."""
+        refused before any job (``input_checks.searched_objects_or_refuse``)."""
         searched = [o for o in self.scenario(name)["objects"] if self._for_object(name, "search", o)]
         searched_objects_or_refuse(searched, target, self.scenario(name), self._refuse)
         return self.optional_targets(step, name)

@@ -15,7 +15,7 @@ adapter.check_version()
 
 from synergrasp.preflight import configfile_problems, group_problems, refuse, slurm_problems
 from synergrasp.steps import RESULTS, rule_costs
-from synergrasp.study_checks import older_results_problems
+from synergrasp.input_checks import older_results_problems
 from synergrasp.wiring import RuleFiles, Wiring, report_archive
 
 # Snakemake read the configuration files itself and kept a repeated key's last value.

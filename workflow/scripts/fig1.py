@@ -1,6 +1,6 @@
 """Fig. 1: the hand along each of the first seven synergies, sigma = -1, 0, +1."""
 
-from synergrasp.figures.hand_figures import Fig1Params, figure_synergy_postures
+from synergrasp.figures.fig1_fig2_postures_grasps import Fig1Params, figure_synergy_postures
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log

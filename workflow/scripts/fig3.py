@@ -3,8 +3,8 @@
 import subprocess
 import sys
 
+from synergrasp.figures.fig3_rulegraph import canonical_rulegraph, figure_rulegraph
 from synergrasp.file_output import replacing
-from synergrasp.figures.rulegraph import canonical_rulegraph, figure_rulegraph
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]) as log:

@@ -3,7 +3,7 @@ objects", and its paired force ratio to the full set pooled over its successes, 
 
 import pandas as pd
 
-from synergrasp.figures.study_figures import FIG5B_RATIO_RANGE, Fig5Params, figure_hierarchy
+from synergrasp.figures.fig4_fig5_forces_hierarchy import FIG5B_RATIO_RANGE, Fig5Params, figure_hierarchy
 from synergrasp.job_log import job_log
 
 with job_log(snakemake.log[0]):

@@ -1,7 +1,7 @@
 """The hand's reach table and its side view (docs/hand_reach.md): per finger the reach along S1
 and in any posture, d_max and the aperture; the study's boxes beside it."""
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.figures.hand_reach import figure_hand_reach
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
@@ -13,8 +13,8 @@ with job_log(snakemake.log[0]):
     hand = load_hand(params.hand)
     synergies = load_synergies(params.synergies, joint_names=hand.joint_names)
     reach = hand_reach(hand, synergies, params.closure, params.reach)
-    tables.write_study_table(
-        reach.table[list(tables.HAND_REACH.names)],
+    table_contracts.write_study_table(
+        reach.table[list(table_contracts.HAND_REACH.names)],
         snakemake.output.csv,
         snakemake.output.md,
         title=f"Hand reach (palm face at x = {reach.palm_face_mm:g} mm; "

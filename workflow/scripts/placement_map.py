@@ -1,6 +1,6 @@
 """The placement map of one object: the search's score over its targets and grasps at the chosen one."""
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.figures.placement_map import figure_placement_map
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.job_log import job_log
@@ -10,12 +10,12 @@ from synergrasp.simulation.opposition import HandAxes, contacts_oppositions
 with job_log(snakemake.log[0]):
     sim = SearchStepParams.from_config(snakemake.params.cfg, snakemake.wildcards.object)
     hand = load_hand(sim.hand)
-    contacts = tables.read(tables.CONTACTS, snakemake.input.contacts)
+    contacts = table_contracts.read(table_contracts.CONTACTS, snakemake.input.contacts)
     oppositions = dict(zip(contacts["pose"], contacts_oppositions(contacts, HandAxes.from_hand(hand), sim.opposition)))
     figure_placement_map(
         hand,
         sim.object,
-        tables.read_csv(tables.PLACEMENT, snakemake.input.placement),
+        table_contracts.read_csv(table_contracts.PLACEMENT, snakemake.input.placement),
         contacts,
         sim.search.spacing_mm,
         snakemake.output.png,

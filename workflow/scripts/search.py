@@ -1,7 +1,7 @@
 """The placement search of one object (docs/placement_search.md, version 3: the grasp types
 this hand can make, with the fallback chain); write its placement.csv."""
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.analysis.periods import alpha_period_deg
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
@@ -15,7 +15,7 @@ with job_log(snakemake.log[0]) as log:
     synergies = load_synergies(sim.synergies, joint_names=hand.joint_names)
     period = alpha_period_deg(sim.placement, sim.object.shape, hand.palm_normal)
     result = search_object_types(hand, synergies, sim, period, processes=snakemake.threads)
-    tables.write_csv(tables.PLACEMENT, result.table(sim.distinct_mm), snakemake.output[0])
+    table_contracts.write_csv(table_contracts.PLACEMENT, result.table(sim.distinct_mm), snakemake.output[0])
     line = fallback_line(result)
     if line:  # on the console and in the job's log
         print(f"WARNING: {line}")

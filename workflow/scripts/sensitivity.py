@@ -5,7 +5,7 @@ import pandas as pd
 from synergrasp.analysis.sensitivity import ScenarioTables, sensitivity_table, table2_long
 from synergrasp.figures.sensitivity import figure_claims_grid, figure_table2_curves
 from synergrasp.job_log import job_log
-from synergrasp.tables import write_study_table
+from synergrasp.table_contracts import write_study_table
 
 with job_log(snakemake.log[0]):
     read = lambda kind: [pd.read_csv(p) for p in snakemake.input[kind]]  # noqa: E731

@@ -1,6 +1,6 @@
 """Close the hand on one object at every pose of the grid; write its contacts table."""
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.job_log import job_log
 from synergrasp.simulation.closure import SimulateParams, simulate_object
@@ -11,6 +11,6 @@ with job_log(snakemake.log[0]):
     hand = load_hand(sim.hand)
     placement = sim.placement
     if placement.mode == "searched":
-        placement = searched_placement(placement, tables.read_csv(tables.PLACEMENT, snakemake.input.search))
+        placement = searched_placement(placement, table_contracts.read_csv(table_contracts.PLACEMENT, snakemake.input.search))
     table = simulate_object(hand, sim.synergies(hand.joint_names), sim.object, placement, sim.closure, mechanics=sim.mechanics)
-    tables.write(tables.CONTACTS, table, snakemake.output[0])
+    table_contracts.write(table_contracts.CONTACTS, table, snakemake.output[0])

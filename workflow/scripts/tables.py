@@ -7,7 +7,7 @@ from synergrasp.analysis.invariants import InvariantWarning
 from synergrasp.analysis.study_tables import object_loaders, study_tables
 from synergrasp.analysis.summaries import NoSuccessWarning, TablesParams
 from synergrasp.job_log import job_log
-from synergrasp.tables import PLANNERS, read_csv, write_study_table
+from synergrasp.table_contracts import PLANNERS, read_csv, write_study_table
 
 with job_log(snakemake.log[0]) as log, warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always", InvariantWarning)

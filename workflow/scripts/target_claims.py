@@ -1,6 +1,6 @@
 """The study's claims at every scored target of one object's placement search."""
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.analysis.periods import alpha_period_deg
 from synergrasp.analysis.target_claims import TargetClaimsParams, claims_at_targets
 from synergrasp.hand.kinematics import load_hand
@@ -12,6 +12,6 @@ with job_log(snakemake.log[0]):
     hand = load_hand(p.search.hand)
     synergies = load_synergies(p.search.synergies, joint_names=hand.joint_names)
     period = alpha_period_deg(p.search.placement, p.search.object.shape, hand.palm_normal)
-    placement = tables.read_csv(tables.PLACEMENT, snakemake.input.placement)
+    placement = table_contracts.read_csv(table_contracts.PLACEMENT, snakemake.input.placement)
     claims = claims_at_targets(hand, synergies, p, period, placement, processes=snakemake.threads)
-    tables.write(tables.TARGET_CLAIMS, claims, snakemake.output[0])
+    table_contracts.write(table_contracts.TARGET_CLAIMS, claims, snakemake.output[0])

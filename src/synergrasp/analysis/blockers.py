@@ -25,9 +25,8 @@ from synergrasp.analysis.verdicts import verdict_columns
 from synergrasp.ids import ALL_OBJECTS, incremental_set_id, set_id
 from synergrasp.optimisation.blocking import Blocking, blocking_contacts
 from synergrasp.optimisation.mechanics import Grasp, first_same_grasp, internal_force_basis, read_grasps
-from synergrasp.optimisation.problem import GFOProblem
 from synergrasp.optimisation.optimise import GFOParams, mechanics_for
-from synergrasp.tables import BLOCKERS, read
+from synergrasp.optimisation.problem import GFOProblem
 from synergrasp.simulation.opposition import (
     FACE_CLASSES,
     LINK_KINDS,
@@ -37,6 +36,7 @@ from synergrasp.simulation.opposition import (
     face_classes,
     surface_features,
 )
+from synergrasp.table_contracts import BLOCKERS, read
 
 __all__ = [
     "BlockersParams",
@@ -165,7 +165,7 @@ def blockers_table(
     params: BlockersParams,
 ) -> pd.DataFrame:
     """One row per (pose, set) of the examined sets that fails where the full set succeeds
-    (columns of `tables.BLOCKERS`), in the gfo table's order."""
+    (columns of `table_contracts.BLOCKERS`), in the gfo table's order."""
     failing = _failing(gfo, params.sets, params.full_set_id)
     grasps = read_grasps(contacts)
     first = first_same_grasp(grasps)
@@ -181,7 +181,7 @@ def blockers_table(
             rotation = np.asarray(contacts["object_rotation"].iloc[i], dtype=float).reshape(3, 3)
             labels[i] = contact_labels(grasps[i], rotation, params.shape, link_names, axes, params.rule)
         rows.append(_row(rec, solved[i][rec.set_id], labels[i]))
-    from synergrasp.tables import BLOCKERS, empty
+    from synergrasp.table_contracts import BLOCKERS, empty
 
     return pd.DataFrame(rows, columns=list(BLOCKERS.names)) if rows else empty(BLOCKERS)
 
@@ -235,7 +235,7 @@ def blockers_summary(blockers: pd.DataFrame, sets: Mapping[str, Any]) -> pd.Data
 
 
 def blockers_summary_by_object(paths: Sequence[str | Path], sets: Mapping[str, Any]) -> pd.DataFrame:
-    """:func:`blockers_summary` of every object's blockers file (``tables.BLOCKERS``), one
+    """:func:`blockers_summary` of every object's blockers file (``table_contracts.BLOCKERS``), one
     object at a time in sorted order (``results/objects/<object>/``): each object's rows are
     reduced to its counts and margins and dropped before the next is read."""
 

@@ -399,7 +399,7 @@ def claims_table(
 def planner_claim(per_object: pd.DataFrame, rules: VerdictRules) -> pd.DataFrame:
     """Claim 8, the study's conjecture as a planner (docs/planner.md, written before it ran),
     one row of :data:`CLAIM_COLUMNS` (view ``across_objects``) from the per-object comparison
-    of the planners (``tables.PLANNERS``). The difference is 100 (C_full − C_inc) / C_full of
+    of the planners (``table_contracts.PLANNERS``). The difference is 100 (C_full − C_inc) / C_full of
     the two families' chosen planners' solve times, % per object; its band the forces' tie band
     (relative, as %); no least number of poses applies (the interval is over objects, and
     ``n_distinct_poses`` holds the number of objects)."""

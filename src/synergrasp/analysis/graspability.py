@@ -11,7 +11,7 @@ this table says so per object with the first stage at which every pose failed:
 4. ``no force closure with the full set``: touching grasps exist, none is in force closure
    (the study's definition, ``analysis.verdicts``) with every synergy enrolled.
 
-Columns: :data:`synergrasp.tables.GRASPABLE_OBJECTS`. Pure functions: DataFrames in, a
+Columns: :data:`synergrasp.table_contracts.GRASPABLE_OBJECTS`. Pure functions: DataFrames in, a
 DataFrame (or lines) out.
 """
 
@@ -23,7 +23,7 @@ import pandas as pd
 
 from synergrasp.analysis.verdicts import verdict_columns
 from synergrasp.ids import set_members, set_name
-from synergrasp.tables import GRASPABLE_OBJECTS
+from synergrasp.table_contracts import GRASPABLE_OBJECTS
 
 __all__ = ["graspable_objects", "with_left_out", "studied", "ungraspable_lines", "grasp_types_of", "fallback_lines", "LEFT_OUT"]
 
@@ -61,7 +61,7 @@ def _reason(rows: pd.DataFrame, n_fc: int, dynamic: bool, full_set_id: str) -> s
 
 def grasp_types_of(grasp_types: Mapping[str, str], placements: Sequence[pd.DataFrame]) -> dict[str, tuple[str, str, str]]:
     """Per object (stated, effective, reason): the chosen row of its placement-search table
-    (``tables.PLACEMENT``; version 3 of docs/placement_search.md) where its placement was
+    (``table_contracts.PLACEMENT``; version 3 of docs/placement_search.md) where its placement was
     searched, else its configured grasp type ``grasp_types[object]`` both stated and effective."""
     out = {name: (kind, kind, "") for name, kind in grasp_types.items()}
     for table in placements:

@@ -24,8 +24,8 @@ from synergrasp.analysis.planners import CANDIDATES, Oracle, PlannerSpec, PoseGr
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.ids import incremental_set_id, set_id
 from synergrasp.optimisation.mechanics import GraspMechanics, first_same_grasp, read_grasps
-from synergrasp.optimisation.problem import SynergySets
 from synergrasp.optimisation.optimise import GFOParams, mechanics_for, optimise_grasps
+from synergrasp.optimisation.problem import SynergySets
 
 __all__ = ["PlanParams", "ObjectPlan", "StudySolver", "plan_object", "PlannersParams", "replay_oracle", "compare_on_study"]
 
@@ -56,8 +56,8 @@ class PlanParams:
 
 @dataclass(frozen=True)
 class ObjectPlan:
-    """The planner on one object: ``table`` (tables.PLAN, one row per radius), ``enrollment``
-    (tables.ENROLLMENT, one row per k), the plans by radius (deg), and ``full``: the full
+    """The planner on one object: ``table`` (table_contracts.PLAN, one row per radius), ``enrollment``
+    (table_contracts.ENROLLMENT, one row per k), the plans by radius (deg), and ``full``: the full
     set's rows of the judged gfo table, one per pose in the contacts' order (``success``,
     ``success_force`` in N)."""
 

@@ -310,7 +310,7 @@ def compare_planners(
     costs: Sequence[float] = SOLVE_COST_BY_SET_SIZE,
 ) -> pd.DataFrame:
     """Every planner on one object against the exhaustive search (one row per planner;
-    columns of ``tables.PLANNERS`` but the across-objects ones). ``new_oracle()`` gives a
+    columns of ``table_contracts.PLANNERS`` but the across-objects ones). ``new_oracle()`` gives a
     fresh oracle (empty ledger) per run; a randomised planner runs once per seed."""
     rows = []
     for spec in specs:
@@ -352,7 +352,7 @@ def compare_planners(
     return pd.DataFrame(rows)
 
 
-#: The columns :func:`across_objects` computes (``tables.PLANNERS_ACROSS`` adds ``recommended``).
+#: The columns :func:`across_objects` computes (``table_contracts.PLANNERS_ACROSS`` adds ``recommended``).
 ACROSS_COLUMNS = (
     "planner",
     "family",

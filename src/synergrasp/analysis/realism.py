@@ -6,7 +6,7 @@ that touch with the thumb, the palm, a proximal or middle phalanx, the share who
 matrix has full rank 6, and the median optimal force with every synergy enrolled as a
 multiple of the object's weight (‖f‖₂ / (m·g), dimensionless); where the closure model
 records per-contact normal forces (the dynamic one), how many contacts per grasp carry load.
-Columns: :data:`synergrasp.tables.GRASP_REALISM`. Pure functions: DataFrames
+Columns: :data:`synergrasp.table_contracts.GRASP_REALISM`. Pure functions: DataFrames
 in, a DataFrame out.
 """
 
@@ -36,7 +36,7 @@ from synergrasp.simulation.opposition import (
     edge_contacts,
     of_grasp_type,
 )
-from synergrasp.tables import CONTACTS, GFO, GRASP_REALISM, read
+from synergrasp.table_contracts import CONTACTS, GFO, GRASP_REALISM, read
 
 __all__ = [
     "RealismParams",
@@ -260,7 +260,7 @@ def grasp_realism(
     labels: pd.DataFrame,
     grasp_types: Mapping[str, str],
 ) -> pd.DataFrame:
-    """The grasp-realism table (columns of :data:`synergrasp.tables.GRASP_REALISM`).
+    """The grasp-realism table (columns of :data:`synergrasp.table_contracts.GRASP_REALISM`).
 
     ``contacts``: contacts tables of the objects (CONTACTS contract; rows are grouped by
     ``closure_model``, loads read from ``contact_normal_force_N``, N).

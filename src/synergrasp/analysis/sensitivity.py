@@ -41,10 +41,10 @@ class ScenarioTables:
     table2: pd.DataFrame  #: object, then one column per k (success rate, %)
     success_rates: pd.DataFrame  #: object, set_id, n_synergies, success_rate (%), ...
     preservation: pd.DataFrame  #: object, pairs, preserved_percent, ...
-    realism: pd.DataFrame | None = None  #: tables.GRASP_REALISM: one row per object
+    realism: pd.DataFrame | None = None  #: table_contracts.GRASP_REALISM: one row per object
 
 
-#: The grasp-realism columns in the summary (tables.GRASP_REALISM), each object's value in the
+#: The grasp-realism columns in the summary (table_contracts.GRASP_REALISM), each object's value in the
 #: scenario's object order joined by "/": what the grasps behind a row's verdicts look like.
 REALISM_COLUMNS: dict[str, tuple[str, str]] = {
     "grasp_contacts_median": ("contacts_median", "{:.0f}"),

@@ -17,8 +17,8 @@ from every object's rows at once (:func:`frames_by_object`).
 
 from __future__ import annotations
 
-import warnings
 import functools
+import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import TypeAlias
@@ -49,7 +49,7 @@ from synergrasp.analysis.summaries import (
 )
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.ids import incremental_set_id, set_members, set_order
-from synergrasp.tables import GFO, MINIMA, STUDY_TABLES, read
+from synergrasp.table_contracts import GFO, MINIMA, STUDY_TABLES, read
 
 __all__ = ["ObjectLoader", "StudyReduction", "frames_by_object", "object_loaders", "study_tables", "study_claims"]
 
@@ -149,7 +149,7 @@ class StudyReduction:
         return claims, chance, pairs
 
     def tables(self, table2_k_max: int, planners: pd.DataFrame | None = None) -> dict[str, tuple[str, pd.DataFrame]]:
-        """Every study table by name (``tables.STUDY_TABLES``, in that order): (title, table)."""
+        """Every study table by name (``table_contracts.STUDY_TABLES``, in that order): (title, table)."""
         s = self.settings
         present = sorted(self.sets, key=lambda x: (len(set_members(x)), x))
         if self.full not in self.sets:
@@ -254,14 +254,14 @@ def study_tables(
     settings: AnalysisSettings,
     planners: pd.DataFrame | None = None,
 ) -> dict[str, tuple[str, pd.DataFrame]]:
-    """Every study table by name (``tables.STUDY_TABLES``, in that order): (title, table).
+    """Every study table by name (``table_contracts.STUDY_TABLES``, in that order): (title, table).
 
     ``objects``: (object name, loader of its gfo and minima tables), read one at a time in
     sorted order (:func:`frames_by_object` for every object's rows at once);
     ``sets_config`` is the configuration's ``synergy_sets`` (incremental_max,
     hierarchy_first, ...): the full set is {S1..S_incremental_max}, the hierarchy uses the
     first ``hierarchy_first`` synergies. ``planners``: the planners compared per object
-    (``tables.PLANNERS``), whose claim 8 joins the claims (None: the seven only). Raises
+    (``table_contracts.PLANNERS``), whose claim 8 joins the claims (None: the seven only). Raises
     :class:`InvariantError` when a success rate exceeds 100 % beyond the tolerance; warns on
     the other invariant checks.
     """

@@ -36,7 +36,7 @@ __all__ = [
     "minimum_preservation",
     "object_preservation",
     "preservation_table",
-    "full_but_not_first7",
+    "full_but_not_first_n",
     "lost_poses",
     "verdict_disagreements",
     "set_sort_key",
@@ -486,7 +486,7 @@ def preservation_table(rows: list[dict], objects: Sequence[str]) -> pd.DataFrame
     return out[["object", "k", "n_minima", "n_preserved", "preserved_percent", "n_minima_distinct", "n_preserved_distinct"]]
 
 
-def full_but_not_first7(table: pd.DataFrame, full_set_id: str, first7_set_id: str) -> pd.DataFrame:
+def full_but_not_first_n(table: pd.DataFrame, full_set_id: str, first_n_set_id: str) -> pd.DataFrame:
     """Poses where the full set succeeds and {S1..S7} does not (the chosen verdict).
 
     ``table``: gfo table with the columns of ``with_verdicts``. Columns: object, pose,
@@ -511,23 +511,23 @@ def full_but_not_first7(table: pd.DataFrame, full_set_id: str, first7_set_id: st
         ),
     )
     present = set(table["set_id"].unique())
-    for name, sid in (("full_set_id", full_set_id), ("first7_set_id", first7_set_id)):
+    for name, sid in (("full_set_id", full_set_id), ("first_n_set_id", first_n_set_id)):
         if sid not in present:
             raise ValueError(f"{name} {sid!r} is not in the gfo table; allowed values: {sorted(present)}")
-    return lost_poses(table, full_set_id, first7_set_id)
+    return lost_poses(table, full_set_id, first_n_set_id)
 
 
-def lost_poses(table: pd.DataFrame, full_set_id: str, first7_set_id: str) -> pd.DataFrame:
-    """:func:`full_but_not_first7` without checking that the two sets are in ``table`` (one
+def lost_poses(table: pd.DataFrame, full_set_id: str, first_n_set_id: str) -> pd.DataFrame:
+    """:func:`full_but_not_first_n` without checking that the two sets are in ``table`` (one
     object's rows, of a study whose tables hold both): a pose where the smaller set was not
     computed counts as lost, status "missing"."""
     keys = ["object", "pose"]
     full = table[(table["set_id"] == full_set_id) & table["success"].astype(bool)]
     small = table.loc[
-        table["set_id"] == first7_set_id, keys + ["status", "success", "verdict_force_closure", "verdict_load_feasible"]
+        table["set_id"] == first_n_set_id, keys + ["status", "success", "verdict_force_closure", "verdict_load_feasible"]
     ]
-    merged = full.merge(small, on=keys, how="left", suffixes=("", "_first7"))
-    lost = merged[~merged["success_first7"].astype("boolean").fillna(False).to_numpy(bool)]
+    merged = full.merge(small, on=keys, how="left", suffixes=("", "_first_n"))
+    lost = merged[~merged["success_first_n"].astype("boolean").fillna(False).to_numpy(bool)]
     out = pd.DataFrame(
         {
             "object": lost["object"],
@@ -535,9 +535,9 @@ def lost_poses(table: pd.DataFrame, full_set_id: str, first7_set_id: str) -> pd.
             "alpha_deg": lost["alpha_deg"],
             "beta_deg": lost["beta_deg"],
             "full_force_norm": lost["force_norm"],
-            "first7_status": lost["status_first7"].fillna("missing"),
-            "first7_force_closure": lost["verdict_force_closure_first7"].astype("boolean").fillna(False).astype(bool),
-            "first7_load_feasible": lost["verdict_load_feasible_first7"].astype("boolean").fillna(False).astype(bool),
+            "first7_status": lost["status_first_n"].fillna("missing"),
+            "first7_force_closure": lost["verdict_force_closure_first_n"].astype("boolean").fillna(False).astype(bool),
+            "first7_load_feasible": lost["verdict_load_feasible_first_n"].astype("boolean").fillna(False).astype(bool),
         }
     )
     return out.sort_values(keys, ignore_index=True)

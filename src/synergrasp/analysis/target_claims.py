@@ -19,16 +19,16 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.analysis.claims import CLAIM_VERDICTS, FAILS, HOLDS, UNDEFINED
 from synergrasp.analysis.minima import MinimaParams, minima_table
 from synergrasp.analysis.study_tables import study_claims
 from synergrasp.analysis.summaries import TablesParams
 from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.ids import synergy_sets
+from synergrasp.optimisation.optimise import gfo_table
 from synergrasp.optimisation.placement_search import SearchStepParams, TargetScorer, full_synergy_set, pose_subset
 from synergrasp.optimisation.problem import SynergySets
-from synergrasp.optimisation.optimise import gfo_table
 
 __all__ = ["TargetClaimsParams", "ClaimsAtTargets", "claims_at_target", "claims_at_targets", "claims_summary"]
 
@@ -114,7 +114,7 @@ class ClaimsAtTargets:
 
 
 def claims_at_target(computer: ClaimsAtTargets, target: Mapping[str, Any]) -> pd.DataFrame:
-    """Rows of ``tables.TARGET_CLAIMS`` for one row of the placement table."""
+    """Rows of ``table_contracts.TARGET_CLAIMS`` for one row of the placement table."""
     point = (float(target["x_mm"]), float(target["y_mm"]), float(target["z_mm"]))
     claims = computer(point)
     return pd.DataFrame(
@@ -154,8 +154,8 @@ def _in_worker(target: dict) -> pd.DataFrame:
 def claims_at_targets(
     hand: Any, synergies: Any, params: TargetClaimsParams, period_deg: float, placement: pd.DataFrame, processes: int = 1
 ) -> pd.DataFrame:
-    """``tables.TARGET_CLAIMS`` of one object: the claims at each target of its placement
-    table (``tables.PLACEMENT``, best first; the best ``max_targets`` when > 0), in rank
+    """``table_contracts.TARGET_CLAIMS`` of one object: the claims at each target of its placement
+    table (``table_contracts.PLACEMENT``, best first; the best ``max_targets`` when > 0), in rank
     order. Deterministic: the same table for any ``processes``."""
     rows = placement.sort_values("rank")
     if params.max_targets > 0:
@@ -174,8 +174,8 @@ def claims_at_targets(
         finally:
             computer.close()
     if not parts:
-        return tables.empty(tables.TARGET_CLAIMS)
-    return pd.concat(parts, ignore_index=True)[list(tables.TARGET_CLAIMS.names)]
+        return table_contracts.empty(table_contracts.TARGET_CLAIMS)
+    return pd.concat(parts, ignore_index=True)[list(table_contracts.TARGET_CLAIMS.names)]
 
 
 def claims_summary(per_target: pd.DataFrame) -> pd.DataFrame:

@@ -26,8 +26,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from synergrasp.file_output import replacing_folder
 from synergrasp.figures.hand_pictures import ABOVE_CAMERA, BOX, PALM_CAMERA, SKIN, ShapeInPicture, hand_shapes
+from synergrasp.file_output import replacing_folder
 from synergrasp.ids import set_name
 from synergrasp.optimisation.optimise import GFOParams
 from synergrasp.simulation.objects import GraspedObject
@@ -401,10 +401,10 @@ def fig2_scenes(
     import pandas as pd
 
     from synergrasp.analysis.realism import representative_grasps
-    from synergrasp.figures.hand_figures import FIG2_GRASPS, object_of
-    from synergrasp.optimisation.problem import SynergySets
+    from synergrasp.figures.fig1_fig2_postures_grasps import FIG2_GRASPS, object_of
     from synergrasp.optimisation.mechanics import read_grasps
     from synergrasp.optimisation.optimise import optimise_grasps
+    from synergrasp.optimisation.problem import SynergySets
 
     sets = SynergySets(np.asarray(synergy_matrix, dtype=float), (params.full_set,))
     name_of_set = set_name(params.full_set)

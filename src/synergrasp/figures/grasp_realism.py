@@ -138,7 +138,7 @@ def _force_panel(ax, table: pd.DataFrame, labels: list[str]) -> None:
 
 
 def figure_grasp_realism(table: pd.DataFrame, png_path: str | Path, pdf_path: str | Path) -> None:
-    """Write the grasp-realism figure of ``table`` (columns of ``synergrasp.tables.GRASP_REALISM``)."""
+    """Write the grasp-realism figure of ``table`` (columns of ``synergrasp.table_contracts.GRASP_REALISM``)."""
     import matplotlib
 
     matplotlib.use("Agg")

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from synergrasp.figures.hand_figures import GRASP_VIEWS, draw_grasp_row
+from synergrasp.figures.fig1_fig2_postures_grasps import GRASP_VIEWS, draw_grasp_row
 from synergrasp.figures.output import save_figure
 
 __all__ = ["figure_placement_map"]

@@ -23,7 +23,7 @@ def _kind(name: str) -> str:
 
 
 def figure_planners(per_object: pd.DataFrame, across: pd.DataFrame, png: str | Path, pdf: str | Path) -> None:
-    """``per_object``: tables.PLANNERS rows; ``across``: tables.PLANNERS_ACROSS rows."""
+    """``per_object``: table_contracts.PLANNERS rows; ``across``: table_contracts.PLANNERS_ACROSS rows."""
     import matplotlib
 
     matplotlib.use("Agg")

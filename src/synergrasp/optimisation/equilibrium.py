@@ -144,7 +144,7 @@ def _one(row, params: EquilibriumParams, synergy: NDArray) -> dict[str, float]:
 
 
 def grasp_equilibrium(contacts: pd.DataFrame, params: EquilibriumParams, synergy: NDArray) -> pd.DataFrame:
-    """The two checks for every grasp (status ``grasp``) of a contacts table (``tables.CONTACTS``).
+    """The two checks for every grasp (status ``grasp``) of a contacts table (``table_contracts.CONTACTS``).
 
     ``synergy``: S1 (n,), rad per unit σ. Returns one row per grasp: ``object``,
     ``closure_model``, ``pose`` and :data:`EQUILIBRIUM_COLUMNS` (``torque_residual``

@@ -1,5 +1,5 @@
 """The study's optimisation step: every (pose, synergy set) of one shard of an object's
-poses, through the front door `gfo.solve_gfo`, into the gfo table (`tables.GFO`).
+poses, through the front door `gfo.solve_gfo`, into the gfo table (`table_contracts.GFO`).
 
 Per pose the mechanics (G, K, G_K^R, f_p, the internal-force projector) is built once;
 the pose's sets are then one `GraspSets` problem. Poses without a grasp give 'no_grasp',
@@ -8,8 +8,7 @@ grasps with rank(G) < 6 'rank_deficient', both without any solve (solver 'none')
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -17,6 +16,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from synergrasp import resolved
 from synergrasp.config import build, dataclass_fields
 from synergrasp.ids import set_id, synergy_sets
 from synergrasp.optimisation.cones import FrictionCone, cone_model
@@ -34,7 +34,6 @@ from synergrasp.optimisation.mechanics import (
 )
 from synergrasp.optimisation.problem import DEFAULT_TOL, MAX_ITER, STRICT_SHRINK, GraspSets, SynergySets
 from synergrasp.optimisation.shards import shard_positions
-from synergrasp import resolved
 
 __all__ = ["GFOParams", "OptimiseParams", "UNSOLVED_STATUSES", "gfo_table", "mechanics_for", "optimise_grasps", "optimise_shard"]
 
@@ -233,7 +232,7 @@ def optimise_grasps(
 def gfo_table(
     contacts: pd.DataFrame, synergies: SynergySets, params: GFOParams, *, strict: bool = True, shard: int = 0, n_shards: int = 1
 ) -> pd.DataFrame:
-    """The gfo table (columns of `tables.GFO`) of the poses of a contacts table, or of shard
+    """The gfo table (columns of `table_contracts.GFO`) of the poses of a contacts table, or of shard
     `shard` of `n_shards` of them, in pose order, each pose's sets in their given order.
 
     Poses with one grasp (`mechanics.first_same_grasp` over the whole table: a box's poses one

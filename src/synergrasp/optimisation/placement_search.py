@@ -27,16 +27,16 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.config import build, dataclass_fields
-from synergrasp.resolved import effective_placement
-from synergrasp.optimisation.problem import SynergySets
 from synergrasp.optimisation.mechanics import read_grasps
 from synergrasp.optimisation.optimise import GFOParams, optimise_grasps
-from synergrasp.simulation.contacts import contacts_row, contacts_table
-from synergrasp.simulation.closure_params import ClosureParams
-from synergrasp.simulation.objects import GraspedObject
+from synergrasp.optimisation.problem import SynergySets
+from synergrasp.resolved import effective_placement
 from synergrasp.resolved import grasp_type as resolved_grasp_type
+from synergrasp.simulation.closure_params import ClosureParams
+from synergrasp.simulation.contacts import contacts_row, contacts_table
+from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.opposition import HandAxes, OppositionRule, contacts_oppositions, of_grasp_type
 from synergrasp.simulation.placement import Placement, hand_region, palm_centre, pose_grid
 from synergrasp.simulation.reach import ReachParams
@@ -441,7 +441,7 @@ class SearchResult:
         return self.ranked[0]
 
     def table(self, distinct_mm: float) -> pd.DataFrame:
-        """The placement table (``tables.PLACEMENT``), best first."""
+        """The placement table (``table_contracts.PLACEMENT``), best first."""
         chosen = np.asarray(self.chosen.target_mm)
         distinct = distinct_ranks(self.ranked, distinct_mm)
         region = "; ".join(f"{axis} {lo:g} … {hi:g}" for axis, (lo, hi) in zip("xyz", self.region_mm))
@@ -469,7 +469,7 @@ class SearchResult:
             }
             for k, s in enumerate(self.ranked)
         ]
-        return pd.DataFrame(rows, columns=list(tables.PLACEMENT.names))
+        return pd.DataFrame(rows, columns=list(table_contracts.PLACEMENT.names))
 
 
 _WORKER: TargetScorer | None = None

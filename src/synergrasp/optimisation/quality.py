@@ -206,7 +206,7 @@ def quality_table(
     params: QualityParams,
     axes: HandAxes,
 ) -> pd.DataFrame:
-    """One row per pose of ``contacts`` (columns of ``synergrasp.tables.QUALITY``): the quality
+    """One row per pose of ``contacts`` (columns of ``synergrasp.table_contracts.QUALITY``): the quality
     indices of its grasp (``grasps``, one per row; None: no grasp, indices NaN), the full
     set's verdict and optimal force over the weight from ``gfo``, and the grasp's opposition
     (``axes``: the hand's, docs/opposition.md). Poses with one grasp

@@ -414,7 +414,7 @@ def contact_forces(client: int, body_a: int | HandBody, body_b: HandBody) -> Con
     return ContactForces(**shared, normal_force=np.array([p[9] for p in pts], dtype=float).reshape(-1))
 
 
-def step_with_torques(client: int, body: HandBody, torques_Nmm: NDArray) -> None:
+def tick_with_torques(client: int, body: HandBody, torques_Nmm: NDArray) -> None:
     """Apply ``torques_Nmm`` (N·mm, one per elementary axis, HandBody order) and take one step."""
     pb.setJointMotorControlArray(
         body.body,

@@ -21,8 +21,8 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from synergrasp.config import build, dataclass_fields
-from synergrasp.resolved import effective_placement, friction_mu
 from synergrasp.hand.synergies import Synergies, synergy_values
+from synergrasp.resolved import effective_placement, friction_mu
 from synergrasp.simulation.closure_params import ClosureMechanics, ClosureParams, DynamicParams
 from synergrasp.simulation.contacts import ClosureResult, contacts_row, contacts_table
 from synergrasp.simulation.objects import GraspedObject
@@ -133,7 +133,7 @@ def simulate_object(
     """Close the hand on the object ``grasped`` (name, shape, mass) at every pose of the
     placement's grid (or at ``poses``).
 
-    Returns the contacts table (``synergrasp.tables.CONTACTS``, one row per pose, in the
+    Returns the contacts table (``synergrasp.table_contracts.CONTACTS``, one row per pose, in the
     order of ``poses``). Deterministic. With the kinematic model a pose whose box fills the
     region of an earlier pose of the run shares that pose's closure (``_RegionResults``);
     ``as_in_grid=True`` closes each of ``poses`` at the first pose of the whole grid that fills

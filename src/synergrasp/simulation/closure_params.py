@@ -74,15 +74,15 @@ class DynamicParams:
         return self.object == "held"
 
     @property
-    def ramp_steps(self) -> int:
+    def ramp_ticks(self) -> int:
         return max(1, int(round(self.ramp_time_s / self.time_step_s)))
 
     @property
-    def max_steps(self) -> int:
-        return max(self.ramp_steps, int(round(self.time_limit_s / self.time_step_s)))
+    def max_ticks(self) -> int:
+        return max(self.ramp_ticks, int(round(self.time_limit_s / self.time_step_s)))
 
     @property
-    def window_steps(self) -> int:
+    def window_ticks(self) -> int:
         return max(1, int(round(self.settle_window_s / self.time_step_s)))
 
 

@@ -1,7 +1,7 @@
 """The outcome of one closure and the contacts table (``results/objects/<object>/contacts.parquet``).
 
 Every closure model returns a :class:`ClosureResult`; :func:`contacts_row` turns it into a
-row of the table whose columns, types and units are ``synergrasp.tables.CONTACTS``;
+row of the table whose columns, types and units are ``synergrasp.table_contracts.CONTACTS``;
 :func:`load_carrying_contacts` keeps the contacts that carry load (where the closure model
 records loads). Pure numpy and pandas: pybullet is never imported here.
 """
@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from synergrasp import tables
+from synergrasp import table_contracts
 from synergrasp.simulation.placement import ObjectPose
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -118,7 +118,7 @@ def closure_result(
 def contacts_row(
     object_name: str, pose: int, alpha_deg: float, beta_deg: float, result: ClosureResult, placed: ObjectPose
 ) -> dict[str, Any]:
-    """One row of the contacts table (``tables.CONTACTS``) from a closure result; the box pose
+    """One row of the contacts table (``table_contracts.CONTACTS``) from a closure result; the box pose
     columns hold its settled pose (``result.settled_pose``, else ``placed``)."""
     final = placed if result.settled_pose is None else result.settled_pose
     forces = (
@@ -152,7 +152,7 @@ def contacts_row(
 
 def contacts_table(rows: list[dict[str, Any]]) -> pd.DataFrame:
     """The contacts table of a list of :func:`contacts_row` rows, in the contract's column order."""
-    table = pd.DataFrame(rows, columns=list(tables.CONTACTS.names))
+    table = pd.DataFrame(rows, columns=list(table_contracts.CONTACTS.names))
     for col in ("pose", "n_contacts"):
         table[col] = table[col].astype(np.int32)
     return table

@@ -105,9 +105,9 @@ class DynamicClosure:
         self.axis_sum = np.zeros((hand.n_joints, len(self.axis_joint)))  # q = axis_sum @ θ
         self.axis_sum[self.axis_joint, np.arange(len(self.axis_joint))] = 1.0
         self.q_open = self.path.reference(self.sigma_open)
-        # the axes' targets s_i·q_r(σ) after each step of the σ ramp, the same for every grasp
-        ramp = p.ramp_steps
-        sigmas = [self.sigma_open + (self.sigma_closed - self.sigma_open) * (step + 1) / ramp for step in range(ramp)]
+        # the axes' targets s_i·q_r(σ) after each tick (time step) of the σ ramp, the same for every grasp
+        ramp = p.ramp_ticks
+        sigmas = [self.sigma_open + (self.sigma_closed - self.sigma_open) * (tick + 1) / ramp for tick in range(ramp)]
         self.ramp_targets = self.axis_scale * self.path.reference(np.array(sigmas))[:, self.axis_joint]
         self.self_pairs = self._colliding_pairs()
         self.capsules = HandCapsules.of(hand)
@@ -162,33 +162,33 @@ class DynamicClosure:
             return self._result("intersects_open_hand", q_open, (), None, True)
         weight = self.weight if p.gravity and not p.held else None
         radius = placed.shape.bounding_radius_mm
-        settled, steps = False, p.max_steps
-        ramp, targets, window_steps = p.ramp_steps, self.ramp_targets, p.window_steps
+        settled, ticks = False, p.max_ticks
+        ramp, targets, window_ticks = p.ramp_ticks, self.ramp_targets, p.window_ticks
         axis_k = self.k_ss / self.axis_scale  # N·mm/rad per axis (2·k_ss for each half of a rolling joint)
         damping, client, body, box = p.joint_damping_Nmm_s_per_rad, self.client, self.body, self.box
         # settled by the change over a window, not by instantaneous speeds: the engine's
         # contacts jitter and creep (~1 mm/s) long after the grasp has formed
-        window: deque = deque(maxlen=window_steps + 1)
-        for step in range(p.max_steps):
+        window: deque = deque(maxlen=window_ticks + 1)
+        for tick in range(p.max_ticks):
             theta, omega = b.axis_states(client, body)
-            if step < ramp:
-                target = targets[step]
+            if tick < ramp:
+                target = targets[tick]
             else:
                 center, rotation = b.body_pose(client, box)
                 window.append((self.axis_sum @ theta, center, rotation))
-                if len(window) > window_steps:
+                if len(window) > window_ticks:
                     q0, c0, r0 = window[0]
                     turn = math.acos(min(1.0, max(-1.0, 0.5 * (float(np.sum(r0 * rotation)) - 1.0))))
                     if (
                         np.max(np.abs(window[-1][0] - q0)) < p.settle_joint_change_rad
                         and np.linalg.norm(center - c0) + turn * radius < p.settle_object_change_mm
                     ):
-                        settled, steps = True, step
+                        settled, ticks = True, tick
                         break
             if weight is not None:
                 b.apply_force(client, box, weight)
-            b.step_with_torques(client, body, axis_k * (target - theta) - damping * omega)
-        self.steps = steps
+            b.tick_with_torques(client, body, axis_k * (target - theta) - damping * omega)
+        self.ticks = ticks
         return self._settled(placed, settled)
 
     def _result(

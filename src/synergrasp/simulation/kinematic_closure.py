@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from synergrasp.hand.kinematics import FINGERS
 from synergrasp.hand.synergies import SynergyPath
 from synergrasp.simulation import bullet
-from synergrasp.simulation.closure_steps import MARCH_CROSS, march
+from synergrasp.simulation.closure_march import MARCH_CROSS, march
 from synergrasp.simulation.contacts import ClosureResult, closure_result
 from synergrasp.simulation.placement import ObjectPose
 from synergrasp.simulation.scene import HandScene
@@ -170,7 +170,7 @@ class KinematicClosure:
 
     def _profiles_of(self, held: NDArray) -> tuple[NDArray, NDArray, NDArray]:
         """Every finger's travel profile (``_travel_profile``) for the joints that are not
-        ``held``, as the padded arrays ``closure_steps.march`` reads: knots (F, K), travel
+        ``held``, as the padded arrays ``closure_march.march`` reads: knots (F, K), travel
         (F, K) and the number of knots per finger (0: none of its joints moves). Cached per
         held set."""
         key = held.tobytes()

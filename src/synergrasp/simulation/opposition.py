@@ -171,7 +171,7 @@ def classify_grasp(links: Sequence[int], normals: NDArray, axes: HandAxes, rule:
 
 
 def contacts_oppositions(contacts: Any, axes: HandAxes, rule: OppositionRule) -> list[str]:
-    """The opposition of every row of a contacts table (``tables.CONTACTS``: contact_link,
+    """The opposition of every row of a contacts table (``table_contracts.CONTACTS``: contact_link,
     contact_normal); a row that is no grasp (status other than ``grasp``) makes none."""
     out = []
     for status, links, normals in zip(contacts["status"], contacts["contact_link"], contacts["contact_normal"]):

@@ -288,7 +288,7 @@ def approach_line(placement: Placement, hand: Hand) -> tuple[NDArray, NDArray]:
 
 def searched_placement(placement: Placement, table: Any) -> Placement:
     """``placement`` (mode ``searched``) with its target: the row of the search's placement
-    table (a DataFrame of ``tables.PLACEMENT``) whose ``distinct_rank`` is the placement's
+    table (a DataFrame of ``table_contracts.PLACEMENT``) whose ``distinct_rank`` is the placement's
     ``search_rank``."""
     rows = table[table["distinct_rank"] == placement.search_rank]
     if len(rows) != 1:

@@ -134,7 +134,7 @@ class HandReachStepParams:
 
 @dataclass(frozen=True)
 class HandReach:
-    """The reach table of one hand (``tables.HAND_REACH``: one row per finger) and the hand's
+    """The reach table of one hand (``table_contracts.HAND_REACH``: one row per finger) and the hand's
     two numbers: d_max (mm, the thickest slab on the palm some link presses toward the palm)
     and the aperture (mm, the widest thumb-to-fingertip gap on the path)."""
 

@@ -201,7 +201,7 @@ class HandScene:
     def query_args(self) -> tuple:
         """The arguments of ``capsules.posture_gaps`` (per link the gaps to the object and to the
         monitored hand links at a posture q: the kinematic closure's query, made by
-        ``closure_steps.march``) after q and before the pairs: the hand's frame tree and
+        ``closure_march.march``) after q and before the pairs: the hand's frame tree and
         capsules, the palm's gap to the object (mm) and the placed object with the radius of a
         ball about its centre that holds it (mm)."""
         c, placed = self.capsules, self.placed

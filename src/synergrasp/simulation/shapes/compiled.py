@@ -23,7 +23,7 @@ SOURCES = (
     "simulation/shapes/polytope.py",
     "simulation/shapes/polytope_axes.py",
     "simulation/capsules.py",
-    "simulation/closure_steps.py",
+    "simulation/closure_march.py",
 )
 
 #: The group; registered before any of its modules defines a function.

@@ -1,5 +1,5 @@
 """Figures of the study drawn from its tables: Fig. 4 (force maps and exploded views), Fig. 5
-(hierarchy matrices). Fig. 3, the rule graph, is `synergrasp.figures.rulegraph`.
+(hierarchy matrices). Fig. 3, the rule graph, is `synergrasp.figures.fig3_rulegraph`.
 
 Every figure function takes tables (pandas) and output paths, and writes PNG and PDF.
 Forces are in N; angles in deg.
@@ -10,8 +10,8 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -21,8 +21,8 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from synergrasp.analysis.verdicts import force_bound  # noqa: E402
-from synergrasp.ids import incremental_set_id  # noqa: E402
 from synergrasp.figures.output import colour_range, save_figure  # noqa: E402
+from synergrasp.ids import incremental_set_id  # noqa: E402
 
 __all__ = [
     "Fig4Params",

@@ -70,8 +70,8 @@ def checked_scenario(config: Mapping[str, Any], name: str = DEFAULT_SCENARIO) ->
         the hand file, the synergy table, the objects' shapes.
     """
     from synergrasp.hand.synergies import load_synergies
-    from synergrasp.simulation.thumb_check import cached_opposition_warnings
     from synergrasp.simulation.objects import object_problems, object_warnings
+    from synergrasp.simulation.thumb_check import cached_opposition_warnings
 
     where = "" if name == DEFAULT_SCENARIO else f"scenario '{name}': "
     try:
@@ -186,18 +186,18 @@ def searched_objects_or_refuse(
 
 def older_results_problems(results: str | Path = "results") -> list[str]:
     """Every table under ``results`` (scenarios' folders included) written by an older version
-    of the study (``tables.older_version``: a column under its old name), one line each naming
+    of the study (``table_contracts.older_version``: a column under its old name), one line each naming
     the file; read from the files' schemas before any job, so that a run refuses them up
     front as ``synergrasp plan`` does, not inside the jobs that read them."""
-    from synergrasp import tables
+    from synergrasp import table_contracts
 
     problems = []
-    for table in tables.TABLES.values():
+    for table in table_contracts.CONTRACTS.values():
         if table.renamed and Path(results).is_dir():
             problems += [
                 line
                 for path in sorted(Path(results).rglob(f"{table.name}.parquet"))
-                if (line := tables.older_version(table, path))
+                if (line := table_contracts.older_version(table, path))
             ]
     return problems
 

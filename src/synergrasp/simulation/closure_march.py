@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from synergrasp.simulation.shapes.compiled import jit  # registers the group first
 from synergrasp.simulation.capsules import posture_gaps  # noqa: I001 (after the group's registration)
+from synergrasp.simulation.shapes.compiled import jit  # registers the group first
 
 __all__ = ["march", "MARCH_END", "MARCH_STALL", "MARCH_CROSS"]
 

@@ -20,7 +20,7 @@ from synergrasp.file_output import replacing
 __all__ = [
     "Column",
     "Table",
-    "TABLES",
+    "CONTRACTS",
     "STUDY_TABLES",
     "CONTACTS",
     "GFO",
@@ -674,7 +674,7 @@ STUDY_TABLES: tuple[str, ...] = (
     "invariant_checks",
     "claims",
 )
-TABLES: dict[str, Table] = {
+CONTRACTS: dict[str, Table] = {
     t.name: t
     for t in (
         CONTACTS,

@@ -8,7 +8,7 @@ import re
 import pandas as pd
 import pytest
 
-from synergrasp import tables
+from synergrasp import table_contracts
 
 
 def _gfo() -> pd.DataFrame:
@@ -34,8 +34,8 @@ def _gfo() -> pd.DataFrame:
 
 
 def test_a_current_gfo_table_reads_back_as_written(tmp_path):
-    tables.write(tables.GFO, _gfo(), tmp_path / "gfo.parquet")
-    read = tables.read(tables.GFO, tmp_path / "gfo.parquet")
+    table_contracts.write(table_contracts.GFO, _gfo(), tmp_path / "gfo.parquet")
+    read = table_contracts.read(table_contracts.GFO, tmp_path / "gfo.parquet")
     assert read["load_feasible"].tolist() == [False, True] and read["force_closure_def1"].tolist() == [False, False]
 
 
@@ -50,18 +50,18 @@ def test_an_older_gfo_table_is_refused_naming_the_file_and_the_old_column(tmp_pa
         "and rerun the study"
     )
     with pytest.raises(ValueError, match=f"^{re.escape(expected)}$"):
-        tables.read(tables.GFO, path)
+        table_contracts.read(table_contracts.GFO, path)
     # one old column alone is refused too (a table whose other column is current)
     _gfo().rename(columns={"load_feasible": "force_closure"}).to_parquet(path)
     with pytest.raises(ValueError, match=re.escape("column 'force_closure' (now 'load_feasible'));")):
-        tables.read(tables.GFO, path)
+        table_contracts.read(table_contracts.GFO, path)
 
 
 def test_an_older_results_folder_is_found_from_the_schemas_with_the_readers_line(tmp_path):
-    """The workflow's check before any job (study_checks.older_results_problems): every gfo
-    table under the folder, scenarios' included, with the line tables.read would give; a
+    """The workflow's check before any job (input_checks.older_results_problems): every gfo
+    table under the folder, scenarios' included, with the line table_contracts.read would give; a
     current table and an unreadable one (left to the step reading it) give none."""
-    from synergrasp.study_checks import older_results_problems
+    from synergrasp.input_checks import older_results_problems
 
     old = tmp_path / "results" / "scenarios" / "s" / "objects" / "obj1" / "gfo.parquet"
     current = tmp_path / "results" / "objects" / "obj1" / "gfo.parquet"
@@ -69,9 +69,9 @@ def test_an_older_results_folder_is_found_from_the_schemas_with_the_readers_line
     for path in (old, current, broken):
         path.parent.mkdir(parents=True)
     _gfo().rename(columns={"load_feasible": "force_closure"}).to_parquet(old)
-    tables.write(tables.GFO, _gfo(), current)
+    table_contracts.write(table_contracts.GFO, _gfo(), current)
     broken.write_bytes(b"not parquet")
     with pytest.raises(ValueError) as read:
-        tables.read(tables.GFO, old)
+        table_contracts.read(table_contracts.GFO, old)
     assert older_results_problems(tmp_path / "results") == [str(read.value)]
     assert older_results_problems(tmp_path / "none") == []
