@@ -4,7 +4,14 @@ One :class:`Table` per table; writers, readers, workflow scripts and ``docs/desi
 take their columns from here. :func:`write` checks a frame against its contract and
 writes Parquet with the exact types; :func:`read` checks what it reads.
 Units are in the column names where a column has one (``_mm``, ``_deg``, ``_N``) and in
-``Column.unit`` always.
+``Column.unit`` always. :data:`CONTRACTS` holds every contract by table name.
+
+The step ``tables`` (its rule, its script and ``results/tables/``) is another thing: it writes
+the study's tables, named in :data:`STUDY_TABLES`, which are shown to the reader and have no
+contract here. In their names and columns, "first7" (the table ``full_not_first7``, its
+columns ``first7_status``, ``first7_force_closure``, ``first7_load_feasible``) means the
+first ``synergy_sets.hierarchy_first`` synergies, {S1..S_hierarchy_first}: 7 in the default
+study, the name kept so that the results' files and columns stay those of earlier runs.
 """
 
 from __future__ import annotations
@@ -674,6 +681,7 @@ STUDY_TABLES: tuple[str, ...] = (
     "invariant_checks",
     "claims",
 )
+#: Every contract of a table passed between steps, by table name.
 CONTRACTS: dict[str, Table] = {
     t.name: t
     for t in (
