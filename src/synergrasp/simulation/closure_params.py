@@ -19,8 +19,9 @@ class DynamicParams:
     The values are checked once, by the config schema and ``config.check_relations``; this
     class only carries them.
 
-    time_step_s:           physics time step, s.
-    solver_iterations:     constraint-solver iterations per step.
+    time_step_s:           physics time step, s (one tick of the engine; a workflow step is
+                           another thing).
+    solver_iterations:     constraint-solver iterations per tick.
     link_mass_kg:          mass of every elementary hand link during the closure, kg.
     link_inertia_kg_mm2:   rotational inertia of every elementary hand link about its own
                            frame, kg·mm² (sets the fastest joint mode: √(k_ss / I)).
@@ -75,14 +76,17 @@ class DynamicParams:
 
     @property
     def ramp_ticks(self) -> int:
+        """Ticks (physics time steps of ``time_step_s``) over which σ runs from open to closed."""
         return max(1, int(round(self.ramp_time_s / self.time_step_s)))
 
     @property
     def max_ticks(self) -> int:
+        """Most ticks a closure runs: ``time_limit_s``, at least the ramp."""
         return max(self.ramp_ticks, int(round(self.time_limit_s / self.time_step_s)))
 
     @property
     def window_ticks(self) -> int:
+        """Ticks in the settling window ``settle_window_s`` (at least one)."""
         return max(1, int(round(self.settle_window_s / self.time_step_s)))
 
 
