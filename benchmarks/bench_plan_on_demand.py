@@ -54,6 +54,15 @@ def plan_objects(objects: list[str], args: argparse.Namespace) -> tuple[pd.DataF
     return (pd.concat(rows, ignore_index=True) if rows else table_contracts.empty(table_contracts.PLAN_ON_DEMAND)), failed
 
 
+def print_rows(table: pd.DataFrame) -> None:
+    """Per object, the machine-read lines of its plan."""
+    for r in table.itertuples():
+        print(f"closures_{r.object}: {r.closures}  ({r.planner}, seed {r.seed}: closures run of {r.n_poses} poses)")
+        print(f"closure_share_{r.object}: {100.0 * r.closures / r.n_poses:.1f}  (% of the exhaustive closures)")
+        print(f"wall_s_{r.object}: {r.wall_s:.1f}  (the plan's wall time, closures and solves, s)")
+        print(f"regret_percent_{r.object}: {r.regret_percent:.2f}  (its force over the study's exhaustive minimum, -1, %)")
+
+
 def summarise(table: pd.DataFrame, n_failed: int) -> None:
     """The figures across the objects (machine-read lines)."""
     share = table["closures"] / table["n_poses"]
@@ -79,18 +88,17 @@ def main() -> None:
     ap.add_argument("--summarise", type=Path, nargs="+", help="only summarise these tables")
     args = ap.parse_args()
     if args.summarise:
-        summarise(pd.concat([table_contracts.read_csv(table_contracts.PLAN_ON_DEMAND, p) for p in args.summarise]), 0)
+        frames = [table_contracts.read_csv(table_contracts.PLAN_ON_DEMAND, p) for p in args.summarise]
+        table = pd.concat(frames, ignore_index=True)
+        print_rows(table)
+        summarise(table, 0)
         return
     k, n = args.shard
     objects = sorted(checked_configuration(args.configfile)["objects"])[k::n]
     table, failed = plan_objects(objects, args)
     if args.table:
         table_contracts.write_csv(table_contracts.PLAN_ON_DEMAND, table, args.table)
-    for r in table.itertuples():
-        print(f"closures_{r.object}: {r.closures}  ({r.planner}, seed {r.seed}: closures run of {r.n_poses} poses)")
-        print(f"closure_share_{r.object}: {100.0 * r.closures / r.n_poses:.1f}  (% of the exhaustive closures)")
-        print(f"wall_s_{r.object}: {r.wall_s:.1f}  (the plan's wall time, closures and solves, s)")
-        print(f"regret_percent_{r.object}: {r.regret_percent:.2f}  (its force over the study's exhaustive minimum, -1, %)")
+    print_rows(table)
     summarise(table, len(failed))
 
 

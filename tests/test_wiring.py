@@ -185,11 +185,11 @@ def test_the_memory_requests_checked_against_a_node_are_those_of_the_checked_sce
     # only the default scenario is checked yet: one request per rule, the rule's own
     assert wiring.memory_requests() == [(rule, mem_mb(rule, wiring.study)) for rule in rules]
     assert dict(wiring.memory_requests())["search"] == 1300  # (700 + 150 MB) x 1.5, by hand above
-    # tables: 4 objects x 1,800 poses x 75 sets: (231 + 2.2e-4 x 540,000) x 1.5 = 524.7 -> 600 MB
-    assert dict(wiring.memory_requests())["tables"] == 600
+    # tables: 4 objects x 1,800 poses x 75 sets: (400 + 1.4e-5 x 540,000) x 1.5 = 611.3 -> 700 MB
+    assert dict(wiring.memory_requests())["tables"] == 700
     wiring.scenario("coarse")  # a job of the scenario needs it: its requests join (12 x 7 poses)
     coarse = [request for rule, request in wiring.memory_requests()[len(rules) :] if rule == "tables"]
-    assert len(wiring.memory_requests()) == 2 * len(rules) and coarse == [400]  # (231 + 2.2e-4 x 25,200) x 1.5 = 354.8
+    assert len(wiring.memory_requests()) == 2 * len(rules) and coarse == [700]  # (400 + 1.4e-5 x 25,200) x 1.5 = 600.5
 
 
 def test_a_bad_scenario_is_one_error_naming_it():
