@@ -10,8 +10,9 @@ import pytest
 from conftest import study_gfo_params
 from grasp_problems import random_grasp, random_synergies
 from synergrasp.analysis.minima import MinimaParams
-from synergrasp.analysis.plan_study import PlanParams, plan_object
+from synergrasp.analysis.plan_study import PlanParams, StudySolver, plan_object
 from synergrasp.analysis.planner import greedy_order, plan_against_exhaustive, plan_incremental
+from synergrasp.analysis.verdicts import with_verdicts
 from synergrasp.ids import incremental_set_id
 from synergrasp.optimisation.optimise import gfo_table
 from synergrasp.optimisation.problem import SynergySets
@@ -105,8 +106,10 @@ def test_greedy_order_adds_the_synergy_that_adds_most_successes():
     assert order[3:] == (2, 4) and counts[3:].tolist() == [9, 9]
 
 
-def test_the_planner_on_the_study_solver_reproduces_the_gfo_table():
-    rng = np.random.default_rng(38)
+def _random_study(seed: int = 38):
+    """Twelve random grasps (one pose empty) on a 4 x 3 grid, its gfo table of the incremental
+    sets {S1..Sk}, k = 1 … 4, and the plan step's parameters."""
+    rng = np.random.default_rng(seed)
     grasps = [random_grasp(rng, int(rng.integers(4, 10))) for _ in range(12)]
     grasps[5] = None
     from test_optimise import _contacts_of
@@ -120,6 +123,12 @@ def test_the_planner_on_the_study_solver_reproduces_the_gfo_table():
     sets = tuple(tuple(range(1, k + 1)) for k in range(1, n + 1))
     gfo = gfo_table(contacts, SynergySets(matrix, sets), gfo_params)
     params = PlanParams((10.0, 200.0), n, None, gfo_params, MinimaParams(10.0, "load_feasible"))
+    return contacts, gfo, matrix, params
+
+
+def test_the_planner_on_the_study_solver_reproduces_the_gfo_table():
+    contacts, gfo, matrix, params = _random_study()
+    n = params.n_levels
     result = plan_object(contacts, gfo, matrix, params)
     plan, enrollment = result.table, result.enrollment
     assert (plan["study_rows_differing"] == 0).all()
@@ -198,3 +207,29 @@ def test_synergrasp_plan_reads_the_study_s_tables_and_prints_one_line_per_radius
     assert plan["study_rows_differing"].tolist() == [0, 0] and bool(plan["is_global_min"].iloc[1])
     assert main(["plan", "nothing", "--results", str(tmp_path)]) == 2
     assert "synergrasp plan: object: 'nothing' is not an object of the configuration" in capsys.readouterr().err
+
+
+def test_the_study_s_remembered_rows_steer_the_planner_as_solving_them_anew_does():
+    contacts, gfo, matrix, params = _random_study()
+    judged = with_verdicts(gfo, params.minima.success)
+    alpha, beta = contacts["alpha_deg"].to_numpy(float), contacts["beta_deg"].to_numpy(float)
+    solvers = StudySolver(contacts, matrix, params), StudySolver(contacts, matrix, params, study=judged)
+    assert len(solvers[1].memo) == 11 * params.n_levels  # every non-empty pose, every set of the table
+    live, remembered = (plan_incremental(alpha, beta, s.level, params.n_levels, 10.0) for s in solvers)
+    assert solvers[0].n_problems > 0 and solvers[1].n_problems == 0  # nothing handed to the solver again
+    assert [s.tolist() for s in live.solved] == [s.tolist() for s in remembered.solved]
+    assert [s.tolist() for s in live.seeds] == [s.tolist() for s in remembered.seeds]
+    assert live.best_pose == remembered.best_pose >= 0
+    assert remembered.best_force_N == pytest.approx(live.best_force_N, rel=1e-12)
+
+
+def test_the_audit_counts_rows_where_the_study_s_table_disagrees_with_the_solver():
+    contacts, gfo, matrix, params = _random_study()
+    plan = plan_object(contacts, gfo, matrix, params).table
+    best = int(plan["best_pose"].iloc[0])
+    assert best >= 0 and (plan["study_rows_differing"] == 0).all()
+    # the study's table made wrong at the plans' best pose, full set: the audit solves that row anew
+    wrong = gfo.copy()
+    at = (wrong["pose"] == contacts["pose"].iat[best]) & (wrong["set_id"] == incremental_set_id(params.n_levels))
+    wrong.loc[at, "force_norm"] *= 1.01
+    assert (plan_object(contacts, wrong, matrix, params).table["study_rows_differing"] >= 1).all()

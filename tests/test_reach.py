@@ -13,14 +13,14 @@ from synergrasp.hand.kinematics import build_hand, load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.simulation.objects import GraspedObject
 from synergrasp.simulation.placement import hand_region
-from synergrasp.simulation.reach import HandReachStepParams, feasible_types, hand_reach, object_extents, shape_class
+from synergrasp.simulation.reach import ReachStepParams, feasible_types, hand_reach, object_extents, shape_class
 from synergrasp.simulation.shapes.box import Box
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
 
 
 def _params(**reach):
-    params = HandReachStepParams.from_config(defaults())
+    params = ReachStepParams.from_config(defaults())
     from dataclasses import replace
 
     return replace(params, reach=replace(params.reach, posture_steps=3, **reach))

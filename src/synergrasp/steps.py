@@ -238,6 +238,17 @@ STEPS: dict[str, Step] = {
         optional=True,
         inputs={"mesh": MESH},
     ),
+    # what grasps the hand can make (docs/hand_reach.md), once per hand: per finger the reach
+    # along S1 and in any posture, d_max (~60 kinematic closures on slabs lying on the palm)
+    # and the aperture; the search's gate and the hand_reach table read it
+    "reach": Step(
+        rules={"reach": Cost("none", 4.0, 300)},
+        outputs={"reach": "hand/reach.parquet"},
+        reads=("hand", "synergies", "closure", "opposition.angle_deg", "hand_reach"),
+        not_reads=("closure.model", "closure.dynamic"),
+        params="synergrasp.simulation.reach:ReachStepParams",
+        inputs={**HAND_FILES},
+    ),
     # the placement search (docs/placement_search.md): the kinematic closure and the
     # optimisation with the full set {S1..S_incremental_max} only; one job per object with
     # 2 processes: ~30 s of CPU (186-195 targets x 27 poses) plus a cold solver cache's compile
@@ -247,9 +258,10 @@ STEPS: dict[str, Step] = {
         scope="object",
         reads=STEPS_SEARCH_READS,
         not_reads=STEPS_SEARCH_NOT_READS,
+        upstream=("reach",),
         params="synergrasp.optimisation.placement_search:SearchStepParams",
         placement_when=(("mode", "searched"),),
-        inputs={**HAND_FILES},
+        inputs={**HAND_FILES, "reach": "reach"},
     ),
     "simulate": Step(
         rules={"simulate": Cost("closure_pose", 1.5, 178, 4.5e-3, 7.6e-3, local=False)},
@@ -486,20 +498,19 @@ STEPS: dict[str, Step] = {
         report={"png": ("fig1", "Figures")},
         inputs={**HAND_FILES},
     ),
-    # what grasps the hand can make (docs/hand_reach.md): per finger the reach along S1 and in
-    # any posture, d_max (~60 kinematic closures on slabs lying on the palm) and the aperture
+    # the hand's reach as a table and a side view with the study's objects (docs/hand_reach.md)
     "hand_reach": Step(
-        rules={"hand_reach": Cost("none", 8.0, 300)},
+        rules={"hand_reach": Cost("none", 4.0, 300)},
         outputs={
             "csv": "tables/hand_reach.csv",
             "md": "tables/hand_reach.md",
             **_files(("hand_reach",), "figures", _PNG_PDF, named=False),
         },
-        reads=("hand", "synergies", "closure", "opposition.angle_deg", "hand_reach", "objects.*.shape"),
-        not_reads=("closure.model", "closure.dynamic"),
+        reads=("hand", "synergies", "opposition.angle_deg", "hand_reach", "objects.*.shape"),
+        upstream=("reach",),
         params="synergrasp.simulation.reach:HandReachStepParams",
         report={"csv": ("hand_reach_table", "Tables"), "png": ("hand_reach", "Figures")},
-        inputs={**HAND_FILES},
+        inputs={**HAND_FILES, "reach": "reach"},
     ),
     # Fig. 2 and the same grasps in 3-D with the full set's optimal forces: pages sharing one
     # plotly script (docs/inspector.md); one job, so that the pages' imports (the solver, a

@@ -566,7 +566,7 @@ PLAN = Table(
             "study_rows_differing",
             "int32",
             "",
-            "rows the planner solved whose verdict or force (1e-5 relative) differs from the gfo table's",
+            "rows solved anew at the poses that steered the plans (every level's seeds, the best pose) whose verdict or force (1e-5 relative) differs from the gfo table's",
         ),
     ),
 )

@@ -414,7 +414,7 @@ class Wiring:
         if producer == "object" and scope == "scenario":
             return self.object_files(step, output) if output else self.step_inputs(step)
         rel = STEPS[step].outputs[output] if output else next(iter(STEPS[step].outputs.values()))
-        if producer == "scenario" and scope == "scenario":
+        if producer == "scenario" and scope in ("scenario", "object"):
             return self.scenario_input(step, rel)
         if producer == "scenario" and scope == "workflow":
             return lambda w: [self.scenario_file(s, step, rel) for s in self.scenarios]

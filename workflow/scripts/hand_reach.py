@@ -6,13 +6,13 @@ from synergrasp.figures.hand_reach import figure_hand_reach
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
 from synergrasp.job_log import job_log
-from synergrasp.simulation.reach import HandReachStepParams, hand_reach, path_postures
+from synergrasp.simulation.reach import HandReachStepParams, path_postures, read_hand_reach
 
 with job_log(snakemake.log[0]):
     params = HandReachStepParams.from_config(snakemake.params.cfg)
     hand = load_hand(params.hand)
     synergies = load_synergies(params.synergies, joint_names=hand.joint_names)
-    reach = hand_reach(hand, synergies, params.closure, params.reach)
+    reach = read_hand_reach(snakemake.input.reach, hand)
     table_contracts.write_study_table(
         reach.table[list(table_contracts.HAND_REACH.names)],
         snakemake.output.csv,

@@ -1,11 +1,13 @@
 """The incremental planner on one object of the study (the ``plan`` step, docs/planner.md).
 
-Every solve goes through the study's own front door, `optimise_grasps` (one model: the
-gfo step's), on the object's contacts table; the success verdict and its force are the
-study's (`with_verdicts`, ``analyses.success``). The planner (:mod:`synergrasp.analysis.planner`)
-runs once per radius; the object's exhaustive gfo table is the yardstick, and the rows the
-planner solved are compared with it (``study_rows_differing``: same verdict, force within
-1e-5 relative, else counted).
+The planner (:mod:`synergrasp.analysis.planner`) runs once per radius on the object's study:
+a (set, grasp) the gfo table already holds is read from it (the study's own solve, judged by
+`with_verdicts`, ``analyses.success``), and every other set (the greedy enrollment's) is solved
+through the study's front door, `optimise_grasps` (one model: the gfo step's), on the
+object's contacts table. The exhaustive gfo table is the yardstick; the solver the planner
+runs on demand (``synergrasp plan --on-demand``) is audited against it at the poses that
+steered the plans (``study_rows_differing``: same verdict, force within 1e-5 relative, else
+counted).
 """
 
 from __future__ import annotations
@@ -75,7 +77,7 @@ class StudySolver(Oracle):
     problems handed to the solver; as an :class:`~synergrasp.analysis.planners.Oracle`
     (``solver(k, poses)``: a planner's solve of {S1..Sk}) it also keeps the planners' cost ledger."""
 
-    def __init__(self, contacts: pd.DataFrame, matrix: NDArray, params: PlanParams):
+    def __init__(self, contacts: pd.DataFrame, matrix: NDArray, params: PlanParams, study: pd.DataFrame | None = None):
         super().__init__(len(contacts), params.n_levels)
         self.contacts = contacts.reset_index(drop=True)
         self.object_name = str(self.contacts["object"].iat[0]) if len(self.contacts) else ""
@@ -86,15 +88,29 @@ class StudySolver(Oracle):
         self.memo: dict[tuple[str, int], tuple[bool, float]] = {}
         self.mechanics: dict[int, GraspMechanics] = {}
         self.n_problems = 0
+        if study is not None:
+            self._remember(study)
+
+    def _remember(self, study: pd.DataFrame) -> None:
+        """Take the (set, grasp) verdicts the study already holds (its judged gfo table, one row
+        per pose and set) instead of solving them again: the rows at each grasp's first pose."""
+        reps = np.unique(self.first[self.first >= 0])
+        row_of = dict(zip(self.pose_ids[reps].tolist(), reps.tolist()))
+        rows = study[study["pose"].isin(list(row_of))]
+        for pose, sid, ok, force in zip(
+            rows["pose"].tolist(), rows["set_id"].astype(str).tolist(), rows["success"].tolist(), rows["success_force"].tolist()
+        ):
+            self.memo[sid, row_of[pose]] = (bool(ok), float(force))
 
     def verdicts(self, sets: Sequence[tuple[int, ...]], poses: NDArray[np.int64]) -> tuple[NDArray, NDArray]:
         """(len(sets), len(poses)) success (the study's verdict) and its optimal force (N, NaN
         elsewhere) of every set at every pose."""
         ids = [set_id(s) for s in sets]
         reps = np.unique(self.first[poses][self.first[poses] >= 0])
-        new = [int(g) for g in reps if any((i, int(g)) not in self.memo for i in ids)]
+        missing = [i for i, sid in enumerate(ids) if any((sid, int(g)) not in self.memo for g in reps)]
+        new = [int(g) for g in reps if any((ids[i], int(g)) not in self.memo for i in missing)]
         if new:
-            self._solve(sets, ids, new)
+            self._solve([sets[i] for i in missing], [ids[i] for i in missing], new)
         success = np.zeros((len(sets), len(poses)), dtype=bool)
         force = np.full((len(sets), len(poses)), np.nan)
         for j, pose in enumerate(poses):
@@ -137,15 +153,21 @@ class StudySolver(Oracle):
         return out
 
 
-def _study_differences(solver: StudySolver, gfo: pd.DataFrame, plans: Sequence[Plan]) -> int:
-    """Rows the planner solved whose verdict differs from the study's, or whose force differs
-    by more than the minima's tie tolerance (relative)."""
+def _study_differences(live: StudySolver, gfo: pd.DataFrame, plans: Sequence[Plan]) -> int:
+    """The audit of the solver the planner runs on demand: at the poses that steered the plans
+    (every level's seeds, and each plan's best pose at the full set), the rows ``live`` solves
+    anew (no row of the study remembered) whose verdict differs from the study's, or whose force
+    differs by more than the minima's tie tolerance (relative)."""
     bad = 0
-    for k in range(1, solver.params.n_levels + 1):
-        poses = np.unique(np.concatenate([p.solved[k - 1] for p in plans]))
-        mine, force = solver.level(k, poses)
+    n = live.params.n_levels
+    for k in range(1, n + 1):
+        steering = [p.seeds[k - 1] for p in plans] + [np.array([p.best_pose]) for p in plans if k == n and p.best_pose >= 0]
+        poses = np.unique(np.concatenate(steering)).astype(np.int64)
+        if not poses.size:
+            continue
+        mine, force = live.level(k, poses)
         rows = gfo[gfo["set_id"] == incremental_set_id(k)].set_index("pose")
-        theirs = rows.loc[solver.contacts["pose"].to_numpy()[poses]]
+        theirs = rows.loc[live.contacts["pose"].to_numpy()[poses]]
         same = mine == theirs["success"].to_numpy(bool)
         ft = theirs["success_force"].to_numpy(float)
         close = np.where(mine & same, np.abs(force - ft) <= FORCE_TIE_RTOL * np.abs(ft), True)
@@ -163,10 +185,10 @@ def plan_object(contacts: pd.DataFrame, gfo: pd.DataFrame, matrix: NDArray, para
     judged = with_verdicts(gfo, minima.success, weights, minima.bound_multiple)
     n = params.n_levels
     full = judged[judged["set_id"] == incremental_set_id(n)].set_index("pose").loc[contacts["pose"].to_numpy()]
-    solver = StudySolver(contacts, matrix, params)
+    solver = StudySolver(contacts, matrix, params, study=judged)
     alpha, beta = contacts["alpha_deg"].to_numpy(float), contacts["beta_deg"].to_numpy(float)
     plans = {r: plan_incremental(alpha, beta, solver.level, n, r, minima.radius_deg, 360.0) for r in params.radii_deg}
-    differing = _study_differences(solver, judged, list(plans.values()))
+    differing = _study_differences(StudySolver(contacts, matrix, params), judged, list(plans.values()))
     rows = []
     for r, plan in plans.items():
         versus = plan_against_exhaustive(plan, full["success"].to_numpy(bool), full["success_force"].to_numpy(float))

@@ -113,15 +113,22 @@ def fallback_line(result: SearchResult) -> str | None:
 
 
 def search_object_types(
-    hand: Hand, synergies: Synergies, sim: SearchStepParams, period_deg: float, processes: int = 1
+    hand: Hand,
+    synergies: Synergies,
+    sim: SearchStepParams,
+    period_deg: float,
+    processes: int = 1,
+    reach: HandReach | None = None,
 ) -> SearchResult:
-    """The search step's one front door: the hand's reach (the gate), the hand's region (the
-    bound of the region's growth) and the search of each grasp type the chain reaches."""
+    """The search step's one front door: the hand's reach (the gate: ``reach``, the ``reach``
+    step's, else measured here), the hand's region (the bound of the region's growth) and the
+    search of each grasp type the chain reaches."""
     from synergrasp.optimisation.placement_search import SearchResult, TargetScorer, full_synergy_set, pose_subset, search_object
     from synergrasp.simulation.placement import hand_region, palm_centre
     from synergrasp.simulation.reach import hand_reach
 
-    reach = hand_reach(hand, synergies, sim.closure, sim.reach)
+    if reach is None:
+        reach = hand_reach(hand, synergies, sim.closure, sim.reach)
     bound = hand_region(hand, synergies)
     full_set = full_synergy_set(synergies.matrix, sim.full_set_size)
 

@@ -31,6 +31,9 @@ fingers'. An object's thickness is its smallest own extent (for a box its shorte
 thinnest it can lie on the palm at any orientation); its grasped width for a pinch the same.
 Power is feasible when thickness ≤ d_max, precision when width ≤ aperture
 (:func:`feasible_types`). mm, rad; palm frame.
+
+The ``reach`` step computes it once per hand (``hand/reach.parquet``); the placement search of
+every object and the ``hand_reach`` table read that file (:func:`read_hand_reach`).
 """
 
 from __future__ import annotations
@@ -39,6 +42,7 @@ import itertools
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -55,6 +59,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "ReachParams",
+    "ReachStepParams",
     "HandReachStepParams",
     "HandReach",
     "hand_reach",
@@ -64,6 +69,7 @@ __all__ = [
     "feasible_types",
     "path_postures",
     "palm_face_mm",
+    "read_hand_reach",
 ]
 
 #: Samples of the free closure path σ_open … σ_closed (as ``placement.hand_region``).
@@ -107,29 +113,44 @@ class ReachParams:
 
 
 @dataclass(frozen=True)
-class HandReachStepParams:
-    """The ``hand_reach`` step: hand and synergy files, the closure settings (kinematic), how
-    finely to measure, and the study's objects (drawn beside the finger)."""
+class ReachStepParams:
+    """The ``reach`` step, once per hand: hand and synergy files, the closure settings
+    (kinematic) and how finely to measure."""
 
     hand: str | None
     synergies: str | None
     closure: ClosureParams
     reach: ReachParams
-    objects: dict[str, Shape]
 
     @classmethod
-    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> HandReachStepParams:
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> ReachStepParams:
         from synergrasp.config import build, dataclass_fields
         from synergrasp.simulation.closure_params import ClosureParams
-        from synergrasp.simulation.objects import GraspedObject
 
         closure = build(
             ClosureParams,
             "closure",
             **{**dataclass_fields(ClosureParams, config["closure"]), "model": "kinematic", "dynamic": None},
         )
+        return cls(config["hand"], config["synergies"], closure, ReachParams.from_config(config))
+
+
+@dataclass(frozen=True)
+class HandReachStepParams:
+    """The ``hand_reach`` step (the table and the side view): hand and synergy files, how
+    finely the reach was measured, and the study's objects (drawn beside the finger)."""
+
+    hand: str | None
+    synergies: str | None
+    reach: ReachParams
+    objects: dict[str, Shape]
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], obj: str | None = None) -> HandReachStepParams:
+        from synergrasp.simulation.objects import GraspedObject
+
         objects = {name: GraspedObject.from_config(config, name, with_mass=False).shape for name in config["objects"]}
-        return cls(config["hand"], config["synergies"], closure, ReachParams.from_config(config), objects)
+        return cls(config["hand"], config["synergies"], ReachParams.from_config(config), objects)
 
 
 @dataclass(frozen=True)
@@ -148,6 +169,13 @@ class HandReach:
     @property
     def aperture_mm(self) -> float:
         return float(np.nanmax(self.table["aperture_mm"].to_numpy(dtype=float)))
+
+
+def read_hand_reach(path: str | Path, hand: Hand) -> HandReach:
+    """The reach the ``reach`` step wrote for ``hand`` (its table, ``table_contracts.HAND_REACH``)."""
+    from synergrasp import table_contracts
+
+    return HandReach(table_contracts.read(table_contracts.HAND_REACH, path), palm_face_mm(hand))
 
 
 def palm_face_mm(hand: Hand) -> float:
