@@ -82,14 +82,15 @@ def test_the_hand_encloses_its_palm_not_points_far_in_front_or_beside_it():
 def test_posture_gaps_skips_only_distances_the_closure_masks(hand, synergies):
     """The closure's per-posture query leaves +inf for a link that does not move and for one
     surely beyond the query margin (its axis farther from the object's centre than the margin,
-    both radii and the object's bounding ball); every other distance is the scene's own, to
-    the last bit. Checked at postures along S1 and object poses near and far from the hand."""
+    both radii and the object's bounding ball); every other distance within the margin is
+    ``capsule_object``'s, to the last bit, and one beyond it is beyond it (the closure masks
+    both). Checked at postures along S1 and object poses near and far from the hand."""
     from pathlib import Path
 
     from scipy.spatial.transform import Rotation
 
     from synergrasp.hand.synergies import SynergyPath
-    from synergrasp.simulation.capsules import posture_gaps
+    from synergrasp.simulation.capsules import capsule_object, posture_gaps
     from synergrasp.simulation.placement import ObjectPose
     from synergrasp.simulation.scene import HandScene
     from synergrasp.simulation.shapes import Mesh
@@ -105,7 +106,12 @@ def test_posture_gaps_skips_only_distances_the_closure_masks(hand, synergies):
         for centre in ([60.0, 0.0, 80.0], [45.0, 20.0, 120.0], [150.0, 0.0, 60.0], [30.0, -40.0, 40.0]):
             scene.set_posture(q)
             scene.place_object(ObjectPose(np.array(centre), Rotation.random(random_state=rng).as_matrix(), mesh))
-            every = scene.object_distance()  # every link's distance, nothing skipped
+            placed = scene.placed
+            every = np.full(hand.n_links, np.inf)  # every link's distance, nothing skipped
+            every[scene.capsules.links] = capsule_object(
+                *scene.capsules.segments(q), scene.capsules.radius, placed.rotation, placed.center_mm, 3, mesh.kernel_params
+            )[0]
+            assert np.array_equal(scene.object_distance()[1:], every[1:])  # the gaps alone: the same bits
             moving = rng.random(hand.n_links) < 0.7
             d_obj, _, _ = posture_gaps(q, *scene.query_args(), *scene.pair_args(pairs), moving, margin)
             for link in scene.capsules.links:
@@ -114,7 +120,9 @@ def test_posture_gaps_skips_only_distances_the_closure_masks(hand, synergies):
                 elif d_obj[link] == np.inf:  # skipped by the bound: surely beyond the margin
                     assert every[link] > margin
                     skipped += 1
-                else:
+                elif every[link] <= margin:
                     assert d_obj[link] == every[link]
                     kept += 1
+                else:
+                    assert d_obj[link] > margin
     assert skipped > 0 and kept > 0  # both branches ran

@@ -370,3 +370,30 @@ def test_a_meshs_gap_to_a_box_is_the_least_over_its_parts(tmp_path, monkeypatch)
         assert got == best and np.array_equal(at, point)
         outcomes.add(bool(got > 0))
     assert outcomes == {True, False}
+
+
+def test_the_gap_alone_is_the_segment_query_s_distance_to_the_last_bit(tmp_path, monkeypatch):
+    """``polytope.segment_parts_gap`` (the closure's query: parts nearest sphere first, none
+    beyond a cutoff) gives ``segment_parts``'s distance to the last bit below the cutoff, and
+    at least the cutoff above it; segments crossing the L, near it and far from it."""
+    from synergrasp.simulation.shapes.polytope import WORK, segment_parts, segment_parts_gap
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    mesh = Mesh(str(_l_shape(tmp_path, "l.obj", 60.0)), 1.0)
+    assert len(mesh.geometry.parts) >= 2
+    rng = np.random.default_rng(5)
+    work = np.zeros(WORK)
+    signs, cut = set(), 0
+    for _ in range(300):
+        p0, d = rng.uniform(-70.0, 70.0, 3), rng.normal(size=3) * rng.uniform(1.0, 40.0)
+        reference = segment_parts(p0, d, mesh._params, work)[0]
+        assert segment_parts_gap(p0, d, mesh._params, work) == reference
+        cutoff = float(rng.uniform(0.0, 30.0))
+        got = segment_parts_gap(p0, d, mesh._params, work, cutoff)
+        if reference < cutoff:
+            assert got == reference
+        else:
+            assert got >= cutoff
+            cut += 1
+        signs.add(bool(reference > 0))
+    assert signs == {True, False} and cut > 0  # crossing and clear, both sides of the cutoff

@@ -22,13 +22,21 @@ from numpy.typing import NDArray
 
 from synergrasp.hand.checks import closure_shape_problems
 from synergrasp.simulation.shapes.compiled import jit
-from synergrasp.simulation.shapes.kernels import segment_box, segment_object
+from synergrasp.simulation.shapes.kernels import segment_box, segment_object, segment_object_gap
 from synergrasp.simulation.shapes.polytope import WORK
 
 if TYPE_CHECKING:  # pragma: no cover
     from synergrasp.hand.kinematics import Hand
 
-__all__ = ["HandCapsules", "segment_segment_distance", "capsule_object", "pair_gaps", "nearest_per_link", "posture_gaps"]
+__all__ = [
+    "HandCapsules",
+    "segment_segment_distance",
+    "capsule_object",
+    "capsule_object_gap",
+    "pair_gaps",
+    "nearest_per_link",
+    "posture_gaps",
+]
 
 _EPS = 1e-12
 
@@ -145,6 +153,26 @@ def _capsule_to_object(
 
 
 @jit
+def _capsule_gap_to_object(
+    p0: NDArray,
+    p1: NDArray,
+    rotation: NDArray,
+    centre: NDArray,
+    code: int,
+    params: NDArray,
+    work: NDArray,
+    cutoff: float = np.inf,
+) -> float:
+    """:func:`_capsule_to_object`'s signed distance alone, the same where it is below ``cutoff``
+    (mm; ``kernels.segment_object_gap``)."""
+    _to_box(p0, rotation, centre, work[0])
+    _to_box(p1, rotation, centre, work[1])
+    for i in range(3):
+        work[1, i] -= work[0, i]
+    return segment_object_gap(work[0, :3], work[1, :3], code, params, work[2], cutoff)
+
+
+@jit
 def capsule_object(
     p0: NDArray, p1: NDArray, radius: NDArray, rotation: NDArray, centre: NDArray, code: int, params: NDArray
 ) -> tuple[NDArray, NDArray]:
@@ -157,6 +185,20 @@ def capsule_object(
         d, ti = _capsule_to_object(p0[i], p1[i], rotation, centre, code, params, work)
         dist[i], t[i] = d - radius[i], ti
     return dist, t
+
+
+@jit
+def capsule_object_gap(
+    p0: NDArray, p1: NDArray, radius: NDArray, rotation: NDArray, centre: NDArray, code: int, params: NDArray
+) -> NDArray:
+    """:func:`capsule_object`'s signed distances (c,) alone, the same to the last bit, without
+    seeking the closest points (what a question of gaps only needs)."""
+    c = p0.shape[0]
+    dist = np.empty(c)
+    work = np.empty((3, WORK))
+    for i in range(c):
+        dist[i] = _capsule_gap_to_object(p0[i], p1[i], rotation, centre, code, params, work) - radius[i]
+    return dist
 
 
 @jit
@@ -256,7 +298,8 @@ def posture_gaps(
     Only what the closure reads is computed: a link that does not move (``moving_links``
     False) or that is surely farther than ``margin_mm`` from the object (``_beyond``, the
     object in the ball of radius ``bound_mm`` about its centre) gets +inf, as the closure's
-    mask would give it; every other distance is ``capsule_object``'s to the last bit."""
+    mask would give it; every other distance within the margin is ``capsule_object``'s to the
+    last bit, and one beyond it (the closure masks it) is at least the margin."""
     p0, p1 = _segments(_frames(q, parent, offset, axis, joint, scale), cap_frame, ends)
     d_obj = np.full(n_links, np.inf)
     d_obj[0] = palm_gap
@@ -264,8 +307,11 @@ def posture_gaps(
     for i in range(cap_link.shape[0]):
         if not moving_links[cap_link[i]] or _beyond(p0[i], p1[i], radius[i], object_centre, bound_mm, margin_mm):
             continue
-        d, _ = _capsule_to_object(p0[i], p1[i], object_rotation, object_centre, code, params, work)
-        d_obj[cap_link[i]] = d - radius[i]
+        # beyond margin + radius the closure masks the gap: a convex part surely that far is not measured
+        cutoff = margin_mm + radius[i] + _BOUND_SLACK_MM
+        d_obj[cap_link[i]] = (
+            _capsule_gap_to_object(p0[i], p1[i], object_rotation, object_centre, code, params, work, cutoff) - radius[i]
+        )
     gaps = pair_gaps(p0, p1, radius, first, second, palm_rotation, palm_centre, palm_half)
     d_self, partner = nearest_per_link(gaps, pair_ends, n_links)
     return d_obj, d_self, partner

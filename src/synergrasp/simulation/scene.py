@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from synergrasp.simulation.capsules import HandCapsules, capsule_object, pair_gaps
+from synergrasp.simulation.capsules import HandCapsules, capsule_object, capsule_object_gap, pair_gaps
 from synergrasp.simulation.placement import ObjectPose
 from synergrasp.simulation.shapes.box import box_gap, box_samples
 
@@ -130,8 +130,17 @@ class HandScene:
         """(n_links,) signed distance of each hand link to the object at the current posture
         (mm, negative = overlap; +inf beyond ``margin_mm``): with the open hand's posture,
         below zero where the object intersects the open hand."""
+        placed = self.placed
         d = np.full(self.hand.n_links, np.inf)
-        d[self.capsules.links] = self._capsule_object()[0]
+        d[self.capsules.links] = capsule_object_gap(
+            self._p0,
+            self._p1,
+            self.capsules.radius,
+            placed.rotation,
+            placed.center_mm,
+            placed.shape.kernel_code,
+            placed.shape.kernel_params,
+        )
         d[0] = self._palm_gap[0]
         d[d > margin_mm] = np.inf
         return d

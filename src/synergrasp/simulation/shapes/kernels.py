@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from synergrasp.simulation.shapes.compiled import jit
-from synergrasp.simulation.shapes.polytope import WORK, segment_parts
+from synergrasp.simulation.shapes.polytope import WORK, segment_parts, segment_parts_gap
 
 __all__ = [
     "sort_knots",
@@ -259,6 +259,16 @@ def segment_object(p0: NDArray, d: NDArray, code: int, params: NDArray, work: ND
     if code == 2:
         return segment_cylinder(p0, d, params[0], params[1], work)
     return segment_parts(p0, d, params, work)
+
+
+@jit
+def segment_object_gap(p0: NDArray, d: NDArray, code: int, params: NDArray, work: NDArray, cutoff: float = np.inf) -> float:
+    """:func:`segment_object`'s signed distance alone, the same to the last bit where it is below
+    ``cutoff`` (mm; elsewhere at least ``cutoff``): for convex parts without seeking the t that
+    attains it, nor measuring a part surely beyond ``cutoff`` (``polytope.segment_parts_gap``)."""
+    if code == 3:
+        return segment_parts_gap(p0, d, params, work, cutoff)
+    return segment_object(p0, d, code, params, work)[0]
 
 
 @jit
