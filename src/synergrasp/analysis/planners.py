@@ -26,6 +26,8 @@ is measured by ``benchmarks/bench_set_size.py`` (``benchmarks/results/set_size.c
 
 from __future__ import annotations
 
+import functools
+
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -109,11 +111,22 @@ class PoseGrid:
         return int(self.alpha_deg.size)
 
     def neighbours(self, pose: int) -> NDArray[np.int64]:
-        """The up to 8 grid neighbours of a pose (α wrapping, β bounded)."""
+        """The up to 8 grid neighbours of a pose (α wrapping, β bounded), increasing; read-only
+        (every pose's are listed once per grid: the planners ask them many thousand times)."""
+        return self._neighbour_lists[pose]
+
+    @functools.cached_property
+    def _neighbour_lists(self) -> tuple[NDArray[np.int64], ...]:
         na, nb = self.index.shape
-        ia, ib = self.cell[pose]
-        out = [self.index[(ia + da) % na, ib + db] for da in (-1, 0, 1) for db in (-1, 0, 1) if (da or db) and 0 <= ib + db < nb]
-        return np.array(sorted({int(v) for v in out if v >= 0 and v != pose}), dtype=np.int64)
+        lists = []
+        for pose, (ia, ib) in enumerate(self.cell.tolist()):
+            out = [
+                self.index[(ia + da) % na, ib + db] for da in (-1, 0, 1) for db in (-1, 0, 1) if (da or db) and 0 <= ib + db < nb
+            ]
+            near = np.array(sorted({int(v) for v in out if v >= 0 and v != pose}), dtype=np.int64)
+            near.flags.writeable = False
+            lists.append(near)
+        return tuple(lists)
 
     def coarse(self, step: int, offset: tuple[int, int]) -> NDArray[np.int64]:
         """Every ``step``-th pose in α and in β from the cell ``offset``."""
