@@ -359,6 +359,7 @@ _RULES_RUN = (
     "blockers",
     "blockers_table",
     "planners",
+    "reach",
     "hand_reach",
 )
 
