@@ -126,3 +126,41 @@ def test_weighted_median_a_few_rows_at_a_time_is_every_row_at_once(monkeypatch):
     assert len(handed) == 4 and all(r.stop - r.start <= 3 for r in handed)
     np.testing.assert_array_equal(chunked, whole)
     assert chunked[0] == np.median(values) and np.isnan(chunked[3])
+
+
+def test_block_weighted_median_by_hand():
+    """Values 1..5 in blocks (0, 0, 1, 2, 2): weights per block (1, 1, 1) give numpy's median
+    3; (2, 0, 1) give 1, 1, 2, 2, 4, 5 -> 2; (1, 0, 1) give 1, 2, 4, 5 -> (2 + 4) / 2 = 3;
+    (0, 0, 3) give 4, 4, 4, 5, 5, 5 -> 4.5; all zero: NaN."""
+    from synergrasp.analysis.bootstrap import block_weighted_median
+
+    weights = np.array([[1, 1, 1], [2, 0, 1], [1, 0, 1], [0, 0, 3], [0, 0, 0]], dtype=np.uint8)
+    out = block_weighted_median(np.array([5.0, 1.0, 3.0, 4.0, 2.0]), np.array([2, 0, 1, 2, 0]), lambda rows: weights[rows], 5)
+    np.testing.assert_array_equal(out[:4], [3.0, 2.0, 3.0, 4.5])
+    assert np.isnan(out[4])
+
+
+def test_block_weighted_median_is_weighted_median_rows_to_the_bit(monkeypatch):
+    """On random values with ties, blocks with and without values, zero-weight rows and rows
+    whose median lies far from the middle (a small window, widened), the medians of the block
+    weights are those of every pose's weight, bit for bit; a few rows at a time too."""
+    from synergrasp.analysis import bootstrap
+
+    rng = np.random.default_rng(7)
+    monkeypatch.setattr(bootstrap, "_WINDOW", 4)
+    for trial in range(60):
+        n, n_blocks, n_rows = int(rng.integers(1, 900)), int(rng.integers(1, 80)), int(rng.integers(1, 30))
+        values = np.round(rng.normal(size=n), int(rng.integers(0, 3)))  # ties
+        blocks = rng.integers(0, n_blocks, size=n)
+        weights = rng.integers(0, 4, size=(n_rows, n_blocks)).astype(np.uint8)
+        weights[0] = 1
+        weights[n_rows // 2, : n_blocks // 2] = 0  # most of the weight on the upper blocks
+        if n_rows > 2:
+            weights[-1] = 0
+        if trial % 2:
+            monkeypatch.setattr(bootstrap, "_BLOCK_CELLS", 3 * n_blocks)
+        expected = bootstrap.weighted_median_rows(values, lambda rows: weights[rows][:, blocks].astype(float), n_rows)
+        got = bootstrap.block_weighted_median(values, blocks, lambda rows: weights[rows], n_rows)
+        np.testing.assert_array_equal(got, expected)
+    with pytest.raises(ValueError, match="integers"):
+        bootstrap.block_weighted_median(np.ones(3), np.zeros(3, int), lambda rows: np.ones((1, 1)), 1)

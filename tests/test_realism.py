@@ -355,3 +355,23 @@ def test_one_object_at_a_time_gives_the_tables_of_every_objects_rows(hand, tmp_p
     assert table["object"].tolist() == ["a", "b"] and table["poses"].tolist() == [4, 4]
     assert table["grasp_type"].tolist() == ["power", "precision"]
     assert graspable["force_closure_full_set"].tolist() == [2, 2]  # poses 1 and 3 of each, by hand
+
+
+def test_figure_canvas_does_not_grow_past_its_rows(hand, tmp_path, monkeypatch):
+    """Past TALL_ROWS rows the figure is no taller (the realism job's memory is its canvas), and
+    past LISTED_OBJECTS rows the title gives the dropped poses' totals, not a name per row
+    (a title as wide as every object's name made the 97 random objects' figure 184 M pixels)."""
+    from PIL import Image
+
+    from synergrasp.figures import grasp_realism
+
+    monkeypatch.setattr(grasp_realism, "TALL_ROWS", 3)
+    monkeypatch.setattr(grasp_realism, "LISTED_OBJECTS", 3)
+    one = _table(hand)
+    sizes = {}
+    for n in (3, 8):
+        table = pd.concat([one.assign(object=f"object_with_a_long_name_{k}") for k in range(n)], ignore_index=True)
+        grasp_realism.figure_grasp_realism(table, tmp_path / f"{n}.png", tmp_path / f"{n}.pdf")
+        with Image.open(tmp_path / f"{n}.png") as png:
+            sizes[n] = png.size
+    assert sizes[8] == sizes[3]

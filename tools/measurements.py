@@ -74,6 +74,7 @@ SECTIONS = (
             "cluster_groups",
             "tables_memory",
             "tables_memory_1000",
+            "realism_memory",
         ),
         "Whole runs besides the default study; `tools/measurements.py record NAME --timed -- COMMAND` records one "
         "(a workflow from an empty `results/`).",

@@ -452,7 +452,7 @@ STEPS: dict[str, Step] = {
     ),
     "realism": Step(
         # with the equilibrium checks of every grasp: ~0.5 ms of CPU per grasp over 75 sets
-        # one object at a time, yet 397 -> 1,248 MB from 5 to 97 random objects (native memory)
+        # one object at a time; its figure's canvas bounded (figures/grasp_realism.py: it grew with the objects)
         rules={"realism": Cost("object_pose_set", 4.0, 400, 1.1e-5, 6.5e-5)},
         outputs={
             "csv": "tables/grasp_realism.csv",

@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from synergrasp.analysis.bootstrap import PoseResampler, interval, weighted_median_rows
+from synergrasp.analysis.bootstrap import PoseResampler, block_weighted_median, interval
 from synergrasp.ids import set_order
 
 __all__ = ["VIEWS", "StudyCounts", "mean_defined"]
@@ -182,18 +182,24 @@ class StudyCounts:
         """(rows,) weighted median over the distinct poses, of every object, where both ``a``
         and ``b`` succeed, of log(F_b / F_a); and the number of such poses. F_b / F_a > 1:
         ``a`` needs the lower force."""
-        values, where = [], []
+        values, blocks, objects, offset = [], [], [], 0
         for obj in self.objects:
             fa, fb = self.force(obj, a), self.force(obj, b)
             both = np.isfinite(fa) & np.isfinite(fb) & (fa > 0) & (fb > 0)
+            if not both.any():
+                continue
             values.append(np.log(fb[both] / fa[both]))
-            where.append((obj, both))
-        v = np.concatenate(values) if values else np.zeros(0)
+            blocks.append(offset + self.resampler.blocks(obj)[both])  # numbered after the objects before it
+            objects.append(obj)
+            offset += self.resampler.n_blocks(obj)
+        if not values:
+            return np.full(self.rows, np.nan), 0
 
-        def weights(rows: slice) -> NDArray:  # every object's weights of those rows, a few rows at a time
-            return np.hstack([self.resampler.weights(obj, rows)[:, both] for obj, both in where])
+        def block_weights(rows: slice) -> NDArray:  # every object's block weights of those rows, a few rows at a time
+            return np.hstack([self.resampler.block_weights(obj, rows) for obj in objects])
 
-        return weighted_median_rows(v, weights, self.rows), int(v.size)
+        v = np.concatenate(values)
+        return block_weighted_median(v, np.concatenate(blocks), block_weights, self.rows), int(v.size)
 
     def pooled_ratio_to_full(self, sid: str) -> tuple[NDArray, int]:
         """(rows,) weighted median over every object's distinct successes of ``sid`` of its

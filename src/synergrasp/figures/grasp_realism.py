@@ -6,6 +6,11 @@ proximal or middle phalanx, and with rank(G) = 6; (C) the median optimal contact
 every synergy enrolled, in multiples of the object's weight (log scale); (D) equilibrium of the
 end state: the median relative torque residual and the share of grasps with a contact S1
 pushes outside its friction cone (``synergrasp.optimisation.equilibrium``).
+
+Its size is bounded whatever the number of objects (the ``realism`` job's memory is the
+figure's canvas): the title names each object's dropped poses for at most
+:data:`LISTED_OBJECTS` rows (else their totals: the table has each), and the figure is
+0.6 in a row tall up to :data:`TALL_ROWS` rows, then no taller (the rows get thinner).
 """
 
 from __future__ import annotations
@@ -18,7 +23,13 @@ import pandas as pd
 from synergrasp.analysis.realism import CONTACT_BINS
 from synergrasp.figures.output import save_figure
 
-__all__ = ["figure_grasp_realism"]
+__all__ = ["LISTED_OBJECTS", "TALL_ROWS", "figure_grasp_realism"]
+
+#: Rows (object, closure model) whose dropped poses the title names one by one; beyond, their totals.
+LISTED_OBJECTS = 12
+#: Rows drawn 0.6 in tall each; a figure of more rows is as tall as one of these (its canvas,
+#: the job's memory, does not grow with the objects).
+TALL_ROWS = 100
 
 #: (column, legend label) of panel B.
 _SHARES = (
@@ -147,13 +158,17 @@ def figure_grasp_realism(table: pd.DataFrame, png_path: str | Path, pdf_path: st
     if table.empty:
         raise ValueError("the grasp-realism table has no rows: no object was simulated")
     labels = _labels(table)
-    fig, axes = plt.subplots(1, 4, figsize=(17.0, 1.8 + 0.6 * len(table)), sharey=True)
+    fig, axes = plt.subplots(1, 4, figsize=(17.0, 1.8 + 0.6 * min(len(table), TALL_ROWS)), sharey=True)
     _contacts_panel(axes[0], table, labels)
     _shares_panel(axes[1], table, labels)
     _force_panel(axes[2], table, labels)
     _equilibrium_panel(axes[3], table, labels)
     axes[0].invert_yaxis()  # the first row on top (the axes share y: once for all)
-    dropped = ", ".join(f"{o}: {int(d)} of {int(p)}" for o, d, p in zip(labels, table["dropped"], table["poses"]))
+    dropped = (
+        ", ".join(f"{o}: {int(d)} of {int(p)}" for o, d, p in zip(labels, table["dropped"], table["poses"]))
+        if len(table) <= LISTED_OBJECTS
+        else f"{int(table['dropped'].sum())} of {int(table['poses'].sum())} over {len(table)} rows (each row's in the table)"
+    )
     fig.suptitle(
         f"How realistic are the simulated grasps?   Poses dropped — {dropped}".replace("\n", " "), fontsize=10, x=0.01, ha="left"
     )
