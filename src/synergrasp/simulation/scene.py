@@ -112,10 +112,11 @@ class HandScene:
         mean = np.sum(faces, axis=0)
         return mean / np.linalg.norm(mean)
 
-    def _capsule_object(self) -> tuple[NDArray, NDArray]:
-        """Signed distance (c,) of every capsule to the object (mm) and the closest axis points (c, 3)."""
+    def _capsule_query(self) -> tuple:
+        """The capsules at the current posture and the placed object, as the compiled queries
+        (``capsule_object``, ``capsule_object_gap``) take them."""
         placed = self.placed
-        d, t = capsule_object(
+        return (
             self._p0,
             self._p1,
             self.capsules.radius,
@@ -124,23 +125,18 @@ class HandScene:
             placed.shape.kernel_code,
             placed.shape.kernel_params,
         )
+
+    def _capsule_object(self) -> tuple[NDArray, NDArray]:
+        """Signed distance (c,) of every capsule to the object (mm) and the closest axis points (c, 3)."""
+        d, t = capsule_object(*self._capsule_query())
         return d, self._p0 + t[:, None] * (self._p1 - self._p0)
 
     def object_distance(self, margin_mm: float = np.inf) -> NDArray:
         """(n_links,) signed distance of each hand link to the object at the current posture
         (mm, negative = overlap; +inf beyond ``margin_mm``): with the open hand's posture,
         below zero where the object intersects the open hand."""
-        placed = self.placed
         d = np.full(self.hand.n_links, np.inf)
-        d[self.capsules.links] = capsule_object_gap(
-            self._p0,
-            self._p1,
-            self.capsules.radius,
-            placed.rotation,
-            placed.center_mm,
-            placed.shape.kernel_code,
-            placed.shape.kernel_params,
-        )
+        d[self.capsules.links] = capsule_object_gap(*self._capsule_query())
         d[0] = self._palm_gap[0]
         d[d > margin_mm] = np.inf
         return d
