@@ -170,7 +170,12 @@ def figure_grasp_realism(table: pd.DataFrame, png_path: str | Path, pdf_path: st
         else f"{int(table['dropped'].sum())} of {int(table['poses'].sum())} over {len(table)} rows (each row's in the table)"
     )
     fig.suptitle(
-        f"How realistic are the simulated grasps?   Poses dropped — {dropped}".replace("\n", " "), fontsize=10, x=0.01, ha="left"
+        f"How realistic are the simulated grasps?   Poses dropped — {dropped}".replace("\n", " "),
+        fontsize=10,
+        x=0.01,
+        ha="left",
+        y=1.0,
+        va="bottom",  # above the panels' top, whatever the figure's height (the saved bounding box holds it)
     )
     fig.tight_layout()
     save_figure(fig, png_path, pdf_path, tight=True)
