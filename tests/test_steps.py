@@ -318,7 +318,7 @@ def test_a_steps_name_is_its_rules_its_scripts_and_its_log_and_benchmark_folders
 
 @pytest.mark.parametrize("step", [s for s in STEPS if STEPS[s].params and STEPS[s].rules])
 def test_a_steps_script_imports_the_module_its_parameters_come_from(step):
-    # so the rule's code inputs (derived from the script's imports) cover them
+    # so the rule's code digest (derived from the script's imports) covers them
     script = ROOT / "workflow" / "scripts" / f"{list(STEPS[step].rules)[0]}.py"
     module, name = STEPS[step].params.split(":")
     tree = ast.parse(script.read_text())
@@ -415,7 +415,7 @@ def test_a_step_added_to_the_registry_alone_is_planned(tmp_path):
     assert code == 0, out[-3000:]
     assert jobs["toy"] == ["results/tables/toy.csv"]
     toy = out.split("rule toy:", 1)[1].split("\n\n", 1)[0]
-    assert "input: results/tables/hierarchy.csv," in toy and "log: results/logs/toy.log" in toy
+    assert "input: results/tables/hierarchy.csv\n" in toy and "log: results/logs/toy.log" in toy
 
 
 def test_scenarios_differing_in_an_analysis_key_share_simulation_and_optimisation(tmp_path):

@@ -4,7 +4,9 @@ out by hand, the import scanner against a package made here."""
 
 from __future__ import annotations
 
+import hashlib
 import re
+import shutil
 import types
 from pathlib import Path
 
@@ -14,7 +16,7 @@ from synergrasp.config import defaults, validate_config
 from synergrasp.ids import set_members, set_order
 from synergrasp.resolved import effective_placement, friction_mu, study_object, study_objects, weight_N
 from synergrasp.steps import rule_costs, step_config
-from synergrasp.wiring import RuleFiles, Wiring, code_files, job_size, mem_mb, report_archive, runtime_min
+from synergrasp.wiring import RuleFiles, Wiring, code_digest, code_files, job_size, mem_mb, report_archive, runtime_min
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -138,7 +140,7 @@ def test_a_rules_inputs_follow_the_registry_and_the_two_steps_scopes():
     job, study = _W(root="results", object="obj2"), _W(root="results")
     minima = wiring.inputs("minima")
     assert minima["gfo"](job) == "results/objects/obj2/gfo.parquet"
-    assert str(ROOT / "src" / "synergrasp" / "analysis" / "minima.py") in minima["code"]
+    assert "code" not in minima  # a digest param, not a hundred inputs (the next test)
     tables = wiring.inputs("tables")
     assert tables["gfo"](study) == [f"results/objects/{o}/gfo.parquet" for o in ("obj1", "obj2", "obj3", "obj4")]
     assert tables["planners"](study) == "results/tables/planners.csv"
@@ -149,8 +151,30 @@ def test_a_rules_inputs_follow_the_registry_and_the_two_steps_scopes():
     assert claims == ["results/tables/claims.csv", "results/scenarios/mu_1_0/tables/claims.csv"]
     assert wiring.inputs("optimise")["shards"](job) == ["results/objects/obj2/gfo_shards/0.parquet"]
     assert wiring.inputs("fig3")["rules"] == [str(p) for p in sorted((ROOT / "workflow" / "rules").glob("*.smk"))]
-    assert set(wiring.params("fig5")) == {"cfg"} and wiring.params("optimise") == {}
+    assert set(wiring.params("fig5")) == {"cfg", "code"} and set(wiring.params("optimise")) == {"code"}
     assert wiring.params("fig5")["cfg"](study) == step_config(wiring.study, "fig5")
+
+
+def test_a_rules_code_param_is_the_digest_of_the_modules_its_script_imports(tmp_path):
+    """Every rule is handed the digest of the code it runs: the modules its script imports
+    (transitively) and the lock, named relative to the checkout; an edited module changes the
+    digest of the rules that load it and of no other, and another checkout gives the same."""
+    wiring = _wiring()
+    assert str(ROOT / "src" / "synergrasp" / "analysis" / "minima.py") in wiring.code("minima")
+    assert str(ROOT / "environment.lock") in wiring.code("fig5")
+    assert wiring.params("minima")["code"] == wiring.code_digest("minima") != wiring.code_digest("fig5")
+    copy = tmp_path / "copy"
+    files = [Path(f) for f in wiring.code("minima")]
+    for f in files:
+        (copy / f.relative_to(ROOT)).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(f, copy / f.relative_to(ROOT))
+    moved = [copy / f.relative_to(ROOT) for f in files]
+    assert code_digest(moved, copy) == code_digest(files, ROOT)  # any checkout path
+    edited = copy / "src" / "synergrasp" / "analysis" / "minima.py"
+    edited.write_text(edited.read_text() + "# one more line\n")
+    assert code_digest(moved, copy) != code_digest(files, ROOT)
+    by_hand = "".join(f"{f.relative_to(ROOT).as_posix()}\0{hashlib.sha256(f.read_bytes()).hexdigest()}\n" for f in sorted(files))
+    assert code_digest(files, ROOT) == hashlib.sha256(by_hand.encode()).hexdigest()
 
 
 def test_only_a_step_reading_the_search_rank_refuses_a_table_without_it(tmp_path):

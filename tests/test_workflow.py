@@ -4,7 +4,7 @@ Checks every target exists and is non-empty, tables carry their documented colum
 sane values, a second run does nothing, -j1 gives the same tables as -j2, and a broken
 config stops with the schema message and leaves earlier results untouched, and
 `snakemake --report` gathers every figure and table. Then the rerun guarantees: every
-synergrasp module a job loads is among its rule's code inputs, a changed module reruns
+synergrasp module a job loads is in the digest of its rule's code (a param), a changed module reruns
 exactly the rules that load it, and a run killed mid-way (SIGINT, SIGKILL) reruns only
 what did not finish and ends with the same tables as an uninterrupted run.
 """
@@ -19,11 +19,14 @@ import subprocess
 import sys
 import time
 import zipfile
+from collections.abc import Sequence
 from pathlib import Path
 
 import pandas as pd
 import pytest
 import yaml
+
+from synergrasp.wiring import code_files
 
 ROOT = Path(__file__).resolve().parents[1]
 SMALL = ROOT / "tests" / "config" / "small.yaml"
@@ -326,20 +329,12 @@ def planned_jobs(workdir: Path, root: Path = ROOT, env: dict[str, str] | None = 
     return jobs
 
 
-def declared_code_inputs(workdir: Path) -> dict[str, set[str]]:
-    """Rule -> its input files inside the synergrasp package (relative to src/), from a dry run."""
-    out = snakemake(workdir, "-n", "--forceall", "figures")
-    assert out.returncode == 0, out.stderr[-3000:]
-    declared: dict[str, set[str]] = {}
-    rule = None
-    src = str(ROOT / "src") + os.sep
-    for line in (out.stdout + out.stderr).splitlines():
-        if line.startswith(("rule ", "localrule ")) and line.endswith(":"):
-            rule = line.split()[1].rstrip(":")
-        elif rule and line.strip().startswith("input:"):
-            files = line.strip()[len("input:") :].split(", ")
-            declared.setdefault(rule, set()).update(f.strip()[len(src) :] for f in files if f.strip().startswith(src))
-    return declared
+def declared_code(rules: Sequence[str]) -> dict[str, set[str]]:
+    """Rule -> the files inside the synergrasp package (relative to src/) whose digest is its
+    ``code`` param (``Wiring.code``: what its script imports, transitively)."""
+    src = ROOT / "src"
+    scripts = {rule: ROOT / "workflow" / "scripts" / f"{rule}.py" for rule in rules}
+    return {rule: {f.relative_to(src).as_posix() for f in code_files(script, src)} for rule, script in scripts.items()}
 
 
 #: The rules of the small study's run (its placement is not searched, its closure kinematic).
@@ -364,10 +359,11 @@ _RULES_RUN = (
 )
 
 
-def test_code_inputs_hold_every_module_a_job_loads(run_j2):
+def test_a_rules_code_digest_covers_every_module_a_job_loads(run_j2):
     """For every rule, the synergrasp files its script had in sys.modules when it ran are among
-    the rule's code inputs (lazy imports included), so editing any of them reruns the rule."""
-    declared = declared_code_inputs(run_j2)
+    the files of the rule's ``code`` digest (lazy imports included), so editing any of them
+    reruns the rule (the tests below)."""
+    declared = declared_code(_RULES_RUN)
     loaded: dict[str, set[str]] = {}
     for record in (run_j2 / "module_records").glob("*.txt"):
         script, *files = record.read_text().splitlines()
@@ -380,7 +376,7 @@ def test_code_inputs_hold_every_module_a_job_loads(run_j2):
 
 def undeclared_reads(workdir: Path, root: Path = ROOT) -> dict[str, list[str]]:
     """Per rule, the files its jobs read that are not declared by the job: every file under the
-    project (``root``, its environment and source code aside: the code inputs are checked by
+    project (``root``, its environment and source code aside: the code digest is checked by
     the test above) or under the run's folder (Snakemake's own files aside) that a job's
     script opened to read and is none of its job's inputs, outputs or log. The shipped schema
     reaches a job through its params (its defaults), not as a file (``wiring.shipped_data``)."""

@@ -134,8 +134,8 @@ class Step:
                rule of this step: every shard's file), or a file of the study's own
                (``SHIPPED_DATA``, ``USER_FILES``, ``MANIFEST``, ``MESH``, ``RULE_FILES``,
                ``SNAKEFILE``). Which object's or scenario's file a source is follows from the
-               two steps' scopes (``wiring.Wiring.inputs``); the code a rule runs is added to
-               every rule (``wiring.Wiring.code``).
+               two steps' scopes (``wiring.Wiring.inputs``); every rule is handed the digest
+               of the code it runs as its ``code`` param (``wiring.Wiring.code_digest``).
     rule_inputs: the same for a rule before the last: rule -> its inputs.
     handed:    what a rule's script is handed as ``params``, where it differs from the default
                (``("cfg",)``, the part of the configuration its step reads, for a step that

@@ -54,6 +54,7 @@ __all__ = [
     "Wiring",
     "RuleFiles",
     "code_files",
+    "code_digest",
     "report_archive",
     "job_size",
     "runtime_min",
@@ -194,6 +195,16 @@ def code_files(script: Path, src: Path) -> list[Path]:
                     files.add(path)
                     todo.append(path)
     return sorted(files)
+
+
+def code_digest(files: Sequence[Path], root: Path) -> str:
+    """SHA-256 of ``files``' contents, each named by its path relative to ``root`` (else its
+    name): the same code gives the same digest from any checkout, an edited line another."""
+    lines = []
+    for path in sorted(Path(f) for f in files):
+        name = path.relative_to(root).as_posix() if path.is_relative_to(root) else path.name
+        lines.append(f"{name}\0{hashlib.sha256(path.read_bytes()).hexdigest()}\n")
+    return hashlib.sha256("".join(lines).encode()).hexdigest()
 
 
 # --------------------------------------------------------------------------- requests
@@ -383,7 +394,7 @@ class Wiring:
 
     def inputs(self, rule: str) -> dict[str, Any]:
         """A rule's ``input``: each of its registry inputs (``steps.rule_inputs``) as the path,
-        list or input function Snakemake takes, and ``code``, the code its script runs.
+        list or input function Snakemake takes (the code its script runs is a param, :meth:`params`).
 
         A source ``"<step>"`` or ``"<step>.<output>"`` is, by the two steps' scopes: for a
         rule per object reading a step per object, the job's object's file; for a rule per
@@ -391,8 +402,7 @@ class Wiring:
         per scenario; for a rule run once for the workflow, every scenario's file. A source
         naming an earlier rule of the same step is every one of its shards' files."""
         scope = STEPS[rule_step()[rule]].scope
-        found: dict[str, Any] = {name: self._source(rule, scope, source) for name, source in rule_inputs(rule).items()}
-        return {**found, "code": self.code(rule)}
+        return {name: self._source(rule, scope, source) for name, source in rule_inputs(rule).items()}
 
     def _source(self, rule: str, scope: str, source: str) -> Any:
         special = {
@@ -423,14 +433,17 @@ class Wiring:
     def params(self, rule: str) -> dict[str, Any]:
         """A rule's ``params`` (``steps.rule_handed``): ``cfg``, the part of the job's scenario
         configuration its step reads; ``configfile``, the shipped configuration file;
-        ``scenarios``, the scenarios' names; ``placements``, how each places the boxes."""
+        ``scenarios``, the scenarios' names; ``placements``, how each places the boxes. And, for
+        every rule, ``code``: the digest of the code its script runs (:meth:`code`), so that an
+        edited module reruns the rules that load it (Snakemake's ``params`` rerun trigger; as
+        inputs, its hundred files cost a dry run of 1,000 objects a fifth of its time)."""
         handed = {
             "cfg": lambda: self.step_cfg(rule_step()[rule]),
             "configfile": lambda: str(self.root / "config" / "config.yaml"),
             "scenarios": lambda: list(self.scenarios),
             "placements": lambda: lambda w: [self.placement_label(s) for s in self.scenarios],
         }
-        return {name: handed[name]() for name in rule_handed(rule)}
+        return {**{name: handed[name]() for name in rule_handed(rule)}, "code": self.code_digest(rule)}
 
     # ---- input functions of the rules
 
@@ -493,6 +506,10 @@ class Wiring:
         the modules it imports, transitively, and the lock."""
         files = code_files(self.root / "workflow" / "scripts" / f"{script}.py", self.src)
         return [str(f) for f in files] + [str(self.root / "environment.lock")]
+
+    def code_digest(self, script: str) -> str:
+        """:func:`code_digest` of :meth:`code`'s files (paths relative to the checkout)."""
+        return code_digest([Path(f) for f in self.code(script)], self.root)
 
     def user_files(self, wildcards: Any) -> list[str]:
         """Input function: the scenario's own hand/synergy files and the mesh files of its
