@@ -173,8 +173,11 @@ def test_a_rules_code_param_is_the_digest_of_the_modules_its_script_imports(tmp_
     edited = copy / "src" / "synergrasp" / "analysis" / "minima.py"
     edited.write_text(edited.read_text() + "# one more line\n")
     assert code_digest(moved, copy) != code_digest(files, ROOT)
-    by_hand = "".join(f"{f.relative_to(ROOT).as_posix()}\0{hashlib.sha256(f.read_bytes()).hexdigest()}\n" for f in sorted(files))
-    assert code_digest(files, ROOT) == hashlib.sha256(by_hand.encode()).hexdigest()
+    by_hand = hashlib.sha256()
+    for f in sorted(files, key=lambda f: f.relative_to(ROOT).as_posix()):
+        by_hand.update(f.relative_to(ROOT).as_posix().encode())
+        by_hand.update(f.read_bytes())
+    assert code_digest(files, ROOT) == by_hand.hexdigest()
 
 
 def test_only_a_step_reading_the_search_rank_refuses_a_table_without_it(tmp_path):

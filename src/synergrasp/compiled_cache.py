@@ -30,21 +30,26 @@ from pathlib import Path
 import numba
 from numba.core import caching
 
-__all__ = ["CompiledGroup", "register_group", "sources_digest"]
+__all__ = ["CompiledGroup", "register_group", "files_digest", "sources_digest"]
 
 #: The package directory; a group's files are named relative to it.
 PACKAGE = Path(__file__).resolve().parent
 _SELF = Path(__file__).name
 
 
-def sources_digest(files: Sequence[str], root: Path = PACKAGE) -> str:
-    """SHA-256 (hex) of the files (paths relative to ``root``, the package) and of this
-    module: their names and bytes, not where the checkout is."""
+def files_digest(names: Sequence[str], root: Path) -> str:
+    """SHA-256 (hex) of the files ``names`` (paths relative to ``root``, in the order given):
+    their names and bytes, not where the checkout is."""
     h = hashlib.sha256()
-    for name in (*files, _SELF):
+    for name in names:
         h.update(name.encode())
         h.update((root / name).read_bytes())
     return h.hexdigest()
+
+
+def sources_digest(files: Sequence[str], root: Path = PACKAGE) -> str:
+    """:func:`files_digest` of the files (relative to ``root``, the package) and of this module."""
+    return files_digest((*files, _SELF), root)
 
 
 @dataclass(frozen=True)

@@ -198,13 +198,12 @@ def code_files(script: Path, src: Path) -> list[Path]:
 
 
 def code_digest(files: Sequence[Path], root: Path) -> str:
-    """SHA-256 of ``files``' contents, each named by its path relative to ``root`` (else its
-    name): the same code gives the same digest from any checkout, an edited line another."""
-    lines = []
-    for path in sorted(Path(f) for f in files):
-        name = path.relative_to(root).as_posix() if path.is_relative_to(root) else path.name
-        lines.append(f"{name}\0{hashlib.sha256(path.read_bytes()).hexdigest()}\n")
-    return hashlib.sha256("".join(lines).encode()).hexdigest()
+    """``compiled_cache.files_digest`` of ``files`` (under ``root``), named by their sorted
+    paths relative to it: the same code gives the same digest from any checkout, an edited
+    line another."""
+    from synergrasp.compiled_cache import files_digest  # numba's import only when asked
+
+    return files_digest(sorted(Path(f).relative_to(root).as_posix() for f in files), root)
 
 
 # --------------------------------------------------------------------------- requests
