@@ -28,11 +28,14 @@ CORES  ?= 2
 # same hash-checked files as pip would, side by side (docs/measurements.md, fresh_clone). Every
 # file is checked against its hash, so every index the lock names is considered for a version
 # (unsafe-best-match; uv's default would stop at the first index that has the name).
+# The installed packages are compiled to bytecode once, here: where PYTHONDONTWRITEBYTECODE is
+# set (CI images often set it) or the venv is read-only, every job would otherwise compile
+# each module it imports from source again (0.7 CPU s a job, docs/measurements.md).
 UV = $(BIN)/uv pip install --quiet --python $(BIN)/python --no-deps
 $(BIN)/.installed: environment.lock pyproject.toml tools/uv.lock.txt
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --require-hashes --no-deps -r tools/uv.lock.txt
-	$(UV) --require-hashes --index-strategy unsafe-best-match -r environment.lock
+	$(UV) --require-hashes --index-strategy unsafe-best-match --compile-bytecode -r environment.lock
 	$(UV) --no-build-isolation -e .
 	touch $@
 
@@ -40,8 +43,10 @@ venv: $(BIN)/.installed
 
 # Compiled code (the solver's kernel, the closure's queries and steps) is cached per user, named
 # by its sources' hash (any checkout path loads it); build it once here, not in every job, the
-# two groups side by side (one core each).
-WARM_UP = $(BIN)/python -c "from synergrasp.simulation.closure import warm_up; warm_up()" & closure=$$!; \
+# two groups side by side (one core each). The package's own modules are compiled to bytecode
+# first, as the installed ones are (above); compileall skips those already up to date.
+WARM_UP = $(BIN)/python -m compileall -q src/synergrasp >/dev/null; \
+	$(BIN)/python -c "from synergrasp.simulation.closure import warm_up; warm_up()" & closure=$$!; \
 	$(BIN)/python -c "from synergrasp.optimisation.gfo import warm_up; warm_up()" && wait $$closure
 
 study: $(BIN)/.installed
