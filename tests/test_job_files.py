@@ -12,7 +12,7 @@ import pytest  # noqa: E402
 
 from synergrasp.figures.fig3_rulegraph import canonical_rulegraph, parse_rulegraph  # noqa: E402
 from synergrasp.figures.output import save_figure  # noqa: E402
-from synergrasp.job_log import job_log  # noqa: E402
+from synergrasp.job_log import CPU_LINE, job_cpu_s, job_log  # noqa: E402
 
 
 def test_job_log_holds_the_traceback_of_a_failure(tmp_path):
@@ -29,7 +29,36 @@ def test_job_log_holds_the_traceback_of_a_failure(tmp_path):
 def test_job_log_is_written_when_nothing_is_printed(tmp_path):
     with job_log(tmp_path / "quiet.log"):
         pass
-    assert (tmp_path / "quiet.log").read_text() == ""
+    (line,) = (tmp_path / "quiet.log").read_text().splitlines()  # the CPU line alone
+    assert line.startswith(CPU_LINE) and job_cpu_s(tmp_path / "quiet.log") >= 0.0
+
+
+def _spin(seconds: float) -> None:
+    end = time.process_time() + seconds
+    while time.process_time() < end:
+        pass
+
+
+def test_job_log_counts_the_cpu_of_the_job_and_of_the_processes_it_waited_for(tmp_path):
+    """0.3 s spun here and 0.3 s in a child process waited for: the logged CPU grows by at
+    least 0.6 s over this process's own CPU before the block."""
+    import resource
+    import subprocess
+
+    log = tmp_path / "job.log"
+    own, waited = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    before = own.ru_utime + own.ru_stime + waited.ru_utime + waited.ru_stime
+    with job_log(log):
+        _spin(0.3)
+        child = "import time\nend = time.process_time() + 0.3\nwhile time.process_time() < end: pass"
+        subprocess.run([sys.executable, "-c", child], check=True)
+    assert job_cpu_s(log) >= before + 0.6
+    with pytest.raises(ZeroDivisionError):  # a failed job's log ends with the line too
+        with job_log(tmp_path / "failed.log"):
+            1 / 0
+    assert job_cpu_s(tmp_path / "failed.log") is not None
+    (tmp_path / "old.log").write_text("a log from before the line\n")
+    assert job_cpu_s(tmp_path / "old.log") is None
 
 
 def _figure() -> plt.Figure:

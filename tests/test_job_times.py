@@ -30,6 +30,20 @@ def test_rules_are_summed_over_the_default_study_and_every_scenario(tmp_path):
     assert list(table.index) == ["simulate", "optimise_shard", "fig1"]  # largest CPU first
 
 
+def test_a_jobs_cpu_seconds_come_from_its_log_where_it_records_them(tmp_path):
+    """The benchmark read 3.0 s and 1.0 s; the first job's log says 7.5 s (what the benchmark's
+    last sample missed), the second's log predates the line: 8.5 s in all, one logged."""
+    from synergrasp.job_log import CPU_LINE
+
+    _bench(tmp_path / "benchmarks" / "search" / "obj1.tsv", 4.0, 3.0)
+    _bench(tmp_path / "benchmarks" / "search" / "obj2.tsv", 2.0, 1.0)
+    (tmp_path / "logs" / "search").mkdir(parents=True)
+    (tmp_path / "logs" / "search" / "obj1.log").write_text(f"a warning\n{CPU_LINE}7.500\n")
+    (tmp_path / "logs" / "search" / "obj2.log").write_text("")
+    table = job_times.job_times(tmp_path)
+    assert table.loc["search", "cpu_s"] == pytest.approx(8.5) and table.loc["search", "logged"] == 1
+
+
 def _measurements():
     spec = importlib.util.spec_from_file_location("measurements", Path(__file__).parents[1] / "tools" / "measurements.py")
     measurements = importlib.util.module_from_spec(spec)

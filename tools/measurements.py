@@ -216,7 +216,7 @@ def units_done(results: Path, table: str) -> int:
 def study_jobs(results: Path) -> pd.DataFrame:
     """Per rule of the run under ``results``: jobs, wall and CPU seconds, peak MB and the units of
     work its per-object tables count (0 where a rule has none)."""
-    times = job_times(results).drop(columns="cpu_percent")
+    times = job_times(results).drop(columns=["cpu_percent", "logged"])
     units = {rule: units_done(results, table) for rule, (_, table) in UNITS.items() if rule in times.index}
     times["units"] = [units.get(rule, 0) for rule in times.index]
     times["unit"] = [UNITS[rule][0] if units.get(rule) else "" for rule in times.index]
