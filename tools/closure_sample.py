@@ -2,11 +2,12 @@
 
     .venv/bin/python tools/closure_sample.py OUT_DIR [EVERY] [MODEL ...]
     .venv/bin/python tools/closure_sample.py --pictures OUT_DIR PNG POSE_obj1 POSE_obj2 …
-
     .venv/bin/python tools/closure_sample.py --summary OUT_DIR
 
 For every object of the default configuration, closes the hand at the poses 0, EVERY,
-2·EVERY, … (default 6: 300 of the 1800 poses) with each MODEL (``kinematic``, ``dynamic``: a
+2·EVERY, … (default 6: 300 of the 1800 poses) at the default study's placement (a searched
+target is read from ``results/objects/<object>/placement.csv``: the study's search runs
+first) with each MODEL (``kinematic``, ``dynamic``: a
 free box, ``dynamic_held``: ``closure.dynamic.object: held``; default all three), writes the
 contacts that count (the ``contacts`` step's choice) to ``OUT_DIR/<model>/<object>.parquet``
 and prints the closure's CPU seconds. ``--summary``: the grasp-realism table of each model's
@@ -27,7 +28,7 @@ import numpy as np
 import pandas as pd
 
 from synergrasp import table_contracts
-from synergrasp.analysis.realism import RealismParams, grasp_labels, grasp_realism
+from synergrasp.analysis.realism import RealismParams, realism_of
 from synergrasp.config import defaults, validate_config
 from synergrasp.hand.kinematics import load_hand
 from synergrasp.hand.synergies import load_synergies
@@ -36,8 +37,7 @@ from synergrasp.optimisation.optimise import OptimiseParams, gfo_table
 from synergrasp.optimisation.problem import SynergySets
 from synergrasp.simulation.closure import SimulateParams, simulate_object
 from synergrasp.simulation.contacts import ContactsParams, load_carrying_contacts
-from synergrasp.simulation.opposition import HandAxes
-from synergrasp.simulation.placement import pose_grid
+from synergrasp.simulation.placement import pose_grid, searched_placement
 
 MODELS = {"kinematic": ("kinematic", "free"), "dynamic": ("dynamic", "free"), "dynamic_held": ("dynamic", "held")}
 
@@ -49,10 +49,29 @@ def _all_joints(checks: pd.DataFrame) -> pd.Series:
     return ((checks["torque_residual"] * box) ** 2 + other**2) ** 0.5 / (box**2 + other**2) ** 0.5
 
 
-def simulate(out: Path, every: int, models: list[str]) -> None:
-    """Close the hand at every ``every``-th pose with each model; write the contacts that count
+def _searches(config: dict, results: Path) -> dict[str, Path]:
+    """Each object's placement table of the default study (``results/objects/<object>/
+    placement.csv``) where its placement is searched; SystemExit naming every one missing."""
+    files = {
+        name: results / "objects" / name / "placement.csv"
+        for name in config["objects"]
+        if SimulateParams.from_config(config, name).placement.mode == "searched"
+    }
+    missing = [str(path) for path in files.values() if not path.is_file()]
+    if missing:
+        raise SystemExit(
+            f"closure_sample: the searched placements {missing} are not there: run the study's search first "
+            f"(make study, or snakemake -j2 {' '.join(missing)})"
+        )
+    return files
+
+
+def simulate(out: Path, every: int, models: list[str], results: Path = Path("results")) -> None:
+    """Close the hand at every ``every``-th pose with each model, at the default study's
+    placements (its searched targets read from ``results``); write the contacts that count
     (the ``contacts`` step's choice) and print the closure's CPU seconds."""
     config = defaults()
+    searches = _searches(config, results)
     hand = load_hand(config["hand"])
     synergies = load_synergies(config["synergies"], joint_names=hand.joint_names)
     for name in config["objects"]:
@@ -61,12 +80,15 @@ def simulate(out: Path, every: int, models: list[str]) -> None:
             closure = {**config["closure"], "model": model, "dynamic": {**config["closure"]["dynamic"], "object": held}}
             scenario = validate_config({**config, "closure": closure})
             sim = SimulateParams.from_config(scenario, name)
+            placement = sim.placement
+            if name in searches:
+                placement = searched_placement(placement, table_contracts.read_csv(table_contracts.PLACEMENT, searches[name]))
             start = time.process_time()
             contacts = simulate_object(
                 hand,
                 synergies,
                 sim.object,
-                sim.placement,
+                placement,
                 sim.closure,
                 poses=range(0, pose_grid(sim.placement).n_poses, every),
                 mechanics=sim.mechanics,
@@ -105,21 +127,7 @@ def summary(out: Path) -> None:
         start = time.process_time()
         checks = grasp_equilibrium(contacts, checks_params, synergies.columns([1])[:, 0])
         extra.append(checks.assign(cpu_s=time.process_time() - start, all_joints=_all_joints(checks)))
-        labels = grasp_labels(contacts, HandAxes.from_hand(hand), realism.opposition, realism.shapes)
-        parts.append(
-            grasp_realism(
-                contacts,
-                gfo,
-                checks,
-                hand.link_names,
-                hand.link_finger,
-                realism.full_set_id,
-                realism.weights_N,
-                realism.load_threshold_N,
-                labels,
-                realism.grasp_types,
-            )
-        )
+        parts.append(realism_of(contacts, gfo, checks, hand, realism, realism.grasp_types))
     table = pd.concat(parts, ignore_index=True)
     more = (
         pd.concat(extra)
@@ -197,10 +205,29 @@ def pictures(out: Path, png: Path, poses: list[int]) -> None:
     fig.savefig(png, dpi=110)
 
 
-if __name__ == "__main__":
-    if sys.argv[1] == "--pictures":
-        pictures(Path(sys.argv[2]), Path(sys.argv[3]), [int(v) for v in sys.argv[4:]])
-    elif sys.argv[1] == "--summary":
-        summary(Path(sys.argv[2]))
+def _main(argv: list[str]) -> None:
+    """The three modes of the module's docstring; a malformed command line exits naming the
+    argument, before any work."""
+    usage = __doc__.split("\n\n")[1]
+
+    def number(text: str, what: str, least: int = 1) -> int:
+        if not text.isdigit() or int(text) < least:
+            raise SystemExit(f"closure_sample: {what} must be a whole number of at least {least}, not {text!r}\n{usage}")
+        return int(text)
+
+    if not argv or (argv[0] in ("--pictures", "--summary") and len(argv) < (4 if argv[0] == "--pictures" else 2)):
+        raise SystemExit(usage)
+    if argv[0] == "--pictures":
+        pictures(Path(argv[1]), Path(argv[2]), [number(v, "POSE", 0) for v in argv[3:]])
+    elif argv[0] == "--summary":
+        summary(Path(argv[1]))
     else:
-        simulate(Path(sys.argv[1]), int(sys.argv[2]) if len(sys.argv) > 2 else 6, sys.argv[3:] or list(MODELS))
+        models = argv[2:] or list(MODELS)
+        unknown = [m for m in models if m not in MODELS]
+        if unknown:
+            raise SystemExit(f"closure_sample: MODEL {unknown} unknown; one of {list(MODELS)}")
+        simulate(Path(argv[0]), number(argv[1], "EVERY") if len(argv) > 1 else 6, models)
+
+
+if __name__ == "__main__":
+    _main(sys.argv[1:])

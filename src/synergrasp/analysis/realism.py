@@ -47,6 +47,7 @@ __all__ = [
     "link_categories",
     "grasp_labels",
     "grasp_realism",
+    "realism_of",
     "link_shares",
     "representative_grasps",
     "realism_by_object",
@@ -302,6 +303,33 @@ def grasp_realism(
     return pd.DataFrame(rows, columns=list(GRASP_REALISM.names))
 
 
+def realism_of(
+    contacts: pd.DataFrame,
+    gfo: pd.DataFrame,
+    checks: pd.DataFrame,
+    hand: Hand,
+    params: RealismParams,
+    grasp_types: Mapping[str, str],
+    axes: HandAxes | None = None,
+) -> pd.DataFrame:
+    """:func:`grasp_realism` of ``contacts`` with the configuration's choices (``params``) and
+    ``hand``'s links: each grasp labelled (:func:`grasp_labels`, ``axes`` the hand's, built
+    when not given), then tabled. ``checks``: the equilibrium checks of the same contacts."""
+    labels = grasp_labels(contacts, HandAxes.from_hand(hand) if axes is None else axes, params.opposition, params.shapes)
+    return grasp_realism(
+        contacts,
+        gfo,
+        checks,
+        hand.link_names,
+        hand.link_finger,
+        params.full_set_id,
+        params.weights_N,
+        params.load_threshold_N,
+        labels,
+        grasp_types,
+    )
+
+
 def link_shares(contacts: pd.DataFrame, link_names: Sequence[str], link_finger: Sequence[str]) -> pd.DataFrame:
     """Which links touch the box: per (object, closure model) and hand link, the share of the
     simulated grasps (``SIMULATED_STATUSES``) with a contact on that link (``pct_grasps``, %).
@@ -397,26 +425,14 @@ def realism_by_object(
     for contacts_path, gfo_path in sorted(files, key=lambda pair: Path(pair[0]).parent.name):
         contacts, gfo = read(CONTACTS, contacts_path), read(GFO, gfo_path)
         checks = grasp_equilibrium(contacts, equilibrium, synergies.columns([1])[:, 0])
-        labels = grasp_labels(contacts, axes, params.opposition, params.shapes)
         parts.append(
             (
-                grasp_realism(
-                    contacts,
-                    gfo,
-                    checks,
-                    hand.link_names,
-                    hand.link_finger,
-                    params.full_set_id,
-                    params.weights_N,
-                    params.load_threshold_N,
-                    labels,
-                    families,
-                ),
+                realism_of(contacts, gfo, checks, hand, params, families, axes),
                 link_shares(contacts, hand.link_names, hand.link_finger),
                 graspable_objects(contacts, gfo, params.full_set_id, types),
             )
         )
-        del contacts, gfo, checks, labels
+        del contacts, gfo, checks
     if not parts:
         raise ValueError("realism_by_object: no object's files")
     return tuple(pd.concat([p[i] for p in parts], ignore_index=True) for i in range(3))  # type: ignore[return-value]
