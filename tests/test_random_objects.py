@@ -56,6 +56,10 @@ def test_every_drawn_mesh_is_studied_or_left_out_with_its_reason(tmp_path, monke
     assert edited.problem == "sha256 differs from the manifest"
     assert missing.problem.startswith("file missing")
     assert flat.problem.startswith("mesh cannot be read")
+    # the reasons and the table's rows name each mesh within the package, never this checkout
+    assert missing.problem == "file missing: pybullet_data/random_urdfs/002/002.obj"
+    assert "'pybullet_data/random_urdfs/003/003.obj'" in flat.problem and str(tmp_path) not in flat.problem
+    assert flat.row()["path"] == "pybullet_data/random_urdfs/003/003.obj" and flat.path.startswith(str(tmp_path))
     assert ro.left_out(spec, [tmp_path / "manifest.sha256"]) == [(d.name, d.problem) for d in (edited, missing, flat)]
     assert ro.left_out(None, []) == []
     config = {"objects": {"obj1": None}, "random_objects": spec}

@@ -24,7 +24,7 @@ with job_log(snakemake.log[0]):
         p.hierarchy_first,
     )
     drawn = pd.DataFrame(
-        [vars(d) for d in drawn_objects(p.random_objects, manifest=inp.manifest[0])] if p.random_objects else [],
+        [d.row() for d in drawn_objects(p.random_objects, manifest=inp.manifest[0])] if p.random_objects else [],
         columns=["name", "index", "path", "scale", "longest_side_mm", "problem"],
     )
     table_contracts.write_study_table(rows, out.csv, out.md, title="The study per object")

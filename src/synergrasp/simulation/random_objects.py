@@ -37,8 +37,10 @@ N_MESHES = 1000
 
 @dataclass(frozen=True)
 class DrawnObject:
-    """One drawn mesh: name, index, path, scale (mm per unit; NaN if unread), longest side
-    (mm), and why it is left out ('' if it is studied)."""
+    """One drawn mesh: name, index, path (where this machine's ``pybullet_data`` holds it),
+    scale (mm per unit; NaN if unread), longest side (mm), why it is left out ('' if it is
+    studied) and ``source``, its path within the package (``pybullet_data/random_urdfs/…``),
+    which the tables and the reasons name so that they read the same from every checkout."""
 
     name: str
     index: int
@@ -46,6 +48,11 @@ class DrawnObject:
     scale: float
     longest_side_mm: float
     problem: str
+    source: str
+
+    def row(self) -> dict[str, Any]:
+        """The drawn-meshes table's row: the mesh named by its ``source``."""
+        return {**vars(self), "path": self.source}
 
 
 def _manifest(path: str | Path) -> dict[str, str]:
@@ -97,7 +104,9 @@ def drawn_objects(spec: Mapping[str, Any], root: str | Path = ".", manifest: str
     for index, side in zip(indices.tolist(), longest.tolist()):
         rel = f"random_urdfs/{index:03d}/{index:03d}.obj"
         scale, problem = _check(base / rel, digests.get(rel), side)
-        out.append(DrawnObject(f"rand_{index:03d}", index, str(base / rel), scale, side, problem))
+        source = f"pybullet_data/{rel}"
+        problem = problem.replace(str(base / rel), source)
+        out.append(DrawnObject(f"rand_{index:03d}", index, str(base / rel), scale, side, problem, source))
     return out
 
 
