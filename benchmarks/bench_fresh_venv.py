@@ -1,6 +1,7 @@
 """A fresh clone's set-up side by side: `make venv` and the first compile (the two warm-ups of
-the Makefile, side by side) of two commits, one after the other, each in a new clone with empty
-caches (XDG_CACHE_HOME and NUMBA_CACHE_DIR new temporary folders, PIP_NO_CACHE_DIR=1).
+the Makefile, side by side, after the package's bytecode where its Makefile compiles it) of
+two commits, one after the other, each in a new clone with empty caches (XDG_CACHE_HOME and
+NUMBA_CACHE_DIR new temporary folders, PIP_NO_CACHE_DIR=1).
 
     .venv/bin/python benchmarks/bench_fresh_venv.py [BASE [NEW [PAIRS]]]
 
@@ -48,6 +49,8 @@ def set_up(commit: str) -> tuple[float, float, float, float]:
         python = str(clone / ".venv" / "bin" / "python")
 
         def compile_() -> None:
+            if "compileall" in (clone / "Makefile").read_text():  # the package's bytecode first, as its Makefile does
+                subprocess.run([python, "-m", "compileall", "-q", "src/synergrasp"], cwd=clone, env=env, check=True)
             runs = [subprocess.Popen([python, "-c", code], cwd=clone, env=env) for code in WARM_UP]
             if any(run.wait() for run in runs):
                 raise SystemExit(f"the warm-up failed at {commit}")
