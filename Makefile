@@ -1,5 +1,7 @@
 # Entry points for a fresh machine with Python 3.11 (see README):
 #   make venv           - build .venv from environment.lock only
+#   make warm-up        - build .venv, then compile what every job would otherwise compile again
+#                         (make study and make test run it first)
 #   make study          - build .venv from environment.lock, then run the full study
 #   make test           - build .venv from environment.lock, then run the fast tier of the tests
 #                         (all but the end-to-end workflow runs, marker `workflow`, and the
@@ -22,32 +24,32 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 CORES  ?= 2
 
-.PHONY: venv study test test-workflow test-browser test-all lint format cluster-test bench bench-study lock report clean-venv
+.PHONY: venv warm-up study test test-workflow test-browser test-all lint format cluster-test bench bench-study lock report clean-venv
 
 # The installer is uv (tools/uv.lock.txt, installed by pip with --require-hashes): it installs the
 # same hash-checked files as pip would, side by side (docs/measurements.md, fresh_clone). Every
 # file is checked against its hash, so every index the lock names is considered for a version
 # (unsafe-best-match; uv's default would stop at the first index that has the name).
-# The installed packages are compiled to bytecode once, here: where PYTHONDONTWRITEBYTECODE is
-# set (CI images often set it) or the venv is read-only, every job would otherwise compile
-# each module it imports from source again (0.7 CPU s a job, docs/measurements.md).
 UV = $(BIN)/uv pip install --quiet --python $(BIN)/python --no-deps
 $(BIN)/.installed: environment.lock pyproject.toml tools/uv.lock.txt
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --require-hashes --no-deps -r tools/uv.lock.txt
-	$(UV) --require-hashes --index-strategy unsafe-best-match --compile-bytecode -r environment.lock
+	$(UV) --require-hashes --index-strategy unsafe-best-match -r environment.lock
 	$(UV) --no-build-isolation -e .
 	touch $@
 
 venv: $(BIN)/.installed
 
-# Compiled code (the solver's kernel, the closure's queries and steps) is cached per user, named
-# by its sources' hash (any checkout path loads it); build it once here, not in every job, the
-# two groups side by side (one core each). The package's own modules are compiled to bytecode
-# first, as the installed ones are (above); compileall skips those already up to date.
-WARM_UP = $(BIN)/python -m compileall -q src/synergrasp >/dev/null; \
-	$(BIN)/python -c "from synergrasp.simulation.closure import warm_up; warm_up()" & closure=$$!; \
-	$(BIN)/python -c "from synergrasp.optimisation.gfo import warm_up; warm_up()" && wait $$closure
+# The set-up after installation (`python -m synergrasp.warm_up`): the compiled code (the solver's
+# kernel, the closure's queries and steps), cached per user and named by its sources' hash (any
+# checkout path loads it), and the bytecode of every module the workflow imports, written even
+# where PYTHONDONTWRITEBYTECODE is set. Built once here, not in every job; the kernel in one
+# process, the closure then the imports in the other (one core each).
+WARM_UP = $(BIN)/python -m synergrasp.warm_up closure imports & other=$$!; \
+	$(BIN)/python -m synergrasp.warm_up kernel && wait $$other
+
+warm-up: $(BIN)/.installed
+	$(WARM_UP)
 
 study: $(BIN)/.installed
 	$(WARM_UP)

@@ -1,5 +1,6 @@
-"""A fresh clone's set-up side by side: `make venv` and the first compile (the two warm-ups of
-the Makefile, side by side, after the package's bytecode where its Makefile compiles it) of
+"""A fresh clone's set-up side by side: `make venv` and the first compile (`make warm-up` where
+the Makefile has it; before it, the Makefile's two warm-ups side by side, after the package's
+bytecode where its Makefile compiles it) of
 two commits, one after the other, each in a new clone with empty caches (XDG_CACHE_HOME and
 NUMBA_CACHE_DIR new temporary folders, PIP_NO_CACHE_DIR=1).
 
@@ -21,6 +22,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+#: The warm-ups of a Makefile without `make warm-up` (cec0629 and the commits up to 5f77418).
 WARM_UP = (
     "from synergrasp.simulation.closure import warm_up; warm_up()",
     "from synergrasp.optimisation.gfo import warm_up; warm_up()",
@@ -49,7 +51,11 @@ def set_up(commit: str) -> tuple[float, float, float, float]:
         python = str(clone / ".venv" / "bin" / "python")
 
         def compile_() -> None:
-            if "compileall" in (clone / "Makefile").read_text():  # the package's bytecode first, as its Makefile does
+            makefile = (clone / "Makefile").read_text()
+            if "\nwarm-up:" in makefile:  # the Makefile's own set-up step
+                subprocess.run(["make", "warm-up"], cwd=clone, env=env, check=True, stdout=subprocess.DEVNULL)
+                return
+            if "compileall" in makefile:  # the package's bytecode first, as its Makefile does
                 subprocess.run([python, "-m", "compileall", "-q", "src/synergrasp"], cwd=clone, env=env, check=True)
             runs = [subprocess.Popen([python, "-c", code], cwd=clone, env=env) for code in WARM_UP]
             if any(run.wait() for run in runs):

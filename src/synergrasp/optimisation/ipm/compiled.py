@@ -14,6 +14,14 @@ Three kinds of compiled function:
   the Newton solve and the direction are called. The arithmetic and its order are the same
   either way (no `fastmath`: IEEE arithmetic in program order).
 
+Two costs of numba's compile shape the call graph: a called function's machine code is
+optimised and generated again in every compiled function that calls it (numba links the
+callee's code into the caller's), so each level of called functions above `hsde` compiles the
+whole iteration once more; and typing grows faster than a function's size, so `hsde` itself
+is called, never inlined (inlined into the per-set loop, the compile takes four times as
+long). Hence one call site for each step that is inlined (`direction` and `max_step` in a
+predictor-corrector loop, `reduced` in the refinement loop, the set loop's one `solve_one`).
+
 The cache: the kernel's modules (`KERNEL_SOURCES`) are one compiled group
 (`synergrasp.compiled_cache`), cached per user in ``synergrasp-ipm/<hash of their sources>``
 (`cache_dir()`), so any checkout of the same kernel, in any path, loads the same machine code

@@ -240,14 +240,19 @@ def hsde(P, W, Q, opt, refine, y):
         for i in range(q):
             soc_prod(W.lam, W.lam, dsv, L + 3 * i, 3)
         soc_prod(W.lam, W.lam, dsv, o, e + 2)
-        dtau_a, dkappa_a = direction(P, W, refine, hom, 0.0, dsv, tau * kappa, W.dx_a, W.dz_a, W.ds_a)
-        alpha_a = min(1.0, max_step(P, W, W.ds_a, W.dz_a, tau, dtau_a, kappa, dkappa_a))
-        sigma = min(max((1.0 - alpha_a) ** 3, 0.0), 1.0)
-
-        # Corrector.
-        d_kap = corrector_rhs(P, W, dtau_a, dkappa_a, tau, kappa, sigma * mu)
-        dtau, dkappa = direction(P, W, refine, hom, sigma, dsv, d_kap, W.dx, W.dz, W.ds)
-        alpha = min(1.0, opt.step_fraction * max_step(P, W, W.ds, W.dz, tau, dtau, kappa, dkappa))
+        # The predictor (sigma = 0, into the _a arrays), then the corrector with Mehrotra's
+        # second-order term: one call of `direction` and `max_step` (each call site is
+        # compiled again).
+        sigma, d_kap, alpha, dtau, dkappa = 0.0, tau * kappa, 0.0, 0.0, 0.0
+        dx, dz, ds = W.dx_a, W.dz_a, W.ds_a
+        for corrector in range(2):
+            if corrector:
+                sigma = min(max((1.0 - alpha) ** 3, 0.0), 1.0)
+                d_kap = corrector_rhs(P, W, dtau, dkappa, tau, kappa, sigma * mu)
+                dx, dz, ds = W.dx, W.dz, W.ds
+            dtau, dkappa = direction(P, W, refine, hom, sigma, dsv, d_kap, dx, dz, ds)
+            step = max_step(P, W, ds, dz, tau, dtau, kappa, dkappa)
+            alpha = min(1.0, opt.step_fraction * step if corrector else step)
 
         # A vanishing step near the optimum means the normal equations have run out of
         # accuracy: keep the current point and judge it with the reduced tolerance.

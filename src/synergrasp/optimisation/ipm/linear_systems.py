@@ -138,24 +138,28 @@ def reduced(P, W, bx, bz, dx, dz):
 
 @jit_call
 def solve_kkt(P, W, refine, bx, bz, dx, dz):
-    """The Newton system for (bx, bz), with `refine` steps of iterative refinement."""
-    reduced(P, W, bx, bz, dx, dz)
+    """The Newton system for (bx, bz), with `refine` steps of iterative refinement. One call
+    of `reduced` (inlined): each inlined copy is compiled again."""
     n, N = P.e + 1, P.L + 3 * P.q + P.e + 2
     wN2, wN3, wn2 = W.wN2, W.wN3, W.wn2
-    for _ in range(refine):
-        # residual of the full system, then a correction from the same factorisation
-        G_mul(P, dx, wN2)
-        V_mul(P, W, dz, W.wN, wN3)
-        for k in range(N):
-            wN2[k] = bz[k] - wN2[k] + wN3[k]
-        GT_mul(P, dz, wn2)
-        for j in range(n):
-            wn2[j] = bx[j] - wn2[j]
-        reduced(P, W, wn2, wN2, W.ex, W.ez)
-        for j in range(n):
-            dx[j] += W.ex[j]
-        for k in range(N):
-            dz[k] += W.ez[k]
+    for step in range(refine + 1):
+        rx, rz, ox, oz = bx, bz, dx, dz
+        if step > 0:
+            # residual of the full system, then a correction from the same factorisation
+            G_mul(P, dx, wN2)
+            V_mul(P, W, dz, W.wN, wN3)
+            for k in range(N):
+                wN2[k] = bz[k] - wN2[k] + wN3[k]
+            GT_mul(P, dz, wn2)
+            for j in range(n):
+                wn2[j] = bx[j] - wn2[j]
+            rx, rz, ox, oz = wn2, wN2, W.ex, W.ez
+        reduced(P, W, rx, rz, ox, oz)
+        if step > 0:
+            for j in range(n):
+                dx[j] += W.ex[j]
+            for k in range(N):
+                dz[k] += W.ez[k]
 
 
 @jit_inline

@@ -106,16 +106,18 @@ def attempt(P, W, Q, opt, refine, y):
     return code, norm, viol, it
 
 
-@jit_call
+@jit_inline
 def solve_one(P, W, Q, opt, y):
     """`attempt`, and a second one with refinement if the first leaves the problem undecided.
     Returns (code, ||f|| N, worst violation N, iterations of both); fills y."""
-    code, norm, viol, it = attempt(P, W, Q, opt, opt.refine, y)
-    if code == UNDECIDED and opt.retry_refine > opt.refine:
+    code, norm, viol, it = UNDECIDED, math.nan, math.nan, 0
+    for second in range(2):
+        if second and not (code == UNDECIDED and opt.retry_refine > opt.refine):
+            break
         # Undecided problems are mostly stalls at a degenerate optimum, where the normal
         # equations lose accuracy: a second attempt with iterative refinement decides most.
-        code, norm, viol, it2 = attempt(P, W, Q, opt, opt.retry_refine, y)
-        it += it2
+        code, norm, viol, it_k = attempt(P, W, Q, opt, opt.retry_refine if second else opt.refine, y)
+        it += it_k
     return code, norm, viol, it
 
 
@@ -246,54 +248,55 @@ def solve_sets(
                     bases[j, k, q] = F_all[k, cols[j, q]]
     else:
         set_bases(F_all, cols, n_cols, thresholds, nesting.parent, order, np.empty_like(bases), bases, out.e_s)
-    order = order[::-1]
-    for j in order:
-        U, rank = bases[j], out.e_s[j]
-        if rank == 0:
-            out.code[j] = NOT_SOLVED
-            continue
-        k = implying(nesting.within[j], out.code, INFEASIBLE, out.e_s, rank)
-        if k >= 0:
-            out.implied[j] = True
-            out.code[j] = out.code[k]
-            if out.code[k] == OPTIMAL:  # the same subspace: the same problem, the same optimum
-                out.force_norm[j], out.max_violation[j] = out.force_norm[k], out.max_violation[k]
-                for q in range(c):  # a loop, not a slice copy: that compiles numba's shape-error text
-                    out.forces[j, q] = out.forces[k, q]
-            continue
-        # E_s is the first `rank` columns of U
-        code, out.force_norm[j], out.max_violation[j], out.iterations[j] = solve_one(
-            build(rows, cone.lin, U, fp, rank, cone.mu, f_min, W), W, Q, opt, y
-        )
-        out.code[j] = code
-        if code == OPTIMAL:
-            for k in range(c):
-                acc = fp[k]
-                for q in range(rank):
-                    acc += U[k, q] * y[q]
-                out.forces[j, k] = acc
-    if not strict:
-        return
-    # The strict test of every set with e_s > 0, subsets before their supersets, on the same
-    # bases: not strictly feasible where the GFO is infeasible, strictly feasible where a
-    # subset is, the verdict of a subset of the same rank, else solved. (In this function,
-    # not one of its own: a compiled function taking the work arrays costs seconds of typing.)
-    cone_rows(frames, cone_strict.mu, rows)
+    # The GFO of every set, supersets first, then (if `strict`) the strict test, subsets
+    # first, in one loop with one call of `solve_one` (inlined, `ipm.compiled`).
     zero = np.zeros(c)
-    for j in nesting.order:
-        rank = out.e_s[j]
-        if rank == 0:
-            continue
-        if out.code[j] == INFEASIBLE:
-            out.strict_code[j] = INFEASIBLE
-            continue
-        k = implying(nesting.within[:, j], out.strict_code, OPTIMAL, out.e_s, rank)
-        if k >= 0:
-            out.strict_code[j] = out.strict_code[k]
-        else:
-            out.strict_code[j] = solve_one(
-                build(rows, cone_strict.lin, bases[j], zero, rank, cone_strict.mu, 1.0, W), W, Q, opt_strict, y
-            )[0]
+    for phase in range(2 if strict else 1):
+        gfo = phase == 0
+        if not gfo:
+            cone_rows(frames, cone_strict.mu, rows)
+        sequence = nesting.order[::-1] if gfo else nesting.order
+        for j in sequence:
+            rank = out.e_s[j]
+            if rank == 0:
+                if gfo:
+                    out.code[j] = NOT_SOLVED
+                continue
+            if gfo:
+                k = implying(nesting.within[j], out.code, INFEASIBLE, out.e_s, rank)
+                if k >= 0:
+                    out.implied[j] = True
+                    out.code[j] = out.code[k]
+                    if out.code[k] == OPTIMAL:  # the same subspace: the same problem, the same optimum
+                        out.force_norm[j], out.max_violation[j] = out.force_norm[k], out.max_violation[k]
+                        for q in range(c):  # a loop, not a slice copy: that compiles numba's shape-error text
+                            out.forces[j, q] = out.forces[k, q]
+                    continue
+                # E_s is the first `rank` columns of bases[j]
+                P = build(rows, cone.lin, bases[j], fp, rank, cone.mu, f_min, W)
+            else:
+                # Not strictly feasible where the GFO is infeasible, strictly feasible where a
+                # subset is, the verdict of a subset of the same rank, else solved.
+                if out.code[j] == INFEASIBLE:
+                    out.strict_code[j] = INFEASIBLE
+                    continue
+                k = implying(nesting.within[:, j], out.strict_code, OPTIMAL, out.e_s, rank)
+                if k >= 0:
+                    out.strict_code[j] = out.strict_code[k]
+                    continue
+                P = build(rows, cone_strict.lin, bases[j], zero, rank, cone_strict.mu, 1.0, W)
+            code, norm, viol, its = solve_one(P, W, Q, opt if gfo else opt_strict, y)
+            if not gfo:
+                out.strict_code[j] = code
+                continue
+            out.code[j], out.force_norm[j], out.max_violation[j], out.iterations[j] = code, norm, viol, its
+            if code == OPTIMAL:
+                U = bases[j]
+                for k in range(c):
+                    acc = fp[k]
+                    for q in range(rank):
+                        acc += U[k, q] * y[q]
+                    out.forces[j, k] = acc
 
 
 @jit_call
