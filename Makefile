@@ -43,10 +43,11 @@ venv: $(BIN)/.installed
 # The set-up after installation (`python -m synergrasp.warm_up`): the compiled code (the solver's
 # kernel, the closure's queries and steps), cached per user and named by its sources' hash (any
 # checkout path loads it), and the bytecode of every module the workflow imports, written even
-# where PYTHONDONTWRITEBYTECODE is set. Built once here, not in every job; the kernel in one
-# process, the closure then the imports in the other (one core each).
-WARM_UP = $(BIN)/python -m synergrasp.warm_up closure imports & other=$$!; \
-	$(BIN)/python -m synergrasp.warm_up kernel && wait $$other
+# where PYTHONDONTWRITEBYTECODE is set. Built once here, not in every job. Three processes side
+# by side: the kernel's compile is the longest, so the other two yield to it (nice).
+WARM_UP = nice -n 10 $(BIN)/python -m synergrasp.warm_up imports & imports=$$!; \
+	nice -n 10 $(BIN)/python -m synergrasp.warm_up closure & closure=$$!; \
+	$(BIN)/python -m synergrasp.warm_up kernel && wait $$closure && wait $$imports
 
 warm-up: $(BIN)/.installed
 	$(WARM_UP)

@@ -13,9 +13,8 @@ Every step writes the bytecode of the modules it imports, even where ``PYTHONDON
 is set (as CI images often set it): otherwise every job would compile from source each module
 it imports (0.7 CPU s a job, docs/measurements.md). The bytecode is written for what the
 workflow imports, not for every installed file: compiling all of them costs more than the rest
-of the installation. ``make study`` and ``make test`` run ``kernel`` in one process and
-``closure imports`` in the other, side by side (one core each): the kernel's compile is the
-longer one.
+of the installation. ``make warm-up`` (run first by ``make study`` and ``make test``) runs the
+three steps in three processes side by side, the kernel's, the longest, ahead of the others.
 """
 
 from __future__ import annotations
