@@ -20,6 +20,8 @@ stdlib = os.path.realpath(sysconfig.get_paths()["stdlib"])
 startup = set(sys.modules)
 for name in sys.argv[1:]:
     importlib.import_module(name)
+from synergrasp.snakemake_adapter import load_snakemake_modules
+load_snakemake_modules()
 for name, module in list(sys.modules.items()):
     path = getattr(module, "__file__", None)
     if name in startup or not path or not path.endswith(".py") or os.path.realpath(path).startswith(stdlib):
@@ -35,9 +37,8 @@ def _run(args: list[str], prefix: Path) -> subprocess.CompletedProcess[str]:
 
 
 def _job_imports() -> list[str]:
-    """The modules the workflow's scripts import (their import statements), and the module
-    Snakemake's script preamble loads."""
-    names = {"snakemake.script"}
+    """The modules the workflow's scripts import (their import statements)."""
+    names = {"synergrasp.snakemake_adapter"}  # the script preamble's modules: load_snakemake_modules below
     for script in SCRIPTS.glob("*.py"):
         for node in ast.walk(ast.parse(script.read_text())):
             if isinstance(node, ast.Import):

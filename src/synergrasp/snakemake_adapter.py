@@ -13,7 +13,9 @@ tested on a small workflow of its own (tests/test_snakemake_adapter.py):
   groups and the limits a group's jobs are laid within, its rules, the rules run where
   Snakemake runs (:func:`config_files`, :func:`slurm_settings`, :func:`group_limits`,
   :func:`workflow_rules`, :func:`run_locally`);
-- what Snakemake asks the scheduler for a group job (:func:`group_request`).
+- what Snakemake asks the scheduler for a group job (:func:`group_request`);
+- the modules a job's script and the ``snakemake`` command load (:func:`load_snakemake_modules`,
+  which ``synergrasp.warm_up`` runs to write their bytecode).
 
 No other module of the project names a private Snakemake module or attribute
 (tests/test_snakemake_adapter.py scans the sources). Imports nothing of the project.
@@ -42,6 +44,7 @@ __all__ = [
     "slurm_settings",
     "group_limits",
     "group_request",
+    "load_snakemake_modules",
     "run_locally",
     "workflow_rules",
 ]
@@ -238,3 +241,11 @@ def workflow_rules(snakefile: Path, workdir: Path) -> list[Any]:
             config_settings=ConfigSettings(),
         )
         return list(parsed._workflow.rules)
+
+
+def load_snakemake_modules() -> None:
+    """Import the Snakemake modules a job loads (its script's preamble imports ``snakemake.script``
+    and unpickles objects of ``snakemake.io``) and those the ``snakemake`` command loads."""
+    import snakemake.cli  # noqa: F401
+    import snakemake.io  # noqa: F401
+    import snakemake.script  # noqa: F401

@@ -6,8 +6,8 @@ Steps, in the order given, in one process:
 
 - ``kernel``: the interior-point kernel's machine code (`optimisation.gfo.warm_up`);
 - ``closure``: the kinematic closure's distance queries and steps (`simulation.closure.warm_up`);
-- ``imports``: every module of the package, and the Snakemake modules that a job's script and
-  the ``snakemake`` command load, imported once.
+- ``imports``: every module of the package compiled, the libraries it imports and the Snakemake
+  modules that a job's script and the ``snakemake`` command load imported once.
 
 Every step writes the bytecode of the modules it imports, even where ``PYTHONDONTWRITEBYTECODE``
 is set (as CI images often set it): otherwise every job would compile from source each module
@@ -19,18 +19,11 @@ three steps in three processes side by side, the kernel's, the longest, ahead of
 
 from __future__ import annotations
 
-import importlib
 import os
-import pkgutil
 import sys
 from collections.abc import Callable, Sequence
 
 __all__ = ["STEPS", "main"]
-
-#: The Snakemake modules a job loads (its script's preamble and the job object it unpickles)
-#: and those the ``snakemake`` command loads.
-SNAKEMAKE_MODULES = ("snakemake.script", "snakemake.io", "snakemake.cli")
-
 
 def _kernel() -> None:
     from synergrasp.optimisation.gfo import warm_up
@@ -48,12 +41,30 @@ def _imports() -> None:
     import compileall
 
     import synergrasp
+    from synergrasp.snakemake_adapter import load_snakemake_modules
 
-    # the package's own modules first: those imported before this step started too
-    compileall.compile_dir(synergrasp.__path__[0], quiet=1)
-    names = [info.name for info in pkgutil.walk_packages(synergrasp.__path__, "synergrasp.")]
-    for name in (*names, *SNAKEMAKE_MODULES):
-        importlib.import_module(name)
+    compileall.compile_dir(synergrasp.__path__[0], quiet=1)  # the package's modules, without running them
+    # The libraries the package's modules import, and what they import in turn
+    # (tests/test_warm_up.py: every module a workflow script loads then has its bytecode).
+    import clarabel  # noqa: F401
+    import cvxpy  # noqa: F401
+    import jsonschema  # noqa: F401
+    import matplotlib.pyplot  # noqa: F401
+    import mujoco  # noqa: F401
+    import numba  # noqa: F401
+    import pandas  # noqa: F401
+    import piqp  # noqa: F401
+    import plotly.io  # noqa: F401
+    import plotly.offline  # noqa: F401
+    import pyarrow.parquet  # noqa: F401
+    import pybullet  # noqa: F401
+    import scipy.linalg  # noqa: F401
+    import scipy.optimize  # noqa: F401
+    import scipy.sparse.csgraph  # noqa: F401
+    import scipy.spatial.transform  # noqa: F401
+    import yaml  # noqa: F401
+
+    load_snakemake_modules()
 
 
 #: The steps by name.
