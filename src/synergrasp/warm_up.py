@@ -25,6 +25,7 @@ from collections.abc import Callable, Sequence
 
 __all__ = ["STEPS", "main"]
 
+
 def _kernel() -> None:
     from synergrasp.optimisation.gfo import warm_up
 
