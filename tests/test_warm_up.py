@@ -38,7 +38,7 @@ def _run(args: list[str], prefix: Path) -> subprocess.CompletedProcess[str]:
 
 def _job_imports() -> list[str]:
     """The modules the workflow's scripts import (their import statements)."""
-    names = {"synergrasp.snakemake_adapter"}  # the script preamble's modules: load_snakemake_modules below
+    names: set[str] = set()  # the script preamble's modules: load_snakemake_modules in MISSING
     for script in SCRIPTS.glob("*.py"):
         for node in ast.walk(ast.parse(script.read_text())):
             if isinstance(node, ast.Import):

@@ -11,7 +11,7 @@ Steps, in the order given, in one process:
 
 Every step writes the bytecode of the modules it imports, even where ``PYTHONDONTWRITEBYTECODE``
 is set (as CI images often set it): otherwise every job would compile from source each module
-it imports (0.7 CPU s a job, docs/measurements.md). The bytecode is written for what the
+it imports (docs/measurements.md). The bytecode is written for what the
 workflow imports, not for every installed file: compiling all of them costs more than the rest
 of the installation. ``make warm-up`` (run first by ``make study`` and ``make test``) runs the
 three steps in three processes side by side, the kernel's, the longest, ahead of the others.
@@ -19,7 +19,6 @@ three steps in three processes side by side, the kernel's, the longest, ahead of
 
 from __future__ import annotations
 
-import os
 import sys
 from collections.abc import Callable, Sequence
 
@@ -81,7 +80,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"synergrasp.warm_up: {problem}; the steps are {names}", file=sys.stderr)
         return 2
     sys.dont_write_bytecode = False
-    os.environ.pop("PYTHONDONTWRITEBYTECODE", None)  # and in the processes the steps start
     for step in steps:
         STEPS[step]()
     return 0

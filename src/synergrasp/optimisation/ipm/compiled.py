@@ -18,7 +18,7 @@ Two costs of numba's compile shape the call graph: a called function's machine c
 optimised and generated again in every compiled function that calls it (numba links the
 callee's code into the caller's), so each level of called functions above `hsde` compiles the
 whole iteration once more; and typing grows faster than a function's size, so `hsde` itself
-is called, never inlined (inlined into the per-set loop, the compile takes four times as
+is called, never inlined (inlined into the per-set loop, the compile takes several times as
 long). Hence one call site for each step that is inlined (`direction` and `max_step` in a
 predictor-corrector loop, `reduced` in the refinement loop, the set loop's one `solve_one`).
 
