@@ -1,7 +1,8 @@
 # Entry points for a fresh machine with Python 3.11 (see README):
-#   make venv           - build .venv from environment.lock only
-#   make warm-up        - build .venv, then compile what every job would otherwise compile again
-#                         (make study and make test run it first)
+#   make venv           - build .venv from environment.lock and, while it installs, compile what
+#                         every job would otherwise compile again
+#   make warm-up        - build .venv, then compile again what changed since (make study and
+#                         make test run it first)
 #   make study          - build .venv from environment.lock, then run the full study
 #   make test           - build .venv from environment.lock, then run the fast tier of the tests
 #                         (all but the end-to-end workflow runs, marker `workflow`, and the
@@ -30,24 +31,38 @@ CORES  ?= 2
 # same hash-checked files as pip would, side by side (docs/measurements.md, fresh_clone). Every
 # file is checked against its hash, so every index the lock names is considered for a version
 # (unsafe-best-match; uv's default would stop at the first index that has the name).
-UV = $(BIN)/uv pip install --quiet --python $(BIN)/python --no-deps
-$(BIN)/.installed: environment.lock pyproject.toml tools/uv.lock.txt
-	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --require-hashes --no-deps -r tools/uv.lock.txt
-	$(UV) --require-hashes --index-strategy unsafe-best-match -r environment.lock
-	$(UV) --no-build-isolation -e .
-	touch $@
-
-venv: $(BIN)/.installed
+# The venv gets no pip of its own (ensurepip would write pip's thousand modules, seconds of the
+# set-up): the interpreter's pip (22.3 or later, `--python`) installs uv into it, or, where that
+# interpreter has no such pip, the venv's own pip installed then.
+UV = $(BIN)/uv pip install --quiet --python $(BIN)/python --no-deps --index-strategy unsafe-best-match
+PIP_UV = install --quiet --require-hashes --no-deps -r tools/uv.lock.txt
+STEP = $(BIN)/python -m synergrasp.warm_up
 
 # The set-up after installation (`python -m synergrasp.warm_up`): the compiled code (the solver's
 # kernel, the closure's queries and steps), cached per user and named by its sources' hash (any
 # checkout path loads it), and the bytecode of every module the workflow imports, written even
-# where PYTHONDONTWRITEBYTECODE is set. Built once here, not in every job. Three processes side
-# by side: the kernel's compile is the longest, so the other two yield to it (nice).
-WARM_UP = nice -n 10 $(BIN)/python -m synergrasp.warm_up imports & imports=$$!; \
-	nice -n 10 $(BIN)/python -m synergrasp.warm_up closure & closure=$$!; \
-	$(BIN)/python -m synergrasp.warm_up kernel && wait $$closure && wait $$imports
+# where PYTHONDONTWRITEBYTECODE is set. Built once, not in every job, and while the venv is
+# built: the kernel's compile, the longest step, starts as soon as what it imports is installed
+# (KERNEL_NEEDS, each file checked against environment.lock's hashes by `-c`; the list is checked
+# by tests/test_warm_up.py) and runs beside uv installing the rest; then the closure's compile and
+# the imports' bytecode, which yield to the kernel's (nice). A failed install stops the kernel's.
+KERNEL_NEEDS = numba llvmlite numpy scipy clarabel piqp pyyaml charset-normalizer cffi pycparser
+AFTER_KERNEL = ( nice -n 10 $(STEP) imports & imports=$$!; nice -n 10 $(STEP) closure; rc=$$?; wait $$imports && exit $$rc )
+$(BIN)/.installed: environment.lock pyproject.toml tools/uv.lock.txt
+	$(PYTHON) -m venv --without-pip $(VENV)
+	$(PYTHON) -m pip --python $(BIN)/python $(PIP_UV) 2>/dev/null || \
+		{ $(BIN)/python -m ensurepip --default-pip >/dev/null && $(BIN)/python -m pip $(PIP_UV); }
+	$(UV) -c environment.lock $(KERNEL_NEEDS)
+	PYTHONPATH=src $(STEP) kernel & kernel=$$!; rc=0; \
+	$(UV) --require-hashes -r environment.lock && $(UV) --no-build-isolation -e . && $(AFTER_KERNEL) || \
+		{ rc=$$?; kill $$kernel 2>/dev/null; }; \
+	wait $$kernel && exit $$rc
+	touch $@
+
+venv: $(BIN)/.installed
+
+# Every later run compiles again only what changed (each compile loads its cache otherwise).
+WARM_UP = nice -n 10 $(STEP) closure & closure=$$!; $(STEP) kernel && wait $$closure
 
 warm-up: $(BIN)/.installed
 	$(WARM_UP)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ast
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -70,3 +71,32 @@ def test_imports_step_leaves_bytecode_for_every_module_a_job_imports(tmp_path):
     after = _run(["-c", MISSING, *imports], tmp_path)
     assert after.returncode == 0, after.stderr
     assert after.stdout.split() == []
+
+
+# Prints the distributions (normalised names) whose modules the kernel's step loads (numba
+# imports some, such as cffi, only if they are installed: so they are installed first too).
+KERNEL_DISTRIBUTIONS = """
+import importlib.metadata, re, sys
+startup = set(sys.modules)
+from synergrasp.warm_up import STEPS
+STEPS["kernel"]()
+owners = importlib.metadata.packages_distributions()
+loaded = {name.split(".")[0] for name, module in list(sys.modules.items()) if name not in startup and getattr(module, "__file__", None)}
+print(" ".join(sorted({re.sub(r"[-_.]+", "-", d).lower() for name in loaded for d in owners.get(name, ())})))
+"""
+
+
+def test_kernel_compile_starts_on_what_is_installed_first():
+    """`make venv` starts the kernel's compile once KERNEL_NEEDS are installed, beside uv
+    installing the rest: the step must load nothing else, and each of them must be pinned with
+    its hashes in environment.lock (uv checks the files against them, `-c`)."""
+    makefile = (ROOT / "Makefile").read_text()
+    needs = makefile.split("\nKERNEL_NEEDS = ", 1)[1].split("\n", 1)[0].split()
+    run = subprocess.run([sys.executable, "-c", KERNEL_DISTRIBUTIONS], cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    loaded = set(run.stdout.split()) - {"synergrasp"}
+    assert {"numba", "numpy", "llvmlite"} <= loaded  # the check sees the kernel's libraries
+    assert sorted(loaded - set(needs)) == []
+    lock = (ROOT / "environment.lock").read_text()
+    for name in needs:
+        assert re.search(rf"^{re.escape(name)}==\S+ \\\n    --hash=sha256:[0-9a-f]{{64}}", lock, re.M), name

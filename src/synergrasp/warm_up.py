@@ -13,8 +13,10 @@ Every step writes the bytecode of the modules it imports, even where ``PYTHONDON
 is set (as CI images often set it): otherwise every job would compile from source each module
 it imports (docs/measurements.md). The bytecode is written for what the
 workflow imports, not for every installed file: compiling all of them costs more than the rest
-of the installation. ``make warm-up`` (run first by ``make study`` and ``make test``) runs the
-three steps in three processes side by side, the kernel's, the longest, ahead of the others.
+of the installation. ``make venv`` runs the three steps in three processes while it installs:
+the kernel's, the longest, as soon as what it imports is installed; ``make warm-up`` (run
+first by ``make study`` and ``make test``) runs the two compiles again, which load their cache
+unless their sources changed.
 """
 
 from __future__ import annotations

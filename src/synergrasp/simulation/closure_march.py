@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from synergrasp.simulation.capsules import posture_gaps  # noqa: I001 (after the group's registration)
-from synergrasp.simulation.shapes.compiled import jit  # registers the group first
+from synergrasp.simulation.shapes.compiled import jit, jit_inline  # registers the group first
 
 __all__ = ["march", "MARCH_END", "MARCH_STALL", "MARCH_CROSS"]
 
@@ -23,7 +23,7 @@ __all__ = ["march", "MARCH_END", "MARCH_STALL", "MARCH_CROSS"]
 MARCH_END, MARCH_STALL, MARCH_CROSS = 0, 1, 2
 
 
-@jit
+@jit_inline
 def _posture(
     sigma: float, held: NDArray, q_held: NDArray, mean: NDArray, direction: NDArray, lower: NDArray, upper: NDArray
 ) -> NDArray:
@@ -37,19 +37,19 @@ def _posture(
     return q
 
 
-@jit
+@jit_inline
 def _masked(d: NDArray, moving_links: NDArray, margin_mm: float) -> None:
     for i in range(d.shape[0]):
         if not moving_links[i] or d[i] > margin_mm:
             d[i] = np.inf
 
 
-@jit
+@jit_inline
 def _smallest(d_obj: NDArray, d_self: NDArray) -> float:
     return min(d_obj.min(), d_self.min())
 
 
-@jit
+@jit_inline
 def _advance(sigma: float, sigma_closed: float, budget: NDArray, knots: NDArray, travel: NDArray, n_knots: NDArray) -> float:
     """Largest σ' ≤ σ_closed such that no finger f travels more than budget[f] mm on [σ, σ']:
     knots[f, :n_knots[f]] and travel[f, :n_knots[f]] its
@@ -77,7 +77,7 @@ def _advance(sigma: float, sigma_closed: float, budget: NDArray, knots: NDArray,
     return best
 
 
-@jit
+@jit_inline
 def _budget(d_obj: NDArray, d_self: NDArray, finger_links: NDArray, step_mm: float, margin_mm: float) -> NDArray:
     """Travel budget (mm) per finger: max(step_mm, min(its free distance, margin_mm)); hand
     gaps count half."""
@@ -91,7 +91,7 @@ def _budget(d_obj: NDArray, d_self: NDArray, finger_links: NDArray, step_mm: flo
     return out
 
 
-@jit
+@jit_inline
 def _gaps(
     sigma: float,
     held: NDArray,
@@ -201,7 +201,7 @@ def march(
     return MARCH_END, sigma, now
 
 
-@jit
+@jit_inline
 def _event(
     sigma: float,
     now: tuple,

@@ -14,7 +14,7 @@ import numba
 
 from synergrasp.compiled_cache import register_group
 
-__all__ = ["SOURCES", "GROUP", "jit"]
+__all__ = ["SOURCES", "GROUP", "jit", "jit_inline"]
 
 #: The modules whose compiled functions call one another (relative to the package).
 SOURCES = (
@@ -30,3 +30,8 @@ SOURCES = (
 GROUP = register_group("shapes", SOURCES)
 
 jit = numba.njit(cache=True)
+#: For a step whose own compile would only be linked into its one caller: numba optimises and
+#: generates a called function's code again in every compiled caller, so each level of calls
+#: above the distance queries compiles them once more; inlined (numba's IR inlining, the same
+#: operations in the same order) the level is gone.
+jit_inline = numba.njit(cache=True, inline="always")
