@@ -30,8 +30,9 @@ SOURCES = (
 GROUP = register_group("shapes", SOURCES)
 
 jit = numba.njit(cache=True)
-#: For a step whose own compile would only be linked into its one caller: numba optimises and
-#: generates a called function's code again in every compiled caller, so each level of calls
-#: above the distance queries compiles them once more; inlined (numba's IR inlining, the same
-#: operations in the same order) the level is gone.
+#: For the free steps' helpers (`closure_march`), called from compiled code only. numba optimises
+#: and generates a called function's code again in every compiled caller, so each level of calls
+#: above the distance queries compiles them once more; an inlined helper (numba's IR inlining:
+#: the same operations in the same order) is typed in its caller and its level is gone. The
+#: distance queries stay called: Python calls them too, and each inlined copy is typed again.
 jit_inline = numba.njit(cache=True, inline="always")
