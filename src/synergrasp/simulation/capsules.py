@@ -84,8 +84,12 @@ def _frames(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: 
     """(n_frames, 4, 4) frame transforms at q (the same chain as ``hand.frame_transforms``)."""
     n = parent.shape[0]
     out = np.empty((n, 4, 4))
-    out[0] = np.eye(4)
     rot, local = np.empty((3, 3)), np.empty((4, 4))
+    # Element loops, not slice assignments: numba compiles a slice assignment's shape-mismatch
+    # message (string formatting), seconds of the closure's first compile.
+    for i in range(4):
+        for j in range(4):
+            out[0, i, j] = 1.0 if i == j else 0.0
     for f in range(1, n):
         angle = scale[f] * q[joint[f]]
         c, s = np.cos(angle), np.sin(angle)
@@ -94,7 +98,9 @@ def _frames(q: NDArray, parent: NDArray, offset: NDArray, axis: NDArray, joint: 
         rot[0, 0], rot[0, 1], rot[0, 2] = c + x * x * v, x * y * v - z * s, x * z * v + y * s
         rot[1, 0], rot[1, 1], rot[1, 2] = y * x * v + z * s, c + y * y * v, y * z * v - x * s
         rot[2, 0], rot[2, 1], rot[2, 2] = z * x * v - y * s, z * y * v + x * s, c + z * z * v
-        local[:, :] = offset[f]
+        for i in range(4):
+            local[i, 3] = offset[f, i, 3]
+            local[3, i] = offset[f, 3, i]
         for i in range(3):
             for j in range(3):
                 local[i, j] = offset[f, i, 0] * rot[0, j] + offset[f, i, 1] * rot[1, j] + offset[f, i, 2] * rot[2, j]
