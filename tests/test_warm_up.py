@@ -81,7 +81,8 @@ startup = set(sys.modules)
 from synergrasp.warm_up import STEPS
 STEPS["kernel"]()
 owners = importlib.metadata.packages_distributions()
-loaded = {name.split(".")[0] for name, module in list(sys.modules.items()) if name not in startup and getattr(module, "__file__", None)}
+new = [name for name, module in list(sys.modules.items()) if name not in startup and getattr(module, "__file__", None)]
+loaded = {name.split(".")[0] for name in new}
 print(" ".join(sorted({re.sub(r"[-_.]+", "-", d).lower() for name in loaded for d in owners.get(name, ())})))
 """
 
